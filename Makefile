@@ -1,0 +1,134 @@
+# curvestep build. Every module is picked up by wildcard: add a .c file in the right folder and
+# it is built; add tests/unit/test_<module>.c and it becomes a test binary.
+#   make            core library, host program, simulator, freestanding + cross checks of the core
+#   make test       every unit test, once plain and once under ASan+UBSan
+#   make demo       the main job (see README.md)
+#   make bench      benchmarks -> docs/benchmarks.md and build/bench/*.csv
+#   make firmware   cross-compiled core for each target, sizes printed
+#   make format     clang-format -i on every source
+#   make clean
+.DEFAULT_GOAL := all
+SHELL := /bin/bash
+
+BUILD    ?= build
+VARIANT  ?= plain
+CC       ?= cc
+ifeq ($(VARIANT),asan)
+OUT      := $(BUILD)/asan
+SANFLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+OPT      := -O1 -g
+else
+OUT      := $(BUILD)
+SANFLAGS :=
+OPT      := -O2 -g
+endif
+
+CORE_SRC  := $(sort $(wildcard firmware/core/*.c))
+HOST_SRC  := $(sort $(filter-out host/main.c,$(wildcard host/*.c)))
+SIM_SRC   := $(sort $(filter-out sim/main.c,$(wildcard sim/*.c)))
+SUP_SRC   := $(sort $(wildcard tests/support/*.c))
+UNIT_SRC  := $(sort $(wildcard tests/unit/test_*.c))
+BENCH_SRC := $(sort $(wildcard tests/bench/bench_*.c))
+PORT_POSIX_SRC := $(sort $(wildcard firmware/ports/posix/*.c))
+
+PKGS      := cairo expat
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lm
+
+INCLUDES  := -Ifirmware/core -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim -Itests/support
+WARN      := -Wall -Wextra -Werror
+CORE_CFLAGS := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS) $(INCLUDES)
+HOST_CFLAGS := -std=c99 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L $(WARN) $(OPT) $(SANFLAGS) \
+               $(INCLUDES) $(PKG_CFLAGS)
+LDFLAGS_ALL := $(SANFLAGS)
+
+CORE_OBJ := $(CORE_SRC:%.c=$(OUT)/obj/%.o)
+HOST_OBJ := $(HOST_SRC:%.c=$(OUT)/obj/%.o)
+SIM_OBJ  := $(SIM_SRC:%.c=$(OUT)/obj/%.o)
+SUP_OBJ  := $(SUP_SRC:%.c=$(OUT)/obj/%.o)
+PORT_POSIX_OBJ := $(PORT_POSIX_SRC:%.c=$(OUT)/obj/%.o)
+UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(OUT)/tests/%)
+BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
+
+CORE_LIB := $(OUT)/libcscore.a
+HOST_LIB := $(OUT)/libcshost.a
+
+.PHONY: all deps test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
+
+all: deps $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) core-check cross
+
+deps:
+	@sh scripts/deps.sh
+
+# --- objects --------------------------------------------------------------------------------
+$(OUT)/obj/firmware/core/%.o: firmware/core/%.c $(wildcard firmware/core/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(CORE_CFLAGS) -c $< -o $@
+
+$(OUT)/obj/%.o: %.c $(wildcard firmware/core/*.h host/*.h sim/*.h tests/support/*.h firmware/ports/*.h firmware/ports/posix/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -c $< -o $@
+
+$(CORE_LIB): $(CORE_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(HOST_LIB): $(HOST_OBJ) $(SIM_OBJ) $(PORT_POSIX_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^ $(if $^,,/dev/null)
+
+$(OUT)/curvestep: $(OUT)/obj/host/main.o $(HOST_LIB) $(CORE_LIB)
+	$(CC) $(LDFLAGS_ALL) $^ -o $@ $(PKG_LIBS)
+
+$(OUT)/curvestep-sim: $(OUT)/obj/sim/main.o $(HOST_LIB) $(CORE_LIB)
+	$(CC) $(LDFLAGS_ALL) $^ -o $@ $(PKG_LIBS)
+
+$(OUT)/tests/%: $(OUT)/obj/tests/unit/%.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(LDFLAGS_ALL) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ -lcmocka $(PKG_LIBS)
+
+# --- tests ----------------------------------------------------------------------------------
+# Each variant builds everything (host program and simulator too: tests may run them) and runs
+# every unit test binary; scripts/run-tests.sh prints the cmocka totals as "N passed, N failed".
+test: deps
+	$(MAKE) --no-print-directory VARIANT=plain test-variant
+	$(MAKE) --no-print-directory VARIANT=asan test-variant
+	@$(MAKE) --no-print-directory core-check cross
+
+test-variant: $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) $(UNIT_BIN)
+	@CS_BUILD=$(OUT) bash scripts/run-tests.sh $(VARIANT) $(UNIT_BIN)
+
+# --- the core's rules, checked by the build ------------------------------------------------
+FREESTANDING := -std=c99 -ffreestanding -nostdlib -mgeneral-regs-only $(WARN) -Wconversion -Ifirmware/core
+core-check:
+	@mkdir -p $(BUILD)/freestanding
+	@for f in $(CORE_SRC); do \
+	  gcc $(FREESTANDING) -O2 -c $$f -o $(BUILD)/freestanding/$$(basename $$f .c).o || exit 1; done
+	@und=$$(nm -u $(BUILD)/freestanding/*.o | awk '{print $$2}' | sort -u | grep -vE '^(memcpy|memset|memmove)$$' | tr '\n' ' '); \
+	if [ -n "$$und" ]; then echo "core-check: firmware/core calls outside itself: $$und"; exit 1; fi; \
+	echo "core-check: firmware/core builds freestanding (-mgeneral-regs-only), no outside symbols"
+	@if grep -rnE '\b(malloc|calloc|realloc|free)\s*\(' firmware/core; then echo "core-check: heap use in core"; exit 1; fi
+
+# Cross-compile the core for each firmware target and print its code size (text+data, bytes).
+CROSS_TARGETS := cortex-m0plus cortex-m3 avr
+cross:
+	@bash scripts/cross-size.sh $(BUILD)/cross $(CORE_SRC)
+
+firmware: cross
+
+# --- demo, bench ----------------------------------------------------------------------------
+demo: deps all
+	@bash scripts/demo.sh
+
+$(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ $(PKG_LIBS) $(shell pkg-config --libs --cflags libagg 2>/dev/null)
+
+bench: deps all $(BENCH_BIN)
+	@bash scripts/bench.sh $(BENCH_BIN)
+
+format:
+	clang-format -i $$(find firmware host sim tests -name '*.[ch]')
+
+clean:
+	rm -rf $(BUILD)

@@ -1,0 +1,129 @@
+/* cs_fixed: checked fixed-point arithmetic. Every narrowing goes through cs_fixed_narrow so an
+ * overflow is a reported error, never a wrap (DESIGN.md, "Rules for firmware/core"). */
+#include "cs_fixed.h"
+
+CS_STATIC_ASSERT(sizeof(cs_pos_t) == 4, pos_is_32_bit);
+CS_STATIC_ASSERT(((int64_t)CS_POS_LIMIT * 8) <= INT32_MAX + 1LL, limit_leaves_3_bits_headroom);
+
+bool cs_fixed_pos_ok(int64_t v)
+{
+    return v >= -(int64_t)CS_POS_LIMIT && v <= (int64_t)CS_POS_LIMIT;
+}
+
+bool cs_fixed_vec_ok(const cs_vec3_t *p)
+{
+    return cs_fixed_pos_ok(p->x) && cs_fixed_pos_ok(p->y) && cs_fixed_pos_ok(p->z);
+}
+
+cs_err_t cs_fixed_narrow(int64_t v, int32_t *out)
+{
+    if (v > INT32_MAX || v < INT32_MIN)
+        return CS_ERR_OVERFLOW;
+    *out = (int32_t)v;
+    return CS_OK;
+}
+
+cs_err_t cs_fixed_add(int32_t a, int32_t b, int32_t *out)
+{
+    return cs_fixed_narrow((int64_t)a + b, out);
+}
+
+cs_err_t cs_fixed_sub(int32_t a, int32_t b, int32_t *out)
+{
+    return cs_fixed_narrow((int64_t)a - b, out);
+}
+
+int64_t cs_fixed_round_shift64(int64_t v, unsigned n)
+{
+    if (n == 0)
+        return v;
+    /* Work on the magnitude so rounding is symmetric (half away from zero); INT64_MIN has no
+     * magnitude in int64, but no caller can produce it (products of two int32 are > -2^62). */
+    uint64_t m = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+    m = (m + ((uint64_t)1 << (n - 1))) >> n;
+    return v < 0 ? -(int64_t)m : (int64_t)m;
+}
+
+cs_err_t cs_fixed_mul_shift(int32_t a, int32_t b, unsigned shift, int32_t *out)
+{
+    if (shift > 62)
+        return CS_ERR_ARG;
+    return cs_fixed_narrow(cs_fixed_round_shift64((int64_t)a * b, shift), out);
+}
+
+cs_err_t cs_fixed_div_shift(int32_t a, int32_t b, unsigned shift, int32_t *out)
+{
+    if (b == 0 || shift > 30)
+        return CS_ERR_ARG;
+    /* |a| * 2^30 < 2^62: the numerator always fits int64. */
+    uint64_t num = (uint64_t)(a < 0 ? -(int64_t)a : (int64_t)a) << shift;
+    uint64_t den = (uint64_t)(b < 0 ? -(int64_t)b : (int64_t)b);
+    uint64_t q = (num + den / 2) / den;
+    int64_t s = ((a < 0) != (b < 0)) ? -(int64_t)q : (int64_t)q;
+    return cs_fixed_narrow(s, out);
+}
+
+int32_t cs_fixed_add_sat(int32_t a, int32_t b)
+{
+    int64_t s = (int64_t)a + b;
+    return s > INT32_MAX ? INT32_MAX : s < INT32_MIN ? INT32_MIN : (int32_t)s;
+}
+
+int32_t cs_fixed_sub_sat(int32_t a, int32_t b)
+{
+    int64_t s = (int64_t)a - b;
+    return s > INT32_MAX ? INT32_MAX : s < INT32_MIN ? INT32_MIN : (int32_t)s;
+}
+
+uint32_t cs_fixed_isqrt64(uint64_t v)
+{
+    /* Digit-by-digit (base 4) square root: 32 iterations of shift, compare, subtract. */
+    uint64_t rem = v, root = 0, bit = (uint64_t)1 << 62;
+    while (bit > rem)
+        bit >>= 2;
+    while (bit != 0) {
+        if (rem >= root + bit) {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    return (uint32_t)root;
+}
+
+uint32_t cs_fixed_vec_len(int64_t dx, int64_t dy, int64_t dz)
+{
+    uint64_t ax = (uint64_t)(dx < 0 ? -dx : dx), ay = (uint64_t)(dy < 0 ? -dy : dy),
+             az = (uint64_t)(dz < 0 ? -dz : dz);
+    return cs_fixed_isqrt64(ax * ax + ay * ay + az * az);
+}
+
+void cs_fixed_mul_u64(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo)
+{
+    /* Schoolbook on 32-bit halves; the carries are summed in 64 bits so none is lost. */
+    uint64_t a0 = a & 0xFFFFFFFFu, a1 = a >> 32, b0 = b & 0xFFFFFFFFu, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t mid = (p00 >> 32) + (p01 & 0xFFFFFFFFu) + (p10 & 0xFFFFFFFFu);
+    *lo = (p00 & 0xFFFFFFFFu) | (mid << 32);
+    *hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+}
+
+int cs_fixed_cmp_prod_u64(uint64_t a, uint64_t b, uint64_t c, uint64_t d)
+{
+    uint64_t h1, l1, h2, l2;
+    cs_fixed_mul_u64(a, b, &h1, &l1);
+    cs_fixed_mul_u64(c, d, &h2, &l2);
+    if (h1 != h2)
+        return h1 < h2 ? -1 : 1;
+    if (l1 != l2)
+        return l1 < l2 ? -1 : 1;
+    return 0;
+}
+
+cs_vec3_t cs_fixed_vec(cs_pos_t x, cs_pos_t y, cs_pos_t z)
+{
+    cs_vec3_t v = {x, y, z};
+    return v;
+}
