@@ -122,7 +122,7 @@ demo: deps all
 
 $(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ $(PKG_LIBS) $(shell pkg-config --libs --cflags libagg 2>/dev/null)
+	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ $(PKG_LIBS)
 
 bench: deps all $(BENCH_BIN)
 	@bash scripts/bench.sh $(BENCH_BIN)
