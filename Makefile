@@ -53,6 +53,8 @@ BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
 CORE_LIB := $(OUT)/libcscore.a
 HOST_LIB := $(OUT)/libcshost.a
 
+.SECONDARY:
+
 .PHONY: all deps test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
 
 all: deps $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) core-check cross
@@ -104,7 +106,9 @@ core-check:
 	@mkdir -p $(BUILD)/freestanding
 	@for f in $(CORE_SRC); do \
 	  gcc $(FREESTANDING) -O2 -c $$f -o $(BUILD)/freestanding/$$(basename $$f .c).o || exit 1; done
-	@und=$$(nm -u $(BUILD)/freestanding/*.o | awk '{print $$2}' | sort -u | grep -vE '^(memcpy|memset|memmove)$$' | tr '\n' ' '); \
+	@und=$$(comm -23 <(nm -u $(BUILD)/freestanding/*.o | awk 'NF==2 {print $$2}' | sort -u) \
+	  <(nm --defined-only $(BUILD)/freestanding/*.o | awk 'NF==3 {print $$3}' | sort -u) \
+	  | grep -vE '^(memcpy|memset|memmove)$$' | tr '\n' ' '); \
 	if [ -n "$$und" ]; then echo "core-check: firmware/core calls outside itself: $$und"; exit 1; fi; \
 	echo "core-check: firmware/core builds freestanding (-mgeneral-regs-only), no outside symbols"
 	@if grep -rnE '\b(malloc|calloc|realloc|free)\s*\(' firmware/core; then echo "core-check: heap use in core"; exit 1; fi
@@ -126,6 +130,11 @@ $(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
 
 bench: deps all $(BENCH_BIN)
 	@bash scripts/bench.sh $(BENCH_BIN)
+
+# --- fuzzing: every tests/fuzz/fuzz_*.c under libFuzzer+ASan+UBSan, FUZZ_SECONDS (60) each --
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@BUILD=$(BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh
 
 format:
 	clang-format -i $$(find firmware host sim tests -name '*.[ch]')

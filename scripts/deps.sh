@@ -8,7 +8,8 @@ PKGS="make gcc libc6-dev pkg-config \
 libcmocka-dev libexpat1-dev libinih-dev libcairo2-dev \
 gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi \
 gcc-avr avr-libc binutils-avr \
-clang llvm libclang-rt-14-dev libagg-dev"
+clang llvm libclang-rt-14-dev libagg-dev \
+librsvg2-bin"
 
 missing=""
 for p in $PKGS; do

@@ -127,3 +127,92 @@ cs_vec3_t cs_fixed_vec(cs_pos_t x, cs_pos_t y, cs_pos_t z)
     cs_vec3_t v = {x, y, z};
     return v;
 }
+
+cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out)
+{
+    if (c == 0 || a == INT64_MIN || b == INT64_MIN || c == INT64_MIN)
+        return CS_ERR_ARG;
+    bool neg = (a < 0) != (b < 0);
+    if (c < 0)
+        neg = !neg;
+    uint64_t ua = (uint64_t)(a < 0 ? -a : a), ub = (uint64_t)(b < 0 ? -b : b),
+             uc = (uint64_t)(c < 0 ? -c : c);
+    uint64_t hi, lo;
+    cs_fixed_mul_u64(ua, ub, &hi, &lo);
+    /* The quotient fits 64 bits only when hi < c; then restoring long division over the 64 low
+     * bits, starting from the remainder hi (bit-serial: no 128-bit type on 8/32-bit targets). */
+    if (hi >= uc)
+        return CS_ERR_OVERFLOW;
+    uint64_t rem = hi, q = 0;
+    for (int i = 63; i >= 0; i--) {
+        uint64_t carry = rem >> 63;
+        rem = (rem << 1) | ((lo >> i) & 1u);
+        q <<= 1;
+        if (carry != 0 || rem >= uc) {
+            rem -= uc;
+            q |= 1u;
+        }
+    }
+    /* Round half away from zero: rem >= c - rem (no overflow of 2 * rem). Check the range
+     * before the increment too: q = UINT64_MAX would wrap to 0 and pass the check. */
+    if (q > (uint64_t)INT64_MAX)
+        return CS_ERR_OVERFLOW;
+    if (rem >= uc - rem)
+        q++;
+    if (q > (uint64_t)INT64_MAX)
+        return CS_ERR_OVERFLOW;
+    *out = neg ? -(int64_t)q : (int64_t)q;
+    return CS_OK;
+}
+
+int64_t cs_fixed_mul64_q30(int64_t x, int32_t t)
+{
+    /* |x| = xh * 2^32 + xl: |x| * |t| / 2^30 = xh * |t| * 4 + xl * |t| / 2^30, and only the
+     * second term needs rounding. Each partial product stays below 2^62. */
+    uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
+    uint64_t at = t < 0 ? (uint64_t)0 - (uint64_t)(int64_t)t : (uint64_t)t;
+    uint64_t hi = (m >> 32) * at, lo = (m & 0xFFFFFFFFu) * at;
+    uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
+    return ((x < 0) != (t < 0)) ? -(int64_t)r : (int64_t)r;
+}
+
+cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q)
+{
+    if (d == 0 || (d >> 63) != 0)
+        return CS_ERR_ARG;
+    if (hi >= d)
+        return CS_ERR_OVERFLOW;
+    /* rem < d < 2^63 throughout, so rem << 1 never loses a bit. */
+    uint64_t rem = hi, quo = 0;
+    for (unsigned i = 64; i-- > 0;) {
+        rem = (rem << 1) | ((lo >> i) & 1u);
+        quo <<= 1;
+        if (rem >= d) {
+            rem -= d;
+            quo |= 1u;
+        }
+    }
+    if (rem >= d - rem) { /* 2 * rem >= d: round half up */
+        if (quo == UINT64_MAX)
+            return CS_ERR_OVERFLOW;
+        quo++;
+    }
+    *q = quo;
+    return CS_OK;
+}
+
+uint64_t cs_fixed_vec_len64(int64_t x, int64_t y, int64_t z)
+{
+    uint64_t ax = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
+    uint64_t ay = y < 0 ? (uint64_t)0 - (uint64_t)y : (uint64_t)y;
+    uint64_t az = z < 0 ? (uint64_t)0 - (uint64_t)z : (uint64_t)z;
+    uint64_t mx = ax | ay | az;
+    unsigned s = 0;
+    /* Components below 2^31 keep the sum of squares below 3 * 2^62 < 2^64. */
+    while ((mx >> s) >= ((uint64_t)1 << 31))
+        s++;
+    ax >>= s;
+    ay >>= s;
+    az >>= s;
+    return (uint64_t)cs_fixed_isqrt64(ax * ax + ay * ay + az * az) << s;
+}

@@ -80,4 +80,24 @@ int cs_fixed_cmp_prod_u64(uint64_t a, uint64_t b, uint64_t c, uint64_t d);
 /* Conversions between vectors. */
 cs_vec3_t cs_fixed_vec(cs_pos_t x, cs_pos_t y, cs_pos_t z);
 
+/* *out = round(a * b / c) (half away from zero) with a 128-bit intermediate product, so change
+ * of basis and linear solves can scale by exact rationals with one rounding; c != 0 (CS_ERR_ARG),
+ * CS_ERR_OVERFLOW when the quotient leaves int64. a, b, c must not be INT64_MIN (CS_ERR_ARG). */
+cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out);
+
+/* --- wide helpers (added with cs_bezier / cs_join / cs_arclen, which all need them) --- */
+/* round(x * t / 2^30) (half away from zero) for |x| < 2^62 and |t| <= 2^30, with no
+ * intermediate overflow (64x32 product done in two halves): the de Casteljau step on int64
+ * values that carry guard bits. ISR-safe (pure). */
+int64_t cs_fixed_mul64_q30(int64_t x, int32_t t);
+/* *q = round((hi * 2^64 + lo) / d) (half up), by restoring long division (no libc, no 128-bit
+ * type). CS_ERR_ARG when d == 0 or d >= 2^63; CS_ERR_OVERFLOW when the quotient needs more
+ * than 64 bits. ISR-safe (pure). */
+cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q);
+/* Euclidean length of an int64 vector (|components| <= 2^62), rounded down. Exact (floor of the
+ * true length) while every |component| < 2^31; above that the components are shifted right
+ * until they fit, and the result is below the true length by less than 3 * 2^-30 of it. */
+uint64_t cs_fixed_vec_len64(int64_t x, int64_t y, int64_t z);
+
+
 #endif

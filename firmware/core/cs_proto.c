@@ -1,0 +1,298 @@
+/* cs_proto: message <-> bytes. Little-endian, fixed offsets (docs/protocol.md gives every byte).
+ * Encode and decode apply the same range checks, so whatever one side can send the other
+ * accepts, and a decoded message is always one the encoder could have produced. */
+#include "cs_proto.h"
+
+#include "cs_frame.h"
+
+CS_STATIC_ASSERT(CS_PROTO_AXES_MAX == CS_AXES, proto_axes_match_machine);
+CS_STATIC_ASSERT(CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX) <= CS_PROTO_LEN_MAX, status_fits);
+CS_STATIC_ASSERT(CS_PROTO_LEN_SEGMENT <= CS_PROTO_LEN_MAX, segment_fits);
+/* The link must at least carry its own control messages, status and segments in every build;
+ * a build whose CS_FRAME_PAYLOAD_MAX is below CS_PROTO_LEN_CURVE cannot carry curves (the link
+ * then refuses them with CS_ERR_ARG). */
+CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX), frame_fits_status);
+CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_SEGMENT, frame_fits_seg);
+CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_ACK, frame_fits_ack);
+
+/* --- little-endian field access --------------------------------------------------------- */
+static void put16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)(v & 0xFFu);
+    p[1] = (uint8_t)(v >> 8);
+}
+
+static void put32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v & 0xFFu);
+    p[1] = (uint8_t)((v >> 8) & 0xFFu);
+    p[2] = (uint8_t)((v >> 16) & 0xFFu);
+    p[3] = (uint8_t)(v >> 24);
+}
+
+static uint16_t get16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (unsigned)p[1] << 8);
+}
+
+static uint32_t get32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* int32 travels as its two's complement bit pattern (int -> unsigned is modular in C99); back by
+ * arithmetic, not by a cast of an out-of-range value, which C99 leaves implementation-defined. */
+static void puti32(uint8_t *p, int32_t v)
+{
+    put32(p, (uint32_t)v);
+}
+
+static int32_t geti32(const uint8_t *p)
+{
+    uint32_t u = get32(p);
+    if (u <= (uint32_t)INT32_MAX)
+        return (int32_t)u;
+    return (int32_t)(u - (uint32_t)INT32_MAX - 1u) + INT32_MIN;
+}
+
+/* --- field checks shared by encode and decode --------------------------------------------- */
+static bool axes_ok(uint8_t n)
+{
+    return n >= 1 && n <= CS_PROTO_AXES_MAX;
+}
+
+static cs_err_t check(const cs_proto_msg_t *m)
+{
+    switch (m->type) {
+    case CS_PROTO_ACK:
+        return (m->u.ack.flags & (uint8_t)~CS_PROTO_ACK_NAK) ? CS_ERR_RANGE : CS_OK;
+    case CS_PROTO_HELLO: {
+        const cs_proto_hello_t *h = &m->u.hello;
+        if (h->version == 0 || !axes_ok(h->axes) || h->queue_size == 0 || h->tick_hz == 0 ||
+            (h->caps & (uint16_t)~CS_PROTO_CAP_ALL))
+            return CS_ERR_RANGE;
+        return CS_OK;
+    }
+    case CS_PROTO_STATUS:
+        return (m->u.status.state >= CS_PROTO_STATE_COUNT_ || !axes_ok(m->u.status.axes))
+                   ? CS_ERR_RANGE
+                   : CS_OK;
+    case CS_PROTO_ERROR:
+        return (m->u.error.code < CS_ERR_ARG || m->u.error.code >= CS_ERR_COUNT_) ? CS_ERR_RANGE
+                                                                                  : CS_OK;
+    case CS_PROTO_SEGMENT: {
+        const cs_segment_t *g = &m->u.segment;
+        if (g->ticks == 0 || g->ticks > CS_PROTO_SEGMENT_MAX_TICKS)
+            return CS_ERR_RANGE;
+        for (unsigned i = 0; i < CS_AXES; i++) {
+            /* |steps| <= ticks, computed in int64 so INT32_MIN has a magnitude. */
+            int64_t s = g->steps[i];
+            if ((s < 0 ? -s : s) > (int64_t)g->ticks)
+                return CS_ERR_RANGE;
+        }
+        return CS_OK;
+    }
+    case CS_PROTO_CURVE:
+        for (unsigned i = 0; i < 4; i++)
+            if (!cs_fixed_vec_ok(&m->u.curve.p[i]))
+                return CS_ERR_RANGE;
+        return m->u.curve.feed > 0 ? CS_OK : CS_ERR_RANGE;
+    case CS_PROTO_PING:
+    case CS_PROTO_HOLD:
+    case CS_PROTO_RESUME:
+    case CS_PROTO_ABORT:
+        return CS_OK;
+    default:
+        return CS_ERR_UNSUPPORTED;
+    }
+}
+
+/* Payload length of a message of this type (axes from the message), 0 for an unknown type. */
+static size_t msg_len(uint8_t type, uint8_t axes)
+{
+    switch (type) {
+    case CS_PROTO_ACK:
+        return CS_PROTO_LEN_ACK;
+    case CS_PROTO_PING:
+        return CS_PROTO_LEN_PING;
+    case CS_PROTO_HELLO:
+        return CS_PROTO_LEN_HELLO;
+    case CS_PROTO_STATUS:
+        return (size_t)CS_PROTO_LEN_STATUS(axes);
+    case CS_PROTO_ERROR:
+        return CS_PROTO_LEN_ERROR;
+    case CS_PROTO_SEGMENT:
+        return CS_PROTO_LEN_SEGMENT;
+    case CS_PROTO_CURVE:
+        return CS_PROTO_LEN_CURVE;
+    case CS_PROTO_HOLD:
+    case CS_PROTO_RESUME:
+    case CS_PROTO_ABORT:
+        return CS_PROTO_LEN_CONTROL;
+    default:
+        return 0;
+    }
+}
+
+bool cs_proto_sequenced(uint8_t type)
+{
+    return type != CS_PROTO_ACK && type != CS_PROTO_PING;
+}
+
+bool cs_proto_uses_slot(uint8_t type)
+{
+    return type == CS_PROTO_SEGMENT || type == CS_PROTO_CURVE;
+}
+
+cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size_t *len)
+{
+    if (m == NULL || buf == NULL || len == NULL)
+        return CS_ERR_ARG;
+    cs_err_t e = check(m);
+    if (e != CS_OK)
+        return e;
+    uint8_t axes = m->type == CS_PROTO_STATUS ? m->u.status.axes : 0;
+    size_t n = msg_len(m->type, axes);
+    if (cap < n)
+        return CS_ERR_FULL;
+    buf[0] = m->type;
+    switch (m->type) {
+    case CS_PROTO_ACK:
+        buf[1] = m->u.ack.flags;
+        put16(buf + 2, m->u.ack.next_expected);
+        put16(buf + 4, m->u.ack.credits);
+        put32(buf + 6, m->u.ack.boot_id);
+        put32(buf + 10, m->u.ack.echo);
+        break;
+    case CS_PROTO_PING:
+        put32(buf + 1, m->u.ping.nonce);
+        break;
+    case CS_PROTO_HELLO:
+        buf[1] = m->u.hello.version;
+        put32(buf + 2, m->u.hello.boot_id);
+        buf[6] = m->u.hello.axes;
+        put16(buf + 7, m->u.hello.queue_size);
+        put32(buf + 9, m->u.hello.tick_hz);
+        put16(buf + 13, m->u.hello.caps);
+        break;
+    case CS_PROTO_STATUS:
+        buf[1] = m->u.status.state;
+        put32(buf + 2, m->u.status.boot_id);
+        put16(buf + 6, m->u.status.queue_fill);
+        put16(buf + 8, m->u.status.last_seq);
+        buf[10] = axes;
+        for (unsigned i = 0; i < axes; i++)
+            puti32(buf + 11 + 4 * i, m->u.status.pos[i]);
+        break;
+    case CS_PROTO_ERROR:
+        buf[1] = m->u.error.code;
+        put16(buf + 2, m->u.error.seq);
+        break;
+    case CS_PROTO_SEGMENT:
+        put32(buf + 1, m->u.segment.ticks);
+        for (unsigned i = 0; i < CS_AXES; i++)
+            puti32(buf + 5 + 4 * i, m->u.segment.steps[i]);
+        break;
+    case CS_PROTO_CURVE:
+        for (unsigned i = 0; i < 4; i++) {
+            puti32(buf + 1 + 12 * i, m->u.curve.p[i].x);
+            puti32(buf + 5 + 12 * i, m->u.curve.p[i].y);
+            puti32(buf + 9 + 12 * i, m->u.curve.p[i].z);
+        }
+        puti32(buf + 49, m->u.curve.feed);
+        break;
+    default: /* HOLD, RESUME, ABORT: the type byte is the whole message */
+        break;
+    }
+    *len = n;
+    return CS_OK;
+}
+
+cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
+{
+    if (buf == NULL || m == NULL)
+        return CS_ERR_ARG;
+    if (len == 0)
+        return CS_ERR_FRAME;
+    uint8_t type = buf[0];
+    uint8_t axes = 0;
+    if (type == CS_PROTO_STATUS) {
+        if (len <= 10)
+            return CS_ERR_FRAME;
+        axes = buf[10];
+        if (!axes_ok(axes))
+            return CS_ERR_RANGE;
+    }
+    size_t n = msg_len(type, axes);
+    if (n == 0)
+        return CS_ERR_UNSUPPORTED;
+    if (len != n)
+        return CS_ERR_FRAME;
+    *m = (cs_proto_msg_t){0};
+    m->type = type;
+    switch (type) {
+    case CS_PROTO_ACK:
+        m->u.ack.flags = buf[1];
+        m->u.ack.next_expected = get16(buf + 2);
+        m->u.ack.credits = get16(buf + 4);
+        m->u.ack.boot_id = get32(buf + 6);
+        m->u.ack.echo = get32(buf + 10);
+        break;
+    case CS_PROTO_PING:
+        m->u.ping.nonce = get32(buf + 1);
+        break;
+    case CS_PROTO_HELLO:
+        m->u.hello.version = buf[1];
+        m->u.hello.boot_id = get32(buf + 2);
+        m->u.hello.axes = buf[6];
+        m->u.hello.queue_size = get16(buf + 7);
+        m->u.hello.tick_hz = get32(buf + 9);
+        m->u.hello.caps = get16(buf + 13);
+        break;
+    case CS_PROTO_STATUS:
+        m->u.status.state = buf[1];
+        m->u.status.boot_id = get32(buf + 2);
+        m->u.status.queue_fill = get16(buf + 6);
+        m->u.status.last_seq = get16(buf + 8);
+        m->u.status.axes = axes;
+        for (unsigned i = 0; i < axes; i++)
+            m->u.status.pos[i] = geti32(buf + 11 + 4 * i);
+        break;
+    case CS_PROTO_ERROR:
+        m->u.error.code = buf[1];
+        m->u.error.seq = get16(buf + 2);
+        break;
+    case CS_PROTO_SEGMENT:
+        m->u.segment.ticks = get32(buf + 1);
+        for (unsigned i = 0; i < CS_AXES; i++)
+            m->u.segment.steps[i] = geti32(buf + 5 + 4 * i);
+        break;
+    case CS_PROTO_CURVE:
+        for (unsigned i = 0; i < 4; i++) {
+            m->u.curve.p[i].x = geti32(buf + 1 + 12 * i);
+            m->u.curve.p[i].y = geti32(buf + 5 + 12 * i);
+            m->u.curve.p[i].z = geti32(buf + 9 + 12 * i);
+        }
+        m->u.curve.feed = geti32(buf + 49);
+        break;
+    default:
+        break;
+    }
+    return check(m);
+}
+
+bool cs_proto_peek_boot(const uint8_t *buf, size_t len, uint32_t *boot_id)
+{
+    cs_proto_msg_t m;
+    if (boot_id == NULL || cs_proto_decode(buf, len, &m) != CS_OK)
+        return false;
+    if (m.type == CS_PROTO_ACK)
+        *boot_id = m.u.ack.boot_id;
+    else if (m.type == CS_PROTO_HELLO)
+        *boot_id = m.u.hello.boot_id;
+    else if (m.type == CS_PROTO_STATUS)
+        *boot_id = m.u.status.boot_id;
+    else
+        return false;
+    return true;
+}

@@ -1,0 +1,137 @@
+/* cs_proto: the messages of the wire protocol and their byte layout (docs/protocol.md,
+ * "Messages"): plain C structs <-> payload bytes, little-endian, every field range-checked both
+ * ways. Owns the message type numbers, which types are sequenced (delivered reliably by cs_link)
+ * and which take a slot of the device's motion queue (spend a flow-control credit). */
+#ifndef CS_PROTO_H
+#define CS_PROTO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cs_err.h"
+#include "cs_fixed.h"
+#include "cs_segment.h"
+
+#define CS_PROTO_VERSION 1
+/* Axes a hello or a status may announce (x, y, z, a: cs_machine.h's CS_AXES). */
+#define CS_PROTO_AXES_MAX 4
+
+/* Message types (payload byte 0). 0x01..0x0F: link control, not sequenced (cs_link answers
+ * them itself); 0x10..0x1F: device to host; 0x20..0x2F: host to device. */
+typedef enum {
+    CS_PROTO_ACK = 0x01,     /* next expected sequence + credits + boot id + ping echo */
+    CS_PROTO_PING = 0x02,    /* asks the peer for an ACK echoing a nonce */
+    CS_PROTO_HELLO = 0x10,   /* device identity and capacity, first message after boot */
+    CS_PROTO_STATUS = 0x11,  /* state, queue fill, position in steps, last executed sequence */
+    CS_PROTO_ERROR = 0x12,   /* a cs_err_t code about a message */
+    CS_PROTO_SEGMENT = 0x20, /* step segment (cs_segment_t): ticks + signed steps per axis */
+    CS_PROTO_CURVE = 0x21,   /* cubic Bezier, 4 control points + feed, traced on the device */
+    CS_PROTO_HOLD = 0x22,    /* feed hold: decelerate and stop, keep the queue */
+    CS_PROTO_RESUME = 0x23,  /* resume after hold */
+    CS_PROTO_ABORT = 0x24,   /* stop now and flush the queue */
+} cs_proto_type_t;
+
+/* Payload sizes in bytes (n = number of axes a status carries, 1..CS_PROTO_AXES_MAX). */
+#define CS_PROTO_LEN_ACK       14
+#define CS_PROTO_LEN_PING      5
+#define CS_PROTO_LEN_HELLO     15
+#define CS_PROTO_LEN_STATUS(n) (11 + 4 * (n))
+#define CS_PROTO_LEN_ERROR     4
+#define CS_PROTO_LEN_SEGMENT   (5 + 4 * CS_AXES)
+#define CS_PROTO_LEN_CURVE     53
+#define CS_PROTO_LEN_CONTROL   1 /* hold, resume, abort */
+#define CS_PROTO_LEN_MAX       CS_PROTO_LEN_CURVE
+
+/* ACK flags. */
+#define CS_PROTO_ACK_NAK 0x01u /* the receiver saw a gap: resend from next_expected now */
+/* HELLO capability bits. */
+#define CS_PROTO_CAP_SEGMENTS 0x0001u
+#define CS_PROTO_CAP_CURVES   0x0002u
+#define CS_PROTO_CAP_ALL      (CS_PROTO_CAP_SEGMENTS | CS_PROTO_CAP_CURVES)
+
+/* Device states reported by STATUS. */
+typedef enum {
+    CS_PROTO_STATE_IDLE = 0,    /* queue empty, not moving */
+    CS_PROTO_STATE_RUNNING = 1, /* executing the queue */
+    CS_PROTO_STATE_HELD = 2,    /* stopped by HOLD, queue kept */
+    CS_PROTO_STATE_ABORTED = 3, /* stopped by ABORT, queue flushed */
+    CS_PROTO_STATE_FAULT = 4,   /* stopped on an error (see the ERROR messages) */
+    CS_PROTO_STATE_COUNT_
+} cs_proto_state_t;
+
+typedef struct {
+    uint8_t flags;          /* CS_PROTO_ACK_* */
+    uint16_t next_expected; /* sequence the sender of the ack expects next */
+    uint16_t credits;       /* queue slots free for messages with sequence >= next_expected */
+    uint32_t boot_id;       /* boot id of the sender of the ack (a change = reset) */
+    uint32_t echo;          /* nonce of the last PING received (0 before any) */
+} cs_proto_ack_t;
+
+typedef struct {
+    uint32_t nonce;
+} cs_proto_ping_t;
+
+typedef struct {
+    uint8_t version;     /* CS_PROTO_VERSION of the device, >= 1 */
+    uint32_t boot_id;    /* random per boot; a new value means the device restarted */
+    uint8_t axes;        /* 1..CS_PROTO_AXES_MAX */
+    uint16_t queue_size; /* motion queue slots (credits when empty), >= 1 */
+    uint32_t tick_hz;    /* executor ticks per second (segment durations are in ticks), >= 1 */
+    uint16_t caps;       /* CS_PROTO_CAP_* bits; unknown bits are refused */
+} cs_proto_hello_t;
+
+typedef struct {
+    uint8_t state;                  /* cs_proto_state_t */
+    uint32_t boot_id;               /* as in HELLO */
+    uint16_t queue_fill;            /* queue slots in use */
+    uint16_t last_seq;              /* sequence of the last message executed */
+    uint8_t axes;                   /* 1..CS_PROTO_AXES_MAX: entries of pos[] on the wire */
+    int32_t pos[CS_PROTO_AXES_MAX]; /* position in steps per axis */
+} cs_proto_status_t;
+
+typedef struct {
+    uint8_t code; /* cs_err_t, CS_ERR_ARG..CS_ERR_COUNT_-1 (never CS_OK or CS_END) */
+    uint16_t seq; /* sequence of the message the error is about */
+} cs_proto_error_t;
+
+/* Step segments travel as the executor's own cs_segment_t (cs_segment.h): ticks, then
+ * steps[0..CS_AXES) (axes the machine lacks carry 0), with its invariant checked both ways:
+ * 1 <= ticks <= CS_PROTO_SEGMENT_MAX_TICKS and |steps[i]| <= ticks. */
+#define CS_PROTO_SEGMENT_MAX_TICKS ((uint32_t)1 << 24)
+
+typedef struct {
+    cs_vec3_t p[4]; /* control points, each coordinate inside CS_POS_LIMIT */
+    int32_t feed;   /* mm/s, Q15.16 (cs_machine.h CS_MOTION_ONE = 1 mm/s), > 0 */
+} cs_proto_curve_t;
+
+typedef struct {
+    uint8_t type; /* cs_proto_type_t */
+    union {
+        cs_proto_ack_t ack;
+        cs_proto_ping_t ping;
+        cs_proto_hello_t hello;
+        cs_proto_status_t status;
+        cs_proto_error_t error;
+        cs_segment_t segment;
+        cs_proto_curve_t curve;
+    } u; /* none for HOLD, RESUME, ABORT */
+} cs_proto_msg_t;
+
+/* Encode *m into buf[0..cap), *len = bytes written. CS_ERR_UNSUPPORTED for an unknown type,
+ * CS_ERR_RANGE for a field outside its range (as listed above), CS_ERR_FULL when cap is too
+ * small, CS_ERR_ARG for a NULL pointer. ISR-safe (pure). */
+cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size_t *len);
+/* Decode payload buf[0..len) into *m. CS_ERR_FRAME when len is 0 or wrong for the type,
+ * CS_ERR_UNSUPPORTED for an unknown type, CS_ERR_RANGE for a field outside its range (*m is then
+ * unspecified), CS_ERR_ARG for a NULL pointer. Never reads outside buf[0..len). ISR-safe. */
+cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m);
+/* True for the types cs_link delivers reliably (everything but ACK and PING). */
+bool cs_proto_sequenced(uint8_t type);
+/* True for the types that take a slot of the device's motion queue (SEGMENT, CURVE): only
+ * these spend flow-control credits. */
+bool cs_proto_uses_slot(uint8_t type);
+/* Boot id carried by a well-formed ACK, HELLO or STATUS payload (true), else false. */
+bool cs_proto_peek_boot(const uint8_t *buf, size_t len, uint32_t *boot_id);
+
+#endif

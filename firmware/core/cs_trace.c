@@ -1,0 +1,64 @@
+/* cs_trace: one front for the three tracers (see cs_trace.h). It checks the tolerance, picks the
+ * engine (rational curves cannot be forward-differenced exactly in int64, see
+ * docs/fixed-point.md, so FD and AFD hand them to homogeneous subdivision) and caps the vertex
+ * count so no caller can be made to loop forever. */
+#include "cs_trace.h"
+
+CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_subdiv);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_SUBDIV_TOL_MAX, trace_tol_max_within_subdiv);
+
+cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
+                        cs_trace_method_t method)
+{
+    tr->done = true;
+    tr->count = 0;
+    tr->method = (uint8_t)method;
+    if (method != CS_TRACE_FD && method != CS_TRACE_AFD && method != CS_TRACE_SUBDIV)
+        return CS_ERR_ARG;
+    if (tol < CS_TRACE_TOL_MIN || tol > CS_TRACE_TOL_MAX)
+        return CS_ERR_TOLERANCE;
+    cs_err_t e;
+    if (method == CS_TRACE_SUBDIV) {
+        tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
+        e = cs_subdiv_begin(&tr->u.sd, c, tol, true);
+    } else if (c->rational) {
+        tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
+        e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
+    } else if (method == CS_TRACE_FD) {
+        tr->impl = CS_TRACE_IMPL_FD;
+        e = cs_fd_begin(&tr->u.fd, c, tol);
+    } else {
+        tr->impl = CS_TRACE_IMPL_AFD;
+        e = cs_afd_begin(&tr->u.afd, c, tol);
+    }
+    if (e == CS_OK)
+        tr->done = false;
+    return e;
+}
+
+cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
+{
+    if (tr->done)
+        return CS_END;
+    if (tr->count >= CS_TRACE_MAX_VERTICES) {
+        tr->done = true;
+        return CS_ERR_DEPTH;
+    }
+    cs_err_t e;
+    switch (tr->impl) {
+    case CS_TRACE_IMPL_FD:
+        e = cs_fd_next(&tr->u.fd, pt);
+        break;
+    case CS_TRACE_IMPL_AFD:
+        e = cs_afd_next(&tr->u.afd, pt);
+        break;
+    default:
+        e = cs_subdiv_next(&tr->u.sd, pt);
+        break;
+    }
+    if (e == CS_OK)
+        tr->count++;
+    else
+        tr->done = true;
+    return e;
+}

@@ -1,0 +1,65 @@
+/* cs_trace: turns one cs_bezier_t into chords within a tolerance, by one of three methods:
+ * uniform forward differences (cs_fd), adaptive forward differences (cs_afd) or flatness
+ * subdivision by de Casteljau (cs_subdiv). A pull iterator: the caller owns the state and
+ * asks for one vertex at a time, so firmware can interpolate on board with bounded memory. */
+#ifndef CS_TRACE_H
+#define CS_TRACE_H
+
+#include "cs_afd.h"
+#include "cs_bezier.h"
+#include "cs_fd.h"
+#include "cs_subdiv.h"
+
+typedef enum {
+    CS_TRACE_FD = 0,     /* uniform forward differences, step count from Wang's bound */
+    CS_TRACE_AFD = 1,    /* adaptive forward differences (step doubling/halving) */
+    CS_TRACE_SUBDIV = 2, /* flatness subdivision: farthest flat chord by de Casteljau splits */
+} cs_trace_method_t;
+
+/* The state struct (cs_trace_t) is defined below by the tracing modules; its size is fixed at
+ * compile time. Every vertex it yields lies on the curve to within 1 LSB, and every chord between
+ * consecutive vertices (starting from P0) lies within tol of the exact curve. */
+/* --- API every caller uses (host flatten, planner feed, firmware curves mode) --- */
+/* Accepted chord tolerance, cs_pos_t LSB: 4 LSB (61 nm) to 4096 mm. The rounding budget of each
+ * method is charged against it (docs/fixed-point.md). */
+#define CS_TRACE_TOL_MIN 4
+#define CS_TRACE_TOL_MAX CS_POS_LIMIT
+/* Hard cap on vertices per curve: a tracer that would exceed it reports CS_ERR_DEPTH instead of
+ * running on (none does for valid input: FD <= 2^(20+30), subdivision <= 2^depth). */
+#define CS_TRACE_MAX_VERTICES ((uint32_t)1 << 26)
+
+/* Which engine a cs_trace_t runs: rational curves asked for FD or AFD are traced by dyadic
+ * homogeneous subdivision (see docs/fixed-point.md); CS_TRACE_SUBDIV runs the reach tracer. */
+typedef enum {
+    CS_TRACE_IMPL_FD = 0,
+    CS_TRACE_IMPL_AFD = 1,
+    CS_TRACE_IMPL_SUBDIV_DYADIC = 2,
+    CS_TRACE_IMPL_SUBDIV_REACH = 3,
+} cs_trace_impl_t;
+
+/* The tracing state: caller-owned, fixed size (one of the three method states). */
+typedef struct {
+    uint8_t method; /* cs_trace_method_t asked for */
+    uint8_t impl;   /* cs_trace_impl_t running */
+    bool done;
+    uint32_t count; /* vertices returned so far */
+    union {
+        cs_fd_t fd;
+        cs_afd_t afd;
+        cs_subdiv_t sd;
+    } u;
+} cs_trace_t;
+
+/* Start tracing c with chord tolerance tol (cs_pos_t, > 0). CS_ERR_TOLERANCE when tol is
+ * outside the accepted range; CS_ERR_ARG for an unknown method; CS_ERR_DEGREE, CS_ERR_RANGE,
+ * CS_ERR_WEIGHT for a curve cs_bezier_init* would refuse. Bounded work; not meant for ISRs. */
+cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
+                        cs_trace_method_t method);
+/* Next vertex after the previous one (the first call returns the first vertex after P0; the
+ * last vertex is exactly P_n). CS_OK with *pt set, CS_END when the curve is finished, or an
+ * error (overflow, depth) after which the iterator is finished. */
+/* ISR-safe for CS_TRACE_FD (constant time per vertex inside a piece); the other methods do a
+ * bounded amount of work per vertex. */
+cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt);
+
+#endif

@@ -1,0 +1,49 @@
+/* port: the seam between the core and one target. The core never touches a register: the
+ * executor (cs_stepper) says what to do, a port does it. Every target implements these plain
+ * functions (firmware/ports/<target>/); firmware/ports/template/port_template.c says what each
+ * one must do. Ticks are the executor's time base (cs_machine_t.tick_hz). */
+#ifndef PORT_H
+#define PORT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cs_err.h"
+#include "cs_stepper.h"
+
+/* Brings up clocks, the step timer (stopped), STEP/DIR pins (low) and the UART. */
+void port_init(void);
+/* Free-running tick counter (wraps at 2^32; compare with port_ticks_before). ISR-safe. */
+uint32_t port_ticks_now(void);
+/* Ticks per second of port_ticks_now and of the step timer. ISR-safe. */
+uint32_t port_tick_hz(void);
+/* The step interrupt calls cs_stepper_tick on st; attach before arming the timer. */
+void port_stepper_attach(cs_stepper_t *st);
+/* Arms the step timer to fire once, `ticks` (>= 1) ticks from now. ISR-safe. */
+void port_timer_arm(uint32_t ticks);
+/* Stops the step timer (no further step interrupt until armed again). ISR-safe. */
+void port_timer_stop(void);
+/* Masks interrupts and returns the previous state, for port_irq_restore. */
+uint32_t port_irq_save(void);
+/* Restores the interrupt state returned by port_irq_save. */
+void port_irq_restore(uint32_t state);
+/* Raises the STEP line of every axis in mask (bit i = axis i) for the axis's pulse width, with
+ * the DIR lines as they are. ISR-safe. */
+void port_step_pulse(uint8_t mask);
+/* Sets the DIR lines (bit set = high). ISR-safe. */
+void port_dir_set(uint8_t mask);
+/* Reads up to max bytes received on the UART without blocking; returns the count. */
+size_t port_uart_read(uint8_t *buf, size_t max);
+/* Queues len bytes for the UART; returns how many were accepted (non-blocking). */
+size_t port_uart_write(const uint8_t *buf, size_t len);
+/* Unrecoverable error: stop the timer, drop STEP lines, report code, stay safe. */
+void port_fault(cs_err_t code);
+
+/* True when tick a is before tick b, across the 2^32 wrap (valid for distances < 2^31). */
+static inline bool port_ticks_before(uint32_t a, uint32_t b)
+{
+    return (int32_t)(a - b) < 0;
+}
+
+#endif

@@ -1,0 +1,221 @@
+/* port_posix: simulated time for the executor; records every STEP edge with its direction. */
+#include "port_posix.h"
+
+#include <stdlib.h>
+#include <unistd.h>
+
+struct posix_state {
+    uint64_t now;
+    uint32_t hz;
+    bool armed;
+    uint64_t deadline;
+    uint8_t dir_lines;
+    uint8_t invert;
+    cs_stepper_t *st;
+    port_posix_edge_t *edges;
+    size_t n, cap;
+    bool record, record_ok;
+    int64_t pos[8];
+    cs_err_t fault;
+    uint32_t irq_depth;
+    int fd_in, fd_out;
+};
+static struct posix_state g = {
+    .hz = 100000, .record = true, .record_ok = true, .fd_in = -1, .fd_out = -1};
+
+void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
+{
+    free(g.edges);
+    cs_stepper_t *st = g.st;
+    int in = g.fd_in, out = g.fd_out;
+    g = (struct posix_state){0};
+    g.hz = tick_hz;
+    g.invert = invert_mask;
+    g.dir_lines = invert_mask; /* positive direction at rest */
+    g.record = true;
+    g.record_ok = true;
+    g.st = st;
+    g.fd_in = in;
+    g.fd_out = out;
+    g.fault = CS_OK;
+}
+
+void port_init(void)
+{
+    port_posix_reset(g.hz, g.invert);
+}
+
+uint32_t port_ticks_now(void)
+{
+    return (uint32_t)g.now;
+}
+
+uint64_t port_posix_now(void)
+{
+    return g.now;
+}
+
+uint32_t port_tick_hz(void)
+{
+    return g.hz;
+}
+
+void port_stepper_attach(cs_stepper_t *st)
+{
+    g.st = st;
+}
+
+void port_timer_arm(uint32_t ticks)
+{
+    g.armed = true;
+    g.deadline = g.now + (ticks ? ticks : 1u);
+}
+
+void port_timer_stop(void)
+{
+    g.armed = false;
+}
+
+uint32_t port_irq_save(void)
+{
+    return g.irq_depth++;
+}
+
+void port_irq_restore(uint32_t state)
+{
+    g.irq_depth = state;
+}
+
+void port_step_pulse(uint8_t mask)
+{
+    for (unsigned i = 0; i < 8; i++) {
+        if (!(mask & (1u << i)))
+            continue;
+        bool high = (g.dir_lines >> i) & 1u;
+        bool inv = (g.invert >> i) & 1u;
+        int8_t dir = (high != inv) ? 1 : -1;
+        g.pos[i] += dir;
+        if (!g.record)
+            continue;
+        if (g.n == g.cap) {
+            size_t cap = g.cap ? g.cap * 2 : 4096;
+            port_posix_edge_t *e = realloc(g.edges, cap * sizeof *e);
+            if (e == NULL) {
+                g.record_ok = false;
+                continue;
+            }
+            g.edges = e;
+            g.cap = cap;
+        }
+        g.edges[g.n++] = (port_posix_edge_t){g.now, (uint8_t)i, dir};
+    }
+}
+
+void port_dir_set(uint8_t mask)
+{
+    g.dir_lines = mask;
+}
+
+size_t port_uart_read(uint8_t *buf, size_t max)
+{
+    if (g.fd_in < 0)
+        return 0;
+    ssize_t r = read(g.fd_in, buf, max);
+    return r > 0 ? (size_t)r : 0;
+}
+
+size_t port_uart_write(const uint8_t *buf, size_t len)
+{
+    if (g.fd_out < 0)
+        return 0;
+    ssize_t r = write(g.fd_out, buf, len);
+    return r > 0 ? (size_t)r : 0;
+}
+
+void port_fault(cs_err_t code)
+{
+    g.armed = false;
+    g.fault = code;
+}
+
+/* The step interrupt, as a real port's timer ISR would be written. */
+static void step_isr(void)
+{
+    cs_stepper_out_t o;
+    cs_stepper_tick(g.st, &o);
+    port_step_pulse(o.step_mask);
+    port_dir_set(o.dir_mask);
+    if (o.next_ticks != 0)
+        port_timer_arm(o.next_ticks);
+    else
+        port_timer_stop();
+}
+
+bool port_posix_run(uint64_t until)
+{
+    if (g.st == NULL)
+        return false;
+    for (;;) {
+        if (g.fault != CS_OK)
+            return false;
+        if (!g.armed) {
+            if (cs_stepper_idle(g.st))
+                return true;
+            port_timer_arm(1); /* wake up: work was queued while stopped */
+        }
+        if (g.deadline > until) {
+            g.now = until;
+            return true;
+        }
+        g.now = g.deadline;
+        g.armed = false;
+        step_isr();
+    }
+}
+
+bool port_posix_step(void)
+{
+    if (g.st == NULL || g.fault != CS_OK)
+        return false;
+    if (!g.armed) {
+        if (cs_stepper_idle(g.st))
+            return false;
+        port_timer_arm(1);
+    }
+    g.now = g.deadline;
+    g.armed = false;
+    step_isr();
+    return true;
+}
+
+const port_posix_edge_t *port_posix_edges(size_t *n)
+{
+    *n = g.n;
+    return g.edges;
+}
+
+void port_posix_record(bool on)
+{
+    g.record = on;
+}
+
+bool port_posix_record_ok(void)
+{
+    return g.record_ok;
+}
+
+int64_t port_posix_position(unsigned axis)
+{
+    return axis < 8 ? g.pos[axis] : 0;
+}
+
+cs_err_t port_posix_fault(void)
+{
+    return g.fault;
+}
+
+void port_posix_uart(int fd_in, int fd_out)
+{
+    g.fd_in = fd_in;
+    g.fd_out = fd_out;
+}

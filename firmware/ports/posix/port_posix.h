@@ -1,0 +1,46 @@
+/* port_posix: the port in a POSIX process, for the simulator and the tests. Time is simulated
+ * (no sleeping): port_posix_run jumps from one timer deadline to the next and calls the step
+ * interrupt there, so a job runs as fast as the CPU allows and always the same way. Every STEP
+ * pulse is recorded as an edge (time in ticks, axis, direction taken from the DIR lines). */
+#ifndef PORT_POSIX_H
+#define PORT_POSIX_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "port.h"
+
+/* One recorded step: rising STEP edge at tick t on axis, dir = +1 or -1 (DIR line level after
+ * the machine's inversion, i.e. the direction the motor turned). */
+typedef struct {
+    uint64_t t;
+    uint8_t axis;
+    int8_t dir;
+} port_posix_edge_t;
+
+/* Forgets everything (time 0, timer stopped, no edges) and sets the tick rate and which axes have
+ * an inverted DIR line (bit i = axis i). */
+void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask);
+/* Simulated time, 64-bit ticks (port_ticks_now is its low 32 bits). */
+uint64_t port_posix_now(void);
+/* Runs the step timer until the attached stepper is idle (starting the timer if it is stopped
+ * and work is queued) or until simulated time reaches `until` (UINT64_MAX: no limit). Returns
+ * false when a fault was raised. */
+bool port_posix_run(uint64_t until);
+/* Runs exactly one step interrupt (starting the timer if work is queued): advances time to its
+ * deadline. false when the stepper is idle with the timer stopped, or after a fault. */
+bool port_posix_step(void);
+/* The recorded edges, in time order; *n gets their count. */
+const port_posix_edge_t *port_posix_edges(size_t *n);
+/* Turns edge recording on (the default) or off; false on out of memory while recording. */
+void port_posix_record(bool on);
+bool port_posix_record_ok(void);
+/* Signed step count per axis seen on the STEP/DIR lines since reset. */
+int64_t port_posix_position(unsigned axis);
+/* Code passed to port_fault since reset (CS_OK when none). */
+cs_err_t port_posix_fault(void);
+/* The UART: file descriptors (non-blocking reads); -1 disables. */
+void port_posix_uart(int fd_in, int fd_out);
+
+#endif

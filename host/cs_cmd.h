@@ -1,0 +1,26 @@
+/* cs_cmd: the subcommands of the curvestep program. host/main.c dispatches through one table;
+ * adding a command is one line there plus its prototype here. Every command takes its own
+ * argv (argv[0] = the command's name), handles its own --help, and returns an exit status. */
+#ifndef CS_CMD_H
+#define CS_CMD_H
+
+#define CS_VERSION "0.1.0"
+
+/* Exit statuses shared by every command (documented in each --help). */
+enum {
+    CS_EXIT_OK = 0,       /* success */
+    CS_EXIT_INPUT = 1,    /* bad input: "file:line:col: reason" on stderr */
+    CS_EXIT_USAGE = 2,    /* bad command line */
+    CS_EXIT_INTERNAL = 3, /* internal error, arithmetic overflow, out of memory, I/O */
+};
+
+/* A command: argc/argv start at the command's name; returns a CS_EXIT_* status. */
+typedef int (*cs_cmd_fn)(int argc, char **argv);
+
+/* curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg] FILE */
+int cs_cmd_flatten(int argc, char **argv);
+
+/* curvestep plan [--machine FILE.ini] [--tol MM] [--method M] [--feed MM/S] [-o OUT] FILE */
+int cs_cmd_plan(int argc, char **argv);
+
+#endif

@@ -1,0 +1,289 @@
+/* curvestep flatten: reads SVG path data or an SVG document, traces every element with the
+ * core's pull iterator (cs_trace_begin / cs_trace_next) and prints the polyline, one vertex
+ * "x y" (mm, 6 decimals) per line, a blank line between subpaths. Optional summary (--stats)
+ * and picture (--svg). */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_conv.h"
+#include "cs_err_text.h"
+#include "cs_path.h"
+#include "cs_svgdoc.h"
+#include "cs_svgout.h"
+#include "cs_trace.h"
+
+#define FLATTEN_DEFAULT_TOL_MM 0.01
+
+static const struct {
+    const char *name;
+    cs_trace_method_t method;
+} methods[] = {
+    {"fd", CS_TRACE_FD},
+    {"afd", CS_TRACE_AFD},
+    {"subdiv", CS_TRACE_SUBDIV},
+};
+
+/* The default: flatness subdivision, the method whose chords are proven within the tolerance
+ * with the fewest assumptions (cs_trace.h names no preferred method). */
+#define FLATTEN_DEFAULT_METHOD 2
+
+static void flatten_usage(FILE *f)
+{
+    fprintf(
+        f,
+        "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
+        " FILE\n"
+        "\n"
+        "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
+        "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
+        "decimals), a blank line between subpaths.\n"
+        "\n"
+        "FILE is an SVG document (every drawn <path> element's d attribute is read, with the\n"
+        "transforms of its groups) or a file holding bare SVG path data (M L H V C S Q T A Z,\n"
+        "absolute and relative); '-' reads standard input. Basic shapes (<rect>, <circle>...),\n"
+        "text and <use> are not drawn yet: a warning on stderr names them. User units are\n"
+        "millimetres, axes as in the file (SVG's y points down); coordinates must stay\n"
+        "within +/-%d mm.\n"
+        "\n"
+        "Options:\n"
+        "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
+        "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
+        "                  differences) or subdiv (flatness subdivision; the default)\n"
+        "  --stats         print a summary on stderr: elements, chords, and the largest\n"
+        "                  deviation of a chord from its exact curve, measured in double on\n"
+        "                  the host\n"
+        "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
+        "  -h, --help      show this help\n"
+        "\n"
+        "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
+        "coordinates outside the range); 2 usage error; 3 internal error (arithmetic overflow\n"
+        "or depth limit while tracing, out of memory, write error).\n",
+        CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
+        CS_POS_LIMIT_MM);
+}
+
+/* Exit status for a code met while reading input. */
+static int input_status(cs_err_t e)
+{
+    return (e == CS_ERR_FULL || e == CS_ERR_OVERFLOW) ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+}
+
+typedef struct {
+    cs_vec3_t *v;
+    size_t n, cap;
+} vbuf_t;
+
+static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
+{
+    if (b->n == b->cap) {
+        size_t ncap = b->cap ? 2 * b->cap : 256;
+        cs_vec3_t *nv = realloc(b->v, ncap * sizeof *nv);
+        if (!nv)
+            return false;
+        b->v = nv;
+        b->cap = ncap;
+    }
+    b->v[b->n++] = p;
+    return true;
+}
+
+int cs_cmd_flatten(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"tol", required_argument, NULL, 't'}, {"method", required_argument, NULL, 'm'},
+        {"stats", no_argument, NULL, 's'},     {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},      {NULL, 0, NULL, 0},
+    };
+    double tol_mm = FLATTEN_DEFAULT_TOL_MM;
+    size_t method = FLATTEN_DEFAULT_METHOD;
+    bool stats = false;
+    const char *svg_out = NULL;
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 't': {
+            char *end = NULL;
+            tol_mm = strtod(optarg, &end);
+            cs_pos_t t = 0;
+            /* The tracers accept CS_TRACE_TOL_MIN LSB and up (their rounding budget is charged
+             * against the tolerance); the host refuses more than the coordinate range. */
+            if (!end || end == optarg || *end != '\0' || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
+                t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
+                fprintf(stderr,
+                        "curvestep flatten: --tol '%s': expected a tolerance in mm, from %.7f "
+                        "(%d LSB) to %d\n",
+                        optarg, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_TRACE_TOL_MIN,
+                        CS_POS_LIMIT_MM);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        }
+        case 'm': {
+            size_t k = 0;
+            while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
+                k++;
+            if (k == sizeof methods / sizeof methods[0]) {
+                fprintf(stderr, "curvestep flatten: --method '%s': expected fd, afd or subdiv\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            method = k;
+            break;
+        }
+        case 's':
+            stats = true;
+            break;
+        case 'o':
+            svg_out = optarg;
+            break;
+        case 'h':
+            flatten_usage(stdout);
+            return CS_EXIT_OK;
+        case ':':
+            fprintf(stderr, "curvestep flatten: option '%s' needs a value\n", argv[optind - 1]);
+            fprintf(stderr, "Try 'curvestep flatten --help'.\n");
+            return CS_EXIT_USAGE;
+        default:
+            fprintf(stderr, "curvestep flatten: unknown option '%s'\n", argv[optind - 1]);
+            fprintf(stderr, "Try 'curvestep flatten --help'.\n");
+            return CS_EXIT_USAGE;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "curvestep flatten: %s\n",
+                optind >= argc ? "missing FILE" : "expected exactly one FILE");
+        fprintf(stderr, "Try 'curvestep flatten --help'.\n");
+        return CS_EXIT_USAGE;
+    }
+    const char *file = argv[optind];
+    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    cs_pos_t tol;
+    cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
+
+    cs_path_t path;
+    cs_path_init(&path);
+    cs_path_diag_t diag;
+    cs_svgdoc_opts_t dopts;
+    cs_svgdoc_opts_init(&dopts);
+    cs_svgdoc_stats_t dstats;
+    cs_err_t e = cs_svgdoc_read_file(file, &dopts, &path, &diag, &dstats);
+    if (e != CS_OK) {
+        cs_path_diag_print(stderr, &diag);
+        cs_path_free(&path);
+        return input_status(e);
+    }
+
+    int status = CS_EXIT_OK;
+    cs_path_poly_t poly;
+    cs_path_poly_init(&poly);
+    vbuf_t vb = {NULL, 0, 0};
+    size_t nchords = 0;
+    double maxdev = 0.0;
+    size_t maxdev_elem = 0;
+    cs_trace_t tr;
+    for (size_t i = 0; i < path.n && status == CS_EXIT_OK; i++) {
+        const cs_path_elem_t *el = &path.elems[i];
+        const cs_bezier_t *cv = &el->curve;
+        bool new_sub = i == 0 || el->subpath != path.elems[i - 1].subpath;
+        const cs_vec3_t *prev_end =
+            i > 0 ? &path.elems[i - 1].curve.p[path.elems[i - 1].curve.degree] : NULL;
+        if (new_sub || prev_end->x != cv->p[0].x || prev_end->y != cv->p[0].y) {
+            if (i > 0 && new_sub)
+                putchar('\n');
+            printf("%.6f %.6f\n", cs_conv_pos_to_mm(cv->p[0].x), cs_conv_pos_to_mm(cv->p[0].y));
+            if ((new_sub ? cs_path_poly_move(&poly, cs_conv_pos_to_mm(cv->p[0].x),
+                                             cs_conv_pos_to_mm(cv->p[0].y))
+                         : cs_path_poly_line(&poly, cs_conv_pos_to_mm(cv->p[0].x),
+                                             cs_conv_pos_to_mm(cv->p[0].y))) != CS_OK) {
+                status = CS_EXIT_INTERNAL;
+                fprintf(stderr, "curvestep flatten: out of memory\n");
+                break;
+            }
+        }
+        vb.n = 0;
+        if (!vbuf_push(&vb, cv->p[0])) {
+            status = CS_EXIT_INTERNAL;
+            fprintf(stderr, "curvestep flatten: out of memory\n");
+            break;
+        }
+        e = cs_trace_begin(&tr, cv, tol, methods[method].method);
+        if (e == CS_ERR_TOLERANCE) {
+            fprintf(stderr, "curvestep flatten: --tol %g: %s (method %s)\n", tol_mm, cs_err_text(e),
+                    methods[method].name);
+            status = CS_EXIT_USAGE;
+            break;
+        }
+        cs_vec3_t pt;
+        while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK) {
+            printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
+            nchords++;
+            if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
+                    CS_OK ||
+                !vbuf_push(&vb, pt)) {
+                e = CS_ERR_FULL;
+                break;
+            }
+        }
+        if (e != CS_END) {
+            cs_path_diag_set(&diag, e, el->loc, "cannot trace this curve: %s", cs_err_text(e));
+            cs_path_diag_print(stderr, &diag);
+            status = CS_EXIT_INTERNAL;
+            break;
+        }
+        if (stats) {
+            double d = cs_path_deviation_mm(cv, vb.v, vb.n);
+            if (d > maxdev || i == 0) {
+                maxdev = d;
+                maxdev_elem = i;
+            }
+        }
+    }
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "curvestep flatten: error writing the output\n");
+        if (status == CS_EXIT_OK)
+            status = CS_EXIT_INTERNAL;
+    }
+    if (stats && status == CS_EXIT_OK) {
+        fprintf(stderr, "flatten: %s: %zu elements in %u subpaths, %zu chords (%zu vertices)\n",
+                shown, path.n, path.nsubpaths, nchords, poly.n);
+        fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name, tol_mm);
+        if (path.n > 0) {
+            const cs_path_loc_t *l = &path.elems[maxdev_elem].loc;
+            if (isinf(maxdev)) {
+                fprintf(stderr,
+                        "%s:%u:%u: internal error: the tracer returned a vertex off this curve\n",
+                        l->file, l->line, l->col);
+                status = CS_EXIT_INTERNAL;
+            } else
+                fprintf(stderr,
+                        "flatten: max deviation %.6f mm (measured in double on the host against "
+                        "the exact curves; element at %s:%u:%u)\n",
+                        maxdev, l->file, l->line, l->col);
+        } else {
+            fprintf(stderr, "flatten: max deviation 0.000000 mm (nothing to trace)\n");
+        }
+    }
+    if (svg_out && status == CS_EXIT_OK) {
+        cs_svgout_opts_t so;
+        cs_svgout_opts_init(&so);
+        so.title = shown;
+        so.method = methods[method].name;
+        so.tol_mm = tol_mm;
+        so.max_dev_mm = stats && !isinf(maxdev) ? maxdev : -1.0;
+        e = cs_svgout_write(svg_out, &path, &poly, &so, &diag);
+        if (e == CS_ERR_IO) {
+            cs_path_diag_print(stderr, &diag);
+            status = CS_EXIT_INTERNAL;
+        }
+    }
+    free(vb.v);
+    cs_path_poly_free(&poly);
+    cs_path_free(&path);
+    return status;
+}

@@ -1,0 +1,244 @@
+/* cs_machine_ini: INI machine file -> cs_machine_t, every value range-checked. */
+#include "cs_machine_ini.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "cs_conv.h"
+#include "cs_err_text.h"
+#include "cs_planner.h"
+
+typedef struct {
+    cs_machine_t *m;
+    double pulse_us[CS_AXES];
+    double segment_ms;
+    bool has_a;
+    char reason[200];
+    int bad_line;
+} ini_ctx_t;
+
+static const char *const axis_names[CS_AXES] = {"x", "y", "z", "a"};
+
+void cs_machine_ini_default(cs_machine_t *m)
+{
+    memset(m, 0, sizeof *m);
+    m->n_axes = 3;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        cs_axis_cfg_t *a = &m->axis[i];
+        a->steps_per_mm = 80 * CS_MOTION_ONE;
+        a->max_rate = (i == CS_AXIS_Z ? 50 : 200) * CS_MOTION_ONE;
+        a->max_accel = (i == CS_AXIS_Z ? 500 : 1000) * CS_MOTION_ONE;
+        a->travel_min = (i == CS_AXIS_Z ? -100 : -1000) * CS_POS_ONE_MM;
+        a->travel_max = (i == CS_AXIS_Z ? 100 : 1000) * CS_POS_ONE_MM;
+        a->invert_dir = false;
+        a->pulse_ticks = 1;
+    }
+    m->tick_hz = 100000;
+    m->segment_ticks = 500;
+    m->tolerance = CS_POS_ONE_MM / 100;
+    m->junction_deviation = CS_POS_ONE_MM / 100;
+    m->default_feed = 50 * CS_MOTION_ONE;
+    m->profile = CS_PROFILE_TRAPEZOID;
+    m->max_jerk = 100000;
+}
+
+double cs_machine_ini_to_double(int32_t q16)
+{
+    return (double)q16 / CS_MOTION_ONE;
+}
+
+static bool parse_num(const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (end == v || *end != '\0' || errno != 0 || !isfinite(d))
+        return false;
+    *out = d;
+    return true;
+}
+
+/* Positive Q15.16 value in (0, 32768). */
+static bool to_q16_pos(double d, int32_t *out)
+{
+    double q = d * CS_MOTION_ONE;
+    if (!(d > 0) || q >= 2147483647.0)
+        return false;
+    *out = (int32_t)llround(q);
+    if (*out < 1)
+        *out = 1;
+    return true;
+}
+
+static int fail(ini_ctx_t *c, const char *fmt, const char *section, const char *name)
+{
+    snprintf(c->reason, sizeof c->reason, fmt, section, name);
+    return 0;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    ini_ctx_t *c = user;
+    cs_machine_t *m = c->m;
+    double d;
+    if (strcasecmp(section, "machine") == 0) {
+        if (strcasecmp(name, "profile") == 0) {
+            if (strcasecmp(value, "trapezoid") == 0)
+                m->profile = CS_PROFILE_TRAPEZOID;
+            else if (strcasecmp(value, "scurve") == 0)
+                m->profile = CS_PROFILE_SCURVE;
+            else
+                return fail(c, "[%s] %s: expected trapezoid or scurve", section, name);
+            return 1;
+        }
+        if (!parse_num(value, &d))
+            return fail(c, "[%s] %s: not a number", section, name);
+        if (strcasecmp(name, "axes") == 0) {
+            if (d != 3 && d != 4)
+                return fail(c, "[%s] %s: must be 3 or 4", section, name);
+            m->n_axes = (uint8_t)d;
+            c->has_a = d == 4;
+        } else if (strcasecmp(name, "tick_hz") == 0) {
+            if (d < 1000 || d > 16e6 || d != floor(d))
+                return fail(c, "[%s] %s: must be an integer in 1000..16000000", section, name);
+            m->tick_hz = (uint32_t)d;
+        } else if (strcasecmp(name, "segment_ms") == 0) {
+            if (!(d > 0) || d > 1000)
+                return fail(c, "[%s] %s: must be in (0, 1000] ms", section, name);
+            c->segment_ms = d;
+        } else if (strcasecmp(name, "tolerance") == 0) {
+            if (cs_conv_tol_to_pos(d, &m->tolerance) != CS_OK)
+                return fail(c, "[%s] %s: must be in [1/65536, 4096] mm", section, name);
+        } else if (strcasecmp(name, "junction_deviation") == 0) {
+            if (!(d >= 0) || cs_conv_mm_to_pos(d, &m->junction_deviation) != CS_OK)
+                return fail(c, "[%s] %s: must be in [0, 4096] mm", section, name);
+        } else if (strcasecmp(name, "default_feed") == 0) {
+            if (!to_q16_pos(d, &m->default_feed))
+                return fail(c, "[%s] %s: must be in (0, 32768) mm/s", section, name);
+        } else if (strcasecmp(name, "max_jerk") == 0) {
+            if (!(d >= 1) || d > 2e9)
+                return fail(c, "[%s] %s: must be in [1, 2e9] mm/s^3", section, name);
+            m->max_jerk = (int32_t)d;
+        } else {
+            return fail(c, "[%s] %s: unknown key", section, name);
+        }
+        return 1;
+    }
+    int ax = -1;
+    for (int i = 0; i < CS_AXES; i++)
+        if (strcasecmp(section, axis_names[i]) == 0)
+            ax = i;
+    if (ax < 0)
+        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z or a)", section, "");
+    if (ax == CS_AXIS_A) {
+        c->has_a = true;
+        m->n_axes = 4;
+    }
+    cs_axis_cfg_t *a = &m->axis[ax];
+    if (strcasecmp(name, "invert_dir") == 0) {
+        if (strcasecmp(value, "true") == 0 || strcmp(value, "1") == 0 ||
+            strcasecmp(value, "yes") == 0)
+            a->invert_dir = true;
+        else if (strcasecmp(value, "false") == 0 || strcmp(value, "0") == 0 ||
+                 strcasecmp(value, "no") == 0)
+            a->invert_dir = false;
+        else
+            return fail(c, "[%s] %s: expected true or false", section, name);
+        return 1;
+    }
+    if (!parse_num(value, &d))
+        return fail(c, "[%s] %s: not a number", section, name);
+    if (strcasecmp(name, "steps_per_mm") == 0) {
+        if (!(d >= 1.0 / 16) || d > 4096 || !to_q16_pos(d, &a->steps_per_mm))
+            return fail(c, "[%s] %s: must be in [1/16, 4096]", section, name);
+    } else if (strcasecmp(name, "max_rate") == 0) {
+        if (!to_q16_pos(d, &a->max_rate))
+            return fail(c, "[%s] %s: must be in (0, 32768) mm/s", section, name);
+    } else if (strcasecmp(name, "max_accel") == 0) {
+        if (!to_q16_pos(d, &a->max_accel))
+            return fail(c, "[%s] %s: must be in (0, 32768) mm/s^2", section, name);
+    } else if (strcasecmp(name, "travel_min") == 0) {
+        if (cs_conv_mm_to_pos(d, &a->travel_min) != CS_OK)
+            return fail(c, "[%s] %s: must be in [-4096, 4096] mm", section, name);
+    } else if (strcasecmp(name, "travel_max") == 0) {
+        if (cs_conv_mm_to_pos(d, &a->travel_max) != CS_OK)
+            return fail(c, "[%s] %s: must be in [-4096, 4096] mm", section, name);
+    } else if (strcasecmp(name, "pulse_us") == 0) {
+        if (!(d > 0) || d > 10000)
+            return fail(c, "[%s] %s: must be in (0, 10000] us", section, name);
+        c->pulse_us[ax] = d;
+    } else {
+        return fail(c, "[%s] %s: unknown key", section, name);
+    }
+    return 1;
+}
+
+static int finish(ini_ctx_t *c, int rc, const char *name, char *err, size_t errlen)
+{
+    cs_machine_t *m = c->m;
+    if (rc < 0) {
+        snprintf(err, errlen, "%s:0: cannot read the machine file", name);
+        return -1;
+    }
+    if (rc > 0) {
+        snprintf(err, errlen, "%s:%d: %s", name, rc,
+                 c->reason[0] ? c->reason : "syntax error (expected [section] or key = value)");
+        return -1;
+    }
+    m->segment_ticks = (uint32_t)llround(c->segment_ms * m->tick_hz / 1000.0);
+    if (m->segment_ticks < 1)
+        m->segment_ticks = 1;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        double t = ceil(c->pulse_us[i] * m->tick_hz / 1e6 - 1e-9);
+        m->axis[i].pulse_ticks = (uint16_t)(t < 1 ? 1 : t > 65535 ? 65535 : t);
+        if (m->axis[i].travel_min > m->axis[i].travel_max) {
+            snprintf(err, errlen, "%s:0: [%s] travel_min is above travel_max", name, axis_names[i]);
+            return -1;
+        }
+    }
+    cs_planner_t pl;
+    cs_err_t e = cs_planner_init(&pl, m);
+    if (e != CS_OK) {
+        snprintf(err, errlen,
+                 "%s:0: machine rejected: %s (each axis needs max_rate * steps_per_mm <= "
+                 "tick_hz / 2 and a pulse that fits half a step period)",
+                 name, cs_err_text(e));
+        return -1;
+    }
+    return 0;
+}
+
+static void ctx_init(ini_ctx_t *c, cs_machine_t *m)
+{
+    memset(c, 0, sizeof *c);
+    c->m = m;
+    cs_machine_ini_default(m);
+    c->segment_ms = 5.0;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        c->pulse_us[i] = 2.0;
+}
+
+int cs_machine_ini_load(const char *path, cs_machine_t *m, char *err, size_t errlen)
+{
+    ini_ctx_t c;
+    ctx_init(&c, m);
+    int rc = ini_parse(path, handler, &c);
+    return finish(&c, rc, path, err, errlen);
+}
+
+int cs_machine_ini_parse(const char *text, const char *name, cs_machine_t *m, char *err,
+                         size_t errlen)
+{
+    ini_ctx_t c;
+    ctx_init(&c, m);
+    int rc = ini_parse_string(text, handler, &c);
+    return finish(&c, rc, name, err, errlen);
+}

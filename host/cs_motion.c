@@ -1,0 +1,269 @@
+/* cs_motion: planner + segment generator on the host, segments kept in memory. */
+#include "cs_motion.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_conv.h"
+#include "cs_err_text.h"
+#include "cs_svgdoc.h"
+#include "cs_trace.h"
+
+cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m)
+{
+    memset(mo, 0, sizeof *mo);
+    mo->m = m;
+    cs_err_t e = cs_planner_init(&mo->pl, m);
+    if (e == CS_OK)
+        e = cs_segment_init(&mo->gen, m);
+    return e;
+}
+
+void cs_motion_free(cs_motion_t *mo)
+{
+    free(mo->segs.v);
+    mo->segs.v = NULL;
+    mo->segs.n = mo->segs.cap = 0;
+}
+
+static cs_err_t push(cs_motion_t *mo, const cs_segment_t *s)
+{
+    cs_motion_segs_t *v = &mo->segs;
+    if (v->n == v->cap) {
+        size_t cap = v->cap ? v->cap * 2 : 1024;
+        cs_segment_t *p = realloc(v->v, cap * sizeof *p);
+        if (p == NULL)
+            return CS_ERR_FULL;
+        v->v = p;
+        v->cap = cap;
+    }
+    v->v[v->n++] = *s;
+    mo->ticks += s->ticks;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        mo->pos[i] += s->steps[i];
+        mo->steps += s->steps[i] < 0 ? -(int64_t)s->steps[i] : s->steps[i];
+    }
+    return CS_OK;
+}
+
+/* Cuts segments until the oldest block is finished (one slot freed). */
+static cs_err_t cut_one_block(cs_motion_t *mo)
+{
+    cs_segment_t s;
+    do {
+        cs_err_t e = cs_segment_next(&mo->gen, &mo->pl, &s);
+        if (e != CS_OK)
+            return e;
+        e = push(mo, &s);
+        if (e != CS_OK)
+            return e;
+    } while (!cs_segment_block_end(&mo->gen));
+    return CS_OK;
+}
+
+cs_err_t cs_motion_line(cs_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t feed,
+                        uint32_t line)
+{
+    if (cs_planner_full(&mo->pl)) {
+        cs_err_t e = cut_one_block(mo);
+        if (e != CS_OK)
+            return e;
+    }
+    unsigned before = cs_planner_count(&mo->pl);
+    cs_err_t e = cs_planner_line(&mo->pl, target, feed, line);
+    if (e == CS_OK && cs_planner_count(&mo->pl) > before)
+        mo->blocks++;
+    return e;
+}
+
+int32_t cs_motion_speed(double mm_s)
+{
+    if (!(mm_s > 0))
+        return 0;
+    double q = mm_s * CS_MOTION_ONE;
+    return q >= 2147483647.0 ? INT32_MAX : (int32_t)llround(q) < 1 ? 1 : (int32_t)llround(q);
+}
+
+cs_err_t cs_motion_line_mm(cs_motion_t *mo, double x, double y, double z, double feed_mm_s,
+                           uint32_t line)
+{
+    cs_vec3_t p;
+    cs_err_t e = cs_conv_mm_to_vec(x, y, z, &p);
+    if (e != CS_OK)
+        return e;
+    cs_pos_t t[CS_AXES] = {p.x, p.y, p.z, mo->pl.pos[CS_AXIS_A]};
+    return cs_motion_line(mo, t, cs_motion_speed(feed_mm_s), line);
+}
+
+cs_err_t cs_motion_finish(cs_motion_t *mo)
+{
+    while (cs_planner_count(&mo->pl) > 0) {
+        cs_err_t e = cut_one_block(mo);
+        if (e != CS_OK)
+            return e;
+    }
+    return CS_OK;
+}
+
+int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_t n)
+{
+    fprintf(f, "# curvestep segments tick_hz=%u axes=%u\n", (unsigned)m->tick_hz,
+            (unsigned)m->n_axes);
+    for (size_t k = 0; k < n; k++) {
+        fprintf(f, "%u %d %d %d", (unsigned)s[k].ticks, (int)s[k].steps[0], (int)s[k].steps[1],
+                (int)s[k].steps[2]);
+        if (m->n_axes > 3)
+            fprintf(f, " %d", (int)s[k].steps[3]);
+        fputc('\n', f);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
+static int grow(cs_motion_segs_t *v)
+{
+    if (v->n < v->cap)
+        return 0;
+    size_t cap = v->cap ? v->cap * 2 : 1024;
+    cs_segment_t *p = realloc(v->v, cap * sizeof *p);
+    if (p == NULL)
+        return -1;
+    v->v = p;
+    v->cap = cap;
+    return 0;
+}
+
+int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_segs_t *out,
+                   char *err, size_t errlen)
+{
+    char buf[512];
+    unsigned lineno = 0;
+    while (fgets(buf, sizeof buf, f)) {
+        lineno++;
+        char *p = buf;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\n' || *p == '\0' || *p == '\r')
+            continue;
+        if (*p == '#') {
+            unsigned hz, axes;
+            if (sscanf(p, "# curvestep segments tick_hz=%u axes=%u", &hz, &axes) == 2) {
+                if (hz != m->tick_hz || axes != m->n_axes) {
+                    snprintf(err, errlen,
+                             "%s:%u: segments made for tick_hz=%u axes=%u, machine has "
+                             "tick_hz=%u axes=%u (use the same --machine as plan)",
+                             name, lineno, hz, axes, (unsigned)m->tick_hz, (unsigned)m->n_axes);
+                    return -1;
+                }
+            }
+            continue;
+        }
+        long long v[1 + CS_AXES] = {0, 0, 0, 0, 0};
+        int used = 0, k = 0;
+        while (k < 1 + CS_AXES && sscanf(p, "%lld%n", &v[k], &used) == 1) {
+            p += used;
+            k++;
+        }
+        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
+            p++;
+        if (k != 1 + m->n_axes || *p != '\0') {
+            snprintf(err, errlen, "%s:%u: expected %u integers: ticks and the steps of each axis",
+                     name, lineno, 1u + m->n_axes);
+            return -1;
+        }
+        cs_segment_t s = {0, {0, 0, 0, 0}};
+        if (v[0] < 1 || v[0] > (1LL << 24)) {
+            snprintf(err, errlen, "%s:%u: ticks must be in 1..16777216", name, lineno);
+            return -1;
+        }
+        s.ticks = (uint32_t)v[0];
+        for (unsigned i = 0; i < m->n_axes; i++) {
+            if (v[1 + i] > v[0] || v[1 + i] < -v[0]) {
+                snprintf(err, errlen, "%s:%u: more steps than ticks on axis %u", name, lineno, i);
+                return -1;
+            }
+            s.steps[i] = (int32_t)v[1 + i];
+        }
+        if (grow(out) != 0) {
+            snprintf(err, errlen, "%s:%u: out of memory", name, lineno);
+            return -1;
+        }
+        out->v[out->n++] = s;
+    }
+    if (ferror(f)) {
+        snprintf(err, errlen, "%s:%u: read error", name, lineno);
+        return -1;
+    }
+    return 0;
+}
+
+cs_err_t cs_motion_read_job(const char *file, cs_path_t *path, cs_path_diag_t *diag)
+{
+    cs_svgdoc_opts_t o;
+    cs_svgdoc_opts_init(&o);
+    return cs_svgdoc_read_file(file, &o, path, diag, NULL);
+}
+
+static const char *axis_letter(unsigned i)
+{
+    static const char *const n[CS_AXES] = {"x", "y", "z", "a"};
+    return i < CS_AXES ? n[i] : "?";
+}
+
+static cs_err_t move_to(cs_motion_t *mo, const cs_vec3_t *p, int32_t feed, cs_path_loc_t loc,
+                        cs_path_diag_t *diag)
+{
+    cs_pos_t t[CS_AXES] = {p->x, p->y, p->z, mo->pl.pos[CS_AXIS_A]};
+    cs_err_t e = cs_motion_line(mo, t, feed, loc.line);
+    if (e == CS_ERR_LIMIT) {
+        for (unsigned i = 0; i < mo->m->n_axes; i++) {
+            const cs_axis_cfg_t *a = &mo->m->axis[i];
+            if (t[i] < a->travel_min || t[i] > a->travel_max)
+                return cs_path_diag_set(diag, e, loc,
+                                        "move to %s = %.4f mm leaves the travel %.4f .. %.4f mm "
+                                        "(soft limit; nothing was sent)",
+                                        axis_letter(i), cs_conv_pos_to_mm(t[i]),
+                                        cs_conv_pos_to_mm(a->travel_min),
+                                        cs_conv_pos_to_mm(a->travel_max));
+        }
+    }
+    if (e != CS_OK)
+        return cs_path_diag_set(diag, e, loc, "planning failed: %s", cs_err_text(e));
+    return CS_OK;
+}
+
+cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
+                             int32_t feed, cs_path_diag_t *diag)
+{
+    if (feed <= 0)
+        feed = mo->m->default_feed;
+    cs_vec3_t cur = {mo->pl.pos[0], mo->pl.pos[1], mo->pl.pos[2]};
+    for (size_t k = 0; k < path->n; k++) {
+        const cs_path_elem_t *el = &path->elems[k];
+        const cs_bezier_t *c = &el->curve;
+        if (c->p[0].x != cur.x || c->p[0].y != cur.y || c->p[0].z != cur.z) {
+            cs_err_t e = move_to(mo, &c->p[0], 0, el->loc, diag); /* rapid travel */
+            if (e != CS_OK)
+                return e;
+        }
+        cs_trace_t tr;
+        cs_err_t e = cs_trace_begin(&tr, c, tol, (cs_trace_method_t)method);
+        if (e != CS_OK)
+            return cs_path_diag_set(diag, e, el->loc, "cannot trace: %s", cs_err_text(e));
+        cs_vec3_t pt;
+        while ((e = cs_trace_next(&tr, &pt)) == CS_OK) {
+            e = move_to(mo, &pt, feed, el->loc, diag);
+            if (e != CS_OK)
+                return e;
+        }
+        if (e != CS_END)
+            return cs_path_diag_set(diag, e, el->loc, "tracing failed: %s", cs_err_text(e));
+        cur = c->p[c->degree];
+    }
+    cs_err_t e = cs_motion_finish(mo);
+    if (e != CS_OK) {
+        cs_path_loc_t loc = {path->n ? path->elems[path->n - 1].loc.file : "job", 0, 0};
+        return cs_path_diag_set(diag, e, loc, "cutting segments failed: %s", cs_err_text(e));
+    }
+    return CS_OK;
+}

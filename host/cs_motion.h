@@ -1,0 +1,64 @@
+/* cs_motion: the host's motion driver. Feeds moves to the core planner, keeps the look-ahead
+ * ring full (segments are cut only when the ring is full or at the end of the job) and collects
+ * the step segments in a growable array, with the job's totals. Shared by `curvestep plan`, the
+ * simulator and the tests. */
+#ifndef CS_MOTION_H
+#define CS_MOTION_H
+
+#include <stddef.h>
+#include <stdio.h>
+#include <stdint.h>
+
+#include "cs_path.h"
+#include "cs_planner.h"
+#include "cs_segment.h"
+
+typedef struct {
+    cs_segment_t *v;
+    size_t n, cap;
+} cs_motion_segs_t;
+
+typedef struct {
+    const cs_machine_t *m;
+    cs_planner_t pl;
+    cs_segment_gen_t gen;
+    cs_motion_segs_t segs;
+    size_t blocks;        /* blocks queued */
+    uint64_t ticks;       /* sum of the segments' durations */
+    int64_t steps;        /* sum of |steps| over every axis */
+    int64_t pos[CS_AXES]; /* sum of the segments' steps: the final position */
+} cs_motion_t;
+
+/* Planner and generator for machine *m (which must outlive mo), no segments yet. */
+cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m);
+/* Frees the segments. */
+void cs_motion_free(cs_motion_t *mo);
+/* Queues a straight move to target (mm) at feed (mm/s Q15.16, <= 0 rapid); cuts segments first
+ * when the ring is full. Planner errors pass through (CS_ERR_LIMIT: nothing was queued). */
+cs_err_t cs_motion_line(cs_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t feed,
+                        uint32_t line);
+/* Same in mm (double) for x, y, z (a unchanged); CS_ERR_RANGE when a value is not a cs_pos_t. */
+cs_err_t cs_motion_line_mm(cs_motion_t *mo, double x, double y, double z, double feed_mm_s,
+                           uint32_t line);
+/* Cuts every queued block (the job ends with an exact stop). */
+cs_err_t cs_motion_finish(cs_motion_t *mo);
+/* Writes segments as text: a header line "# curvestep segments tick_hz=N axes=N" then one line
+ * per segment, "ticks dx dy dz" (and " da" with 4 axes). Returns 0, -1 on a write error. */
+int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_t n);
+/* Reads that format (lines starting with '#' are comments; a header's tick_hz and axes must
+ * match *m). Appends to *out. Returns 0, or -1 with "name:line: reason" in err. */
+int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_segs_t *out,
+                   char *err, size_t errlen);
+/* Reads a job file into *path: SVG (a document, or bare path data) -- the inputs the host reads
+ * today. CS_OK, or an error with *diag filled ("file:line:col: reason"). */
+cs_err_t cs_motion_read_job(const char *file, cs_path_t *path, cs_path_diag_t *diag);
+/* Plans a whole path: from the current position a rapid move to each element that does not start
+ * where the previous one ended, then the element's chords (cs_trace, tolerance tol, method) at
+ * feed (mm/s Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error *diag
+ * names the element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
+cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
+                             int32_t feed, cs_path_diag_t *diag);
+/* mm/s -> Q15.16 (<= 0 stays 0: rapid). */
+int32_t cs_motion_speed(double mm_s);
+
+#endif

@@ -1,0 +1,127 @@
+/* cs_path: the host-side path model every command shares. A path is a growable list of
+ * elements, each one cs_bezier_t (lines are degree 1, SVG/G-code arcs the rational quadratics of
+ * cs_arc_build, quadratic and cubic Béziers) with its source location and subpath index.
+ * Also owns what goes with it on the host: affine transforms (applied in double before
+ * conversion), diagnostics "file:line:col: reason", double evaluation, and chord polylines. */
+#ifndef CS_PATH_H
+#define CS_PATH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "cs_bezier.h"
+
+/* What an element was written as in its source (the curve itself is always a cs_bezier_t). */
+typedef enum {
+    CS_PATH_LINE = 0,  /* degree 1 */
+    CS_PATH_QUAD = 1,  /* quadratic Bézier (SVG Q/T) */
+    CS_PATH_CUBIC = 2, /* cubic Bézier (SVG C/S) */
+    CS_PATH_ARC = 3,   /* one piece (<= 90 degrees) of a circular/elliptical arc, rational */
+    CS_PATH_OTHER = 4, /* any other curve converted to Bézier form */
+} cs_path_kind_t;
+
+/* A place in an input file: 1-based line and column (columns count characters, a tab is 1).
+ * file points to a name owned by the cs_path_t (or a static string); never NULL. */
+typedef struct {
+    const char *file;
+    unsigned line, col;
+} cs_path_loc_t;
+
+typedef struct {
+    cs_bezier_t curve;
+    cs_path_kind_t kind;
+    cs_path_loc_t loc; /* the command (or argument) the element comes from */
+    unsigned subpath;  /* 0-based, counts only subpaths that hold at least one element */
+} cs_path_elem_t;
+
+typedef struct {
+    cs_path_elem_t *elems;
+    size_t n, cap;
+    char **files; /* interned file names, freed with the path */
+    size_t nfiles, capfiles;
+    unsigned nsubpaths;
+    bool pending_subpath; /* the next element added starts a new subpath */
+} cs_path_t;
+
+/* Empty path. */
+void cs_path_init(cs_path_t *p);
+/* Frees every element and interned name; the path is empty (and reusable) afterwards. */
+void cs_path_free(cs_path_t *p);
+/* Stable copy of name owned by p (the same pointer for the same name), NULL when out of memory. */
+const char *cs_path_intern(cs_path_t *p, const char *name);
+/* Marks that the next element added starts a new subpath (a pen lift before it). */
+void cs_path_new_subpath(cs_path_t *p);
+/* Appends curve as a new element of the current subpath. CS_ERR_FULL when out of memory. */
+cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
+                     cs_path_loc_t loc);
+
+/* Affine map of the plane in SVG matrix order: x' = a x + c y + e, y' = b x + d y + f. */
+typedef struct {
+    double a, b, c, d, e, f;
+} cs_path_affine_t;
+
+/* The identity map. */
+cs_path_affine_t cs_path_affine_identity(void);
+/* m * n: the map that applies n first, then m (SVG nesting order: parent * child). */
+cs_path_affine_t cs_path_affine_mul(cs_path_affine_t m, cs_path_affine_t n);
+/* Image of the point (x, y). */
+void cs_path_affine_point(const cs_path_affine_t *m, double x, double y, double *ox, double *oy);
+/* Image of the vector (x, y) (linear part only, no translation). */
+void cs_path_affine_vector(const cs_path_affine_t *m, double x, double y, double *ox, double *oy);
+/* True when m is exactly the identity. */
+bool cs_path_affine_is_identity(const cs_path_affine_t *m);
+
+/* A diagnostic for bad input: code plus "file:line:col: reason". */
+typedef struct {
+    cs_err_t code;
+    cs_path_loc_t loc;
+    char reason[256];
+} cs_path_diag_t;
+
+/* Fills *d (printf-style reason). Returns code, so callers can `return cs_path_diag_set(...)`. */
+cs_err_t cs_path_diag_set(cs_path_diag_t *d, cs_err_t code, cs_path_loc_t loc, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+/* Prints "file:line:col: reason\n" to f. */
+void cs_path_diag_print(FILE *f, const cs_path_diag_t *d);
+
+/* Point of curve c at t in [0, 1], in mm, evaluated in double by de Casteljau (rational curves
+ * in homogeneous coordinates): the exact curve the fixed-point control points describe. */
+void cs_path_eval_mm(const cs_bezier_t *c, double t, double out[3]);
+/* Largest distance (mm) from the exact curve c to the polyline v[0..n-1] that traces it
+ * (v[0] = P0, v[n-1] = P_n, vertices on the curve in order), measured in double: each inner
+ * vertex is placed at the first parameter after its predecessor where the curve comes within
+ * 2 LSB of it (dense grid, then golden-section refinement), then each chord is measured against
+ * its piece of curve (grid maximum, refined). Returns HUGE_VAL when a vertex is not on the curve
+ * (no such parameter). Host only: slow and plain, for --stats and checks. */
+double cs_path_deviation_mm(const cs_bezier_t *c, const cs_vec3_t *v, size_t n);
+/* Box of every element's control points (which contains the curves), in mm. false when empty. */
+bool cs_path_bbox_mm(const cs_path_t *p, double min[3], double max[3]);
+
+/* A set of polylines in mm (the chords a tracer emitted), for pictures and checks. */
+typedef struct {
+    double x, y;
+} cs_path_pt_t;
+
+typedef struct {
+    cs_path_pt_t *pts;
+    size_t n, cap;
+    size_t *starts; /* index in pts of each polyline's first vertex */
+    size_t nlines, caplines;
+} cs_path_poly_t;
+
+/* Empty set. */
+void cs_path_poly_init(cs_path_poly_t *s);
+/* Frees it; empty and reusable afterwards. */
+void cs_path_poly_free(cs_path_poly_t *s);
+/* Starts a new polyline whose first vertex is (x, y). CS_ERR_FULL when out of memory. */
+cs_err_t cs_path_poly_move(cs_path_poly_t *s, double x, double y);
+/* Appends (x, y) to the current polyline (starts one if there is none). CS_ERR_FULL on OOM. */
+cs_err_t cs_path_poly_line(cs_path_poly_t *s, double x, double y);
+/* Number of vertices of polyline i. */
+size_t cs_path_poly_len(const cs_path_poly_t *s, size_t i);
+
+#endif

@@ -1,0 +1,148 @@
+/* curvestep plan: job file -> step segments. Reads the job (SVG), traces every element into
+ * chords within the machine's tolerance, plans them (cs_planner, look-ahead ring kept full),
+ * cuts step segments (cs_segment) and writes them one per line, "ticks dx dy dz". */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_conv.h"
+#include "cs_machine_ini.h"
+#include "cs_motion.h"
+#include "cs_trace.h"
+
+static void usage(FILE *f)
+{
+    fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv]\n"
+          "                      [--feed MM/S] [-o OUT] FILE\n"
+          "Plans the job FILE (SVG document or bare SVG path data) on the machine and writes its\n"
+          "step segments to OUT (default: standard output): a header line\n"
+          "  # curvestep segments tick_hz=N axes=N\n"
+          "then one line per segment, \"ticks dx dy dz\" (\" da\" too on a 4-axis machine): the\n"
+          "segment lasts ticks executor ticks and moves each axis by that many steps.\n"
+          "The machine starts at 0 and moves in straight rapid travel to each subpath start.\n"
+          "A summary goes to standard error: blocks, segments, steps, job time.\n"
+          "  --machine FILE.ini  machine description (default: built-in 3-axis plotter,\n"
+          "                      80 steps/mm; keys in docs/motion.md)\n"
+          "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
+          "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
+          "  --feed MM/S         feed for drawing moves (default: the machine's default_feed)\n"
+          "  -o OUT              write segments to OUT\n"
+          "Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
+          "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
+          f);
+}
+
+int cs_cmd_plan(int argc, char **argv)
+{
+    const char *machine_file = NULL, *out_file = NULL, *job = NULL;
+    double tol_mm = 0, feed = 0;
+    int method = CS_TRACE_SUBDIV;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return CS_EXIT_OK;
+        } else if (strcmp(a, "--machine") == 0 && i + 1 < argc) {
+            machine_file = argv[++i];
+        } else if (strcmp(a, "-o") == 0 && i + 1 < argc) {
+            out_file = argv[++i];
+        } else if (strcmp(a, "--tol") == 0 && i + 1 < argc) {
+            char *end;
+            tol_mm = strtod(argv[++i], &end);
+            if (*end != '\0' || !(tol_mm > 0)) {
+                fprintf(stderr, "curvestep plan: --tol wants a positive number of mm\n");
+                return CS_EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--feed") == 0 && i + 1 < argc) {
+            char *end;
+            feed = strtod(argv[++i], &end);
+            if (*end != '\0' || !(feed > 0) || feed >= 32768) {
+                fprintf(stderr, "curvestep plan: --feed wants a speed in (0, 32768) mm/s\n");
+                return CS_EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--method") == 0 && i + 1 < argc) {
+            const char *m = argv[++i];
+            if (strcmp(m, "fd") == 0)
+                method = CS_TRACE_FD;
+            else if (strcmp(m, "afd") == 0)
+                method = CS_TRACE_AFD;
+            else if (strcmp(m, "subdiv") == 0)
+                method = CS_TRACE_SUBDIV;
+            else {
+                fprintf(stderr, "curvestep plan: --method wants fd, afd or subdiv\n");
+                return CS_EXIT_USAGE;
+            }
+        } else if (a[0] == '-' && a[1] != '\0') {
+            fprintf(stderr, "curvestep plan: unknown or incomplete option %s\n", a);
+            usage(stderr);
+            return CS_EXIT_USAGE;
+        } else if (job == NULL) {
+            job = a;
+        } else {
+            fprintf(stderr, "curvestep plan: one job file only\n");
+            return CS_EXIT_USAGE;
+        }
+    }
+    if (job == NULL) {
+        usage(stderr);
+        return CS_EXIT_USAGE;
+    }
+    cs_machine_t m;
+    char err[512];
+    if (machine_file) {
+        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+            fprintf(stderr, "%s\n", err);
+            return CS_EXIT_INPUT;
+        }
+    } else {
+        cs_machine_ini_default(&m);
+    }
+    cs_pos_t tol = m.tolerance;
+    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &tol) != CS_OK) {
+        fprintf(stderr, "curvestep plan: --tol %g mm is outside the accepted range\n", tol_mm);
+        return CS_EXIT_USAGE;
+    }
+    cs_path_t path;
+    cs_path_init(&path);
+    cs_path_diag_t diag;
+    cs_err_t e = cs_motion_read_job(job, &path, &diag);
+    if (e != CS_OK) {
+        cs_path_diag_print(stderr, &diag);
+        cs_path_free(&path);
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    }
+    cs_motion_t mo;
+    e = cs_motion_init(&mo, &m);
+    if (e == CS_OK)
+        e = cs_motion_plan_path(&mo, &path, tol, method, cs_motion_speed(feed), &diag);
+    else
+        fprintf(stderr, "curvestep plan: machine rejected\n");
+    int rc = CS_EXIT_OK;
+    if (e != CS_OK) {
+        cs_path_diag_print(stderr, &diag);
+        rc = (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE) ? CS_EXIT_INPUT
+                                                                               : CS_EXIT_INTERNAL;
+    } else {
+        FILE *f = out_file ? fopen(out_file, "w") : stdout;
+        if (f == NULL) {
+            perror(out_file);
+            rc = CS_EXIT_INTERNAL;
+        } else {
+            if (cs_motion_write(f, &m, mo.segs.v, mo.segs.n) != 0 || (out_file && fclose(f) != 0) ||
+                (!out_file && fflush(f) != 0)) {
+                fprintf(stderr, "curvestep plan: write error\n");
+                rc = CS_EXIT_INTERNAL;
+            }
+        }
+        if (rc == CS_EXIT_OK)
+            fprintf(stderr,
+                    "plan: %zu elements, %zu blocks, %zu segments, %lld steps, job time %.4f s "
+                    "(%llu ticks at %u Hz)\n",
+                    path.n, mo.blocks, mo.segs.n, (long long)mo.steps, (double)mo.ticks / m.tick_hz,
+                    (unsigned long long)mo.ticks, (unsigned)m.tick_hz);
+    }
+    cs_motion_free(&mo);
+    cs_path_free(&path);
+    return rc;
+}

@@ -1,0 +1,58 @@
+/* cs_svgdoc: reads an SVG document with expat into a cs_path_t: every rendered <path>'s 'd'
+ * attribute (through cs_svgpath), with transforms of <g>/<path> (matrix, translate, scale,
+ * rotate, skewX, skewY) composed down the tree. Path-data errors point at the character inside
+ * the attribute in the file. Per-element handlers sit in one table, so shapes (<rect>,
+ * <circle>...) and document units (width/height/viewBox) slot in later; today those are
+ * reported once as warnings. Also reads bare path data (a file holding only a 'd' value). */
+#ifndef CS_SVGDOC_H
+#define CS_SVGDOC_H
+
+#include <stddef.h>
+
+#include "cs_path.h"
+
+/* Receives each warning (code CS_OK, loc and reason filled). */
+typedef void (*cs_svgdoc_warn_fn)(void *ctx, const cs_path_diag_t *w);
+
+typedef struct {
+    cs_path_affine_t xform; /* applied after the document's own transforms (user units -> mm) */
+    cs_svgdoc_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    void *warn_ctx;
+} cs_svgdoc_opts_t;
+
+/* What a read found (for --stats and tests). */
+typedef struct {
+    unsigned paths;    /* <path> elements read (with or without a 'd' attribute) */
+    unsigned ignored;  /* elements skipped: shapes, text, use, paths inside <defs> and the like */
+    unsigned warnings; /* warnings issued (each kind once per document) */
+} cs_svgdoc_stats_t;
+
+/* Identity transform, warnings to stderr. */
+void cs_svgdoc_opts_init(cs_svgdoc_opts_t *o);
+
+/* Reads the whole of filename ("-" = standard input) into a NUL-terminated heap buffer (*buf,
+ * free() it; *len excludes the NUL). CS_ERR_IO with *diag ("file:0:0: reason") on failure. */
+cs_err_t cs_svgdoc_load(const char *filename, char **buf, size_t *len, cs_path_diag_t *diag);
+
+/* Parses an SVG document held in buf[0..len) named name; appends every rendered <path>'s
+ * elements to *path. CS_ERR_PARSE for XML errors and path-data errors, CS_ERR_RANGE for points
+ * outside +/-4096 mm, CS_ERR_FULL when out of memory (all with *diag). stats may be NULL. */
+cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs_svgdoc_opts_t *o,
+                         cs_path_t *path, cs_path_diag_t *diag, cs_svgdoc_stats_t *stats);
+
+/* Either kind of input: an SVG document when the first non-blank character is '<' (path data
+ * never starts with one), else bare path data with o->xform applied. Same results as above. */
+cs_err_t cs_svgdoc_read(const char *buf, size_t len, const char *name, const cs_svgdoc_opts_t *o,
+                        cs_path_t *path, cs_path_diag_t *diag, cs_svgdoc_stats_t *stats);
+
+/* cs_svgdoc_load then cs_svgdoc_read; the name in diagnostics is filename ("<stdin>" for "-"). */
+cs_err_t cs_svgdoc_read_file(const char *filename, const cs_svgdoc_opts_t *o, cs_path_t *path,
+                             cs_path_diag_t *diag, cs_svgdoc_stats_t *stats);
+
+/* Parses an SVG transform list (SVG 1.1 §7.6: matrix, translate, scale, rotate, skewX, skewY)
+ * in s[0..len) into *out (identity for an empty list). CS_ERR_PARSE with *bad = offset of the
+ * offending character and *why (static text) set; *out untouched then. */
+cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *out, size_t *bad,
+                                   const char **why);
+
+#endif

@@ -1,0 +1,193 @@
+/* curvestep-sim: runs step segments through the firmware's executor on the POSIX port (simulated
+ * time), then reports what the steps did: final position, per-axis peak velocity and
+ * acceleration against the machine's limits, and (given the job) the largest distance between
+ * the executed path and the exact geometry. Draws both as SVG/PNG and dumps a CSV trace. */
+#include <stdio.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_err_text.h"
+#include "cs_machine_ini.h"
+#include "cs_motion.h"
+#include "cs_sim.h"
+#include "cs_sim_draw.h"
+
+enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_INTERNAL = 3, EXIT_CHECK = 4 };
+
+static void usage(FILE *f)
+{
+    fputs("usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
+          "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
+          "                     [--window MS]\n"
+          "Executes the step segments written by `curvestep plan` (same --machine) with the\n"
+          "firmware's executor in simulated time, records every STEP edge and reports:\n"
+          "  - the final position of each axis, in steps and mm;\n"
+          "  - each axis's peak velocity and acceleration against its limits, estimated from\n"
+          "    the edges over windows of --window ms (default 50): velocity = steps over one\n"
+          "    window, acceleration = change of that between windows; the estimator's own error\n"
+          "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
+          "  - with --reference FILE (the job: SVG), the largest distance from any position the\n"
+          "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
+          "    plus one step, and whether the final position is the job's end rounded to steps.\n"
+          "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
+          "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed\n"
+          "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
+          "  --check           exit 4 when a limit, the deviation or the final position fails\n"
+          "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
+          "3 internal error, 4 a check failed (with --check).\n",
+          f);
+}
+
+int main(int argc, char **argv)
+{
+    const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
+               *png = NULL;
+    bool check = false;
+    double window_ms = 50;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return EXIT_OK;
+        } else if (strcmp(a, "--replay") == 0 && has) {
+            replay = argv[++i];
+        } else if (strcmp(a, "--machine") == 0 && has) {
+            machine_file = argv[++i];
+        } else if (strcmp(a, "--reference") == 0 && has) {
+            reference = argv[++i];
+        } else if (strcmp(a, "--trace") == 0 && has) {
+            trace = argv[++i];
+        } else if (strcmp(a, "--svg") == 0 && has) {
+            svg = argv[++i];
+        } else if (strcmp(a, "--png") == 0 && has) {
+            png = argv[++i];
+        } else if (strcmp(a, "--window") == 0 && has) {
+            char *end;
+            window_ms = strtod(argv[++i], &end);
+            if (*end != '\0' || !(window_ms > 0) || window_ms > 10000) {
+                fprintf(stderr, "curvestep-sim: --window wants milliseconds in (0, 10000]\n");
+                return EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--check") == 0) {
+            check = true;
+        } else {
+            fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (replay == NULL) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    cs_machine_t m;
+    char err[512];
+    if (machine_file) {
+        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+            fprintf(stderr, "%s\n", err);
+            return EXIT_INPUT;
+        }
+    } else {
+        cs_machine_ini_default(&m);
+    }
+    FILE *f = strcmp(replay, "-") == 0 ? stdin : fopen(replay, "r");
+    if (f == NULL) {
+        fprintf(stderr, "%s:0: cannot open the segments file\n", replay);
+        return EXIT_INPUT;
+    }
+    cs_motion_segs_t segs = {0};
+    int r = cs_motion_read(f, replay, &m, &segs, err, sizeof err);
+    if (f != stdin)
+        fclose(f);
+    if (r != 0) {
+        fprintf(stderr, "%s\n", err);
+        free(segs.v);
+        return EXIT_INPUT;
+    }
+    cs_sim_exec_t ex;
+    cs_err_t e = cs_sim_execute(&m, segs.v, segs.n, &ex);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep-sim: execution failed: %s\n", cs_err_text(e));
+        free(segs.v);
+        return EXIT_INTERNAL;
+    }
+    bool ok = true;
+    static const char names[] = "xyza";
+    printf("replay: %zu segments, %zu steps, job time %.4f s\n", segs.n, ex.n,
+           (double)ex.end_tick / m.tick_hz);
+    printf("final position:");
+    for (unsigned i = 0; i < m.n_axes; i++)
+        printf(" %c=%lld steps (%.4f mm)", names[i], (long long)ex.pos[i],
+               (double)ex.pos[i] * CS_MOTION_ONE / m.axis[i].steps_per_mm);
+    printf("\n");
+    cs_sim_dyn_t dyn;
+    cs_sim_dynamics(&m, &ex, window_ms / 1000.0, &dyn);
+    for (unsigned i = 0; i < m.n_axes; i++) {
+        double rate = cs_machine_ini_to_double(m.axis[i].max_rate);
+        double acc = cs_machine_ini_to_double(m.axis[i].max_accel);
+        printf("axis %c: peak velocity %.3f mm/s at %.3f s (limit %.3f + %.3f) %s; "
+               "peak acceleration %.1f mm/s^2 at %.3f s (limit %.1f + %.1f) %s\n",
+               names[i], dyn.peak_rate[i], dyn.t_rate[i], rate, dyn.rate_allow[i],
+               dyn.rate_ok[i] ? "ok" : "OVER", dyn.peak_accel[i], dyn.t_accel[i], acc,
+               dyn.accel_allow[i], dyn.accel_ok[i] ? "ok" : "OVER");
+        ok = ok && dyn.rate_ok[i] && dyn.accel_ok[i];
+    }
+    cs_sim_ref_t ref;
+    cs_sim_ref_init(&ref);
+    int rc = EXIT_OK;
+    if (reference) {
+        cs_path_t path;
+        cs_path_init(&path);
+        cs_path_diag_t diag;
+        e = cs_motion_read_job(reference, &path, &diag);
+        double end[3];
+        if (e == CS_OK)
+            e = cs_sim_ref_from_path(&ref, &path, end);
+        else
+            cs_path_diag_print(stderr, &diag);
+        cs_path_free(&path);
+        if (e != CS_OK) {
+            rc = EXIT_INPUT;
+        } else {
+            double where[3];
+            double dev = cs_sim_deviation(&m, &ex, &ref, where);
+            double bound = cs_machine_ini_to_double(m.tolerance) + cs_sim_step_mm(&m);
+            bool dev_ok = dev <= bound;
+            printf("deviation: %.5f mm at (%.4f, %.4f, %.4f) (tolerance + one step = %.5f mm) "
+                   "%s\n",
+                   dev, where[0], where[1], where[2], bound, dev_ok ? "ok" : "OVER");
+            bool end_ok = true;
+            for (unsigned i = 0; i < 3; i++) {
+                double spm = (double)m.axis[i].steps_per_mm / CS_MOTION_ONE;
+                long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
+                if (want != ex.pos[i])
+                    end_ok = false;
+            }
+            printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0],
+                   end[1], end[2], end_ok ? "exact" : "DIFFERENT");
+            ok = ok && dev_ok && end_ok;
+        }
+    }
+    if (rc == EXIT_OK && trace && cs_sim_write_trace(trace, &m, &ex) != 0) {
+        perror(trace);
+        rc = EXIT_INTERNAL;
+    }
+    if (rc == EXIT_OK && svg && cs_sim_draw_svg(svg, &m, &ex, reference ? &ref : NULL) != 0) {
+        perror(svg);
+        rc = EXIT_INTERNAL;
+    }
+    if (rc == EXIT_OK && png && cs_sim_draw_png(png, &m, &ex, reference ? &ref : NULL, 1600) != 0)
+        rc = EXIT_INTERNAL;
+    if (rc == EXIT_OK && check && !ok) {
+        printf("check: FAILED\n");
+        rc = EXIT_CHECK;
+    } else if (rc == EXIT_OK && check) {
+        printf("check: ok\n");
+    }
+    cs_sim_ref_free(&ref);
+    cs_sim_exec_free(&ex);
+    free(segs.v);
+    return rc;
+}
