@@ -23,4 +23,12 @@ int cs_cmd_flatten(int argc, char **argv);
 /* curvestep plan [--machine FILE.ini] [--tol MM] [--method M] [--feed MM/S] [-o OUT] FILE */
 int cs_cmd_plan(int argc, char **argv);
 
+/* curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM] [--svg OUT.svg]
+ *                    [--ball R --scallop H [--safe-z Z]] */
+int cs_cmd_toolpath(int argc, char **argv);
+
+/* curvestep stream --port DEV [--baud N] [--machine FILE.ini] [--mode segments|curves]
+ * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] FILE */
+int cs_cmd_stream(int argc, char **argv);
+
 #endif

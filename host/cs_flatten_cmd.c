@@ -1,7 +1,7 @@
-/* curvestep flatten: reads SVG path data or an SVG document, traces every element with the
- * core's pull iterator (cs_trace_begin / cs_trace_next) and prints the polyline, one vertex
- * "x y" (mm, 6 decimals) per line, a blank line between subpaths. Optional summary (--stats)
- * and picture (--svg). */
+/* curvestep flatten: reads any input cs_input_load takes (SVG, G-code, HP-GL), traces every
+ * element with the core's pull iterator (cs_trace_begin / cs_trace_next) and prints the
+ * polyline, one vertex "x y" (mm, 6 decimals) per line, a blank line between subpaths.
+ * Optional summary (--stats) and picture (--svg). */
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,6 +11,7 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_input.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -33,37 +34,42 @@ static const struct {
 
 static void flatten_usage(FILE *f)
 {
-    fprintf(
-        f,
-        "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-        " FILE\n"
-        "\n"
-        "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
-        "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
-        "decimals), a blank line between subpaths.\n"
-        "\n"
-        "FILE is an SVG document (every drawn <path> element's d attribute is read, with the\n"
-        "transforms of its groups) or a file holding bare SVG path data (M L H V C S Q T A Z,\n"
-        "absolute and relative); '-' reads standard input. Basic shapes (<rect>, <circle>...),\n"
-        "text and <use> are not drawn yet: a warning on stderr names them. User units are\n"
-        "millimetres, axes as in the file (SVG's y points down); coordinates must stay\n"
-        "within +/-%d mm.\n"
-        "\n"
-        "Options:\n"
-        "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
-        "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
-        "                  differences) or subdiv (flatness subdivision; the default)\n"
-        "  --stats         print a summary on stderr: elements, chords, and the largest\n"
-        "                  deviation of a chord from its exact curve, measured in double on\n"
-        "                  the host\n"
-        "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
-        "  -h, --help      show this help\n"
-        "\n"
-        "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
-        "coordinates outside the range); 2 usage error; 3 internal error (arithmetic overflow\n"
-        "or depth limit while tracing, out of memory, write error).\n",
-        CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
-        CS_POS_LIMIT_MM);
+    fprintf(f,
+            "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
+            "\n                         [--lenient] FILE\n"
+            "\n"
+            "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
+            "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
+            "decimals), a blank line between subpaths.\n"
+            "\n"
+            "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2, see\n"
+            "docs/inputs.md), HP-GL (.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
+            "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
+            "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
+            "fills are drawn as outlines; text and <use> are not drawn: a warning on stderr\n"
+            "names them) or a file holding bare SVG path data (M L H V C S Q T A Z, absolute\n"
+            "and relative); other names and '-' (standard input) are recognised by their\n"
+            "content. SVG without width/height and bare path data: 1 user unit = 1 mm. Axes\n"
+            "as in the file (SVG's y points down, HP-GL's up); coordinates must stay within\n"
+            "+/-%d mm.\n"
+            "\n"
+            "Options:\n"
+            "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
+            "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
+            "                  differences) or subdiv (flatness subdivision; the default)\n"
+            "  --stats         print a summary on stderr: elements, chords, and the largest\n"
+            "                  deviation of a chord from its exact curve, measured in double on\n"
+            "                  the host\n"
+            "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
+            "  --lenient       G-code: a word curvestep does not carry out is a warning (and is\n"
+            "                  ignored) instead of an error\n"
+            "  -h, --help      show this help\n"
+            "\n"
+            "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
+            "coordinates outside the range); 2 usage error; 3 internal error (arithmetic overflow\n"
+            "or depth limit while tracing, out of memory, write error).\n",
+            CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
+            CS_POS_LIMIT_MM);
 }
 
 /* Exit status for a code met while reading input. */
@@ -94,14 +100,19 @@ static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
 int cs_cmd_flatten(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"tol", required_argument, NULL, 't'}, {"method", required_argument, NULL, 'm'},
-        {"stats", no_argument, NULL, 's'},     {"svg", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'},      {NULL, 0, NULL, 0},
+        {"tol", required_argument, NULL, 't'},
+        {"method", required_argument, NULL, 'm'},
+        {"stats", no_argument, NULL, 's'},
+        {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},
+        {"lenient", no_argument, NULL, 'l'},
+        {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
     size_t method = FLATTEN_DEFAULT_METHOD;
     bool stats = false;
     const char *svg_out = NULL;
+    bool lenient = false;
     int c;
     optind = 1;
     opterr = 0;
@@ -142,6 +153,9 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'o':
             svg_out = optarg;
             break;
+        case 'l':
+            lenient = true;
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -169,10 +183,10 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_path_t path;
     cs_path_init(&path);
     cs_path_diag_t diag;
-    cs_svgdoc_opts_t dopts;
-    cs_svgdoc_opts_init(&dopts);
-    cs_svgdoc_stats_t dstats;
-    cs_err_t e = cs_svgdoc_read_file(file, &dopts, &path, &diag, &dstats);
+    cs_input_opts_t iopts;
+    cs_input_opts_init(&iopts);
+    iopts.lenient = lenient;
+    cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);
         cs_path_free(&path);

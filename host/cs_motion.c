@@ -7,7 +7,7 @@
 
 #include "cs_conv.h"
 #include "cs_err_text.h"
-#include "cs_svgdoc.h"
+#include "cs_input.h"
 #include "cs_trace.h"
 
 cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m)
@@ -199,9 +199,16 @@ int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_s
 
 cs_err_t cs_motion_read_job(const char *file, cs_path_t *path, cs_path_diag_t *diag)
 {
-    cs_svgdoc_opts_t o;
-    cs_svgdoc_opts_init(&o);
-    return cs_svgdoc_read_file(file, &o, path, diag, NULL);
+    return cs_motion_read_job_ex(file, false, path, diag);
+}
+
+cs_err_t cs_motion_read_job_ex(const char *file, bool lenient, cs_path_t *path,
+                               cs_path_diag_t *diag)
+{
+    cs_input_opts_t o;
+    cs_input_opts_init(&o);
+    o.lenient = lenient;
+    return cs_input_load(file, &o, path, diag);
 }
 
 static const char *axis_letter(unsigned i)
@@ -241,6 +248,8 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
     for (size_t k = 0; k < path->n; k++) {
         const cs_path_elem_t *el = &path->elems[k];
         const cs_bezier_t *c = &el->curve;
+        /* The job's own feed (G-code F) wins; rapid moves (G0) run at the axes' max rates. */
+        int32_t el_feed = el->rapid ? 0 : el->feed_mm_s > 0 ? cs_motion_speed(el->feed_mm_s) : feed;
         if (c->p[0].x != cur.x || c->p[0].y != cur.y || c->p[0].z != cur.z) {
             cs_err_t e = move_to(mo, &c->p[0], 0, el->loc, diag); /* rapid travel */
             if (e != CS_OK)
@@ -252,7 +261,7 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
             return cs_path_diag_set(diag, e, el->loc, "cannot trace: %s", cs_err_text(e));
         cs_vec3_t pt;
         while ((e = cs_trace_next(&tr, &pt)) == CS_OK) {
-            e = move_to(mo, &pt, feed, el->loc, diag);
+            e = move_to(mo, &pt, el_feed, el->loc, diag);
             if (e != CS_OK)
                 return e;
         }

@@ -5,6 +5,7 @@
 #ifndef CS_MOTION_H
 #define CS_MOTION_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdint.h>
@@ -49,13 +50,17 @@ int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_
  * match *m). Appends to *out. Returns 0, or -1 with "name:line: reason" in err. */
 int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_segs_t *out,
                    char *err, size_t errlen);
-/* Reads a job file into *path: SVG (a document, or bare path data) -- the inputs the host reads
- * today. CS_OK, or an error with *diag filled ("file:line:col: reason"). */
+/* Reads a job file into *path with the host's input loader (cs_input: SVG, G-code, HPGL, by
+ * extension then content). CS_OK, or an error with *diag filled ("file:line:col: reason"). */
 cs_err_t cs_motion_read_job(const char *file, cs_path_t *path, cs_path_diag_t *diag);
+/* Same, lenient: unsupported G-code words are warnings, not errors (cs_input_opts_t.lenient). */
+cs_err_t cs_motion_read_job_ex(const char *file, bool lenient, cs_path_t *path,
+                               cs_path_diag_t *diag);
 /* Plans a whole path: from the current position a rapid move to each element that does not start
  * where the previous one ended, then the element's chords (cs_trace, tolerance tol, method) at
- * feed (mm/s Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error *diag
- * names the element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
+ * the element's own feed (G-code F), or rapid for a rapid element (G0), or else at feed (mm/s
+ * Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error *diag names the
+ * element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag);
 /* mm/s -> Q15.16 (<= 0 stays 0: rapid). */

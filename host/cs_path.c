@@ -68,6 +68,12 @@ void cs_path_new_subpath(cs_path_t *p)
 
 cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind, cs_path_loc_t loc)
 {
+    return cs_path_add_move(p, curve, kind, loc, 0.0, false);
+}
+
+cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
+                          cs_path_loc_t loc, double feed_mm_s, bool rapid)
+{
     void *buf = p->elems;
     if (!grow(&buf, &p->cap, p->n + 1, sizeof *p->elems))
         return CS_ERR_FULL;
@@ -81,6 +87,8 @@ cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind
     e->kind = kind;
     e->loc = loc;
     e->subpath = p->nsubpaths - 1;
+    e->feed_mm_s = feed_mm_s;
+    e->rapid = rapid;
     return CS_OK;
 }
 

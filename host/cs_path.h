@@ -33,6 +33,8 @@ typedef struct {
     cs_path_kind_t kind;
     cs_path_loc_t loc; /* the command (or argument) the element comes from */
     unsigned subpath;  /* 0-based, counts only subpaths that hold at least one element */
+    double feed_mm_s;  /* feed for this move in mm/s; 0 = the machine's default (cs_path_add) */
+    bool rapid;        /* a travel move (G-code G0): at the machine's rapid rate, not drawn */
 } cs_path_elem_t;
 
 typedef struct {
@@ -55,6 +57,10 @@ void cs_path_new_subpath(cs_path_t *p);
 /* Appends curve as a new element of the current subpath. CS_ERR_FULL when out of memory. */
 cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
                      cs_path_loc_t loc);
+/* cs_path_add with motion attributes: feed in mm/s (0 = machine default), rapid for G0 travel.
+ * cs_path_add is this with feed 0 and rapid false. CS_ERR_FULL when out of memory. */
+cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
+                          cs_path_loc_t loc, double feed_mm_s, bool rapid);
 
 /* Affine map of the plane in SVG matrix order: x' = a x + c y + e, y' = b x + d y + f. */
 typedef struct {

@@ -1,12 +1,14 @@
-/* curvestep plan: job file -> step segments. Reads the job (SVG), traces every element into
- * chords within the machine's tolerance, plans them (cs_planner, look-ahead ring kept full),
- * cuts step segments (cs_segment) and writes them one per line, "ticks dx dy dz". */
+/* curvestep plan: job file -> step segments. Reads the job (cs_input_load: SVG, G-code,
+ * HP-GL), traces every element into chords within the machine's tolerance, plans them
+ * (cs_planner, look-ahead ring kept full), cuts step segments (cs_segment) and writes them one
+ * per line, "ticks dx dy dz". */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cs_cmd.h"
 #include "cs_conv.h"
+#include "cs_input.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_trace.h"
@@ -14,19 +16,23 @@
 static void usage(FILE *f)
 {
     fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv]\n"
-          "                      [--feed MM/S] [-o OUT] FILE\n"
-          "Plans the job FILE (SVG document or bare SVG path data) on the machine and writes its\n"
-          "step segments to OUT (default: standard output): a header line\n"
+          "                      [--feed MM/S] [--lenient] [-o OUT] FILE\n"
+          "Plans the job FILE (G-code .nc .gcode .ngc .g .tap .cnc, HP-GL .plt .hpgl .hgl .hpg,\n"
+          "SVG document or bare SVG path data; other names and '-' by content) on the machine\n"
+          "and writes its step segments to OUT (default: standard output): a header line\n"
           "  # curvestep segments tick_hz=N axes=N\n"
           "then one line per segment, \"ticks dx dy dz\" (\" da\" too on a 4-axis machine): the\n"
           "segment lasts ticks executor ticks and moves each axis by that many steps.\n"
-          "The machine starts at 0 and moves in straight rapid travel to each subpath start.\n"
+          "The machine starts at 0 and moves in straight rapid travel to each subpath start;\n"
+          "G-code G0 moves are rapid too (each axis at its max_rate), G1/G2/G3 use their F.\n"
           "A summary goes to standard error: blocks, segments, steps, job time.\n"
           "  --machine FILE.ini  machine description (default: built-in 3-axis plotter,\n"
           "                      80 steps/mm; keys in docs/motion.md)\n"
           "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
           "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
-          "  --feed MM/S         feed for drawing moves (default: the machine's default_feed)\n"
+          "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
+          "                      any F; default: the machine's default_feed)\n"
+          "  --lenient           G-code: unsupported words are warnings (ignored), not errors\n"
           "  -o OUT              write segments to OUT\n"
           "Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
           "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
@@ -38,11 +44,14 @@ int cs_cmd_plan(int argc, char **argv)
     const char *machine_file = NULL, *out_file = NULL, *job = NULL;
     double tol_mm = 0, feed = 0;
     int method = CS_TRACE_SUBDIV;
+    bool lenient = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return CS_EXIT_OK;
+        } else if (strcmp(a, "--lenient") == 0) {
+            lenient = true;
         } else if (strcmp(a, "--machine") == 0 && i + 1 < argc) {
             machine_file = argv[++i];
         } else if (strcmp(a, "-o") == 0 && i + 1 < argc) {
@@ -106,7 +115,10 @@ int cs_cmd_plan(int argc, char **argv)
     cs_path_t path;
     cs_path_init(&path);
     cs_path_diag_t diag;
-    cs_err_t e = cs_motion_read_job(job, &path, &diag);
+    cs_input_opts_t iopts;
+    cs_input_opts_init(&iopts);
+    iopts.lenient = lenient;
+    cs_err_t e = cs_input_load(job, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);
         cs_path_free(&path);

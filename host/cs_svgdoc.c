@@ -420,6 +420,10 @@ cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *
 typedef struct {
     cs_path_affine_t m; /* user space of this element -> mm */
     bool hidden;        /* inside <defs>, <symbol>, <clipPath>...: not drawn directly */
+    bool none;          /* display="none" here or above: nothing below is drawn */
+    bool invisible;     /* visibility hidden/collapse (inherited, a child may override) */
+    bool stroke, fill;  /* stroke / fill paint other than none (inherited properties) */
+    double vw, vh;      /* nearest viewport's size in user units (percentages); 0 = unknown */
 } frame_t;
 
 typedef struct doc doc_t;
@@ -545,6 +549,374 @@ static cs_err_t element_transform(doc_t *d, const char **atts, size_t tag, cs_pa
     return e;
 }
 
+/* --- lengths, viewports, style ------------------------------------------------------------- */
+
+/* Millimetres per CSS pixel: SVG user units without a unit are px, at 96 per inch. */
+#define MM_PER_PX (25.4 / 96.0)
+
+/* Error at byte `off` of attribute `name`'s raw value in the current tag (or at the tag). */
+static cs_err_t attr_fail(doc_t *d, size_t tag, const char *name, size_t off, cs_err_t code,
+                          const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+
+static cs_err_t attr_fail(doc_t *d, size_t tag, const char *name, size_t off, cs_err_t code,
+                          const char *fmt, ...)
+{
+    size_t vs = tag, ve = tag;
+    if (find_raw_attr(d->buf, d->len, tag, name, &vs, &ve))
+        vs = vs + off <= ve ? vs + off : ve;
+    char msg[200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return cs_path_diag_set(d->diag, code, loc_of(d, vs), "%s: %s", name, msg);
+}
+
+typedef enum { LEN_X, LEN_Y, LEN_OTHER } len_axis_t;
+
+/* A <length> attribute (number, optional unit px/mm/cm/in/pt/pc/%) in user units of frame f.
+ * *present false (and *out = dflt) when the attribute is absent. Percentages refer to the
+ * nearest viewport (SVG 1.1 §7.10); an unknown viewport size makes them an error. */
+static cs_err_t get_length(doc_t *d, const frame_t *f, const char **atts, size_t tag,
+                           const char *name, len_axis_t axis, double dflt, double *out,
+                           bool *present)
+{
+    const char *v = att_get(atts, name);
+    *out = dflt;
+    if (present)
+        *present = false;
+    if (!v)
+        return CS_OK;
+    size_t n = strlen(v), i = 0;
+    while (i < n && is_xml_space(v[i]))
+        i++;
+    double x = 0.0;
+    size_t bad = 0, k = cs_svgpath_scan_number(v + i, n - i, &x, &bad);
+    if (k == 0)
+        return attr_fail(d, tag, name, i + bad, CS_ERR_PARSE, "expected a length");
+    if (!isfinite(x))
+        return attr_fail(d, tag, name, i, CS_ERR_RANGE, "number too large");
+    size_t us = i + k;
+    i = us;
+    while (i < n && (is_alpha(v[i]) || v[i] == '%'))
+        i++;
+    size_t ul = i - us;
+    const char *u = v + us;
+    double s;
+    if (ul == 0 || (ul == 2 && memcmp(u, "px", 2) == 0))
+        s = 1.0;
+    else if (ul == 2 && memcmp(u, "mm", 2) == 0)
+        s = 1.0 / MM_PER_PX;
+    else if (ul == 2 && memcmp(u, "cm", 2) == 0)
+        s = 10.0 / MM_PER_PX;
+    else if (ul == 2 && memcmp(u, "in", 2) == 0)
+        s = 96.0;
+    else if (ul == 2 && memcmp(u, "pt", 2) == 0)
+        s = 96.0 / 72.0;
+    else if (ul == 2 && memcmp(u, "pc", 2) == 0)
+        s = 16.0;
+    else if (ul == 1 && u[0] == '%') {
+        double ref = axis == LEN_X   ? f->vw
+                     : axis == LEN_Y ? f->vh
+                                     : sqrt((f->vw * f->vw + f->vh * f->vh) / 2.0);
+        if (!(f->vw > 0.0 && f->vh > 0.0))
+            return attr_fail(d, tag, name, us, CS_ERR_PARSE,
+                             "a percentage needs a viewport size (width/height or viewBox)");
+        s = ref / 100.0;
+    } else
+        return attr_fail(d, tag, name, us, CS_ERR_PARSE,
+                         "unsupported unit (expected px, mm, cm, in, pt, pc or %%)");
+    while (i < n && is_xml_space(v[i]))
+        i++;
+    if (i < n)
+        return attr_fail(d, tag, name, i, CS_ERR_PARSE, "unexpected text after the length");
+    *out = x * s;
+    if (!isfinite(*out))
+        return attr_fail(d, tag, name, 0, CS_ERR_RANGE, "length too large");
+    if (present)
+        *present = true;
+    return CS_OK;
+}
+
+/* The document size attribute width/height of the root <svg> in mm; *known false when absent
+ * or a percentage (the size of a plotter's page is not known here). */
+static cs_err_t get_doc_size(doc_t *d, const char **atts, size_t tag, const char *name, double *mm,
+                             bool *known)
+{
+    frame_t f;
+    memset(&f, 0, sizeof f);
+    f.vw = f.vh = 100.0; /* a percentage reads as "unknown" below */
+    *known = false;
+    const char *v = att_get(atts, name);
+    if (!v || strchr(v, '%'))
+        return CS_OK;
+    double px;
+    bool present;
+    cs_err_t e = get_length(d, &f, atts, tag, name, LEN_OTHER, 0.0, &px, &present);
+    if (e != CS_OK)
+        return e;
+    if (px < 0.0)
+        return attr_fail(d, tag, name, 0, CS_ERR_PARSE, "negative size");
+    *mm = px * MM_PER_PX;
+    *known = present;
+    return CS_OK;
+}
+
+typedef struct {
+    bool have;
+    double x, y, w, h;
+    int ax, ay; /* alignment: 0 min, 1 mid, 2 max; -1 = none (stretch) */
+    bool slice;
+} viewbox_t;
+
+static cs_err_t get_viewbox(doc_t *d, const char **atts, size_t tag, viewbox_t *vb)
+{
+    memset(vb, 0, sizeof *vb);
+    vb->ax = vb->ay = 1; /* default xMidYMid meet */
+    const char *v = att_get(atts, "viewBox");
+    if (!v)
+        return CS_OK;
+    size_t n = strlen(v), i = 0;
+    double a[4];
+    for (int k = 0; k < 4; k++) {
+        while (i < n && (is_xml_space(v[i]) || (k > 0 && v[i] == ',')))
+            i++;
+        size_t bad = 0, m = cs_svgpath_scan_number(v + i, n - i, &a[k], &bad);
+        if (m == 0)
+            return attr_fail(d, tag, "viewBox", i + bad, CS_ERR_PARSE,
+                             "expected four numbers: min-x min-y width height");
+        if (!isfinite(a[k]))
+            return attr_fail(d, tag, "viewBox", i, CS_ERR_RANGE, "number too large");
+        i += m;
+    }
+    while (i < n && is_xml_space(v[i]))
+        i++;
+    if (i < n)
+        return attr_fail(d, tag, "viewBox", i, CS_ERR_PARSE, "unexpected text after 4 numbers");
+    if (!(a[2] > 0.0 && a[3] > 0.0))
+        return attr_fail(d, tag, "viewBox", 0, CS_ERR_PARSE, "width and height must be positive");
+    vb->have = true;
+    vb->x = a[0];
+    vb->y = a[1];
+    vb->w = a[2];
+    vb->h = a[3];
+    const char *p = att_get(atts, "preserveAspectRatio");
+    if (!p)
+        return CS_OK;
+    n = strlen(p);
+    i = 0;
+    while (i < n && is_xml_space(p[i]))
+        i++;
+    if (n - i >= 5 && memcmp(p + i, "defer", 5) == 0) {
+        i += 5;
+        while (i < n && is_xml_space(p[i]))
+            i++;
+    }
+    static const char *const names[3] = {"Min", "Mid", "Max"};
+    if (n - i >= 4 && memcmp(p + i, "none", 4) == 0) {
+        vb->ax = vb->ay = -1;
+        i += 4;
+    } else {
+        bool ok = false;
+        if (n - i >= 8 && p[i] == 'x' && p[i + 4] == 'Y') {
+            for (int x = 0; x < 3; x++)
+                for (int y = 0; y < 3; y++)
+                    if (memcmp(p + i + 1, names[x], 3) == 0 &&
+                        memcmp(p + i + 5, names[y], 3) == 0) {
+                        vb->ax = x;
+                        vb->ay = y;
+                        ok = true;
+                    }
+        }
+        if (!ok)
+            return attr_fail(d, tag, "preserveAspectRatio", i, CS_ERR_PARSE,
+                             "expected none or x(Min|Mid|Max)Y(Min|Mid|Max)");
+        i += 8;
+    }
+    while (i < n && is_xml_space(p[i]))
+        i++;
+    if (n - i >= 5 && memcmp(p + i, "slice", 5) == 0) {
+        vb->slice = true;
+        i += 5;
+    } else if (n - i >= 4 && memcmp(p + i, "meet", 4) == 0) {
+        i += 4;
+    }
+    while (i < n && is_xml_space(p[i]))
+        i++;
+    if (i < n)
+        return attr_fail(d, tag, "preserveAspectRatio", i, CS_ERR_PARSE, "expected meet or slice");
+    return CS_OK;
+}
+
+/* The viewBox -> viewport map (SVG 1.1 §7.8): viewport at (ex, ey), size ew x eh. */
+static cs_path_affine_t viewbox_map(const viewbox_t *vb, double ex, double ey, double ew, double eh)
+{
+    cs_path_affine_t m = cs_path_affine_identity();
+    double sx = ew / vb->w, sy = eh / vb->h;
+    if (vb->ax >= 0) {
+        double s = vb->slice ? (sx > sy ? sx : sy) : (sx < sy ? sx : sy);
+        sx = sy = s;
+    }
+    double tx = ex - vb->x * sx, ty = ey - vb->y * sy;
+    if (vb->ax > 0)
+        tx += (ew - vb->w * sx) * (vb->ax == 1 ? 0.5 : 1.0);
+    if (vb->ay > 0)
+        ty += (eh - vb->h * sy) * (vb->ay == 1 ? 0.5 : 1.0);
+    m.a = sx;
+    m.d = sy;
+    m.e = tx;
+    m.f = ty;
+    return m;
+}
+
+/* Value of a presentation property: the style attribute's declaration wins over the
+ * attribute of the same name (CSS specificity of style="" over presentation attributes).
+ * Writes a NUL-terminated, trimmed copy to out; false when neither is given. */
+static bool get_prop(const char **atts, const char *prop, char *out, size_t cap)
+{
+    const char *found = NULL;
+    size_t flen = 0;
+    const char *st = att_get(atts, "style");
+    size_t pl = strlen(prop);
+    for (const char *s = st; s && *s;) {
+        const char *semi = strchr(s, ';');
+        const char *end = semi ? semi : s + strlen(s);
+        const char *colon = memchr(s, ':', (size_t)(end - s));
+        if (colon) {
+            const char *a = s, *b = colon;
+            while (a < b && is_xml_space(*a))
+                a++;
+            while (b > a && is_xml_space(b[-1]))
+                b--;
+            if ((size_t)(b - a) == pl && memcmp(a, prop, pl) == 0) {
+                found = colon + 1;
+                flen = (size_t)(end - found);
+            }
+        }
+        s = semi ? semi + 1 : end;
+    }
+    if (!found) {
+        found = att_get(atts, prop);
+        if (!found)
+            return false;
+        flen = strlen(found);
+    }
+    while (flen > 0 && is_xml_space(*found)) {
+        found++;
+        flen--;
+    }
+    while (flen > 0 && is_xml_space(found[flen - 1]))
+        flen--;
+    /* "!important" does not matter here: there is no style sheet to win against. */
+    const char *bang = memchr(found, '!', flen);
+    if (bang) {
+        flen = (size_t)(bang - found);
+        while (flen > 0 && is_xml_space(found[flen - 1]))
+            flen--;
+    }
+    if (flen >= cap)
+        flen = cap - 1;
+    memcpy(out, found, flen);
+    out[flen] = '\0';
+    return true;
+}
+
+/* display, visibility, stroke and fill of this element (inherited ones start from the parent's
+ * values, already in *f). */
+static void read_style(const char **atts, frame_t *f)
+{
+    char v[64];
+    if (get_prop(atts, "display", v, sizeof v) && strcmp(v, "none") == 0)
+        f->none = true;
+    if (get_prop(atts, "visibility", v, sizeof v) && strcmp(v, "inherit") != 0)
+        f->invisible = strcmp(v, "hidden") == 0 || strcmp(v, "collapse") == 0;
+    if (get_prop(atts, "stroke", v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
+        f->stroke = strcmp(v, "none") != 0;
+    if (get_prop(atts, "fill", v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
+        f->fill = strcmp(v, "none") != 0;
+}
+
+/* --- elements ---------------------------------------------------------------------------- */
+
+/* <svg>: the root maps its viewBox (or px user units) to the document size in mm; a nested one
+ * establishes a new viewport at x, y of size width x height in its parent's user units. A
+ * transform attribute (SVG 2) applies in the parent's space. No width/height on the root (or
+ * percentages): one user unit is one millimetre, as for bare path data. Clipping to the
+ * viewport is not done. */
+static cs_err_t on_svg(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    (void)local;
+    frame_t *f = &d->stack[d->depth - 1];
+    const frame_t *parent = d->depth >= 2 ? &d->stack[d->depth - 2] : NULL;
+    cs_err_t e = element_transform(d, atts, tag, &f->m);
+    if (e != CS_OK)
+        return e;
+    viewbox_t vb;
+    if ((e = get_viewbox(d, atts, tag, &vb)) != CS_OK)
+        return e;
+    if (!parent) {
+        double w = 0.0, h = 0.0;
+        bool hw, hh;
+        if ((e = get_doc_size(d, atts, tag, "width", &w, &hw)) != CS_OK ||
+            (e = get_doc_size(d, atts, tag, "height", &h, &hh)) != CS_OK)
+            return e;
+        if (vb.have && hw != hh) { /* one size given: the other from the viewBox's ratio */
+            if (hw) {
+                h = w * vb.h / vb.w;
+                hh = true;
+            } else {
+                w = h * vb.w / vb.h;
+                hw = true;
+            }
+        }
+        if ((hw && w == 0.0) || (hh && h == 0.0)) {
+            f->none = true; /* a zero-sized viewport disables rendering (SVG 1.1 §7.10) */
+            return CS_OK;
+        }
+        if (hw && hh && vb.have) {
+            f->m = cs_path_affine_mul(f->m, viewbox_map(&vb, 0.0, 0.0, w, h));
+        } else if (hw || hh) {
+            cs_path_affine_t s = cs_path_affine_identity();
+            s.a = s.d = MM_PER_PX;
+            f->m = cs_path_affine_mul(f->m, s);
+        }
+        if (vb.have) {
+            f->vw = vb.w;
+            f->vh = vb.h;
+        } else {
+            f->vw = hw ? w / MM_PER_PX : 0.0;
+            f->vh = hh ? h / MM_PER_PX : 0.0;
+        }
+        return CS_OK;
+    }
+    double x, y, w, h;
+    bool hw, hh;
+    if ((e = get_length(d, f, atts, tag, "x", LEN_X, 0.0, &x, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "y", LEN_Y, 0.0, &y, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "width", LEN_X, f->vw, &w, &hw)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "height", LEN_Y, f->vh, &h, &hh)) != CS_OK)
+        return e;
+    if (w < 0.0 || h < 0.0)
+        return attr_fail(d, tag, w < 0.0 ? "width" : "height", 0, CS_ERR_PARSE, "negative size");
+    if ((hw && w == 0.0) || (hh && h == 0.0)) {
+        f->none = true;
+        return CS_OK;
+    }
+    cs_path_affine_t t = cs_path_affine_identity();
+    t.e = x;
+    t.f = y;
+    if (vb.have && w > 0.0 && h > 0.0)
+        t = viewbox_map(&vb, x, y, w, h);
+    f->m = cs_path_affine_mul(f->m, t);
+    f->vw = vb.have ? vb.w : w;
+    f->vh = vb.have ? vb.h : h;
+    return CS_OK;
+}
+
 static cs_err_t on_container(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     (void)local;
@@ -560,18 +932,56 @@ static cs_err_t on_hidden(doc_t *d, const char *local, const char **atts, size_t
     return CS_OK;
 }
 
+/* Whether a shape or path is drawn: not in <defs> and the like, visible, and with a stroke or a
+ * fill (fills are drawn as their outline: a plotter has no area fill; said once). `open`
+ * shapes (line) have no area, so only their stroke counts. */
+static bool drawn(doc_t *d, const char *local, size_t tag, bool open)
+{
+    frame_t *f = &d->stack[d->depth - 1];
+    if (f->hidden) {
+        d->stats->ignored++;
+        warn_once(d, "hidden", tag,
+                  "ignoring <%s> inside <defs>/<symbol>/<clipPath>... (not drawn directly; <use> "
+                  "is not supported yet)",
+                  local);
+        return false;
+    }
+    if (f->invisible || (!f->stroke && (open || !f->fill))) {
+        d->stats->ignored++; /* visibility:hidden, or neither stroke nor fill: nothing shows */
+        return false;
+    }
+    return true;
+}
+
+/* Said once, when a filled element is actually drawn. */
+static void note_fill(doc_t *d, size_t tag)
+{
+    if (d->stack[d->depth - 1].fill)
+        warn_once(d, "fill", tag,
+                  "fills are not drawn: filled shapes are drawn as their outline (with or "
+                  "without a stroke)");
+}
+
+/* Parses path data text[0..n) in the current element's user space; positions come from
+ * locate/ctx (into an attribute, or the element's tag for generated data). */
+static cs_err_t draw_data(doc_t *d, const char *text, size_t n, cs_svgpath_locate_fn locate,
+                          void *ctx)
+{
+    frame_t *f = &d->stack[d->depth - 1];
+    cs_svgpath_opts_t po;
+    cs_svgpath_opts_init(&po, d->name);
+    po.xform = cs_path_affine_mul(d->o->xform, f->m);
+    po.locate = locate;
+    po.locate_ctx = ctx;
+    return cs_svgpath_parse(text, n, &po, d->path, d->diag);
+}
+
 static cs_err_t on_path(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     frame_t *f = &d->stack[d->depth - 1];
     d->stats->paths++;
-    if (f->hidden) {
-        d->stats->ignored++;
-        warn_once(d, "hidden-path", tag,
-                  "ignoring <%s> inside <defs>/<symbol>/<clipPath>... (not drawn directly; <use> "
-                  "is not supported yet)",
-                  local);
+    if (!drawn(d, local, tag, false))
         return CS_OK;
-    }
     cs_err_t e = element_transform(d, atts, tag, &f->m);
     if (e != CS_OK)
         return e;
@@ -581,12 +991,255 @@ static cs_err_t on_path(doc_t *d, const char *local, const char **atts, size_t t
     attr_t a;
     if ((e = attr_load(d, dv, "d", tag, &a)) != CS_OK)
         return e;
-    cs_svgpath_opts_t po;
-    cs_svgpath_opts_init(&po, d->name);
-    po.xform = cs_path_affine_mul(d->o->xform, f->m);
-    po.locate = attr_locate;
-    po.locate_ctx = &a;
-    e = cs_svgpath_parse(a.text, a.n, &po, d->path, d->diag);
+    note_fill(d, tag);
+    e = draw_data(d, a.text, a.n, attr_locate, &a);
+    attr_free(&a);
+    return e;
+}
+
+/* Generated path data for a basic shape (SVG 1.1 §9: each shape is defined as an equivalent
+ * path); numbers printed with 17 significant digits, so they read back as the same doubles. */
+typedef struct {
+    char *s;
+    size_t n, cap;
+    bool oom;
+} gen_t;
+
+static void gen_put(gen_t *g, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void gen_put(gen_t *g, const char *fmt, ...)
+{
+    if (g->oom)
+        return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int k = vsnprintf(g->s ? g->s + g->n : NULL, g->s ? g->cap - g->n : 0, fmt, ap);
+        va_end(ap);
+        if (k < 0) {
+            g->oom = true;
+            return;
+        }
+        if (g->s && g->n + (size_t)k < g->cap) {
+            g->n += (size_t)k;
+            return;
+        }
+        size_t ncap = (g->cap ? g->cap * 2 : 256) + (size_t)k;
+        char *ns = realloc(g->s, ncap);
+        if (!ns) {
+            g->oom = true;
+            return;
+        }
+        g->s = ns;
+        g->cap = ncap;
+    }
+}
+
+/* Draws generated data; errors point at the element's tag. */
+static cs_err_t draw_gen(doc_t *d, const char *local, gen_t *g, size_t tag)
+{
+    if (g->oom) {
+        free(g->s);
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, tag), "out of memory");
+    }
+    if (strcmp(local, "line") != 0)
+        note_fill(d, tag);
+    attr_t a;
+    memset(&a, 0, sizeof a);
+    a.raw_start = a.raw_end = tag;
+    a.base = cursor_at(d, tag);
+    a.cur = a.base;
+    cs_err_t e = draw_data(d, g->s, g->n, attr_locate, &a);
+    free(g->s);
+    return e;
+}
+
+/* Shape prologue: counts it, decides whether it is drawn, applies its transform. */
+static cs_err_t shape_begin(doc_t *d, const char *local, const char **atts, size_t tag, bool open,
+                            bool *draw)
+{
+    d->stats->shapes++;
+    *draw = drawn(d, local, tag, open);
+    if (!*draw)
+        return CS_OK;
+    return element_transform(d, atts, tag, &d->stack[d->depth - 1].m);
+}
+
+/* A negative value is an error (SVG 1.1 §9.2-9.4). */
+static cs_err_t non_negative(doc_t *d, size_t tag, const char *name, double v)
+{
+    if (v < 0.0)
+        return attr_fail(d, tag, name, 0, CS_ERR_PARSE, "negative value");
+    return CS_OK;
+}
+
+/* <rect> (SVG 1.1 §9.2): x, y, width, height, rounded corners rx/ry: one given stands for
+ * both ("auto"), each clamped to half the width/height; zero width or height draws nothing. */
+static cs_err_t on_rect(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    bool draw, hrx, hry;
+    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    if (e != CS_OK || !draw)
+        return e;
+    frame_t *f = &d->stack[d->depth - 1];
+    double x, y, w, h, rx, ry;
+    if ((e = get_length(d, f, atts, tag, "x", LEN_X, 0.0, &x, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "y", LEN_Y, 0.0, &y, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "width", LEN_X, 0.0, &w, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "height", LEN_Y, 0.0, &h, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "rx", LEN_X, 0.0, &rx, &hrx)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "ry", LEN_Y, 0.0, &ry, &hry)) != CS_OK ||
+        (e = non_negative(d, tag, "width", w)) != CS_OK ||
+        (e = non_negative(d, tag, "height", h)) != CS_OK ||
+        (e = non_negative(d, tag, "rx", rx)) != CS_OK ||
+        (e = non_negative(d, tag, "ry", ry)) != CS_OK)
+        return e;
+    if (w == 0.0 || h == 0.0)
+        return CS_OK;
+    if (hrx && !hry)
+        ry = rx;
+    else if (hry && !hrx)
+        rx = ry;
+    if (rx > w / 2.0)
+        rx = w / 2.0;
+    if (ry > h / 2.0)
+        ry = h / 2.0;
+    gen_t g = {NULL, 0, 0, false};
+    double x1 = x + w, y1 = y + h;
+    if (rx == 0.0 || ry == 0.0) {
+        gen_put(&g, "M%.17g %.17gH%.17gV%.17gH%.17gZ", x, y, x1, y1, x);
+    } else {
+        /* The path of SVG 1.1 §9.2, straight sides left out where the corners meet. */
+        double xa = x + rx, xb = x1 - rx, ya = y + ry, yb = y1 - ry;
+        gen_put(&g, "M%.17g %.17g", xa, y);
+        if (xb > xa)
+            gen_put(&g, "H%.17g", xb);
+        gen_put(&g, "A%.17g %.17g 0 0 1 %.17g %.17g", rx, ry, x1, ya);
+        if (yb > ya)
+            gen_put(&g, "V%.17g", yb);
+        gen_put(&g, "A%.17g %.17g 0 0 1 %.17g %.17g", rx, ry, xb, y1);
+        if (xb > xa)
+            gen_put(&g, "H%.17g", xa);
+        gen_put(&g, "A%.17g %.17g 0 0 1 %.17g %.17g", rx, ry, x, yb);
+        if (yb > ya)
+            gen_put(&g, "V%.17g", ya);
+        gen_put(&g, "A%.17g %.17g 0 0 1 %.17g %.17gZ", rx, ry, xa, y);
+    }
+    return draw_gen(d, local, &g, tag);
+}
+
+/* <circle> and <ellipse> (SVG 1.1 §9.3-9.4): two half-turn arcs from (cx + rx, cy) in the
+ * positive angle direction, through cs_svgpath's arcs (hence cs_arc_build). An ellipse with
+ * one radius given uses it for both (SVG 2 "auto"); a zero radius draws nothing. */
+static cs_err_t on_ellipse(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    bool draw, hrx = false, hry = false;
+    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    if (e != CS_OK || !draw)
+        return e;
+    frame_t *f = &d->stack[d->depth - 1];
+    double cx, cy, rx, ry;
+    if ((e = get_length(d, f, atts, tag, "cx", LEN_X, 0.0, &cx, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "cy", LEN_Y, 0.0, &cy, NULL)) != CS_OK)
+        return e;
+    if (strcmp(local, "circle") == 0) {
+        if ((e = get_length(d, f, atts, tag, "r", LEN_OTHER, 0.0, &rx, NULL)) != CS_OK ||
+            (e = non_negative(d, tag, "r", rx)) != CS_OK)
+            return e;
+        ry = rx;
+    } else {
+        if ((e = get_length(d, f, atts, tag, "rx", LEN_X, 0.0, &rx, &hrx)) != CS_OK ||
+            (e = get_length(d, f, atts, tag, "ry", LEN_Y, 0.0, &ry, &hry)) != CS_OK ||
+            (e = non_negative(d, tag, "rx", rx)) != CS_OK ||
+            (e = non_negative(d, tag, "ry", ry)) != CS_OK)
+            return e;
+        if (hrx && !hry)
+            ry = rx;
+        else if (hry && !hrx)
+            rx = ry;
+    }
+    if (rx == 0.0 || ry == 0.0)
+        return CS_OK;
+    gen_t g = {NULL, 0, 0, false};
+    gen_put(&g, "M%.17g %.17gA%.17g %.17g 0 1 1 %.17g %.17gA%.17g %.17g 0 1 1 %.17g %.17gZ",
+            cx + rx, cy, rx, ry, cx - rx, cy, rx, ry, cx + rx, cy);
+    return draw_gen(d, local, &g, tag);
+}
+
+/* <line> (SVG 1.1 §9.5): drawn only when stroked (a line has no area to fill). */
+static cs_err_t on_line(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    bool draw;
+    cs_err_t e = shape_begin(d, local, atts, tag, true, &draw);
+    if (e != CS_OK || !draw)
+        return e;
+    frame_t *f = &d->stack[d->depth - 1];
+    double x1, y1, x2, y2;
+    if ((e = get_length(d, f, atts, tag, "x1", LEN_X, 0.0, &x1, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "y1", LEN_Y, 0.0, &y1, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "x2", LEN_X, 0.0, &x2, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "y2", LEN_Y, 0.0, &y2, NULL)) != CS_OK)
+        return e;
+    gen_t g = {NULL, 0, 0, false};
+    gen_put(&g, "M%.17g %.17gL%.17g %.17g", x1, y1, x2, y2);
+    return draw_gen(d, local, &g, tag);
+}
+
+/* Offsets of "M " + points map back into the points attribute. */
+typedef struct {
+    attr_t *a;
+    size_t shift;
+} shifted_t;
+
+static void shifted_locate(void *ctx, size_t off, unsigned *line, unsigned *col)
+{
+    shifted_t *s = ctx;
+    attr_locate(s->a, off >= s->shift ? off - s->shift : 0, line, col);
+}
+
+/* <polyline> and <polygon> (SVG 1.1 §9.6-9.7): the points list is path data "M x y x y ..."
+ * (implicit linetos), closed for a polygon. An odd number of coordinates is an error at the
+ * end of the list; a single point draws nothing. */
+static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    bool draw;
+    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    if (e != CS_OK || !draw)
+        return e;
+    const char *pv = att_get(atts, "points");
+    if (!pv)
+        return CS_OK;
+    attr_t a;
+    if ((e = attr_load(d, pv, "points", tag, &a)) != CS_OK)
+        return e;
+    /* Only numbers, commas and white space: path commands are not allowed in a points list. */
+    for (size_t i = 0; i < a.n; i++) {
+        char c = a.text[i];
+        if (!(is_xml_space(c) || c == ',' || c == '+' || c == '-' || c == '.' || c == 'e' ||
+              c == 'E' || (c >= '0' && c <= '9'))) {
+            cs_path_loc_t l = {d->name, 0, 0};
+            attr_locate(&a, i, &l.line, &l.col);
+            attr_free(&a);
+            return cs_path_diag_set(d->diag, CS_ERR_PARSE, l,
+                                    "points: expected numbers separated by commas or spaces");
+        }
+    }
+    bool polygon = strcmp(local, "polygon") == 0;
+    gen_t g = {NULL, 0, 0, false};
+    gen_put(&g, "M %.*s%s", (int)(a.n > INT_MAX - 8 ? INT_MAX - 8 : a.n), a.text,
+            polygon ? " Z" : "");
+    if (g.oom) {
+        attr_free(&a);
+        return draw_gen(d, local, &g, tag);
+    }
+    note_fill(d, tag);
+    shifted_t s = {&a, 2};
+    e = draw_data(d, g.s, g.n, shifted_locate, &s);
+    free(g.s);
     attr_free(&a);
     return e;
 }
@@ -597,38 +1250,27 @@ static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, s
     if (d->stack[d->depth - 1].hidden)
         return CS_OK;
     d->stats->ignored++;
-    static const char *const shapes[] = {"rect", "circle",   "ellipse",
-                                         "line", "polyline", "polygon"};
-    for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++)
-        if (strcmp(local, shapes[i]) == 0) {
-            warn_once(d, shapes[i], tag,
-                      "ignoring <%s> elements: basic shapes are not supported yet (only <path>)",
-                      local);
-            return CS_OK;
-        }
-    static const char *const others[] = {"text", "use", "image"};
-    for (size_t i = 0; i < sizeof others / sizeof others[0]; i++)
-        if (strcmp(local, others[i]) == 0) {
-            warn_once(d, others[i], tag, "ignoring <%s> elements: not drawn", local);
-            return CS_OK;
-        }
+    warn_once(d,
+              strcmp(local, "text") == 0  ? "text"
+              : strcmp(local, "use") == 0 ? "use"
+                                          : "image",
+              tag, "ignoring <%s> elements: not drawn", local);
     return CS_OK;
 }
 
 /* What each SVG element does. Unlisted elements (title, desc, style, metadata...) are skipped
- * with their subtree drawn normally; shapes, units (width/height/viewBox on <svg>) and <use>
- * get their own handlers here when they are implemented. */
+ * with their subtree drawn normally. */
 static const struct {
     const char *name;
     elem_fn fn;
 } handlers[] = {
-    {"svg", on_container},        {"g", on_container},         {"a", on_container},
-    {"switch", on_container},     {"path", on_path},           {"defs", on_hidden},
-    {"symbol", on_hidden},        {"clipPath", on_hidden},     {"mask", on_hidden},
-    {"marker", on_hidden},        {"pattern", on_hidden},      {"rect", on_unsupported},
-    {"circle", on_unsupported},   {"ellipse", on_unsupported}, {"line", on_unsupported},
-    {"polyline", on_unsupported}, {"polygon", on_unsupported}, {"text", on_unsupported},
-    {"use", on_unsupported},      {"image", on_unsupported},
+    {"svg", on_svg},          {"g", on_container},       {"a", on_container},
+    {"switch", on_container}, {"path", on_path},         {"defs", on_hidden},
+    {"symbol", on_hidden},    {"clipPath", on_hidden},   {"mask", on_hidden},
+    {"marker", on_hidden},    {"pattern", on_hidden},    {"rect", on_rect},
+    {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
+    {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_unsupported},
+    {"use", on_unsupported},  {"image", on_unsupported},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */
@@ -659,12 +1301,13 @@ static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **atts
         d->stack = ns;
         d->cap = ncap;
     }
-    /* A new frame inherits its parent's transform and visibility. */
+    /* A new frame inherits its parent's transform, visibility, paint and viewport. */
     if (d->depth > 0)
         d->stack[d->depth] = d->stack[d->depth - 1];
     else {
+        memset(&d->stack[0], 0, sizeof d->stack[0]);
         d->stack[0].m = cs_path_affine_identity();
-        d->stack[0].hidden = false;
+        d->stack[0].fill = true; /* SVG initial values: fill black, stroke none */
     }
     d->depth++;
     XML_Index bi = XML_GetCurrentByteIndex(d->xp);
@@ -674,8 +1317,14 @@ static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **atts
     const char *local = svg_local(el);
     if (d->elements++ == 0 && (!local || strcmp(local, "svg") != 0))
         warn_once(d, "root", tag, "the root element is not <svg>");
-    if (!local)
+    frame_t *f = &d->stack[d->depth - 1];
+    if (!local || f->none)
+        return; /* foreign elements, and everything under display="none" */
+    read_style(atts, f);
+    if (f->none) {
+        d->stats->ignored++;
         return;
+    }
     for (size_t i = 0; i < sizeof handlers / sizeof handlers[0]; i++)
         if (strcmp(local, handlers[i].name) == 0) {
             cs_err_t e = handlers[i].fn(d, local, atts, tag);

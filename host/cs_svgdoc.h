@@ -1,9 +1,10 @@
-/* cs_svgdoc: reads an SVG document with expat into a cs_path_t: every rendered <path>'s 'd'
- * attribute (through cs_svgpath), with transforms of <g>/<path> (matrix, translate, scale,
- * rotate, skewX, skewY) composed down the tree. Path-data errors point at the character inside
- * the attribute in the file. Per-element handlers sit in one table, so shapes (<rect>,
- * <circle>...) and document units (width/height/viewBox) slot in later; today those are
- * reported once as warnings. Also reads bare path data (a file holding only a 'd' value). */
+/* cs_svgdoc: reads an SVG document with expat into a cs_path_t: <path> data (through
+ * cs_svgpath) and the basic shapes (rect with rounded corners, circle, ellipse, line, polyline,
+ * polygon) as their SVG 1.1 equivalent paths, with every transform composed down the tree, the
+ * root's width/height/viewBox/preserveAspectRatio (and nested <svg> viewports) mapped to mm, and
+ * the display/visibility/stroke/fill properties (attributes or style="") deciding what is
+ * drawn: fills are drawn as outlines. Errors point at the character inside the attribute in the
+ * file. Also reads bare path data (a file holding only a 'd' value). See docs/inputs.md. */
 #ifndef CS_SVGDOC_H
 #define CS_SVGDOC_H
 
@@ -23,7 +24,9 @@ typedef struct {
 /* What a read found (for --stats and tests). */
 typedef struct {
     unsigned paths;    /* <path> elements read (with or without a 'd' attribute) */
-    unsigned ignored;  /* elements skipped: shapes, text, use, paths inside <defs> and the like */
+    unsigned shapes;   /* basic shapes read: rect, circle, ellipse, line, polyline, polygon */
+    unsigned ignored;  /* elements not drawn: text, use, image, display="none", no stroke and no
+                          fill, visibility hidden, paths and shapes inside <defs> and the like */
     unsigned warnings; /* warnings issued (each kind once per document) */
 } cs_svgdoc_stats_t;
 
@@ -34,9 +37,11 @@ void cs_svgdoc_opts_init(cs_svgdoc_opts_t *o);
  * free() it; *len excludes the NUL). CS_ERR_IO with *diag ("file:0:0: reason") on failure. */
 cs_err_t cs_svgdoc_load(const char *filename, char **buf, size_t *len, cs_path_diag_t *diag);
 
-/* Parses an SVG document held in buf[0..len) named name; appends every rendered <path>'s
- * elements to *path. CS_ERR_PARSE for XML errors and path-data errors, CS_ERR_RANGE for points
- * outside +/-4096 mm, CS_ERR_FULL when out of memory (all with *diag). stats may be NULL. */
+/* Parses an SVG document held in buf[0..len) named name; appends every drawn path's and shape's
+ * elements to *path (every moveto and every shape starts a subpath). CS_ERR_PARSE for XML
+ * errors, path-data errors and bad attribute values (lengths, viewBox, preserveAspectRatio,
+ * points, transform, negative sizes), CS_ERR_RANGE for points outside +/-4096 mm, CS_ERR_FULL
+ * when out of memory (all with *diag). stats may be NULL. */
 cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs_svgdoc_opts_t *o,
                          cs_path_t *path, cs_path_diag_t *diag, cs_svgdoc_stats_t *stats);
 

@@ -13,8 +13,10 @@ static const struct {
     cs_cmd_fn fn;
     const char *summary;
 } commands[] = {
-    {"flatten", cs_cmd_flatten, "print the chords of SVG paths, within a tolerance"},
+    {"flatten", cs_cmd_flatten, "print a job's chords (SVG, G-code, HP-GL), within a tolerance"},
     {"plan", cs_cmd_plan, "plan a job into step segments (ticks dx dy dz) for a machine"},
+    {"toolpath", cs_cmd_toolpath, "surface patches: projected wireframe or ball-end finishing"},
+    {"stream", cs_cmd_stream, "stream a job to a device on a serial port (segments or curves)"},
     {"help", cmd_help, "show this help, or a command's help: curvestep help COMMAND"},
 };
 

@@ -1,70 +1,100 @@
 #!/usr/bin/env bash
-# make demo (first version): flattens real drawings (the W3C SVG 1.1 path tests and resvg arc
-# cases copied in tests/data/svg) with `curvestep flatten --stats --svg`, checks each result
-# (the command succeeded, every drawing produced vertices, the deviation measured against the
-# exact curves is within the tolerance), prints a short report and where the pictures are.
-# Later issues replace this with a streamed job.
+# make demo: the main job. Starts the simulator as the device on a pseudo-terminal, streams a real
+# SVG drawing (tests/data, copied from shared/data) to it with `curvestep stream`, and prints the
+# device's check report: max deviation from the exact curves, job time, retransmissions, final
+# position, and the picture it drew. Part 1 streams step segments; part 2 the same drawing as
+# cubic curves the device interpolates itself, over a line paced at 115200 baud; part 3 keeps the
+# first demo's flattening picture. Exits non-zero when any check fails. Every background process
+# is bounded by `timeout` and killed on exit.
 set -u
 BUILD=${BUILD:-build}
-BIN=$BUILD/curvestep
+CS=$BUILD/curvestep
+SIM=$BUILD/curvestep-sim
 OUT=$BUILD/demo
-TOL=0.01
+JOB=tests/data/svg/w3c/paths-data-01-t.svg # W3C SVG 1.1: cubic Béziers, subpaths, closepath
+SPEED=20                                   # simulated seconds per wall second
 mkdir -p "$OUT"
 failures=0
+pids=()
+cleanup() {
+    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+    wait 2>/dev/null
+}
+trap cleanup EXIT
 
-if [ ! -x "$BIN" ]; then
-    echo "demo: $BIN is missing (run make all)" >&2
-    exit 1
-fi
-
-# flatten NAME INPUT TOL METHOD: runs one flattening into $OUT/NAME.{txt,log,svg} and checks it.
-flatten() {
-    local name=$1 input=$2 tol=$3 method=$4
-    "$BIN" flatten --stats --tol "$tol" --method "$method" --svg "$OUT/$name.svg" "$input" \
-        >"$OUT/$name.txt" 2>"$OUT/$name.log"
-    local rc=$?
-    local vertices dev summary status=ok
-    vertices=$(grep -c . "$OUT/$name.txt")
-    dev=$(sed -n 's/.*max deviation \([0-9.]*\) mm.*/\1/p' "$OUT/$name.log")
-    summary=$(sed -n 's/^flatten: [^:]*: \(.*\)$/\1/p' "$OUT/$name.log")
-    if [ "$rc" -ne 0 ]; then
-        status="FAILED (exit $rc)"
-    elif [ "$vertices" -eq 0 ]; then
-        status="FAILED (no vertices)"
-    elif [ -z "$dev" ] || ! awk -v d="$dev" -v t="$tol" 'BEGIN { exit !(d <= t) }'; then
-        status="FAILED (deviation '$dev' > tol $tol)"
+for b in "$CS" "$SIM"; do
+    if [ ! -x "$b" ]; then
+        echo "demo: $b is missing (run make all)" >&2
+        exit 1
     fi
-    [ "$status" = ok ] || failures=$((failures + 1))
-    printf '  %-22s %-6s tol %-5s %s, max deviation %s mm: %s\n' "$name" "$method" "$tol" \
-        "$summary" "${dev:-?}" "$status"
-    if [ "$status" != ok ]; then sed 's/^/      /' "$OUT/$name.log" | head -5; fi
-    if command -v rsvg-convert >/dev/null 2>&1 && [ -s "$OUT/$name.svg" ]; then
-        rsvg-convert "$OUT/$name.svg" -o "$OUT/$name.png" 2>/dev/null || true
+done
+
+# stream NAME MODE SIM-ARGS -- STREAM-ARGS: one streamed job, checked; report in $OUT/NAME.*
+stream() {
+    local name=$1 mode=$2; shift 2
+    local simargs=() streamargs=()
+    while [ $# -gt 0 ] && [ "$1" != -- ]; do simargs+=("$1"); shift; done
+    [ $# -gt 0 ] && shift
+    streamargs=("$@")
+    timeout 300 "$SIM" --pty --speed "$SPEED" --idle-exit 1 --reference "$JOB" --check \
+        --svg "$OUT/$name.svg" --png "$OUT/$name.png" "${simargs[@]}" \
+        >"$OUT/$name.report" 2>"$OUT/$name.simlog" &
+    local sim=$!
+    pids+=("$sim")
+    local pty=
+    for _ in $(seq 100); do
+        pty=$(head -n1 "$OUT/$name.report" 2>/dev/null)
+        [ -n "$pty" ] && break
+        sleep 0.05
+    done
+    if [ -z "$pty" ]; then
+        echo "  $name: FAILED (the simulator did not start)"
+        failures=$((failures + 1))
+        return
+    fi
+    echo "  device on $pty; curvestep stream --mode $mode ${streamargs[*]} $JOB"
+    timeout 300 "$CS" stream --port "$pty" --mode "$mode" "${streamargs[@]}" "$JOB" \
+        >"$OUT/$name.stream" 2>"$OUT/$name.progress"
+    local rc=$?
+    for _ in $(seq 600); do kill -0 "$sim" 2>/dev/null || break; sleep 0.05; done
+    wait "$sim"
+    local simrc=$?
+    grep -v 'to continue' "$OUT/$name.stream" | sed 's/^stream: /  host:   /'
+    grep -E '^(device|link|executor|job time|final position|max deviation|check)' \
+        "$OUT/$name.report" | sed 's/^device: /device: /; s/^/  /'
+    echo "  picture: $OUT/$name.svg ($OUT/$name.png)"
+    if [ "$rc" -ne 0 ] || [ "$simrc" -ne 0 ] || ! grep -q '^check: ok$' "$OUT/$name.report"; then
+        echo "  $name: FAILED (stream exit $rc, simulator exit $simrc)"
+        failures=$((failures + 1))
     fi
 }
 
-echo "demo: curvestep flatten on real drawings (vertices in mm, deviation measured in double)"
-# The main picture: W3C paths-data-01 (cubic Béziers C c S s, subpaths, closepath).
-flatten flatten tests/data/svg/w3c/paths-data-01-t.svg "$TOL" subdiv
-# The same drawing with each tracing method, for comparison of chord counts.
-flatten cubics-fd tests/data/svg/w3c/paths-data-01-t.svg "$TOL" fd
-flatten cubics-afd tests/data/svg/w3c/paths-data-01-t.svg "$TOL" afd
-# Quadratics (Q q T t), poly-Béziers with implicit S, an initial relative moveto under a
-# group transform, and elliptical arcs (rotated, radii scaled up, after z).
-flatten quadratics tests/data/svg/w3c/paths-data-02-t.svg "$TOL" subdiv
-flatten polybezier tests/data/svg/w3c/paths-data-12-t.svg "$TOL" subdiv
-flatten transformed tests/data/svg/w3c/paths-data-14-t.svg "$TOL" subdiv
-flatten arc-then-s tests/data/svg/resvg/M-A-s.svg "$TOL" subdiv
-flatten arc-after-z tests/data/svg/resvg/M-L-Z-A.svg "$TOL" subdiv
-# A coarse tolerance, so the chords are visible in the picture.
-flatten quadratics-coarse tests/data/svg/w3c/paths-data-02-t.svg 1 subdiv
+echo "demo 1: step segments planned on the host, streamed over a pty to the simulated device"
+echo "        (device at ${SPEED}x real time, 32-slot queue; the executor's STEP edges are checked"
+echo "        against the exact curves)"
+stream stream segments --
+echo
+echo "demo 2: the same drawing as cubic curves, interpolated and planned on the device, over a"
+echo "        line paced at 115200 baud in both directions"
+stream stream-curves curves --line-rate 115200 -- --line-rate 115200
+echo
+
+# demo 3: the flattening picture of the first demo (chords within 0.01 mm, measured in double).
+echo "demo 3: curvestep flatten (chords within 0.01 mm of the exact curves)"
+"$CS" flatten --stats --tol 0.01 --svg "$OUT/flatten.svg" "$JOB" >"$OUT/flatten.txt" \
+    2>"$OUT/flatten.log"
+rc=$?
+dev=$(sed -n 's/.*max deviation \([0-9.]*\) mm.*/\1/p' "$OUT/flatten.log")
+if [ $rc -ne 0 ] || [ -z "$dev" ] || ! awk -v d="$dev" 'BEGIN { exit !(d <= 0.01) }'; then
+    echo "  flatten: FAILED (exit $rc, deviation '${dev:-?}')"
+    failures=$((failures + 1))
+else
+    echo "  max deviation $dev mm; picture: $OUT/flatten.svg"
+fi
 
 echo
-echo "demo: picture of the main drawing: $OUT/flatten.svg (exact curves in blue, chords and"
-echo "      vertices in red); chords visible at 1 mm: $OUT/quadratics-coarse.svg"
-[ -f "$OUT/flatten.png" ] && echo "      PNG renderings (rsvg-convert): $OUT/*.png"
 if [ "$failures" -ne 0 ]; then
     echo "demo: $failures check(s) FAILED"
     exit 1
 fi
-echo "demo: all checks passed"
+echo "demo: all checks passed; the streamed drawing: $OUT/stream.svg"

@@ -29,11 +29,14 @@ for name in "${targets[@]}"; do
     corpus=$out/corpus_$short
     mkdir -p "$corpus"
     if [ -d "tests/fuzz/corpus_$short" ]; then cp -n "tests/fuzz/corpus_$short"/* "$corpus"/ 2>/dev/null || true; fi
+    # Extra link libraries a target names in a comment line "fuzz-libs: -lexpat ..." (host
+    # parsers built on Debian libraries).
+    libs=$(sed -n 's/^.*fuzz-libs: *\([-a-zA-Z0-9_ ]*\).*$/\1/p' "$src" | head -n1)
     if grep -q CS_FUZZ_SEED_MAIN "$src"; then
-        $CLANG $flags -DCS_FUZZ_SEED_MAIN $inc "$src" "${core[@]}" -o "$out/${name}_seed"
+        $CLANG $flags -DCS_FUZZ_SEED_MAIN $inc "$src" "${core[@]}" -o "$out/${name}_seed" $libs
         "$out/${name}_seed" "$corpus"
     fi
-    $CLANG $flags -fsanitize=fuzzer $inc "$src" "${core[@]}" -o "$out/$name"
+    $CLANG $flags -fsanitize=fuzzer $inc "$src" "${core[@]}" -o "$out/$name" $libs
     log=$out/$name.log
     start=$(date +%s)
     rc=0

@@ -11,39 +11,46 @@
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_sim.h"
+#include "cs_sim_device.h"
 #include "cs_sim_draw.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_INTERNAL = 3, EXIT_CHECK = 4 };
 
 static void usage(FILE *f)
 {
-    fputs("usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
-          "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-          "                     [--window MS]\n"
-          "Executes the step segments written by `curvestep plan` (same --machine) with the\n"
-          "firmware's executor in simulated time, records every STEP edge and reports:\n"
-          "  - the final position of each axis, in steps and mm;\n"
-          "  - each axis's peak velocity and acceleration against its limits, estimated from\n"
-          "    the edges over windows of --window ms (default 50): velocity = steps over one\n"
-          "    window, acceleration = change of that between windows; the estimator's own error\n"
-          "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
-          "  - with --reference FILE (the job: SVG), the largest distance from any position the\n"
-          "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
-          "    plus one step, and whether the final position is the job's end rounded to steps.\n"
-          "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
-          "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed\n"
-          "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
-          "  --check           exit 4 when a limit, the deviation or the final position fails\n"
-          "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
-          "3 internal error, 4 a check failed (with --check).\n",
-          f);
+    fputs(
+        "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
+        "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
+        "                     [--window MS] [--lenient]\n"
+        "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
+        "Executes the step segments written by `curvestep plan` (same --machine) with the\n"
+        "firmware's executor in simulated time, records every STEP edge and reports:\n"
+        "  - the final position of each axis, in steps and mm;\n"
+        "  - each axis's peak velocity and acceleration against its limits, estimated from\n"
+        "    the edges over windows of --window ms (default 50): velocity = steps over one\n"
+        "    window, acceleration = change of that between windows; the estimator's own error\n"
+        "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
+        "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
+        "    --lenient as for plan), the largest distance from any position the\n"
+        "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
+        "    plus one step, and whether the final position is the job's end rounded to steps.\n"
+        "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
+        "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed\n"
+        "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
+        "  --check           exit 4 when a limit, the deviation or the final position fails\n"
+        "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
+        "3 internal error, 4 a check failed (with --check).\n",
+        f);
 }
 
 int main(int argc, char **argv)
 {
+    for (int i = 1; i < argc; i++) /* device mode: the simulator behind a serial line */
+        if (strcmp(argv[i], "--pty") == 0 || strcmp(argv[i], "--port") == 0)
+            return cs_sim_device_main(argc, argv);
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
-    bool check = false;
+    bool check = false, lenient = false;
     double window_ms = 50;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -72,6 +79,8 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(a, "--check") == 0) {
             check = true;
+        } else if (strcmp(a, "--lenient") == 0) {
+            lenient = true;
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             usage(stderr);
@@ -141,7 +150,7 @@ int main(int argc, char **argv)
         cs_path_t path;
         cs_path_init(&path);
         cs_path_diag_t diag;
-        e = cs_motion_read_job(reference, &path, &diag);
+        e = cs_motion_read_job_ex(reference, lenient, &path, &diag);
         double end[3];
         if (e == CS_OK)
             e = cs_sim_ref_from_path(&ref, &path, end);

@@ -145,6 +145,219 @@ void cs_fd_init_diffs(const cs_fd_pt_t *p, unsigned degree, unsigned k,
     }
 }
 
+#if CS_FD_RATIONAL
+/* --- rational curves: exact homogeneous differences in 128 bits ------------------------- */
+
+static cs_fd_i128_t i128_from64(int64_t v)
+{
+    cs_fd_i128_t r;
+    r.lo = (uint64_t)v;
+    r.hi = v < 0 ? UINT64_MAX : 0u;
+    return r;
+}
+
+static cs_fd_i128_t i128_add(cs_fd_i128_t a, cs_fd_i128_t b)
+{
+    cs_fd_i128_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+
+static cs_fd_i128_t i128_sub(cs_fd_i128_t a, cs_fd_i128_t b)
+{
+    cs_fd_i128_t r;
+    r.lo = a.lo - b.lo;
+    r.hi = a.hi - b.hi - (a.lo < b.lo ? 1u : 0u);
+    return r;
+}
+
+static bool i128_is_neg(cs_fd_i128_t a)
+{
+    return (a.hi >> 63) != 0;
+}
+
+static cs_fd_i128_t i128_negate(cs_fd_i128_t a)
+{
+    cs_fd_i128_t zero = {0u, 0u};
+    return i128_sub(zero, a);
+}
+
+/* a * m for m <= 2^32 and |a * m| < 2^127 (callers keep values below 2^126). */
+static cs_fd_i128_t i128_mul_small(cs_fd_i128_t a, uint64_t m)
+{
+    bool neg = i128_is_neg(a);
+    cs_fd_i128_t mag = neg ? i128_negate(a) : a, r;
+    uint64_t h;
+    cs_fixed_mul_u64(mag.lo, m, &h, &r.lo);
+    r.hi = mag.hi * m + h;
+    return neg ? i128_negate(r) : r;
+}
+
+static unsigned bitlen64(uint64_t v)
+{
+    unsigned b = 0;
+    while (v) {
+        b++;
+        v >>= 1;
+    }
+    return b;
+}
+
+/* Magnitude a >> s, 0 < s < 128. */
+static cs_fd_i128_t u128_shr(cs_fd_i128_t a, unsigned s)
+{
+    cs_fd_i128_t r;
+    if (s >= 64) {
+        r.lo = a.hi >> (s - 64);
+        r.hi = 0u;
+    } else {
+        r.lo = (a.lo >> s) | (a.hi << (64 - s));
+        r.hi = a.hi >> s;
+    }
+    return r;
+}
+
+/* round(x / w) for w > 0: both are normalised so w < 2^62 (relative error <= 2^-61, i.e. far
+ * below 2^-30 LSB here), then 31 restoring-division steps (|x / w| < 2^31 LSB). */
+static cs_err_t rat_project(cs_fd_i128_t x, cs_fd_i128_t w, cs_pos_t *out)
+{
+    bool neg = i128_is_neg(x);
+    cs_fd_i128_t m = neg ? i128_negate(x) : x;
+    unsigned bl = w.hi ? 64 + bitlen64(w.hi) : bitlen64(w.lo);
+    if (bl > 62) {
+        m = u128_shr(m, bl - 62);
+        w = u128_shr(w, bl - 62);
+    }
+    uint64_t wd = w.lo;
+    if (wd == 0)
+        return CS_ERR_OVERFLOW;
+    uint64_t q = 0;
+    for (unsigned b = 31; b-- > 0;) {
+        cs_fd_i128_t t;
+        t.lo = wd << b;
+        t.hi = b ? wd >> (64 - b) : 0u;
+        if (m.hi > t.hi || (m.hi == t.hi && m.lo >= t.lo)) {
+            m = i128_sub(m, t);
+            q |= (uint64_t)1 << b;
+        }
+    }
+    if (m.hi != 0 || m.lo >= wd)
+        return CS_ERR_OVERFLOW; /* remainder still >= w: |x / w| >= 2^31, not a cs_pos_t */
+    if ((m.lo << 1) >= wd)
+        q++;
+    return cs_fixed_narrow(neg ? -(int64_t)q : (int64_t)q, out);
+}
+
+static uint64_t sat_mul(uint64_t a, uint64_t b)
+{
+    uint64_t h, l;
+    cs_fixed_mul_u64(a, b, &h, &l);
+    return h ? UINT64_MAX : l;
+}
+
+static uint64_t sat_add(uint64_t a, uint64_t b)
+{
+    uint64_t r = a + b;
+    return r < a ? UINT64_MAX : r;
+}
+
+/* Upper bound of |(x, y, z)| >> 31 (components |.| <= 2^61). */
+static uint64_t norm_up_shr31(int64_t x, int64_t y, int64_t z)
+{
+    uint64_t a = mag_ceil_shift(x, 31), b = mag_ceil_shift(y, 31), c = mag_ceil_shift(z, 31);
+    return (uint64_t)cs_fixed_isqrt64(a * a + b * b + c * c) + 1u;
+}
+
+unsigned cs_fd_rational_k(const cs_bezier_t *c, cs_pos_t tol)
+{
+    unsigned n = c->degree;
+    /* R = C + Y / W with C = P0, Y_i = w_i (P_i - P0) (units LSB x Q30, |.| <= 2^59), W >= wmin.
+     * R' = (Y' - (R - C) W') / W and R'' = (Y'' - 2 R' W' - (R - C) W'') / W, with hodograph
+     * bounds |Y'| <= n max|dY|, |Y''| <= n(n-1) max|d2Y| (same for W), |R - C| <= rho. */
+    int64_t y[CS_BEZIER_MAX_POINTS][3];
+    uint64_t rho = 0, wmin = UINT64_MAX, b = 0, a = 0, om1 = 0, om2 = 0;
+    for (unsigned i = 0; i <= n; i++) {
+        int64_t dx = (int64_t)c->p[i].x - c->p[0].x, dy = (int64_t)c->p[i].y - c->p[0].y,
+                dz = (int64_t)c->p[i].z - c->p[0].z;
+        uint64_t r2 = (uint64_t)(dx * dx) + (uint64_t)(dy * dy) + (uint64_t)(dz * dz);
+        uint64_t r = (uint64_t)cs_fixed_isqrt64(r2) + 1u;
+        rho = r > rho ? r : rho;
+        uint64_t w = (uint64_t)c->w[i];
+        wmin = w < wmin ? w : wmin;
+        y[i][0] = dx * c->w[i];
+        y[i][1] = dy * c->w[i];
+        y[i][2] = dz * c->w[i];
+    }
+    for (unsigned i = 0; i < n; i++) {
+        uint64_t v = 2u * norm_up_shr31(y[i + 1][0] - y[i][0], y[i + 1][1] - y[i][1],
+                                        y[i + 1][2] - y[i][2]); /* LSB */
+        b = v > b ? v : b;
+        int64_t dw = (int64_t)c->w[i + 1] - c->w[i];
+        uint64_t adw = (uint64_t)(dw < 0 ? -dw : dw);
+        om1 = adw > om1 ? adw : om1;
+    }
+    for (unsigned i = 0; i + 2 <= n; i++) {
+        uint64_t v = 2u * norm_up_shr31(y[i][0] - 2 * y[i + 1][0] + y[i + 2][0],
+                                        y[i][1] - 2 * y[i + 1][1] + y[i + 2][1],
+                                        y[i][2] - 2 * y[i + 1][2] + y[i + 2][2]);
+        a = v > a ? v : a;
+        int64_t d2w = (int64_t)c->w[i] - 2 * (int64_t)c->w[i + 1] + c->w[i + 2];
+        uint64_t ad2w = (uint64_t)(d2w < 0 ? -d2w : d2w);
+        om2 = ad2w > om2 ? ad2w : om2;
+    }
+    /* 1/W <= 2^(30-e) with 2^e <= wmin (weights in Q30). */
+    unsigned e = bitlen64(wmin) - 1u, f = CS_WEIGHT_FRAC_BITS - e;
+    uint64_t r1 = sat_add(sat_mul(sat_mul(n, b), (uint64_t)1 << f),
+                          (sat_mul(sat_mul(rho, n), om1) >> e) + 1u);
+    uint64_t t = sat_add(sat_mul(sat_mul(2u * n, r1), om1),
+                         sat_mul(sat_mul(rho, (uint64_t)n * (n - 1u)), om2));
+    uint64_t r2 = sat_add(sat_mul(sat_mul((uint64_t)n * (n - 1u), a), (uint64_t)1 << f),
+                          (t == UINT64_MAX ? t : t >> e) + 1u);
+    /* Chords over steps h = 2^-K deviate at most h^2 / 8 max|R''|. */
+    uint64_t rhs = (uint64_t)tol * 8u;
+    unsigned k = 0;
+    while (rhs < r2) {
+        if (rhs > (UINT64_MAX >> 2) || k >= 60)
+            return 255;
+        rhs <<= 2;
+        k++;
+    }
+    return k;
+}
+
+/* Exact homogeneous differences (x, y, z = w P in LSB x Q30; w in Q30) at step 2^-k, x 2^(n k). */
+static void rat_init_diffs(const cs_bezier_t *c, unsigned k,
+                           cs_fd_i128_t d[4][CS_BEZIER_MAX_POINTS])
+{
+    unsigned n = c->degree;
+    uint64_t steps = (uint64_t)1 << k;
+    unsigned m = steps < n ? (unsigned)steps : n;
+    for (unsigned a = 0; a < 4; a++) {
+        cs_fd_i128_t x[CS_BEZIER_MAX_POINTS];
+        for (unsigned i = 0; i <= m; i++) {
+            cs_fd_i128_t v[CS_BEZIER_MAX_POINTS];
+            for (unsigned q = 0; q <= n; q++) {
+                int64_t w = c->w[q];
+                v[q] = i128_from64(a == 0   ? w * c->p[q].x
+                                   : a == 1 ? w * c->p[q].y
+                                   : a == 2 ? w * c->p[q].z
+                                            : w);
+            }
+            for (unsigned r = 1; r <= n; r++)
+                for (unsigned q = 0; q + r <= n; q++)
+                    v[q] = i128_add(i128_mul_small(v[q], steps - i), i128_mul_small(v[q + 1], i));
+            x[i] = v[0];
+        }
+        for (unsigned r = 1; r <= m; r++)
+            for (unsigned i = m; i >= r; i--)
+                x[i] = i128_sub(x[i], x[i - 1]);
+        for (unsigned j = 0; j < CS_BEZIER_MAX_POINTS; j++)
+            d[a][j] = j <= m ? x[j] : i128_from64(0);
+    }
+}
+#endif /* CS_FD_RATIONAL */
+
 static void start_piece(cs_fd_t *f)
 {
     cs_fd_pt_t q[CS_BEZIER_MAX_POINTS];
@@ -166,13 +379,41 @@ cs_err_t cs_fd_begin(cs_fd_t *f, const cs_bezier_t *c, cs_pos_t tol)
     f->done = true;
     if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
         return CS_ERR_DEGREE;
-    if (c->rational)
-        return CS_ERR_UNSUPPORTED;
-    for (unsigned i = 0; i <= c->degree; i++)
+    for (unsigned i = 0; i <= c->degree; i++) {
         if (!cs_fixed_vec_ok(&c->p[i]))
             return CS_ERR_RANGE;
+        if (c->rational && (c->w[i] < CS_WEIGHT_MIN || c->w[i] > CS_WEIGHT_ONE))
+            return CS_ERR_WEIGHT;
+    }
     if (tol < 1 || tol > CS_POS_LIMIT)
         return CS_ERR_TOLERANCE;
+    f->rational = c->rational;
+#if !CS_FD_RATIONAL
+    if (c->rational)
+        return CS_ERR_UNSUPPORTED;
+#else
+    if (c->rational) {
+        /* Output rounding (<= sqrt(3)/2 LSB, the normalised division adds < 2^-30) charged as
+         * 1 LSB; no pre-split: a curve needing more than 2^(60/n) steps is handed back. */
+        if (tol < 2)
+            return CS_ERR_TOLERANCE;
+        unsigned k = cs_fd_rational_k(c, tol - 1);
+        unsigned kmax = cs_fd_kmax(c->degree, CS_FD_RAT_GUARD_BITS, 0);
+        if (k > kmax)
+            return CS_ERR_UNSUPPORTED;
+        f->degree = c->degree;
+        f->k = (uint8_t)k;
+        f->split = 0;
+        f->guard = 0;
+        f->piece = 0;
+        f->step = 0;
+        f->tol_eff = tol - 1;
+        f->curve = *c;
+        rat_init_diffs(c, k, f->rd);
+        f->done = false;
+        return CS_OK;
+    }
+#endif
     unsigned s;
     cs_err_t e = cs_fd_plan(c, tol, CS_FD_GUARD_BITS, 0, &s, &f->tol_eff);
     if (e != CS_OK)
@@ -208,6 +449,25 @@ cs_err_t cs_fd_next(cs_fd_t *f, cs_vec3_t *pt)
      * update there keeps every value a forward difference inside [0, 1] (bounded). */
     uint64_t left = steps - 1 - f->step;
     unsigned top = left < (uint64_t)f->degree - 1u ? (unsigned)left : f->degree - 1u;
+#if CS_FD_RATIONAL
+    if (f->rational) {
+        for (unsigned a = 0; a < 4; a++) {
+            cs_fd_i128_t *d = f->rd[a];
+            d[0] = i128_add(d[0], d[1]);
+            for (unsigned j = 1; j <= top; j++)
+                d[j] = i128_add(d[j], d[j + 1]);
+        }
+        f->step++;
+        cs_err_t e = rat_project(f->rd[0][0], f->rd[3][0], &pt->x);
+        if (e == CS_OK)
+            e = rat_project(f->rd[1][0], f->rd[3][0], &pt->y);
+        if (e == CS_OK)
+            e = rat_project(f->rd[2][0], f->rd[3][0], &pt->z);
+        if (e != CS_OK || f->step == steps)
+            f->done = true;
+        return e;
+    }
+#endif
     for (unsigned a = 0; a < 3; a++) {
         int64_t *d = f->d[a];
         d[0] += d[1];

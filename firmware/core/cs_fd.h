@@ -25,8 +25,23 @@ typedef struct {
     int64_t x, y, z;
 } cs_fd_pt_t;
 
+/* Two's-complement 128-bit integer (rational FD accumulators; no __int128 on small targets). */
+typedef struct {
+    uint64_t lo, hi;
+} cs_fd_i128_t;
+
+/* Rational FD: homogeneous numerator w*P (Q30 x LSB, <= 2^58) and weight w (Q30) differenced
+ * exactly with n*K guard bits in 128 bits: n*K <= CS_FD_RAT_GUARD_BITS. Build with
+ * -DCS_FD_RATIONAL=0 to leave it out (about 18 KB of AVR flash, 512 bytes of state): rational
+ * curves then get CS_ERR_UNSUPPORTED and cs_trace routes them to cs_subdiv. */
+#define CS_FD_RAT_GUARD_BITS 60
+#ifndef CS_FD_RATIONAL
+#define CS_FD_RATIONAL 1
+#endif
+
 typedef struct {
     uint8_t degree;
+    bool rational; /* homogeneous 128-bit differences in rd[] instead of d[] */
     uint8_t k;     /* this piece has 2^k steps */
     uint8_t split; /* the curve is cut into 2^split pieces */
     uint8_t guard; /* fraction bits of the pieces' control points (0 when split == 0) */
@@ -35,6 +50,9 @@ typedef struct {
     uint64_t step;  /* steps done in the current piece */
     cs_pos_t tol_eff;
     int64_t d[3][CS_BEZIER_MAX_POINTS]; /* [axis][order] x 2^(guard + n*k) */
+#if CS_FD_RATIONAL
+    cs_fd_i128_t rd[4][CS_BEZIER_MAX_POINTS]; /* rational: [x, y, z, w][order] x 2^(n*k) */
+#endif
     cs_bezier_t curve;
 } cs_fd_t;
 
@@ -59,9 +77,17 @@ cs_err_t cs_fd_plan(const cs_bezier_t *c, cs_pos_t tol, unsigned bits, unsigned 
 void cs_fd_init_diffs(const cs_fd_pt_t *p, unsigned degree, unsigned k,
                       int64_t d[3][CS_BEZIER_MAX_POINTS]);
 
-/* Start uniform FD of the polynomial c at chord tolerance tol (LSB). CS_ERR_UNSUPPORTED for a
- * rational curve (cs_trace routes those to cs_subdiv), CS_ERR_DEGREE / CS_ERR_RANGE for bad
- * input, CS_ERR_TOLERANCE when tol cannot be met. Bounded work (<= 21 Wang bounds, one piece of
+/* Smallest K such that 2^K uniform chords of the rational curve c are within tol (LSB), from
+ * the conservative bound h^2/8 max|R''| (docs/fixed-point.md); 255 when the bound saturates. */
+#if CS_FD_RATIONAL
+unsigned cs_fd_rational_k(const cs_bezier_t *c, cs_pos_t tol);
+#endif
+
+/* Start uniform FD of c at chord tolerance tol (LSB). Rational curves are differenced in
+ * homogeneous space (128-bit, exact) and divided per vertex; CS_ERR_UNSUPPORTED when a rational
+ * curve would need more than 2^(60/n) steps (cs_trace then routes it to cs_subdiv).
+ * CS_ERR_DEGREE / CS_ERR_RANGE / CS_ERR_WEIGHT for bad input, CS_ERR_TOLERANCE when tol cannot
+ * be met. Bounded work (<= 21 Wang bounds, one piece of
  * <= 20 halvings); not meant for ISRs. */
 cs_err_t cs_fd_begin(cs_fd_t *f, const cs_bezier_t *c, cs_pos_t tol);
 /* Next vertex: n additions per axis (3 for a cubic) and one rounding; CS_END when finished.

@@ -285,11 +285,11 @@ static int64_t iso_accel(const cs_machine_t *m, const int32_t *u1, const int32_t
 }
 
 /* Highest junction speed squared between blocks p and b (b follows p). A vertex of a flattened
- * curve gets the curvature rule; any other turn gets Grbl's junction deviation, capped so that no
- * axis's velocity jumps by more than its acceleration times one segment time. Blocks meeting at a
- * turn taken at speed accelerate at (4/5) a: the remaining fifth absorbs the jump (curves: the
- * normal acceleration). docs/motion.md derives the budget. */
-static int64_t junction_v2(const cs_machine_t *m, cs_block_t *p, cs_block_t *b, bool p_busy)
+ * curve gets the curvature rule; any other turn gets Grbl's junction deviation. Both cap each
+ * axis's velocity jump and cut the two blocks' tangential acceleration so that the jump (and on
+ * curves the normal acceleration) fits the axes' limits: the budget is in cs_planner.h and
+ * docs/motion.md. */
+static int64_t junction_v2(const cs_machine_t *m, cs_block_t *p, cs_block_t *b, bool p_frozen)
 {
     unsigned n = m->n_axes;
     int64_t sum[CS_AXES], diff[CS_AXES];
@@ -304,8 +304,8 @@ static int64_t junction_v2(const cs_machine_t *m, cs_block_t *p, cs_block_t *b, 
     int64_t d = len_n(diff, n);
     if (d == 0 || s >= Q30_ONE)
         return V2_UNLIMITED; /* straight on: no junction limit, no acceleration cut */
-    if (p_busy)
-        return 0; /* the executing block cannot share its acceleration any more: stop */
+    if (p_frozen)
+        return 0; /* p cannot share its acceleration any more: stop */
     int32_t acc = p->accel_axes < b->accel_axes ? p->accel_axes : b->accel_axes;
     cs_pos_t lmin = p->length < b->length ? p->length : b->length;
     int64_t v2 = 0;
@@ -412,8 +412,13 @@ cs_err_t cs_planner_line(cs_planner_t *pl, const cs_pos_t target[CS_AXES], int32
         b->max_entry_v2 = min64(pl->start_v2, nom2); /* from rest */
     } else {
         cs_block_t *p = blk(pl, pl->count - 1u);
-        bool p_busy = pl->busy && pl->count == 1;
-        int64_t v2 = junction_v2(m, p, b, p_busy);
+        /* p's acceleration may be cut by the junction; not when p executes, nor when p is the
+         * first block after it with an entry speed already fixed above rest (its deceleration
+         * from that entry was planned with the full acceleration). Then the turn is from rest. */
+        unsigned first = pl->busy ? 1u : 0u;
+        int64_t fixed = pl->busy ? blk(pl, 0)->exit_v2 : pl->start_v2;
+        bool p_frozen = (pl->busy && pl->count == 1) || (pl->count - 1u == first && fixed > 0);
+        int64_t v2 = junction_v2(m, p, b, p_frozen);
         int64_t pnom2 = (int64_t)p->nominal * p->nominal;
         b->max_entry_v2 = min64(v2, min64(nom2, pnom2));
     }

@@ -1,8 +1,9 @@
-/* cs_segment: trapezoidal profile of one block sampled every segment_ticks. The distance reached
- * at time t is computed in closed form from the phase it falls in (never accumulated), and each
- * axis's step position is round(steps_total * d / L): the difference between two consecutive
- * samples is the segment's steps, so rounding carries from segment to segment and the last
- * sample (d = L) lands exactly on the block's target (docs/motion.md). */
+/* cs_segment: the velocity profile of one block (trapezoid, or S-curve speed changes) sampled
+ * every segment_ticks. The distance reached at time t is computed in closed form from the phase
+ * it falls in (never accumulated), and each axis's step position is the block's exact chord at
+ * that distance, rounded: the difference between two consecutive samples is the segment's steps,
+ * so rounding carries from segment to segment and the last sample (d = L) lands exactly on the
+ * block's target (docs/motion.md). */
 #include "cs_segment.h"
 
 #include <stddef.h>
@@ -150,8 +151,8 @@ static cs_err_t load_block(cs_segment_gen_t *g, const cs_block_t *b)
     int64_t d_dec = (vc * vc - v1 * v1) / (2 * a);
     int64_t vp = vc;
     if (d_acc + d_dec > len) {
-        /* Triangle: the peak where both meet, vp^2 = (2 a L + v0^2 + v1^2) / 2. */
-        int64_t vp2 = (2 * a * len + v0 * v0 + v1 * v1) / 2;
+        /* Triangle: the peak where both meet, vp^2 = a L + (v0^2 + v1^2) / 2 (each term < 2^62). */
+        int64_t vp2 = a * len + v0 * v0 / 2 + v1 * v1 / 2;
         vp = cs_planner_speed(vp2);
         if (vp < v0)
             vp = v0;

@@ -1,7 +1,7 @@
 /* cs_trace: one front for the three tracers (see cs_trace.h). It checks the tolerance, picks the
- * engine (rational curves cannot be forward-differenced exactly in int64, see
- * docs/fixed-point.md, so FD and AFD hand them to homogeneous subdivision) and caps the vertex
- * count so no caller can be made to loop forever. */
+ * engine (AFD does not difference rational curves, and FD hands back those that would need too
+ * many steps for its 128-bit format: both then go to homogeneous subdivision, see
+ * docs/fixed-point.md) and caps the vertex count so no caller can be made to loop forever. */
 #include "cs_trace.h"
 
 CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_subdiv);
@@ -21,12 +21,16 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
     if (method == CS_TRACE_SUBDIV) {
         tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
         e = cs_subdiv_begin(&tr->u.sd, c, tol, true);
-    } else if (c->rational) {
-        tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
-        e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
     } else if (method == CS_TRACE_FD) {
         tr->impl = CS_TRACE_IMPL_FD;
         e = cs_fd_begin(&tr->u.fd, c, tol);
+        if (e == CS_ERR_UNSUPPORTED) { /* rational curve needing more than 2^(60/n) steps */
+            tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
+            e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
+        }
+    } else if (c->rational) {
+        tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
+        e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
     } else {
         tr->impl = CS_TRACE_IMPL_AFD;
         e = cs_afd_begin(&tr->u.afd, c, tol);

@@ -28,8 +28,9 @@ typedef enum {
  * running on (none does for valid input: FD <= 2^(20+30), subdivision <= 2^depth). */
 #define CS_TRACE_MAX_VERTICES ((uint32_t)1 << 26)
 
-/* Which engine a cs_trace_t runs: rational curves asked for FD or AFD are traced by dyadic
- * homogeneous subdivision (see docs/fixed-point.md); CS_TRACE_SUBDIV runs the reach tracer. */
+/* Which engine a cs_trace_t runs: rational curves asked for AFD, or for FD when they would need
+ * more than 2^(60/n) uniform steps, are traced by dyadic homogeneous subdivision (see
+ * docs/fixed-point.md); CS_TRACE_SUBDIV runs the reach tracer. */
 typedef enum {
     CS_TRACE_IMPL_FD = 0,
     CS_TRACE_IMPL_AFD = 1,

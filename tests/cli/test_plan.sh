@@ -84,7 +84,21 @@ for f in tests/data/svg/*/*.svg; do
     fi
 done
 
-# 8. --help tells the truth and exits 0.
+# 8. G-code (arcs in each plane, a helix with --lenient for its G42/D words) and HP-GL: the
+#    job's own F and G0 rapids are planned, and the replay passes every check.
+for f in tests/data/gcode/arc-xy-plane.nc tests/data/gcode/arc-zx-plane.nc \
+    tests/data/gcode/one-inch-circle.nc tests/data/gcode/helical-thread-milling.nc \
+    tests/data/hpgl/feature-exercise.plt; do
+    if "$CS" plan --lenient "$f" -o "$T/g.txt" 2>/dev/null &&
+        "$SIM" --replay "$T/g.txt" --reference "$f" --lenient --check >"$T/g.out" 2>/dev/null; then
+        ok
+    else
+        bad "plan + replay --check on $f"
+        cat "$T/g.out"
+    fi
+done
+
+# 9. --help tells the truth and exits 0.
 "$CS" plan --help >"$T/h1.txt"; rc=$?
 expect "plan --help" [ $rc -eq 0 ]
 expect "plan --help text" grep -q 'usage: curvestep plan' "$T/h1.txt"

@@ -4,7 +4,7 @@
  * holds, for every degree (error <= 1/2 LSB per axis, so <= 1 LSB). Also: the initial
  * differences equal the exact ones, the dyadic pieces used beyond the longest run are within
  * their rounding budget, Wang's step count keeps chords within tol (and is tight for a
- * parabola), and bad input is refused. */
+ * parabola), rational curves are differenced exactly in 128 bits, and bad input is refused. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -265,6 +265,65 @@ static void test_wang_bound(void **state)
     }
 }
 
+/* Rational curves: homogeneous differences are exact in 128 bits, so each vertex is the exact
+ * rational point at t = i / 2^K rounded once; the step count comes from the conservative bound
+ * h^2/8 max|R''|, so every chord is within tol. */
+static void test_rational(void **state)
+{
+    (void)state;
+    static cs_fd_t f;
+    const double tols[3] = {0.1, 0.01, 0.001};
+    rng = 31;
+    int handed_back = 0, traced = 0;
+    for (int k = 0; k < 40; k++) {
+        cs_bezier_t c;
+        memset(&c, 0, sizeof c);
+        c.rational = true;
+        if (k == 0) { /* quarter circle, r = 50 mm */
+            c.degree = 2;
+            c.p[0] = cs_fixed_vec(50 * 65536, 0, 0);
+            c.p[1] = cs_fixed_vec(50 * 65536, 50 * 65536, 0);
+            c.p[2] = cs_fixed_vec(0, 50 * 65536, 0);
+            c.w[0] = c.w[2] = CS_WEIGHT_ONE;
+            c.w[1] = (cs_weight_t)lround(0.70710678118654752 * CS_WEIGHT_ONE);
+        } else {
+            c.degree = (uint8_t)(2 + k % 6);
+            for (unsigned i = 0; i <= c.degree; i++) {
+                c.p[i].x = (cs_pos_t)((unit() * 2 - 1) * 100 * 65536);
+                c.p[i].y = (cs_pos_t)((unit() * 2 - 1) * 100 * 65536);
+                c.p[i].z = (cs_pos_t)((unit() * 2 - 1) * 10 * 65536);
+                c.w[i] = (cs_weight_t)((0.05 + 0.95 * unit()) * CS_WEIGHT_ONE);
+            }
+        }
+        for (int ti = 0; ti < 3; ti++) {
+            cs_pos_t tol = (cs_pos_t)lround(tols[ti] * 65536);
+            cs_err_t e = cs_fd_begin(&f, &c, tol);
+            if (e == CS_ERR_UNSUPPORTED) {
+                handed_back++;
+                continue;
+            }
+            assert_int_equal(e, CS_OK);
+            traced++;
+            size_t nv = trace(&f, &c, tol);
+            assert_int_equal(nv, (size_t)1 << f.k);
+            double err = max_axis_error(&c, nv);
+            if (!(err <= 0.5 + 1e-6))
+                fail_msg("rational degree %u: vertex %.6f LSB off its exact point", c.degree, err);
+            double dev = cs_ref_max_deviation(&c, verts, nv);
+            if (!(dev <= tols[ti]))
+                fail_msg("rational degree %u tol %g: deviation %.9g", c.degree, tols[ti], dev);
+            assert_true(verts[nv - 1].x == c.p[c.degree].x && verts[nv - 1].y == c.p[c.degree].y &&
+                        verts[nv - 1].z == c.p[c.degree].z);
+            if (k == 0)
+                print_message("  quarter circle r = 50 mm, tol %g: 2^%u chords (greedy %zu)\n",
+                              tols[ti], f.k, cs_ref_greedy_count(&c, tols[ti]));
+        }
+    }
+    print_message("  rational: %d traced by FD, %d handed back (more than 2^(60/n) steps)\n",
+                  traced, handed_back);
+    assert_true(traced > 60);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -273,9 +332,12 @@ static void test_errors(void **state)
     cs_vec3_t v;
     c.rational = true;
     for (int i = 0; i < 4; i++)
-        c.w[i] = CS_WEIGHT_ONE;
-    assert_int_equal(cs_fd_begin(&f, &c, 100), CS_ERR_UNSUPPORTED);
+        c.w[i] = CS_WEIGHT_MIN;
+    c.w[1] = CS_WEIGHT_ONE; /* 2^20 weight ratio at 4 km: more than 2^20 steps, handed back */
+    assert_int_equal(cs_fd_begin(&f, &c, 2), CS_ERR_UNSUPPORTED);
     assert_int_equal(cs_fd_next(&f, &v), CS_END);
+    c.w[2] = 0;
+    assert_int_equal(cs_fd_begin(&f, &c, 100), CS_ERR_WEIGHT);
     c.rational = false;
     assert_int_equal(cs_fd_begin(&f, &c, 0), CS_ERR_TOLERANCE);
     assert_int_equal(cs_fd_begin(&f, &c, 1), CS_ERR_TOLERANCE); /* no room for the rounding */
@@ -305,6 +367,7 @@ int main(void)
         cmocka_unit_test(test_init_diffs_exact),
         cmocka_unit_test(test_piece_rounding),
         cmocka_unit_test(test_wang_bound),
+        cmocka_unit_test(test_rational),
         cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -226,6 +226,40 @@ static void test_passes_keep_every_block_reachable(void **state)
     }
 }
 
+/* S-curve planning: every change between consecutive entry speeds (and to the final stop) fits
+ * its block: (v1 + v2) / 2 * max(1.5 |dv| / a, sqrt(6 |dv| / j)) <= L, in double. */
+static void test_scurve_passes_fit_every_change(void **state)
+{
+    (void)state;
+    cs_machine_t m = machine;
+    m.profile = CS_PROFILE_SCURVE;
+    m.max_jerk = 20000;
+    cs_planner_t pl;
+    assert_int_equal(cs_planner_init(&pl, &m), CS_OK);
+    rng = 777;
+    double x = 0, y = 0;
+    for (int k = 0; k < 600; k++) {
+        if (cs_planner_full(&pl)) {
+            assert_non_null(cs_planner_begin_head(&pl));
+            cs_planner_end_head(&pl);
+        }
+        double len = urand(0.05, 15), ang = k % 3 ? 0.05 * sin(0.3 * k) : urand(-M_PI, M_PI);
+        x = fmin(fmax(x + len * cos(ang), -900), 900);
+        y = fmin(fmax(y + len * sin(ang), -900), 900);
+        assert_int_equal(line_mm(&pl, x, y, 0, urand(5, 200)), CS_OK);
+        unsigned n = cs_planner_count(&pl);
+        for (unsigned i = pl.busy ? 1 : 0; i < n; i++) {
+            const cs_block_t *b = cs_planner_block(&pl, i);
+            double v1 = sqrt(b->entry_v2 / Q32);
+            double v2 = i + 1 < n ? sqrt(cs_planner_block(&pl, i + 1)->entry_v2 / Q32) : 0;
+            double a = b->accel / Q16, dv = fabs(v2 - v1), L = b->length / Q16;
+            double T = fmax(1.5 * dv / a, sqrt(6 * dv / m.max_jerk));
+            assert_true((v1 + v2) / 2 * T <= L * (1 + 1e-6) + 1e-6);
+            assert_true(v1 <= b->nominal / Q16 + 1e-6);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -236,6 +270,7 @@ int main(void)
         cmocka_unit_test_setup(test_collinear_chords_do_not_slow, setup),
         cmocka_unit_test_setup(test_curvature_rule_on_flattened_circle, setup),
         cmocka_unit_test_setup(test_passes_keep_every_block_reachable, setup),
+        cmocka_unit_test_setup(test_scurve_passes_fit_every_change, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,11 +17,16 @@
 
 #include <cmocka.h>
 
+#include "cs_ref.h"
 #include "cs_svgdoc.h"
+#include "cs_trace.h"
 
 #define LSB    (1.0 / 65536.0)
 #define PT_TOL (0.5 * LSB + 1e-9)
-#define DATA   "tests/data/svg/"
+/* Arc points: cs_arc_build keeps within 2 LSB of the ellipse its quantised centre and axes
+ * describe; each of those is rounded once more (up to 1 LSB per coordinate): 4 LSB in all. */
+#define ARC_TOL (4.0 * LSB)
+#define DATA    "tests/data/svg/"
 
 static cs_path_t P;
 static cs_path_diag_t D;
@@ -101,6 +106,50 @@ static const cs_vec3_t *last_pt(void)
     return &c->p[c->degree];
 }
 
+/* Keeps only the elements that come from <path> data: a shape's elements carry the position of
+ * its start tag ('<' in the file), a path's the position of a command inside its 'd'. Subpaths
+ * are renumbered. Returns how many elements were dropped. */
+static size_t drop_shapes(const char *file)
+{
+    FILE *f = fopen(file, "rb");
+    assert_non_null(f);
+    static char buf[1 << 16];
+    size_t len = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[len] = '\0';
+    size_t k = 0, dropped = 0;
+    unsigned last_in = (unsigned)-1, sub = (unsigned)-1;
+    for (size_t i = 0; i < P.n; i++) {
+        /* Byte offset of (line, col): columns count characters (UTF-8 lead bytes). */
+        unsigned line = 1, col = 1;
+        size_t off = 0;
+        while (off < len && (line < P.elems[i].loc.line || col < P.elems[i].loc.col)) {
+            if (buf[off] == '\n') {
+                line++;
+                col = 1;
+            } else if (((unsigned char)buf[off] & 0xC0) != 0x80 && buf[off] != '\r') {
+                col++;
+            }
+            off++;
+            while (off < len && ((unsigned char)buf[off] & 0xC0) == 0x80)
+                off++;
+        }
+        if (buf[off] == '<') {
+            dropped++;
+            continue;
+        }
+        if (P.elems[i].subpath != last_in) {
+            last_in = P.elems[i].subpath;
+            sub++;
+        }
+        P.elems[k] = P.elems[i];
+        P.elems[k++].subpath = sub;
+    }
+    P.n = k;
+    P.nsubpaths = sub + 1;
+    return dropped;
+}
+
 /* --- the resvg path tests -------------------------------------------------------------- */
 
 typedef struct {
@@ -162,6 +211,18 @@ static void test_resvg_files(void **state)
         cs_err_t e = read_file(name);
         if (e != CS_OK)
             fail_msg("%s: %d %s", c->file, e, D.reason);
+        /* Each file ends with the frame <rect x=1 y=1 width=198 height=198 fill=none
+         * stroke=black>: drawn as 4 lines, a subpath of its own. */
+        assert_true(P.n >= 4);
+        static const double fr[5][2] = {{1, 1}, {199, 1}, {199, 199}, {1, 199}, {1, 1}};
+        for (size_t j = 0; j < 4; j++) {
+            const cs_path_elem_t *el = &P.elems[P.n - 4 + j];
+            assert_int_equal(el->kind, CS_PATH_LINE);
+            assert_int_equal(el->subpath, P.nsubpaths - 1);
+            expect_pt(&el->curve.p[0], fr[j][0], fr[j][1]);
+            expect_pt(&el->curve.p[1], fr[j + 1][0], fr[j + 1][1]);
+        }
+        assert_int_equal(drop_shapes(name), 4);
         unsigned k[5] = {0, 0, 0, 0, 0};
         for (size_t j = 0; j < P.n; j++)
             k[P.elems[j].kind]++;
@@ -175,11 +236,14 @@ static void test_resvg_files(void **state)
             expect_pt(first_pt(), c->x0, c->y0);
             expect_pt(last_pt(), c->x1, c->y1);
         }
-        /* One <path> each, and the frame <rect> is reported (once) as not drawn. */
+        /* One <path> and one shape each, both drawn; a filled path says fills are drawn as
+         * outlines (the only warning). */
         assert_int_equal(S.paths, 1);
-        assert_int_equal(nwarn, 1);
-        assert_non_null(strstr(last_warn, "<rect>"));
-        assert_int_equal(S.ignored, 1);
+        assert_int_equal(S.shapes, 1);
+        assert_int_equal(S.ignored, 0);
+        assert_true(nwarn <= 1);
+        if (nwarn == 1)
+            assert_non_null(strstr(last_warn, "fills are not drawn"));
     }
 }
 
@@ -273,6 +337,24 @@ static void test_w3c_01_cubics(void **state)
     assert_int_equal(read_file(file), CS_OK);
     markers_t m;
     read_markers(file, true, &m);
+    /* Every 4x4 marker square (filled, not stroked) is drawn as its outline: a closed
+     * 4-line subpath from its corner (x, y) = centre - (2, 2), clockwise on the page. */
+    for (int i = 0; i < m.n; i++) {
+        bool found = false;
+        for (size_t j = 0; j + 3 < P.n && !found; j++) {
+            const cs_path_elem_t *el = &P.elems[j];
+            if (el->kind != CS_PATH_LINE || !pt_is(&el->curve.p[0], m.x[i] - 2, m.y[i] - 2))
+                continue;
+            found = pt_is(&el[0].curve.p[1], m.x[i] + 2, m.y[i] - 2) &&
+                    pt_is(&el[1].curve.p[1], m.x[i] + 2, m.y[i] + 2) &&
+                    pt_is(&el[2].curve.p[1], m.x[i] - 2, m.y[i] + 2) &&
+                    pt_is(&el[3].curve.p[1], m.x[i] - 2, m.y[i] - 2) &&
+                    el[3].subpath == el[0].subpath;
+        }
+        if (!found)
+            fail_msg("marker (%g, %g) is not drawn as a square", m.x[i], m.y[i]);
+    }
+    assert_true(drop_shapes(file) >= 4 * (size_t)m.n);
     assert_int_equal(S.paths, 8);
     for (size_t i = 0; i < P.n; i++) {
         const cs_bezier_t *c = &P.elems[i].curve;
@@ -297,6 +379,7 @@ static void test_w3c_02_quadratics(void **state)
     (void)state;
     const char *file = DATA "w3c/paths-data-02-t.svg";
     assert_int_equal(read_file(file), CS_OK);
+    drop_shapes(file);
     markers_t m;
     read_markers(file, true, &m);
     for (size_t i = 0; i < P.n; i++) {
@@ -324,6 +407,7 @@ static void test_w3c_12_polybezier(void **state)
     (void)state;
     const char *file = DATA "w3c/paths-data-12-t.svg";
     assert_int_equal(read_file(file), CS_OK);
+    drop_shapes(file);
     markers_t m;
     read_markers(file, false, &m);
     assert_int_equal(P.n, 4);
@@ -360,6 +444,7 @@ static void test_w3c_14_initial_relative_moveto(void **state)
 {
     (void)state;
     assert_int_equal(read_file(DATA "w3c/paths-data-14-t.svg"), CS_OK);
+    assert_int_equal(drop_shapes(DATA "w3c/paths-data-14-t.svg"), 4); /* the test frame */
     static const double lines[13][5] = {
         /* subpath, x0, y0, x1, y1 (user units) */
         {0, 62, 56, 113.96152, 146},
@@ -520,8 +605,9 @@ static void test_transforms(void **state)
 static void test_skipped_content(void **state)
 {
     (void)state;
-    /* Paths in <defs> are not drawn; shapes warn once per kind; a path without d draws
-     * nothing; foreign-namespace elements are ignored; svg-prefixed elements are read. */
+    /* Paths in <defs> are not drawn (said once); shapes without a size draw nothing; a path
+     * without d draws nothing; foreign-namespace elements are ignored; svg-prefixed elements
+     * are read; the drawn path is filled (the default paint): said once. */
     const char *doc = "<svg xmlns='http://www.w3.org/2000/svg' xmlns:x='urn:x'>"
                       "<defs><path d='M0 0 L1 1'/></defs>"
                       "<rect/><rect/><circle/>"
@@ -533,8 +619,10 @@ static void test_skipped_content(void **state)
     assert_int_equal(P.n, 1);
     expect_pt(&P.elems[0].curve.p[1], 2, 2);
     assert_int_equal(S.paths, 3); /* defs path, empty path, drawn path */
-    assert_int_equal(nwarn, 3);   /* hidden path, rect (once), circle */
-    assert_int_equal(S.ignored, 4);
+    assert_int_equal(S.shapes, 3);
+    assert_int_equal(nwarn, 2); /* hidden path, fill */
+    assert_non_null(strstr(last_warn, "fills are not drawn"));
+    assert_int_equal(S.ignored, 1);
     assert_int_equal(read_text("<s:svg xmlns:s='http://www.w3.org/2000/svg'>"
                                "<s:path d='M0 0 L1 1'/></s:svg>"),
                      CS_OK);
@@ -550,6 +638,492 @@ static void test_skipped_content(void **state)
     assert_string_equal(D.loc.file, DATA "no-such-file.svg");
 }
 
+/* --- basic shapes ----------------------------------------------------------------------------- */
+
+/* Distance from (px, py) to the ellipse (cx, cy, rx, ry) (axis-aligned), in double: the best of
+ * 720 parameters, refined by golden section. */
+static double ellipse_dist(double px, double py, double cx, double cy, double rx, double ry)
+{
+    double best = HUGE_VAL, bt = 0.0;
+    for (int i = 0; i < 720; i++) {
+        double t = i * (2 * M_PI / 720);
+        double d = hypot(cx + rx * cos(t) - px, cy + ry * sin(t) - py);
+        if (d < best) {
+            best = d;
+            bt = t;
+        }
+    }
+    double a = bt - 2 * M_PI / 720, b = bt + 2 * M_PI / 720, g = (sqrt(5.0) - 1) / 2;
+    for (int i = 0; i < 80; i++) {
+        double t1 = b - g * (b - a), t2 = a + g * (b - a);
+        double d1 = hypot(cx + rx * cos(t1) - px, cy + ry * sin(t1) - py);
+        double d2 = hypot(cx + rx * cos(t2) - px, cy + ry * sin(t2) - py);
+        if (d1 < d2)
+            b = t2;
+        else
+            a = t1;
+    }
+    double t = (a + b) / 2, d = hypot(cx + rx * cos(t) - px, cy + ry * sin(t) - py);
+    return d < best ? d : best;
+}
+
+/* Distance from (px, py) to the outline of the rounded rectangle (x, y, w, h, rx, ry). */
+static double rrect_dist(double px, double py, double x, double y, double w, double h, double rx,
+                         double ry)
+{
+    double best = HUGE_VAL;
+    /* The four straight sides (between the corners). */
+    double sx[4][4] = {{x + rx, y, x + w - rx, y},
+                       {x + w, y + ry, x + w, y + h - ry},
+                       {x + rx, y + h, x + w - rx, y + h},
+                       {x, y + ry, x, y + h - ry}};
+    for (int i = 0; i < 4; i++) {
+        cs_ref_vec_t p = {px, py, 0}, a = {sx[i][0], sx[i][1], 0}, b = {sx[i][2], sx[i][3], 0};
+        double d = cs_ref_dist_point_segment(p, a, b);
+        best = d < best ? d : best;
+    }
+    /* The corners: the quarter of each corner ellipse facing out. */
+    double cc[4][2] = {
+        {x + rx, y + ry}, {x + w - rx, y + ry}, {x + w - rx, y + h - ry}, {x + rx, y + h - ry}};
+    for (int i = 0; i < 4; i++) {
+        bool right = i == 1 || i == 2, below = i >= 2;
+        if ((px >= cc[i][0]) == right && (py >= cc[i][1]) == below) {
+            double d = ellipse_dist(px, py, cc[i][0], cc[i][1], rx, ry);
+            best = d < best ? d : best;
+        }
+    }
+    return best;
+}
+
+/* Every element samples (33 per element) within tol of the outline `dist` describes, the
+ * elements chained end to start in one subpath that closes. */
+static void expect_closed_outline(double (*dist)(double, double, const double *), const double *a,
+                                  double tol)
+{
+    assert_true(P.n > 0);
+    for (size_t i = 0; i < P.n; i++) {
+        assert_int_equal(P.elems[i].subpath, P.elems[0].subpath);
+        const cs_bezier_t *c = &P.elems[i].curve;
+        if (i + 1 < P.n) {
+            const cs_vec3_t *e = &c->p[c->degree], *n = &P.elems[i + 1].curve.p[0];
+            assert_true(e->x == n->x && e->y == n->y);
+        }
+        for (int k = 0; k <= 32; k++) {
+            cs_ref_vec_t q = cs_ref_eval(c, k / 32.0);
+            double d = dist(q.x, q.y, a);
+            if (d > tol)
+                fail_msg("element %zu at t=%g: (%.9f, %.9f) is %.3g mm off the outline", i,
+                         k / 32.0, q.x, q.y, d);
+        }
+    }
+    const cs_bezier_t *l = &P.elems[P.n - 1].curve;
+    assert_true(l->p[l->degree].x == first_pt()->x && l->p[l->degree].y == first_pt()->y);
+}
+
+static double rrect_fn(double x, double y, const double *a)
+{
+    return rrect_dist(x, y, a[0], a[1], a[2], a[3], a[4], a[5]);
+}
+
+static double ellipse_fn(double x, double y, const double *a)
+{
+    return ellipse_dist(x, y, a[0], a[1], a[2], a[3]);
+}
+
+static void test_rect(void **state)
+{
+    (void)state;
+    /* Plain: 4 lines clockwise on the page from (x, y). Stroked, not filled: no warning. */
+    assert_int_equal(read_text("<svg><rect x='10' y='20' width='30' height='40' stroke='black' "
+                               "fill='none'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 4);
+    static const double v[5][2] = {{10, 20}, {40, 20}, {40, 60}, {10, 60}, {10, 20}};
+    for (size_t i = 0; i < 4; i++) {
+        assert_int_equal(P.elems[i].kind, CS_PATH_LINE);
+        expect_pt(&P.elems[i].curve.p[0], v[i][0], v[i][1]);
+        expect_pt(&P.elems[i].curve.p[1], v[i + 1][0], v[i + 1][1]);
+    }
+    assert_int_equal(S.shapes, 1);
+    assert_int_equal(nwarn, 0);
+    /* Rounded, rx only: ry = rx ("auto"); 4 sides and 4 quarter-circle corners. */
+    assert_int_equal(read_text("<svg><rect x='5' y='7' width='100' height='50' rx='10'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 8);
+    const double a1[6] = {5, 7, 100, 50, 10, 10};
+    expect_closed_outline(rrect_fn, a1, ARC_TOL);
+    expect_pt(first_pt(), 15, 7);
+    assert_int_equal(nwarn, 1); /* filled (the default), drawn as its outline: said once */
+    /* ry only, and different radii. */
+    assert_int_equal(read_text("<svg><rect width='40' height='30' ry='6'/>"
+                               "<rect x='50' width='40' height='30' rx='8' ry='3'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 16);
+    assert_int_equal(nwarn, 1);
+    size_t n = P.n;
+    P.n = 8;
+    const double a2[6] = {0, 0, 40, 30, 6, 6};
+    expect_closed_outline(rrect_fn, a2, ARC_TOL);
+    memmove(P.elems, P.elems + 8, 8 * sizeof *P.elems);
+    P.n = n - 8;
+    const double a3[6] = {50, 0, 40, 30, 8, 3};
+    expect_closed_outline(rrect_fn, a3, ARC_TOL);
+    /* Radii clamped to half the width / height: rx 15 -> 10, so no top and bottom sides
+     * (2 sides + 4 corners); ry 30 alone: rx = ry = 30 first, then clamped to 20 and 5: the
+     * ellipse inscribed in the rectangle (4 corners, no sides). */
+    assert_int_equal(read_text("<svg><rect width='20' height='10' rx='15' ry='3'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 6);
+    const double a4[6] = {0, 0, 20, 10, 10, 3};
+    expect_closed_outline(rrect_fn, a4, ARC_TOL);
+    assert_int_equal(read_text("<svg><rect width='40' height='10' ry='30'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 4);
+    const double a5[6] = {0, 0, 40, 10, 20, 5};
+    expect_closed_outline(rrect_fn, a5, ARC_TOL);
+    /* Zero width or height: nothing; negative: an error at the value. */
+    assert_int_equal(read_text("<svg><rect width='0' height='10'/><rect width='5'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 0);
+    assert_int_equal(read_text("<svg>\n<rect width='-5' height='1'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.line, 2);
+    assert_int_equal(D.loc.col, 14);
+    assert_non_null(strstr(D.reason, "width"));
+    assert_int_equal(read_text("<svg><rect width='5' height='1' rx='-1'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(read_text("<svg><rect width='5x' height='1'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 20); /* at the unit */
+    assert_int_equal(read_text("<svg><rect width='5em' height='1'/></svg>"), CS_ERR_PARSE);
+}
+
+static void test_circle_ellipse(void **state)
+{
+    (void)state;
+    /* Circle: 4 quarter pieces from (cx + r, cy), in the positive angle direction (towards +y),
+     * through (cx, cy + r) after the first quarter. */
+    assert_int_equal(read_text("<svg><circle cx='50' cy='40' r='20'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 4);
+    for (size_t i = 0; i < 4; i++)
+        assert_int_equal(P.elems[i].kind, CS_PATH_ARC);
+    expect_pt(first_pt(), 70, 40);
+    assert_true(fabs(P.elems[0].curve.p[2].x * LSB - 50) <= ARC_TOL + PT_TOL);
+    assert_true(fabs(P.elems[0].curve.p[2].y * LSB - 60) <= ARC_TOL + PT_TOL);
+    const double c1[4] = {50, 40, 20, 20};
+    expect_closed_outline(ellipse_fn, c1, ARC_TOL);
+    /* Ellipse; one radius alone stands for both; zero draws nothing. */
+    assert_int_equal(read_text("<svg><ellipse cx='100' cy='50' rx='30' ry='10'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 4);
+    expect_pt(first_pt(), 130, 50);
+    const double e1[4] = {100, 50, 30, 10};
+    expect_closed_outline(ellipse_fn, e1, ARC_TOL);
+    assert_int_equal(read_text("<svg><ellipse cx='1' cy='2' ry='3'/></svg>"), CS_OK);
+    const double e2[4] = {1, 2, 3, 3};
+    expect_closed_outline(ellipse_fn, e2, ARC_TOL);
+    assert_int_equal(read_text("<svg><circle r='0'/><circle cx='5'/><ellipse rx='0' ry='4'/>"
+                               "</svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 0);
+    assert_int_equal(read_text("<svg><circle r='-2'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 17);
+    /* A circle leaving the +/-4096 mm range: a range error at the element. */
+    assert_int_equal(read_text("<svg>\n  <circle cx='4000' r='100'/></svg>"), CS_ERR_RANGE);
+    assert_int_equal(D.loc.line, 2);
+    assert_int_equal(D.loc.col, 3);
+}
+
+static void test_line_poly(void **state)
+{
+    (void)state;
+    assert_int_equal(read_text("<svg><line x1='1' y1='2' x2='3' y2='4' stroke='black'/>"
+                               "<line x1='9' y1='9' x2='8' y2='8'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1); /* the second one has no stroke: a line has nothing to fill */
+    expect_pt(&P.elems[0].curve.p[0], 1, 2);
+    expect_pt(&P.elems[0].curve.p[1], 3, 4);
+    assert_int_equal(S.ignored, 1);
+    assert_int_equal(nwarn, 0);
+    /* Polyline open, polygon closed; numbers in every form. */
+    assert_int_equal(read_text("<svg fill='none' stroke='red'>"
+                               "<polyline points='0,0 10,0 10,10'/>"
+                               "<polygon points=' 1e1,-2 +3 .5,7-1 '/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 5);
+    assert_int_equal(P.nsubpaths, 2);
+    expect_pt(&P.elems[1].curve.p[0], 10, 0);
+    expect_pt(&P.elems[1].curve.p[1], 10, 10);
+    static const double g[4][2] = {{10, -2}, {3, 0.5}, {7, -1}, {10, -2}};
+    for (size_t i = 0; i < 3; i++) {
+        expect_pt(&P.elems[2 + i].curve.p[0], g[i][0], g[i][1]);
+        expect_pt(&P.elems[2 + i].curve.p[1], g[i + 1][0], g[i + 1][1]);
+        assert_int_equal(P.elems[2 + i].subpath, 1);
+    }
+    /* One point draws nothing. */
+    assert_int_equal(read_text("<svg stroke='red'><polyline points='5 5'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 0);
+    /* An odd number of coordinates: at the end of the list (the closing quote, column 28). */
+    assert_int_equal(read_text("<svg><polygon points='1 2 3'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.line, 1);
+    assert_int_equal(D.loc.col, 28);
+    /* Path commands are not allowed in a points list: at the 'L' (column 28). */
+    assert_int_equal(read_text("<svg><polyline points='1 2 L 3 4'/></svg>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 28);
+}
+
+/* Every transform on a circle: each traced point, mapped back by the inverse transform
+ * (computed here in double), lies on the original circle, to the arc tolerance stretched by the
+ * inverse's largest singular value. */
+static void test_shape_transforms(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *t;
+        double m[6];
+    } cases[] = {
+        {"matrix(1 2 3 4 5 6)", {1, 2, 3, 4, 5, 6}}, {"translate(5 6)", {1, 0, 0, 1, 5, 6}},
+        {"translate(7)", {1, 0, 0, 1, 7, 0}},        {"scale(2 3)", {2, 0, 0, 3, 0, 0}},
+        {"scale(-1.5)", {-1.5, 0, 0, -1.5, 0, 0}},   {"rotate(30)", {0, 0, 0, 0, 0, 0}},
+        {"rotate(30 10 20)", {0, 0, 0, 0, 0, 0}},    {"skewX(20)", {1, 0, 0, 1, 0, 0}},
+        {"skewY(-15)", {1, 0, 0, 1, 0, 0}},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        double m[6];
+        memcpy(m, cases[i].m, sizeof m);
+        double r = 30 * M_PI / 180;
+        if (i == 5 || i == 6) {
+            m[0] = cos(r);
+            m[1] = sin(r);
+            m[2] = -sin(r);
+            m[3] = cos(r);
+            if (i == 6) { /* about (10, 20) */
+                m[4] = 10 - m[0] * 10 - m[2] * 20;
+                m[5] = 20 - m[1] * 10 - m[3] * 20;
+            }
+        } else if (i == 7) {
+            m[2] = tan(20 * M_PI / 180);
+        } else if (i == 8) {
+            m[1] = tan(-15 * M_PI / 180);
+        }
+        char doc[256];
+        snprintf(doc, sizeof doc,
+                 "<svg><g transform='translate(100 100)'><circle cx='10' cy='20' r='5' "
+                 "transform='%s'/></g></svg>",
+                 cases[i].t);
+        if (read_text(doc) != CS_OK)
+            fail_msg("%s: %s", cases[i].t, D.reason);
+        assert_int_equal(P.n, 4);
+        double det = m[0] * m[3] - m[1] * m[2];
+        double ia = m[3] / det, ib = -m[1] / det, ic = -m[2] / det, id = m[0] / det;
+        /* Largest singular value of the inverse's linear part. */
+        double s1 = ia * ia + ib * ib + ic * ic + id * id;
+        double s2 = sqrt(s1 * s1 - 4 * (ia * id - ib * ic) * (ia * id - ib * ic));
+        double norm = sqrt((s1 + s2) / 2);
+        for (size_t e = 0; e < P.n; e++)
+            for (int k = 0; k <= 32; k++) {
+                cs_ref_vec_t q = cs_ref_eval(&P.elems[e].curve, k / 32.0);
+                double x = q.x - 100 - m[4], y = q.y - 100 - m[5];
+                double ux = ia * x + ic * y, uy = ib * x + id * y;
+                double d = fabs(hypot(ux - 10, uy - 20) - 5);
+                if (d > ARC_TOL * norm)
+                    fail_msg("%s: point off the circle by %.3g user units", cases[i].t, d);
+            }
+    }
+    /* Nested groups compose parent * child: scale(2) inside translate(100, 0). */
+    assert_int_equal(read_text("<svg><g transform='translate(100,0)'><g transform='scale(2)'>"
+                               "<rect x='1' y='2' width='3' height='4' transform='translate(1 1)'/>"
+                               "</g></g></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 104, 6);
+    expect_pt(&P.elems[1].curve.p[1], 110, 14);
+}
+
+static void test_units_viewbox(void **state)
+{
+    (void)state;
+    /* viewBox 200 x 100 on 100 mm x 50 mm: half a millimetre per user unit. */
+    assert_int_equal(read_text("<svg width='100mm' height='50mm' viewBox='0 0 200 100'>"
+                               "<path d='M0 0 L200 100'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 0, 0);
+    expect_pt(&P.elems[0].curve.p[1], 100, 50);
+    /* Units: a 1-unit viewBox on one inch written in each unit. */
+    static const char *const inch[] = {"25.4mm", "2.54cm", "1in", "72pt", "6pc", "96px", "96"};
+    for (size_t i = 0; i < sizeof inch / sizeof inch[0]; i++) {
+        char doc[200];
+        snprintf(doc, sizeof doc,
+                 "<svg width='%s' height='%s' viewBox='0 0 1 1'><path d='M0 0 L1 1'/></svg>",
+                 inch[i], inch[i]);
+        assert_int_equal(read_text(doc), CS_OK);
+        expect_pt(&P.elems[0].curve.p[1], 25.4, 25.4);
+    }
+    /* Size without viewBox: user units are px (96 per inch). */
+    assert_int_equal(read_text("<svg width='4in' height='2in'><path d='M96 0 L0 192'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 25.4, 0);
+    expect_pt(&P.elems[0].curve.p[1], 0, 50.8);
+    /* preserveAspectRatio: viewBox 100 x 100 on 100 mm x 50 mm; the point (100, 100). */
+    static const struct {
+        const char *par;
+        double x, y, ox, oy; /* image of (100, 100) and of (0, 0) */
+    } par[] = {
+        {NULL, 75, 50, 25, 0}, /* default xMidYMid meet: 0.5, centred in x */
+        {"xMinYMin", 50, 50, 0, 0},
+        {"xMaxYMax meet", 100, 50, 50, 0},
+        {"xMidYMid slice", 100, 75, 0, -25},
+        {"xMinYMax slice", 100, 50, 0, -50},
+        {"none", 100, 50, 0, 0},
+        {"defer xMaxYMid", 100, 50, 50, 0},
+    };
+    for (size_t i = 0; i < sizeof par / sizeof par[0]; i++) {
+        char doc[256];
+        snprintf(doc, sizeof doc,
+                 "<svg width='100mm' height='50mm' viewBox='0 0 100 100' %s%s%s>"
+                 "<path d='M0 0 L100 100'/></svg>",
+                 par[i].par ? "preserveAspectRatio='" : "", par[i].par ? par[i].par : "",
+                 par[i].par ? "'" : "");
+        assert_int_equal(read_text(doc), CS_OK);
+        expect_pt(&P.elems[0].curve.p[0], par[i].ox, par[i].oy);
+        expect_pt(&P.elems[0].curve.p[1], par[i].x, par[i].y);
+    }
+    /* viewBox origin; one size given (the other from the viewBox's ratio). */
+    assert_int_equal(read_text("<svg width='100mm' height='100mm' viewBox='-10 -20 100 100'>"
+                               "<path d='M0 0 L1 1'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 10, 20);
+    assert_int_equal(read_text("<svg width='50mm' viewBox='0 0 100 200'><path d='M100 200 L0 0'/>"
+                               "</svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 50, 100);
+    /* No size, or a percentage: one user unit is one millimetre, viewBox or not. */
+    assert_int_equal(read_text("<svg viewBox='10 10 100 100'><path d='M12 34 L0 0'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 12, 34);
+    assert_int_equal(read_text("<svg width='100%' height='100%' viewBox='0 0 480 360'>"
+                               "<path d='M12 34 L0 0'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 12, 34);
+    /* Lengths with units inside user space (px-based); percentages of the viewport. */
+    assert_int_equal(read_text("<svg width='210mm' height='297mm'><rect x='1cm' y='72pt' "
+                               "width='1in' height='10mm'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 10, 25.4);
+    expect_pt(&P.elems[1].curve.p[1], 10 + 25.4, 25.4 + 10);
+    assert_int_equal(read_text("<svg width='100mm' height='50mm' viewBox='0 0 200 100'>"
+                               "<rect width='50%' height='50%'/></svg>"),
+                     CS_OK);
+    expect_pt(&P.elems[1].curve.p[1], 50, 25);
+    assert_int_equal(read_text("<svg><rect width='50%' height='1'/></svg>"), CS_ERR_PARSE);
+    /* Nested <svg>: a viewport at (10, 20), 50 x 50 (or 50% of 100), viewBox 10 x 10. */
+    static const char *const nested[] = {"width='50' height='50'", "width='50%' height='50%'"};
+    for (size_t i = 0; i < 2; i++) {
+        char doc[300];
+        snprintf(doc, sizeof doc,
+                 "<svg width='100mm' height='100mm' viewBox='0 0 100 100'>"
+                 "<svg x='10' y='20' %s viewBox='0 0 10 10'><path d='M1 1 L10 10'/></svg>"
+                 "<path d='M1 1 L2 2'/></svg>",
+                 nested[i]);
+        assert_int_equal(read_text(doc), CS_OK);
+        expect_pt(&P.elems[0].curve.p[0], 15, 25);
+        expect_pt(&P.elems[0].curve.p[1], 60, 70);
+        expect_pt(&P.elems[1].curve.p[0], 1, 1); /* back in the outer viewport */
+    }
+    /* Without viewBox a nested <svg> only moves the origin. */
+    assert_int_equal(read_text("<svg><svg x='3' y='4'><path d='M1 1 L0 0'/></svg></svg>"), CS_OK);
+    expect_pt(&P.elems[0].curve.p[0], 4, 5);
+    /* Zero size disables rendering. */
+    assert_int_equal(read_text("<svg width='0' height='10'><path d='M1 1 L0 0'/></svg>"), CS_OK);
+    assert_int_equal(P.n, 0);
+    /* Errors point into the attribute. */
+    assert_int_equal(read_text("<svg viewBox='0 0 -1 5'/>"), CS_ERR_PARSE);
+    assert_non_null(strstr(D.reason, "viewBox"));
+    assert_int_equal(read_text("<svg viewBox='0 0 1'/>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 20);
+    assert_int_equal(read_text("<svg viewBox='0 0 1 1' preserveAspectRatio='xMidYMad'/>"),
+                     CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 45);
+    assert_int_equal(read_text("<svg width='10qq' height='1'/>"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 15);
+}
+
+static void test_style_display(void **state)
+{
+    (void)state;
+    /* display none (attribute or style) hides the element and everything below it. */
+    assert_int_equal(read_text("<svg><g display='none'><rect width='1' height='1'/></g>"
+                               "<g style='display:none'><g><circle r='1'/></g></g>"
+                               "<path display='none' d='M0 0 L1 1'/>"
+                               "<path d='M0 0 L2 2' stroke='red' fill='none'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[1], 2, 2);
+    assert_int_equal(nwarn, 0);
+    /* Visibility is inherited, and a child may show itself again. */
+    assert_int_equal(read_text("<svg><g visibility='hidden'><rect width='1' height='1'/>"
+                               "<rect width='3' height='3' visibility='visible'/></g></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 4);
+    expect_pt(&P.elems[1].curve.p[0], 3, 0);
+    /* Neither stroke nor fill: nothing shows. style wins over the attribute. */
+    assert_int_equal(read_text("<svg><rect width='1' height='1' fill='none'/>"
+                               "<rect width='1' height='1' stroke='black' fill='none' "
+                               "style='stroke:none'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 0);
+    assert_int_equal(S.ignored, 2);
+    /* Stroke inherited from a group; "!important" and blanks in style; no fill, no warning. */
+    assert_int_equal(read_text("<svg><g stroke='black' style=' fill : none ; '>"
+                               "<rect width='1' height='1'/></g>"
+                               "<circle r='1' style='fill:none;stroke: red !important'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 8);
+    assert_int_equal(nwarn, 0);
+    /* Filled without stroke: drawn as outlines, said once for the document. */
+    assert_int_equal(read_text("<svg><rect width='1' height='1' fill='blue'/>"
+                               "<circle r='1' style='fill:#00f'/><path d='M0 0 L5 5'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 9);
+    assert_int_equal(nwarn, 1);
+    assert_non_null(strstr(last_warn, "fills are not drawn"));
+    assert_non_null(strstr(last_warn, "doc.svg:1:6:"));
+}
+
+/* Every SVG file of tests/data (copies of ../shared/data/svg) reads, or fails only as the file
+ * itself says (resvg A.svg: "MoveTo is required"), and every element traces at 0.01 mm, ending
+ * exactly on its last control point. */
+static void test_all_files_flatten(void **state)
+{
+    (void)state;
+    static const char *const w3c[] = {"paths-data-01-t.svg", "paths-data-02-t.svg",
+                                      "paths-data-12-t.svg", "paths-data-14-t.svg"};
+    char name[256];
+    size_t files = 0, elems = 0;
+    for (size_t i = 0; i < sizeof resvg_cases / sizeof resvg_cases[0] + 5; i++) {
+        size_t nr = sizeof resvg_cases / sizeof resvg_cases[0];
+        if (i < nr)
+            snprintf(name, sizeof name, DATA "resvg/%s", resvg_cases[i].file);
+        else if (i < nr + 4)
+            snprintf(name, sizeof name, DATA "w3c/%s", w3c[i - nr]);
+        else
+            snprintf(name, sizeof name, DATA "resvg/A.svg");
+        cs_err_t e = read_file(name);
+        if (i == nr + 4) {
+            assert_int_equal(e, CS_ERR_PARSE);
+            continue;
+        }
+        if (e != CS_OK)
+            fail_msg("%s: %s", name, D.reason);
+        files++;
+        for (size_t j = 0; j < P.n; j++) {
+            cs_trace_t tr;
+            const cs_bezier_t *c = &P.elems[j].curve;
+            assert_int_equal(cs_trace_begin(&tr, c, CS_POS_ONE_MM / 100, CS_TRACE_SUBDIV), CS_OK);
+            cs_vec3_t pt, last = c->p[0];
+            while ((e = cs_trace_next(&tr, &pt)) == CS_OK)
+                last = pt;
+            assert_int_equal(e, CS_END);
+            assert_true(last.x == c->p[c->degree].x && last.y == c->p[c->degree].y);
+            elems++;
+        }
+    }
+    assert_int_equal(files, 41);
+    assert_true(elems > 41 * 4);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -562,6 +1136,13 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_error_positions, setup, teardown),
         cmocka_unit_test_setup_teardown(test_transforms, setup, teardown),
         cmocka_unit_test_setup_teardown(test_skipped_content, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_rect, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_circle_ellipse, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_line_poly, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_shape_transforms, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_units_viewbox, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_style_display, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_all_files_flatten, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

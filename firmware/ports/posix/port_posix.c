@@ -164,7 +164,8 @@ bool port_posix_run(uint64_t until)
             port_timer_arm(1); /* wake up: work was queued while stopped */
         }
         if (g.deadline > until) {
-            g.now = until;
+            if (until > g.now)
+                g.now = until; /* time never runs backwards */
             return true;
         }
         g.now = g.deadline;

@@ -25,8 +25,9 @@ void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask);
 /* Simulated time, 64-bit ticks (port_ticks_now is its low 32 bits). */
 uint64_t port_posix_now(void);
 /* Runs the step timer until the attached stepper is idle (starting the timer if it is stopped
- * and work is queued) or until simulated time reaches `until` (UINT64_MAX: no limit). Returns
- * false when a fault was raised. */
+ * and work is queued) or until simulated time reaches `until` (UINT64_MAX: no limit; an `until`
+ * in the past runs nothing and leaves the time as it is). Returns false when a fault was raised
+ * or no stepper is attached. */
 bool port_posix_run(uint64_t until);
 /* Runs exactly one step interrupt (starting the timer if work is queued): advances time to its
  * deadline. false when the stepper is idle with the timer stopped, or after a fault. */

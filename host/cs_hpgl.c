@@ -1,0 +1,913 @@
+/* cs_hpgl: HP-GL / HP-GL/2 -> cs_path_t (see cs_hpgl.h).
+ * Positions are kept in double plotter units (absolute); every point is converted once to
+ * cs_pos_t, so the end of one element and the start of the next are the same cs_pos_t.
+ * Instruction semantics follow the HP-GL/2 reference (HP 5959-9733): a mnemonic is two letters,
+ * its parameters numbers separated by commas or blanks, ended by ';' or by the next mnemonic. */
+#include "cs_hpgl.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_arc.h"
+#include "cs_conv.h"
+#include "cs_err_text.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* HP-GL/2 parameters are at most 2^30 in magnitude (integers -2^30..2^30-1). */
+#define HP_NUM_MAX 1073741824.0
+/* Longest number text accepted (digits, sign, point). */
+#define HP_NUM_CHARS 40
+/* The default label terminator: ETX. */
+#define HP_ETX 3
+/* Arc end points are moved onto the exact neighbouring point (as cs_svgpath does); beyond this
+ * many LSB the builder disagrees with the arc and it is refused rather than bent. */
+#define HP_ARC_SNAP_MAX_LSB 8
+
+typedef struct {
+    const char *buf;
+    size_t len, pos;
+    const char *file;
+    const cs_hpgl_opts_t *o;
+    cs_path_t *path;
+    cs_path_diag_t *diag;
+    size_t loc_off; /* line/column cache: offsets mostly increase */
+    unsigned loc_line, loc_col;
+    double x, y;   /* current position, plotter units, absolute */
+    cs_vec3_t cur; /* the same, converted */
+    bool relative, pen_down;
+    long pen;        /* selected pen; 0 = none (nothing is drawn) */
+    char label_term; /* LB/BL/WD text terminator (DT) */
+    bool warned[26 * 26];
+    bool warned_esc, warned_nopen, warned_big_sweep;
+} hp_t;
+
+static cs_path_loc_t loc_at(hp_t *h, size_t off)
+{
+    cs_path_loc_t l = {h->file, 1, 1};
+    if (off > h->len)
+        off = h->len;
+    if (off < h->loc_off) {
+        h->loc_off = 0;
+        h->loc_line = 1;
+        h->loc_col = 1;
+    }
+    for (size_t i = h->loc_off; i < off; i++) {
+        unsigned char ch = (unsigned char)h->buf[i];
+        if (ch == '\n') {
+            h->loc_line++;
+            h->loc_col = 1;
+        } else if (ch != '\r' && (ch & 0xC0) != 0x80) {
+            h->loc_col++; /* one column per character, not per UTF-8 byte */
+        }
+    }
+    h->loc_off = off;
+    l.line = h->loc_line;
+    l.col = h->loc_col;
+    return l;
+}
+
+static cs_err_t fail(hp_t *h, size_t off, cs_err_t code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static cs_err_t fail(hp_t *h, size_t off, cs_err_t code, const char *fmt, ...)
+{
+    char msg[200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return cs_path_diag_set(h->diag, code, loc_at(h, off), "%s", msg);
+}
+
+static void warn(hp_t *h, size_t off, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void warn(hp_t *h, size_t off, const char *fmt, ...)
+{
+    cs_path_diag_t w;
+    char msg[220];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    cs_path_diag_set(&w, CS_OK, loc_at(h, off), "%s", msg);
+    if (h->o->warn)
+        h->o->warn(h->o->warn_ctx, &w);
+    else
+        fprintf(stderr, "%s:%u:%u: warning: %s\n", w.loc.file, w.loc.line, w.loc.col, w.reason);
+}
+
+/* What sits at offset off, for messages. */
+static const char *what_at(const hp_t *h, size_t off, char buf[24])
+{
+    if (off >= h->len)
+        return "end of file";
+    unsigned char ch = (unsigned char)h->buf[off];
+    if (ch > 0x20 && ch < 0x7f)
+        snprintf(buf, 24, "'%c'", ch);
+    else
+        snprintf(buf, 24, "byte 0x%02X", (unsigned)ch);
+    return buf;
+}
+
+static bool is_letter(char c)
+{
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z');
+}
+
+static bool is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+static char upper(char c)
+{
+    return (c >= 'a' && c <= 'z') ? (char)(c - 'a' + 'A') : c;
+}
+
+/* Blanks and control characters (other than ESC) separate everything and mean nothing. */
+static bool is_blank(char c)
+{
+    unsigned char u = (unsigned char)c;
+    return u == ' ' || (u < 0x20 && u != 0x1B);
+}
+
+/* --- parameters ------------------------------------------------------------------------ */
+
+/* Skips blanks and commas before a parameter. */
+static void skip_sep(hp_t *h)
+{
+    while (h->pos < h->len && (is_blank(h->buf[h->pos]) || h->buf[h->pos] == ','))
+        h->pos++;
+}
+
+/* Next numeric parameter of instruction mn: 1 with *v and *off set, 0 when the parameters end
+ * (';', a letter, ESC, end of file; the terminator is left in place), or -1 with *e set. */
+static int next_num(hp_t *h, const char *mn, double *v, size_t *off, cs_err_t *e)
+{
+    skip_sep(h);
+    if (h->pos >= h->len)
+        return 0;
+    char c = h->buf[h->pos];
+    if (c == ';' || is_letter(c) || c == 0x1B)
+        return 0;
+    size_t s = h->pos, i = s;
+    if (i < h->len && (h->buf[i] == '+' || h->buf[i] == '-'))
+        i++;
+    size_t digits = 0;
+    while (i < h->len && is_digit(h->buf[i])) {
+        i++;
+        digits++;
+    }
+    if (i < h->len && h->buf[i] == '.') {
+        i++;
+        while (i < h->len && is_digit(h->buf[i])) {
+            i++;
+            digits++;
+        }
+    }
+    if (digits == 0) {
+        char b[24];
+        *e = fail(h, digits == 0 && i > s ? i : s, CS_ERR_PARSE,
+                  "%s: expected a number, ';' or the next instruction, found %s", mn,
+                  what_at(h, i > s ? i : s, b));
+        return -1;
+    }
+    if (i - s > HP_NUM_CHARS) {
+        *e = fail(h, s, CS_ERR_RANGE, "%s: number too long (%zu characters)", mn, i - s);
+        return -1;
+    }
+    char tmp[HP_NUM_CHARS + 1];
+    memcpy(tmp, h->buf + s, i - s);
+    tmp[i - s] = '\0';
+    double d = strtod(tmp, NULL);
+    if (!(fabs(d) <= HP_NUM_MAX)) {
+        *e = fail(h, s, CS_ERR_RANGE, "%s: number %s is outside the HP-GL/2 range of +/-2^30", mn,
+                  tmp);
+        return -1;
+    }
+    *v = d;
+    *off = s;
+    h->pos = i;
+    return 1;
+}
+
+/* End of an instruction's parameters: blanks, then an optional ';'. Anything other than ';',
+ * a letter, ESC or the end of file is an error. */
+static cs_err_t end_instr(hp_t *h, const char *mn)
+{
+    skip_sep(h);
+    if (h->pos >= h->len)
+        return CS_OK;
+    char c = h->buf[h->pos];
+    if (c == ';') {
+        h->pos++;
+        return CS_OK;
+    }
+    if (is_letter(c) || c == 0x1B)
+        return CS_OK;
+    char b[24];
+    return fail(h, h->pos, CS_ERR_PARSE, "%s: unexpected %s in the parameters", mn,
+                what_at(h, h->pos, b));
+}
+
+/* Skips an unsupported instruction's numeric parameters. */
+static cs_err_t skip_params(hp_t *h, const char *mn)
+{
+    double v;
+    size_t off;
+    cs_err_t e = CS_OK;
+    int r;
+    while ((r = next_num(h, mn, &v, &off, &e)) == 1)
+        ;
+    return r < 0 ? e : end_instr(h, mn);
+}
+
+/* --- geometry ------------------------------------------------------------------------------ */
+
+/* Plotter units -> cs_vec3_t in mm; CS_ERR_RANGE reported at off. */
+static cs_err_t convert(hp_t *h, double x, double y, size_t off, cs_vec3_t *out)
+{
+    double mx = x / CS_HPGL_PLU_PER_MM, my = y / CS_HPGL_PLU_PER_MM;
+    if (cs_conv_mm_to_vec(mx, my, 0.0, out) != CS_OK)
+        return fail(h, off, CS_ERR_RANGE,
+                    "point (%.6g, %.6g) plotter units = (%.6g, %.6g) mm is outside the accepted "
+                    "range of +/-%d mm",
+                    x, y, mx, my, CS_POS_LIMIT_MM);
+    return CS_OK;
+}
+
+static bool drawing(hp_t *h, size_t off)
+{
+    if (h->pen != 0)
+        return true;
+    if (!h->warned_nopen) {
+        h->warned_nopen = true;
+        warn(h, off, "drawing with no pen selected (SP0): not drawn");
+    }
+    return false;
+}
+
+static cs_err_t emit(hp_t *h, cs_path_kind_t kind, unsigned degree, const cs_vec3_t *pts,
+                     size_t off)
+{
+    cs_bezier_t c;
+    memset(&c, 0, sizeof c);
+    c.degree = (uint8_t)degree;
+    for (unsigned i = 0; i <= degree; i++) {
+        c.p[i] = pts[i];
+        c.w[i] = CS_WEIGHT_ONE;
+    }
+    if (cs_path_add(h->path, &c, kind, loc_at(h, off)) != CS_OK)
+        return fail(h, off, CS_ERR_FULL, "out of memory");
+    return CS_OK;
+}
+
+/* Moves the pen to (x, y) plotter units (absolute), drawing a line when the pen is down. A
+ * pen-down move to the current point draws nothing (a dot has no path). */
+static cs_err_t move_to(hp_t *h, double x, double y, size_t off)
+{
+    cs_vec3_t q[2];
+    cs_err_t e = convert(h, x, y, off, &q[1]);
+    if (e != CS_OK)
+        return e;
+    q[0] = h->cur;
+    if (h->pen_down && drawing(h, off)) {
+        if (q[0].x != q[1].x || q[0].y != q[1].y) {
+            if ((e = emit(h, CS_PATH_LINE, 1, q, off)) != CS_OK)
+                return e;
+        }
+    } else {
+        cs_path_new_subpath(h->path);
+    }
+    h->x = x;
+    h->y = y;
+    h->cur = q[1];
+    return CS_OK;
+}
+
+static int64_t lsb_dist(const cs_vec3_t *a, const cs_vec3_t *b)
+{
+    int64_t dx = (int64_t)a->x - b->x, dy = (int64_t)a->y - b->y;
+    dx = dx < 0 ? -dx : dx;
+    dy = dy < 0 ? -dy : dy;
+    return dx > dy ? dx : dy;
+}
+
+/* The arc about centre (cx, cy) plotter units from the current point over sweep degrees
+ * (positive = counter-clockwise; |sweep| >= 360 is one full turn). When draw is false the pen
+ * only moves to the end. The current point becomes the arc's end. */
+static cs_err_t arc(hp_t *h, double cx, double cy, double sweep, bool draw, size_t off)
+{
+    double ux = h->x - cx, uy = h->y - cy;
+    bool full = fabs(sweep) >= 360.0;
+    if (fabs(sweep) > 360.0 && !h->warned_big_sweep) {
+        h->warned_big_sweep = true;
+        warn(h, off, "arc sweep beyond 360 degrees: drawn as one full turn");
+    }
+    double r = sweep * (M_PI / 180.0);
+    double cs = full ? 1.0 : cos(r), sn = full ? 0.0 : sin(r);
+    /* End: C + U cos + V sin with V = U turned +90 degrees. */
+    double ex = cx + ux * cs - uy * sn, ey = cy + uy * cs + ux * sn;
+    cs_vec3_t endf;
+    cs_err_t e = convert(h, ex, ey, off, &endf);
+    if (e != CS_OK)
+        return e;
+    cs_vec3_t C, U, V;
+    if ((e = convert(h, cx, cy, off, &C)) != CS_OK)
+        return e;
+    bool degenerate = (ux == 0.0 && uy == 0.0) || sweep == 0.0;
+    if (!draw || !drawing(h, off))
+        cs_path_new_subpath(h->path);
+    if (!draw || degenerate || h->pen == 0) {
+        /* Pen up, no pen, or an arc that is a point (radius 0, sweep 0): the pen just goes
+         * to the end. */
+        h->x = ex;
+        h->y = ey;
+        h->cur = endf;
+        return CS_OK;
+    }
+    if (cs_conv_mm_to_vec(ux / CS_HPGL_PLU_PER_MM, uy / CS_HPGL_PLU_PER_MM, 0.0, &U) != CS_OK ||
+        cs_conv_mm_to_vec(-uy / CS_HPGL_PLU_PER_MM, ux / CS_HPGL_PLU_PER_MM, 0.0, &V) != CS_OK)
+        return fail(h, off, CS_ERR_RANGE, "arc radius too large for the +/-%d mm range",
+                    CS_POS_LIMIT_MM);
+    cs_param_t c1, s1;
+    if (cs_conv_to_param(cs, &c1) != CS_OK || cs_conv_to_param(sn, &s1) != CS_OK)
+        return fail(h, off, CS_ERR_RANGE, "arc direction not representable");
+    if (!full && c1 == CS_PARAM_ONE && s1 == 0) {
+        /* A sweep too small to turn the direction by one Q1.30 step would read as a full
+         * turn; at any radius in range it is within an LSB of its chord. */
+        bool pd = h->pen_down;
+        h->pen_down = true;
+        e = move_to(h, ex, ey, off);
+        h->pen_down = pd;
+        return e;
+    }
+    cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
+    memset(seg, 0, sizeof seg);
+    unsigned n = 0;
+    e = cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, c1, s1, sweep > 0.0, seg, &n);
+    if (e != CS_OK)
+        return fail(h, off, e == CS_ERR_OVERFLOW ? CS_ERR_RANGE : e, "arc cannot be built: %s",
+                    cs_err_text(e));
+    if (n < 1 || n > CS_ARC_MAX_SEGMENTS)
+        return fail(h, off, CS_ERR_ARG, "arc builder returned %u pieces", n);
+    if (lsb_dist(&seg[0].p[0], &h->cur) > HP_ARC_SNAP_MAX_LSB ||
+        lsb_dist(&seg[n - 1].p[2], &endf) > HP_ARC_SNAP_MAX_LSB)
+        return fail(h, off, CS_ERR_ARG, "arc builder's end points are off the arc's ends");
+    seg[0].p[0] = h->cur; /* continuous to the LSB with the neighbours */
+    seg[n - 1].p[2] = endf;
+    for (unsigned i = 0; i < n; i++)
+        if (cs_path_add(h->path, &seg[i], CS_PATH_ARC, loc_at(h, off)) != CS_OK)
+            return fail(h, off, CS_ERR_FULL, "out of memory");
+    h->x = ex;
+    h->y = ey;
+    h->cur = endf;
+    return CS_OK;
+}
+
+/* --- instructions -------------------------------------------------------------------------- */
+
+/* PU, PD, PA, PR: optional coordinate pairs, each interpreted in the current PA/PR mode. */
+static cs_err_t pen_moves(hp_t *h, const char *mn)
+{
+    for (;;) {
+        double a, b;
+        size_t oa, ob;
+        cs_err_t e = CS_OK;
+        int r = next_num(h, mn, &a, &oa, &e);
+        if (r < 0)
+            return e;
+        if (r == 0)
+            break;
+        r = next_num(h, mn, &b, &ob, &e);
+        if (r < 0)
+            return e;
+        if (r == 0)
+            return fail(h, oa, CS_ERR_PARSE, "%s: x without y (coordinates come in pairs)", mn);
+        double x = h->relative ? h->x + a : a, y = h->relative ? h->y + b : b;
+        if ((e = move_to(h, x, y, oa)) != CS_OK)
+            return e;
+    }
+    return end_instr(h, mn);
+}
+
+/* Reads exactly the parameters an instruction needs (min..max); extras are an error. */
+static cs_err_t get_params(hp_t *h, const char *mn, size_t mn_off, double *v, size_t *voff,
+                           unsigned min, unsigned max, unsigned *n, const char *usage)
+{
+    *n = 0;
+    for (;;) {
+        double x;
+        size_t off;
+        cs_err_t e = CS_OK;
+        int r = next_num(h, mn, &x, &off, &e);
+        if (r < 0)
+            return e;
+        if (r == 0)
+            break;
+        if (*n >= max)
+            return fail(h, off, CS_ERR_PARSE, "%s: too many parameters (%s)", mn, usage);
+        v[*n] = x;
+        voff[*n] = off;
+        (*n)++;
+    }
+    if (*n < min)
+        return fail(h, mn_off, CS_ERR_PARSE, "%s: too few parameters (%s)", mn, usage);
+    return end_instr(h, mn);
+}
+
+static void select_pen(hp_t *h, double v)
+{
+    h->pen = v < 1.0 ? 0 : (long)v;
+    cs_path_new_subpath(h->path);
+}
+
+/* CI radius[,chord]: a full circle about the current point, drawn whatever the pen state
+ * (the plotter lowers the pen for it), starting at angle 0 (180 for a negative radius) and
+ * counter-clockwise; the pen then returns to the centre in its former state. The chord angle
+ * is ignored: the circle is exact. */
+static cs_err_t circle(hp_t *h, size_t mn_off)
+{
+    double v[2];
+    size_t vo[2];
+    unsigned n;
+    cs_err_t e = get_params(h, "CI", mn_off, v, vo, 1, 2, &n, "CI radius[,chord angle]");
+    if (e != CS_OK)
+        return e;
+    double cx = h->x, cy = h->y;
+    cs_vec3_t centre = h->cur;
+    if (v[0] == 0.0 || !drawing(h, mn_off))
+        return CS_OK;
+    cs_vec3_t start;
+    if ((e = convert(h, cx + v[0], cy, vo[0], &start)) != CS_OK)
+        return e;
+    cs_path_new_subpath(h->path);
+    h->x = cx + v[0];
+    h->cur = start;
+    bool pd = h->pen_down;
+    e = arc(h, cx, cy, 360.0, true, vo[0]);
+    h->pen_down = pd;
+    cs_path_new_subpath(h->path);
+    h->x = cx;
+    h->y = cy;
+    h->cur = centre;
+    return e;
+}
+
+/* AA x,y,sweep[,chord] (centre absolute) and AR dx,dy,sweep[,chord] (centre relative to the
+ * current point): the arc from the current point, + = counter-clockwise, drawn when the pen is
+ * down; the pen ends on the arc's end. */
+static cs_err_t arc_instr(hp_t *h, const char *mn, size_t mn_off, bool rel)
+{
+    double v[4];
+    size_t vo[4];
+    unsigned n;
+    cs_err_t e =
+        get_params(h, mn, mn_off, v, vo, 3, 4, &n,
+                   rel ? "AR dx,dy,sweep angle[,chord angle]" : "AA x,y,sweep angle[,chord angle]");
+    if (e != CS_OK)
+        return e;
+    double cx = rel ? h->x + v[0] : v[0], cy = rel ? h->y + v[1] : v[1];
+    return arc(h, cx, cy, v[2], h->pen_down, vo[0]);
+}
+
+/* BZ (absolute) and BR (relative: every point of a curve relative to that curve's start):
+ * cubic Béziers from the current point, control points in groups of three x,y pairs. */
+static cs_err_t bezier(hp_t *h, const char *mn, bool rel)
+{
+    for (;;) {
+        double v[6];
+        size_t vo[6];
+        unsigned k = 0;
+        cs_err_t e = CS_OK;
+        for (; k < 6; k++) {
+            int r = next_num(h, mn, &v[k], &vo[k], &e);
+            if (r < 0)
+                return e;
+            if (r == 0)
+                break;
+        }
+        if (k == 0)
+            break;
+        if (k < 6)
+            return fail(h, vo[0], CS_ERR_PARSE,
+                        "%s: incomplete curve (%u of 6 numbers: control points come in groups of "
+                        "three x,y pairs)",
+                        mn, k);
+        cs_vec3_t q[4];
+        q[0] = h->cur;
+        double px[3], py[3];
+        for (unsigned i = 0; i < 3; i++) {
+            px[i] = rel ? h->x + v[2 * i] : v[2 * i];
+            py[i] = rel ? h->y + v[2 * i + 1] : v[2 * i + 1];
+            if ((e = convert(h, px[i], py[i], vo[2 * i], &q[i + 1])) != CS_OK)
+                return e;
+        }
+        if (h->pen_down && drawing(h, vo[0])) {
+            if ((e = emit(h, CS_PATH_CUBIC, 3, q, vo[0])) != CS_OK)
+                return e;
+        } else {
+            cs_path_new_subpath(h->path);
+        }
+        h->x = px[2];
+        h->y = py[2];
+        h->cur = q[3];
+    }
+    return end_instr(h, mn);
+}
+
+/* One PE value (HP-GL/2 polyline encoding): base-64 digits, least significant first, 63..126
+ * continuing and 191..254 ending (base 32 in 7-bit mode: 63..94 and 95..126); other bytes are
+ * ignored. The lowest bit of the result is the sign. 1 with *v set, 0 at ';'/end, -1 error. */
+static int pe_value(hp_t *h, bool seven, int64_t *v, cs_err_t *e)
+{
+    uint64_t acc = 0;
+    unsigned shift = 0, bits = seven ? 5u : 6u;
+    size_t start = h->pos;
+    while (h->pos < h->len) {
+        unsigned char c = (unsigned char)h->buf[h->pos];
+        if (c == ';')
+            break;
+        h->pos++;
+        unsigned d;
+        bool last;
+        if (seven && c >= 63 && c <= 126) {
+            last = c >= 95;
+            d = last ? c - 95u : c - 63u;
+        } else if (!seven && c >= 63 && c <= 126) {
+            last = false;
+            d = c - 63u;
+        } else if (!seven && c >= 191 && c <= 254) {
+            last = true;
+            d = c - 191u;
+        } else {
+            continue;
+        }
+        if (shift > 36) {
+            *e = fail(h, start, CS_ERR_RANGE, "PE: encoded number too long");
+            return -1;
+        }
+        acc |= (uint64_t)d << shift;
+        shift += bits;
+        if (last) {
+            int64_t m = (int64_t)(acc >> 1);
+            *v = (acc & 1u) ? -m : m;
+            return 1;
+        }
+    }
+    if (shift > 0) {
+        *e = fail(h, start, CS_ERR_PARSE, "PE: encoded number not terminated");
+        return -1;
+    }
+    return 0;
+}
+
+/* PE: flags ':' pen, '<' next move pen up, '>' fractional bits, '=' next point absolute, '7'
+ * 7-bit mode; coordinates are relative pen-down moves unless flagged. The pen state after PE is
+ * that of its last move. */
+static cs_err_t polyline_encoded(hp_t *h, size_t mn_off)
+{
+    bool seven = false, next_up = false, next_abs = false;
+    int64_t frac = 0;
+    cs_err_t e = CS_OK;
+    for (;;) {
+        while (h->pos < h->len && h->buf[h->pos] != ';') {
+            unsigned char c = (unsigned char)h->buf[h->pos];
+            if ((c >= 63 && c <= 126) || (c >= 191 && c <= 254))
+                break;
+            h->pos++;
+            size_t foff = h->pos - 1;
+            int64_t v;
+            int r;
+            switch (c) {
+            case ':':
+                if ((r = pe_value(h, seven, &v, &e)) < 0)
+                    return e;
+                if (r == 0)
+                    return fail(h, foff, CS_ERR_PARSE, "PE: pen flag ':' without a pen number");
+                select_pen(h, (double)v);
+                break;
+            case '<':
+                next_up = true;
+                break;
+            case '>':
+                if ((r = pe_value(h, seven, &v, &e)) < 0)
+                    return e;
+                if (r == 0 || v < -26 || v > 26)
+                    return fail(h, foff, CS_ERR_PARSE,
+                                "PE: fractional-bits flag '>' needs a value in -26..26");
+                frac = v;
+                break;
+            case '=':
+                next_abs = true;
+                break;
+            case '7':
+                seven = true;
+                break;
+            default:
+                break; /* other bytes are ignored */
+            }
+        }
+        if (h->pos >= h->len || h->buf[h->pos] == ';')
+            break;
+        int64_t a, b;
+        size_t off = h->pos;
+        int r = pe_value(h, seven, &a, &e);
+        if (r < 0)
+            return e;
+        if (r == 0)
+            break;
+        if ((r = pe_value(h, seven, &b, &e)) < 0)
+            return e;
+        if (r == 0)
+            return fail(h, off, CS_ERR_PARSE, "PE: x without y (coordinates come in pairs)");
+        double s = ldexp(1.0, (int)-frac), x = (double)a * s, y = (double)b * s;
+        if (!next_abs) {
+            x += h->x;
+            y += h->y;
+        }
+        if (!(fabs(x) <= HP_NUM_MAX && fabs(y) <= HP_NUM_MAX))
+            return fail(h, off, CS_ERR_RANGE, "PE: point outside the HP-GL/2 range");
+        h->pen_down = !next_up;
+        if ((e = move_to(h, x, y, off)) != CS_OK)
+            return e;
+        next_up = next_abs = false;
+    }
+    (void)mn_off;
+    if (h->pos < h->len)
+        h->pos++; /* ';' */
+    return CS_OK;
+}
+
+/* Text up to the label terminator (LB, BL, WD): skipped, the terminator consumed. */
+static void skip_label(hp_t *h)
+{
+    while (h->pos < h->len && h->buf[h->pos] != h->label_term)
+        h->pos++;
+    if (h->pos < h->len)
+        h->pos++;
+}
+
+/* What skipping an instruction costs the drawing, for its one warning. */
+static const struct {
+    const char *mn;
+    const char *why;
+} skipped[] = {
+    {"EA", "rectangle outline not drawn: geometry is missing"},
+    {"ER", "rectangle outline not drawn: geometry is missing"},
+    {"EW", "wedge outline not drawn: geometry is missing"},
+    {"RA", "filled rectangle not drawn (fills are not supported): geometry is missing"},
+    {"RR", "filled rectangle not drawn (fills are not supported): geometry is missing"},
+    {"WG", "filled wedge not drawn (fills are not supported): geometry is missing"},
+    {"EP", "polygon edge instruction ignored: moves made in polygon mode are drawn as they come"},
+    {"FP", "polygon fill ignored: moves made in polygon mode are drawn as outlines"},
+    {"PM", "polygon mode ignored: pen-down moves inside it are drawn as ordinary lines (a "
+           "polygon later filled or edged shows as its outline; one never used would not have "
+           "been drawn by a plotter)"},
+    {"IW", "clipping window ignored: lines outside it ARE drawn"},
+    {"RO", "rotation ignored: the drawing is NOT rotated"},
+    {"SC", "scaling ignored: coordinates are read as plotter units (0.025 mm), the drawing's "
+           "size and position differ from the plotter's"},
+    {"IP", "scaling points ignored: coordinates are read as plotter units (0.025 mm)"},
+    {"IR", "scaling points ignored: coordinates are read as plotter units (0.025 mm)"},
+    {"LT", "line types ignored: dashed lines are drawn solid"},
+    {"DF", "defaults instruction skipped (text, fill, line type and scaling settings are not "
+           "used here)"},
+    {"FT", "fill type ignored (fills are not drawn)"},
+    {"PT", "pen thickness ignored"},
+    {"PW", "pen width ignored"},
+    {"VS", "velocity ignored (the planner sets speeds)"},
+    {"SI", "text setting ignored (text is not drawn)"},
+    {"SL", "text setting ignored (text is not drawn)"},
+    {"SR", "text setting ignored (text is not drawn)"},
+    {"DI", "text setting ignored (text is not drawn)"},
+    {"DR", "text setting ignored (text is not drawn)"},
+    {"CS", "text setting ignored (text is not drawn)"},
+    {"CA", "text setting ignored (text is not drawn)"},
+    {"SA", "text setting ignored (text is not drawn)"},
+    {"SS", "text setting ignored (text is not drawn)"},
+    {"CP", "character plot ignored (text is not drawn): the pen does not move"},
+};
+
+static void warn_mnemonic(hp_t *h, const char *mn, size_t off, const char *why)
+{
+    size_t k = (size_t)(mn[0] - 'A') * 26 + (size_t)(mn[1] - 'A');
+    if (h->warned[k])
+        return;
+    h->warned[k] = true;
+    if (!why) {
+        why = "not supported, skipped";
+        for (size_t i = 0; i < sizeof skipped / sizeof skipped[0]; i++)
+            if (strcmp(skipped[i].mn, mn) == 0)
+                why = skipped[i].why;
+    }
+    warn(h, off, "%s: %s", mn, why);
+}
+
+/* ESC sequences (RS-232 device control "ESC . x ... :", PCL "ESC % n A|B", "ESC E"): skipped. */
+static cs_err_t escape(hp_t *h)
+{
+    size_t off = h->pos++;
+    if (!h->warned_esc) {
+        h->warned_esc = true;
+        warn(h, off, "device-control escape sequences skipped");
+    }
+    if (h->pos >= h->len)
+        return CS_OK;
+    char c = h->buf[h->pos++];
+    if (c == 'E')
+        return CS_OK;
+    if (c == '%') {
+        if (h->pos < h->len && (h->buf[h->pos] == '-' || h->buf[h->pos] == '+'))
+            h->pos++;
+        while (h->pos < h->len && is_digit(h->buf[h->pos]))
+            h->pos++;
+        if (h->pos < h->len && is_letter(h->buf[h->pos])) {
+            h->pos++;
+            return CS_OK;
+        }
+        return fail(h, off, CS_ERR_PARSE, "malformed escape sequence ESC %%");
+    }
+    if (c == '.') {
+        if (h->pos >= h->len)
+            return fail(h, off, CS_ERR_PARSE, "malformed escape sequence ESC .");
+        char k = h->buf[h->pos++];
+        if (k == '(' || k == ')' || k == 'Y' || k == 'Z' || k == 'K' || k == 'J' || k == 'R')
+            return CS_OK;
+        /* The others (ESC.@ .B .H .I .M .N .T and the queries) end with ':' when they have
+         * parameters; those without end right after their letter. */
+        size_t i = h->pos;
+        while (i < h->len && (is_digit(h->buf[i]) || h->buf[i] == ';' || h->buf[i] == ' '))
+            i++;
+        if (i < h->len && h->buf[i] == ':')
+            h->pos = i + 1;
+        return CS_OK;
+    }
+    char b[24];
+    return fail(h, off, CS_ERR_PARSE, "unknown escape sequence (ESC followed by %s)",
+                what_at(h, h->pos - 1, b));
+}
+
+static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
+{
+    double v[2];
+    size_t vo[2];
+    unsigned n;
+    cs_err_t e;
+    switch ((mn[0] << 8) | mn[1]) {
+    case ('I' << 8) | 'N':
+        if ((e = get_params(h, mn, off, v, vo, 0, 1, &n, "IN[n]")) != CS_OK)
+            return e;
+        /* Initialise: absolute, pen up, at the origin; default label terminator. */
+        h->relative = false;
+        h->pen_down = false;
+        h->label_term = HP_ETX;
+        if ((e = move_to(h, 0.0, 0.0, off)) != CS_OK)
+            return e;
+        return CS_OK;
+    case ('P' << 8) | 'U':
+        h->pen_down = false;
+        cs_path_new_subpath(h->path);
+        return pen_moves(h, mn);
+    case ('P' << 8) | 'D':
+        h->pen_down = true;
+        return pen_moves(h, mn);
+    case ('P' << 8) | 'A':
+        h->relative = false;
+        return pen_moves(h, mn);
+    case ('P' << 8) | 'R':
+        h->relative = true;
+        return pen_moves(h, mn);
+    case ('S' << 8) | 'P':
+        if ((e = get_params(h, mn, off, v, vo, 0, 1, &n, "SP[pen]")) != CS_OK)
+            return e;
+        select_pen(h, n ? v[0] : 0.0);
+        return CS_OK;
+    case ('C' << 8) | 'I':
+        return circle(h, off);
+    case ('A' << 8) | 'A':
+        return arc_instr(h, mn, off, false);
+    case ('A' << 8) | 'R':
+        return arc_instr(h, mn, off, true);
+    case ('B' << 8) | 'Z':
+        return bezier(h, mn, false);
+    case ('B' << 8) | 'R':
+        return bezier(h, mn, true);
+    case ('P' << 8) | 'E':
+        return polyline_encoded(h, off);
+    case ('L' << 8) | 'B':
+        warn_mnemonic(h, mn, off, "labels are not drawn (text is not supported)");
+        skip_label(h);
+        return CS_OK;
+    case ('B' << 8) | 'L':
+    case ('W' << 8) | 'D':
+        warn_mnemonic(h, mn, off, "text instruction skipped (text is not drawn)");
+        skip_label(h);
+        return CS_OK;
+    case ('D' << 8) | 'T':
+        /* DT t[,mode]: the label terminator is the next character ("DT;" = ETX again). */
+        if (h->pos < h->len && h->buf[h->pos] != ';')
+            h->label_term = h->buf[h->pos++];
+        else
+            h->label_term = HP_ETX;
+        return skip_params(h, mn);
+    case ('S' << 8) | 'M':
+        /* SM c: symbol mode with the next character as the symbol; "SM;" ends it. */
+        warn_mnemonic(h, mn, off, "symbol mode ignored: no symbol is drawn at the points");
+        if (h->pos < h->len && h->buf[h->pos] != ';' && !is_blank(h->buf[h->pos]))
+            h->pos++;
+        return end_instr(h, mn);
+    case ('C' << 8) | 'O':
+        /* HP-GL/2 comment: CO "text". */
+        skip_sep(h);
+        if (h->pos < h->len && h->buf[h->pos] == '"') {
+            size_t q = h->pos++;
+            while (h->pos < h->len && h->buf[h->pos] != '"')
+                h->pos++;
+            if (h->pos >= h->len)
+                return fail(h, q, CS_ERR_PARSE, "CO: comment string not closed");
+            h->pos++;
+        }
+        return end_instr(h, mn);
+    default:
+        warn_mnemonic(h, mn, off, NULL);
+        return skip_params(h, mn);
+    }
+}
+
+void cs_hpgl_opts_init(cs_hpgl_opts_t *o)
+{
+    memset(o, 0, sizeof *o);
+}
+
+cs_err_t cs_hpgl_read(const char *name, const char *buf, size_t len, const cs_hpgl_opts_t *opts,
+                      cs_path_t *path, cs_path_diag_t *diag)
+{
+    cs_hpgl_opts_t defaults;
+    if (!opts) {
+        cs_hpgl_opts_init(&defaults);
+        opts = &defaults;
+    }
+    hp_t *h = calloc(1, sizeof *h);
+    if (!h) {
+        cs_path_loc_t l = {"-", 0, 0};
+        return cs_path_diag_set(diag, CS_ERR_FULL, l, "out of memory");
+    }
+    h->buf = buf;
+    h->len = len;
+    h->o = opts;
+    h->path = path;
+    h->diag = diag;
+    h->loc_line = h->loc_col = 1;
+    h->pen = 1; /* files that never say SP still draw */
+    h->label_term = HP_ETX;
+    h->file = cs_path_intern(path, name ? name : "-");
+    cs_err_t e = CS_OK;
+    if (!h->file) {
+        cs_path_loc_t l = {"-", 0, 0};
+        e = cs_path_diag_set(diag, CS_ERR_FULL, l, "out of memory");
+    }
+    cs_path_new_subpath(path);
+    /* The plotter starts at the origin, pen up, absolute. */
+    if (e == CS_OK)
+        e = convert(h, 0.0, 0.0, 0, &h->cur);
+    while (e == CS_OK && h->pos < len) {
+        char c = buf[h->pos];
+        if (is_blank(c) || c == ';') {
+            h->pos++;
+            continue;
+        }
+        if (c == 0x1B) {
+            e = escape(h);
+            continue;
+        }
+        size_t off = h->pos;
+        if (!is_letter(c) || off + 1 >= len || !is_letter(buf[off + 1])) {
+            char b[24];
+            size_t at = is_letter(c) ? off + 1 : off;
+            e = fail(h, at, CS_ERR_PARSE, "expected a two-letter instruction, found %s",
+                     what_at(h, at, b));
+            break;
+        }
+        char mn[3] = {upper(c), upper(buf[off + 1]), '\0'};
+        h->pos += 2;
+        e = instruction(h, mn, off);
+    }
+    free(h);
+    return e;
+}

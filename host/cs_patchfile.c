@@ -1,0 +1,339 @@
+/* cs_patchfile: Newell's indexed patch format (see cs_patchfile.h), parsed line by line. */
+#include "cs_patchfile.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_conv.h"
+
+/* Most patches / vertices accepted (guards the allocation a hostile count would ask for). */
+#define PATCHFILE_MAX_COUNT 1000000
+
+typedef struct {
+    const char *name;
+    const char *s, *end; /* whole text */
+    const char *line;    /* start of the current line */
+    unsigned lineno;
+    cs_path_diag_t *diag;
+} lexer_t;
+
+#define MAX_FIELDS 17 /* one more than any line needs, to report "too many" */
+
+typedef struct {
+    size_t n;
+    double v[MAX_FIELDS];
+    unsigned col[MAX_FIELDS];
+    bool integer[MAX_FIELDS];
+    unsigned lineno, endcol;
+} fields_t;
+
+static cs_path_loc_t loc(const lexer_t *lx, unsigned line, unsigned col)
+{
+    cs_path_loc_t l = {lx->name, line, col};
+    return l;
+}
+
+/* Next non-blank line split into numbers; false at end of text. CS_ERR_PARSE in *e for a
+ * malformed field. */
+static bool next_line(lexer_t *lx, fields_t *f, cs_err_t *e)
+{
+    *e = CS_OK;
+    while (lx->s < lx->end) {
+        const char *b = lx->s, *nl = memchr(b, '\n', (size_t)(lx->end - b));
+        const char *le = nl ? nl : lx->end;
+        lx->s = nl ? nl + 1 : lx->end;
+        lx->lineno++;
+        f->n = 0;
+        f->lineno = lx->lineno;
+        const char *p = b;
+        bool want_value = false; /* after a comma */
+        while (p < le) {
+            while (p < le && (*p == ' ' || *p == '\t' || *p == '\r'))
+                p++;
+            if (p >= le)
+                break;
+            unsigned col = (unsigned)(p - b) + 1;
+            if (*p == ',') {
+                if (f->n == 0 || want_value) {
+                    *e = cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno, col),
+                                          "empty field before ','");
+                    return true;
+                }
+                want_value = true;
+                p++;
+                continue;
+            }
+            char buf[64];
+            size_t k = 0;
+            while (p + k < le && k < sizeof buf - 1 && !isspace((unsigned char)p[k]) && p[k] != ',')
+                buf[k] = p[k], k++;
+            buf[k] = '\0';
+            if (p + k < le && !isspace((unsigned char)p[k]) && p[k] != ',') {
+                *e = cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno, col),
+                                      "number longer than %zu characters", sizeof buf - 1);
+                return true;
+            }
+            char *ep = NULL;
+            errno = 0;
+            double v = strtod(buf, &ep);
+            if (ep == buf || *ep != '\0' || !isfinite(v) || (errno == ERANGE && fabs(v) > 1.0)) {
+                bool overflow = ep != buf && *ep == '\0' && errno == ERANGE; /* not underflow */
+                *e = cs_path_diag_set(lx->diag, overflow ? CS_ERR_RANGE : CS_ERR_PARSE,
+                                      loc(lx, lx->lineno, col), "'%s' is not a finite number", buf);
+                return true;
+            }
+            if (f->n == MAX_FIELDS) {
+                f->n++; /* the caller reports "too many" */
+                f->endcol = col;
+                return true;
+            }
+            f->v[f->n] = v;
+            f->col[f->n] = col;
+            f->integer[f->n] = strspn(buf, "+-0123456789") == k;
+            f->n++;
+            want_value = false;
+            p += k;
+        }
+        if (want_value) {
+            *e = cs_path_diag_set(lx->diag, CS_ERR_PARSE,
+                                  loc(lx, lx->lineno, (unsigned)(le - b) + 1),
+                                  "a number was expected after the last ','");
+            return true;
+        }
+        f->endcol = (unsigned)(le - b) + 1;
+        if (f->n > 0)
+            return true;
+    }
+    return false;
+}
+
+/* A count line: exactly one integer 1..PATCHFILE_MAX_COUNT. */
+static cs_err_t read_count(lexer_t *lx, const char *what, size_t *out)
+{
+    fields_t f;
+    cs_err_t e;
+    if (!next_line(lx, &f, &e))
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno + 1, 1),
+                                "end of file: the %s count was expected", what);
+    if (e != CS_OK)
+        return e;
+    if (f.n != 1 || !f.integer[0])
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, f.lineno, f.col[0]),
+                                "expected the %s count (one integer) on this line", what);
+    if (f.v[0] < 1 || f.v[0] > PATCHFILE_MAX_COUNT)
+        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, loc(lx, f.lineno, f.col[0]),
+                                "%s count %.0f outside 1..%d", what, f.v[0], PATCHFILE_MAX_COUNT);
+    *out = (size_t)f.v[0];
+    return CS_OK;
+}
+
+void cs_patchfile_free(cs_patchfile_t *pf)
+{
+    free(pf->file);
+    free(pf->idx);
+    free(pf->line);
+    free(pf->vert);
+    free(pf->vert_line);
+    memset(pf, 0, sizeof *pf);
+}
+
+cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_patchfile_t *pf,
+                            cs_path_diag_t *diag)
+{
+    memset(pf, 0, sizeof *pf);
+    pf->file = strdup(name ? name : "-");
+    if (!pf->file)
+        return CS_ERR_FULL;
+    lexer_t lx = {pf->file, text, text + len, text, 0, diag};
+    cs_err_t e = read_count(&lx, "patch", &pf->npatches);
+    if (e != CS_OK)
+        goto fail;
+    pf->idx = calloc(pf->npatches, sizeof *pf->idx);
+    pf->line = calloc(pf->npatches, sizeof *pf->line);
+    unsigned(*icol)[16] = calloc(pf->npatches, sizeof *icol);
+    if (!pf->idx || !pf->line || !icol) {
+        free(icol);
+        e = CS_ERR_FULL;
+        goto fail;
+    }
+    for (size_t i = 0; i < pf->npatches; i++) {
+        fields_t f;
+        if (!next_line(&lx, &f, &e)) {
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, lx.lineno + 1, 1),
+                                 "end of file after %zu of %zu patches", i, pf->npatches);
+            break;
+        }
+        if (e != CS_OK)
+            break;
+        if (f.n != 16) {
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.endcol),
+                                 "patch %zu: expected 16 vertex indices, found %s%zu", i + 1,
+                                 f.n > 16 ? "more than " : "", f.n > 16 ? (size_t)16 : f.n);
+            break;
+        }
+        pf->line[i] = f.lineno;
+        for (unsigned k = 0; k < 16; k++) {
+            if (!f.integer[k] || f.v[k] < 1) {
+                e = cs_path_diag_set(diag, f.integer[k] ? CS_ERR_RANGE : CS_ERR_PARSE,
+                                     loc(&lx, f.lineno, f.col[k]),
+                                     "vertex index must be an integer >= 1 (indices are "
+                                     "one-based)");
+                break;
+            }
+            pf->idx[i][k] = (size_t)f.v[k] - 1;
+            icol[i][k] = f.col[k];
+        }
+        if (e != CS_OK)
+            break;
+    }
+    if (e == CS_OK)
+        e = read_count(&lx, "vertex", &pf->nverts);
+    if (e == CS_OK) {
+        /* Every index must name a vertex (checked now that the count is known). */
+        for (size_t i = 0; i < pf->npatches && e == CS_OK; i++)
+            for (unsigned k = 0; k < 16 && e == CS_OK; k++)
+                if (pf->idx[i][k] >= pf->nverts)
+                    e = cs_path_diag_set(diag, CS_ERR_RANGE, loc(&lx, pf->line[i], icol[i][k]),
+                                         "vertex index %zu outside 1..%zu", pf->idx[i][k] + 1,
+                                         pf->nverts);
+    }
+    free(icol);
+    if (e != CS_OK)
+        goto fail;
+    pf->vert = calloc(pf->nverts, sizeof *pf->vert);
+    pf->vert_line = calloc(pf->nverts, sizeof *pf->vert_line);
+    if (!pf->vert || !pf->vert_line) {
+        e = CS_ERR_FULL;
+        goto fail;
+    }
+    for (size_t i = 0; i < pf->nverts; i++) {
+        fields_t f;
+        if (!next_line(&lx, &f, &e)) {
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, lx.lineno + 1, 1),
+                                 "end of file after %zu of %zu vertices", i, pf->nverts);
+            goto fail;
+        }
+        if (e != CS_OK)
+            goto fail;
+        if (f.n != 3) {
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.endcol),
+                                 "vertex %zu: expected x,y,z (3 numbers), found %s%zu", i + 1,
+                                 f.n > MAX_FIELDS ? "more than " : "",
+                                 f.n > MAX_FIELDS ? (size_t)MAX_FIELDS : f.n);
+            goto fail;
+        }
+        for (unsigned a = 0; a < 3; a++)
+            pf->vert[i][a] = f.v[a];
+        pf->vert_line[i] = f.lineno;
+    }
+    {
+        fields_t f;
+        if (next_line(&lx, &f, &e)) {
+            if (e == CS_OK)
+                e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.col[0]),
+                                     "unexpected data after the last of %zu vertices", pf->nverts);
+            goto fail;
+        }
+    }
+    return CS_OK;
+fail:
+    /* Keep only the name, which the diagnostic points to (freed by cs_patchfile_free). */
+    {
+        char *file = pf->file;
+        pf->file = NULL;
+        cs_patchfile_free(pf);
+        pf->file = file;
+    }
+    return e;
+}
+
+cs_err_t cs_patchfile_read(const char *filename, cs_patchfile_t *pf, cs_path_diag_t *diag)
+{
+    memset(pf, 0, sizeof *pf);
+    bool use_stdin = strcmp(filename, "-") == 0;
+    const char *name = use_stdin ? "<stdin>" : filename;
+    FILE *f = use_stdin ? stdin : fopen(filename, "rb");
+    if (!f) {
+        int err = errno;
+        pf->file = strdup(name);
+        cs_path_loc_t l = {pf->file ? pf->file : "-", 0, 0};
+        cs_path_diag_set(diag, CS_ERR_IO, l, "cannot open: %s", strerror(err));
+        return CS_ERR_IO;
+    }
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (n == cap) {
+            size_t nc = cap ? 2 * cap : 65536;
+            char *nb = realloc(buf, nc);
+            if (!nb) {
+                free(buf);
+                if (!use_stdin)
+                    fclose(f);
+                return CS_ERR_FULL;
+            }
+            buf = nb;
+            cap = nc;
+        }
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0)
+            break;
+    }
+    bool err = ferror(f) != 0;
+    if (!use_stdin)
+        fclose(f);
+    if (err) {
+        free(buf);
+        pf->file = strdup(name);
+        cs_path_loc_t l = {pf->file ? pf->file : "-", 0, 0};
+        cs_path_diag_set(diag, CS_ERR_IO, l, "read error");
+        return CS_ERR_IO;
+    }
+    cs_err_t e = cs_patchfile_parse(buf, n, name, pf, diag);
+    free(buf);
+    return e;
+}
+
+cs_err_t cs_patchfile_patch(const cs_patchfile_t *pf, size_t i, double scale, cs_patch_t *out,
+                            cs_path_diag_t *diag)
+{
+    if (i >= pf->npatches || !isfinite(scale))
+        return CS_ERR_ARG;
+    cs_vec3_t pts[16];
+    for (unsigned k = 0; k < 16; k++) {
+        size_t v = pf->idx[i][k];
+        const double *q = pf->vert[v];
+        if (cs_conv_mm_to_vec(q[0] * scale, q[1] * scale, q[2] * scale, &pts[k]) != CS_OK) {
+            cs_path_loc_t l = {pf->file, pf->vert_line[v], 1};
+            return cs_path_diag_set(diag, CS_ERR_RANGE, l,
+                                    "vertex %zu (patch %zu) times scale %g is outside +/-%d mm",
+                                    v + 1, i + 1, scale, CS_POS_LIMIT_MM);
+        }
+    }
+    return cs_patch_init(out, 3, 3, pts);
+}
+
+cs_err_t cs_patchfile_write(FILE *f, const cs_patch_t *patches, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (patches[i].deg_u != 3 || patches[i].deg_v != 3)
+            return CS_ERR_DEGREE;
+    fprintf(f, "%zu\n", n);
+    for (size_t i = 0; i < n; i++)
+        for (unsigned k = 0; k < 16; k++)
+            fprintf(f, "%zu%c", 16 * i + k + 1, k == 15 ? '\n' : ',');
+    fprintf(f, "%zu\n", 16 * n);
+    for (size_t i = 0; i < n; i++)
+        for (unsigned k = 0; k < 16; k++) {
+            const cs_vec3_t *p = &patches[i].p[k / 4][k % 4];
+            fprintf(f, "%.6f,%.6f,%.6f\n", cs_conv_pos_to_mm(p->x), cs_conv_pos_to_mm(p->y),
+                    cs_conv_pos_to_mm(p->z));
+        }
+    return ferror(f) ? CS_ERR_IO : CS_OK;
+}

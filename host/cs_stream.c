@@ -1,0 +1,579 @@
+/* cs_stream: streaming a planned job to a device over cs_link (see cs_stream.h and
+ * docs/streaming.md). */
+#include "cs_stream.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cs_conv.h"
+#include "cs_err_text.h"
+#include "cs_motion.h"
+
+/* --- the job ------------------------------------------------------------------------------ */
+
+void cs_stream_job_init(cs_stream_job_t *j, cs_stream_mode_t mode)
+{
+    memset(j, 0, sizeof *j);
+    j->mode = mode;
+}
+
+void cs_stream_job_free(cs_stream_job_t *j)
+{
+    free(j->v);
+    j->v = NULL;
+    j->n = j->cap = 0;
+}
+
+static cs_err_t job_push(cs_stream_job_t *j, const cs_proto_msg_t *m)
+{
+    uint8_t buf[CS_PROTO_LEN_MAX];
+    size_t len;
+    cs_err_t e = cs_proto_encode(m, buf, sizeof buf, &len); /* refuse now what cannot be sent */
+    if (e != CS_OK)
+        return e;
+    if (j->n == j->cap) {
+        size_t cap = j->cap ? j->cap * 2 : 1024;
+        cs_proto_msg_t *p = realloc(j->v, cap * sizeof *p);
+        if (p == NULL)
+            return CS_ERR_FULL;
+        j->v = p;
+        j->cap = cap;
+    }
+    j->v[j->n++] = *m;
+    return CS_OK;
+}
+
+cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        cs_proto_msg_t m = {.type = CS_PROTO_SEGMENT};
+        m.u.segment = s[k];
+        cs_err_t e = job_push(j, &m);
+        if (e != CS_OK)
+            return e;
+    }
+    return CS_OK;
+}
+
+static cs_err_t push_curve(cs_stream_job_t *j, const cs_vec3_t p[4], int32_t feed)
+{
+    cs_proto_msg_t m = {.type = CS_PROTO_CURVE};
+    memcpy(m.u.curve.p, p, 4 * sizeof p[0]);
+    m.u.curve.feed = feed;
+    return job_push(j, &m);
+}
+
+/* Derivative of the exact element at t, one-sided second-order differences inside [0, 1]. */
+static void deriv(const cs_bezier_t *c, double t, double d[3])
+{
+    const double h = 1e-5;
+    double a[3], b[3], e[3];
+    if (t + 2 * h <= 1.0) {
+        cs_path_eval_mm(c, t, a);
+        cs_path_eval_mm(c, t + h, b);
+        cs_path_eval_mm(c, t + 2 * h, e);
+        for (int i = 0; i < 3; i++)
+            d[i] = (-3 * a[i] + 4 * b[i] - e[i]) / (2 * h);
+    } else {
+        cs_path_eval_mm(c, t, a);
+        cs_path_eval_mm(c, t - h, b);
+        cs_path_eval_mm(c, t - 2 * h, e);
+        for (int i = 0; i < 3; i++)
+            d[i] = (3 * a[i] - 4 * b[i] + e[i]) / (2 * h);
+    }
+}
+
+/* Hermite cubic of the exact element on [t0, t1] (end points given in fixed point), and its
+ * largest parametric distance to the element over 64 samples, mm. */
+static double hermite(const cs_bezier_t *c, double t0, double t1, const cs_vec3_t *a,
+                      const cs_vec3_t *b, cs_vec3_t out[4], bool *ok)
+{
+    double p0[3] = {cs_conv_pos_to_mm(a->x), cs_conv_pos_to_mm(a->y), cs_conv_pos_to_mm(a->z)};
+    double p3[3] = {cs_conv_pos_to_mm(b->x), cs_conv_pos_to_mm(b->y), cs_conv_pos_to_mm(b->z)};
+    double d0[3], d1[3], p1[3], p2[3];
+    deriv(c, t0, d0);
+    deriv(c, t1, d1);
+    double h = t1 - t0;
+    for (int i = 0; i < 3; i++) {
+        p1[i] = p0[i] + d0[i] * h / 3;
+        p2[i] = p3[i] - d1[i] * h / 3;
+    }
+    out[0] = *a;
+    out[3] = *b;
+    *ok = cs_conv_mm_to_vec(p1[0], p1[1], p1[2], &out[1]) == CS_OK &&
+          cs_conv_mm_to_vec(p2[0], p2[1], p2[2], &out[2]) == CS_OK;
+    /* measure with the rounded control points: what the device will trace */
+    double q[4][3];
+    for (int k = 0; k < 4; k++) {
+        q[k][0] = cs_conv_pos_to_mm(out[k].x);
+        q[k][1] = cs_conv_pos_to_mm(out[k].y);
+        q[k][2] = cs_conv_pos_to_mm(out[k].z);
+    }
+    double worst = 0;
+    for (int s = 1; s < 64; s++) {
+        double u = s / 64.0, v = 1 - u;
+        double bz[3], ex[3];
+        for (int i = 0; i < 3; i++)
+            bz[i] = v * v * v * q[0][i] + 3 * v * v * u * q[1][i] + 3 * v * u * u * q[2][i] +
+                    u * u * u * q[3][i];
+        cs_path_eval_mm(c, t0 + u * h, ex);
+        double dd = sqrt((bz[0] - ex[0]) * (bz[0] - ex[0]) + (bz[1] - ex[1]) * (bz[1] - ex[1]) +
+                         (bz[2] - ex[2]) * (bz[2] - ex[2]));
+        if (dd > worst)
+            worst = dd;
+    }
+    return worst;
+}
+
+typedef struct {
+    double t0, t1;
+    cs_vec3_t a, b;
+    int depth;
+} piece_t;
+
+static cs_err_t approximate(cs_stream_job_t *j, const cs_path_elem_t *el, int32_t feed,
+                            cs_pos_t tol, cs_path_diag_t *diag)
+{
+    const cs_bezier_t *c = &el->curve;
+    double limit = cs_conv_pos_to_mm(tol) / 4;
+    if (limit < 2.0 / 65536)
+        limit = 2.0 / 65536;
+    enum { DEPTH = 16 };
+    piece_t stack[DEPTH + 2];
+    int sp = 0;
+    stack[sp++] = (piece_t){0.0, 1.0, c->p[0], c->p[c->degree], 0};
+    while (sp > 0) {
+        piece_t it = stack[--sp];
+        cs_vec3_t cub[4];
+        bool ok;
+        double err = hermite(c, it.t0, it.t1, &it.a, &it.b, cub, &ok);
+        if (!ok)
+            return cs_path_diag_set(diag, CS_ERR_RANGE, el->loc,
+                                    "cubic approximation leaves the coordinate range");
+        if (err <= limit || it.depth >= DEPTH) {
+            if (err > limit)
+                return cs_path_diag_set(diag, CS_ERR_DEPTH, el->loc,
+                                        "cannot approximate this curve by cubics within %g mm",
+                                        limit);
+            cs_err_t e = push_curve(j, cub, feed);
+            if (e != CS_OK)
+                return cs_path_diag_set(diag, e, el->loc, "%s", cs_err_text(e));
+            continue;
+        }
+        double tm = 0.5 * (it.t0 + it.t1), pm[3];
+        cs_path_eval_mm(c, tm, pm);
+        cs_vec3_t m;
+        if (cs_conv_mm_to_vec(pm[0], pm[1], pm[2], &m) != CS_OK)
+            return cs_path_diag_set(diag, CS_ERR_RANGE, el->loc, "point outside the range");
+        /* right half below the left one: the left is emitted first */
+        stack[sp++] = (piece_t){tm, it.t1, m, it.b, it.depth + 1};
+        stack[sp++] = (piece_t){it.t0, tm, it.a, m, it.depth + 1};
+    }
+    j->approximated++;
+    return CS_OK;
+}
+
+cs_err_t cs_stream_job_add_path(cs_stream_job_t *j, const cs_path_t *path, int32_t feed,
+                                cs_pos_t tol, cs_path_diag_t *diag)
+{
+    for (size_t k = 0; k < path->n; k++) {
+        const cs_path_elem_t *el = &path->elems[k];
+        const cs_bezier_t *c = &el->curve;
+        cs_err_t e = CS_OK;
+        /* the element's own feed (G-code F) wins; a rapid (G0) asks for the largest feed, which
+         * the device's planner limits to each axis's max rate, as it does for its own rapids */
+        int32_t f = el->rapid           ? INT32_MAX
+                    : el->feed_mm_s > 0 ? cs_motion_speed(el->feed_mm_s)
+                                        : feed;
+        if (c->rational || c->degree > 3) {
+            e = approximate(j, el, f, tol, diag);
+            if (e != CS_OK)
+                return e;
+            continue;
+        }
+        cs_bezier_t b = *c;
+        while (e == CS_OK && b.degree < 3) {
+            cs_bezier_t up;
+            e = cs_bezier_elevate(&b, &up);
+            b = up;
+        }
+        if (e == CS_OK)
+            e = push_curve(j, b.p, f);
+        if (e != CS_OK)
+            return cs_path_diag_set(diag, e, el->loc, "cannot send as a curve: %s", cs_err_text(e));
+        j->exact++;
+    }
+    return CS_OK;
+}
+
+/* --- streaming ------------------------------------------------------------------------------ */
+
+const char *cs_stream_outcome_text(cs_stream_outcome_t oc)
+{
+    switch (oc) {
+    case CS_STREAM_DONE:
+        return "job executed";
+    case CS_STREAM_NO_DEVICE:
+        return "no device answered";
+    case CS_STREAM_INCOMPATIBLE:
+        return "device incompatible with the job";
+    case CS_STREAM_RESET:
+        return "device reset mid-job";
+    case CS_STREAM_CLOSED:
+        return "link closed";
+    case CS_STREAM_DEVICE_ERROR:
+        return "device reported an error";
+    case CS_STREAM_INTERRUPTED:
+        return "interrupted: held, then aborted";
+    }
+    return "?";
+}
+
+void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes, uint32_t tick_hz)
+{
+    memset(o, 0, sizeof *o);
+    o->ser = ser;
+    o->axes = axes;
+    o->tick_hz = tick_hz;
+    o->link.keepalive = 500000;
+    cs_stream_link_timing(&o->link, 0);
+    o->hello_ms = 5000;
+    o->status_ms = 3000;
+}
+
+void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s)
+{
+    if (bits_per_s == 0) {
+        /* memory speed (a pty): a round trip is tens of microseconds, shorter than any useful
+         * hold-off, so every NAK rewinds (repeats cost a few duplicate frames). A receiver
+         * answers a burst of frames with one ACK, so a damaged ACK can hide a NAK: short 5 ms
+         * timeouts repair that quickly, and 200 of them in a row (1 s of silence) close the
+         * link */
+        c->rto = 5000;
+        c->nak_holdoff = 0;
+        c->max_retries = 200;
+        return;
+    }
+    double frame_us = CS_FRAME_WIRE_MAX * 10.0 * 1e6 / bits_per_s;
+    c->rto = (uint32_t)(40000 + 3 * CS_LINK_WINDOW * frame_us);
+    c->nak_holdoff = (uint32_t)(2 * frame_us);
+    c->max_retries = 20;
+}
+
+typedef struct {
+    const cs_stream_job_t *job;
+    const cs_stream_opts_t *o;
+    cs_stream_result_t *r;
+    cs_link_t link;
+    bool open, have_hello;
+    uint16_t first_seq; /* sequence of message resume_from + 1 */
+    uint16_t exec_seq;  /* last executed sequence seen */
+    size_t next;        /* job index of the next message to send (0-based) */
+    bool stop;          /* outcome decided */
+    double t0, t_first, last_progress;
+    double rate_t, rate_ex; /* for the speed estimate */
+    double rate;
+    int progress_len;
+} run_t;
+
+static void finish(run_t *s, cs_stream_outcome_t oc)
+{
+    if (!s->stop) {
+        s->r->outcome = oc;
+        s->stop = true;
+    }
+}
+
+static void on_status(run_t *s, const cs_proto_status_t *st)
+{
+    s->r->dev_state = st->state;
+    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
+        s->r->dev_pos[i] = i < st->axes ? st->pos[i] : 0;
+    if (!s->open)
+        return;
+    size_t base = s->o->resume_from;
+    size_t in_flight = s->r->sent - s->r->executed;
+    uint16_t d = (uint16_t)(st->last_seq - s->exec_seq);
+    if (d != 0 && d <= in_flight) {
+        s->r->executed += d;
+        s->exec_seq = st->last_seq;
+    }
+    (void)base;
+}
+
+static void on_deliver(run_t *s, const cs_link_event_t *ev)
+{
+    cs_proto_msg_t m;
+    if (cs_proto_decode(ev->payload, ev->len, &m) != CS_OK)
+        return;
+    if (m.type == CS_PROTO_HELLO) {
+        s->r->hello = m.u.hello;
+        s->have_hello = true;
+    } else if (m.type == CS_PROTO_STATUS) {
+        on_status(s, &m.u.status);
+    } else if (m.type == CS_PROTO_ERROR) {
+        s->r->dev_error = m.u.error;
+        uint16_t k = (uint16_t)(m.u.error.seq - s->first_seq);
+        s->r->dev_error_msg =
+            s->open && k < s->r->sent - s->o->resume_from ? s->o->resume_from + k + 1 : 0;
+        finish(s, CS_STREAM_DEVICE_ERROR);
+    }
+}
+
+static int pump_out(run_t *s, uint32_t now)
+{
+    for (int k = 0; k < 64; k++) {
+        const uint8_t *b;
+        size_t n;
+        cs_err_t e = cs_link_poll(&s->link, now, 0, &b, &n);
+        if (e == CS_END)
+            return 0;
+        if (e == CS_ERR_TIMEOUT) {
+            snprintf(s->r->why, sizeof s->r->why,
+                     "the device stopped answering (%u retransmission timeouts of %u ms)",
+                     (unsigned)s->o->link.max_retries + 1u, (unsigned)s->o->link.rto / 1000u);
+            finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
+            return 0;
+        }
+        if (e == CS_OK && cs_serial_write(s->o->ser, b, n) != 0) {
+            snprintf(s->r->why, sizeof s->r->why, "write failed: %s", strerror(errno));
+            finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Reads what arrived (waiting up to wait_ms) and feeds it to the link. */
+static void pump_in(run_t *s, int wait_ms)
+{
+    uint8_t buf[2048];
+    ssize_t n = cs_serial_read(s->o->ser, buf, sizeof buf, wait_ms);
+    if (n < 0) {
+        snprintf(s->r->why, sizeof s->r->why, "the line closed (%s)", strerror(errno));
+        finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
+        return;
+    }
+    uint32_t now = cs_serial_now_us();
+    for (ssize_t k = 0; k < n; k++) {
+        cs_link_event_t ev;
+        if (cs_link_feed(&s->link, buf[k], now, 0, &ev) != CS_OK)
+            continue;
+        if (ev.what & CS_LINK_EV_OPEN) {
+            s->open = true;
+            s->first_seq = (uint16_t)(ev.last_acked + 1u);
+            s->exec_seq = ev.last_acked;
+        }
+        if (ev.what & CS_LINK_EV_RESET) {
+            s->r->old_boot = ev.old_boot;
+            s->r->new_boot = ev.new_boot;
+            s->r->unacked = ev.unacked;
+            finish(s, CS_STREAM_RESET);
+        }
+        if (ev.what & CS_LINK_EV_DELIVER)
+            on_deliver(s, &ev);
+    }
+    if (s->open) {
+        uint16_t acked = cs_link_last_acked(&s->link);
+        uint16_t k = (uint16_t)(acked - s->first_seq + 1u);
+        size_t in_session = s->r->sent - s->o->resume_from;
+        if (k <= in_session)
+            s->r->delivered = s->o->resume_from + k;
+    }
+}
+
+static void progress(run_t *s, bool final)
+{
+    FILE *f = s->o->progress;
+    if (f == NULL)
+        return;
+    double now = cs_serial_now_s();
+    double period = s->o->progress_tty ? 0.1 : 1.0;
+    if (!final && now - s->last_progress < period)
+        return;
+    s->last_progress = now;
+    size_t n = s->job->n, ex = s->r->executed;
+    if (now - s->rate_t >= 0.5) { /* speed over the last half second or more */
+        if (s->rate_t > 0)
+            s->rate = ((double)ex - s->rate_ex) / (now - s->rate_t);
+        s->rate_t = now;
+        s->rate_ex = (double)ex;
+    }
+    double pct = n ? 100.0 * (double)ex / (double)n : 100.0;
+    double eta = s->rate > 0 ? (double)(n - ex) / s->rate : -1;
+    const char *what = s->job->mode == CS_STREAM_CURVES ? "curves" : "segments";
+    unsigned retx = s->link.stats.retransmits;
+    if (s->o->progress_tty) {
+        char bar[31];
+        int fill = (int)(pct * 30 / 100);
+        for (int i = 0; i < 30; i++)
+            bar[i] = i < fill ? '#' : '-';
+        bar[30] = '\0';
+        char etas[32];
+        if (eta >= 0)
+            snprintf(etas, sizeof etas, "%d:%02d", (int)eta / 60, (int)eta % 60);
+        else
+            snprintf(etas, sizeof etas, "--:--");
+        fprintf(f, "\r[%s] %5.1f%% %zu/%zu %s  ETA %s  %.0f %s/s  retx %u ", bar, pct, ex, n, what,
+                etas, s->rate, what, retx);
+        if (final)
+            fputc('\n', f);
+    } else {
+        fprintf(f,
+                "stream: %zu/%zu %s executed (%.1f %%), %zu sent, %.0f/s, ETA %s%.0f s, "
+                "%u retransmissions\n",
+                ex, n, what, pct, s->r->sent, s->rate, eta >= 0 ? "" : "~", eta >= 0 ? eta : 0,
+                retx);
+    }
+    fflush(f);
+}
+
+/* Sends one control message (HOLD or ABORT) and waits until the device says it obeyed (state in
+ * want_a or want_b) or wait_ms passed. */
+static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint32_t wait_ms)
+{
+    cs_proto_msg_t m = {.type = type};
+    double t_end = cs_serial_now_s() + wait_ms / 1000.0;
+    bool sent = false;
+    uint8_t before = s->r->dev_state;
+    (void)before;
+    s->r->dev_state = 0xFF; /* wait for a STATUS sent after the message */
+    while (cs_serial_now_s() < t_end) {
+        uint32_t now = cs_serial_now_us();
+        if (!sent && cs_link_can_send(&s->link, type))
+            sent = cs_link_send_msg(&s->link, &m, NULL) == CS_OK;
+        if (pump_out(s, now) != 0)
+            return;
+        pump_in(s, 5);
+        if (sent && cs_link_unacked(&s->link) == 0 &&
+            (s->r->dev_state == want_a || s->r->dev_state == want_b))
+            return;
+        if (cs_link_state(&s->link) != CS_LINK_OPEN)
+            return;
+        if (s->o->interrupt != NULL && *s->o->interrupt >= 2)
+            return;
+    }
+}
+
+cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs_stream_result_t *r)
+{
+    memset(r, 0, sizeof *r);
+    r->dev_state = 0xFF;
+    if (job == NULL || o == NULL || o->ser == NULL || o->resume_from > job->n)
+        return CS_ERR_ARG;
+    run_t *s = calloc(1, sizeof *s);
+    if (s == NULL)
+        return CS_ERR_FULL;
+    s->job = job;
+    s->o = o;
+    s->r = r;
+    /* a line that takes no more bytes (the peer stopped reading) must not block the loop: what
+     * the driver refuses is lost, and the link resends it or declares the peer gone */
+    cs_serial_set_lossy(o->ser, true);
+    r->sent = r->delivered = r->executed = o->resume_from;
+    s->next = o->resume_from;
+    s->t0 = cs_serial_now_s();
+    uint32_t seed = (uint32_t)getpid() * 2654435761u ^ (uint32_t)(s->t0 * 1e6);
+    uint32_t boot = seed ? seed : 1u;
+    uint32_t nonce = seed * 1664525u + 1013904223u;
+    cs_err_t e = cs_link_init(&s->link, &o->link, boot, nonce ? nonce : 1u, 0, cs_serial_now_us());
+    if (e != CS_OK) {
+        free(s);
+        return CS_ERR_ARG;
+    }
+    /* 1. connect and wait for the HELLO */
+    double t_hello = s->t0 + o->hello_ms / 1000.0;
+    while (!s->stop && !(s->open && s->have_hello)) {
+        if (cs_serial_now_s() > t_hello) {
+            snprintf(r->why, sizeof r->why, "%s within %u ms",
+                     s->open ? "connected, but no HELLO" : "no answer to the connection",
+                     (unsigned)o->hello_ms);
+            finish(s, CS_STREAM_NO_DEVICE);
+            break;
+        }
+        if (o->interrupt != NULL && *o->interrupt) {
+            finish(s, CS_STREAM_INTERRUPTED);
+            break;
+        }
+        pump_out(s, cs_serial_now_us());
+        pump_in(s, 5);
+    }
+    if (!s->stop) {
+        const cs_proto_hello_t *h = &r->hello;
+        uint16_t need = job->mode == CS_STREAM_CURVES ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
+        if (h->version != CS_PROTO_VERSION)
+            snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
+                     (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
+        else if (h->axes != o->axes)
+            snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",
+                     (unsigned)h->axes, (unsigned)o->axes);
+        else if (job->mode == CS_STREAM_SEGMENTS && h->tick_hz != o->tick_hz)
+            snprintf(r->why, sizeof r->why,
+                     "the device ticks at %u Hz, the segments were planned for %u Hz",
+                     (unsigned)h->tick_hz, (unsigned)o->tick_hz);
+        else if (!(h->caps & need))
+            snprintf(r->why, sizeof r->why, "the device cannot take %s",
+                     job->mode == CS_STREAM_CURVES ? "curves" : "step segments");
+        if (r->why[0] != '\0')
+            finish(s, CS_STREAM_INCOMPATIBLE);
+    }
+    /* 2. stream */
+    double t_last_ack = 0;
+    s->t_first = cs_serial_now_s();
+    while (!s->stop) {
+        uint32_t now = cs_serial_now_us();
+        if (o->interrupt != NULL && *o->interrupt) {
+            if (*o->interrupt < 2) {
+                control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
+                control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
+            }
+            finish(s, CS_STREAM_INTERRUPTED);
+            break;
+        }
+        while (s->next < job->n && cs_link_can_send(&s->link, job->v[s->next].type)) {
+            if (cs_link_send_msg(&s->link, &job->v[s->next], NULL) != CS_OK)
+                break;
+            s->next++;
+            r->sent = s->next;
+        }
+        if (pump_out(s, now) != 0)
+            break;
+        pump_in(s, 2);
+        if (s->stop)
+            break;
+        progress(s, false);
+        if (r->sent == job->n && cs_link_unacked(&s->link) == 0) {
+            if (t_last_ack == 0)
+                t_last_ack = cs_serial_now_s();
+            if (r->executed == job->n && r->dev_state != CS_PROTO_STATE_RUNNING) {
+                finish(s, CS_STREAM_DONE);
+                break;
+            }
+            /* the device reports its progress at least every 250 ms; a job whose last
+             * messages are still executing keeps sending STATUS while running */
+            if (r->dev_state != CS_PROTO_STATE_RUNNING &&
+                cs_serial_now_s() - t_last_ack > o->status_ms / 1000.0) {
+                snprintf(r->why, sizeof r->why,
+                         "everything was delivered but the device reports %zu executed",
+                         r->executed);
+                finish(s, CS_STREAM_CLOSED);
+            }
+        }
+    }
+    if (r->outcome == CS_STREAM_DEVICE_ERROR && cs_link_state(&s->link) == CS_LINK_OPEN)
+        control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
+    double t_end = cs_serial_now_s();
+    /* the ACKs still due (the device's last STATUS) go out before we leave */
+    pump_out(s, cs_serial_now_us());
+    progress(s, true);
+    r->link = s->link.stats;
+    r->bytes_out = o->ser->bytes_out;
+    r->bytes_in = o->ser->bytes_in;
+    r->wall_s = t_end - s->t0;
+    r->stream_s = t_end - s->t_first;
+    free(s);
+    return CS_OK;
+}

@@ -1,0 +1,109 @@
+/* cs_stream: the host's streaming engine. Holds a whole planned job as wire messages (SEGMENT
+ * step segments, or CURVE cubic Béziers the device interpolates), connects to the device through
+ * cs_link over a cs_serial port, checks its HELLO, keeps the window and the credits full, follows
+ * the device's STATUS to know the last executed message, and stops at once on a device reset
+ * (new boot id), a closed link, a device ERROR or Ctrl-C (HOLD, then ABORT). Host only. */
+#ifndef CS_STREAM_H
+#define CS_STREAM_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "cs_link.h"
+#include "cs_path.h"
+#include "cs_proto.h"
+#include "cs_serial.h"
+
+typedef enum {
+    CS_STREAM_SEGMENTS = 0, /* the host plans; the device executes step segments */
+    CS_STREAM_CURVES = 1,   /* the device traces cubic Béziers with the core and plans them */
+} cs_stream_mode_t;
+
+/* The job: every message, in order (numbered 1..n in reports and --resume-from). */
+typedef struct {
+    cs_proto_msg_t *v;
+    size_t n, cap;
+    cs_stream_mode_t mode;
+    size_t exact; /* curves mode: elements sent exactly (lines, quadratics elevated, cubics) */
+    size_t approximated; /* curves mode: elements (arcs, other rationals, degree > 3) sent as
+                          * cubic Hermite pieces within tol/4 */
+} cs_stream_job_t;
+
+void cs_stream_job_init(cs_stream_job_t *j, cs_stream_mode_t mode);
+void cs_stream_job_free(cs_stream_job_t *j);
+/* Appends step segments as SEGMENT messages. CS_ERR_FULL out of memory, CS_ERR_RANGE for a
+ * segment the protocol cannot carry. */
+cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n);
+/* Appends every element of path as CURVE messages at the element's own feed (G-code F), else
+ * at feed (mm/s Q15.16, > 0); a rapid element (G0) gets INT32_MAX, which the device's planner
+ * limits to each axis's max rate (its rapid, as `curvestep plan` does). Lines and
+ * quadratics degree-elevated to cubics (exact up to 1 LSB of rounding), cubics as they are;
+ * rational elements (arcs) and degrees above 3 are approximated, in double, by cubic Hermite
+ * pieces that match the exact curve's end points and end tangents, halved until every piece is
+ * within max(tol/4, 2 LSB) of the exact curve (parametric distance, 64 samples). On error
+ * *diag names the element. The device travels in a straight rapid move to a curve's P0 when it
+ * is not already there (the rule `curvestep plan` follows). */
+cs_err_t cs_stream_job_add_path(cs_stream_job_t *j, const cs_path_t *path, int32_t feed,
+                                cs_pos_t tol, cs_path_diag_t *diag);
+
+typedef enum {
+    CS_STREAM_DONE = 0,         /* every message executed (device idle, last one reported) */
+    CS_STREAM_NO_DEVICE = 1,    /* no answer to the connection or no HELLO in time */
+    CS_STREAM_INCOMPATIBLE = 2, /* HELLO: other protocol version, axes, tick rate or caps */
+    CS_STREAM_RESET = 3,        /* the device restarted mid-job (new boot id) */
+    CS_STREAM_CLOSED = 4,       /* the line closed or the device stopped answering */
+    CS_STREAM_DEVICE_ERROR = 5, /* the device sent ERROR about a message (then ABORT was sent) */
+    CS_STREAM_INTERRUPTED = 6,  /* the user asked to stop: HOLD, then ABORT */
+} cs_stream_outcome_t;
+
+typedef struct {
+    cs_serial_t *ser;
+    uint8_t axes; /* the machine: HELLO must announce the same */
+    uint32_t tick_hz;
+    size_t resume_from; /* messages 1..resume_from were executed already: start after them */
+    volatile sig_atomic_t *interrupt; /* > 0: stop (HOLD, ABORT); >= 2: give up at once */
+    FILE *progress;                   /* NULL: none; else progress bar (tty) or lines */
+    bool progress_tty;
+    cs_link_cfg_t link; /* in microseconds (cs_serial_now_us) */
+    uint32_t hello_ms;  /* wait this long for the connection and HELLO */
+    uint32_t status_ms; /* after the last ACK, wait this long for the final STATUS */
+    bool quiet_hello;
+} cs_stream_opts_t;
+
+typedef struct {
+    cs_stream_outcome_t outcome;
+    size_t sent;      /* messages handed to the link (job numbering: last one's number) */
+    size_t delivered; /* acknowledged by the device */
+    size_t executed;  /* last message the device reported executed (job numbering) */
+    cs_proto_hello_t hello;
+    uint32_t old_boot, new_boot; /* RESET */
+    uint16_t unacked;            /* RESET: messages sent whose fate is unknown */
+    cs_proto_error_t dev_error;  /* DEVICE_ERROR */
+    size_t dev_error_msg;        /* DEVICE_ERROR: job number of the message it is about (0: ?) */
+    uint8_t dev_state;           /* last STATUS */
+    int32_t dev_pos[CS_PROTO_AXES_MAX];
+    cs_link_stats_t link;
+    uint64_t bytes_out, bytes_in;
+    double wall_s;   /* from the connection to the end */
+    double stream_s; /* from the first message sent to the last one executed */
+    char why[160];   /* one sentence for NO_DEVICE / INCOMPATIBLE / CLOSED */
+} cs_stream_result_t;
+
+/* Defaults: link timing for a pty at memory speed (cs_stream_link_timing(.., 0)), keepalive
+ * 500 ms, HELLO within 5 s, final STATUS within 3 s. */
+void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes, uint32_t tick_hz);
+/* Link timing for a line of bits_per_s (0: a pty at memory speed): rto = 40 ms + three windows
+ * of the largest frame, NAK hold-off = two largest frames + 0.3 ms (docs/protocol.md 3.6). */
+void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s);
+/* Streams job messages resume_from+1..n (the port is switched to lossy writes: a peer that
+ * stops reading never blocks the host). Always fills *r; returns CS_OK when it ran to an
+ * outcome (see r->outcome), CS_ERR_ARG for bad options, CS_ERR_IO for a write error. */
+cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o,
+                       cs_stream_result_t *r);
+/* One line for an outcome ("device reset", ...). */
+const char *cs_stream_outcome_text(cs_stream_outcome_t oc);
+
+#endif

@@ -1,0 +1,651 @@
+/* curvestep toolpath: surface patches (Newell's format or the native one, cs_surffile) turned
+ * into paths.
+ *  - wireframe (default): the iso-parametric lines of every patch, N + 1 in each direction
+ *    (edges included), made by the core (cs_patch_raster_* forward differences when N is a power
+ *    of two, cs_patch_iso otherwise), traced in 3D by cs_trace within --tol, and projected
+ *    through a view to 2D: "x y" per line, a blank line between polylines, like flatten.
+ *  - finishing (--ball R): see the comment above finish_patch.
+ * Neighbouring patches that share an edge's control points get identical iso-curve end points
+ * (the same integer computation), so the wireframe has no cracks. */
+#include <getopt.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_conv.h"
+#include "cs_finish.h"
+#include "cs_err_text.h"
+#include "cs_patch.h"
+#include "cs_surffile.h"
+#include "cs_path.h"
+#include "cs_trace.h"
+
+#define TP_DEFAULT_TOL_MM 0.01
+#define TP_DEFAULT_LINES  8
+#define TP_MAX_LINES      4096
+
+/* A view: rows 0 and 1 give the printed x and y, row 2 the depth (unused): v = M (x y z 1). */
+typedef struct {
+    const char *name;
+    double m[3][4];
+} tp_view_t;
+
+#define S2 0.70710678118654752440
+#define S6 0.40824829046386301637
+#define S3 0.57735026918962576451
+static const tp_view_t views[] = {
+    {"top", {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}},
+    {"front", {{1, 0, 0, 0}, {0, 0, 1, 0}, {0, -1, 0, 0}}},
+    {"side", {{0, 1, 0, 0}, {0, 0, 1, 0}, {1, 0, 0, 0}}},
+    /* Orthographic, seen from (1, -1, 1): right (1, 1, 0)/sqrt 2, up (-1, 1, 2)/sqrt 6. */
+    {"iso", {{S2, S2, 0, 0}, {-S6, S6, 2 * S6, 0}, {S3, -S3, S3, 0}}},
+};
+
+static void tp_usage(FILE *f)
+{
+    fprintf(
+        f,
+        "Usage: curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM]\n"
+        "                          [--scale S] [--stats] [--svg OUT.svg]\n"
+        "       curvestep toolpath --patches FILE --ball R --scallop H [--tol MM]\n"
+        "                          [--safe-z Z] [--scale S] [--view V] [--svg OUT.svg]\n"
+        "\n"
+        "Reads surface patches and prints a path over them. FILE is either in Newell's\n"
+        "format (a patch count; one line of 16 one-based vertex indices per patch; a vertex\n"
+        "count; one \"x,y,z\" line per vertex: the Utah teapot's format) or in curvestep's\n"
+        "native surface format (first word \"curvestep-surfaces 1\", then bezier, tri,\n"
+        "hermite, power, coons-bilinear, coons-bicubic, ruled, extrude and revolve items;\n"
+        "see docs/surfaces.md). Surfaces of revolution are approximated within --tol / 4.\n"
+        "\n"
+        "Wireframe (without --ball): the iso-parametric lines of each patch, N + 1 in each\n"
+        "parameter direction (edges included), traced into chords within the tolerance of the\n"
+        "exact lines in 3D, then projected through the view; one vertex \"x y\" (mm, 6 decimals)\n"
+        "per line, a blank line between polylines.\n"
+        "\n"
+        "Finishing (--ball R): a zig-zag raster along each patch's u lines for a ball-end tool\n"
+        "of radius R, its centre on the offset surface P + R N (N = Pu x Pv as the file orients\n"
+        "the patch), passes spaced so the measured scallop stays below H; prints the tool\n"
+        "centre \"x y z\" (mm) per line (the tool tip is R below it). Each patch is one block:\n"
+        "approach at the safe height, the passes, retract to the safe height; a blank line\n"
+        "between patches. Warnings on stderr where the surface is concave with a curvature\n"
+        "radius below R (gouge) or faces down (undercut). See docs/surfaces.md.\n"
+        "\n"
+        "Options:\n"
+        "  --patches FILE  the surface file ('-' reads standard input)\n"
+        "  --view V        top (x y), front (x z), side (y z), iso (orthographic, seen from\n"
+        "                  (1,-1,1)) or 12 comma-separated numbers: a 3x4 matrix, row-major,\n"
+        "                  whose first two rows give the printed x and y (default iso)\n"
+        "  --lines N       iso-parametric intervals per patch and direction, 1..%d\n"
+        "                  (default %d; powers of two use exact forward differences;\n"
+        "                  triangular patches get N + 1 lines in each of 3 directions)\n"
+        "  --tol MM        chord tolerance in mm, in 3D model space (default %g)\n"
+        "  --scale S       millimetres per file unit (default 1)\n"
+        "  --ball R        ball-end tool radius in mm: finishing path instead of wireframe\n"
+        "  --scallop H     largest scallop height in mm (with --ball; 0 < H < R)\n"
+        "  --safe-z Z      retract height in mm (default: 5 mm above the highest control point\n"
+        "                  plus R)\n"
+        "  --stats         summary on stderr: patches, curves, chords, largest deviation of a\n"
+        "                  chord from its exact curve (measured in double)\n"
+        "  --svg OUT.svg   also draw the projected path (y up)\n"
+        "  -h, --help      show this help\n"
+        "\n"
+        "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
+        "coordinates outside +/-%d mm after scaling); 2 usage error; 3 internal error.\n",
+        TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
+}
+
+static bool parse_double(const char *s, double *out)
+{
+    char *end = NULL;
+    double v = strtod(s, &end);
+    if (!end || end == s || *end != '\0' || !isfinite(v))
+        return false;
+    *out = v;
+    return true;
+}
+
+static bool parse_view(const char *s, tp_view_t *v)
+{
+    for (size_t k = 0; k < sizeof views / sizeof views[0]; k++)
+        if (strcmp(s, views[k].name) == 0) {
+            *v = views[k];
+            return true;
+        }
+    double m[12];
+    const char *p = s;
+    for (int k = 0; k < 12; k++) {
+        char *end = NULL;
+        m[k] = strtod(p, &end);
+        if (end == p || !isfinite(m[k]))
+            return false;
+        p = end;
+        if (k < 11) {
+            if (*p != ',')
+                return false;
+            p++;
+        }
+    }
+    if (*p != '\0')
+        return false;
+    v->name = "matrix";
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++)
+            v->m[r][c] = m[4 * r + c];
+    return true;
+}
+
+static void project(const tp_view_t *v, const double q[3], double *x, double *y)
+{
+    *x = v->m[0][0] * q[0] + v->m[0][1] * q[1] + v->m[0][2] * q[2] + v->m[0][3];
+    *y = v->m[1][0] * q[0] + v->m[1][1] * q[1] + v->m[1][2] * q[2] + v->m[1][3];
+}
+
+static void to_mm(const cs_vec3_t *p, double q[3])
+{
+    q[0] = cs_conv_pos_to_mm(p->x);
+    q[1] = cs_conv_pos_to_mm(p->y);
+    q[2] = cs_conv_pos_to_mm(p->z);
+}
+
+/* Output: stdout text plus the projected polylines for the picture. */
+typedef struct {
+    const tp_view_t *view;
+    bool three_d; /* print x y z instead of the projection */
+    bool first;   /* nothing printed yet */
+    cs_path_poly_t poly;
+    cs_vec3_t *v; /* vertices of the current curve (for --stats) */
+    size_t nv, capv;
+    size_t curves, chords;
+    double maxdev;
+    bool stats;
+} tp_out_t;
+
+static bool out_vertex(tp_out_t *o, const cs_vec3_t *p, bool start)
+{
+    double q[3], x, y;
+    to_mm(p, q);
+    project(o->view, q, &x, &y);
+    if (start && !o->first)
+        putchar('\n');
+    o->first = false;
+    if (o->three_d)
+        printf("%.6f %.6f %.6f\n", q[0], q[1], q[2]);
+    else
+        printf("%.6f %.6f\n", x, y);
+    return (start ? cs_path_poly_move(&o->poly, x, y) : cs_path_poly_line(&o->poly, x, y)) == CS_OK;
+}
+
+static bool keep_vertex(tp_out_t *o, const cs_vec3_t *p)
+{
+    if (o->nv == o->capv) {
+        size_t nc = o->capv ? 2 * o->capv : 256;
+        cs_vec3_t *nv = realloc(o->v, nc * sizeof *nv);
+        if (!nv)
+            return false;
+        o->v = nv;
+        o->capv = nc;
+    }
+    o->v[o->nv++] = *p;
+    return true;
+}
+
+static bool degenerate_curve(const cs_bezier_t *c)
+{
+    for (unsigned k = 1; k <= c->degree; k++)
+        if (c->p[k].x != c->p[0].x || c->p[k].y != c->p[0].y || c->p[k].z != c->p[0].z)
+            return false;
+    return true;
+}
+
+/* Trace one curve and print it as one polyline (or continue the current one when !start). */
+static cs_err_t emit_curve(tp_out_t *o, const cs_bezier_t *c, cs_pos_t tol, bool start)
+{
+    o->nv = 0;
+    if (!keep_vertex(o, &c->p[0]) || !out_vertex(o, &c->p[0], start))
+        return CS_ERR_FULL;
+    if (degenerate_curve(c))
+        return CS_OK; /* a collapsed edge: a single point */
+    cs_trace_t tr;
+    cs_err_t e = cs_trace_begin(&tr, c, tol, CS_TRACE_SUBDIV);
+    cs_vec3_t pt;
+    while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK) {
+        o->chords++;
+        if (!out_vertex(o, &pt, false) || !keep_vertex(o, &pt))
+            return CS_ERR_FULL;
+    }
+    if (e != CS_END)
+        return e;
+    o->curves++;
+    if (o->stats) {
+        double d = cs_path_deviation_mm(c, o->v, o->nv);
+        if (d > o->maxdev)
+            o->maxdev = d;
+    }
+    return CS_OK;
+}
+
+static bool is_pow2(unsigned n)
+{
+    return n && (n & (n - 1)) == 0;
+}
+
+static cs_err_t wire_patch(tp_out_t *o, const cs_patch_t *p, unsigned lines, cs_pos_t tol)
+{
+    for (int dir = 0; dir < 2; dir++) {
+        cs_bezier_t c;
+        cs_err_t e;
+        if (is_pow2(lines) && lines <= (1u << CS_PATCH_RASTER_MAX_SHIFT)) {
+            unsigned shift = 0;
+            while ((1u << shift) < lines)
+                shift++;
+            cs_patch_raster_t r;
+            e = cs_patch_raster_begin(&r, p, (cs_patch_iso_t)dir, shift);
+            while (e == CS_OK && (e = cs_patch_raster_next(&r, &c, NULL)) == CS_OK)
+                e = emit_curve(o, &c, tol, true);
+            if (e != CS_END)
+                return e;
+        } else {
+            for (unsigned k = 0; k <= lines; k++) {
+                cs_param_t t = (cs_param_t)(((int64_t)k * CS_PARAM_ONE + lines / 2) / lines);
+                e = cs_patch_iso(p, (cs_patch_iso_t)dir, t, &c);
+                if (e == CS_OK)
+                    e = emit_curve(o, &c, tol, true);
+                if (e != CS_OK)
+                    return e;
+            }
+        }
+    }
+    return CS_OK;
+}
+
+/* Triangular patch: the lines u = k/N, v = k/N and w = k/N (k = 0..N), each the image of a
+ * straight domain segment (cs_tripatch_line). */
+static cs_err_t wire_tri(tp_out_t *o, const cs_tripatch_t *t, unsigned lines, cs_pos_t tol)
+{
+    for (unsigned k = 0; k <= lines; k++) {
+        cs_param_t c = (cs_param_t)(((int64_t)k * CS_PARAM_ONE + lines / 2) / lines);
+        cs_param_t r = CS_PARAM_ONE - c;
+        /* (u, v) end points of the three families; w = 1 - u - v. */
+        const cs_param_t seg[3][4] = {{c, 0, c, r}, {0, c, r, c}, {r, 0, 0, r}};
+        for (int f = 0; f < 3; f++) {
+            cs_bezier_t b;
+            cs_err_t e = cs_tripatch_line(t, seg[f][0], seg[f][1], seg[f][2], seg[f][3], &b);
+            if (e == CS_OK)
+                e = emit_curve(o, &b, tol, true);
+            if (e != CS_OK)
+                return e;
+        }
+    }
+    return CS_OK;
+}
+
+/* One domain segment of an n-sided patch: fitted cubics (within tol / 4 of the surface), each
+ * traced, printed as one polyline. */
+static cs_err_t varady_segment(tp_out_t *o, const cs_varady_t *v, const double a[2],
+                               const double b[2], cs_pos_t tol)
+{
+    cs_bezier_t pieces[64];
+    size_t n = 0;
+    cs_err_t e = cs_varady_curve(v, a, b, cs_conv_pos_to_mm(tol) / 4, pieces, 64, &n);
+    for (size_t k = 0; e == CS_OK && k < n; k++)
+        e = emit_curve(o, &pieces[k], tol, k == 0);
+    return e;
+}
+
+/* n-sided patch: the boundary curves themselves, rays from the domain centre to every vertex
+ * and N - 1 concentric copies of the domain polygon (scaled by k / N about the centre). */
+static cs_err_t wire_varady(tp_out_t *o, const cs_varady_t *v, unsigned lines, cs_pos_t tol)
+{
+    cs_err_t e = CS_OK;
+    for (size_t i = 0; e == CS_OK && i < v->n; i++)
+        e = emit_curve(o, &v->side[i], tol, true);
+    double c[2] = {0, 0};
+    for (size_t i = 0; e == CS_OK && i < v->n; i++) {
+        double p[2];
+        cs_varady_vertex(v, i, p);
+        e = varady_segment(o, v, c, p, tol);
+    }
+    for (unsigned k = 1; e == CS_OK && k < lines; k++) {
+        double f = (double)k / lines;
+        for (size_t i = 0; e == CS_OK && i < v->n; i++) {
+            double p[2], q[2];
+            cs_varady_vertex(v, i, p);
+            cs_varady_vertex(v, (i + 1) % v->n, q);
+            double a[2] = {f * p[0], f * p[1]}, b[2] = {f * q[0], f * q[1]};
+            e = varady_segment(o, v, a, b, tol);
+        }
+    }
+    return e;
+}
+
+/* --- finishing with a ball-end tool -------------------------------------------------------- */
+
+typedef struct {
+    double r_mm, h_mm, safe_z_mm;
+    bool have_safe_z;
+} tp_ball_t;
+
+typedef struct {
+    tp_out_t *o;
+    bool patch_start;
+    cs_vec3_t last;
+    double safe_z;
+} tp_ball_ctx_t;
+
+static bool ball_emit(void *ctx, size_t pass, double u, double v, const cs_vec3_t *c,
+                      bool pass_start)
+{
+    (void)pass;
+    (void)u;
+    (void)v;
+    (void)pass_start;
+    tp_ball_ctx_t *b = ctx;
+    cs_vec3_t above = *c;
+    if (b->patch_start) {
+        /* Rapid approach: over the first point at the safe height, then down. */
+        cs_conv_mm_to_pos(b->safe_z, &above.z);
+        if (!out_vertex(b->o, &above, true))
+            return false;
+        b->patch_start = false;
+    }
+    b->last = *c;
+    b->o->chords++;
+    return out_vertex(b->o, c, false);
+}
+
+/* Every patch in turn: approach from the safe height, the zig-zag passes, retract. */
+static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const tp_ball_t *bp,
+                      cs_finish_stats_t *st)
+{
+    double top = -HUGE_VAL;
+    for (size_t i = 0; i < sf->n; i++) {
+        const cs_surf_item_t *it = &sf->items[i];
+        if (it->tri || it->varady) {
+            cs_path_diag_t d;
+            cs_path_loc_t l = {sf->file, it->line, 1};
+            cs_path_diag_set(&d, CS_ERR_UNSUPPORTED, l,
+                             "%s patches cannot be finished with --ball yet",
+                             it->tri ? "triangular" : "n-sided");
+            cs_path_diag_print(stderr, &d);
+            return CS_EXIT_INPUT;
+        }
+        for (int a = 0; a <= it->quad.deg_u; a++)
+            for (int b = 0; b <= it->quad.deg_v; b++)
+                top = fmax(top, cs_conv_pos_to_mm(it->quad.p[a][b].z));
+    }
+    tp_ball_ctx_t ctx = {o, true, {0, 0, 0}, bp->have_safe_z ? bp->safe_z_mm : top + bp->r_mm + 5};
+    cs_pos_t zq;
+    if (cs_conv_mm_to_pos(ctx.safe_z, &zq) != CS_OK) {
+        fprintf(stderr, "curvestep toolpath: safe height %g mm outside +/-%d mm\n", ctx.safe_z,
+                CS_POS_LIMIT_MM);
+        return CS_EXIT_USAGE;
+    }
+    for (size_t i = 0; i < sf->n; i++) {
+        ctx.patch_start = true;
+        cs_err_t e =
+            cs_finish_patch(&sf->items[i].quad, bp->r_mm, bp->h_mm, tol, ball_emit, &ctx, st);
+        if (e != CS_OK) {
+            cs_path_diag_t d;
+            cs_path_loc_t l = {sf->file, sf->items[i].line, 1};
+            cs_path_diag_set(&d, e, l, "patch %zu: cannot plan the finishing passes: %s", i + 1,
+                             cs_err_text(e));
+            cs_path_diag_print(stderr, &d);
+            return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+        }
+        cs_vec3_t up = ctx.last;
+        up.z = zq;
+        if (!out_vertex(o, &up, false))
+            return CS_EXIT_INTERNAL;
+        o->curves++;
+    }
+    if (st->gouge_points > 0)
+        fprintf(stderr,
+                "curvestep toolpath: warning: %zu surface samples are concave with a curvature "
+                "radius below R = %g mm (smallest %.4g mm): the ball gouges there\n",
+                st->gouge_points, bp->r_mm, st->min_radius);
+    if (st->undercut > 0)
+        fprintf(stderr,
+                "curvestep toolpath: warning: %zu vertices have a downward normal (undercut): "
+                "not reachable by a 3-axis tool from above\n",
+                st->undercut);
+    return CS_EXIT_OK;
+}
+
+/* --- picture ------------------------------------------------------------------------------ */
+
+static cs_err_t write_svg(const char *file, const cs_path_poly_t *poly, const char *title)
+{
+    FILE *f = fopen(file, "w");
+    if (!f)
+        return CS_ERR_IO;
+    double box[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < poly->n; i++) {
+        double x = poly->pts[i].x, y = poly->pts[i].y;
+        if (i == 0 || x < box[0])
+            box[0] = x;
+        if (i == 0 || y < box[1])
+            box[1] = y;
+        if (i == 0 || x > box[2])
+            box[2] = x;
+        if (i == 0 || y > box[3])
+            box[3] = y;
+    }
+    double w = box[2] - box[0], h = box[3] - box[1], ext = fmax(fmax(w, h), 1e-3);
+    double m = 0.05 * ext, sw = ext / 800;
+    double px =
+        800.0 / (w + 2 * m) < 800.0 / (h + 2 * m) ? 800.0 / (w + 2 * m) : 800.0 / (h + 2 * m);
+    fprintf(f,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+            "viewBox=\"%.6f %.6f %.6f %.6f\">\n",
+            (w + 2 * m) * px, (h + 2 * m) * px, box[0] - m, -box[3] - m, w + 2 * m, h + 2 * m);
+    fprintf(f, "<title>%s</title>\n", title);
+    fprintf(f, "<rect x=\"%.6f\" y=\"%.6f\" width=\"%.6f\" height=\"%.6f\" fill=\"white\"/>\n",
+            box[0] - m, -box[3] - m, w + 2 * m, h + 2 * m);
+    /* y up: every y is negated (SVG's y points down). */
+    fprintf(f,
+            "<g fill=\"none\" stroke=\"#1f4e9a\" stroke-width=\"%.6f\" "
+            "stroke-linejoin=\"round\" stroke-linecap=\"round\">\n",
+            sw);
+    for (size_t l = 0; l < poly->nlines; l++) {
+        size_t s = poly->starts[l], n = cs_path_poly_len(poly, l);
+        fprintf(f, "<polyline points=\"");
+        for (size_t k = 0; k < n; k++)
+            fprintf(f, "%s%.5f,%.5f", k ? " " : "", poly->pts[s + k].x, -poly->pts[s + k].y);
+        fprintf(f, "\"/>\n");
+    }
+    fprintf(f, "</g>\n</svg>\n");
+    bool bad = ferror(f) != 0;
+    if (fclose(f) != 0 || bad)
+        return CS_ERR_IO;
+    return CS_OK;
+}
+
+/* --- command ------------------------------------------------------------------------------ */
+
+int cs_cmd_toolpath(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"patches", required_argument, NULL, 'p'}, {"view", required_argument, NULL, 'v'},
+        {"lines", required_argument, NULL, 'n'},   {"tol", required_argument, NULL, 't'},
+        {"scale", required_argument, NULL, 'S'},   {"ball", required_argument, NULL, 'b'},
+        {"scallop", required_argument, NULL, 'H'}, {"safe-z", required_argument, NULL, 'z'},
+        {"stats", no_argument, NULL, 's'},         {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+    };
+    const char *file = NULL, *svg_out = NULL;
+    tp_view_t view = views[3];
+    double tol_mm = TP_DEFAULT_TOL_MM, scale = 1.0;
+    unsigned lines = TP_DEFAULT_LINES;
+    bool stats = false, ball = false, have_h = false;
+    tp_ball_t bp = {0, 0, 0, false};
+    cs_finish_stats_t fst = {0, 0, 0, 0, 0.0, HUGE_VAL, 0, 0};
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
+        double d = 0;
+        switch (c) {
+        case 'p':
+            file = optarg;
+            break;
+        case 'v':
+            if (!parse_view(optarg, &view)) {
+                fprintf(stderr,
+                        "curvestep toolpath: --view '%s': expected top, front, side, iso "
+                        "or 12 comma-separated numbers\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        case 'n':
+            if (!parse_double(optarg, &d) || d != floor(d) || d < 1 || d > TP_MAX_LINES) {
+                fprintf(stderr, "curvestep toolpath: --lines '%s': expected an integer 1..%d\n",
+                        optarg, TP_MAX_LINES);
+                return CS_EXIT_USAGE;
+            }
+            lines = (unsigned)d;
+            break;
+        case 't': {
+            cs_pos_t t = 0;
+            if (!parse_double(optarg, &tol_mm) || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
+                t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
+                fprintf(stderr,
+                        "curvestep toolpath: --tol '%s': expected a tolerance in mm, from %.7f "
+                        "to %d\n",
+                        optarg, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_POS_LIMIT_MM);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        }
+        case 'S':
+            if (!parse_double(optarg, &scale) || scale <= 0) {
+                fprintf(stderr, "curvestep toolpath: --scale '%s': expected a number > 0\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        case 'b':
+            if (!parse_double(optarg, &bp.r_mm) || bp.r_mm <= 0 || bp.r_mm > 100) {
+                fprintf(stderr,
+                        "curvestep toolpath: --ball '%s': expected a radius in mm, "
+                        "0 < R <= 100\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            ball = true;
+            break;
+        case 'H':
+            if (!parse_double(optarg, &bp.h_mm) || bp.h_mm <= 0) {
+                fprintf(stderr,
+                        "curvestep toolpath: --scallop '%s': expected a height in mm "
+                        "> 0\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            have_h = true;
+            break;
+        case 'z':
+            if (!parse_double(optarg, &bp.safe_z_mm) || fabs(bp.safe_z_mm) > CS_POS_LIMIT_MM) {
+                fprintf(stderr, "curvestep toolpath: --safe-z '%s': expected a height in mm\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            bp.have_safe_z = true;
+            break;
+        case 's':
+            stats = true;
+            break;
+        case 'o':
+            svg_out = optarg;
+            break;
+        case 'h':
+            tp_usage(stdout);
+            return CS_EXIT_OK;
+        case ':':
+            fprintf(stderr, "curvestep toolpath: option '%s' needs a value\n", argv[optind - 1]);
+            fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
+            return CS_EXIT_USAGE;
+        default:
+            fprintf(stderr, "curvestep toolpath: unknown option '%s'\n", argv[optind - 1]);
+            fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
+            return CS_EXIT_USAGE;
+        }
+    }
+    if (optind != argc || !file) {
+        fprintf(stderr, "curvestep toolpath: %s\n",
+                optind != argc ? "unexpected argument (the file goes after --patches)"
+                               : "missing --patches FILE");
+        fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
+        return CS_EXIT_USAGE;
+    }
+    if (ball != have_h || (ball && bp.h_mm >= bp.r_mm)) {
+        fprintf(stderr, "curvestep toolpath: --ball R and --scallop H go together, 0 < H < R\n");
+        return CS_EXIT_USAGE;
+    }
+    if (!ball && bp.have_safe_z) {
+        fprintf(stderr, "curvestep toolpath: --safe-z needs --ball\n");
+        return CS_EXIT_USAGE;
+    }
+    cs_pos_t tol;
+    cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
+
+    cs_surffile_t sf;
+    cs_path_diag_t diag;
+    /* Surfaces of revolution are approximated within tol / 4 before tracing. */
+    cs_err_t e = cs_surffile_read(file, scale, tol_mm / 4, &sf, &diag);
+    if (e != CS_OK) {
+        if (e == CS_ERR_FULL)
+            fprintf(stderr, "curvestep toolpath: out of memory\n");
+        else
+            cs_path_diag_print(stderr, &diag);
+        cs_surffile_free(&sf);
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    }
+    int status = CS_EXIT_OK;
+    tp_out_t o = {&view, ball, true, {0}, NULL, 0, 0, 0, 0, 0.0, stats};
+    cs_path_poly_init(&o.poly);
+    if (status == CS_EXIT_OK && ball)
+        status = finish_all(&o, &sf, tol, &bp, &fst);
+    for (size_t i = 0; i < sf.n && status == CS_EXIT_OK && !ball; i++) {
+        e = sf.items[i].tri      ? wire_tri(&o, &sf.items[i].trip, lines, tol)
+            : sf.items[i].varady ? wire_varady(&o, &sf.items[i].nside, lines, tol)
+                                 : wire_patch(&o, &sf.items[i].quad, lines, tol);
+        if (e != CS_OK) {
+            cs_path_loc_t l = {sf.file, sf.items[i].line, 1};
+            cs_path_diag_set(&diag, e, l, "patch %zu: %s", i + 1, cs_err_text(e));
+            cs_path_diag_print(stderr, &diag);
+            status = CS_EXIT_INTERNAL;
+        }
+    }
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "curvestep toolpath: error writing the output\n");
+        if (status == CS_EXIT_OK)
+            status = CS_EXIT_INTERNAL;
+    }
+    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    if (stats && status == CS_EXIT_OK) {
+        fprintf(stderr, "toolpath: %s: %zu patches, %zu curves, %zu chords, view %s\n", shown, sf.n,
+                o.curves, o.chords, view.name);
+        if (ball)
+            fprintf(stderr,
+                    "toolpath: ball R %.6g mm, scallop %.6g mm: %zu passes, measured scallop "
+                    "%.6f mm (between pass centres, double)\n",
+                    bp.r_mm, bp.h_mm, fst.passes, fst.max_scallop);
+        if (!ball)
+            fprintf(stderr,
+                    "toolpath: tolerance %.6g mm, max deviation %.6f mm (chords against their "
+                    "exact curves, 3D, measured in double)\n",
+                    tol_mm, o.maxdev);
+    }
+    if (svg_out && status == CS_EXIT_OK && write_svg(svg_out, &o.poly, shown) != CS_OK) {
+        fprintf(stderr, "%s:0:0: cannot write the picture\n", svg_out);
+        status = CS_EXIT_INTERNAL;
+    }
+    free(o.v);
+    cs_path_poly_free(&o.poly);
+    cs_surffile_free(&sf);
+    return status;
+}

@@ -1,0 +1,80 @@
+/* cs_sim_device: the simulator as the device on the far end of a serial line (a pty or a tty).
+ * Runs what the firmware runs -- the cs_link receiver/sender, a motion queue whose free slots are
+ * the flow-control credits, the core planner and segment generator for CURVE messages (traced
+ * with cs_trace on the device), the cs_stepper executor on the POSIX port -- with the simulated
+ * time paced against the wall clock (see docs/streaming.md, "The device's pacing"), answers
+ * HELLO/STATUS/HOLD/RESUME/ABORT, injects faults for tests, and records every STEP edge for the
+ * check report. Host only (POSIX); one device per process (the POSIX port is process-wide). */
+#ifndef CS_SIM_DEVICE_H
+#define CS_SIM_DEVICE_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cs_link.h"
+#include "cs_machine.h"
+#include "cs_serial.h"
+#include "cs_sim.h"
+
+/* Largest motion queue (slot-using messages waiting for the executor). */
+#define CS_SIM_DEVICE_QUEUE_MAX 256
+
+typedef struct {
+    const cs_machine_t *m;
+    uint16_t queue_size; /* motion-queue slots announced in HELLO, 1..CS_SIM_DEVICE_QUEUE_MAX */
+    double speed;        /* simulated seconds per wall second (1 = real time); 0 = instant:
+                          * everything queued is executed at once, the queue never fills */
+    uint32_t line_rate;  /* pace the device's writes to this many bits/s (0 = memory speed) */
+    cs_serial_faults_t faults; /* injected into what the device writes; all zero = none */
+    double corrupt_in;         /* probability that a byte the device reads is changed */
+    uint64_t reset_after; /* after executing this many messages, reboot (new boot id, queue lost,
+                           * position kept as a machine that homes would): 0 = never */
+    uint64_t hang_after;  /* after this many, stop reading and writing (a dead cable): 0 = never */
+    uint64_t close_after; /* after this many, close the line and return: 0 = never */
+    uint32_t boot_id;     /* first boot id (0 = from the clock and pid) */
+    cs_pos_t tol;         /* chord tolerance for CURVE messages (0 = the machine's) */
+    int method;           /* cs_trace_method_t for CURVE messages */
+    uint32_t status_ms;   /* STATUS period while running or held (0 = 50 ms) */
+    double idle_exit_s;   /* return after this long idle with nothing received, once something
+                           * was executed (0 = never) */
+    bool keep_edges;      /* copy the recorded STEP edges into the result (for checks) */
+} cs_sim_device_cfg_t;
+
+typedef struct {
+    uint64_t executed;       /* slot-using messages executed (SEGMENT and CURVE) */
+    uint64_t segments;       /* step segments run by the executor */
+    uint64_t seg_hash;       /* FNV-1a 64 over every executed SEGMENT message, in order */
+    uint64_t curves;         /* CURVE messages executed */
+    uint64_t out_of_order;   /* deliveries whose sequence was not the previous + 1 (must be 0) */
+    uint32_t resets;         /* simulated reboots */
+    uint32_t boot_id;        /* boot id at the end */
+    uint32_t holds, aborts;  /* HOLD and ABORT messages obeyed */
+    uint32_t errors_sent;    /* ERROR messages sent (bad CURVE, refused SEGMENT) */
+    uint32_t exec_gaps;      /* times the executor ran dry and was fed again later */
+    double gap_wall_s;       /* wall time spent dry between two such feeds */
+    cs_link_stats_t link;    /* the device's link counters (duplicates, out of order, ...) */
+    cs_frame_stats_t frames; /* frames decoded, CRC errors, malformed */
+    uint64_t bytes_in, bytes_out;
+    uint64_t ticks;       /* simulated time at the end (executor ticks) */
+    double wall_s;        /* wall time served */
+    int64_t pos[CS_AXES]; /* final position from the STEP/DIR lines, steps */
+    cs_sim_exec_t ex;     /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
+} cs_sim_device_result_t;
+
+/* Defaults: queue 32, real time, no faults, subdivision at the machine's tolerance. */
+void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m);
+/* Serves the device on fd (a pty master or an open tty, made non-blocking) until *stop becomes
+ * non-zero (may be NULL), the line fails, a close_after fault fires or idle_exit_s elapses.
+ * Fills *res (always). CS_OK, CS_ERR_IO when the line failed, CS_ERR_ARG for a bad cfg,
+ * CS_ERR_FULL when out of memory. Not reentrant (uses the process-wide POSIX port). */
+cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile sig_atomic_t *stop,
+                             cs_sim_device_result_t *res);
+/* FNV-1a 64 of one segment (ticks, then each of the CS_AXES steps, little-endian), chained from
+ * h (start with CS_SIM_DEVICE_HASH0): what the tests compare with the host's own sum. */
+#define CS_SIM_DEVICE_HASH0 0xcbf29ce484222325ull
+uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s);
+/* The `curvestep-sim --pty | --port DEV ...` command line (sim/main.c hands these over). */
+int cs_sim_device_main(int argc, char **argv);
+
+#endif

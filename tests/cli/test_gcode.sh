@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# CLI tests of G-code input through the one loader: `curvestep flatten` and `curvestep plan` on
+# G-code files (by extension, by content on stdin), exact vertices of lines, separated rapid
+# moves, the measured deviation of arcs and helices within the tolerance, --lenient, errors as
+# file:line:col with exit 1 and nothing written by plan, --help. Every file of tests/data/gcode
+# (copies of shared/data/gcode/cncjs) either reads and flattens or fails where it should.
+# Uses $CS_BUILD (the build directory); ends with "cli: N passed, M failed".
+set -u
+BIN=${CS_BUILD:-build}/curvestep
+DATA=tests/data/gcode
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+pass=0
+fail=0
+
+ok() { pass=$((pass + 1)); }
+ko() { fail=$((fail + 1)); echo "FAIL: $*"; }
+
+# run NAME EXPECTED_RC ARGS...: runs the program, output in $TMP/out, $TMP/err, status in $rc.
+run() {
+    local name=$1 want=$2
+    shift 2
+    "$BIN" "$@" >"$TMP/out" 2>"$TMP/err"
+    rc=$?
+    if [ "$rc" -ne "$want" ]; then
+        ko "$name: exit $rc, expected $want"
+        sed 's/^/    /' "$TMP/err" | head -5
+        return 1
+    fi
+    ok
+    return 0
+}
+
+expect_out() {
+    local name=$1
+    printf "$2" >"$TMP/want"
+    if cmp -s "$TMP/out" "$TMP/want"; then ok; else
+        ko "$name: output differs"
+        diff "$TMP/want" "$TMP/out" | head -10 | sed 's/^/    /'
+    fi
+}
+
+expect_err() {
+    if grep -qE "$2" "$TMP/err"; then ok; else
+        ko "$1: stderr does not match /$2/"
+        head -5 "$TMP/err" | sed 's/^/    /'
+    fi
+}
+
+expect_empty_out() {
+    if [ ! -s "$TMP/out" ]; then ok; else ko "$1: stdout not empty"; fi
+}
+
+# expect_dev NAME TOL: --stats's measured max deviation must be <= TOL mm.
+expect_dev() {
+    local d
+    d=$(sed -n 's/^flatten: max deviation \([0-9.]*\) mm.*/\1/p' "$TMP/err")
+    if [ -n "$d" ] && awk -v d="$d" -v t="$2" 'BEGIN { exit !(d <= t) }'; then ok; else
+        ko "$1: max deviation '$d' not within $2 mm"
+    fi
+}
+
+if [ ! -x "$BIN" ]; then
+    echo "no $BIN"
+    echo "cli: 0 passed, 1 failed"
+    exit 1
+fi
+
+# --- lines: exact vertices, rapid moves as their own polyline -------------------------------
+printf 'G21 G90\nG0 X1 Y1\nG1 X10 Y1 F600\nY5\nG91 X-2\n' >"$TMP/l.nc"
+run "lines" 0 flatten "$TMP/l.nc" &&
+    expect_out "lines" '0.000000 0.000000\n1.000000 1.000000\n\n1.000000 1.000000\n10.000000 1.000000\n10.000000 5.000000\n8.000000 5.000000\n'
+# inches
+# inches (1.25 in = 31.75 mm and 0.625 in = 15.875 mm are exact in Q15.16)
+printf 'G20 G1 X1.25 Y0.625 F10\n' >"$TMP/in.ngc"
+run "inches" 0 flatten "$TMP/in.ngc" && expect_out "inches" '0.000000 0.000000\n31.750000 15.875000\n'
+# stdin: G-code recognised by content
+run "stdin" 0 flatten - <"$TMP/l.nc" &&
+    expect_out "stdin" '0.000000 0.000000\n1.000000 1.000000\n\n1.000000 1.000000\n10.000000 1.000000\n10.000000 5.000000\n8.000000 5.000000\n'
+# unknown extension: content
+cp "$TMP/in.ngc" "$TMP/job.dat"
+run "by content" 0 flatten "$TMP/job.dat" && expect_out "by content" '0.000000 0.000000\n31.750000 15.875000\n'
+
+# --- arcs, helices, splines within the tolerance -------------------------------------------
+printf 'G1 X10 Y0 F600\nG3 X10 Y0 I-10 J0\nG2 X0 Y10 R-10\nG5 I0 J3 P0 Q-3 X1 Y1\nG5.1 X5 I2 J-8\n' >"$TMP/a.nc"
+run "arcs" 0 flatten --stats --tol 0.005 "$TMP/a.nc" && expect_dev "arcs" 0.005
+printf 'G1 X10 Y0 F600\nG3 X10 Y0 Z6 I-10 J0 P3\n' >"$TMP/h.nc"
+run "helix" 0 flatten --stats "$TMP/h.nc" && expect_dev "helix" 0.01
+# the last vertex is the programmed end
+run "helix end" 0 flatten "$TMP/h.nc" &&
+    { [ "$(tail -n1 "$TMP/out")" = "10.000000 0.000000" ] && ok || ko "helix end: $(tail -n1 "$TMP/out")"; }
+printf 'G0 X0 Y0\nF10\nG5.2 X0 Y1 P1 L3\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3\n' >"$TMP/n.nc"
+run "nurbs" 0 flatten --stats "$TMP/n.nc" && expect_dev "nurbs" 0.01
+
+# --- the cncjs fixtures ---------------------------------------------------------------------
+for f in arc-xy-plane.nc arc-yz-plane.nc arc-zx-plane.nc one-inch-circle.nc; do
+    run "$f" 0 flatten --stats "$DATA/$f" && expect_dev "$f" 0.01
+done
+run "thread strict" 1 flatten "$DATA/helical-thread-milling.nc" &&
+    expect_err "thread strict" "^$DATA/helical-thread-milling.nc:2:9: the D word is not supported"
+run "thread lenient" 0 flatten --lenient --stats "$DATA/helical-thread-milling.nc" &&
+    expect_dev "thread lenient" 0.01 && expect_err "thread warns" ":2:5: warning: G42 is not supported"
+run "arc-r" 1 flatten "$DATA/arc-r.nc" && expect_err "arc-r" "^$DATA/arc-r.nc:3:1: G2 needs R"
+run "motion" 1 flatten --lenient "$DATA/motion.nc" &&
+    expect_err "motion" "^$DATA/motion.nc:4:9: R-form arc ends where it starts"
+run "checksum" 1 flatten --lenient "$DATA/special-fields.gcode" &&
+    expect_err "checksum" "^$DATA/special-fields.gcode:8:16: checksum \\*30 does not match" &&
+    expect_empty_out "checksum"
+
+# --- errors: file:line:col, exit 1 ----------------------------------------------------------
+printf 'G1 X1 F60\nG1 X2 Q\n' >"$TMP/e1.nc"
+run "syntax" 1 flatten "$TMP/e1.nc" && expect_err "syntax" "^$TMP/e1.nc:2:7: Q must be followed by a number"
+printf 'G1 X10 F60\nG2 X0 Y11 I-10\n' >"$TMP/e2.nc"
+run "radius" 1 flatten "$TMP/e2.nc" && expect_err "radius" "^$TMP/e2.nc:2:1: radius to end of arc"
+printf 'G1 X1 F60\nM6 T1\n' >"$TMP/e3.nc"
+run "unsupported" 1 flatten "$TMP/e3.nc" && expect_err "unsupported" "^$TMP/e3.nc:2:4: the T word"
+run "lenient" 0 flatten --lenient "$TMP/e3.nc" && expect_err "lenient" "$TMP/e3.nc:2:1: warning: M6"
+printf 'G1 X5000 F60\n' >"$TMP/e4.nc"
+run "range" 1 flatten "$TMP/e4.nc" && expect_err "range" "^$TMP/e4.nc:1:1: point .* outside"
+
+# --- plan: G-code in, nothing written on error ----------------------------------------------
+run "plan" 0 plan "$DATA/one-inch-circle.nc" && expect_err "plan" "^plan: [0-9]+ elements" &&
+    { head -n1 "$TMP/out" | grep -q '^# curvestep segments' && ok || ko "plan: no header"; }
+run "plan lenient" 0 plan --lenient "$DATA/helical-thread-milling.nc"
+run "plan bad" 1 plan "$TMP/e2.nc" && expect_err "plan bad" "^$TMP/e2.nc:2:1:" &&
+    expect_empty_out "plan bad"
+run "plan bad -o" 1 plan -o "$TMP/seg.txt" "$TMP/e2.nc" &&
+    { [ ! -s "$TMP/seg.txt" ] && ok || ko "plan bad -o: segments written"; }
+
+# --- help tells the truth -------------------------------------------------------------------
+run "flatten help" 0 flatten --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
+    ok || ko "flatten --help lacks G-code or --lenient"
+run "plan help" 0 plan --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
+    ok || ko "plan --help lacks G-code or --lenient"
+
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,139 @@
+#!/usr/bin/env bash
+# Command-line tests of `curvestep stream` against `curvestep-sim --pty`: a real SVG job streamed
+# in segments mode and in curves mode with the simulator's check passing (deviation, exact final
+# position); a device reset mid-job reported with the last executed segment and finished with
+# --resume-from; a closed line reported; usage errors. Every process is bounded by `timeout` and
+# killed on exit. Prints "cli: N passed, M failed".
+set -u
+B=${CS_BUILD:-build}
+CS=$B/curvestep
+SIM=$B/curvestep-sim
+T=$(mktemp -d)
+pids=()
+cleanup() {
+    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+    wait 2>/dev/null
+    rm -rf "$T"
+}
+trap cleanup EXIT
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+expect() { # expect NAME CONDITION...
+    local name=$1; shift
+    if "$@"; then ok; else bad "$name"; fi
+}
+
+JOB=tests/data/svg/w3c/paths-data-12-t.svg
+ARCS=tests/data/svg/resvg/M-L-Z-A.svg
+
+# start_sim NAME ARGS...: starts the device on a pty in the background (bounded by timeout;
+# --instant unless ARGS start with --speed),
+# sets PTY to its path (empty when it did not start).
+start_sim() {
+    local name=$1; shift
+    local pace=--instant
+    [ "${1:-}" = --speed ] && pace=
+    timeout 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    pids+=($!)
+    SIMPID=$!
+    PTY=
+    for _ in $(seq 100); do
+        PTY=$(head -n1 "$T/$name.sim" 2>/dev/null)
+        [ -n "$PTY" ] && break
+        sleep 0.05
+    done
+}
+# wait_sim: waits (bounded) for the device started last to finish its report.
+wait_sim() {
+    for _ in $(seq 200); do
+        kill -0 "$SIMPID" 2>/dev/null || break
+        sleep 0.05
+    done
+    kill "$SIMPID" 2>/dev/null
+    wait "$SIMPID" 2>/dev/null
+}
+
+# 1. segments mode: the whole job executed, the device's check passes.
+start_sim seg --reference "$JOB" --check --svg "$T/seg.svg"
+expect "sim printed a pty path" [ -c "$PTY" ]
+timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/seg.out" 2>"$T/seg.err"; rc=$?
+wait_sim
+expect "segments: exit 0" [ $rc -eq 0 ]
+n=$(sed -n 's/.* -> \([0-9]*\) segments .*/\1/p' "$T/seg.err")
+expect "segments: job size on stderr" [ -n "$n" ]
+expect "segments: job executed" grep -q "^stream: $PTY: job executed$" "$T/seg.out"
+expect "segments: every segment executed" grep -q "^stream: $n of $n segments executed, $n delivered" "$T/seg.out"
+expect "segments: plain progress lines" grep -q '^stream: [0-9]*/[0-9]* segments executed' "$T/seg.err"
+expect "segments: device executed them all" grep -q "^device: .* $n messages executed ($n step segments" "$T/seg.sim"
+expect "segments: device check ok" grep -q '^check: ok$' "$T/seg.sim"
+expect "segments: final position exact" grep -q 'rounded to steps: exact' "$T/seg.sim"
+expect "segments: deviation reported" grep -qE '^max deviation: [0-9.]+ mm .* ok$' "$T/seg.sim"
+expect "segments: picture drawn" grep -q '<polyline' "$T/seg.svg"
+
+# 2. curves mode, with arcs approximated by cubics: same checks on the device.
+start_sim cur --reference "$ARCS" --check
+timeout 60 "$CS" stream --mode curves --port "$PTY" "$ARCS" >"$T/cur.out" 2>"$T/cur.err"; rc=$?
+wait_sim
+expect "curves: exit 0" [ $rc -eq 0 ]
+expect "curves: job executed" grep -q "job executed" "$T/cur.out"
+expect "curves: arcs approximated (said so)" grep -q 'approximated by cubics' "$T/cur.err"
+expect "curves: device traced curves" grep -qE '^device: .*, [1-9][0-9]* curves\)' "$T/cur.sim"
+expect "curves: device check ok" grep -q '^check: ok$' "$T/cur.sim"
+expect "curves: final position exact" grep -q 'rounded to steps: exact' "$T/cur.sim"
+
+# 3. a device reset after 500 segments: exit 5, last executed 500; --resume-from 500 finishes.
+start_sim rst --reference "$JOB" --check --faults reset-after=500
+timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/rst.out" 2>"$T/rst.err"; rc=$?
+expect "reset: exit 5" [ $rc -eq 5 ]
+expect "reset: reported" grep -q 'device reset mid-job (boot id' "$T/rst.out"
+expect "reset: last executed 500" grep -q 'last executed: 500$' "$T/rst.out"
+expect "reset: says how to resume" grep -q -- '--resume-from 500' "$T/rst.out"
+timeout 60 "$CS" stream --resume-from 500 --port "$PTY" "$JOB" >"$T/rst2.out" 2>"$T/rst2.err"; rc=$?
+wait_sim
+expect "resume: exit 0" [ $rc -eq 0 ]
+expect "resume: job executed" grep -q "job executed" "$T/rst2.out"
+expect "resume: device saw one reset" grep -q ' 1 resets' "$T/rst.sim"
+expect "resume: device check ok" grep -q '^check: ok$' "$T/rst.sim"
+expect "resume: final position exact" grep -q 'rounded to steps: exact' "$T/rst.sim"
+
+# 4. the device closes the line after 300 segments: exit 6, last executed 300.
+start_sim cls --faults close-after=300
+timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/cls.out" 2>"$T/cls.err"; rc=$?
+wait_sim
+expect "closed: exit 6" [ $rc -eq 6 ]
+expect "closed: reported" grep -q 'link closed' "$T/cls.out"
+expect "closed: last executed 300" grep -q 'last executed: 300$' "$T/cls.out"
+
+# 5. Ctrl-C (SIGINT) while the device runs in real time: hold, abort, exit 8.
+start_sim int --speed 1 --reference "$JOB"
+timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
+spid=$!
+pids+=("$spid")
+sleep 1
+kill -INT "$spid"
+wait "$spid"; rc=$?
+wait_sim
+expect "ctrl-c: exit 8" [ $rc -eq 8 ]
+expect "ctrl-c: reported" grep -q 'interrupted: held, then aborted' "$T/int.out"
+expect "ctrl-c: device held and aborted" grep -q ' 1 holds, 1 aborts' "$T/int.sim"
+k=$(sed -n 's/.*last executed: \([0-9]*\)$/\1/p' "$T/int.out")
+expect "ctrl-c: host and device agree on what ran" grep -q "^device: .* $k messages executed" "$T/int.sim"
+
+# 6. usage and a port that is not there.
+"$CS" stream --help >"$T/help.out"; rc=$?
+expect "help: exit 0" [ $rc -eq 0 ]
+expect "help: exit codes" grep -q '5 the device reset mid-job' "$T/help.out"
+"$CS" stream "$JOB" >/dev/null 2>&1; rc=$?
+expect "no --port: exit 2" [ $rc -eq 2 ]
+timeout 10 "$CS" stream --port "$T/nope" "$JOB" >/dev/null 2>"$T/nope.err"; rc=$?
+expect "missing port: exit 4" [ $rc -eq 4 ]
+expect "missing port: named" grep -q "$T/nope" "$T/nope.err"
+printf 'M 0 0 L 10 10 Q\n' >"$T/bad.svg"
+timeout 10 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err"; rc=$?
+expect "bad job: exit 1, nothing opened" [ $rc -eq 1 ]
+expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
+
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

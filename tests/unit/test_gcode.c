@@ -1,0 +1,864 @@
+/* test_gcode: G-code text (host/cs_gcode.c) -> path elements, compared with geometry computed
+ * here in double: line end points, points on arcs (radius, centre, direction of turn, sweep),
+ * helix pitch, LinuxCNC's published G5 facts, the G5.1 parabola y = x^2, G5.2 against a double
+ * Cox-de Boor NURBS evaluation; units, G91, G90.1, G92, feed, subpaths; every error with its
+ * file:line:col; the cncjs fixtures in tests/data/gcode. Tolerances: points given in the file
+ * are rounded once (0.5 LSB); arc pieces stay within 2 LSB of the exact circle (cs_arc.h) plus
+ * 2 LSB for the end snapping (4 LSB); helices add the stated helix tolerance (0.001 mm).
+ * Run from the repository root. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "cs_gcode.h"
+
+#define LSB     (1.0 / 65536.0)
+#define PT_TOL  (0.5 * LSB + 1e-9)
+#define ARC_TOL (4 * LSB)
+#define DATA    "tests/data/gcode/"
+
+static cs_path_t P;
+static cs_path_diag_t D;
+static cs_gcode_stats_t S;
+static int nwarn;
+static char last_warn[600];
+
+static void on_warn(void *ctx, const cs_path_diag_t *w)
+{
+    (void)ctx;
+    nwarn++;
+    snprintf(last_warn, sizeof last_warn, "%s:%u:%u: %s", w->loc.file, w->loc.line, w->loc.col,
+             w->reason);
+}
+
+static cs_err_t parse_opts(const char *text, bool lenient)
+{
+    cs_path_free(&P);
+    cs_path_init(&P);
+    memset(&D, 0, sizeof D);
+    nwarn = 0;
+    last_warn[0] = '\0';
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.lenient = lenient;
+    o.warn = on_warn;
+    return cs_gcode_read("t.nc", text, strlen(text), &o, &P, &D, &S);
+}
+
+static cs_err_t parse(const char *text)
+{
+    return parse_opts(text, false);
+}
+
+static char *slurp(const char *name, size_t *len)
+{
+    FILE *f = fopen(name, "rb");
+    assert_non_null(f);
+    char *b = malloc(1 << 16);
+    assert_non_null(b);
+    *len = fread(b, 1, 1 << 16, f);
+    fclose(f);
+    return b;
+}
+
+static cs_err_t parse_file(const char *name, bool lenient)
+{
+    size_t len;
+    char *b = slurp(name, &len);
+    cs_path_free(&P);
+    cs_path_init(&P);
+    nwarn = 0;
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.lenient = lenient;
+    o.warn = on_warn;
+    cs_err_t e = cs_gcode_read(name, b, len, &o, &P, &D, &S);
+    free(b);
+    return e;
+}
+
+/* The diagnostic must be exactly at line:col with code. */
+static void expect_diag(cs_err_t e, cs_err_t code, unsigned line, unsigned col)
+{
+    if (e != code || D.loc.line != line || D.loc.col != col)
+        print_error("got %d at %u:%u (%s), expected %d at %u:%u\n", e, D.loc.line, D.loc.col,
+                    D.reason, code, line, col);
+    assert_int_equal(e, code);
+    assert_int_equal(D.loc.line, line);
+    assert_int_equal(D.loc.col, col);
+    assert_true(strlen(D.reason) > 0);
+}
+
+static void pt(size_t el, unsigned i, double out[3])
+{
+    const cs_vec3_t *p = &P.elems[el].curve.p[i];
+    out[0] = p->x * LSB;
+    out[1] = p->y * LSB;
+    out[2] = p->z * LSB;
+}
+
+static void expect_pt(size_t el, unsigned i, double x, double y, double z, double tol)
+{
+    double p[3];
+    pt(el, i, p);
+    if (fabs(p[0] - x) > tol || fabs(p[1] - y) > tol || fabs(p[2] - z) > tol)
+        print_error("elem %zu point %u = (%.9f, %.9f, %.9f), expected (%.9f, %.9f, %.9f)\n", el, i,
+                    p[0], p[1], p[2], x, y, z);
+    assert_true(fabs(p[0] - x) <= tol && fabs(p[1] - y) <= tol && fabs(p[2] - z) <= tol);
+}
+
+static void end_of(size_t el, double out[3])
+{
+    pt(el, P.elems[el].curve.degree, out);
+}
+
+/* Every element starts exactly where the previous one of its subpath ended. */
+static void expect_continuous(void)
+{
+    for (size_t i = 1; i < P.n; i++) {
+        const cs_bezier_t *a = &P.elems[i - 1].curve, *b = &P.elems[i].curve;
+        const cs_vec3_t *e = &a->p[a->degree];
+        assert_true(e->x == b->p[0].x && e->y == b->p[0].y && e->z == b->p[0].z);
+    }
+}
+
+/* Samples every element from `first` on (n points each) and checks they lie on the circle of
+ * radius r around (cx, cy) in the plane axes (i0, i1), within tol; the third axis must equal
+ * z0 + pitch_per_rad * (turned angle) within ztol. Returns the signed total angle turned. */
+static double check_circle(size_t first, int i0, int i1, double cx, double cy, double r, double tol,
+                           double z0, double pitch_per_rad, double ztol)
+{
+    int in = 3 - i0 - i1;
+    double turned = 0, prev = 0;
+    bool have = false;
+    for (size_t k = first; k < P.n; k++) {
+        for (int s = 0; s <= 64; s++) {
+            double q[3];
+            cs_path_eval_mm(&P.elems[k].curve, s / 64.0, q);
+            double dx = q[i0] - cx, dy = q[i1] - cy;
+            double rr = hypot(dx, dy);
+            if (fabs(rr - r) > tol)
+                print_error("elem %zu t=%g: radius %.9f, expected %.9f\n", k, s / 64.0, rr, r);
+            assert_true(fabs(rr - r) <= tol);
+            double a = atan2(dy, dx);
+            if (have) {
+                double d = a - prev;
+                while (d > M_PI)
+                    d -= 2 * M_PI;
+                while (d < -M_PI)
+                    d += 2 * M_PI;
+                turned += d;
+            }
+            prev = a;
+            have = true;
+            double zexp = z0 + pitch_per_rad * fabs(turned);
+            if (fabs(q[in] - zexp) > ztol)
+                print_error("elem %zu t=%g: third axis %.9f, expected %.9f\n", k, s / 64.0, q[in],
+                            zexp);
+            assert_true(fabs(q[in] - zexp) <= ztol);
+        }
+    }
+    return turned;
+}
+
+/* ---- lines, units, modes ----------------------------------------------------------------- */
+
+static void test_g0_g1_lines_feed_rapid(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G0 X1 Y2\nG1 X3 Y4 Z5 F600\n"), CS_OK);
+    assert_int_equal(P.n, 2);
+    assert_int_equal(P.elems[0].curve.degree, 1);
+    expect_pt(0, 0, 0, 0, 0, PT_TOL);
+    expect_pt(0, 1, 1, 2, 0, PT_TOL);
+    assert_true(P.elems[0].rapid);
+    assert_true(P.elems[0].feed_mm_s == 0.0);
+    expect_pt(1, 1, 3, 4, 5, PT_TOL);
+    assert_false(P.elems[1].rapid);
+    assert_true(fabs(P.elems[1].feed_mm_s - 600.0 / 60.0) < 1e-12);
+    /* A rapid and a feed move are different subpaths (the travel is not drawn). */
+    assert_int_not_equal(P.elems[0].subpath, P.elems[1].subpath);
+    assert_int_equal(P.elems[1].loc.line, 2);
+    assert_int_equal(P.elems[1].loc.col, 1);
+}
+
+static void test_modal_motion_and_lowercase(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("g1 x1 f60\ny1\nX0\n"), CS_OK);
+    assert_int_equal(P.n, 3);
+    expect_pt(1, 1, 1, 1, 0, PT_TOL);
+    expect_pt(2, 1, 0, 1, 0, PT_TOL);
+    assert_true(fabs(P.elems[2].feed_mm_s - 1.0) < 1e-12);
+    expect_continuous();
+}
+
+static void test_units_inch_and_incremental(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G20 G91 G1 X1 Y1 F60\nX1\nG21 Y-10\n"), CS_OK);
+    assert_int_equal(P.n, 3);
+    expect_pt(0, 1, 25.4, 25.4, 0, PT_TOL);
+    expect_pt(1, 1, 50.8, 25.4, 0, PT_TOL);
+    expect_pt(2, 1, 50.8, 15.4, 0, PT_TOL);
+    /* F60 in inches per minute = 25.4 mm/s; after G21 the same F60 means 1 mm/s. */
+    assert_true(fabs(P.elems[0].feed_mm_s - 25.4) < 1e-12);
+    assert_true(fabs(P.elems[2].feed_mm_s - 1.0) < 1e-12);
+}
+
+static void test_g92_offsets(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G1 X5 Y5 F60\nG92 X10 Y10\nG1 X11 Y12\nG92.1\nG1 X0 Y0\n"), CS_OK);
+    assert_int_equal(P.n, 3);
+    /* (5,5) is now (10,10): X11 Y12 is (6,7) in machine coordinates. */
+    expect_pt(1, 1, 6, 7, 0, PT_TOL);
+    expect_pt(2, 1, 0, 0, 0, PT_TOL);
+}
+
+static void test_subpaths_pen_and_program_end(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("M3 S1000\nG1 X1 F60\nM5\nG1 X2\nM3\nG1 X3\nM2\nG1 X9\n"), CS_OK);
+    assert_int_equal(P.n, 3); /* nothing after M2 */
+    assert_int_equal(P.nsubpaths, 3);
+    assert_int_equal(P.elems[2].subpath, 2);
+    assert_int_equal(parse("G1 X1 F60\nM30\nG1 X9\n"), CS_OK);
+    assert_int_equal(P.n, 1);
+}
+
+static void test_pen_z_moves(void **state)
+{
+    (void)state;
+    cs_path_free(&P);
+    cs_path_init(&P);
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.pen_z = true;
+    o.pen_down_z_mm = -1;
+    o.pen_up_z_mm = 2.5;
+    const char *t = "G0 X5\nM3\nG1 X10 F60\nM5\nG0 X0\n";
+    assert_int_equal(cs_gcode_read("t.nc", t, strlen(t), &o, &P, &D, NULL), CS_OK);
+    assert_int_equal(P.n, 5);
+    expect_pt(1, 0, 5, 0, 0, PT_TOL);
+    expect_pt(1, 1, 5, 0, -1, PT_TOL); /* M3: down to Z-1, rapid */
+    assert_true(P.elems[1].rapid);
+    expect_pt(2, 1, 10, 0, -1, PT_TOL);
+    assert_false(P.elems[2].rapid);
+    expect_pt(3, 1, 10, 0, 2.5, PT_TOL); /* M5: up to Z2.5 */
+    assert_true(P.elems[3].rapid);
+    expect_pt(4, 1, 0, 0, 2.5, PT_TOL);
+    expect_continuous();
+    assert_int_equal(P.elems[3].loc.line, 4);
+    assert_int_equal(P.elems[3].loc.col, 1);
+}
+
+static void test_comments_line_numbers_block_delete(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("%\n(header ; with a semicolon)\nN10 G1 X1 (mid) Y2 F60 ; tail (x\n"
+                           "/G1 X100\n  \nN20 G1 X3\n%\n"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_pt(0, 1, 1, 2, 0, PT_TOL);
+    expect_pt(1, 1, 3, 2, 0, PT_TOL);
+    assert_int_equal(P.elems[1].loc.line, 6);
+    assert_int_equal(P.elems[1].loc.col, 5);
+    expect_diag(parse("G1 X1 F1\nG1 (open\n"), CS_ERR_PARSE, 2, 4);
+}
+
+/* XOR of the bytes of s, as RepRap firmware computes it. */
+static unsigned xor_of(const char *s)
+{
+    unsigned x = 0;
+    while (*s)
+        x ^= (unsigned char)*s++;
+    return x;
+}
+
+static void test_checksums(void **state)
+{
+    (void)state;
+    char text[200];
+    snprintf(text, sizeof text, "N1 G1 X1 F60*%u\nN2 G1 X2*%u ; ok\n", xor_of("N1 G1 X1 F60"),
+             xor_of("N2 G1 X2"));
+    assert_int_equal(parse(text), CS_OK);
+    assert_int_equal(P.n, 2);
+    snprintf(text, sizeof text, "N1 G1 X1 F60\nN2 G1 X2*%u\n", (xor_of("N2 G1 X2") + 1) & 255);
+    expect_diag(parse(text), CS_ERR_PARSE, 2, 9);
+    assert_non_null(strstr(D.reason, "checksum"));
+    expect_diag(parse("G1 X1 F60*\n"), CS_ERR_PARSE, 1, 10);
+    expect_diag(parse("G1 X1 F60*300\n"), CS_ERR_PARSE, 1, 10);
+}
+
+static void test_unsupported_strict_and_lenient(void **state)
+{
+    (void)state;
+    expect_diag(parse("G1 X1 F60\nG4 P1\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G1 X1 F60 M6\n"), CS_ERR_UNSUPPORTED, 1, 11);
+    expect_diag(parse("G1 X1 A3 F60\n"), CS_ERR_UNSUPPORTED, 1, 7);
+    assert_int_equal(parse_opts("G1 X1 F60\nG4 P1\nG1 X2 A3\n", true), CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_pt(1, 1, 2, 0, 0, PT_TOL);
+    assert_true(nwarn >= 2);
+    /* Parameters cannot be ignored safely: an error even when lenient. */
+    expect_diag(parse_opts("G1 X#1 F60\n", true), CS_ERR_UNSUPPORTED, 1, 5);
+    expect_diag(parse_opts("#1=2\n", true), CS_ERR_UNSUPPORTED, 1, 1);
+}
+
+/* --lenient drops a canned cycle with its moves, and G28/G53 with their axis words: executing
+ * those words as ordinary moves could drive the tool into the work. */
+static void test_lenient_drops_words_of_dropped_codes(void **state)
+{
+    (void)state;
+    const char *t = "G0 Z5\nG81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG0 X3\nG28 X0 Y0\nG53 G0 Z0\n"
+                    "G1 X4 F60\n";
+    expect_diag(parse(t), CS_ERR_UNSUPPORTED, 2, 1);
+    assert_int_equal(parse_opts(t, true), CS_OK);
+    assert_int_equal(P.n, 3);
+    expect_pt(0, 1, 0, 0, 5, PT_TOL);
+    expect_pt(1, 1, 3, 0, 5, PT_TOL);
+    expect_pt(2, 1, 4, 0, 5, PT_TOL);
+    expect_continuous();
+    assert_true(nwarn >= 5);
+}
+
+static void test_syntax_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
+    expect_diag(parse("G1 X1 F1\nG1 X2 @\n"), CS_ERR_PARSE, 2, 7);
+    expect_diag(parse("G0 G1 X1\n"), CS_ERR_PARSE, 1, 4);
+    expect_diag(parse("X1 Y1\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G1 X1 I2 F1\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse("G1 X1 F0\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse("G1 X5000 F1\n"), CS_ERR_RANGE, 1, 1);
+    expect_diag(parse("G1.5 X1\n"), CS_ERR_UNSUPPORTED, 1, 1);
+}
+
+/* ---- arcs -------------------------------------------------------------------------------- */
+
+static void test_arc_ijk_quarter_both_directions(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G1 X10 Y0 F60\nG3 X0 Y10 I-10 J0\n"), CS_OK);
+    assert_int_equal(S.arcs, 1);
+    expect_pt(1, 0, 10, 0, 0, 0);
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[0]) <= PT_TOL && fabs(e[1] - 10) <= PT_TOL);
+    double turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+    assert_int_equal(P.elems[1].kind, CS_PATH_ARC);
+    expect_continuous();
+    /* G2 between the same points goes the long way round, clockwise. */
+    assert_int_equal(parse("G1 X10 Y0 F60\nG2 X0 Y10 I-10 J0\n"), CS_OK);
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + 3 * M_PI / 2) < 1e-6);
+    expect_continuous();
+    /* G90.1: the centre is given absolutely. */
+    assert_int_equal(parse("G90.1 G1 X12 Y2 F60\nG3 X2 Y12 I2 J2\n"), CS_OK);
+    turned = check_circle(1, 0, 1, 2, 2, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+}
+
+static void test_arc_planes(void **state)
+{
+    (void)state;
+    /* G18: Z then X, counter-clockwise about +Y; G2 from Z20 to X20 about the origin turns
+     * clockwise (through X-20): three quarters. */
+    assert_int_equal(parse("G18\nG1 X0 Z20 F200\nG2 X20 Z0 I0 K-20.0\n"), CS_OK);
+    double turned = check_circle(1, 2, 0, 0, 0, 20, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + 3 * M_PI / 2) < 1e-6);
+    assert_int_equal(parse("G18\nG1 X0 Z20 F200\nG3 X20 Z0 I0 K-20.0\n"), CS_OK);
+    turned = check_circle(1, 2, 0, 0, 0, 20, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+    /* G19: Y then Z. */
+    assert_int_equal(parse("G19\nG1 Y0 Z20 F200\nG2 Y20 Z0 J0 K-20.0\n"), CS_OK);
+    turned = check_circle(1, 1, 2, 0, 0, 20, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + M_PI / 2) < 1e-6);
+    /* An offset word of the wrong plane is refused. */
+    expect_diag(parse("G1 X10 F60\nG2 X0 Y10 I-10 K1\n"), CS_ERR_PARSE, 2, 16);
+}
+
+static void test_arc_full_circle_and_turns(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G1 X10 Y0 F60\nG2 X10 Y0 I-10 J0\n"), CS_OK);
+    double turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + 2 * M_PI) < 1e-6);
+    assert_int_equal(parse("G1 X10 Y0 F60\nG3 X10 Y0 I-10 J0 P3\n"), CS_OK);
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - 6 * M_PI) < 1e-6);
+    /* A full circle from the current point with only I (LinuxCNC allows no axis words). */
+    assert_int_equal(parse("G1 X5 F60\nG3 I5\n"), CS_OK);
+    turned = check_circle(1, 0, 1, 10, 0, 5, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - 2 * M_PI) < 1e-6);
+}
+
+static void test_arc_r_form(void **state)
+{
+    (void)state;
+    /* G2 R10 from (0,0) to (10,10): centre right of the chord, (10,0): the short quarter. */
+    assert_int_equal(parse("G1 X0 Y0 F60\nG2 X10 Y10 R10\n"), CS_OK);
+    double turned = check_circle(0, 0, 1, 10, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + M_PI / 2) < 1e-6);
+    /* the long way, centre (0,10). */
+    assert_int_equal(parse("G1 X0 Y0 F60\nG2 X10 Y10 R-10\n"), CS_OK);
+    turned = check_circle(0, 0, 1, 0, 10, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + 3 * M_PI / 2) < 1e-6);
+    /* G3 R10: centre (0,10), short, counter-clockwise. */
+    assert_int_equal(parse("G1 X0 Y0 F60\nG3 X10 Y10 R10\n"), CS_OK);
+    turned = check_circle(0, 0, 1, 0, 10, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+    /* Semicircle: chord = 2R. */
+    assert_int_equal(parse("G1 X0 Y0 F60\nG2 X20 Y0 R10\n"), CS_OK);
+    turned = check_circle(0, 0, 1, 10, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned + M_PI) < 1e-6);
+}
+
+static void test_arc_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G1 X1 F60\nG2 X2 Y0 R0\n"), CS_ERR_DEGENERATE, 2, 10);
+    expect_diag(parse("G1 X1 F60\nG2 X1 Y0 R5\n"), CS_ERR_DEGENERATE, 2, 10);
+    expect_diag(parse("G1 X1 F60\nG2 X3 Y0 R0.5\n"), CS_ERR_DEGENERATE, 2, 10);
+    expect_diag(parse("G1 X1 F60\nG2 X1 Y1\n"), CS_ERR_PARSE, 2, 1);
+    expect_diag(parse("G1 X1 F60\nG2 X0 Y1 R1 I-1\n"), CS_ERR_PARSE, 2, 10);
+    /* End radius 11 against start radius 10: 1 mm and 10 % apart. */
+    expect_diag(parse("G1 X10 F60\nG2 X0 Y11 I-10\n"), CS_ERR_DEGENERATE, 2, 1);
+    /* Zero radius: the centre on the start point. */
+    expect_diag(parse("G1 X10 F60\nG2 X0 Y10 I0 J0\n"), CS_ERR_DEGENERATE, 2, 1);
+    /* LinuxCNC's limits: at most 2 * 0.01 * sqrt(2) = 0.0283 mm and 0.1 % apart. */
+    expect_diag(parse("G1 X1 F60\nG3 X0 Y1.002 I-1\n"), CS_ERR_DEGENERATE, 2, 1); /* 0.2 % */
+    expect_diag(parse("G1 X100 F60\nG3 X0 Y100.05 I-100\n"), CS_ERR_DEGENERATE, 2, 1);
+    /* 0.008 mm and 0.08 % apart: accepted, and the arc ends exactly on the programmed point. */
+    assert_int_equal(parse("G1 X10 F60\nG3 X0 Y10.008 I-10\n"), CS_OK);
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[0]) <= PT_TOL && fabs(e[1] - 10.008) <= PT_TOL);
+    for (size_t k = 1; k < P.n; k++)
+        for (int s = 0; s <= 32; s++) {
+            double q[3];
+            cs_path_eval_mm(&P.elems[k].curve, s / 32.0, q);
+            double r = hypot(q[0], q[1]);
+            assert_true(r >= 10 - ARC_TOL && r <= 10.008 + ARC_TOL);
+        }
+    /* Inch mode: 2 * 0.001 * sqrt(2) = 0.00283 in; on a 5 in radius 0.003 in is refused,
+     * 0.002 in accepted. */
+    expect_diag(parse("G20 G1 X5 F1\nG3 X0 Y5.003 I-5\n"), CS_ERR_DEGENERATE, 2, 1);
+    assert_int_equal(parse("G20 G1 X5 F1\nG3 X0 Y5.002 I-5\n"), CS_OK);
+    /* The R form reaches a half chord up to |R| + 0.00005 in = 0.00127 mm (a semicircle). */
+    assert_int_equal(parse("G1 X0 F60\nG2 X20.003 Y0 R10\n"), CS_ERR_DEGENERATE);
+    assert_int_equal(parse("G1 X0 F60\nG2 X20.002 Y0 R10\n"), CS_OK);
+}
+
+/* Arcs whose chord is a few LSB on a huge radius: the end directions are nearly equal, and must
+ * never be read as a full turn: every point stays next to the short arc. */
+static void test_arc_tiny_pieces(void **state)
+{
+    (void)state;
+    static const char *const t[] = {
+        "G1 X4000 Y0 F1\nG3 X3999.99999 Y0.0001 I-4000\n",
+        "G1 X4000 Y0 F1\nG2 X4000 Y-0.00002 I-4000\n",
+        "G1 X2000 Y0 F1\nG3 X2000 Y0.00003 R2000\n",
+        "G1 X2000 Y0 F1\nG3 X2000 Y0.1 Z0.00001 R2000\n",
+    };
+    for (size_t k = 0; k < sizeof t / sizeof t[0]; k++) {
+        assert_int_equal(parse(t[k]), CS_OK);
+        expect_continuous();
+        double s0[3];
+        pt(0, 1, s0);
+        for (size_t e = 1; e < P.n; e++)
+            for (int i = 0; i <= P.elems[e].curve.degree; i++) {
+                double q[3];
+                pt(e, (unsigned)i, q);
+                assert_true(fabs(q[0] - s0[0]) < 0.2 && fabs(q[1] - s0[1]) < 0.2);
+            }
+    }
+}
+
+/* Radius 0.0015 mm (98 LSB), sweeps just under 90 degrees at 90 start angles: rounding the ends
+ * to the LSB may push a piece over 90 degrees; the result must still be the short arc, on the
+ * circle (within the 4 LSB of the pieces plus 1 LSB for the rounded ends), ending on its end. */
+static void test_arc_small_radius_near_quarter(void **state)
+{
+    (void)state;
+    const double r = 0.0015;
+    for (int k = 0; k < 90; k++) {
+        double a0 = k * 4 * M_PI / 180, a1 = a0 + 89.95 * M_PI / 180;
+        char t[200];
+        snprintf(t, sizeof t, "G1 X%.9f Y%.9f F60\nG3 X%.9f Y%.9f I%.9f J%.9f\n", r * cos(a0),
+                 r * sin(a0), r * cos(a1), r * sin(a1), -r * cos(a0), -r * sin(a0));
+        assert_int_equal(parse(t), CS_OK);
+        expect_continuous();
+        double turned = check_circle(1, 0, 1, 0, 0, r, 5 * LSB, 0, 0, PT_TOL);
+        assert_true(fabs(turned - 89.95 * M_PI / 180) < 0.02);
+    }
+}
+
+/* Found by a search: small arcs just under 90 degrees whose centre is off the LSB grid, where
+ * the rounded ends make the arc builder halve the piece. Still the short arc, on its circle. */
+static void test_arc_piece_halved_by_rounding(void **state)
+{
+    (void)state;
+    static const double a[3][6] = {
+        {0.300754270, 0.699119086, 0.301910305, 0.701317731, -0.000524680, 0.001679114},
+        {0.300463779, 0.699287247, 0.301619155, 0.701124398, -0.000344829, 0.001498743},
+        {0.298643171, 0.701349843, 0.299366081, 0.698762904, 0.001657399, -0.000931323},
+    };
+    for (int k = 0; k < 3; k++) {
+        char t[200];
+        snprintf(t, sizeof t, "G1 X%.9f Y%.9f F60\nG3 X%.9f Y%.9f I%.9f J%.9f\n", a[k][0], a[k][1],
+                 a[k][2], a[k][3], a[k][4], a[k][5]);
+        assert_int_equal(parse(t), CS_OK);
+        expect_continuous();
+        double cx = a[k][0] + a[k][4], cy = a[k][1] + a[k][5];
+        double r = hypot(a[k][4], a[k][5]);
+        double sweep = atan2(a[k][3] - cy, a[k][2] - cx) - atan2(a[k][1] - cy, a[k][0] - cx);
+        while (sweep <= 0)
+            sweep += 2 * M_PI;
+        double turned = check_circle(1, 0, 1, cx, cy, r, 5 * LSB, 0, 0, PT_TOL);
+        assert_true(fabs(turned - sweep) < 0.01);
+        double e[3];
+        end_of(P.n - 1, e);
+        assert_true(fabs(e[0] - a[k][2]) <= PT_TOL && fabs(e[1] - a[k][3]) <= PT_TOL);
+    }
+}
+
+static void test_helix(void **state)
+{
+    (void)state;
+    /* Two turns of radius 10 climbing 5 mm: pitch 2.5 mm per turn. */
+    assert_int_equal(parse("G1 X10 Y0 Z0 F60\nG3 X10 Y0 Z5 I-10 J0 P2\n"), CS_OK);
+    assert_int_equal(S.helices, 1);
+    double pitch = 2.5 / (2 * M_PI);
+    double turned =
+        check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, pitch, CS_GCODE_HELIX_TOL_MM + ARC_TOL);
+    assert_true(fabs(turned - 4 * M_PI) < 1e-6);
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[2] - 5) <= PT_TOL);
+    expect_continuous();
+    /* A steep helix in G19 (axis X), clockwise, with a coarser tolerance. */
+    cs_path_free(&P);
+    cs_path_init(&P);
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.helix_tol_mm = 0.01;
+    const char *t = "G19 G1 Y3 F60\nG2 Y3 Z0 X-40 J-3 K0\n";
+    assert_int_equal(cs_gcode_read("t.nc", t, strlen(t), &o, &P, &D, NULL), CS_OK);
+    /* Clockwise: the third axis (X) goes down by 40 over a full turn, in G19's Y-Z plane. */
+    for (size_t k = 1; k < P.n; k++)
+        for (int s = 0; s <= 64; s++) {
+            double q[3];
+            cs_path_eval_mm(&P.elems[k].curve, s / 64.0, q);
+            assert_true(fabs(hypot(q[1], q[2]) - 3) <= ARC_TOL);
+        }
+    double turned2 = 0, prev = 0;
+    for (size_t k = 1; k < P.n; k++)
+        for (int s = 0; s <= 64; s++) {
+            double q[3];
+            cs_path_eval_mm(&P.elems[k].curve, s / 64.0, q);
+            double a = atan2(q[2], q[1]);
+            if (k > 1 || s > 0) {
+                double d = a - prev;
+                while (d > M_PI)
+                    d -= 2 * M_PI;
+                while (d < -M_PI)
+                    d += 2 * M_PI;
+                turned2 += d;
+            }
+            prev = a;
+            double xexp = -40 * fabs(turned2) / (2 * M_PI);
+            assert_true(fabs(q[0] - xexp) <= 0.01 + ARC_TOL);
+        }
+    assert_true(fabs(turned2 + 2 * M_PI) < 1e-6);
+}
+
+/* ---- splines ----------------------------------------------------------------------------- */
+
+static void test_g5_linuxcnc_facts(void **state)
+{
+    (void)state;
+    /* LinuxCNC's documentation: G5 I0 J3 P0 Q-3 X1 Y1 from (0,0) passes through (0.5, 0.5) at
+     * t = 0.5; the continuation G5 P0 Q-3 X2 Y2 passes through (1.5, 1.5). */
+    assert_int_equal(parse("G1 X0 Y0 F60\nG5 I0 J3 P0 Q-3 X1 Y1\nG5 P0 Q-3 X2 Y2\n"), CS_OK);
+    assert_int_equal(P.n, 2);
+    assert_int_equal(P.elems[0].kind, CS_PATH_CUBIC);
+    double q[3];
+    cs_path_eval_mm(&P.elems[0].curve, 0.5, q);
+    assert_true(fabs(q[0] - 0.5) <= PT_TOL && fabs(q[1] - 0.5) <= PT_TOL);
+    cs_path_eval_mm(&P.elems[1].curve, 0.5, q);
+    assert_true(fabs(q[0] - 1.5) <= PT_TOL && fabs(q[1] - 1.5) <= PT_TOL);
+    /* Control points: P1 = P0 + (I,J), P2 = P3 + (P,Q); the continuation's I,J = -(P,Q). */
+    expect_pt(0, 1, 0, 3, 0, PT_TOL);
+    expect_pt(0, 2, 1, -2, 0, PT_TOL);
+    expect_pt(1, 1, 1, 4, 0, PT_TOL);
+    expect_pt(1, 2, 2, -1, 0, PT_TOL);
+    expect_continuous();
+    /* Inches: offsets scale too. */
+    assert_int_equal(parse("G20 G5 I0 J3 P0 Q-3 X1 Y1\n"), CS_OK);
+    expect_pt(0, 1, 0, 3 * 25.4, 0, PT_TOL);
+}
+
+static void test_g5_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G5 P0 Q-3 X1 Y1\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G1 X1 F1\nG5 P0 Q-3 X1 Y1\n"), CS_ERR_PARSE, 2, 1);
+    expect_diag(parse("G5 I1 P0 Q-3 X1 Y1\n"), CS_ERR_PARSE, 1, 4);
+    expect_diag(parse("G5 I1 J1 X1 Y1\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G18 G5 I1 J1 P1 Q1 X1 Y1\n"), CS_ERR_UNSUPPORTED, 1, 5);
+    expect_diag(parse("G5 I1 J1 P1 Q1 X1 Y1 Z1\n"), CS_ERR_PARSE, 1, 22);
+    expect_diag(parse("G5.1 X1 Y1\n"), CS_ERR_PARSE, 1, 1);
+}
+
+static void test_g51_parabola(void **state)
+{
+    (void)state;
+    /* LinuxCNC: G5.1 X2 I2 J-8 from (-2, 4) traces y = x^2 exactly. */
+    assert_int_equal(parse("G0 X-2 Y4\nG5.1 X2 I2 J-8\n"), CS_OK);
+    assert_int_equal(P.n, 2);
+    assert_int_equal(P.elems[1].kind, CS_PATH_QUAD);
+    for (int s = 0; s <= 100; s++) {
+        double q[3];
+        cs_path_eval_mm(&P.elems[1].curve, s / 100.0, q);
+        assert_true(fabs(q[1] - q[0] * q[0]) <= 1e-9);
+    }
+    double e[3];
+    end_of(1, e);
+    assert_true(e[0] == 2 && e[1] == 4);
+}
+
+/* Cox-de Boor basis N_{i,p}(u) over knots kn (u in the last span counts as inside). */
+static double basis(int i, int p, double u, const double *kn, int nk)
+{
+    if (p == 0) {
+        if (u >= kn[i] && u < kn[i + 1])
+            return 1;
+        if (u == kn[nk - 1] && kn[i] < kn[i + 1] && kn[i + 1] == kn[nk - 1])
+            return 1;
+        return 0;
+    }
+    double a = 0, b = 0;
+    if (kn[i + p] > kn[i])
+        a = (u - kn[i]) / (kn[i + p] - kn[i]) * basis(i, p - 1, u, kn, nk);
+    if (kn[i + p + 1] > kn[i + 1])
+        b = (kn[i + p + 1] - u) / (kn[i + p + 1] - kn[i + 1]) * basis(i + 1, p - 1, u, kn, nk);
+    return a + b;
+}
+
+static void nurbs_eval(const double (*cp)[3], int n, int order, double u, double out[2])
+{
+    double kn[32];
+    int nk = n + order;
+    for (int i = 0; i < nk; i++)
+        kn[i] = i < order ? 0 : i <= n - 1 ? i - order + 1 : n - order + 1;
+    double x = 0, y = 0, w = 0;
+    for (int i = 0; i < n; i++) {
+        double b = basis(i, order - 1, u, kn, nk) * cp[i][2];
+        x += b * cp[i][0];
+        y += b * cp[i][1];
+        w += b;
+    }
+    out[0] = x / w;
+    out[1] = y / w;
+}
+
+static void check_nurbs(const char *text, const double (*cp)[3], int n, int order, double tol)
+{
+    assert_int_equal(parse(text), CS_OK);
+    int spans = n - order + 1;
+    /* Two elements before the block (the G0 and the G1), then one per knot span. */
+    assert_int_equal((int)P.n, 2 + spans);
+    for (int s = 0; s < spans; s++) {
+        assert_int_equal(P.elems[2 + s].curve.degree, order - 1);
+        for (int k = 0; k <= 50; k++) {
+            double t = k / 50.0, q[3], r[2];
+            cs_path_eval_mm(&P.elems[2 + s].curve, t, q);
+            nurbs_eval(cp, n, order, s + t, r);
+            if (fabs(q[0] - r[0]) > tol || fabs(q[1] - r[1]) > tol)
+                print_error("span %d t %g: (%.9f, %.9f) vs (%.9f, %.9f)\n", s, t, q[0], q[1], r[0],
+                            r[1]);
+            assert_true(fabs(q[0] - r[0]) <= tol && fabs(q[1] - r[1]) <= tol);
+        }
+    }
+    expect_continuous();
+}
+
+static void test_g52_nurbs(void **state)
+{
+    (void)state;
+    /* LinuxCNC's example block: the current point is the first control point (weight 1). */
+    static const double cp[5][3] = {{0, 0, 1}, {0, 1, 1}, {2, 2, 1}, {2, 0, 1}, {0, 0, 2}};
+    check_nurbs("G0 X0 Y0.0001\nG1 X0 Y0 F10\nG5.2 X0 Y1 P1 L3\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\n"
+                "G5.3\n",
+                cp, 5, 3, 2 * LSB);
+    /* Order 4 (cubic), weights of several sizes. */
+    static const double cq[6][3] = {{1, 1, 1},   {2, 5, 0.5}, {6, 6, 3},
+                                    {9, 2, 1.5}, {12, 4, 1},  {14, 0, 2}};
+    check_nurbs("G0 X1 Y1.5\nG1 Y1 F10\nG5.2 X2 Y5 P0.5 L4\nX6 Y6 P3\nX9 Y2 P1.5\nX12 Y4 P1\n"
+                "X14 Y0 P2\nG5.3\n",
+                cq, 6, 4, 2 * LSB);
+}
+
+static void test_g52_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G5.2 X1 Y1 P1\nX2 Y2\nG5.3\n"), CS_ERR_WEIGHT, 2, 1);
+    expect_diag(parse("G5.2 X1 Y1 P1\nX2 Y2 P1\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G5.2 X1 Y1 P1\nG5.3\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G5.2 X1 Y1 P1 L5\nX2 Y2 P1\nX3 Y3 P1\nG5.3\n"), CS_ERR_UNSUPPORTED, 1, 15);
+    expect_diag(parse("G5.3\n"), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse("G5.2 X1 Y1 P1\nG1 X2\n"), CS_ERR_PARSE, 2, 1);
+    expect_diag(parse("G5.2 X1 P1\n"), CS_ERR_PARSE, 1, 6);
+}
+
+/* ---- the cncjs fixtures ------------------------------------------------------------------ */
+
+static void test_cncjs_plane_arcs(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *file;
+        int i0, i1;
+    } f[] = {{DATA "arc-xy-plane.nc", 0, 1},
+             {DATA "arc-zx-plane.nc", 2, 0},
+             {DATA "arc-yz-plane.nc", 1, 2}};
+    for (size_t k = 0; k < 3; k++) {
+        assert_int_equal(parse_file(f[k].file, false), CS_OK);
+        expect_continuous();
+        /* Every arc piece lies on the radius-20 circle around the origin of its plane. */
+        for (size_t e = 0; e < P.n; e++) {
+            if (P.elems[e].kind != CS_PATH_ARC)
+                continue;
+            for (int s = 0; s <= 32; s++) {
+                double q[3];
+                cs_path_eval_mm(&P.elems[e].curve, s / 32.0, q);
+                assert_true(fabs(hypot(q[f[k].i0], q[f[k].i1]) - 20) <= ARC_TOL);
+                assert_true(fabs(q[3 - f[k].i0 - f[k].i1]) <= PT_TOL);
+            }
+        }
+        assert_true(fabs(P.elems[1].feed_mm_s - 200.0 / 60.0) < 1e-12);
+    }
+}
+
+static void test_cncjs_one_inch_circle(void **state)
+{
+    (void)state;
+    assert_int_equal(parse_file(DATA "one-inch-circle.nc", false), CS_OK);
+    expect_continuous();
+    /* G20: the circle of diameter 1 in around the origin, at Z0, four G2 quarters. */
+    double turned = 0;
+    size_t first = 0;
+    while (P.elems[first].kind != CS_PATH_ARC)
+        first++;
+    size_t last = first;
+    while (last < P.n && P.elems[last].kind == CS_PATH_ARC)
+        last++;
+    for (size_t e = first; e < last; e++)
+        for (int s = 0; s <= 32; s++) {
+            double q[3];
+            cs_path_eval_mm(&P.elems[e].curve, s / 32.0, q);
+            assert_true(fabs(hypot(q[0], q[1]) - 12.7) <= ARC_TOL);
+            assert_true(fabs(q[2]) <= PT_TOL);
+        }
+    double a0[3], a1[3];
+    pt(first, 0, a0);
+    end_of(last - 1, a1);
+    assert_true(fabs(a0[0] + 12.7) <= PT_TOL && fabs(a1[0] + 12.7) <= PT_TOL);
+    (void)turned;
+    /* F2.5 in/min on the arcs. */
+    assert_true(fabs(P.elems[first].feed_mm_s - 2.5 * 25.4 / 60) < 1e-12);
+}
+
+static void test_cncjs_helical_thread(void **state)
+{
+    (void)state;
+    /* G42 D08 (cutter compensation) is not carried out: an error, a warning when lenient. */
+    expect_diag(parse_file(DATA "helical-thread-milling.nc", false), CS_ERR_UNSUPPORTED, 2, 9);
+    assert_int_equal(parse_file(DATA "helical-thread-milling.nc", true), CS_OK);
+    assert_int_equal(nwarn, 2);
+    expect_continuous();
+    assert_int_equal(S.helices, 10);
+    /* G91: ten arcs each climbing 0.0179 from -0.6533: the end is at 10 * 0.0179 - 0.6533. */
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[2] - (10 * 0.0179 - 0.6533)) <= 10 * PT_TOL);
+}
+
+static void test_cncjs_bad_files(void **state)
+{
+    (void)state;
+    /* "X0Y20" in G2 mode without R or I/J (LinuxCNC refuses it too). */
+    expect_diag(parse_file(DATA "arc-r.nc", false), CS_ERR_PARSE, 3, 1);
+    expect_diag(parse_file(DATA "arc-r.nc", true), CS_ERR_PARSE, 3, 1);
+    /* A bare G92; lenient: G2 X0Y0 R0 from (0,0) has no centre. */
+    expect_diag(parse_file(DATA "motion.nc", false), CS_ERR_PARSE, 1, 1);
+    expect_diag(parse_file(DATA "motion.nc", true), CS_ERR_DEGENERATE, 4, 9);
+    /* T0 is refused; lenient reads on to the bad checksum of line 8 (column of the '*'). */
+    expect_diag(parse_file(DATA "special-fields.gcode", false), CS_ERR_UNSUPPORTED, 3, 4);
+    expect_diag(parse_file(DATA "special-fields.gcode", true), CS_ERR_PARSE, 8, 16);
+    assert_non_null(strstr(D.reason, "checksum"));
+    assert_int_equal(P.n, 1); /* N7 G1 X2.0 Y2.0 (inches) was read before */
+    expect_pt(0, 1, 50.8, 50.8, 0, PT_TOL);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    cs_path_init(&P);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    cs_path_free(&P);
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_g0_g1_lines_feed_rapid),
+        cmocka_unit_test(test_modal_motion_and_lowercase),
+        cmocka_unit_test(test_units_inch_and_incremental),
+        cmocka_unit_test(test_g92_offsets),
+        cmocka_unit_test(test_subpaths_pen_and_program_end),
+        cmocka_unit_test(test_pen_z_moves),
+        cmocka_unit_test(test_comments_line_numbers_block_delete),
+        cmocka_unit_test(test_checksums),
+        cmocka_unit_test(test_unsupported_strict_and_lenient),
+        cmocka_unit_test(test_lenient_drops_words_of_dropped_codes),
+        cmocka_unit_test(test_syntax_errors),
+        cmocka_unit_test(test_arc_ijk_quarter_both_directions),
+        cmocka_unit_test(test_arc_planes),
+        cmocka_unit_test(test_arc_full_circle_and_turns),
+        cmocka_unit_test(test_arc_r_form),
+        cmocka_unit_test(test_arc_errors),
+        cmocka_unit_test(test_arc_tiny_pieces),
+        cmocka_unit_test(test_arc_small_radius_near_quarter),
+        cmocka_unit_test(test_arc_piece_halved_by_rounding),
+        cmocka_unit_test(test_helix),
+        cmocka_unit_test(test_g5_linuxcnc_facts),
+        cmocka_unit_test(test_g5_errors),
+        cmocka_unit_test(test_g51_parabola),
+        cmocka_unit_test(test_g52_nurbs),
+        cmocka_unit_test(test_g52_errors),
+        cmocka_unit_test(test_cncjs_plane_arcs),
+        cmocka_unit_test(test_cncjs_one_inch_circle),
+        cmocka_unit_test(test_cncjs_helical_thread),
+        cmocka_unit_test(test_cncjs_bad_files),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
