@@ -128,6 +128,21 @@ $(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ $(PKG_LIBS)
 
+# bench_peers also links AGG (C++ headers + static lib, pkg-config libagg) via agg_flat.cpp.
+AGG_CFLAGS := $(shell pkg-config --cflags libagg 2>/dev/null)
+AGG_LIBS   := $(shell pkg-config --libs libagg 2>/dev/null)
+CXX        ?= g++
+$(BUILD)/bench/agg_flat.o: tests/bench/agg_flat.cpp tests/bench/agg_flat.h
+	@mkdir -p $(@D)
+	$(CXX) -O2 -Wall -Wextra $(AGG_CFLAGS) -Itests/bench -c $< -o $@
+
+$(BUILD)/bench/bench_peers: tests/bench/bench_peers.c tests/bench/agg_flat.h \
+		$(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CFLAGS) -Itests/bench -c $< -o $@.o
+	$(CXX) $@.o $(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ \
+		$(PKG_LIBS) $(AGG_LIBS)
+
 bench: deps all $(BENCH_BIN)
 	@bash scripts/bench.sh $(BENCH_BIN)
 

@@ -31,4 +31,14 @@ int cs_cmd_toolpath(int argc, char **argv);
  * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] FILE */
 int cs_cmd_stream(int argc, char **argv);
 
+/* curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH] */
+int cs_cmd_serve(int argc, char **argv);
+/* curvestep submit [--socket PATH] [--mode M] [--tol MM] [--feed MM/S] FILE */
+int cs_cmd_submit(int argc, char **argv);
+/* curvestep status | pause | resume [--socket PATH]; curvestep cancel [--socket PATH] [JOB] */
+int cs_cmd_status(int argc, char **argv);
+int cs_cmd_pause(int argc, char **argv);
+int cs_cmd_resume(int argc, char **argv);
+int cs_cmd_cancel(int argc, char **argv);
+
 #endif

@@ -389,9 +389,24 @@ static cs_err_t do_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
     if (r->has && has_ijk)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, r->col),
                                 "R and %s in one arc: give the centre one way", names);
-    if (!r->has && !has_ijk)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
-                                "G%d needs R (radius) or %s (centre)", ccw ? 3 : 2, names);
+    if (!r->has && !has_ijk) {
+        if (!g->o->lenient)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                    "G%d needs R (radius) or %s (centre)", ccw ? 3 : 2, names);
+        /* Lenient: the arc's shape is unknown but its end is not. Skipping it would leave the
+         * machine elsewhere than the program assumes, so every later R arc (whose centre
+         * depends on its start) and every G91 move would be drawn wrong; a rapid would cross
+         * the work at full speed. A straight feed move to the programmed end keeps the rest of
+         * the file exact and only replaces this one arc by its chord. */
+        warn(g, col,
+             "G%d without R or %s: moved in a straight line (G1) to its end point instead "
+             "(--lenient)",
+             ccw ? 3 : 2, names);
+        cs_err_t el = add_line(g, g->pos, t, col, false);
+        if (el == CS_OK)
+            memcpy(g->pos, t, sizeof g->pos);
+        return el;
+    }
     int turns = 1;
     const word_t *pw = &b->w['P' - 'A'];
     if (pw->has) {
@@ -409,11 +424,23 @@ static cs_err_t do_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
     if (r->has) {
         b->used |= BIT('R');
         double R = r->v * g->unit, aR = fabs(R);
-        if (s0 == e0 && s1 == e1)
-            return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, r->col),
-                                    "R-form arc ends where it starts: its centre is undefined "
-                                    "(a full circle needs %s)",
-                                    names);
+        if (s0 == e0 && s1 == e1) {
+            if (!g->o->lenient)
+                return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, r->col),
+                                        "R-form arc ends where it starts: its centre is "
+                                        "undefined (a full circle needs %s)",
+                                        names);
+            /* Lenient: no circle can be chosen (any centre at distance |R| fits), so nothing
+             * is drawn in the plane; a move along the plane's normal is still made, straight
+             * (the limit of a helix of no radius), so the position stays the programmed one. */
+            warn(g, r->col,
+                 "R-form arc ends where it starts (centre undefined): nothing drawn in the "
+                 "plane (--lenient)");
+            cs_err_t el = add_line(g, g->pos, t, col, false);
+            if (el == CS_OK)
+                memcpy(g->pos, t, sizeof g->pos);
+            return el;
+        }
         if (aR < rtol)
             return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, r->col),
                                     "zero-radius arc (R %g)", r->v);
@@ -720,8 +747,12 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
             continue;
         char what[48];
         snprintf(what, sizeof what, "the %c word", 'A' + i);
-        if ((e = unsupported(g, b->w[i].col, what)) != CS_OK)
+        if (i == 'T' - 'A' && g->o->lenient) {
+            /* No tool changer: the tool in the machine stays, nothing moves. */
+            warn(g, b->w[i].col, "T (tool select): ignored, there is no tool changer (--lenient)");
+        } else if ((e = unsupported(g, b->w[i].col, what)) != CS_OK) {
             return e;
+        }
         b->w[i].has = false;
     }
     b->used |= BIT('N');
@@ -879,7 +910,7 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
                 return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, g92col),
                                         "G92 needs axis words (the coordinates to give the "
                                         "current position)");
-            warn(g, g92col, "G92 without X, Y or Z: ignored (--lenient)");
+            warn(g, g92col, "G92 without X, Y or Z: ignored, offsets unchanged (--lenient)");
         }
         for (int a = 0; a < 3; a++) {
             const word_t *w = &b->w['X' - 'A' + a];

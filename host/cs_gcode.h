@@ -18,7 +18,10 @@ typedef void (*cs_gcode_warn_fn)(void *ctx, const cs_path_diag_t *w);
 #define CS_GCODE_HELIX_TOL_MM 0.001
 
 typedef struct {
-    bool lenient;          /* unsupported words: a warning and the word is ignored (not an error) */
+    bool lenient;          /* unsupported words: a warning and the word is ignored (not an error);
+                            * also (each warned) bare G92 = no-op, G2/G3 without R or I/J/K = a
+                            * straight feed move to its end, R arc ending on its start = nothing
+                            * drawn in the plane, T = ignored. Checksums stay errors. */
     double helix_tol_mm;   /* > 0: bound on the helix approximation (see docs/inputs.md) */
     size_t max_elements;   /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
     bool pen_z;            /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */

@@ -24,7 +24,7 @@ typedef struct {
     cs_input_format_t format; /* CS_INPUT_AUTO unless the caller knows better */
     bool lenient;             /* G-code: unsupported words are warnings, not errors */
     double helix_tol_mm;      /* G-code helices (default CS_GCODE_HELIX_TOL_MM) */
-    bool pen_z;               /* G-code M3/M4/M5 also move Z (see cs_gcode_opts_t) */
+    bool pen_z; /* G-code M3/M4/M5 also move Z (cs_gcode_opts_t); plan/stream: [pen] mode = z */
     double pen_down_z_mm, pen_up_z_mm;
     cs_input_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;

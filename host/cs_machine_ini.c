@@ -19,6 +19,8 @@ typedef struct {
     double pulse_us[CS_AXES];
     double segment_ms;
     bool has_a;
+    cs_machine_pen_t pen;
+    bool has_up_z, has_down_z;
     char reason[200];
     int bad_line;
 } ini_ctx_t;
@@ -84,11 +86,48 @@ static int fail(ini_ctx_t *c, const char *fmt, const char *section, const char *
     return 0;
 }
 
+void cs_machine_ini_pen_default(cs_machine_pen_t *pen)
+{
+    memset(pen, 0, sizeof *pen);
+    pen->mode = CS_MACHINE_PEN_NONE;
+}
+
+/* [pen]: mode = none | z, up_z, down_z (mm). */
+static int pen_key(ini_ctx_t *c, const char *section, const char *name, const char *value)
+{
+    double d;
+    cs_pos_t q;
+    if (strcasecmp(name, "mode") == 0) {
+        if (strcasecmp(value, "none") == 0)
+            c->pen.mode = CS_MACHINE_PEN_NONE;
+        else if (strcasecmp(value, "z") == 0)
+            c->pen.mode = CS_MACHINE_PEN_Z;
+        else
+            return fail(c, "[%s] %s: expected none or z", section, name);
+        return 1;
+    }
+    bool up = strcasecmp(name, "up_z") == 0;
+    if (!up && strcasecmp(name, "down_z") != 0)
+        return fail(c, "[%s] %s: unknown key (expected mode, up_z or down_z)", section, name);
+    if (!parse_num(value, &d) || cs_conv_mm_to_pos(d, &q) != CS_OK)
+        return fail(c, "[%s] %s: must be a number in [-4096, 4096] mm", section, name);
+    if (up) {
+        c->pen.up_z_mm = d;
+        c->has_up_z = true;
+    } else {
+        c->pen.down_z_mm = d;
+        c->has_down_z = true;
+    }
+    return 1;
+}
+
 static int handler(void *user, const char *section, const char *name, const char *value)
 {
     ini_ctx_t *c = user;
     cs_machine_t *m = c->m;
     double d;
+    if (strcasecmp(section, "pen") == 0)
+        return pen_key(c, section, name, value);
     if (strcasecmp(section, "machine") == 0) {
         if (strcasecmp(name, "profile") == 0) {
             if (strcasecmp(value, "trapezoid") == 0)
@@ -137,7 +176,8 @@ static int handler(void *user, const char *section, const char *name, const char
         if (strcasecmp(section, axis_names[i]) == 0)
             ax = i;
     if (ax < 0)
-        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z or a)", section, "");
+        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z, a or pen)", section,
+                    "");
     if (ax == CS_AXIS_A) {
         c->has_a = true;
         m->n_axes = 4;
@@ -204,6 +244,27 @@ static int finish(ini_ctx_t *c, int rc, const char *name, char *err, size_t errl
             return -1;
         }
     }
+    if (c->pen.mode == CS_MACHINE_PEN_Z) {
+        /* No default heights: a guessed down_z could drive the pen (or a tool) into the bed. */
+        if (!c->has_up_z || !c->has_down_z) {
+            snprintf(err, errlen, "%s:0: [pen] mode = z needs both up_z and down_z", name);
+            return -1;
+        }
+        if (c->pen.up_z_mm == c->pen.down_z_mm) {
+            snprintf(err, errlen, "%s:0: [pen] up_z and down_z are equal: the pen would not move",
+                     name);
+            return -1;
+        }
+        double zmin = (double)m->axis[CS_AXIS_Z].travel_min / CS_POS_ONE_MM;
+        double zmax = (double)m->axis[CS_AXIS_Z].travel_max / CS_POS_ONE_MM;
+        const double zs[2] = {c->pen.up_z_mm, c->pen.down_z_mm};
+        for (int k = 0; k < 2; k++)
+            if (zs[k] < zmin || zs[k] > zmax) {
+                snprintf(err, errlen, "%s:0: [pen] %s = %g mm is outside the z travel [%g, %g] mm",
+                         name, k == 0 ? "up_z" : "down_z", zs[k], zmin, zmax);
+                return -1;
+            }
+    }
     cs_planner_t pl;
     cs_err_t e = cs_planner_init(&pl, m);
     if (e != CS_OK) {
@@ -222,23 +283,40 @@ static void ctx_init(ini_ctx_t *c, cs_machine_t *m)
     c->m = m;
     cs_machine_ini_default(m);
     c->segment_ms = 5.0;
+    cs_machine_ini_pen_default(&c->pen);
     for (unsigned i = 0; i < CS_AXES; i++)
         c->pulse_us[i] = 2.0;
 }
 
-int cs_machine_ini_load(const char *path, cs_machine_t *m, char *err, size_t errlen)
+int cs_machine_ini_load_pen(const char *path, cs_machine_t *m, cs_machine_pen_t *pen, char *err,
+                            size_t errlen)
 {
     ini_ctx_t c;
     ctx_init(&c, m);
-    int rc = ini_parse(path, handler, &c);
-    return finish(&c, rc, path, err, errlen);
+    int rc = finish(&c, ini_parse(path, handler, &c), path, err, errlen);
+    if (rc == 0 && pen)
+        *pen = c.pen;
+    return rc;
+}
+
+int cs_machine_ini_parse_pen(const char *text, const char *name, cs_machine_t *m,
+                             cs_machine_pen_t *pen, char *err, size_t errlen)
+{
+    ini_ctx_t c;
+    ctx_init(&c, m);
+    int rc = finish(&c, ini_parse_string(text, handler, &c), name, err, errlen);
+    if (rc == 0 && pen)
+        *pen = c.pen;
+    return rc;
+}
+
+int cs_machine_ini_load(const char *path, cs_machine_t *m, char *err, size_t errlen)
+{
+    return cs_machine_ini_load_pen(path, m, NULL, err, errlen);
 }
 
 int cs_machine_ini_parse(const char *text, const char *name, cs_machine_t *m, char *err,
                          size_t errlen)
 {
-    ini_ctx_t c;
-    ctx_init(&c, m);
-    int rc = ini_parse_string(text, handler, &c);
-    return finish(&c, rc, name, err, errlen);
+    return cs_machine_ini_parse_pen(text, name, m, NULL, err, errlen);
 }

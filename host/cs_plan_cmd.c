@@ -27,7 +27,9 @@ static void usage(FILE *f)
           "G-code G0 moves are rapid too (each axis at its max_rate), G1/G2/G3 use their F.\n"
           "A summary goes to standard error: blocks, segments, steps, job time.\n"
           "  --machine FILE.ini  machine description (default: built-in 3-axis plotter,\n"
-          "                      80 steps/mm; keys in docs/motion.md)\n"
+          "                      80 steps/mm; keys in docs/motion.md); with [pen] mode = z\n"
+          "                      G-code M3/M4 (pen down) and M5 (pen up) move Z, rapid, to\n"
+          "                      its down_z / up_z\n"
           "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
           "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
@@ -98,9 +100,11 @@ int cs_cmd_plan(int argc, char **argv)
         return CS_EXIT_USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return CS_EXIT_INPUT;
         }
@@ -118,6 +122,10 @@ int cs_cmd_plan(int argc, char **argv)
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
+    iopts.pen_z = pen.mode == CS_MACHINE_PEN_Z;
+    iopts.pen_up_z_mm = pen.up_z_mm;
+    iopts.pen_down_z_mm = pen.down_z_mm;
     cs_err_t e = cs_input_load(job, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);

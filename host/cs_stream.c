@@ -263,6 +263,8 @@ void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s)
     c->max_retries = 20;
 }
 
+#define CS_STREAM_CTL_MAX 16
+
 typedef struct {
     const cs_stream_job_t *job;
     const cs_stream_opts_t *o;
@@ -273,6 +275,11 @@ typedef struct {
     uint16_t exec_seq;  /* last executed sequence seen */
     size_t next;        /* job index of the next message to send (0-based) */
     bool stop;          /* outcome decided */
+    bool held;          /* HOLD sent for o->pause, RESUME not yet */
+    /* sequences of the HOLD/RESUME sent for o->pause that the device's last executed sequence
+     * has not passed yet: they are not job messages, so they do not count as executed */
+    uint16_t ctl_seq[CS_STREAM_CTL_MAX];
+    size_t nctl;
     double t0, t_first, last_progress;
     double rate_t, rate_ex; /* for the speed estimate */
     double rate;
@@ -297,7 +304,20 @@ static void on_status(run_t *s, const cs_proto_status_t *st)
     size_t base = s->o->resume_from;
     size_t in_flight = s->r->sent - s->r->executed;
     uint16_t d = (uint16_t)(st->last_seq - s->exec_seq);
-    if (d != 0 && d <= in_flight) {
+    size_t skipped = 0; /* control messages among the newly executed sequences */
+    for (size_t i = 0; i < s->nctl; i++) {
+        uint16_t k = (uint16_t)(s->ctl_seq[i] - s->exec_seq);
+        skipped += k != 0 && k <= d;
+    }
+    if (d != 0 && d >= skipped && d - skipped <= in_flight) {
+        size_t keep = 0;
+        for (size_t i = 0; i < s->nctl; i++) {
+            uint16_t k = (uint16_t)(s->ctl_seq[i] - s->exec_seq);
+            if (!(k != 0 && k <= d))
+                s->ctl_seq[keep++] = s->ctl_seq[i];
+        }
+        s->nctl = keep;
+        d = (uint16_t)(d - skipped);
         s->r->executed += d;
         s->exec_seq = st->last_seq;
     }
@@ -402,8 +422,10 @@ static void progress(run_t *s, bool final)
         s->rate_t = now;
         s->rate_ex = (double)ex;
     }
+    if (final && now > s->t_first) /* the summary: the average over the whole stream */
+        s->rate = (double)(ex - s->o->resume_from) / (now - s->t_first);
     double pct = n ? 100.0 * (double)ex / (double)n : 100.0;
-    double eta = s->rate > 0 ? (double)(n - ex) / s->rate : -1;
+    double eta = ex >= n ? 0 : s->rate > 0 ? (double)(n - ex) / s->rate : -1;
     const char *what = s->job->mode == CS_STREAM_CURVES ? "curves" : "segments";
     unsigned retx = s->link.stats.retransmits;
     if (s->o->progress_tty) {
@@ -435,6 +457,8 @@ static void progress(run_t *s, bool final)
  * want_a or want_b) or wait_ms passed. */
 static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint32_t wait_ms)
 {
+    uint16_t seq = 0;
+    bool track = type == CS_PROTO_HOLD || type == CS_PROTO_RESUME;
     cs_proto_msg_t m = {.type = type};
     double t_end = cs_serial_now_s() + wait_ms / 1000.0;
     bool sent = false;
@@ -444,7 +468,11 @@ static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint
     while (cs_serial_now_s() < t_end) {
         uint32_t now = cs_serial_now_us();
         if (!sent && cs_link_can_send(&s->link, type))
-            sent = cs_link_send_msg(&s->link, &m, NULL) == CS_OK;
+            sent = cs_link_send_msg(&s->link, &m, &seq) == CS_OK;
+        if (sent && track && s->nctl < CS_STREAM_CTL_MAX) {
+            s->ctl_seq[s->nctl++] = seq; /* not a job message (see run_t.ctl_seq) */
+            track = false;
+        }
         if (pump_out(s, now) != 0)
             return;
         pump_in(s, 5);
@@ -533,6 +561,14 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
             finish(s, CS_STREAM_INTERRUPTED);
             break;
         }
+        if (o->pause != NULL && (*o->pause != 0) != s->held && s->nctl + 2 <= CS_STREAM_CTL_MAX) {
+            s->held = !s->held;
+            if (s->held)
+                control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
+            else
+                control(s, CS_PROTO_RESUME, CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
+            t_last_ack = 0;
+        }
         while (s->next < job->n && cs_link_can_send(&s->link, job->v[s->next].type)) {
             if (cs_link_send_msg(&s->link, &job->v[s->next], NULL) != CS_OK)
                 break;
@@ -554,7 +590,7 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
             }
             /* the device reports its progress at least every 250 ms; a job whose last
              * messages are still executing keeps sending STATUS while running */
-            if (r->dev_state != CS_PROTO_STATE_RUNNING &&
+            if (r->dev_state != CS_PROTO_STATE_RUNNING && !s->held &&
                 cs_serial_now_s() - t_last_ack > o->status_ms / 1000.0) {
                 snprintf(r->why, sizeof r->why,
                          "everything was delivered but the device reports %zu executed",

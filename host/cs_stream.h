@@ -65,6 +65,7 @@ typedef struct {
     uint32_t tick_hz;
     size_t resume_from; /* messages 1..resume_from were executed already: start after them */
     volatile sig_atomic_t *interrupt; /* > 0: stop (HOLD, ABORT); >= 2: give up at once */
+    volatile sig_atomic_t *pause;     /* NULL: never; != 0: HOLD (queue kept), back to 0: RESUME */
     FILE *progress;                   /* NULL: none; else progress bar (tty) or lines */
     bool progress_tty;
     cs_link_cfg_t link; /* in microseconds (cs_serial_now_us) */

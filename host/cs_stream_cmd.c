@@ -11,6 +11,7 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_input.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_serial.h"
@@ -49,7 +50,9 @@ static void usage(FILE *f)
           "line lost or damaged.\n"
           "  --port DEV         serial device (required)\n"
           "  --baud N           line speed (default 115200)\n"
-          "  --machine FILE     machine description (default: the built-in plotter)\n"
+          "  --machine FILE     machine description (default: the built-in plotter); with\n"
+          "                     [pen] mode = z, G-code M3/M4 (pen down) and M5 (pen up) move\n"
+          "                     Z, rapid, to its down_z / up_z\n"
           "  --mode segments    send step segments planned here (default)\n"
           "  --mode curves      send cubic Beziers; the device traces and plans them itself.\n"
           "                     Lines and quadratics are sent as exact cubics; arcs and other\n"
@@ -159,9 +162,11 @@ int cs_cmd_stream(int argc, char **argv)
         return CS_EXIT_USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return CS_EXIT_INPUT;
         }
@@ -178,7 +183,13 @@ int cs_cmd_stream(int argc, char **argv)
     cs_path_t path;
     cs_path_init(&path);
     cs_path_diag_t diag;
-    cs_err_t e = cs_motion_read_job(job_file, &path, &diag);
+    /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
+    cs_input_opts_t iopts;
+    cs_input_opts_init(&iopts);
+    iopts.pen_z = pen.mode == CS_MACHINE_PEN_Z;
+    iopts.pen_up_z_mm = pen.up_z_mm;
+    iopts.pen_down_z_mm = pen.down_z_mm;
+    cs_err_t e = cs_input_load(job_file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);
         cs_path_free(&path);
@@ -285,8 +296,8 @@ int cs_cmd_stream(int argc, char **argv)
         printf(" (boot id %08x -> %08x; %u messages were in flight)", (unsigned)r.old_boot,
                (unsigned)r.new_boot, (unsigned)r.unacked);
     if (r.outcome == CS_STREAM_DEVICE_ERROR)
-        printf(" (%s, about %s %zu)", cs_err_text((cs_err_t)r.dev_error.code), what,
-               r.dev_error_msg);
+        printf(" (%s, about %s no. %zu)", cs_err_text((cs_err_t)r.dev_error.code),
+               curves ? "curve" : "segment", r.dev_error_msg);
     printf("\n");
     printf("stream: %zu of %zu %s executed, %zu delivered, %zu sent; last executed: %zu\n",
            r.executed, job.n, what, r.delivered, r.sent, r.executed);

@@ -17,6 +17,12 @@ static const struct {
     {"plan", cs_cmd_plan, "plan a job into step segments (ticks dx dy dz) for a machine"},
     {"toolpath", cs_cmd_toolpath, "surface patches: projected wireframe or ball-end finishing"},
     {"stream", cs_cmd_stream, "stream a job to a device on a serial port (segments or curves)"},
+    {"serve", cs_cmd_serve, "the daemon: keep a device open, stream queued jobs one by one"},
+    {"submit", cs_cmd_submit, "queue a job on the daemon (planned whole, refused if bad)"},
+    {"status", cs_cmd_status, "the daemon's queue and the running job's progress"},
+    {"pause", cs_cmd_pause, "hold the daemon's running job and its queue"},
+    {"resume", cs_cmd_resume, "resume the daemon's held job and queue"},
+    {"cancel", cs_cmd_cancel, "cancel a queued job, or the running one (hold, then abort)"},
     {"help", cmd_help, "show this help, or a command's help: curvestep help COMMAND"},
 };
 

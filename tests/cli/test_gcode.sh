@@ -100,9 +100,31 @@ run "thread strict" 1 flatten "$DATA/helical-thread-milling.nc" &&
     expect_err "thread strict" "^$DATA/helical-thread-milling.nc:2:9: the D word is not supported"
 run "thread lenient" 0 flatten --lenient --stats "$DATA/helical-thread-milling.nc" &&
     expect_dev "thread lenient" 0.01 && expect_err "thread warns" ":2:5: warning: G42 is not supported"
-run "arc-r" 1 flatten "$DATA/arc-r.nc" && expect_err "arc-r" "^$DATA/arc-r.nc:3:1: G2 needs R"
-run "motion" 1 flatten --lenient "$DATA/motion.nc" &&
-    expect_err "motion" "^$DATA/motion.nc:4:9: R-form arc ends where it starts"
+# refused by default (as LinuxCNC does), each at its exact line:col ...
+run "arc-r" 1 flatten "$DATA/arc-r.nc" && expect_err "arc-r" "^$DATA/arc-r.nc:3:1: G2 needs R" &&
+    expect_empty_out "arc-r"
+run "motion" 1 flatten "$DATA/motion.nc" && expect_err "motion" "^$DATA/motion.nc:1:1: G92 needs axis words"
+run "special" 1 flatten "$DATA/special-fields.gcode" &&
+    expect_err "special" "^$DATA/special-fields.gcode:3:4: the T word is not supported"
+# ... and read with --lenient, one warning per case
+run "arc-r lenient" 0 flatten --lenient --stats "$DATA/arc-r.nc" &&
+    expect_err "arc-r lenient" "^$DATA/arc-r.nc:3:1: warning: G2 without R or I/J: moved in a straight line" &&
+    expect_err "arc-r lenient 7" "^$DATA/arc-r.nc:7:1: warning: G3 without R or I/J" &&
+    expect_dev "arc-r lenient" 0.01 &&
+    { [ "$(grep -c ': warning: ' "$TMP/err")" = 2 ] && ok || ko "arc-r lenient: not 2 warnings"; }
+# the straight move keeps the R20 arc's start: (0,0) (0,20) then the arc, ending at (10,0)
+[ "$(sed -n 2p "$TMP/out")" = "0.000000 20.000000" ] && ok || ko "arc-r lenient: second vertex $(sed -n 2p "$TMP/out")"
+run "motion lenient" 0 flatten --lenient "$DATA/motion.nc" &&
+    expect_err "motion lenient G92" "^$DATA/motion.nc:1:1: warning: G92 without X, Y or Z: ignored" &&
+    expect_err "motion lenient R0" "^$DATA/motion.nc:4:9: warning: R-form arc ends where it starts.*nothing drawn" &&
+    expect_err "motion lenient R0 G3" "^$DATA/motion.nc:5:9: warning: R-form arc ends where it starts" &&
+    { [ "$(grep -c ': warning: ' "$TMP/err")" = 7 ] && ok || ko "motion lenient: not 7 warnings"; }
+run "plan motion lenient" 0 plan --lenient "$DATA/motion.nc"
+printf 'N3 T0*57\nG1 X1 F60\n' >"$TMP/t0.gcode"
+run "T0 lenient" 0 flatten --lenient "$TMP/t0.gcode" &&
+    expect_err "T0 lenient" "^$TMP/t0.gcode:1:4: warning: T \\(tool select\\): ignored, there is no tool changer" &&
+    expect_out "T0 lenient" '0.000000 0.000000\n1.000000 0.000000\n'
+# the corrupted line 8 stays an error even with --lenient (after the warnings for lines 3-5)
 run "checksum" 1 flatten --lenient "$DATA/special-fields.gcode" &&
     expect_err "checksum" "^$DATA/special-fields.gcode:8:16: checksum \\*30 does not match" &&
     expect_empty_out "checksum"
@@ -127,11 +149,58 @@ run "plan bad" 1 plan "$TMP/e2.nc" && expect_err "plan bad" "^$TMP/e2.nc:2:1:" &
 run "plan bad -o" 1 plan -o "$TMP/seg.txt" "$TMP/e2.nc" &&
     { [ ! -s "$TMP/seg.txt" ] && ok || ko "plan bad -o: segments written"; }
 
+# --- pen lift: [pen] mode = z in the machine file turns M3 / M5 into Z moves -------------------
+# 80 steps/mm: M3 lowers Z 0 -> -1 mm (-80 steps), M5 raises it -1 -> 4 mm (+400 steps); X goes
+# 0 -> 20 -> 0 (net 0); without [pen] Z never moves.
+printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n' >"$TMP/pen.ini"
+printf 'G0 X10\nM3\nG1 X20 F600\nM5\nG0 X0\n' >"$TMP/pen.nc"
+zsum() { awk 'NR > 1 { if ($4 > 0) p += $4; else n += $4; x += $2 } END { print p + 0, n + 0, x + 0 }' "$TMP/out"; }
+run "pen z" 0 plan --machine "$TMP/pen.ini" "$TMP/pen.nc" &&
+    { [ "$(zsum)" = "400 -80 0" ] && ok || ko "pen z: z up, z down, net x = $(zsum), expected 400 -80 0"; }
+run "pen none" 0 plan "$TMP/pen.nc" &&
+    { [ "$(zsum)" = "0 0 0" ] && ok || ko "pen none: $(zsum), expected 0 0 0"; }
+printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n[z]\ntravel_min = 0\n' >"$TMP/pen-bad.ini"
+run "pen outside travel" 1 plan --machine "$TMP/pen-bad.ini" "$TMP/pen.nc" &&
+    expect_err "pen outside travel" "^$TMP/pen-bad.ini:0: \\[pen\\] down_z = -1 mm is outside the z travel" &&
+    expect_empty_out "pen outside travel"
+printf '[pen]\nmode = lift\n' >"$TMP/pen-bad2.ini"
+run "pen bad mode" 1 plan --machine "$TMP/pen-bad2.ini" "$TMP/pen.nc" &&
+    expect_err "pen bad mode" "^$TMP/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
+
+# stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
+# (320 steps), x back at 0.
+SIM=${CS_BUILD:-build}/curvestep-sim
+if [ -x "$SIM" ]; then
+    timeout 60 "$SIM" --pty --instant --idle-exit 1 --machine "$TMP/pen.ini" >"$TMP/sim.out" \
+        2>"$TMP/sim.err" &
+    simpid=$!
+    PTY=
+    for _ in $(seq 100); do
+        PTY=$(head -n1 "$TMP/sim.out" 2>/dev/null)
+        [ -n "$PTY" ] && break
+        sleep 0.05
+    done
+    if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$TMP/pen.ini" --port "$PTY" "$TMP/pen.nc"; then
+        for _ in $(seq 200); do kill -0 "$simpid" 2>/dev/null || break; sleep 0.05; done
+        grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
+            "$TMP/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$TMP/sim.out")"
+    else
+        [ -n "$PTY" ] || ko "stream pen z: the simulator did not start"
+    fi
+    kill "$simpid" 2>/dev/null
+    wait "$simpid" 2>/dev/null
+else
+    ko "no $SIM"
+fi
+run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$TMP/out" && ok ||
+    ko "stream --help lacks [pen]"
+
 # --- help tells the truth -------------------------------------------------------------------
 run "flatten help" 0 flatten --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
     ok || ko "flatten --help lacks G-code or --lenient"
 run "plan help" 0 plan --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
     ok || ko "plan --help lacks G-code or --lenient"
+grep -q "\[pen\] mode = z" "$TMP/out" && ok || ko "plan --help lacks [pen]"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -83,6 +83,16 @@ expect "curves: device traced curves" grep -qE '^device: .*, [1-9][0-9]* curves\
 expect "curves: device check ok" grep -q '^check: ok$' "$T/cur.sim"
 expect "curves: final position exact" grep -q 'rounded to steps: exact' "$T/cur.sim"
 
+# 2b. on a terminal (script(1) gives it one): a progress bar with percent, ETA, rate, retx.
+if command -v script >/dev/null 2>&1; then
+    start_sim tty
+    timeout 60 script -qec "'$CS' stream --port '$PTY' '$ARCS'" /dev/null >"$T/tty.out" 2>&1
+    rc=$?
+    wait_sim
+    expect "tty: exit 0" [ $rc -eq 0 ]
+    expect "tty: progress bar" grep -qE '\[#+\] 100\.0% [0-9]+/[0-9]+ segments  ETA 0:00  [0-9]+ segments/s  retx [0-9]+' "$T/tty.out"
+fi
+
 # 3. a device reset after 500 segments: exit 5, last executed 500; --resume-from 500 finishes.
 start_sim rst --reference "$JOB" --check --faults reset-after=500
 timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/rst.out" 2>"$T/rst.err"; rc=$?
@@ -108,7 +118,9 @@ expect "closed: last executed 300" grep -q 'last executed: 300$' "$T/cls.out"
 
 # 5. Ctrl-C (SIGINT) while the device runs in real time: hold, abort, exit 8.
 start_sim int --speed 1 --reference "$JOB"
-timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
+# (--foreground: timeout would otherwise pass the signal on twice, to the command and to its
+# process group, and a second Ctrl-C means "leave at once")
+timeout --foreground 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
 sleep 1
@@ -121,7 +133,16 @@ expect "ctrl-c: device held and aborted" grep -q ' 1 holds, 1 aborts' "$T/int.si
 k=$(sed -n 's/.*last executed: \([0-9]*\)$/\1/p' "$T/int.out")
 expect "ctrl-c: host and device agree on what ran" grep -q "^device: .* $k messages executed" "$T/int.sim"
 
-# 6. usage and a port that is not there.
+# 6. a device whose travel is smaller than the host's machine refuses a curve: exit 7, ABORT.
+printf '[x]\ntravel_min = 0\ntravel_max = 100\n' >"$T/small.ini"
+start_sim err --machine "$T/small.ini"
+timeout 60 "$CS" stream --mode curves --port "$PTY" "$JOB" >"$T/err.out" 2>"$T/err.err"; rc=$?
+wait_sim
+expect "device error: exit 7" [ $rc -eq 7 ]
+expect "device error: reported" grep -qE "device reported an error \(move outside the machine's travel limits, about curve no. [0-9]+\)" "$T/err.out"
+expect "device error: aborted" grep -q ' 1 aborts' "$T/err.sim"
+
+# 7. usage and a port that is not there.
 "$CS" stream --help >"$T/help.out"; rc=$?
 expect "help: exit 0" [ $rc -eq 0 ]
 expect "help: exit codes" grep -q '5 the device reset mid-job' "$T/help.out"

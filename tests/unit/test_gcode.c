@@ -799,18 +799,118 @@ static void test_cncjs_helical_thread(void **state)
 static void test_cncjs_bad_files(void **state)
 {
     (void)state;
-    /* "X0Y20" in G2 mode without R or I/J (LinuxCNC refuses it too). */
+    /* By default each is refused where LinuxCNC refuses it. "X0Y20" in G2 mode without R or
+     * I/J. */
     expect_diag(parse_file(DATA "arc-r.nc", false), CS_ERR_PARSE, 3, 1);
-    expect_diag(parse_file(DATA "arc-r.nc", true), CS_ERR_PARSE, 3, 1);
     /* A bare G92; lenient: G2 X0Y0 R0 from (0,0) has no centre. */
     expect_diag(parse_file(DATA "motion.nc", false), CS_ERR_PARSE, 1, 1);
-    expect_diag(parse_file(DATA "motion.nc", true), CS_ERR_DEGENERATE, 4, 9);
-    /* T0 is refused; lenient reads on to the bad checksum of line 8 (column of the '*'). */
+    /* T0 is refused; lenient reads on to the bad checksum of line 8 (column of the '*'): a
+     * corrupted line stays an error. */
     expect_diag(parse_file(DATA "special-fields.gcode", false), CS_ERR_UNSUPPORTED, 3, 4);
     expect_diag(parse_file(DATA "special-fields.gcode", true), CS_ERR_PARSE, 8, 16);
     assert_non_null(strstr(D.reason, "checksum"));
     assert_int_equal(P.n, 1); /* N7 G1 X2.0 Y2.0 (inches) was read before */
     expect_pt(0, 1, 50.8, 50.8, 0, PT_TOL);
+}
+
+/* Centre (double reference) of the short arc of radius r from a to b: right of the chord for a
+ * clockwise arc, left for a counter-clockwise one. */
+static void short_arc_centre(const double a[2], const double b[2], double r, bool ccw, double c[2])
+{
+    double dx = b[0] - a[0], dy = b[1] - a[1], len = hypot(dx, dy);
+    double d = sqrt(r * r - len * len / 4), nx = -dy / len, ny = dx / len; /* left normal */
+    double sgn = ccw ? 1.0 : -1.0;
+    c[0] = (a[0] + b[0]) / 2 + sgn * d * nx;
+    c[1] = (a[1] + b[1]) / 2 + sgn * d * ny;
+}
+
+/* --lenient reads arc-r.nc: each arc without R or I/J becomes a straight feed move to its end,
+ * so the R20 arcs after them start where the program says and keep their true centres. */
+static void test_cncjs_arc_r_lenient(void **state)
+{
+    (void)state;
+    assert_int_equal(parse_file(DATA "arc-r.nc", true), CS_OK);
+    assert_int_equal(nwarn, 2); /* one per arc without R or I/J (lines 3 and 7) */
+    assert_non_null(strstr(last_warn, "arc-r.nc:7:1: G3 without R or I/J"));
+    assert_non_null(strstr(last_warn, "straight line"));
+    /* Line 3: (0,0) -> (0,20), a feed move. */
+    assert_int_equal(P.elems[0].kind, CS_PATH_LINE);
+    assert_false(P.elems[0].rapid);
+    expect_pt(0, 0, 0, 0, 0, PT_TOL);
+    expect_pt(0, 1, 0, 20, 0, PT_TOL);
+    const double a[2] = {0, 20}, b[2] = {10, 0};
+    double cw[2], ccw[2];
+    short_arc_centre(a, b, 20, false, cw);
+    short_arc_centre(a, b, 20, true, ccw);
+    unsigned arcs[2] = {0, 0}, lines = 0, rapids = 0;
+    for (size_t i = 1; i < P.n; i++) {
+        const cs_path_elem_t *el = &P.elems[i];
+        if (el->rapid) {
+            rapids++; /* line 5: G0 X0Y0 from (10,0) */
+            expect_pt(i, 0, 10, 0, 0, PT_TOL);
+            expect_pt(i, 1, 0, 0, 0, PT_TOL);
+            continue;
+        }
+        if (el->loc.line == 7) {
+            lines++;
+            expect_pt(i, 0, 0, 0, 0, PT_TOL);
+            expect_pt(i, 1, 0, 20, 0, PT_TOL);
+            continue;
+        }
+        assert_int_equal(el->kind, CS_PATH_ARC);
+        bool is_ccw = el->loc.line == 8;
+        assert_true(is_ccw || el->loc.line == 4);
+        arcs[is_ccw]++;
+        const double *c = is_ccw ? ccw : cw;
+        for (int k = 0; k <= 32; k++) {
+            double q[3];
+            cs_path_eval_mm(&el->curve, k / 32.0, q);
+            assert_true(fabs(hypot(q[0] - c[0], q[1] - c[1]) - 20) <= ARC_TOL);
+        }
+    }
+    assert_int_equal(rapids, 1);
+    assert_int_equal(lines, 1);
+    assert_true(arcs[0] >= 1 && arcs[1] >= 1);
+    expect_pt(P.n - 1, P.elems[P.n - 1].curve.degree, 10, 0, 0, PT_TOL);
+}
+
+/* --lenient reads motion.nc: bare G92 ignored, the R0 arcs that end where they start draw
+ * nothing, the probing moves are dropped; nothing moves at all. */
+static void test_cncjs_motion_lenient(void **state)
+{
+    (void)state;
+    assert_int_equal(parse_file(DATA "motion.nc", true), CS_OK);
+    /* G92, two R0 arcs, G38.2 .. G38.5: one warning each. */
+    assert_int_equal(nwarn, 7);
+    assert_int_equal(P.n, 0);
+    /* An R arc that ends on its start but moves along the plane's normal: the straight move. */
+    assert_int_equal(parse_opts("G1 X5 F60\nG2 X5 Y0 Z-2 R3\nG1 X6\n", true), CS_OK);
+    assert_int_equal(nwarn, 1);
+    assert_non_null(strstr(last_warn, "t.nc:2:14: R-form arc ends where it starts"));
+    assert_int_equal(P.n, 3);
+    expect_pt(1, 0, 5, 0, 0, PT_TOL);
+    expect_pt(1, 1, 5, 0, -2, PT_TOL);
+    expect_pt(2, 1, 6, 0, -2, PT_TOL);
+    /* Strict: the same is an error at the R word. */
+    expect_diag(parse("G1 X5 F60\nG2 X5 Y0 Z-2 R3\n"), CS_ERR_DEGENERATE, 2, 14);
+    /* An R0 arc that does go somewhere is still refused, lenient or not. */
+    expect_diag(parse_opts("G2 X1 Y0 R0\n", true), CS_ERR_DEGENERATE, 1, 10);
+}
+
+/* --lenient reads special-fields.gcode up to its corrupted line 8: T0 ignored (no tool changer),
+ * "G92 E0" ignored (E dropped, then a bare G92), G28 dropped. */
+static void test_cncjs_special_fields_lenient(void **state)
+{
+    (void)state;
+    const char *txt = "N3 T0*57\n";
+    assert_int_equal(parse_opts(txt, true), CS_OK);
+    assert_int_equal(nwarn, 1);
+    assert_non_null(strstr(last_warn, "t.nc:1:4: T (tool select): ignored"));
+    assert_int_equal(P.n, 0);
+    expect_diag(parse(txt), CS_ERR_UNSUPPORTED, 1, 4);
+    /* The file itself, lenient: T0, E, bare G92, G28 warned once each before the line-8 error. */
+    expect_diag(parse_file(DATA "special-fields.gcode", true), CS_ERR_PARSE, 8, 16);
+    assert_int_equal(nwarn, 4);
 }
 
 static int setup(void **state)
@@ -859,6 +959,9 @@ int main(void)
         cmocka_unit_test(test_cncjs_one_inch_circle),
         cmocka_unit_test(test_cncjs_helical_thread),
         cmocka_unit_test(test_cncjs_bad_files),
+        cmocka_unit_test(test_cncjs_arc_r_lenient),
+        cmocka_unit_test(test_cncjs_motion_lenient),
+        cmocka_unit_test(test_cncjs_special_fields_lenient),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1,7 +1,8 @@
 /* Tests of cs_machine_ini: the built-in plotter, every key read and converted to the core's
  * formats (compared with the decimal value in double, within 1 LSB), the optional a axis, and
  * errors reported as file:line: reason (unknown key, bad value, unknown section, a rate the
- * executor cannot step, a missing file). */
+ * executor cannot step, a missing file), and the host-only [pen] section (mode, heights, their
+ * checks against the z travel). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -143,6 +144,46 @@ static void test_load_from_file(void **state)
     remove(path);
 }
 
+/* [pen]: absent = mode none; mode = z with both heights read exactly (mm, as written); the plain
+ * parser accepts the section too; every bad [pen] named with file and line. */
+static void test_pen_section(void **state)
+{
+    (void)state;
+    cs_machine_t m;
+    cs_machine_pen_t pen;
+    char err[256] = "";
+    pen.mode = CS_MACHINE_PEN_Z;
+    assert_int_equal(cs_machine_ini_parse_pen("", "p.ini", &m, &pen, err, sizeof err), 0);
+    assert_int_equal(pen.mode, CS_MACHINE_PEN_NONE);
+    const char *z = "[z]\ntravel_min = -20\ntravel_max = 30\n[pen]\nmode = Z\nup_z = 12.5\n"
+                    "down_z = -3.25\n";
+    assert_int_equal(cs_machine_ini_parse_pen(z, "p.ini", &m, &pen, err, sizeof err), 0);
+    assert_int_equal(pen.mode, CS_MACHINE_PEN_Z);
+    assert_true(fabs(pen.up_z_mm - 12.5) <= 1e-12);
+    assert_true(fabs(pen.down_z_mm + 3.25) <= 1e-12);
+    /* The other keys are unchanged by [pen]. */
+    close_to(m.axis[2].travel_min, -20);
+    assert_int_equal(cs_machine_ini_parse(z, "p.ini", &m, err, sizeof err), 0);
+    assert_int_equal(
+        cs_machine_ini_parse_pen("[pen]\nmode = none\n", "p.ini", &m, &pen, err, sizeof err), 0);
+    assert_int_equal(pen.mode, CS_MACHINE_PEN_NONE);
+
+    expect_error("[pen]\nmode = lift\n", "bad.ini:2: [pen] mode: expected none or z");
+    expect_error("[pen]\nmode = z\nheight = 3\n", "bad.ini:3: [pen] height: unknown key");
+    expect_error("[pen]\nup_z = high\n", "bad.ini:2: [pen] up_z: must be a number");
+    expect_error("[pen]\ndown_z = 5000\n", "bad.ini:2: [pen] down_z: must be a number in");
+    expect_error("[pen]\nmode = z\nup_z = 5\n", "bad.ini:0: [pen] mode = z needs both");
+    expect_error("[pen]\nmode = z\nup_z = 5\ndown_z = 5\n", "bad.ini:0: [pen] up_z and down_z");
+    /* Default z travel is -100..100 mm. */
+    expect_error("[pen]\nmode = z\nup_z = 101\ndown_z = 0\n",
+                 "bad.ini:0: [pen] up_z = 101 mm is outside the z travel [-100, 100] mm");
+    expect_error("[z]\ntravel_min = 0\n[pen]\nmode = z\nup_z = 5\ndown_z = -0.5\n",
+                 "bad.ini:0: [pen] down_z = -0.5 mm is outside the z travel [0, 100] mm");
+    /* Heights are only checked when used: mode none ignores them. */
+    assert_int_equal(
+        cs_machine_ini_parse_pen("[pen]\nup_z = 101\n", "p.ini", &m, &pen, err, sizeof err), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -150,6 +191,7 @@ int main(void)
         cmocka_unit_test(test_every_key_read),
         cmocka_unit_test(test_errors_name_file_and_line),
         cmocka_unit_test(test_load_from_file),
+        cmocka_unit_test(test_pen_section),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

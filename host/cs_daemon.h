@@ -1,0 +1,39 @@
+/* cs_daemon: the streaming daemon (`curvestep serve`) and its client side. The daemon keeps one
+ * serial port open, plans every submitted job whole at submit time, and streams the jobs one at a
+ * time (each in a child process running cs_stream_run on the inherited port); clients talk to it
+ * over a UNIX socket (mode 0600) with the one-line text protocol of docs/streaming.md. Host only.
+ */
+#ifndef CS_DAEMON_H
+#define CS_DAEMON_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+/* Maximum length of a request line (the path included). */
+#define CS_DAEMON_LINE_MAX 4400
+
+typedef struct {
+    const char *port;         /* serial device, opened once and kept open */
+    uint32_t baud;            /* termios rate */
+    const char *socket_path;  /* UNIX socket to create (0600); removed on exit */
+    const char *machine_file; /* NULL: the built-in machine */
+    FILE *log;                /* one line per event (job queued, started, ended); NULL: none */
+} cs_daemon_cfg_t;
+
+/* Runs the daemon until SIGTERM or SIGINT (the running job is then held and aborted). Returns an
+ * exit status: 0 after a clean stop, 1 bad machine file, 3 socket error (or a daemon already
+ * answers on the socket), 4 the port cannot be opened. Not reentrant (installs signal handlers). */
+int cs_daemon_serve(const cs_daemon_cfg_t *cfg);
+
+/* The default socket path: $XDG_RUNTIME_DIR/curvestep.sock, else /tmp/curvestep-UID.sock, into
+ * buf (cap bytes). Returns buf. */
+char *cs_daemon_default_socket(char *buf, size_t cap);
+
+/* Client: sends one request line (no newline) to the daemon at socket_path and copies its reply
+ * to out. Returns 0 when the reply starts with "OK", 1 with "ERR", -1 when no daemon answers on
+ * socket_path (a sentence naming the path in err, errcap bytes). */
+int cs_daemon_request(const char *socket_path, const char *request, FILE *out, char *err,
+                      size_t errcap);
+
+#endif
