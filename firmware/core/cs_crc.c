@@ -18,3 +18,20 @@ uint16_t cs_crc16_update(uint16_t crc, const uint8_t *data, size_t len)
         crc = cs_crc16_byte(crc, data[i]);
     return crc;
 }
+
+uint32_t cs_crc32_byte(uint32_t reg, uint8_t byte)
+{
+    /* Reflected (LSB-first) shift register: one conditional xor of the polynomial per bit,
+     * written without a branch so every byte costs the same. */
+    reg ^= byte;
+    for (unsigned i = 0; i < 8; i++)
+        reg = (reg >> 1) ^ (0xEDB88320u & (0u - (reg & 1u)));
+    return reg;
+}
+
+uint32_t cs_crc32_update(uint32_t reg, const uint8_t *data, size_t len)
+{
+    for (size_t i = 0; i < len; i++)
+        reg = cs_crc32_byte(reg, data[i]);
+    return reg;
+}

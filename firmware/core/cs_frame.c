@@ -1,9 +1,12 @@
-/* cs_frame: COBS framing with a CRC-16 (docs/protocol.md, "Frames").
+/* cs_frame: COBS framing with a CRC-32 (docs/protocol.md, "Frames").
  * Why COBS: the sync byte 0x00 can then never appear inside a frame, so after any garbage
  * (corrupted, lost or inserted bytes) the decoder is back in step at the very next sync, in O(1)
  * per byte, without rescanning buffered bytes (Klipper's scheme, sync byte at the end and no
  * stuffing, may lose the frame after an error; this one loses only the damaged frame). The cost is
  * one code byte per started 254-byte block, i.e. exactly one byte for every frame of this protocol.
+ * Why CRC-32 and not CRC-16: at 1 % corrupted bytes a quarter of the frames arrive damaged, and
+ * CRC-16 passes about one damaged frame in 65536 -- about one wrong segment per 100,000 sent,
+ * which the loopback test saw. CRC-32 makes that one in 4e9.
  */
 #include "cs_frame.h"
 
@@ -18,13 +21,13 @@ static void stat_inc(uint32_t *c)
 void cs_frame_dec_init(cs_frame_dec_t *d)
 {
     *d = (cs_frame_dec_t){0};
-    d->crc = CS_CRC16_INIT;
+    d->crc = CS_CRC32_INIT;
 }
 
 static void dec_restart(cs_frame_dec_t *d)
 {
     d->len = 0;
-    d->crc = CS_CRC16_INIT;
+    d->crc = CS_CRC32_INIT;
     d->left = 0;
     d->code = 0;
     d->started = false;
@@ -38,7 +41,7 @@ static void dec_put(cs_frame_dec_t *d, uint8_t b)
         return;
     }
     d->buf[d->len++] = b;
-    d->crc = cs_crc16_byte(d->crc, b);
+    d->crc = cs_crc32_byte(d->crc, b);
 }
 
 /* A sync byte ended a frame: judge it. */
@@ -49,7 +52,7 @@ static cs_err_t dec_finish(cs_frame_dec_t *d, cs_frame_t *out)
         stat_inc(&d->stats.bad);
         return CS_ERR_FRAME;
     }
-    if (d->crc != CS_CRC16_RESIDUE) {
+    if (d->crc != CS_CRC32_RESIDUE) {
         stat_inc(&d->stats.crc_errs);
         return CS_ERR_CRC;
     }
@@ -85,8 +88,8 @@ cs_err_t cs_frame_dec_feed(cs_frame_dec_t *d, uint8_t byte, cs_frame_t *out)
     return CS_ERR_EMPTY;
 }
 
-/* Byte i of the inner frame LEN SEQ PAYLOAD CRC (CRC high byte first). */
-static uint8_t inner_byte(size_t i, uint16_t seq, const uint8_t *payload, size_t len, uint16_t crc)
+/* Byte i of the inner frame LEN SEQ PAYLOAD CRC (CRC-32 low byte first). */
+static uint8_t inner_byte(size_t i, uint16_t seq, const uint8_t *payload, size_t len, uint32_t crc)
 {
     if (i == 0)
         return (uint8_t)len;
@@ -96,9 +99,7 @@ static uint8_t inner_byte(size_t i, uint16_t seq, const uint8_t *payload, size_t
         return (uint8_t)(seq >> 8);
     if (i < CS_FRAME_HEADER + len)
         return payload[i - CS_FRAME_HEADER];
-    if (i == CS_FRAME_HEADER + len)
-        return (uint8_t)(crc >> 8);
-    return (uint8_t)(crc & 0xFFu);
+    return (uint8_t)(crc >> (8u * (unsigned)(i - CS_FRAME_HEADER - len)));
 }
 
 cs_err_t cs_frame_encode(uint16_t seq, const uint8_t *payload, size_t len, uint8_t *out, size_t cap,
@@ -109,8 +110,8 @@ cs_err_t cs_frame_encode(uint16_t seq, const uint8_t *payload, size_t len, uint8
     if (cap < (size_t)CS_FRAME_WIRE_LEN(len))
         return CS_ERR_FULL;
     uint8_t hdr[CS_FRAME_HEADER] = {(uint8_t)len, (uint8_t)(seq & 0xFFu), (uint8_t)(seq >> 8)};
-    uint16_t crc = cs_crc16_update(CS_CRC16_INIT, hdr, sizeof hdr);
-    crc = cs_crc16_update(crc, payload, len);
+    uint32_t crc = cs_crc32_update(CS_CRC32_INIT, hdr, sizeof hdr);
+    crc = cs_crc32_update(crc, payload, len) ^ 0xFFFFFFFFu;
 
     size_t inner = CS_FRAME_HEADER + len + CS_FRAME_TRAILER;
     size_t pos = 0;

@@ -1,5 +1,5 @@
 /* cs_frame: the framing layer of the wire protocol (docs/protocol.md, "Frames"). A frame is
- * LEN, SEQ (16-bit), PAYLOAD (LEN bytes), CRC-16 (cs_crc), COBS-encoded so that 0x00 never occurs
+ * LEN, SEQ (16-bit), PAYLOAD (LEN bytes), CRC-32 (cs_crc), COBS-encoded so that 0x00 never occurs
  * inside it, and delimited by 0x00 sync bytes. Owns the encoder (into a caller buffer) and the
  * incremental byte-at-a-time decoder that resynchronises on the next 0x00 after any garbage. */
 #ifndef CS_FRAME_H
@@ -20,7 +20,7 @@
 /* The sync byte: delimits frames; COBS guarantees it never occurs inside one. */
 #define CS_FRAME_SYNC    0x00u
 #define CS_FRAME_HEADER  3 /* LEN, SEQ low, SEQ high */
-#define CS_FRAME_TRAILER 2 /* CRC high, CRC low */
+#define CS_FRAME_TRAILER 4 /* CRC-32, low byte first */
 /* Decoded (inner) frame: header + payload + CRC. */
 #define CS_FRAME_INNER_MAX (CS_FRAME_HEADER + CS_FRAME_PAYLOAD_MAX + CS_FRAME_TRAILER)
 /* Bytes on the wire for the largest frame: leading sync, COBS (1 code byte per started 254-byte
@@ -49,7 +49,7 @@ typedef struct {
 typedef struct {
     uint8_t buf[CS_FRAME_INNER_MAX];
     uint16_t len; /* decoded bytes in buf */
-    uint16_t crc; /* CRC register over buf[0..len) */
+    uint32_t crc; /* CRC-32 register over buf[0..len) */
     uint8_t left; /* bytes still to come in the current COBS block (0: next is a code) */
     uint8_t code; /* code byte of the current COBS block */
     bool started; /* a non-sync byte has been seen since the last sync */

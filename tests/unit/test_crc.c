@@ -41,6 +41,23 @@ static void test_published_check_values(void **state)
     assert_int_equal(cs_crc16_update(CS_CRC16_INIT, check_msg, 9) ^ 0xFFFF, 0xD64E); /* GENIBUS */
 }
 
+/* CRC-32 (IEEE 802.3), the frame check: the published check value, and the residue that the frame
+ * decoder relies on (message followed by its CRC, low byte first) for every length up to 80. */
+static void test_crc32_check_value_and_residue(void **state)
+{
+    (void)state;
+    assert_int_equal(cs_crc32_update(CS_CRC32_INIT, check_msg, 9) ^ 0xFFFFFFFFu, 0xCBF43926u);
+    uint8_t msg[84];
+    for (size_t n = 0; n <= 80; n++) {
+        for (size_t i = 0; i < n; i++)
+            msg[i] = (uint8_t)(i * 37u + n);
+        uint32_t c = cs_crc32_update(CS_CRC32_INIT, msg, n) ^ 0xFFFFFFFFu;
+        for (int k = 0; k < 4; k++)
+            msg[n + (size_t)k] = (uint8_t)(c >> (8 * k));
+        assert_int_equal(cs_crc32_update(CS_CRC32_INIT, msg, n + 4), CS_CRC32_RESIDUE);
+    }
+}
+
 static void test_empty_input_keeps_register(void **state)
 {
     (void)state;
@@ -104,6 +121,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_published_check_values),
+        cmocka_unit_test(test_crc32_check_value_and_residue),
         cmocka_unit_test(test_empty_input_keeps_register),
         cmocka_unit_test(test_byte_update_matches_bitwise_definition),
         cmocka_unit_test(test_appended_crc_leaves_zero_residue),

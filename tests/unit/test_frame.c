@@ -21,15 +21,16 @@ static uint64_t rng(void)
     return rng_state;
 }
 
-static uint16_t ref_crc(const uint8_t *p, size_t n)
+/* CRC-32 (IEEE 802.3) written from its definition, bit by bit with a branch. */
+static uint32_t ref_crc(const uint8_t *p, size_t n)
 {
-    uint16_t crc = 0xFFFF;
+    uint32_t crc = 0xFFFFFFFFu;
     for (size_t i = 0; i < n; i++) {
-        crc ^= (uint16_t)(p[i] << 8);
+        crc ^= p[i];
         for (int b = 0; b < 8; b++)
-            crc = (crc & 0x8000u) ? (uint16_t)((crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
+            crc = (crc & 1u) ? (crc >> 1) ^ 0xEDB88320u : crc >> 1;
     }
-    return crc;
+    return ~crc;
 }
 
 /* Inner frame with an arbitrary LEN byte (to build malformed but CRC-correct frames). */
@@ -39,10 +40,10 @@ static size_t ref_inner(uint8_t len_byte, uint16_t seq, const uint8_t *pl, size_
     out[1] = (uint8_t)(seq & 0xFF);
     out[2] = (uint8_t)(seq >> 8);
     memcpy(out + 3, pl, n);
-    uint16_t c = ref_crc(out, 3 + n);
-    out[3 + n] = (uint8_t)(c >> 8);
-    out[4 + n] = (uint8_t)c;
-    return 5 + n;
+    uint32_t c = ref_crc(out, 3 + n);
+    for (int k = 0; k < 4; k++)
+        out[3 + n + (size_t)k] = (uint8_t)(c >> (8 * k));
+    return 7 + n;
 }
 
 /* 00 COBS(in) 00, COBS per the paper: split at zeros, runs of 254 non-zero bytes get code 0xFF. */
