@@ -31,9 +31,9 @@ UNIT_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 BENCH_SRC := $(sort $(wildcard tests/bench/bench_*.c))
 PORT_POSIX_SRC := $(sort $(wildcard firmware/ports/posix/*.c))
 
-PKGS      := cairo expat
+PKGS      := cairo expat libmodbus libgpiod
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lm
+PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lpthread -lm
 
 INCLUDES  := -Ifirmware/core -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim -Itests/support
 WARN      := -Wall -Wextra -Werror
@@ -55,9 +55,10 @@ HOST_LIB := $(OUT)/libcshost.a
 
 .SECONDARY:
 
-.PHONY: all deps test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
+.PHONY: fw-test all deps test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
 
-all: deps $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) core-check cross
+all: deps $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) core-check cross \
+     firmware
 
 deps:
 	@sh scripts/deps.sh
@@ -96,6 +97,7 @@ test: deps
 	$(MAKE) --no-print-directory VARIANT=plain test-variant
 	$(MAKE) --no-print-directory VARIANT=asan test-variant
 	@$(MAKE) --no-print-directory core-check cross
+	$(MAKE) --no-print-directory fw-test
 
 test-variant: $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) $(UNIT_BIN)
 	@CS_BUILD=$(OUT) bash scripts/run-tests.sh $(VARIANT) $(UNIT_BIN)
@@ -118,7 +120,17 @@ CROSS_TARGETS := cortex-m0plus cortex-m3 avr
 cross:
 	@bash scripts/cross-size.sh $(BUILD)/cross $(CORE_SRC)
 
-firmware: cross
+# --- firmware images -------------------------------------------------------------------------
+# Each target's rules live in mk/fw-<target>.mk (one file a target). Each appends its images
+# (ELF, HEX, BIN) to FW_IMAGES; its emulator tests are tests/fw/*.sh, run by `make fw-test`
+# (part of `make test`) with the plain host build, printing "cli: N passed, M failed".
+FW_IMAGES :=
+-include $(sort $(wildcard mk/*.mk))
+
+firmware: cross $(FW_IMAGES)
+
+fw-test: firmware $(BUILD)/curvestep $(BUILD)/curvestep-sim
+	@CLI_DIR=tests/fw CS_BUILD=$(BUILD) bash scripts/run-tests.sh firmware
 
 # --- demo, bench ----------------------------------------------------------------------------
 demo: deps all

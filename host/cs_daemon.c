@@ -23,6 +23,7 @@
 
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_serial.h"
@@ -56,6 +57,7 @@ typedef struct {
 typedef struct {
     const cs_daemon_cfg_t *cfg;
     cs_machine_t m;
+    cs_machine_pen_t pen; /* [pen]: G-code M3/M4/M5 as Z moves, as `stream` does */
     cs_serial_t ser;
     djob_t *jobs;
     size_t njobs, cap;
@@ -199,49 +201,32 @@ static void job_release(djob_t *j)
 static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, double feed,
                      const int32_t *start_steps, cs_stream_job_t *job, char *err, size_t errcap)
 {
-    cs_pos_t tol = d->m.tolerance;
-    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &tol) != CS_OK) {
+    cs_pos_t tol;
+    if (!cs_jobplan_tol(&d->m, tol_mm, &tol)) {
         snprintf(err, errcap, "tol %g mm is outside the accepted range", tol_mm);
         return false;
     }
-    cs_path_t path;
-    cs_path_init(&path);
-    cs_path_diag_t diag;
-    memset(&diag, 0, sizeof diag);
-    cs_motion_t mo;
-    bool have_mo = false;
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
     cs_stream_job_init(job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
-    cs_err_t e = cs_motion_read_job(file, &path, &diag);
-    if (e == CS_OK) {
-        e = cs_motion_init(&mo, &d->m);
-        have_mo = e == CS_OK;
-        /* step segments are relative: plan them from where the device is (the position the
-         * previous job left it at), rounded to the nearest LSB (far below half a step) */
-        if (e == CS_OK && start_steps != NULL) {
-            cs_pos_t p[CS_AXES] = {0};
-            for (unsigned i = 0; i < d->m.n_axes && i < CS_PROTO_AXES_MAX; i++)
-                p[i] = (cs_pos_t)llround((double)start_steps[i] * 65536.0 * 65536.0 /
+    cs_err_t e = cs_jobplan_read(&jp, file, &d->pen, false);
+    /* step segments are relative: plan them from where the device is (the position the
+     * previous job left it at), rounded to the nearest LSB (far below half a step) */
+    cs_pos_t start[CS_AXES] = {0};
+    if (start_steps != NULL)
+        for (unsigned i = 0; i < d->m.n_axes && i < CS_PROTO_AXES_MAX; i++)
+            start[i] = (cs_pos_t)llround((double)start_steps[i] * 65536.0 * 65536.0 /
                                          (double)d->m.axis[i].steps_per_mm);
-            e = cs_planner_set_position(&mo.pl, p);
-            if (e != CS_OK)
-                snprintf(diag.reason, sizeof diag.reason,
-                         "the device's position is outside the machine's travel"),
-                    diag.loc.file = file;
-        }
-        if (e != CS_OK && !have_mo)
-            snprintf(diag.reason, sizeof diag.reason, "machine rejected"), diag.loc.file = file;
-    }
     int32_t feed_q = cs_motion_speed(feed);
     if (e == CS_OK)
-        e = cs_motion_plan_path(&mo, &path, tol, CS_TRACE_SUBDIV, feed_q, &diag);
+        e = cs_jobplan_plan(&jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
+                            CS_TRACE_SUBDIV, feed_q);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(job, &path, feed_q > 0 ? feed_q : d->m.default_feed,
-                                            tol, &diag)
-                   : cs_stream_job_add_segments(job, mo.segs.v, mo.segs.n);
-    if (have_mo)
-        cs_motion_free(&mo);
+        e = curves ? cs_stream_job_add_path(job, &jp.path, feed_q > 0 ? feed_q : d->m.default_feed,
+                                            tol, &jp.diag)
+                   : cs_stream_job_add_segments(job, jp.mo.segs.v, jp.mo.segs.n);
     if (e == CS_OK) {
-        cs_path_free(&path);
+        cs_jobplan_free(&jp);
         return true;
     }
     cs_stream_job_free(job);
@@ -249,7 +234,7 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
     size_t slen = 0;
     FILE *f = open_memstream(&s, &slen);
     if (f != NULL) {
-        cs_path_diag_print(f, &diag);
+        cs_path_diag_print(f, &jp.diag);
         fclose(f);
     }
     if (s != NULL) {
@@ -263,7 +248,7 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
         snprintf(err, errcap, "%s: %s", file, cs_err_text(e));
     }
     free(s);
-    cs_path_free(&path); /* after the message: diag.loc.file may point into it */
+    cs_jobplan_free(&jp); /* after the message: diag.loc.file may point into its path */
     return false;
 }
 
@@ -707,13 +692,14 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
     int rc = 0;
     char err[512];
     if (cfg->machine_file) {
-        if (cs_machine_ini_load(cfg->machine_file, &d->m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(cfg->machine_file, &d->m, &d->pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             free(d);
             return 1;
         }
     } else {
         cs_machine_ini_default(&d->m);
+        cs_machine_ini_pen_default(&d->pen);
     }
     if (cs_serial_open(&d->ser, cfg->port, cfg->baud) != 0) {
         fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));

@@ -152,6 +152,39 @@ double cs_finish_scallop(const cs_patch_t *p, double r_mm, double v1, double v2,
     return worst;
 }
 
+cs_err_t cs_finish_tri_patch(const cs_tripatch_t *t, cs_patch_t *out)
+{
+    static const int64_t binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+    if (!t || !out || t->degree < 1 || t->degree > 3)
+        return CS_ERR_DEGREE;
+    unsigned n = t->degree;
+    cs_vec3_t pts[16];
+    for (unsigned i = 0; i <= n; i++) {
+        unsigned m = n - i;
+        for (unsigned l = 0; l <= n; l++) {
+            /* degree elevation m -> n of b_j = S_{i,j,m-j}: c_l = sum_j C(m,j) C(n-m,l-j) b_j
+             * / C(n,l), at t = 1 - a, so it lands at a-index n - l */
+            int64_t acc[3] = {0, 0, 0};
+            for (unsigned j = 0; j <= m; j++) {
+                if (l < j || l - j > n - m)
+                    continue;
+                int64_t w = binom[m][j] * binom[n - m][l - j];
+                const cs_vec3_t *b = &t->p[cs_tripatch_index(n, i, j)];
+                acc[0] += w * b->x;
+                acc[1] += w * b->y;
+                acc[2] += w * b->z;
+            }
+            int64_t den = binom[n][l], r[3];
+            for (int k = 0; k < 3; k++) /* round half away from zero */
+                r[k] = acc[k] >= 0 ? (2 * acc[k] + den) / (2 * den)
+                                   : -((-2 * acc[k] + den) / (2 * den));
+            pts[(n - l) * (n + 1) + i] =
+                cs_fixed_vec((cs_pos_t)r[0], (cs_pos_t)r[1], (cs_pos_t)r[2]);
+        }
+    }
+    return cs_patch_init(out, n, n, pts);
+}
+
 /* Tool centre at (u, v) in fixed point: P + R N from the core, R N rounded once. */
 static cs_err_t centre_at(const cs_patch_t *p, cs_param_t u, cs_param_t v, int64_t r_lsb,
                           cs_vec3_t *c)
@@ -186,6 +219,7 @@ static double seg_dist(const cs_vec3_t *q, const cs_vec3_t *a, const cs_vec3_t *
 typedef struct {
     cs_param_t u;
     cs_vec3_t c;
+    bool back; /* the chord ending here runs backwards against the surface (a fold) */
 } pass_pt_t;
 
 /* One pass at v: the u values where the chords of the offset curve stay within tol / 2 of it
@@ -212,7 +246,7 @@ static cs_err_t pass_points(const cs_patch_t *p, cs_param_t v, int64_t r_lsb, cs
             return CS_ERR_FULL;
         *cap = 64;
     }
-    (*pts)[(*n)++] = (pass_pt_t){0, c0};
+    (*pts)[(*n)++] = (pass_pt_t){0, c0, false};
     stack[sp].a = 0;
     stack[sp].b = CS_PARAM_ONE;
     stack[sp].ca = c0;
@@ -243,7 +277,7 @@ static cs_err_t pass_points(const cs_patch_t *p, cs_param_t v, int64_t r_lsb, cs
                 *pts = np;
                 *cap *= 2;
             }
-            (*pts)[(*n)++] = (pass_pt_t){b, cb};
+            (*pts)[(*n)++] = (pass_pt_t){b, cb, false};
             continue;
         }
         if (depth >= PASS_MAX_LOG || b - a < 4)
@@ -263,6 +297,97 @@ static cs_err_t pass_points(const cs_patch_t *p, cs_param_t v, int64_t r_lsb, cs
         sp++;
     }
     return CS_OK;
+}
+
+/* Closest points of the segments a0-a1 and b0-b1 (mm): parameters *s, *t in [0, 1] and the
+ * distance (Ericson, "Real-Time Collision Detection", 5.1.9). */
+static double seg_seg(const double a0[3], const double a1[3], const double b0[3],
+                      const double b1[3], double *s, double *t)
+{
+    double d1[3], d2[3], r[3];
+    for (int k = 0; k < 3; k++) {
+        d1[k] = a1[k] - a0[k];
+        d2[k] = b1[k] - b0[k];
+        r[k] = a0[k] - b0[k];
+    }
+    double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r), ss = 0, tt = 0;
+    if (a <= 1e-30 && e <= 1e-30) {
+        ss = tt = 0;
+    } else if (a <= 1e-30) {
+        tt = fmin(fmax(f / e, 0), 1);
+    } else {
+        double c = dot(d1, r);
+        if (e <= 1e-30) {
+            ss = fmin(fmax(-c / a, 0), 1);
+        } else {
+            double b = dot(d1, d2), den = a * e - b * b;
+            ss = den > 0 ? fmin(fmax((b * f - c * e) / den, 0), 1) : 0;
+            tt = (b * ss + f) / e;
+            if (tt < 0) {
+                tt = 0;
+                ss = fmin(fmax(-c / a, 0), 1);
+            } else if (tt > 1) {
+                tt = 1;
+                ss = fmin(fmax((b - c) / a, 0), 1);
+            }
+        }
+    }
+    double q[3];
+    for (int k = 0; k < 3; k++)
+        q[k] = a0[k] + ss * d1[k] - (b0[k] + tt * d2[k]);
+    *s = ss;
+    *t = tt;
+    return sqrt(dot(q, q));
+}
+
+static void pt_mm(const pass_pt_t *q, double out[3])
+{
+    out[0] = cs_conv_pos_to_mm(q->c.x);
+    out[1] = cs_conv_pos_to_mm(q->c.y);
+    out[2] = cs_conv_pos_to_mm(q->c.z);
+}
+
+/* Cuts the loops of one pass: where chord i (pts[i] -> pts[i+1]) and a later chord j come
+ * within tol_mm of each other and a backward chord lies between them, the vertices i + 1 .. j
+ * are replaced by one vertex at the crossing (the midpoint of the closest points), as a 2D
+ * offset curve's swallowtail is trimmed at its self-intersection. Returns the loops cut. */
+static size_t trim_loops(pass_pt_t *pts, size_t *n, double tol_mm)
+{
+    size_t cut = 0;
+    for (size_t i = 0; i + 3 < *n; i++) {
+        bool back = false; /* a backward chord among i + 2 .. j */
+        double a0[3], a1[3];
+        pt_mm(&pts[i], a0);
+        pt_mm(&pts[i + 1], a1);
+        for (size_t j = i + 2; j + 1 < *n; j++) {
+            back = back || pts[j].back;
+            if (!back)
+                continue;
+            double b0[3], b1[3], s, t;
+            pt_mm(&pts[j], b0);
+            pt_mm(&pts[j + 1], b1);
+            if (seg_seg(a0, a1, b0, b1, &s, &t) > tol_mm)
+                continue;
+            double x[3];
+            for (int k = 0; k < 3; k++)
+                x[k] = 0.5 * (a0[k] + s * (a1[k] - a0[k]) + b0[k] + t * (b1[k] - b0[k]));
+            pass_pt_t m = pts[i + 1];
+            if (cs_conv_mm_to_vec(x[0], x[1], x[2], &m.c) != CS_OK)
+                continue;
+            m.u = pts[i].u + (cs_param_t)llround(s * (pts[i + 1].u - pts[i].u));
+            m.back = false;
+            /* keep i, the crossing, then j + 1 .. */
+            pts[i + 1] = m;
+            size_t tail = *n - (j + 1);
+            for (size_t k = 0; k < tail; k++)
+                pts[i + 2 + k] = pts[j + 1 + k];
+            pts[i + 2].back = false;
+            *n = i + 2 + tail;
+            cut++;
+            break;
+        }
+    }
+    return cut;
 }
 
 cs_err_t cs_finish_patch(const cs_patch_t *p, double r_mm, double h_mm, cs_pos_t tol,
@@ -296,6 +421,30 @@ cs_err_t cs_finish_patch(const cs_patch_t *p, double r_mm, double h_mm, cs_pos_t
         e = pass_points(p, vq, r_lsb, tol, &pts, &n, &cap);
         if (e != CS_OK)
             break;
+        /* Folds: the offset path running backwards against the surface along the pass. */
+        double prev_p[3] = {0, 0, 0};
+        for (size_t k = 0; k < n; k++) {
+            double sp[3];
+            cs_finish_eval(p, pts[k].u / Q30, vq / Q30, sp, NULL);
+            if (k > 0) {
+                double dc[3] = {cs_conv_pos_to_mm(pts[k].c.x - pts[k - 1].c.x),
+                                cs_conv_pos_to_mm(pts[k].c.y - pts[k - 1].c.y),
+                                cs_conv_pos_to_mm(pts[k].c.z - pts[k - 1].c.z)};
+                double ds[3] = {sp[0] - prev_p[0], sp[1] - prev_p[1], sp[2] - prev_p[2]};
+                pts[k].back = dot(dc, ds) < 0;
+                if (pts[k].back) {
+                    if (st->folded == 0) {
+                        st->fold_u = pts[k - 1].u / Q30;
+                        st->fold_v = vq / Q30;
+                    }
+                    st->folded++;
+                }
+            }
+            prev_p[0] = sp[0];
+            prev_p[1] = sp[1];
+            prev_p[2] = sp[2];
+        }
+        st->loops_cut += trim_loops(pts, &n, cs_conv_pos_to_mm(tol));
         for (size_t k = 0; k < n; k++) {
             const pass_pt_t *q = &pts[pass % 2 ? n - 1 - k : k];
             double nn[3];

@@ -128,6 +128,10 @@ static int handler(void *user, const char *section, const char *name, const char
     double d;
     if (strcasecmp(section, "pen") == 0)
         return pen_key(c, section, name, value);
+    /* [gpio] (pins of the GPIO link) is read and checked by cs_gpio_cfg in a second pass over
+     * the file; the machine itself does not depend on it. */
+    if (strcasecmp(section, "gpio") == 0)
+        return 1;
     if (strcasecmp(section, "machine") == 0) {
         if (strcasecmp(name, "profile") == 0) {
             if (strcasecmp(value, "trapezoid") == 0)
@@ -176,8 +180,8 @@ static int handler(void *user, const char *section, const char *name, const char
         if (strcasecmp(section, axis_names[i]) == 0)
             ax = i;
     if (ax < 0)
-        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z, a or pen)", section,
-                    "");
+        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z, a, pen or gpio)",
+                    section, "");
     if (ax == CS_AXIS_A) {
         c->has_a = true;
         m->n_axes = 4;

@@ -2,7 +2,8 @@
  * (x, y, z and optional a axis: steps/mm, rate, acceleration, travel, DIR inversion, pulse
  * width; tolerance, junction deviation, tick rate, segment time, default feed, profile) and
  * owns the built-in default, a generic 3-axis pen plotter at 80 steps/mm. Also reads the host-only
- * [pen] section (how pen up / down, G-code M3/M4/M5, is carried out). Keys: docs/motion.md. */
+ * [pen] section (how pen up / down, G-code M3/M4/M5, is carried out). A [gpio] section is
+ * accepted and skipped here (host/cs_gpio_cfg.h reads it). Keys: docs/motion.md, docs/gpio.md. */
 #ifndef CS_MACHINE_INI_H
 #define CS_MACHINE_INI_H
 

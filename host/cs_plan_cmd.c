@@ -7,10 +7,7 @@
 #include <string.h>
 
 #include "cs_cmd.h"
-#include "cs_conv.h"
-#include "cs_input.h"
-#include "cs_machine_ini.h"
-#include "cs_motion.h"
+#include "cs_jobplan.h"
 #include "cs_trace.h"
 
 static void usage(FILE *f)
@@ -43,35 +40,25 @@ static void usage(FILE *f)
 
 int cs_cmd_plan(int argc, char **argv)
 {
-    const char *machine_file = NULL, *out_file = NULL, *job = NULL;
-    double tol_mm = 0, feed = 0;
+    const char *out_file = NULL, *job = NULL;
+    cs_jobplan_opts_t jo;
+    cs_jobplan_opts_init(&jo);
     int method = CS_TRACE_SUBDIV;
     bool lenient = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
+        int r = cs_jobplan_option("plan", argc, argv, &i, &jo);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return CS_EXIT_OK;
         } else if (strcmp(a, "--lenient") == 0) {
             lenient = true;
-        } else if (strcmp(a, "--machine") == 0 && i + 1 < argc) {
-            machine_file = argv[++i];
         } else if (strcmp(a, "-o") == 0 && i + 1 < argc) {
             out_file = argv[++i];
-        } else if (strcmp(a, "--tol") == 0 && i + 1 < argc) {
-            char *end;
-            tol_mm = strtod(argv[++i], &end);
-            if (*end != '\0' || !(tol_mm > 0)) {
-                fprintf(stderr, "curvestep plan: --tol wants a positive number of mm\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--feed") == 0 && i + 1 < argc) {
-            char *end;
-            feed = strtod(argv[++i], &end);
-            if (*end != '\0' || !(feed > 0) || feed >= 32768) {
-                fprintf(stderr, "curvestep plan: --feed wants a speed in (0, 32768) mm/s\n");
-                return CS_EXIT_USAGE;
-            }
         } else if (strcmp(a, "--method") == 0 && i + 1 < argc) {
             const char *m = argv[++i];
             if (strcmp(m, "fd") == 0)
@@ -101,56 +88,26 @@ int cs_cmd_plan(int argc, char **argv)
     }
     cs_machine_t m;
     cs_machine_pen_t pen;
-    cs_machine_ini_pen_default(&pen);
-    char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(&m);
-    }
-    cs_pos_t tol = m.tolerance;
-    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &tol) != CS_OK) {
-        fprintf(stderr, "curvestep plan: --tol %g mm is outside the accepted range\n", tol_mm);
-        return CS_EXIT_USAGE;
-    }
-    cs_path_t path;
-    cs_path_init(&path);
-    cs_path_diag_t diag;
-    cs_input_opts_t iopts;
-    cs_input_opts_init(&iopts);
-    iopts.lenient = lenient;
-    /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
-    iopts.pen_z = pen.mode == CS_MACHINE_PEN_Z;
-    iopts.pen_up_z_mm = pen.up_z_mm;
-    iopts.pen_down_z_mm = pen.down_z_mm;
-    cs_err_t e = cs_input_load(job, &iopts, &path, &diag);
-    if (e != CS_OK) {
-        cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
-        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
-    }
-    cs_motion_t mo;
-    e = cs_motion_init(&mo, &m);
+    cs_pos_t tol;
+    int rc = cs_jobplan_machine("plan", &jo, &m, &pen, &tol);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    cs_err_t e = cs_jobplan_read(&jp, job, &pen, lenient);
     if (e == CS_OK)
-        e = cs_motion_plan_path(&mo, &path, tol, method, cs_motion_speed(feed), &diag);
-    else
-        fprintf(stderr, "curvestep plan: machine rejected\n");
-    int rc = CS_EXIT_OK;
+        e = cs_jobplan_plan(&jp, job, &m, NULL, tol, method, cs_motion_speed(jo.feed_mm_s));
     if (e != CS_OK) {
-        cs_path_diag_print(stderr, &diag);
-        rc = (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE) ? CS_EXIT_INPUT
-                                                                               : CS_EXIT_INTERNAL;
+        cs_path_diag_print(stderr, &jp.diag);
+        rc = cs_jobplan_exit(&jp, e);
     } else {
         FILE *f = out_file ? fopen(out_file, "w") : stdout;
         if (f == NULL) {
             perror(out_file);
             rc = CS_EXIT_INTERNAL;
         } else {
-            if (cs_motion_write(f, &m, mo.segs.v, mo.segs.n) != 0 || (out_file && fclose(f) != 0) ||
-                (!out_file && fflush(f) != 0)) {
+            if (cs_motion_write(f, &m, jp.mo.segs.v, jp.mo.segs.n) != 0 ||
+                (out_file && fclose(f) != 0) || (!out_file && fflush(f) != 0)) {
                 fprintf(stderr, "curvestep plan: write error\n");
                 rc = CS_EXIT_INTERNAL;
             }
@@ -159,10 +116,10 @@ int cs_cmd_plan(int argc, char **argv)
             fprintf(stderr,
                     "plan: %zu elements, %zu blocks, %zu segments, %lld steps, job time %.4f s "
                     "(%llu ticks at %u Hz)\n",
-                    path.n, mo.blocks, mo.segs.n, (long long)mo.steps, (double)mo.ticks / m.tick_hz,
-                    (unsigned long long)mo.ticks, (unsigned)m.tick_hz);
+                    jp.path.n, jp.mo.blocks, jp.mo.segs.n, (long long)jp.mo.steps,
+                    (double)jp.mo.ticks / m.tick_hz, (unsigned long long)jp.mo.ticks,
+                    (unsigned)m.tick_hz);
     }
-    cs_motion_free(&mo);
-    cs_path_free(&path);
+    cs_jobplan_free(&jp);
     return rc;
 }

@@ -280,10 +280,8 @@ typedef struct {
      * has not passed yet: they are not job messages, so they do not count as executed */
     uint16_t ctl_seq[CS_STREAM_CTL_MAX];
     size_t nctl;
-    double t0, t_first, last_progress;
-    double rate_t, rate_ex; /* for the speed estimate */
-    double rate;
-    int progress_len;
+    double t0, t_first;
+    cs_stream_progress_t prog;
 } run_t;
 
 static void finish(run_t *s, cs_stream_outcome_t oc)
@@ -405,30 +403,27 @@ static void pump_in(run_t *s, int wait_ms)
     }
 }
 
-static void progress(run_t *s, bool final)
+void cs_stream_progress(cs_stream_progress_t *p, FILE *f, bool tty, bool final, size_t n, size_t ex,
+                        size_t sent, size_t resume_from, unsigned retx, const char *what)
 {
-    FILE *f = s->o->progress;
     if (f == NULL)
         return;
     double now = cs_serial_now_s();
-    double period = s->o->progress_tty ? 0.1 : 1.0;
-    if (!final && now - s->last_progress < period)
+    double period = tty ? 0.1 : 1.0;
+    if (!final && now - p->last < period)
         return;
-    s->last_progress = now;
-    size_t n = s->job->n, ex = s->r->executed;
-    if (now - s->rate_t >= 0.5) { /* speed over the last half second or more */
-        if (s->rate_t > 0)
-            s->rate = ((double)ex - s->rate_ex) / (now - s->rate_t);
-        s->rate_t = now;
-        s->rate_ex = (double)ex;
+    p->last = now;
+    if (now - p->rate_t >= 0.5) { /* speed over the last half second or more */
+        if (p->rate_t > 0)
+            p->rate = ((double)ex - p->rate_ex) / (now - p->rate_t);
+        p->rate_t = now;
+        p->rate_ex = (double)ex;
     }
-    if (final && now > s->t_first) /* the summary: the average over the whole stream */
-        s->rate = (double)(ex - s->o->resume_from) / (now - s->t_first);
+    if (final && now > p->t_first) /* the summary: the average over the whole stream */
+        p->rate = (double)(ex - resume_from) / (now - p->t_first);
     double pct = n ? 100.0 * (double)ex / (double)n : 100.0;
-    double eta = ex >= n ? 0 : s->rate > 0 ? (double)(n - ex) / s->rate : -1;
-    const char *what = s->job->mode == CS_STREAM_CURVES ? "curves" : "segments";
-    unsigned retx = s->link.stats.retransmits;
-    if (s->o->progress_tty) {
+    double eta = ex >= n ? 0 : p->rate > 0 ? (double)(n - ex) / p->rate : -1;
+    if (tty) {
         char bar[31];
         int fill = (int)(pct * 30 / 100);
         for (int i = 0; i < 30; i++)
@@ -440,17 +435,24 @@ static void progress(run_t *s, bool final)
         else
             snprintf(etas, sizeof etas, "--:--");
         fprintf(f, "\r[%s] %5.1f%% %zu/%zu %s  ETA %s  %.0f %s/s  retx %u ", bar, pct, ex, n, what,
-                etas, s->rate, what, retx);
+                etas, p->rate, what, retx);
         if (final)
             fputc('\n', f);
     } else {
         fprintf(f,
                 "stream: %zu/%zu %s executed (%.1f %%), %zu sent, %.0f/s, ETA %s%.0f s, "
                 "%u retransmissions\n",
-                ex, n, what, pct, s->r->sent, s->rate, eta >= 0 ? "" : "~", eta >= 0 ? eta : 0,
-                retx);
+                ex, n, what, pct, sent, p->rate, eta >= 0 ? "" : "~", eta >= 0 ? eta : 0, retx);
     }
     fflush(f);
+}
+
+static void progress(run_t *s, bool final)
+{
+    s->prog.t_first = s->t_first;
+    cs_stream_progress(&s->prog, s->o->progress, s->o->progress_tty, final, s->job->n,
+                       s->r->executed, s->r->sent, s->o->resume_from, s->link.stats.retransmits,
+                       s->job->mode == CS_STREAM_CURVES ? "curves" : "segments");
 }
 
 /* Sends one control message (HOLD or ABORT) and waits until the device says it obeyed (state in

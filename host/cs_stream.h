@@ -104,6 +104,19 @@ void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s);
  * outcome (see r->outcome), CS_ERR_ARG for bad options, CS_ERR_IO for a write error. */
 cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o,
                        cs_stream_result_t *r);
+/* The progress display every link shares: on a terminal (tty) a bar redrawn at most ten times
+ * a second, else one plain line a second; final: the last one, with the average rate since
+ * p->t_first (set it when the first message goes out). n messages in the job, ex executed,
+ * sent handed to the link, resume_from skipped, retx retransmissions, what "segments" or
+ * "curves". Start with p zeroed; f NULL prints nothing. */
+typedef struct {
+    double t_first;         /* cs_serial_now_s() when streaming started */
+    double last;            /* last display */
+    double rate_t, rate_ex; /* for the speed estimate */
+    double rate;            /* messages per second */
+} cs_stream_progress_t;
+void cs_stream_progress(cs_stream_progress_t *p, FILE *f, bool tty, bool final, size_t n, size_t ex,
+                        size_t sent, size_t resume_from, unsigned retx, const char *what);
 /* One line for an outcome ("device reset", ...). */
 const char *cs_stream_outcome_text(cs_stream_outcome_t oc);
 

@@ -1,6 +1,7 @@
 /* curvestep stream: plans a job whole (nothing is sent before the whole job planned without an
- * error), then streams it to a device over a serial port with cs_stream, showing progress, and
- * reports how it ended (docs/streaming.md). */
+ * error), then streams it to a device over a serial port with cs_stream (or hands it to the
+ * Modbus or GPIO link, cs_stream_cmd.h), showing progress, and reports how it ended
+ * (docs/streaming.md). */
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>
@@ -11,21 +12,17 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_err_text.h"
-#include "cs_input.h"
-#include "cs_machine_ini.h"
-#include "cs_motion.h"
+#include "cs_jobplan.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_cmd.h"
 #include "cs_trace.h"
 
-/* Exit statuses of `stream` beyond the shared ones (cs_cmd.h). */
-enum {
-    EXIT_NO_DEVICE = 4,  /* the port cannot be opened, no device answered, or it is incompatible */
-    EXIT_RESET = 5,      /* the device reset mid-job */
-    EXIT_CLOSED = 6,     /* the link closed or the device stopped answering mid-job */
-    EXIT_DEV_ERROR = 7,  /* the device refused a message (ERROR) */
-    EXIT_INTERRUPTED = 8 /* Ctrl-C: held, then aborted */
-};
+#define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
+#define EXIT_RESET CS_EXIT_RESET
+#define EXIT_CLOSED CS_EXIT_CLOSED
+#define EXIT_DEV_ERROR CS_EXIT_DEV_ERROR
+#define EXIT_INTERRUPTED CS_EXIT_INTERRUPTED
 
 static volatile sig_atomic_t interrupted;
 
@@ -41,6 +38,9 @@ static void usage(FILE *f)
     fputs("usage: curvestep stream --port DEV [--baud N] [--machine FILE.ini]\n"
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
           "                        [--resume-from N] [--line-rate BPS] [--quiet] FILE\n"
+          "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
+          "       curvestep stream --modbus-rtu DEV [--baud N] [--unit ID] [options] FILE\n"
+          "       curvestep stream --gpio CHIP [--machine FILE.ini] [options] FILE\n"
           "Plans the job FILE (SVG, G-code or HPGL) for the machine, whole, before sending\n"
           "anything, then streams it to the device on the serial port DEV (a tty, or the pty\n"
           "path printed by `curvestep-sim --pty`) with the protocol of docs/protocol.md:\n"
@@ -48,7 +48,15 @@ static void usage(FILE *f)
           "must match the machine: axes, tick rate, capabilities), then every message,\n"
           "keeping the device's queue full without ever overflowing it, resending what the\n"
           "line lost or damaged.\n"
-          "  --port DEV         serial device (required)\n"
+          "  --port DEV         serial device\n"
+          "  --modbus-tcp H:P   Modbus TCP device at host H, port P (docs/modbus.md)\n"
+          "  --modbus-rtu DEV   Modbus RTU device on serial line DEV (docs/modbus.md)\n"
+          "  --unit ID          Modbus unit id, 1..247 (default 1)\n"
+          "  --gpio CHIP        run the job here, on the step/dir lines of GPIO chip CHIP\n"
+          "                     (the machine file's [gpio] section; README, GPIO).\n"
+          "                     --gpio record:FILE runs it on no hardware and writes every\n"
+          "                     edge with its time to FILE (CSV; docs/gpio.md)\n"
+          "                     One of --port, --modbus-tcp, --modbus-rtu, --gpio is required\n"
           "  --baud N           line speed (default 115200)\n"
           "  --machine FILE     machine description (default: the built-in plotter); with\n"
           "                     [pen] mode = z, G-code M3/M4 (pen down) and M5 (pen up) move\n"
@@ -90,20 +98,36 @@ static int parse_count(const char *s, unsigned long long max, unsigned long long
 
 int cs_cmd_stream(int argc, char **argv)
 {
-    const char *port = NULL, *machine_file = NULL, *job_file = NULL;
-    unsigned long long baud = 115200, resume = 0, line_rate = 0;
-    double tol_mm = 0, feed = 0;
+    const char *port = NULL, *job_file = NULL;
+    const char *mb_tcp = NULL, *mb_rtu = NULL, *gpio = NULL;
+    unsigned long long baud = 115200, resume = 0, line_rate = 0, unit = 1;
+    cs_jobplan_opts_t jo;
+    cs_jobplan_opts_init(&jo);
     bool curves = false, quiet = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
+        int r = cs_jobplan_option("stream", argc, argv, &i, &jo);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return CS_EXIT_OK;
         } else if (strcmp(a, "--port") == 0 && has) {
             port = argv[++i];
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            machine_file = argv[++i];
+        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
+            mb_tcp = argv[++i];
+        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
+            mb_rtu = argv[++i];
+        } else if (strcmp(a, "--gpio") == 0 && has) {
+            gpio = argv[++i];
+        } else if (strcmp(a, "--unit") == 0 && has) {
+            if (parse_count(argv[++i], 247, &unit) != 0 || unit < 1) {
+                fprintf(stderr, "curvestep stream: --unit wants a Modbus unit id, 1..247\n");
+                return CS_EXIT_USAGE;
+            }
         } else if (strcmp(a, "--baud") == 0 && has) {
             if (parse_count(argv[++i], 4000000, &baud) != 0 || !cs_serial_baud_ok((uint32_t)baud)) {
                 fprintf(stderr, "curvestep stream: --baud wants a termios rate (e.g. 115200)\n");
@@ -129,20 +153,6 @@ int cs_cmd_stream(int argc, char **argv)
                 fprintf(stderr, "curvestep stream: --mode wants segments or curves\n");
                 return CS_EXIT_USAGE;
             }
-        } else if (strcmp(a, "--tol") == 0 && has) {
-            char *end;
-            tol_mm = strtod(argv[++i], &end);
-            if (*end != '\0' || !(tol_mm > 0)) {
-                fprintf(stderr, "curvestep stream: --tol wants a positive number of mm\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--feed") == 0 && has) {
-            char *end;
-            feed = strtod(argv[++i], &end);
-            if (*end != '\0' || !(feed > 0) || feed >= 32768) {
-                fprintf(stderr, "curvestep stream: --feed wants a speed in (0, 32768) mm/s\n");
-                return CS_EXIT_USAGE;
-            }
         } else if (strcmp(a, "--quiet") == 0) {
             quiet = true;
         } else if (a[0] == '-' && a[1] != '\0') {
@@ -156,72 +166,51 @@ int cs_cmd_stream(int argc, char **argv)
             return CS_EXIT_USAGE;
         }
     }
-    if (job_file == NULL || port == NULL) {
-        fprintf(stderr, "curvestep stream: %s\n", port ? "no job file" : "--port DEV is required");
+    int links = (port != NULL) + (mb_tcp != NULL) + (mb_rtu != NULL) + (gpio != NULL);
+    if (job_file == NULL || links != 1) {
+        fprintf(stderr, "curvestep stream: %s\n",
+                links == 0  ? "one of --port, --modbus-tcp, --modbus-rtu or --gpio is required"
+                : links > 1 ? "--port, --modbus-tcp, --modbus-rtu and --gpio exclude each other"
+                            : "no job file");
         usage(stderr);
         return CS_EXIT_USAGE;
     }
     cs_machine_t m;
     cs_machine_pen_t pen;
-    cs_machine_ini_pen_default(&pen);
-    char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(&m);
-    }
-    cs_pos_t tol = m.tolerance;
-    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &tol) != CS_OK) {
-        fprintf(stderr, "curvestep stream: --tol %g mm is outside the accepted range\n", tol_mm);
-        return CS_EXIT_USAGE;
-    }
+    cs_pos_t tol;
+    int mrc = cs_jobplan_machine("stream", &jo, &m, &pen, &tol);
+    if (mrc != CS_EXIT_OK)
+        return mrc;
     /* 1. the whole job, planned before anything is sent (the plan also checks the travel
      * limits in curves mode, where the device plans again itself) */
-    cs_path_t path;
-    cs_path_init(&path);
-    cs_path_diag_t diag;
-    /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
-    cs_input_opts_t iopts;
-    cs_input_opts_init(&iopts);
-    iopts.pen_z = pen.mode == CS_MACHINE_PEN_Z;
-    iopts.pen_up_z_mm = pen.up_z_mm;
-    iopts.pen_down_z_mm = pen.down_z_mm;
-    cs_err_t e = cs_input_load(job_file, &iopts, &path, &diag);
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    cs_err_t e = cs_jobplan_read(&jp, job_file, &pen, false);
     if (e != CS_OK) {
-        cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
-        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+        cs_path_diag_print(stderr, &jp.diag);
+        int rc = cs_jobplan_exit(&jp, e);
+        cs_jobplan_free(&jp);
+        return rc;
     }
-    cs_motion_t mo;
-    e = cs_motion_init(&mo, &m);
-    int32_t feed_q = cs_motion_speed(feed);
-    if (e == CS_OK)
-        e = cs_motion_plan_path(&mo, &path, tol, CS_TRACE_SUBDIV, feed_q, &diag);
-    else
-        snprintf(diag.reason, sizeof diag.reason, "machine rejected"), diag.loc.file = job_file;
+    int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
+    e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_SUBDIV, feed_q);
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(&job, &path, feed_q > 0 ? feed_q : m.default_feed, tol,
-                                            &diag)
-                   : cs_stream_job_add_segments(&job, mo.segs.v, mo.segs.n);
+        e = curves ? cs_stream_job_add_path(&job, &jp.path, feed_q > 0 ? feed_q : m.default_feed,
+                                            tol, &jp.diag)
+                   : cs_stream_job_add_segments(&job, jp.mo.segs.v, jp.mo.segs.n);
     if (e != CS_OK) {
-        cs_path_diag_print(stderr, &diag);
+        cs_path_diag_print(stderr, &jp.diag);
+        int rc = cs_jobplan_exit(&jp, e);
         cs_stream_job_free(&job);
-        cs_motion_free(&mo);
-        cs_path_free(&path);
-        return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE ||
-                e == CS_ERR_DEPTH)
-                   ? CS_EXIT_INPUT
-                   : CS_EXIT_INTERNAL;
+        cs_jobplan_free(&jp);
+        return rc;
     }
     const char *what = curves ? "curves" : "segments";
     fprintf(stderr,
             "stream: %s: %zu elements -> %zu %s (%zu segments planned here, job time %.3f s)%s\n",
-            job_file, path.n, job.n, what, mo.segs.n, (double)mo.ticks / m.tick_hz,
+            job_file, jp.path.n, job.n, what, jp.mo.segs.n, (double)jp.mo.ticks / m.tick_hz,
             curves && job.approximated
                 ? " ; arcs and other rational curves approximated by cubics within tol/4"
                 : "");
@@ -229,12 +218,45 @@ int cs_cmd_stream(int argc, char **argv)
         fprintf(stderr, "curvestep stream: --resume-from %llu: the job has %zu %s\n", resume, job.n,
                 what);
         cs_stream_job_free(&job);
-        cs_motion_free(&mo);
-        cs_path_free(&path);
+        cs_jobplan_free(&jp);
         return CS_EXIT_USAGE;
     }
-    cs_motion_free(&mo);
-    cs_path_free(&path);
+    cs_path_free(&jp.path);
+    if (port == NULL) { /* 2'. another link: Modbus or GPIO */
+        cs_stream_args_t sa;
+        memset(&sa, 0, sizeof sa);
+        sa.job_file = job_file;
+        sa.machine_file = jo.machine_file;
+        sa.modbus_tcp = mb_tcp;
+        sa.modbus_rtu = mb_rtu;
+        sa.gpio_chip = gpio;
+        sa.baud = (uint32_t)baud;
+        sa.unit = (int)unit;
+        sa.resume_from = (size_t)resume;
+        sa.line_rate = (uint32_t)line_rate;
+        sa.curves = curves;
+        sa.quiet = quiet;
+        cs_stream_plan_t pl;
+        pl.m = m;
+        pl.pen = pen;
+        pl.job = job;
+        pl.segs = jp.mo.segs.v;
+        pl.nsegs = jp.mo.segs.n;
+        pl.ticks = jp.mo.ticks;
+        struct sigaction sig;
+        memset(&sig, 0, sizeof sig);
+        sig.sa_handler = on_sigint;
+        sigaction(SIGINT, &sig, NULL);
+        signal(SIGPIPE, SIG_IGN);
+        int lrc = gpio ? cs_stream_cmd_gpio(&sa, &pl, &interrupted)
+                       : cs_stream_cmd_modbus(&sa, &pl, &interrupted);
+        signal(SIGINT, SIG_DFL);
+        fflush(stdout);
+        cs_stream_job_free(&job);
+        cs_jobplan_free(&jp);
+        return lrc;
+    }
+    cs_jobplan_free(&jp);
     /* 2. the port */
     cs_serial_t ser;
     if (cs_serial_open(&ser, port, (uint32_t)baud) != 0) {

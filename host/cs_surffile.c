@@ -264,16 +264,43 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
             if (e == CS_OK || e == CS_ERR_FULL)
                 return e;
         }
-    } else if (strcmp(kw, "varady") == 0) {
+    } else if (strcmp(kw, "varady") == 0 || strcmp(kw, "varady-scheme") == 0) {
         int n;
         cs_bezier_t c[CS_VARADY_MAX_SIDES];
+        cs_varady_blend_t blend = CS_VARADY_MU;
+        cs_varady_param_t param = CS_VARADY_SIDE;
+        if (strcmp(kw, "varady-scheme") == 0) {
+            /* varady-scheme BLEND PARAM N C x N */
+            static const char *const blends[] = {"mu", "lambda-kappa"};
+            static const char *const params[] = {"side", "radial", "centre"};
+            int got = -1;
+            if (next_tok(lx))
+                for (int k = 0; k < 2; k++)
+                    if (strcmp(lx->tok, blends[k]) == 0)
+                        got = k;
+            if (got < 0)
+                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
+                                        "'%s': blend mu or lambda-kappa expected", lx->tok);
+            blend = (cs_varady_blend_t)got;
+            got = -1;
+            if (next_tok(lx))
+                for (int k = 0; k < 3; k++)
+                    if (strcmp(lx->tok, params[k]) == 0)
+                        got = k;
+            if (got < 0)
+                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
+                                        "'%s': parametrisation side, radial or centre expected",
+                                        lx->tok);
+            param = (cs_varady_param_t)got;
+        }
         e = integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
         for (int k = 0; e == CS_OK && k < n; k++)
             e = curve(lx, &c[k]);
         cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
         if (e == CS_OK && !it)
             return CS_ERR_FULL;
-        if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK) {
+        if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
+            (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK) {
             it->varady = true;
             it->line = at.line;
             e = push(sf, it);
@@ -285,7 +312,7 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
         return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at,
                                 "unknown surface '%s' (bezier, tri, hermite, power, "
                                 "coons-bilinear, coons-bicubic, ruled, extrude, revolve, "
-                                "varady)",
+                                "varady, varady-scheme)",
                                 kw);
     }
     if (e != CS_OK && lx->diag->code != e)

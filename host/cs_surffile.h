@@ -14,6 +14,8 @@
  *   revolve O A R SWEEP C           profile C (x = radius, y = height) about the axis through O
  *                                   along A, from the direction R, SWEEP degrees
  *   varady N C x N                  n-sided transfinite patch (seed 002) bounded by a loop
+ *   varady-scheme B P N C x N       same with blend B (mu, lambda-kappa) and parametrisation
+ *                                   P (side, radial, centre); varady = "varady-scheme mu side"
  * where C = "N P0 .. PN" (a Bézier curve of degree N = 1..3), P and V = three numbers, '#'
  * starts a comment; numbers are free-form across lines. Every item becomes core patches
  * (cs_patch_t or cs_tripatch_t) with the line of its keyword. Bad input: file:line:col. */

@@ -52,6 +52,7 @@ static void tp_usage(FILE *f)
         "                          [--scale S] [--stats] [--svg OUT.svg]\n"
         "       curvestep toolpath --patches FILE --ball R --scallop H [--tol MM]\n"
         "                          [--safe-z Z] [--scale S] [--view V] [--svg OUT.svg]\n"
+        "       (either form also takes --gcode OUT.nc)\n"
         "\n"
         "Reads surface patches and prints a path over them. FILE is either in Newell's\n"
         "format (a patch count; one line of 16 one-based vertex indices per patch; a vertex\n"
@@ -65,13 +66,16 @@ static void tp_usage(FILE *f)
         "exact lines in 3D, then projected through the view; one vertex \"x y\" (mm, 6 decimals)\n"
         "per line, a blank line between polylines.\n"
         "\n"
-        "Finishing (--ball R): a zig-zag raster along each patch's u lines for a ball-end tool\n"
-        "of radius R, its centre on the offset surface P + R N (N = Pu x Pv as the file orients\n"
-        "the patch), passes spaced so the measured scallop stays below H; prints the tool\n"
-        "centre \"x y z\" (mm) per line (the tool tip is R below it). Each patch is one block:\n"
-        "approach at the safe height, the passes, retract to the safe height; a blank line\n"
-        "between patches. Warnings on stderr where the surface is concave with a curvature\n"
-        "radius below R (gouge) or faces down (undercut). See docs/surfaces.md.\n"
+        "Finishing (--ball R): a zig-zag raster along each patch's u lines (a triangle's\n"
+        "iso-lines u = const) for a ball-end tool of radius R, its centre on the offset\n"
+        "surface P + R N (N = Pu x Pv as the file orients the patch), passes spaced so the\n"
+        "measured scallop stays below H; prints the tool centre \"x y z\" (mm) per line (the\n"
+        "tool tip is R below it). Each patch is one block: approach at the safe height, the\n"
+        "passes, retract to the safe height; a blank line between patches. Warnings on stderr\n"
+        "where the surface is concave with a curvature radius below R (gouge), where the path\n"
+        "folds back on itself there (loops that close within a pass are cut at the crossing)\n"
+        "or faces down (undercut). n-sided patches are finished as bicubic cells fitted within\n"
+        "tol / 2, one block per cell. See docs/surfaces.md.\n"
         "\n"
         "Options:\n"
         "  --patches FILE  the surface file ('-' reads standard input)\n"
@@ -90,6 +94,13 @@ static void tp_usage(FILE *f)
         "  --stats         summary on stderr: patches, curves, chords, largest deviation of a\n"
         "                  chord from its exact curve (measured in double)\n"
         "  --svg OUT.svg   also draw the projected path (y up)\n"
+        "  --gcode OUT.nc  also write the path as G-code for `curvestep plan`: G21 G90, a G0\n"
+        "                  travel to the start of each polyline and G1 moves along it, no F\n"
+        "                  (plan's --feed or the machine's default feed applies); the\n"
+        "                  wireframe as projected X Y with the pen lifted (M5) for every\n"
+        "                  travel and lowered (M3) to draw, the finishing path as the tool\n"
+        "                  centre X Y Z (G0 up to the safe height first, G0 approach over each\n"
+        "                  patch, G1 plunge and passes, G0 retract)\n"
         "  -h, --help      show this help\n"
         "\n"
         "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
@@ -150,11 +161,14 @@ static void to_mm(const cs_vec3_t *p, double q[3])
     q[2] = cs_conv_pos_to_mm(p->z);
 }
 
-/* Output: stdout text plus the projected polylines for the picture. */
+/* Output: stdout text plus the projected polylines for the picture, and optionally the same
+ * path as G-code (--gcode): G0 for a polyline's first vertex (travel), G1 for the others. */
 typedef struct {
     const tp_view_t *view;
     bool three_d; /* print x y z instead of the projection */
     bool first;   /* nothing printed yet */
+    FILE *gcode;  /* NULL: no G-code */
+    bool pen;     /* wireframe G-code: the pen is down (M3; M5 lifts it for every G0) */
     cs_path_poly_t poly;
     cs_vec3_t *v; /* vertices of the current curve (for --stats) */
     size_t nv, capv;
@@ -163,7 +177,9 @@ typedef struct {
     bool stats;
 } tp_out_t;
 
-static bool out_vertex(tp_out_t *o, const cs_vec3_t *p, bool start)
+/* One vertex: printed, kept for the picture, and written as G-code, a G0 (travel) when rapid.
+ * start begins a new polyline of the text output. */
+static bool out_vertex_g(tp_out_t *o, const cs_vec3_t *p, bool start, bool rapid)
 {
     double q[3], x, y;
     to_mm(p, q);
@@ -175,7 +191,21 @@ static bool out_vertex(tp_out_t *o, const cs_vec3_t *p, bool start)
         printf("%.6f %.6f %.6f\n", q[0], q[1], q[2]);
     else
         printf("%.6f %.6f\n", x, y);
+    if (o->gcode && o->three_d)
+        fprintf(o->gcode, "G%d X%.6f Y%.6f Z%.6f\n", rapid ? 0 : 1, q[0], q[1], q[2]);
+    else if (o->gcode) {
+        if (rapid == o->pen) /* pen up before a travel, down before the first drawn move */
+            fprintf(o->gcode, "%s\n", rapid ? "M5" : "M3");
+        o->pen = !rapid;
+        fprintf(o->gcode, "G%d X%.6f Y%.6f\n", rapid ? 0 : 1, x, y);
+    }
     return (start ? cs_path_poly_move(&o->poly, x, y) : cs_path_poly_line(&o->poly, x, y)) == CS_OK;
+}
+
+/* Wireframe vertices: a polyline starts with a travel. */
+static bool out_vertex(tp_out_t *o, const cs_vec3_t *p, bool start)
+{
+    return out_vertex_g(o, p, start, start);
 }
 
 static bool keep_vertex(tp_out_t *o, const cs_vec3_t *p)
@@ -347,32 +377,29 @@ static bool ball_emit(void *ctx, size_t pass, double u, double v, const cs_vec3_
     if (b->patch_start) {
         /* Rapid approach: over the first point at the safe height, then down. */
         cs_conv_mm_to_pos(b->safe_z, &above.z);
-        if (!out_vertex(b->o, &above, true))
+        if (!out_vertex_g(b->o, &above, true, true))
             return false;
         b->patch_start = false;
     }
     b->last = *c;
     b->o->chords++;
-    return out_vertex(b->o, c, false);
+    return out_vertex_g(b->o, c, false, false); /* the plunge too is a feed move */
 }
 
 /* Every patch in turn: approach from the safe height, the zig-zag passes, retract. */
 static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const tp_ball_t *bp,
-                      cs_finish_stats_t *st)
+                      cs_finish_stats_t *st, double *fit_out)
 {
     double top = -HUGE_VAL;
     for (size_t i = 0; i < sf->n; i++) {
         const cs_surf_item_t *it = &sf->items[i];
-        if (it->tri || it->varady) {
-            cs_path_diag_t d;
-            cs_path_loc_t l = {sf->file, it->line, 1};
-            cs_path_diag_set(&d, CS_ERR_UNSUPPORTED, l,
-                             "%s patches cannot be finished with --ball yet",
-                             it->tri ? "triangular" : "n-sided");
-            cs_path_diag_print(stderr, &d);
-            return CS_EXIT_INPUT;
-        }
-        for (int a = 0; a <= it->quad.deg_u; a++)
+        for (size_t k = 0; it->varady && k < it->nside.n; k++)
+            for (unsigned j = 0; j <= it->nside.side[k].degree; j++)
+                top = fmax(top, cs_conv_pos_to_mm(it->nside.side[k].p[j].z));
+        if (it->tri)
+            for (unsigned k = 0; k < (it->trip.degree + 1u) * (it->trip.degree + 2u) / 2; k++)
+                top = fmax(top, cs_conv_pos_to_mm(it->trip.p[k].z));
+        for (int a = 0; !it->tri && !it->varady && a <= it->quad.deg_u; a++)
             for (int b = 0; b <= it->quad.deg_v; b++)
                 top = fmax(top, cs_conv_pos_to_mm(it->quad.p[a][b].z));
     }
@@ -383,11 +410,44 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
                 CS_POS_LIMIT_MM);
         return CS_EXIT_USAGE;
     }
+    if (o->gcode) /* up first, so the first travel does not cross the part */
+        fprintf(o->gcode, "G0 Z%.6f\n", cs_conv_pos_to_mm(zq));
+    cs_patch_t *cells = NULL;
     for (size_t i = 0; i < sf->n; i++) {
-        ctx.patch_start = true;
-        cs_err_t e =
-            cs_finish_patch(&sf->items[i].quad, bp->r_mm, bp->h_mm, tol, ball_emit, &ctx, st);
+        /* A triangle is finished as its exact collapsed tensor form, along its iso-lines u; an
+         * n-sided patch as bicubic cells fitted within tol / 2 (cs_varady_patches), each cell
+         * its own block. */
+        const cs_surf_item_t *it = &sf->items[i];
+        cs_patch_t tq;
+        size_t ncell = 1;
+        const cs_patch_t *list = &it->quad;
+        cs_err_t e = CS_OK;
+        if (it->tri) {
+            e = cs_finish_tri_patch(&it->trip, &tq);
+            list = &tq;
+        } else if (it->varady) {
+            if (!cells && !(cells = malloc(CS_VARADY_MAX_PATCHES * sizeof *cells)))
+                e = CS_ERR_FULL;
+            double fit = 0;
+            if (e == CS_OK)
+                e = cs_varady_patches(&it->nside, cs_conv_pos_to_mm(tol) / 2, cells, NULL,
+                                      CS_VARADY_MAX_PATCHES, &ncell, &fit);
+            if (e == CS_OK && *fit_out < fit)
+                *fit_out = fit;
+            list = cells;
+        }
+        for (size_t c = 0; e == CS_OK && c < ncell; c++) {
+            ctx.patch_start = true;
+            e = cs_finish_patch(&list[c], bp->r_mm, bp->h_mm, tol, ball_emit, &ctx, st);
+            if (e == CS_OK && c + 1 < ncell) {
+                cs_vec3_t up = ctx.last;
+                up.z = zq;
+                if (!out_vertex_g(o, &up, false, true))
+                    e = CS_ERR_FULL;
+            }
+        }
         if (e != CS_OK) {
+            free(cells);
             cs_path_diag_t d;
             cs_path_loc_t l = {sf->file, sf->items[i].line, 1};
             cs_path_diag_set(&d, e, l, "patch %zu: cannot plan the finishing passes: %s", i + 1,
@@ -397,15 +457,25 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
         }
         cs_vec3_t up = ctx.last;
         up.z = zq;
-        if (!out_vertex(o, &up, false))
+        if (!out_vertex_g(o, &up, false, true)) { /* retract: a travel */
+            free(cells);
             return CS_EXIT_INTERNAL;
+        }
         o->curves++;
     }
+    free(cells);
     if (st->gouge_points > 0)
         fprintf(stderr,
                 "curvestep toolpath: warning: %zu surface samples are concave with a curvature "
                 "radius below R = %g mm (smallest %.4g mm): the ball gouges there\n",
                 st->gouge_points, bp->r_mm, st->min_radius);
+    if (st->folded > 0)
+        fprintf(stderr,
+                "curvestep toolpath: warning: %zu chords of the tool path run backwards (first "
+                "at u %.3f, v %.3f of a patch): the offset surface folds over itself where the "
+                "surface is concave with a radius below R; %zu loops were cut out of their "
+                "passes at the self-crossing, the other folds remain\n",
+                st->folded, st->fold_u, st->fold_v, st->loops_cut);
     if (st->undercut > 0)
         fprintf(stderr,
                 "curvestep toolpath: warning: %zu vertices have a downward normal (undercut): "
@@ -441,7 +511,10 @@ static cs_err_t write_svg(const char *file, const cs_path_poly_t *poly, const ch
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
             "viewBox=\"%.6f %.6f %.6f %.6f\">\n",
             (w + 2 * m) * px, (h + 2 * m) * px, box[0] - m, -box[3] - m, w + 2 * m, h + 2 * m);
-    fprintf(f, "<title>%s</title>\n", title);
+    fprintf(f, "<title>"); /* XML-escaped: "<stdin>" or a file name with & or < */
+    for (const char *c = title; *c; c++)
+        fputs(*c == '<' ? "&lt;" : *c == '>' ? "&gt;" : *c == '&' ? "&amp;" : (char[2]){*c, 0}, f);
+    fprintf(f, "</title>\n");
     fprintf(f, "<rect x=\"%.6f\" y=\"%.6f\" width=\"%.6f\" height=\"%.6f\" fill=\"white\"/>\n",
             box[0] - m, -box[3] - m, w + 2 * m, h + 2 * m);
     /* y up: every y is negated (SVG's y points down). */
@@ -468,20 +541,28 @@ static cs_err_t write_svg(const char *file, const cs_path_poly_t *poly, const ch
 int cs_cmd_toolpath(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"patches", required_argument, NULL, 'p'}, {"view", required_argument, NULL, 'v'},
-        {"lines", required_argument, NULL, 'n'},   {"tol", required_argument, NULL, 't'},
-        {"scale", required_argument, NULL, 'S'},   {"ball", required_argument, NULL, 'b'},
-        {"scallop", required_argument, NULL, 'H'}, {"safe-z", required_argument, NULL, 'z'},
-        {"stats", no_argument, NULL, 's'},         {"svg", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+        {"patches", required_argument, NULL, 'p'},
+        {"view", required_argument, NULL, 'v'},
+        {"lines", required_argument, NULL, 'n'},
+        {"tol", required_argument, NULL, 't'},
+        {"scale", required_argument, NULL, 'S'},
+        {"ball", required_argument, NULL, 'b'},
+        {"scallop", required_argument, NULL, 'H'},
+        {"safe-z", required_argument, NULL, 'z'},
+        {"stats", no_argument, NULL, 's'},
+        {"svg", required_argument, NULL, 'o'},
+        {"gcode", required_argument, NULL, 'g'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
     };
-    const char *file = NULL, *svg_out = NULL;
+    const char *file = NULL, *svg_out = NULL, *gcode_out = NULL;
     tp_view_t view = views[3];
     double tol_mm = TP_DEFAULT_TOL_MM, scale = 1.0;
     unsigned lines = TP_DEFAULT_LINES;
     bool stats = false, ball = false, have_h = false;
     tp_ball_t bp = {0, 0, 0, false};
-    cs_finish_stats_t fst = {0, 0, 0, 0, 0.0, HUGE_VAL, 0, 0};
+    cs_finish_stats_t fst = {0, 0, 0, 0, 0.0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
+    double varady_fit = 0; /* n-sided patches: largest sampled distance of the fitted cells */
     int c;
     optind = 1;
     opterr = 0;
@@ -561,6 +642,9 @@ int cs_cmd_toolpath(int argc, char **argv)
         case 'o':
             svg_out = optarg;
             break;
+        case 'g':
+            gcode_out = optarg;
+            break;
         case 'h':
             tp_usage(stdout);
             return CS_EXIT_OK;
@@ -605,10 +689,29 @@ int cs_cmd_toolpath(int argc, char **argv)
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
     }
     int status = CS_EXIT_OK;
-    tp_out_t o = {&view, ball, true, {0}, NULL, 0, 0, 0, 0, 0.0, stats};
+    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    tp_out_t o = {&view, ball, true, NULL, false, {0}, NULL, 0, 0, 0, 0, 0.0, stats};
     cs_path_poly_init(&o.poly);
+    if (gcode_out) {
+        o.gcode = fopen(gcode_out, "w");
+        if (!o.gcode) {
+            fprintf(stderr, "%s:0:0: cannot write the G-code\n", gcode_out);
+            cs_path_poly_free(&o.poly);
+            cs_surffile_free(&sf);
+            return CS_EXIT_INTERNAL;
+        }
+        /* Parentheses would end the comment early: the file name is only cited when it has none. */
+        bool plain = strchr(shown, '(') == NULL && strchr(shown, ')') == NULL;
+        if (ball)
+            fprintf(o.gcode, "(curvestep toolpath: finishing of %s, ball R %g mm, tool centre)\n",
+                    plain ? shown : "the input", bp.r_mm);
+        else
+            fprintf(o.gcode, "(curvestep toolpath: wireframe of %s, view %s)\n",
+                    plain ? shown : "the input", view.name);
+        fprintf(o.gcode, "G21 G90\n");
+    }
     if (status == CS_EXIT_OK && ball)
-        status = finish_all(&o, &sf, tol, &bp, &fst);
+        status = finish_all(&o, &sf, tol, &bp, &fst, &varady_fit);
     for (size_t i = 0; i < sf.n && status == CS_EXIT_OK && !ball; i++) {
         e = sf.items[i].tri      ? wire_tri(&o, &sf.items[i].trip, lines, tol)
             : sf.items[i].varady ? wire_varady(&o, &sf.items[i].nside, lines, tol)
@@ -625,7 +728,14 @@ int cs_cmd_toolpath(int argc, char **argv)
         if (status == CS_EXIT_OK)
             status = CS_EXIT_INTERNAL;
     }
-    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    if (o.gcode) {
+        fprintf(o.gcode, "%sM2\n", o.pen ? "M5\n" : "");
+        bool bad = ferror(o.gcode) != 0;
+        if ((fclose(o.gcode) != 0 || bad) && status == CS_EXIT_OK) {
+            fprintf(stderr, "%s:0:0: cannot write the G-code\n", gcode_out);
+            status = CS_EXIT_INTERNAL;
+        }
+    }
     if (stats && status == CS_EXIT_OK) {
         fprintf(stderr, "toolpath: %s: %zu patches, %zu curves, %zu chords, view %s\n", shown, sf.n,
                 o.curves, o.chords, view.name);
@@ -634,6 +744,11 @@ int cs_cmd_toolpath(int argc, char **argv)
                     "toolpath: ball R %.6g mm, scallop %.6g mm: %zu passes, measured scallop "
                     "%.6f mm (between pass centres, double)\n",
                     bp.r_mm, bp.h_mm, fst.passes, fst.max_scallop);
+        if (ball && varady_fit > 0)
+            fprintf(stderr,
+                    "toolpath: n-sided patches finished as fitted bicubic cells within %.6f mm "
+                    "(sampled, 9 x 9 per cell)\n",
+                    varady_fit);
         if (!ball)
             fprintf(stderr,
                     "toolpath: tolerance %.6g mm, max deviation %.6f mm (chords against their "

@@ -75,6 +75,43 @@ cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
         v->vert[i][1] = rho * sin(beta);
         acc += v->len[i];
     }
+    /* Local frames of the domain sides (for the radial and central-line parametrisations). */
+    double cx = 0, cy = 0;
+    for (size_t i = 0; i < n; i++) {
+        cx += v->vert[i][0] / (double)n;
+        cy += v->vert[i][1] / (double)n;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const double *a = v->vert[i], *b = v->vert[(i + 1) % n];
+        const double *pp = v->vert[(i + n - 1) % n], *nn = v->vert[(i + 2) % n];
+        double eu[2] = {b[0] - a[0], b[1] - a[1]}, l = sqrt(eu[0] * eu[0] + eu[1] * eu[1]);
+        eu[0] /= l;
+        eu[1] /= l;
+        v->len_d[i] = l;
+        double q1[2] = {pp[0] - a[0], pp[1] - a[1]}, q2[2] = {nn[0] - b[0], nn[1] - b[1]};
+        double l1 = sqrt(q1[0] * q1[0] + q1[1] * q1[1]), l2 = sqrt(q2[0] * q2[0] + q2[1] * q2[1]);
+        /* local (u, v) of a vector (x, y): u = x eu, v = x (-eu_y, eu_x) (inward: CCW) */
+        v->w1[i][0] = (q1[0] * eu[0] + q1[1] * eu[1]) / l1;
+        v->w1[i][1] = (-q1[0] * eu[1] + q1[1] * eu[0]) / l1;
+        v->w2[i][0] = (q2[0] * eu[0] + q2[1] * eu[1]) / l2;
+        v->w2[i][1] = (-q2[0] * eu[1] + q2[1] * eu[0]) / l2;
+        /* Central line (seed 002, "Balayage de ligne centrale"): w12v = (w1v + w2v) / 2, then
+         * r(1/2, dc) = c gives dc = 2 cv / (w1v + w2v) and w12u from cu. */
+        double cu = (cx - a[0]) * eu[0] + (cy - a[1]) * eu[1];
+        double cv = -(cx - a[0]) * eu[1] + (cy - a[1]) * eu[0];
+        double dc = 2 * cv / (v->w1[i][1] + v->w2[i][1]);
+        v->w12u[i] = (4 * (cu - 0.5 * l) / dc - v->w1[i][0] - v->w2[i][0]) / 2;
+        /* Radial: the lines of sides i - 1 (through the origin along w1) and i + 1 (through
+         * (l, 0) along w2) meet at a w1 = (l, 0) + b w2, unless parallel. */
+        double det = -v->w1[i][0] * v->w2[i][1] + v->w1[i][1] * v->w2[i][0];
+        if (fabs(det) < 1e-12) {
+            v->rpar[i] = 1;
+        } else {
+            double ka = (-l * v->w2[i][1]) / det;
+            v->rc[i][0] = ka * v->w1[i][0];
+            v->rc[i][1] = ka * v->w1[i][1];
+        }
+    }
     /* Cross-boundary tangents: away from each corner along the neighbouring side. */
     for (size_t i = 0; i < n; i++) {
         double a[3], b[3];
@@ -106,47 +143,197 @@ static double side_dist(const cs_varady_t *v, size_t i, double x, double y)
     return (ex * (y - a[1]) - ey * (x - a[0])) / l;
 }
 
+cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param)
+{
+    if (!v || (blend != CS_VARADY_MU && blend != CS_VARADY_LAMBDA_KAPPA) ||
+        (param != CS_VARADY_SIDE && param != CS_VARADY_RADIAL && param != CS_VARADY_CENTRE))
+        return CS_ERR_ARG;
+    v->blend = blend;
+    v->param = param;
+    return CS_OK;
+}
+
+/* Central-line sweep for side i (seed 002): f(s) = (u0 - l s) (w1v (1 - s) + w2v s)
+ * - v0 (w1u (1 - s)^2 + 2 w12u (1 - s) s + w2u s^2), zero where the seed's two expressions of d0
+ * agree, i.e. where r(s, d0) = (u0, v0). */
+static double centre_f(const cs_varady_t *v, size_t i, double u0, double v0, double s)
+{
+    const double *w1 = v->w1[i], *w2 = v->w2[i];
+    double l = v->len_d[i], m = 1 - s;
+    return (u0 - l * s) * (w1[1] * m + w2[1] * s) -
+           v0 * (w1[0] * m * m + 2 * v->w12u[i] * m * s + w2[0] * s * s);
+}
+
+/* Its root in [0, 1] by bisection: inside the domain f(0) >= 0 (side i - 1's side) and
+ * f(1) <= 0. Outside that wedge s is clamped to the end where |f| is smaller. */
+static double centre_s(const cs_varady_t *v, size_t i, double u0, double v0)
+{
+    double f0 = centre_f(v, i, u0, v0, 0), f1 = centre_f(v, i, u0, v0, 1);
+    if ((f0 > 0 && f1 > 0) || (f0 < 0 && f1 < 0))
+        return fabs(f0) <= fabs(f1) ? 0 : 1;
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 64; k++) {
+        double m = 0.5 * (lo + hi);
+        if (m <= lo || m >= hi)
+            break;
+        if ((centre_f(v, i, u0, v0, m) >= 0) == (f0 >= 0))
+            lo = m;
+        else
+            hi = m;
+    }
+    return f0 == 0 ? 0 : f1 == 0 ? 1 : 0.5 * (lo + hi);
+}
+
+void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], double d[])
+{
+    size_t n = v->n;
+    double dist[CS_VARADY_MAX_SIDES];
+    for (size_t i = 0; i < n; i++)
+        dist[i] = side_dist(v, i, x, y);
+    for (size_t i = 0; i < n; i++) {
+        const double *a = v->vert[i], *b = v->vert[(i + 1) % n];
+        double l = v->len_d[i], eu[2] = {(b[0] - a[0]) / l, (b[1] - a[1]) / l};
+        double u0 = (x - a[0]) * eu[0] + (y - a[1]) * eu[1];
+        double v0 = -(x - a[0]) * eu[1] + (y - a[1]) * eu[0];
+        if (v->param == CS_VARADY_SIDE) {
+            double dp = dist[(i + n - 1) % n], dn = dist[(i + 1) % n];
+            s[i] = dp + dn != 0 ? dp / (dp + dn) : 0.5;
+            d[i] = dist[i];
+        } else if (v->param == CS_VARADY_RADIAL) {
+            /* e: where the ray from the centre rc (or along w1) through (u0, v0) meets v = 0. */
+            double eu0, len;
+            if (v->rpar[i]) {
+                const double *w = v->w1[i];
+                eu0 = u0 - v0 * w[0] / w[1];
+                len = fabs(v0 / w[1]);
+            } else {
+                const double *c = v->rc[i];
+                double den = c[1] - v0;
+                if (fabs(den) < 1e-12 * l) { /* at the centre itself: any ray (blend is 0) */
+                    eu0 = 0.5 * l;
+                } else {
+                    double t = c[1] / den;
+                    eu0 = c[0] + t * (u0 - c[0]);
+                }
+                len = sqrt((u0 - eu0) * (u0 - eu0) + v0 * v0);
+            }
+            s[i] = eu0 / l;
+            d[i] = v0 < 0 ? -len : len;
+        } else {
+            double si = centre_s(v, i, u0, v0);
+            double den = v->w1[i][1] * (1 - si) + v->w2[i][1] * si;
+            s[i] = si;
+            d[i] = v0 / den;
+        }
+    }
+}
+
+void cs_varady_blends(size_t n, const double d[], double lambda[], double kappa[], double mu[])
+{
+    /* The blends are ratios of products of equal degree: scale the distances to about 1 so
+     * the products of up to 14 factors stay far from overflow and underflow. */
+    double big = 0, q[CS_VARADY_MAX_SIDES];
+    for (size_t i = 0; i < n; i++)
+        big = fmax(big, fabs(d[i]));
+    for (size_t i = 0; i < n; i++)
+        q[i] = big > 0 ? (d[i] / big) * (d[i] / big) : 0;
+    /* D_{i-1,i} = prod_{j != i-1, i} q_j and D_i = prod_{j != i} q_j. */
+    double Dc[CS_VARADY_MAX_SIDES], Ds[CS_VARADY_MAX_SIDES], sc = 0, ss = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t im = (i + n - 1) % n;
+        Dc[i] = 1;
+        Ds[i] = 1;
+        for (size_t j = 0; j < n; j++) {
+            if (j != i)
+                Ds[i] *= q[j];
+            if (j != i && j != im)
+                Dc[i] *= q[j];
+        }
+        sc += Dc[i];
+        ss += Ds[i];
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (lambda)
+            lambda[i] = sc > 0 ? (Dc[i] + Dc[(i + 1) % n]) / sc : 0;
+        if (kappa)
+            kappa[i] = sc > 0 ? Dc[i] / sc : 0;
+        if (mu)
+            mu[i] = ss > 0 ? Ds[i] / ss : 0;
+    }
+}
+
+/* The corner nearest to (x, y): the surface's value where the blends are undefined. */
+static void nearest_corner(const cs_varady_t *v, double x, double y, double out[3])
+{
+    size_t best = 0;
+    double bd = HUGE_VAL;
+    for (size_t i = 0; i < v->n; i++) {
+        double dx = x - v->vert[i][0], dy = y - v->vert[i][1];
+        if (dx * dx + dy * dy < bd) {
+            bd = dx * dx + dy * dy;
+            best = i;
+        }
+    }
+    curve_d(&v->side[best], 0, out, NULL);
+}
+
+/* Ribbon R_i(s, d) = P_i(s) + d T_i(s), T_i linear between t0 and t1. */
+static void ribbon(const cs_varady_t *v, size_t i, double s, double d, double out[3])
+{
+    double p[3];
+    curve_d(&v->side[i], s, p, NULL);
+    for (int k = 0; k < 3; k++)
+        out[k] = p[k] + d * ((1 - s) * v->t0[i][k] + s * v->t1[i][k]);
+}
+
 void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
 {
     size_t n = v->n;
-    double d[CS_VARADY_MAX_SIDES];
-    for (size_t i = 0; i < n; i++)
-        d[i] = side_dist(v, i, x, y);
-    /* mu_i = D_i / sum D_j with D_i = prod_{j != i} d_j^2. */
-    double D[CS_VARADY_MAX_SIDES], sum = 0;
-    for (size_t i = 0; i < n; i++) {
-        D[i] = 1;
-        for (size_t j = 0; j < n; j++)
-            if (j != i)
-                D[i] *= d[j] * d[j];
-        sum += D[i];
-    }
+    double s[CS_VARADY_MAX_SIDES], d[CS_VARADY_MAX_SIDES];
+    double lambda[CS_VARADY_MAX_SIDES], kappa[CS_VARADY_MAX_SIDES], mu[CS_VARADY_MAX_SIDES];
+    cs_varady_params(v, x, y, s, d);
     out[0] = out[1] = out[2] = 0;
-    if (!(sum > 1e-300)) {
-        /* At a vertex (two distances zero): the corner itself. */
-        size_t best = 0;
-        double bd = HUGE_VAL;
-        for (size_t i = 0; i < n; i++) {
-            double dx = x - v->vert[i][0], dy = y - v->vert[i][1];
-            if (dx * dx + dy * dy < bd) {
-                bd = dx * dx + dy * dy;
-                best = i;
-            }
+    if (v->blend == CS_VARADY_MU) {
+        cs_varady_blends(n, d, NULL, NULL, mu);
+        double sum = 0;
+        for (size_t i = 0; i < n; i++)
+            sum += mu[i];
+        if (!(sum > 0.5)) { /* at a vertex (two distances zero): the corner itself */
+            nearest_corner(v, x, y, out);
+            return;
         }
-        curve_d(&v->side[best], 0, out, NULL);
+        for (size_t i = 0; i < n; i++) {
+            if (mu[i] == 0)
+                continue;
+            double r[3];
+            ribbon(v, i, s[i], d[i], r);
+            for (int k = 0; k < 3; k++)
+                out[k] += mu[i] * r[k];
+        }
+        return;
+    }
+    cs_varady_blends(n, d, lambda, kappa, NULL);
+    double sum = 0;
+    for (size_t i = 0; i < n; i++)
+        sum += kappa[i];
+    if (!(sum > 0.5)) {
+        nearest_corner(v, x, y, out);
         return;
     }
     for (size_t i = 0; i < n; i++) {
-        double mu = D[i] / sum;
-        if (mu == 0)
-            continue;
-        double dp = d[(i + n - 1) % n], dn = d[(i + 1) % n];
-        double s = dp + dn != 0 ? dp / (dp + dn) : 0.5;
-        double p[3];
-        curve_d(&v->side[i], s, p, NULL);
-        for (int k = 0; k < 3; k++) {
-            double t = (1 - s) * v->t0[i][k] + s * v->t1[i][k];
-            out[k] += mu * (p[k] + d[i] * t);
+        if (lambda[i] != 0) {
+            double r[3];
+            ribbon(v, i, s[i], d[i], r);
+            for (int k = 0; k < 3; k++)
+                out[k] += lambda[i] * r[k];
+        }
+        if (kappa[i] != 0) {
+            /* Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0), zero twist (seed 000's choice). */
+            size_t im = (i + n - 1) % n;
+            double p[3];
+            curve_d(&v->side[i], 0, p, NULL);
+            for (int k = 0; k < 3; k++)
+                out[k] -= kappa[i] * (p[k] + d[im] * v->t1[im][k] + d[i] * v->t0[i][k]);
         }
     }
 }
@@ -227,4 +414,155 @@ cs_err_t cs_varady_curve(const cs_varady_t *v, const double a[2], const double b
         return CS_OK;
     }
     return CS_ERR_TOLERANCE;
+}
+
+void cs_varady_quad_point(const cs_varady_t *v, size_t i, double a, double b, double out[2])
+{
+    size_t n = v->n;
+    double c[2] = {0, 0};
+    for (size_t k = 0; k < n; k++) {
+        c[0] += v->vert[k][0] / (double)n;
+        c[1] += v->vert[k][1] / (double)n;
+    }
+    const double *pp = v->vert[(i + n - 1) % n], *p = v->vert[i], *pn = v->vert[(i + 1) % n];
+    double m0[2] = {0.5 * (pp[0] + p[0]), 0.5 * (pp[1] + p[1])};
+    double m1[2] = {0.5 * (p[0] + pn[0]), 0.5 * (p[1] + pn[1])};
+    /* X(0,0) = c, X(1,0) = m_{i-1}, X(1,1) = p_i, X(0,1) = m_i */
+    for (int k = 0; k < 2; k++)
+        out[k] =
+            (1 - a) * (1 - b) * c[k] + a * (1 - b) * m0[k] + a * b * p[k] + (1 - a) * b * m1[k];
+}
+
+static void quad_eval(const cs_varady_t *v, size_t i, double a, double b, double out[3])
+{
+    double x[2];
+    cs_varady_quad_point(v, i, a, b, x);
+    cs_varady_eval(v, x[0], x[1], out);
+}
+
+/* Hermite data of quad i at (a, b): point, derivatives in a and b, twist (central differences;
+ * the surface is extrapolated a little beyond the domain's sides). */
+static void quad_hermite(const cs_varady_t *v, size_t i, double a, double b, double pt[3],
+                         double da[3], double db[3], double dab[3])
+{
+    const double h = 1e-5, g = 1e-4;
+    double p0[3], p1[3], q0[3], q1[3], r[4][3];
+    quad_eval(v, i, a, b, pt);
+    quad_eval(v, i, a - h, b, p0);
+    quad_eval(v, i, a + h, b, p1);
+    quad_eval(v, i, a, b - h, q0);
+    quad_eval(v, i, a, b + h, q1);
+    quad_eval(v, i, a + g, b + g, r[0]);
+    quad_eval(v, i, a + g, b - g, r[1]);
+    quad_eval(v, i, a - g, b + g, r[2]);
+    quad_eval(v, i, a - g, b - g, r[3]);
+    for (int k = 0; k < 3; k++) {
+        da[k] = (p1[k] - p0[k]) / (2 * h);
+        db[k] = (q1[k] - q0[k]) / (2 * h);
+        dab[k] = (r[0][k] - r[1][k] - r[2][k] + r[3][k]) / (4 * g * g);
+    }
+}
+
+/* Bicubic point in double from the control net (mm). */
+static void patch_point(const cs_patch_t *p, double u, double w, double out[3])
+{
+    double bu[4], bw[4];
+    for (int k = 0; k <= 3; k++) {
+        static const double c[4] = {1, 3, 3, 1};
+        bu[k] = c[k] * pow(u, k) * pow(1 - u, 3 - k);
+        bw[k] = c[k] * pow(w, k) * pow(1 - w, 3 - k);
+    }
+    out[0] = out[1] = out[2] = 0;
+    for (int i = 0; i <= 3; i++)
+        for (int j = 0; j <= 3; j++) {
+            out[0] += bu[i] * bw[j] * cs_conv_pos_to_mm(p->p[i][j].x);
+            out[1] += bu[i] * bw[j] * cs_conv_pos_to_mm(p->p[i][j].y);
+            out[2] += bu[i] * bw[j] * cs_conv_pos_to_mm(p->p[i][j].z);
+        }
+}
+
+/* One cell of quad i: [a0, a0 + w] x [b0, b0 + w] as a Hermite bicubic, and its largest
+ * distance to the surface at 9 x 9 samples. */
+static cs_err_t fit_cell(const cs_varady_t *v, size_t i, double a0, double b0, double w,
+                         cs_patch_t *out, double *err)
+{
+    cs_patch_hermite_t hm;
+    for (int ca = 0; ca < 2; ca++)
+        for (int cb = 0; cb < 2; cb++) {
+            double pt[3], da[3], db[3], dab[3];
+            quad_hermite(v, i, a0 + ca * w, b0 + cb * w, pt, da, db, dab);
+            /* per unit of the cell's own parameters: x w, the twist x w^2 */
+            cs_err_t e = cs_conv_mm_to_vec(pt[0], pt[1], pt[2], &hm.p[ca][cb]);
+            if (e == CS_OK)
+                e = cs_conv_mm_to_vec(da[0] * w, da[1] * w, da[2] * w, &hm.pu[ca][cb]);
+            if (e == CS_OK)
+                e = cs_conv_mm_to_vec(db[0] * w, db[1] * w, db[2] * w, &hm.pv[ca][cb]);
+            if (e == CS_OK)
+                e = cs_conv_mm_to_vec(dab[0] * w * w, dab[1] * w * w, dab[2] * w * w,
+                                      &hm.puv[ca][cb]);
+            if (e != CS_OK)
+                return CS_ERR_RANGE;
+        }
+    cs_err_t e = cs_patch_from_hermite(out, &hm);
+    if (e != CS_OK)
+        return e;
+    *err = 0;
+    for (int sa = 0; sa <= 8; sa++)
+        for (int sb = 0; sb <= 8; sb++) {
+            double q[3], r[3];
+            patch_point(out, sa / 8.0, sb / 8.0, q);
+            quad_eval(v, i, a0 + w * sa / 8.0, b0 + w * sb / 8.0, r);
+            double d[3] = {q[0] - r[0], q[1] - r[1], q[2] - r[2]};
+            *err = fmax(*err, norm3(d));
+        }
+    return CS_OK;
+}
+
+cs_err_t cs_varady_patches(const cs_varady_t *v, double tol_mm, cs_patch_t *out,
+                           cs_varady_cell_t *cells, size_t max, size_t *count, double *err_mm)
+{
+    if (!v || !out || !count || !(tol_mm > 0))
+        return CS_ERR_ARG;
+    /* Quadtree per quad, depth-first: a cell that misses tol is split in four. */
+    struct {
+        double a, b, w;
+    } stack[4 * CS_VARADY_MAX_DEPTH + 4];
+    size_t c = 0;
+    double worst = 0;
+    for (size_t i = 0; i < v->n; i++) {
+        size_t sp = 0;
+        stack[sp].a = 0;
+        stack[sp].b = 0;
+        stack[sp].w = 1;
+        sp++;
+        while (sp > 0) {
+            sp--;
+            double a = stack[sp].a, b = stack[sp].b, w = stack[sp].w, err;
+            if (c == max)
+                return CS_ERR_FULL;
+            cs_err_t e = fit_cell(v, i, a, b, w, &out[c], &err);
+            if (e != CS_OK)
+                return e;
+            if (err <= tol_mm) {
+                worst = fmax(worst, err);
+                if (cells)
+                    cells[c] = (cs_varady_cell_t){i, a, b, w};
+                c++;
+                continue;
+            }
+            if (w <= 1.0 / (1 << CS_VARADY_MAX_DEPTH))
+                return CS_ERR_TOLERANCE;
+            double h = w / 2;
+            for (int k = 3; k >= 0; k--) { /* pushed in reverse: popped row by row */
+                stack[sp].a = a + h * (k % 2);
+                stack[sp].b = b + h * (k / 2);
+                stack[sp].w = h;
+                sp++;
+            }
+        }
+    }
+    *count = c;
+    if (err_mm)
+        *err_mm = worst;
+    return CS_OK;
 }

@@ -5,23 +5,55 @@
  * lengths), the side-based parametrisation (d_i = distance to domain side i,
  * s_i = d_{i-1} / (d_{i-1} + d_{i+1})), linear ribbons R_i(s, d) = P_i(s) + d T_i(s) and the
  * seed's special side blends mu_i = D_i / sum D_j, D_i = prod_{j != i} d_j^2:
- * S = sum R_i(s_i, d_i) mu_i. (The lambda / kappa scheme with corner patches is not done.) */
+ * S = sum R_i(s_i, d_i) mu_i (the default). Also the seed's side / corner blends
+ * S = sum lambda_i R_i(s_i, d_i) - sum kappa_i Q_i (corner correction patches Q_i), and its
+ * radial (Charrot-Gregory) and central-line-sweep parametrisations (cs_varady_set_scheme). */
 #ifndef CS_VARADY_H
 #define CS_VARADY_H
 
 #include <stddef.h>
 
 #include "cs_bezier.h"
+#include "cs_patch.h"
 
 #define CS_VARADY_MAX_SIDES 8
 
+/* Blending of the ribbons (seed 002, "Fonctions de mélange"). */
+typedef enum {
+    CS_VARADY_MU = 0,       /* S = sum mu_i R_i */
+    CS_VARADY_LAMBDA_KAPPA, /* S = sum lambda_i R_i - sum kappa_i Q_i */
+} cs_varady_blend_t;
+
+/* Local coordinates (s_i, d_i) of a domain point for side i (seed 002, "Choix de la
+ * paramétrisation"). Each gives s_i = 0 on side i - 1, s_i = 1 on side i + 1, d_i = 0 on side
+ * i, s_i linear along side i except for CS_VARADY_SIDE. */
+typedef enum {
+    CS_VARADY_SIDE = 0, /* d_i = distance to side i's line, s_i = d_{i-1} / (d_{i-1} + d_{i+1}) */
+    CS_VARADY_RADIAL,   /* rays from where the lines of sides i - 1 and i + 1 meet: e_i where
+                         * the ray through the point crosses side i, s_i = |e_i - p_i| / side
+                         * length, d_i = |point - e_i| */
+    CS_VARADY_CENTRE,   /* central-line sweep: r(s, d) = p_i + (p_{i+1} - p_i) s + [w1 (1 - s)^2
+                         * + 2 w12 (1 - s) s + w2 s^2] d, w1 and w2 the unit directions of the
+                         * neighbouring sides, w12 chosen so that r(1/2, d_c) is the domain
+                         * centre; (s_i, d_i) = r^-1(point) */
+} cs_varady_param_t;
+
 typedef struct {
     size_t n;
+    cs_varady_blend_t blend;
+    cs_varady_param_t param;
     cs_bezier_t side[CS_VARADY_MAX_SIDES]; /* P_i(s), s in [0, 1], P_i(1) = P_{i+1}(0) */
     double len[CS_VARADY_MAX_SIDES];       /* arc length of each side, mm */
     double vert[CS_VARADY_MAX_SIDES][2];   /* domain polygon, vertex i starts side i */
     double t0[CS_VARADY_MAX_SIDES][3];     /* cross-boundary tangent of side i at s = 0 */
     double t1[CS_VARADY_MAX_SIDES][3];     /* ... at s = 1 (unit vectors into the patch) */
+    /* Per side i, in its local frame (origin p_i, u along side i, v into the domain): */
+    double len_d[CS_VARADY_MAX_SIDES]; /* domain side length |p_{i+1} - p_i| */
+    double w1[CS_VARADY_MAX_SIDES][2]; /* unit direction p_i -> p_{i-1} */
+    double w2[CS_VARADY_MAX_SIDES][2]; /* unit direction p_{i+1} -> p_{i+2} */
+    double w12u[CS_VARADY_MAX_SIDES];  /* central line: u of w12 (its v is (w1v + w2v) / 2) */
+    double rc[CS_VARADY_MAX_SIDES][2]; /* radial: where the lines of sides i - 1, i + 1 meet */
+    int rpar[CS_VARADY_MAX_SIDES];     /* radial: those lines are parallel (rays along w1) */
 } cs_varady_t;
 
 /* n (3..CS_VARADY_MAX_SIDES) polynomial boundary curves of degree 1..3 forming a loop (the end
@@ -31,8 +63,23 @@ typedef struct {
  * corner the unit tangent of the neighbouring side leading away from it, blended linearly
  * along the side (1 mm per domain mm). */
 cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n);
+/* Chooses the blending and the parametrisation (cs_varady_init sets CS_VARADY_MU,
+ * CS_VARADY_SIDE). CS_ERR_ARG for unknown values. */
+cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param);
+/* The parametrisation's (s_i, d_i) of domain point (x, y) for every side (d in domain units,
+ * >= 0 inside the polygon). */
+void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], double d[]);
+/* The seed's blends of n distances d[0..n-1] (any array may be NULL): with
+ * D_{a..} = prod_{j not in a..} d_j^2, lambda_i = (D_{i-1,i} + D_{i,i+1}) / sum_j D_{j-1,j}
+ * (sum 2), kappa_i = D_{i-1,i} / sum_j D_{j-1,j} (sum 1; corner i is the start of side i),
+ * mu_i = D_i / sum_j D_j (sum 1). Where a denominator vanishes (two or more distances zero for
+ * mu, more for lambda / kappa) that family is set to 0. */
+void cs_varady_blends(size_t n, const double d[], double lambda[], double kappa[], double mu[]);
 /* Surface point (mm) at domain point (x, y) inside the polygon (outside: extrapolated). On a
- * domain side it is that boundary curve; at a vertex, the corner. */
+ * domain side it is that boundary curve; at a vertex, the corner. Lambda / kappa:
+ * S = sum lambda_i R_i(s_i, d_i) - sum kappa_i Q_i with the corner patch
+ * Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0) (zero twist), which equals R_{i-1} on side i and
+ * R_i on side i - 1, so the corrections cancel the neighbouring ribbons on every side. */
 void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3]);
 /* Domain polygon vertex i (i < n), in domain units. */
 void cs_varady_vertex(const cs_varady_t *v, size_t i, double out[2]);
@@ -43,5 +90,33 @@ void cs_varady_vertex(const cs_varady_t *v, size_t i, double out[2]);
  * too small, CS_ERR_RANGE when a point leaves the coordinate range. */
 cs_err_t cs_varady_curve(const cs_varady_t *v, const double a[2], const double b[2], double tol_mm,
                          cs_bezier_t *out, size_t max, size_t *count);
+
+/* Room the toolpath gives cs_varady_patches, and the deepest split (cells down to 2^-10 of a
+ * quad's side). */
+#define CS_VARADY_MAX_PATCHES 4096
+#define CS_VARADY_MAX_DEPTH   10
+
+/* A cell of cs_varady_patches. */
+typedef struct {
+    size_t quad;    /* which quad (side / vertex index) */
+    double a, b, w; /* the cell [a, a + w] x [b, b + w] of the quad's unit square */
+} cs_varady_cell_t;
+
+/* Bicubic patches covering the n-sided surface, for tools that need tensor patches (ball-end
+ * finishing): the domain is split into n quads (the centre of the vertices, the midpoint of side
+ * i - 1, vertex i, the midpoint of side i: counter-clockwise, so Pu x Pv points like the
+ * surface's Sx x Sy), each mapped bilinearly from the unit square (cs_varady_quad_point). A cell
+ * of the square becomes the Hermite bicubic of the surface's corner points, tangents and twists
+ * (central differences in the square's parameters); a cell whose patch is farther than tol_mm
+ * from the surface at the same parameters (9 x 9 samples) is split in four (quadtree, down to
+ * 2^-CS_VARADY_MAX_DEPTH). Neighbouring cells of different sizes meet within about tol_mm, not
+ * exactly. Writes *count patches to out[0 .. max - 1], quad by quad, and (cells may be NULL)
+ * the cell each covers, patch parameters (u, v) = ((a' - a) / w, (b' - b) / w); *err_mm (may be
+ * NULL) gets the largest sampled distance. CS_ERR_TOLERANCE when the deepest cells miss tol_mm,
+ * CS_ERR_FULL when max is too small, CS_ERR_RANGE when a point leaves the coordinate range. */
+cs_err_t cs_varady_patches(const cs_varady_t *v, double tol_mm, cs_patch_t *out,
+                           cs_varady_cell_t *cells, size_t max, size_t *count, double *err_mm);
+/* The domain point of quad i's parameters (a, b) in [0, 1]^2 used by cs_varady_patches. */
+void cs_varady_quad_point(const cs_varady_t *v, size_t i, double a, double b, double out[2]);
 
 #endif

@@ -3,6 +3,172 @@
 # Each program gets the CSV path it must write (build/bench/<name>.csv) as its first argument
 # and prints its Markdown section on stdout (progress goes to stderr).
 set -euo pipefail
+# --- Firmware (make bench, after make firmware) ----------------------------------------------
+# hex -> decimal in (m)awk, which has no strtonum
+AWK_HEX='function hex(h,  i, c, v) { v = 0; h = tolower(h); sub(/^0x/, "", h);
+    for (i = 1; i <= length(h); i++) { c = index("0123456789abcdef", substr(h, i, 1)) - 1;
+    v = v * 16 + c } return v }'
+
+# flash and RAM of a linked image: flash = everything loaded from flash (text, rodata, vectors,
+# the initial values of data), RAM = data + bss (+ noinit)
+image_size() { # SIZE-TOOL ELF -> "flash ram"
+    "$1" -A "$2" | awk '$1 ~ /^\.(isr_vector|text|rodata|ARM\.exidx|data)$/ {f += $2}
+        $1 ~ /^\.(data|bss|noinit)$/ {r += $2} END {print f + 0, r + 0}'
+}
+
+# bytes per module of a linked image, from its map file (input sections kept by --gc-sections)
+map_modules() { # MAP -> "module bytes" lines (flash: text, rodata, data init)
+    awk "$AWK_HEX"'
+    /^Linker script and memory map/ {go = 1; next}
+    !go {next}
+    /^ \.(text|rodata|data)/ {
+        if (NF >= 4) {sz = $3; f = $4} else {getline; sz = $2; f = $3}
+        m = f
+        if (m ~ /libgcc/) m = "libgcc (64-bit arithmetic)"
+        else {sub(/.*\//, "", m); sub(/\.o$/, "", m)}
+        s[m] += hex(sz)
+    }
+    END {for (k in s) if (s[k] > 0) print k, s[k]}' "$1" | sort -k2,2nr -t' '
+}
+
+# The curve core linked alone on a Cortex-M0+: tests/fw/curve_core_m0.c with the modules given.
+curve_core() { # NAME DEFINES MODULES... -> prints a table section
+    local name=$1 defs=$2; shift 2
+    local d=build/bench/curve_core/$name
+    mkdir -p "$d"
+    local fl="-std=c99 -ffreestanding -Wall -Wextra -Werror -Wconversion -Os -ffunction-sections \
+-fdata-sections -mcpu=cortex-m0plus -mthumb -Ifirmware/core $defs"
+    local objs=()
+    for f in tests/fw/curve_core_m0.c "$@"; do
+        arm-none-eabi-gcc $fl -c "$f" -o "$d/$(basename "$f" .c).o"
+        objs+=("$d/$(basename "$f" .c).o")
+    done
+    arm-none-eabi-gcc -mcpu=cortex-m0plus -mthumb -nostdlib -nostartfiles -e main \
+        -Wl,--gc-sections -Wl,-Map="$d/m.map" "${objs[@]}" -lgcc -o "$d/m.elf"
+    bash scripts/fw-check.sh arm-none-eabi-nm "$d/m.elf"
+    local total core
+    total=$(map_modules "$d/m.map" | awk '{s += $NF} END {print s}')
+    core=$(map_modules "$d/m.map" | awk '$1 != "curve_core_m0" {s += $NF} END {print s}')
+    echo "| module | flash bytes |"
+    echo "|---|---:|"
+    map_modules "$d/m.map" | awk '{n = $NF; $NF = ""; sub(/ $/, ""); printf "| %s | %d |\n", $0, n}'
+    echo "| **curve core (all but the test main)** | **$core** |"
+    echo "| whole test program | $total |"
+    echo
+    CORE_BYTES=$core
+}
+
+fw_section() {
+    echo "## Firmware"
+    echo
+    echo "From the images \`make firmware\` builds (docs/firmware.md): arm-none-eabi-gcc"
+    echo "$(arm-none-eabi-gcc -dumpversion), avr-gcc $(avr-gcc -dumpversion 2>/dev/null || echo '?'), -Os, -ffunction-sections, --gc-sections."
+    echo
+    echo "### Flash and RAM of each image"
+    echo
+    echo "RAM is the static part (data + bss + noinit); the stack comes on top."
+    echo
+    echo "| image | flash bytes | of | RAM bytes | of |"
+    echo "|---|---:|---:|---:|---:|"
+    local elf tool fl ram fsz rsz
+    for elf in build/fw/*/curvestep.elf build/fw/*/*bench*.elf; do
+        [ -f "$elf" ] || continue
+        case "$elf" in
+        */avr/*) tool=avr-size; fsz=32768; rsz=2048 ;;
+        *) tool=arm-none-eabi-size; fsz=262144; rsz=65536 ;;
+        esac
+        read -r fl ram < <(image_size "$tool" "$elf")
+        echo "| \`$elf\` | $fl | $fsz | $ram | $rsz |"
+    done
+    echo
+    echo "### The core alone, per target"
+    echo
+    echo "Every module of firmware/core compiled (not linked) at -Os (\`make cross\`): the upper"
+    echo "bound of what an image can take from the core; an image links only what it calls."
+    echo
+    echo '| target | text + data bytes |'
+    echo '|---|---:|'
+    bash scripts/cross-size.sh build/cross $(ls firmware/core/*.c) |
+        awk '/^  [a-z]/ {printf "| %s | %s |\n", $1, $2}'
+    echo
+    echo "### The curve core on Cortex-M0+"
+    echo
+    echo "The goal: the curve core under 3 KB of flash on a Cortex-M0+ (Marlin's floating-point G5"
+    echo "costs about 2.7 KB). Measured by linking tests/fw/curve_core_m0.c (a main that traces"
+    echo "one cubic Bezier) with --gc-sections for -mcpu=cortex-m0plus at -Os and summing the"
+    echo "input sections the linker kept per module (its map file). libgcc supplies the 64-bit"
+    echo "multiply and shifts the M0+ lacks; memcpy/memset are in the test main."
+    echo
+    echo "**Polynomial cubic by forward differences** (cs_fixed + cs_bezier + cs_fd, built with"
+    echo "\`-DCS_FD_RATIONAL=0\`, the G5 equivalent):"
+    echo
+    curve_core fd_poly "-DCURVE_CORE_FD -DCS_FD_RATIONAL=0" firmware/core/cs_fixed.c \
+        firmware/core/cs_bezier.c firmware/core/cs_fd.c
+    local fd_poly=$CORE_BYTES
+    echo "**The same with rational curves** (default build: exact 128-bit homogeneous FD):"
+    echo
+    curve_core fd_rat "-DCURVE_CORE_FD" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
+        firmware/core/cs_fd.c
+    local fd_rat=$CORE_BYTES
+    echo "**Every tracer** (cs_trace: FD, AFD and flatness subdivision, rational included):"
+    echo
+    curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
+        firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
+        firmware/core/cs_trace.c
+    local trace=$CORE_BYTES
+    local verdict="met"
+    [ "$fd_poly" -lt 3072 ] || verdict="NOT met"
+    echo "Against the goal (3 KB = 3072 bytes): the polynomial FD curve core takes **$fd_poly bytes**:"
+    echo "goal $verdict. With rational curves it takes $fd_rat bytes, with every tracer $trace bytes"
+    echo "(over the goal: those are what curves mode links, not the G5 equivalent)."
+    echo
+    local bench=build/fw/cortex-m3/fdbench.elf
+    if [ -f "$bench" ] && command -v qemu-system-arm >/dev/null; then
+        echo "### Cortex-M3 instructions per point and per chord (qemu -icount)"
+        echo
+        echo "\`$bench\` (firmware/ports/cortex-m3/fdbench.c) runs the curve code on the LM3S6965"
+        echo "in qemu-system-arm with \`-icount shift=0\`: the virtual clock advances exactly 1 ns per"
+        echo "guest instruction, so the SysTick cycles it reads (20 ns each at 50 MHz) count"
+        echo "instructions (x 20; a read of the counter itself costs about one cycle). One 100 mm S-shaped cubic;"
+        echo "FD points at 1 um tolerance, chords at 0.01 mm. Instructions, not cycles: a real"
+        echo "Cortex-M3 takes about 1 to 1.5 cycles per instruction (loads, taken branches)."
+        echo
+        local out
+        out=$(timeout 60 qemu-system-arm -M lm3s6965evb -kernel "$bench" -display none \
+            -monitor none -serial null -icount shift=0 \
+            -semihosting-config enable=on,target=native 2>&1) || {
+            echo "(fdbench failed: $out)"
+            return
+        }
+        echo "| what | calls | instructions | per call |"
+        echo "|---|---:|---:|---:|"
+        printf '%s\n' "$out" | awk '
+            $1 == "bench:" && $2 != "overhead" && $2 != "planner_segments" {
+                n = $4; i = $6 * 20
+                w = $2
+                if (w == "fd_begin") w = "cs_fd_begin (Wang bound, initial differences)"
+                else if (w == "fd_point") w = "**cs_fd_next: one FD point**"
+                else if (w == "trace_fd_chord") w = "cs_trace, FD: one chord (begin included)"
+                else if (w == "trace_afd_chord") w = "cs_trace, AFD: one chord (begin included)"
+                else if (w == "trace_subdiv_chord") w = "cs_trace, subdivision: one chord (begin included)"
+                else if (w == "planner_chord") w = "**cs_planner_line3 + cs_segment_next: one chord planned and cut**"
+                printf "| %s | %d | %d | %.0f |\n", w, n, i, i / n }
+            $2 == "planner_segments" {seg = $4}
+            END {if (seg) printf "\n(The planner run cut its chords into %d step segments.)\n", seg}'
+        echo
+        echo "Per chord of a CURVE message the M3 device thus spends the tracer's share plus the"
+        echo "planner's; at 50 MHz that bounds how many chords per second curves mode can plan."
+        echo
+    fi
+    local b
+    for b in tests/fw/bench_*.sh; do
+        [ -f "$b" ] || continue
+        echo "bench: running $b" >&2
+        bash "$b" "build/bench/$(basename "$b" .sh).csv" || echo "($b failed)"
+        echo
+    done
+}
+
 out=docs/benchmarks.md
 tmp=$(mktemp)
 cpu=$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -n1)
@@ -29,6 +195,10 @@ cpu=$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -n1)
         echo '```'
         bash scripts/cross-size.sh build/cross $(ls firmware/core/*.c)
         echo '```'
+        echo
+    fi
+    if [ -n "$(ls build/fw/*/curvestep.elf 2>/dev/null)" ]; then
+        fw_section
     fi
 } > "$tmp"
 mv "$tmp" "$out"

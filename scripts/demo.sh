@@ -4,7 +4,9 @@
 # device's check report: max deviation from the exact curves, job time, retransmissions, final
 # position, and the picture it drew. Part 1 streams step segments; part 2 the same drawing as
 # cubic curves the device interpolates itself, over a line paced at 115200 baud; part 3 keeps the
-# first demo's flattening picture. Exits non-zero when any check fails. Every background process
+# first demo's flattening picture; part 4 makes the Utah teapot's iso wireframe and ball-end
+# finishing path (`curvestep toolpath --gcode`), plans them and runs them through the simulator,
+# which checks and draws them. Exits non-zero when any check fails. Every background process
 # is bounded by `timeout` and killed on exit.
 set -u
 BUILD=${BUILD:-build}
@@ -92,9 +94,49 @@ else
     echo "  max deviation $dev mm; picture: $OUT/flatten.svg"
 fi
 
+# demo 4: the Utah teapot (tests/data/teapot, 10 mm per unit): its iso wireframe for a pen plotter
+# and its ball-end finishing path, each written as G-code by `curvestep toolpath`, planned, and
+# executed and drawn by the simulator (coarse settings keep it to a few seconds).
+TEAPOT=tests/data/teapot/newell_teapot.txt
+echo
+echo "demo 4: the Utah teapot through the simulator (toolpath --gcode, plan, curvestep-sim)"
+# surface NAME VIEW TOOLPATH-ARGS...: toolpath -> G-code -> plan -> simulated run, checked, drawn.
+surface() {
+    local name=$1 view=$2
+    shift 2
+    echo "  curvestep toolpath --patches $TEAPOT --scale 10 $* --gcode $OUT/$name.nc"
+    if ! timeout 120 "$CS" toolpath --patches "$TEAPOT" --scale 10 "$@" --gcode "$OUT/$name.nc" \
+        --stats >"$OUT/$name.txt" 2>"$OUT/$name.toolpath"; then
+        echo "  $name: FAILED (toolpath)"
+        failures=$((failures + 1))
+        return
+    fi
+    grep -E '^(toolpath: |curvestep toolpath: warning)' "$OUT/$name.toolpath" | sed 's/^/  /'
+    if ! timeout 120 "$CS" plan -o "$OUT/$name.seg" "$OUT/$name.nc" 2>"$OUT/$name.plan"; then
+        echo "  $name: FAILED (plan)"
+        failures=$((failures + 1))
+        return
+    fi
+    sed 's/^/  /' "$OUT/$name.plan"
+    timeout 120 "$SIM" --replay "$OUT/$name.seg" --reference "$OUT/$name.nc" --check \
+        --view "$view" --svg "$OUT/$name.svg" --png "$OUT/$name.png" >"$OUT/$name.report" 2>&1
+    local rc=$?
+    grep -E '^(replay|final position|deviation|check)' "$OUT/$name.report" | sed 's/^/  /'
+    echo "  picture ($view view, drawn by the simulator): $OUT/$name.svg ($OUT/$name.png)"
+    if [ $rc -ne 0 ] || ! grep -q '^check: ok$' "$OUT/$name.report"; then
+        echo "  $name: FAILED (simulator exit $rc)"
+        failures=$((failures + 1))
+    fi
+}
+# The wireframe is projected to the iso view by toolpath (a 2D job): the simulator draws it as is.
+surface teapot-wireframe top --view iso --lines 4
+echo
+surface teapot-finish iso --ball 2 --scallop 0.5
+
 echo
 if [ "$failures" -ne 0 ]; then
     echo "demo: $failures check(s) FAILED"
     exit 1
 fi
-echo "demo: all checks passed; the streamed drawing: $OUT/stream.svg"
+echo "demo: all checks passed; the streamed drawing: $OUT/stream.svg; the teapot:"
+echo "      $OUT/teapot-wireframe.png, $OUT/teapot-finish.png"

@@ -9,7 +9,9 @@ libcmocka-dev libexpat1-dev libinih-dev libcairo2-dev \
 gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi \
 gcc-avr avr-libc binutils-avr \
 clang llvm libclang-rt-14-dev libagg-dev \
-librsvg2-bin"
+librsvg2-bin \
+libmodbus-dev libgpiod-dev \
+qemu-system-arm simavr libsimavr-dev libelf-dev"
 
 missing=""
 for p in $PKGS; do

@@ -114,11 +114,12 @@ void cs_sim_ref_init(cs_sim_ref_t *r)
 void cs_sim_ref_free(cs_sim_ref_t *r)
 {
     free(r->xyz);
+    free(r->travel);
     free(r->starts);
     cs_sim_ref_init(r);
 }
 
-static cs_err_t ref_point(cs_sim_ref_t *r, const double p[3])
+static cs_err_t ref_point(cs_sim_ref_t *r, const double p[3], bool travel)
 {
     if (r->n == r->cap) {
         size_t cap = r->cap ? r->cap * 2 : 1024;
@@ -126,9 +127,14 @@ static cs_err_t ref_point(cs_sim_ref_t *r, const double p[3])
         if (v == NULL)
             return CS_ERR_FULL;
         r->xyz = v;
+        unsigned char *t = realloc(r->travel, cap);
+        if (t == NULL)
+            return CS_ERR_FULL;
+        r->travel = t;
         r->cap = cap;
     }
     memcpy(&r->xyz[3 * r->n], p, 3 * sizeof *p);
+    r->travel[r->n] = travel;
     r->n++;
     return CS_OK;
 }
@@ -144,14 +150,21 @@ cs_err_t cs_sim_ref_move(cs_sim_ref_t *r, const double p[3])
         r->caplines = cap;
     }
     r->starts[r->nlines++] = r->n;
-    return ref_point(r, p);
+    return ref_point(r, p, false);
 }
 
 cs_err_t cs_sim_ref_line(cs_sim_ref_t *r, const double p[3])
 {
     if (r->nlines == 0)
         return cs_sim_ref_move(r, p);
-    return ref_point(r, p);
+    return ref_point(r, p, false);
+}
+
+cs_err_t cs_sim_ref_travel(cs_sim_ref_t *r, const double p[3])
+{
+    if (r->nlines == 0)
+        return cs_sim_ref_move(r, p);
+    return ref_point(r, p, true);
 }
 
 double cs_sim_step_mm(const cs_machine_t *m)
@@ -335,8 +348,9 @@ cs_err_t cs_sim_ref_from_path(cs_sim_ref_t *r, const cs_path_t *path, double end
         const cs_bezier_t *c = &path->elems[k].curve;
         double p0[3], poly = 0;
         cs_path_eval_mm(c, 0.0, p0);
+        bool rapid = path->elems[k].rapid;
         if (p0[0] != cur[0] || p0[1] != cur[1] || p0[2] != cur[2])
-            e = cs_sim_ref_line(r, p0); /* travel */
+            e = cs_sim_ref_travel(r, p0); /* travel */
         for (unsigned i = 0; i < c->degree; i++) {
             double dx = (c->p[i + 1].x - c->p[i].x) / 65536.0;
             double dy = (c->p[i + 1].y - c->p[i].y) / 65536.0;
@@ -347,7 +361,7 @@ cs_err_t cs_sim_ref_from_path(cs_sim_ref_t *r, const cs_path_t *path, double end
         for (size_t j = 1; j <= n && e == CS_OK; j++) {
             double q[3];
             cs_path_eval_mm(c, (double)j / (double)n, q);
-            e = cs_sim_ref_line(r, q);
+            e = rapid ? cs_sim_ref_travel(r, q) : cs_sim_ref_line(r, q);
             memcpy(cur, q, sizeof q);
         }
     }

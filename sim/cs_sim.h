@@ -45,7 +45,8 @@ void cs_sim_dynamics(const cs_machine_t *m, const cs_sim_exec_t *ex, double wind
 
 /* Reference geometry: polylines in mm (3D), dense enough to stand for the exact curves. */
 typedef struct {
-    double *xyz; /* 3 per point */
+    double *xyz;           /* 3 per point */
+    unsigned char *travel; /* per point: 1 when the piece ending there is a travel (G0 or gap) */
     size_t n, cap;
     size_t *starts; /* first point of each polyline */
     size_t nlines, caplines;
@@ -56,9 +57,12 @@ void cs_sim_ref_free(cs_sim_ref_t *r);
 /* Starts a new polyline at p / appends p to the current one. CS_ERR_FULL on out of memory. */
 cs_err_t cs_sim_ref_move(cs_sim_ref_t *r, const double p[3]);
 cs_err_t cs_sim_ref_line(cs_sim_ref_t *r, const double p[3]);
+/* Appends p as the end of a travel move (not drawn like a cut). CS_ERR_FULL on out of memory. */
+cs_err_t cs_sim_ref_travel(cs_sim_ref_t *r, const double p[3]);
 
 /* The job's exact geometry as dense polylines: from (0, 0, 0), a straight travel to every element
- * that does not start where the previous one ended, then each element sampled in double
+ * that does not start where the previous one ended (marked travel, as are rapid elements), then
+ * each element sampled in double
  * (cs_path_eval_mm) every 0.005 mm of its control polygon (at least 64 pieces). *end gets the
  * last point (the job's final position). */
 cs_err_t cs_sim_ref_from_path(cs_sim_ref_t *r, const cs_path_t *path, double end[3]);

@@ -32,7 +32,7 @@ typedef struct {
     bool item_end; /* last segment of that item (SEGMENT messages: always) */
 } tag_t;
 
-typedef struct {
+struct cs_sim_motion {
     const cs_sim_device_cfg_t *cfg;
     const cs_machine_t *m;
     cs_sim_device_result_t *res;
@@ -87,7 +87,9 @@ typedef struct {
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
     double last_rx_s;
-} sim_dev_t;
+    uint8_t inv; /* DIR lines inverted (port_posix_reset) */
+};
+typedef struct cs_sim_motion sim_dev_t;
 
 uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s)
 {
@@ -463,13 +465,8 @@ static void on_deliver(sim_dev_t *d, const cs_link_event_t *ev)
     switch (m.type) {
     case CS_PROTO_SEGMENT:
     case CS_PROTO_CURVE:
-        if (d->qcount >= d->cfg->queue_size) { /* cs_link refuses it first; belt and braces */
+        if (cs_sim_motion_queue(d, &m, ev->seq) != CS_OK) /* cs_link refuses it first */
             push_error(d, CS_ERR_FULL, ev->seq);
-            return;
-        }
-        d->q[(d->qhead + d->qcount) % CS_SIM_DEVICE_QUEUE_MAX] = (qitem_t){m, ev->seq};
-        d->qcount++;
-        d->aborted = false;
         break;
     case CS_PROTO_HOLD:
         d->held = true;
@@ -559,34 +556,10 @@ static void sleep_ms(int ms)
 cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile sig_atomic_t *stop,
                              cs_sim_device_result_t *res)
 {
-    memset(res, 0, sizeof *res);
-    res->seg_hash = CS_SIM_DEVICE_HASH0;
-    if (cfg == NULL || cfg->m == NULL || cfg->queue_size < 1 ||
-        cfg->queue_size > CS_SIM_DEVICE_QUEUE_MAX)
-        return CS_ERR_ARG;
-    sim_dev_t *d = calloc(1, sizeof *d);
-    if (d == NULL)
-        return CS_ERR_FULL;
-    d->cfg = cfg;
-    d->m = cfg->m;
-    d->res = res;
-    cs_err_t e = cs_stepper_init(&d->st, d->m);
-    if (e == CS_OK)
-        e = cs_planner_init(&d->pl, d->m);
-    if (e == CS_OK)
-        e = cs_segment_init(&d->gen, d->m);
-    if (e != CS_OK) {
-        free(d);
-        return CS_ERR_ARG;
-    }
-    uint8_t inv = 0;
-    for (unsigned i = 0; i < d->m->n_axes; i++)
-        if (d->m->axis[i].invert_dir)
-            inv = (uint8_t)(inv | (1u << i));
-    port_posix_reset(d->m->tick_hz, inv);
-    port_posix_record(true);
-    port_stepper_attach(&d->st);
-
+    sim_dev_t *d;
+    cs_err_t e = cs_sim_motion_open(&d, cfg, res);
+    if (e != CS_OK)
+        return e;
     cs_serial_attach(&d->ser, fd);
     cs_serial_set_lossy(&d->ser, true);
     cs_serial_set_line_rate(&d->ser, cfg->line_rate);
@@ -681,18 +654,138 @@ cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile si
             wall - d->last_rx_s > cfg->idle_exit_s)
             break;
     }
-    /* what the executor still holds is executed (a stop request finishes the ring) */
-    port_posix_run(UINT64_MAX);
-    note_completed(d);
     res->link = d->link.stats;
     res->frames = d->link.dec.stats;
     res->bytes_in = d->ser.bytes_in;
     res->bytes_out = d->ser.bytes_out;
-    res->ticks = port_posix_now();
     res->wall_s = cs_serial_now_s() - start;
+    cs_err_t ce = cs_sim_motion_close(d);
+    return rc != CS_OK ? rc : ce;
+}
+
+/* --- the motion side, shared with the Modbus device ---------------------------------------- */
+
+cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
+                            cs_sim_device_result_t *res)
+{
+    *out = NULL;
+    memset(res, 0, sizeof *res);
+    res->seg_hash = CS_SIM_DEVICE_HASH0;
+    if (cfg == NULL || cfg->m == NULL || cfg->queue_size < 1 ||
+        cfg->queue_size > CS_SIM_DEVICE_QUEUE_MAX)
+        return CS_ERR_ARG;
+    sim_dev_t *d = calloc(1, sizeof *d);
+    if (d == NULL)
+        return CS_ERR_FULL;
+    d->cfg = cfg;
+    d->m = cfg->m;
+    d->res = res;
+    cs_err_t e = cs_stepper_init(&d->st, d->m);
+    if (e == CS_OK)
+        e = cs_planner_init(&d->pl, d->m);
+    if (e == CS_OK)
+        e = cs_segment_init(&d->gen, d->m);
+    if (e != CS_OK) {
+        free(d);
+        return CS_ERR_ARG;
+    }
+    for (unsigned i = 0; i < d->m->n_axes; i++)
+        if (d->m->axis[i].invert_dir)
+            d->inv = (uint8_t)(d->inv | (1u << i));
+    port_posix_reset(d->m->tick_hz, d->inv);
+    port_posix_record(true);
+    port_stepper_attach(&d->st);
+    d->exec_seq = 0xFFFFu;
+    d->item_seq[0] = 0xFFFFu;
+    d->state = CS_PROTO_STATE_IDLE;
+    *out = d;
+    return CS_OK;
+}
+
+cs_err_t cs_sim_motion_queue(sim_dev_t *d, const cs_proto_msg_t *m, uint16_t seq)
+{
+    if (m->type != CS_PROTO_SEGMENT && m->type != CS_PROTO_CURVE)
+        return CS_ERR_UNSUPPORTED;
+    if (d->qcount >= d->cfg->queue_size)
+        return CS_ERR_FULL;
+    d->q[(d->qhead + d->qcount) % CS_SIM_DEVICE_QUEUE_MAX] = (qitem_t){*m, seq};
+    d->qcount++;
+    d->aborted = false;
+    return CS_OK;
+}
+
+void cs_sim_motion_hold(sim_dev_t *d, bool on)
+{
+    if (on && !d->held)
+        d->res->holds++;
+    d->held = on;
+    d->status_due = true;
+}
+
+void cs_sim_motion_abort(sim_dev_t *d)
+{
+    do_abort(d);
+    d->status_due = true;
+}
+
+void cs_sim_motion_advance(sim_dev_t *d, double wall_s)
+{
+    advance(d, wall_s);
+}
+
+uint16_t cs_sim_motion_free_slots(const sim_dev_t *d)
+{
+    return free_slots(d);
+}
+
+void cs_sim_motion_status(const sim_dev_t *d, cs_proto_status_t *st)
+{
+    st->state = d->state;
+    st->boot_id = d->boot;
+    st->queue_fill = (uint16_t)d->qcount;
+    st->last_seq = d->exec_seq;
+    st->axes = d->m->n_axes;
+    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
+        st->pos[i] = i < d->m->n_axes ? cs_stepper_position(&d->st, i) : 0;
+}
+
+bool cs_sim_motion_pop_error(sim_dev_t *d, cs_proto_error_t *e)
+{
+    if (d->nerr == 0)
+        return false;
+    *e = d->errs[0];
+    memmove(d->errs, d->errs + 1, (d->nerr - 1) * sizeof d->errs[0]);
+    d->nerr--;
+    d->res->errors_sent++;
+    return true;
+}
+
+bool cs_sim_motion_done(const sim_dev_t *d)
+{
+    return everything_done(d);
+}
+
+bool cs_sim_motion_started(const sim_dev_t *d)
+{
+    return d->exec_item > 0;
+}
+
+bool cs_sim_motion_busy(const sim_dev_t *d)
+{
+    return !everything_done(d) && !d->held;
+}
+
+cs_err_t cs_sim_motion_close(sim_dev_t *d)
+{
+    cs_sim_device_result_t *res = d->res;
+    cs_err_t rc = CS_OK;
+    /* what the executor still holds is executed (a stop request finishes the ring) */
+    port_posix_run(UINT64_MAX);
+    note_completed(d);
+    res->ticks = port_posix_now();
     for (unsigned i = 0; i < CS_AXES; i++)
         res->pos[i] = port_posix_position(i);
-    if (cfg->keep_edges) {
+    if (d->cfg->keep_edges) {
         size_t ne;
         const port_posix_edge_t *edges = port_posix_edges(&ne);
         if (!port_posix_record_ok()) {
@@ -712,7 +805,7 @@ cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile si
             res->ex.exec_pos[i] = cs_stepper_position(&d->st, i);
         }
     }
-    port_posix_reset(d->m->tick_hz, inv); /* frees the port's copy of the edges */
+    port_posix_reset(d->m->tick_hz, d->inv); /* frees the port's copy of the edges */
     port_stepper_attach(NULL);
     free(d);
     return rc;
@@ -977,7 +1070,6 @@ int cs_sim_device_main(int argc, char **argv)
         rc = INTERNAL;
     }
     bool ok = true;
-    static const char names[] = "xyza";
     printf("device: served %.2f s; %llu messages executed (%llu step segments, %llu curves); "
            "%u resets, %u holds, %u aborts, %u errors sent%s\n",
            res.wall_s, (unsigned long long)res.executed, (unsigned long long)res.segments,
@@ -990,8 +1082,31 @@ int cs_sim_device_main(int argc, char **argv)
            (unsigned)res.frames.frames, (unsigned)res.frames.crc_errs, (unsigned)res.frames.bad,
            (unsigned)res.link.duplicates, (unsigned)res.link.out_of_order,
            (unsigned)res.link.retransmits);
+    cs_sim_device_out_t out = {reference, trace, svg, png, check, &ref, {0, 0, 0}};
+    memcpy(out.end_mm, end_mm, sizeof end_mm);
+    rc = cs_sim_device_report(&m, &cfg, &res, &out, ok, rc);
+    fflush(stdout);
+    cs_sim_ref_free(&ref);
+    cs_sim_exec_free(&res.ex);
+    return rc;
+}
+
+int cs_sim_device_report(const cs_machine_t *mp, const cs_sim_device_cfg_t *cfg,
+                         const cs_sim_device_result_t *resp, const cs_sim_device_out_t *o, bool ok,
+                         int rc)
+{
+    enum { OK = 0, INTERNAL = 3, CHECK = 4 };
+    static const char names[] = "xyza";
+    const cs_machine_t m = *mp;
+    const cs_sim_device_result_t res = *resp;
+    const char *reference = o->reference, *trace = o->trace, *svg = o->svg, *png = o->png;
+    const cs_sim_ref_t ref = *o->ref;
+    const double *end_mm = o->end_mm;
+    bool check = o->check;
     printf("executor ran dry %u times mid-job (%.3f s of wall time)\n", (unsigned)res.exec_gaps,
            res.gap_wall_s);
+    printf("executed step segments' hash (FNV-1a 64, in order): %016llx\n",
+           (unsigned long long)res.seg_hash);
     printf("job time: %.4f s simulated, %zu steps\n", (double)res.ticks / m.tick_hz, res.ex.n);
     printf("final position:");
     for (unsigned i = 0; i < m.n_axes; i++)
@@ -1017,7 +1132,7 @@ int cs_sim_device_main(int argc, char **argv)
     if (reference) {
         double where[3];
         double dev = cs_sim_deviation(&m, &res.ex, &ref, where);
-        double tol = cs_conv_pos_to_mm(cfg.tol > 0 ? cfg.tol : m.tolerance);
+        double tol = cs_conv_pos_to_mm(cfg->tol > 0 ? cfg->tol : m.tolerance);
         double bound = tol + cs_sim_step_mm(&m);
         bool dev_ok = dev <= bound;
         printf("max deviation: %.5f mm at (%.4f, %.4f, %.4f) (tolerance + one step = %.5f mm) "
@@ -1055,7 +1170,5 @@ int cs_sim_device_main(int argc, char **argv)
             rc = CHECK;
     }
     fflush(stdout);
-    cs_sim_ref_free(&ref);
-    cs_sim_exec_free(&res.ex);
     return rc;
 }

@@ -74,6 +74,52 @@ cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile si
  * h (start with CS_SIM_DEVICE_HASH0): what the tests compare with the host's own sum. */
 #define CS_SIM_DEVICE_HASH0 0xcbf29ce484222325ull
 uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s);
+
+/* The device's motion side, shared by the serial device above and the Modbus device
+ * (cs_sim_modbus): the motion queue, the planner and tracer for CURVE, the executor on the POSIX
+ * port paced against the wall clock (cfg->speed), HOLD / RESUME / ABORT, the sequence of the
+ * last executed message. Uses cfg's m, queue_size, speed, tol, method and keep_edges; one at a
+ * time per process (the POSIX port is process-wide). */
+typedef struct cs_sim_motion cs_sim_motion_t;
+/* Starts one (the last executed sequence reads 0xFFFF until something runs); *res is zeroed and
+ * filled as it runs. CS_ERR_ARG for a bad cfg, CS_ERR_FULL out of memory. */
+cs_err_t cs_sim_motion_open(cs_sim_motion_t **d, const cs_sim_device_cfg_t *cfg,
+                            cs_sim_device_result_t *res);
+/* Queues a SEGMENT or CURVE with its sequence: CS_ERR_FULL when no slot is free,
+ * CS_ERR_UNSUPPORTED for another type. */
+cs_err_t cs_sim_motion_queue(cs_sim_motion_t *d, const cs_proto_msg_t *m, uint16_t seq);
+/* HOLD (on) or RESUME (off); ABORT (the queue is flushed, the executor's ring finishes). */
+void cs_sim_motion_hold(cs_sim_motion_t *d, bool on);
+void cs_sim_motion_abort(cs_sim_motion_t *d);
+/* Runs the executor up to the wall time wall_s (cs_serial_now_s), feeding it from the queue. */
+void cs_sim_motion_advance(cs_sim_motion_t *d, double wall_s);
+uint16_t cs_sim_motion_free_slots(const cs_sim_motion_t *d);
+/* State, queue fill, last executed sequence and position (boot_id is not the motion's). */
+void cs_sim_motion_status(const cs_sim_motion_t *d, cs_proto_status_t *st);
+/* The oldest error the motion raised (a CURVE it cannot trace, ...): true and *e, else false. */
+bool cs_sim_motion_pop_error(cs_sim_motion_t *d, cs_proto_error_t *e);
+/* Queue empty and everything executed / something was executed / work to do and not held. */
+bool cs_sim_motion_done(const cs_sim_motion_t *d);
+bool cs_sim_motion_started(const cs_sim_motion_t *d);
+bool cs_sim_motion_busy(const cs_sim_motion_t *d);
+/* Finishes what the executor holds, fills res (ticks, pos, edges with keep_edges) and frees d.
+ * CS_ERR_FULL when the edges could not be kept. */
+cs_err_t cs_sim_motion_close(cs_sim_motion_t *d);
+
+/* The end-of-service report's common part (executor gaps, job time, final position, order,
+ * per-axis peaks, deviation from the reference, pictures, the check line), shared by the
+ * serial and the Modbus devices. ok: the link-specific checks passed. Returns rc, or 3 when a
+ * file could not be written, 4 when --check failed. */
+typedef struct {
+    const char *reference, *trace, *svg, *png; /* NULL: none */
+    bool check;
+    const cs_sim_ref_t *ref; /* loaded from reference (cs_sim_ref_from_path) */
+    double end_mm[3];        /* the job's end */
+} cs_sim_device_out_t;
+int cs_sim_device_report(const cs_machine_t *m, const cs_sim_device_cfg_t *cfg,
+                         const cs_sim_device_result_t *res, const cs_sim_device_out_t *o, bool ok,
+                         int rc);
+
 /* The `curvestep-sim --pty | --port DEV ...` command line (sim/main.c hands these over). */
 int cs_sim_device_main(int argc, char **argv);
 

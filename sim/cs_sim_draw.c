@@ -5,14 +5,54 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#define S2 0.70710678118654752440
+#define S6 0.40824829046386301637
+/* The projections of `curvestep toolpath --view` (host/cs_toolpath_cmd.c), same matrices:
+ * orthographic, orthonormal rows, picture y up. */
+static const cs_sim_view_t views[] = {
+    {"top", {{1, 0, 0, 0}, {0, 1, 0, 0}}, false},
+    {"front", {{1, 0, 0, 0}, {0, 0, 1, 0}}, false},
+    {"side", {{0, 1, 0, 0}, {0, 0, 1, 0}}, false},
+    /* seen from (1, -1, 1): right (1, 1, 0)/sqrt 2, up (-1, 1, 2)/sqrt 6 */
+    {"iso", {{S2, S2, 0, 0}, {-S6, S6, 2 * S6, 0}}, false},
+};
+
+void cs_sim_view_default(cs_sim_view_t *v)
+{
+    *v = views[0];
+    v->name = "xy";
+    v->y_down = true;
+}
+
+bool cs_sim_view_parse(const char *s, cs_sim_view_t *v)
+{
+    for (size_t k = 0; k < sizeof views / sizeof views[0]; k++)
+        if (strcmp(s, views[k].name) == 0) {
+            *v = views[k];
+            return true;
+        }
+    return false;
+}
+
+void cs_sim_view_project(const cs_sim_view_t *v, const double p[3], double out[2])
+{
+    for (int r = 0; r < 2; r++)
+        out[r] = v->m[r][0] * p[0] + v->m[r][1] * p[1] + v->m[r][2] * p[2] + v->m[r][3];
+    if (!v->y_down)
+        out[1] = -out[1]; /* picture coordinates have y down */
+}
 
 typedef struct {
-    double x, y, v; /* mm, and speed over the sample before it (mm/s) */
+    double x, y, v; /* picture coordinates (mm), and speed over the sample before it (mm/s) */
+    double p[3];    /* machine position, mm */
+    bool travel;    /* the reference piece it lies on is a travel */
 } sample_t;
 
 /* The executed path sampled every dt ticks (about 20000 samples at most, >= 1 ms apart). */
-static sample_t *exec_samples(const cs_machine_t *m, const cs_sim_exec_t *ex, size_t *n,
-                              double *vmax)
+static sample_t *exec_samples(const cs_machine_t *m, const cs_sim_exec_t *ex,
+                              const cs_sim_view_t *view, size_t *n)
 {
     uint64_t dt = m->tick_hz / 1000;
     if (ex->end_tick / 20000 > dt)
@@ -28,21 +68,25 @@ static sample_t *exec_samples(const cs_machine_t *m, const cs_sim_exec_t *ex, si
         spm[i] = (double)m->axis[i].steps_per_mm / CS_MOTION_ONE;
     int64_t pos[CS_AXES] = {0, 0, 0, 0};
     size_t e = 0, k = 0;
-    *vmax = 0;
     for (uint64_t t = 0; k < cap; t += dt) {
         while (e < ex->n && ex->edges[e].t <= t) {
             pos[ex->edges[e].axis] += ex->edges[e].dir;
             e++;
         }
-        s[k].x = (double)pos[0] / spm[0];
-        s[k].y = (double)pos[1] / spm[1];
+        for (int i = 0; i < 3; i++)
+            s[k].p[i] = (double)pos[i] / spm[i];
+        double q[2];
+        cs_sim_view_project(view, s[k].p, q);
+        s[k].x = q[0];
+        s[k].y = q[1];
         s[k].v = 0;
+        s[k].travel = false;
         if (k > 0) {
-            double dx = s[k].x - s[k - 1].x, dy = s[k].y - s[k - 1].y;
-            double z0 = 0; /* z speed ignored in the picture (pen up/down) */
-            s[k].v = sqrt(dx * dx + dy * dy + z0) / ((double)dt / m->tick_hz);
-            if (s[k].v > *vmax)
-                *vmax = s[k].v;
+            double d2 = 0;
+            /* The legacy xy picture ignores z in the speed (pen up/down); a view uses 3D speed. */
+            for (int i = 0; i < (view->y_down ? 2 : 3); i++)
+                d2 += (s[k].p[i] - s[k - 1].p[i]) * (s[k].p[i] - s[k - 1].p[i]);
+            s[k].v = sqrt(d2) / ((double)dt / m->tick_hz);
         }
         k++;
         if (t > ex->end_tick)
@@ -52,7 +96,104 @@ static sample_t *exec_samples(const cs_machine_t *m, const cs_sim_exec_t *ex, si
     return s;
 }
 
-static void bounds(const sample_t *s, size_t n, const cs_sim_ref_t *ref, double lo[2], double hi[2])
+static double seg_dist(const double *p, const double *a, const double *b)
+{
+    double ab[3], ap[3], l2 = 0, t = 0, d2 = 0;
+    for (int i = 0; i < 3; i++) {
+        ab[i] = b[i] - a[i];
+        ap[i] = p[i] - a[i];
+        l2 += ab[i] * ab[i];
+        t += ab[i] * ap[i];
+    }
+    t = l2 > 0 ? fmin(fmax(t / l2, 0), 1) : 0;
+    for (int i = 0; i < 3; i++) {
+        double d = ap[i] - t * ab[i];
+        d2 += d * d;
+    }
+    return sqrt(d2);
+}
+
+/* Piece j of the reference runs from point j - 1 to point j; false for a polyline's first point
+ * (no piece ends there). */
+static bool is_piece(const cs_sim_ref_t *r, size_t j, size_t *line)
+{
+    while (*line + 1 < r->nlines && r->starts[*line + 1] <= j)
+        (*line)++;
+    return j > 0 && r->starts[*line] != j;
+}
+
+/* Marks the samples that lie on travel pieces of the reference. The executor runs the job in
+ * order, so a cursor moves forward along the reference: each sample takes the nearest piece
+ * within a window ahead of the cursor (the rest of the cursor's piece and then an arc length of
+ * 2 x the larger of the sample's move and its distance from the cursor's piece, + 1 mm; a piece
+ * that points against the sample's motion counts 0.1 mm farther; ties go to the earliest
+ * piece); when nothing in the window is within 0.2 mm (the executed path stays within
+ * tolerance + one step of the reference) the rest of the reference is searched (at most 200
+ * times per picture). Returns whether any sample is travel. */
+static bool classify(sample_t *s, size_t n, const cs_sim_ref_t *r)
+{
+    if (r == NULL || r->travel == NULL || r->n < 2)
+        return false;
+    bool any = false;
+    size_t cur = 1, line = 0;
+    int searches = 0;
+    for (size_t k = 0; k < n; k++) {
+        double move = 0;
+        if (k > 0)
+            for (int i = 0; i < 3; i++)
+                move += (s[k].p[i] - s[k - 1].p[i]) * (s[k].p[i] - s[k - 1].p[i]);
+        double dcur = seg_dist(s[k].p, &r->xyz[3 * (cur - 1)], &r->xyz[3 * cur]);
+        const double *ca = &r->xyz[3 * (cur - 1)], *cb = &r->xyz[3 * cur];
+        /* The window is the rest of the cursor's piece (counted whole) and reach beyond it. */
+        double reach = 2 * fmax(sqrt(move), dcur) + 1, best = HUGE_VAL;
+        double walked =
+            -sqrt((cb[0] - ca[0]) * (cb[0] - ca[0]) + (cb[1] - ca[1]) * (cb[1] - ca[1]) +
+                  (cb[2] - ca[2]) * (cb[2] - ca[2]));
+        size_t best_j = cur, l = line, best_l = line;
+        /* The search of the whole rest costs the reference's size: at most 200 of them (a
+         * reference that does not match the run, or a machine tolerance above 0.2 mm). */
+        for (int pass = 0; pass < 2 && best > 0.2 && (pass == 0 || searches++ < 200); pass++) {
+            for (size_t j = cur; j < r->n && (pass == 1 || walked <= reach); j++) {
+                if (!is_piece(r, j, &l))
+                    continue;
+                const double *a = &r->xyz[3 * (j - 1)], *b = &r->xyz[3 * j];
+                double d = seg_dist(s[k].p, a, b);
+                /* A piece run backwards scores worse: the retract of one patch and the plunge
+                 * of the next can be the same line, told apart by the direction of motion. */
+                double dot = 0;
+                for (int i = 0; k > 0 && i < 3; i++)
+                    dot += (s[k].p[i] - s[k - 1].p[i]) * (b[i] - a[i]);
+                if (dot < 0)
+                    d += 0.1;
+                if (d < best) {
+                    best = d;
+                    best_j = j;
+                    best_l = l;
+                }
+                walked += sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                               (b[2] - a[2]) * (b[2] - a[2]));
+            }
+            l = line;
+        }
+        cur = best_j;
+        line = best_l;
+        s[k].travel = r->travel[cur] != 0;
+        any = any || s[k].travel;
+    }
+    return any;
+}
+
+static double top_speed(const sample_t *s, size_t n)
+{
+    double vmax = 0;
+    for (size_t k = 1; k < n; k++)
+        if (!s[k].travel && s[k].v > vmax)
+            vmax = s[k].v;
+    return vmax;
+}
+
+static void bounds(const sample_t *s, size_t n, const cs_sim_ref_t *ref, const cs_sim_view_t *view,
+                   double lo[2], double hi[2])
 {
     lo[0] = lo[1] = HUGE_VAL;
     hi[0] = hi[1] = -HUGE_VAL;
@@ -63,10 +204,12 @@ static void bounds(const sample_t *s, size_t n, const cs_sim_ref_t *ref, double 
         hi[1] = fmax(hi[1], s[k].y);
     }
     for (size_t k = 0; ref && k < ref->n; k++) {
-        lo[0] = fmin(lo[0], ref->xyz[3 * k]);
-        lo[1] = fmin(lo[1], ref->xyz[3 * k + 1]);
-        hi[0] = fmax(hi[0], ref->xyz[3 * k]);
-        hi[1] = fmax(hi[1], ref->xyz[3 * k + 1]);
+        double q[2];
+        cs_sim_view_project(view, &ref->xyz[3 * k], q);
+        lo[0] = fmin(lo[0], q[0]);
+        lo[1] = fmin(lo[1], q[1]);
+        hi[0] = fmax(hi[0], q[0]);
+        hi[1] = fmax(hi[1], q[1]);
     }
     if (!(lo[0] <= hi[0])) {
         lo[0] = lo[1] = 0;
@@ -99,31 +242,84 @@ static void speed_rgb(double f, double rgb[3])
     rgb[2] = b * 0.9;
 }
 
-int cs_sim_draw_svg(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
-                    const cs_sim_ref_t *ref)
+/* The reference's cut pieces as runs of consecutive points (travel pieces are left out: the
+ * executed travel is drawn instead). Calls fn(ctx, first, count) per run of >= 2 points. */
+static void ref_runs(const cs_sim_ref_t *ref,
+                     void (*fn)(void *, const cs_sim_ref_t *, size_t, size_t,
+                                const cs_sim_view_t *),
+                     void *ctx, const cs_sim_view_t *view)
+{
+    for (size_t li = 0; ref && li < ref->nlines; li++) {
+        size_t b = ref->starts[li], e = li + 1 < ref->nlines ? ref->starts[li + 1] : ref->n;
+        size_t run = b;
+        for (size_t k = b + 1; k <= e; k++) {
+            bool cut_piece = k < e && !(ref->travel && ref->travel[k]);
+            if (cut_piece)
+                continue;
+            if (k - run >= 2)
+                fn(ctx, ref, run, k - run, view);
+            run = k;
+        }
+        if (e - b == 1)
+            fn(ctx, ref, b, 1, view);
+    }
+}
+
+static void svg_ref_run(void *ctx, const cs_sim_ref_t *ref, size_t b, size_t n,
+                        const cs_sim_view_t *view)
+{
+    FILE *f = ctx;
+    fprintf(f, "<polyline points=\"");
+    for (size_t k = b; k < b + n; k++) {
+        double q[2];
+        cs_sim_view_project(view, &ref->xyz[3 * k], q);
+        fprintf(f, "%.4f,%.4f ", q[0], q[1]);
+    }
+    fprintf(f, "\"/>\n");
+}
+
+int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                         const cs_sim_ref_t *ref, const cs_sim_view_t *view)
 {
     size_t n;
-    double vmax, lo[2], hi[2];
-    sample_t *s = exec_samples(m, ex, &n, &vmax);
+    double lo[2], hi[2];
+    sample_t *s = exec_samples(m, ex, view, &n);
     if (s == NULL)
         return -1;
+    bool travel = classify(s, n, ref);
+    double vmax = top_speed(s, n);
     FILE *f = fopen(file, "w");
     if (f == NULL) {
         free(s);
         return -1;
     }
-    bounds(s, n, ref, lo, hi);
+    bounds(s, n, ref, view, lo, hi);
     double w = hi[0] - lo[0], h = hi[1] - lo[1], lw = fmax(w, h) / 1500;
     fprintf(f,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.3fmm\" height=\"%.3fmm\" "
             "viewBox=\"%.4f %.4f %.4f %.4f\">\n"
-            "<title>curvestep-sim: exact geometry (black) and executed path coloured by speed "
-            "(blue slow .. red %.1f mm/s)</title>\n"
+            "<title>curvestep-sim, view %s: exact geometry (black), executed path coloured by "
+            "speed (blue slow .. red %.1f mm/s)%s</title>\n"
             "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" fill=\"white\"/>\n",
-            w, h, lo[0], lo[1], w, h, vmax, lo[0], lo[1], w, h);
+            w, h, lo[0], lo[1], w, h, view->name, vmax, travel ? ", travel moves dashed grey" : "",
+            lo[0], lo[1], w, h);
+    /* Travel first (underneath): runs of travel samples as dashed grey polylines. */
+    for (size_t k = 1; k < n;) {
+        if (!s[k].travel) {
+            k++;
+            continue;
+        }
+        fprintf(f,
+                "<polyline class=\"travel\" fill=\"none\" stroke=\"#999999\" "
+                "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" points=\"%.4f,%.4f",
+                lw, 6 * lw, 4 * lw, s[k - 1].x, s[k - 1].y);
+        for (; k < n && s[k].travel; k++)
+            fprintf(f, " %.4f,%.4f", s[k].x, s[k].y);
+        fprintf(f, "\"/>\n");
+    }
     for (size_t k = 1; k < n; k++) {
-        if (s[k].x == s[k - 1].x && s[k].y == s[k - 1].y)
+        if (s[k].travel || (s[k].x == s[k - 1].x && s[k].y == s[k - 1].y))
             continue;
         double rgb[3];
         speed_rgb(vmax > 0 ? s[k].v / vmax : 0, rgb);
@@ -133,27 +329,43 @@ int cs_sim_draw_svg(const char *file, const cs_machine_t *m, const cs_sim_exec_t
                 s[k - 1].x, s[k - 1].y, s[k].x, s[k].y, (int)(rgb[0] * 255), (int)(rgb[1] * 255),
                 (int)(rgb[2] * 255), 4 * lw);
     }
-    for (size_t li = 0; ref && li < ref->nlines; li++) {
-        size_t b = ref->starts[li], e = li + 1 < ref->nlines ? ref->starts[li + 1] : ref->n;
-        fprintf(f, "<polyline fill=\"none\" stroke=\"black\" stroke-width=\"%.4f\" points=\"", lw);
-        for (size_t k = b; k < e; k++)
-            fprintf(f, "%.4f,%.4f ", ref->xyz[3 * k], ref->xyz[3 * k + 1]);
-        fprintf(f, "\"/>\n");
+    if (ref) {
+        fprintf(f, "<g class=\"reference\" fill=\"none\" stroke=\"black\" stroke-width=\"%.4f\">\n",
+                lw);
+        ref_runs(ref, svg_ref_run, f, view);
+        fprintf(f, "</g>\n");
     }
     fprintf(f, "</svg>\n");
     free(s);
     return fclose(f) == 0 ? 0 : -1;
 }
 
-int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
-                    const cs_sim_ref_t *ref, int width_px)
+static void png_ref_run(void *ctx, const cs_sim_ref_t *ref, size_t b, size_t n,
+                        const cs_sim_view_t *view)
+{
+    cairo_t *cr = ctx;
+    for (size_t k = b; k < b + n; k++) {
+        double q[2];
+        cs_sim_view_project(view, &ref->xyz[3 * k], q);
+        if (k == b)
+            cairo_move_to(cr, q[0], q[1]);
+        else
+            cairo_line_to(cr, q[0], q[1]);
+    }
+    cairo_stroke(cr);
+}
+
+int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                         const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px)
 {
     size_t n;
-    double vmax, lo[2], hi[2];
-    sample_t *s = exec_samples(m, ex, &n, &vmax);
+    double lo[2], hi[2];
+    sample_t *s = exec_samples(m, ex, view, &n);
     if (s == NULL)
         return -1;
-    bounds(s, n, ref, lo, hi);
+    classify(s, n, ref);
+    double vmax = top_speed(s, n);
+    bounds(s, n, ref, view, lo, hi);
     double w = hi[0] - lo[0], h = hi[1] - lo[1];
     double scale = width_px / w;
     int height_px = (int)ceil(h * scale);
@@ -168,9 +380,25 @@ int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t
     cairo_scale(cr, scale, scale);
     cairo_translate(cr, -lo[0], -lo[1]);
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-    cairo_set_line_width(cr, 3.0 / scale);
+    /* Travel: thin dashed grey, underneath. */
+    double dash[2] = {6.0 / scale, 4.0 / scale};
+    cairo_set_dash(cr, dash, 2, 0);
+    cairo_set_line_width(cr, 1.0 / scale);
+    cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
+    for (size_t k = 1; k < n;) {
+        if (!s[k].travel) {
+            k++;
+            continue;
+        }
+        cairo_move_to(cr, s[k - 1].x, s[k - 1].y);
+        for (; k < n && s[k].travel; k++)
+            cairo_line_to(cr, s[k].x, s[k].y);
+        cairo_stroke(cr);
+    }
+    cairo_set_dash(cr, NULL, 0, 0);
+    cairo_set_line_width(cr, (view->y_down ? 3.0 : 2.0) / scale);
     for (size_t k = 1; k < n; k++) {
-        if (s[k].x == s[k - 1].x && s[k].y == s[k - 1].y)
+        if (s[k].travel || (s[k].x == s[k - 1].x && s[k].y == s[k - 1].y))
             continue;
         double rgb[3];
         speed_rgb(vmax > 0 ? s[k].v / vmax : 0, rgb);
@@ -181,16 +409,7 @@ int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t
     }
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_set_line_width(cr, 0.8 / scale);
-    for (size_t li = 0; ref && li < ref->nlines; li++) {
-        size_t b = ref->starts[li], e = li + 1 < ref->nlines ? ref->starts[li + 1] : ref->n;
-        for (size_t k = b; k < e; k++) {
-            if (k == b)
-                cairo_move_to(cr, ref->xyz[3 * k], ref->xyz[3 * k + 1]);
-            else
-                cairo_line_to(cr, ref->xyz[3 * k], ref->xyz[3 * k + 1]);
-        }
-        cairo_stroke(cr);
-    }
+    ref_runs(ref, png_ref_run, cr, view);
     cairo_destroy(cr);
     cairo_status_t st = cairo_surface_write_to_png(sf, file);
     cairo_surface_destroy(sf);
@@ -200,6 +419,22 @@ int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t
         return -1;
     }
     return 0;
+}
+
+int cs_sim_draw_svg(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                    const cs_sim_ref_t *ref)
+{
+    cs_sim_view_t v;
+    cs_sim_view_default(&v);
+    return cs_sim_draw_svg_view(file, m, ex, ref, &v);
+}
+
+int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                    const cs_sim_ref_t *ref, int width_px)
+{
+    cs_sim_view_t v;
+    cs_sim_view_default(&v);
+    return cs_sim_draw_png_view(file, m, ex, ref, &v, width_px);
 }
 
 int cs_sim_write_trace(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex)

@@ -1,12 +1,39 @@
 /* cs_sim_draw: pictures of a simulated run. The exact geometry (reference) in thin black and the
  * executed path (reconstructed from the step edges, sampled every few ms) coloured by speed,
- * blue = slow to red = the run's top speed; as SVG written directly or PNG through cairo. */
+ * blue = slow to red = the run's top cutting speed; travel moves (the reference's G0 moves and
+ * the gaps between its elements) thin dashed grey; projected through a view (the machine's x y
+ * by default, or top/front/side/iso); as SVG written directly or PNG through cairo. */
 #ifndef CS_SIM_DRAW_H
 #define CS_SIM_DRAW_H
 
+#include <stdbool.h>
+
 #include "cs_sim.h"
 
-/* ref may be NULL. Return 0, or -1 (I/O or cairo error; errno / message on stderr). */
+/* A projection to the picture: picture x, y = rows of m applied to (x y z 1), mm. */
+typedef struct {
+    const char *name;
+    double m[2][4];
+    bool y_down; /* the default picture: machine y drawn downwards (as SVG inputs are written) */
+} cs_sim_view_t;
+
+/* The default: machine x, y, y down (name "xy"). */
+void cs_sim_view_default(cs_sim_view_t *v);
+/* top (x y), front (x z), side (y z), iso (orthographic from (1, -1, 1)), y up; the same as
+ * `curvestep toolpath --view`. false for anything else. */
+bool cs_sim_view_parse(const char *s, cs_sim_view_t *v);
+/* Machine point p (mm) -> picture coordinates (mm, y down as in SVG and cairo). */
+void cs_sim_view_project(const cs_sim_view_t *v, const double p[3], double out[2]);
+
+/* With a view. A reference with travel marks lets every executed sample be classified (travel
+ * or cut, by the nearest reference piece ahead of a cursor that follows the job in order). */
+int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                         const cs_sim_ref_t *ref, const cs_sim_view_t *view);
+int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                         const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px);
+
+/* The default view. ref may be NULL. Return 0, or -1 (I/O or cairo error; errno / message on
+ * stderr). */
 int cs_sim_draw_svg(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                     const cs_sim_ref_t *ref);
 /* width_px: picture width (height follows the drawing's aspect ratio). */

@@ -13,6 +13,7 @@
 #include "cs_sim.h"
 #include "cs_sim_device.h"
 #include "cs_sim_draw.h"
+#include "cs_sim_modbus.h"
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_INTERNAL = 3, EXIT_CHECK = 4 };
 
@@ -21,8 +22,10 @@ static void usage(FILE *f)
     fputs(
         "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
         "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-        "                     [--window MS] [--lenient]\n"
+        "                     [--window MS] [--lenient] [--view top|front|side|iso]\n"
         "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
+        "       curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu ...  (the device behind\n"
+        "                     Modbus: --modbus-tcp --help)\n"
         "Executes the step segments written by `curvestep plan` (same --machine) with the\n"
         "firmware's executor in simulated time, records every STEP edge and reports:\n"
         "  - the final position of each axis, in steps and mm;\n"
@@ -35,8 +38,14 @@ static void usage(FILE *f)
         "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
         "    plus one step, and whether the final position is the job's end rounded to steps.\n"
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
-        "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed\n"
+        "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
+        "                    with --reference, executed travel moves (the job's G0 moves and\n"
+        "                    the jumps between its elements) thin dashed grey\n"
         "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
+        "  --png-width PX    width of that picture, 100..8000 px (default 1600)\n"
+        "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
+        "                    (orthographic from (1,-1,1)), y up, as `curvestep toolpath --view`;\n"
+        "                    default: machine x y with y down (as SVG jobs are written)\n"
         "  --check           exit 4 when a limit, the deviation or the final position fails\n"
         "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
         "3 internal error, 4 a check failed (with --check).\n",
@@ -48,10 +57,16 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) /* device mode: the simulator behind a serial line */
         if (strcmp(argv[i], "--pty") == 0 || strcmp(argv[i], "--port") == 0)
             return cs_sim_device_main(argc, argv);
+    for (int i = 1; i < argc; i++) /* the device behind Modbus TCP or RTU (sim/cs_sim_modbus.h) */
+        if (strcmp(argv[i], "--modbus-tcp") == 0 || strcmp(argv[i], "--modbus-rtu") == 0)
+            return cs_sim_modbus_main(argc, argv);
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
     bool check = false, lenient = false;
     double window_ms = 50;
+    long png_width = 1600;
+    cs_sim_view_t view;
+    cs_sim_view_default(&view);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -75,6 +90,18 @@ int main(int argc, char **argv)
             window_ms = strtod(argv[++i], &end);
             if (*end != '\0' || !(window_ms > 0) || window_ms > 10000) {
                 fprintf(stderr, "curvestep-sim: --window wants milliseconds in (0, 10000]\n");
+                return EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--png-width") == 0 && has) {
+            char *end;
+            png_width = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || png_width < 100 || png_width > 8000) {
+                fprintf(stderr, "curvestep-sim: --png-width wants pixels in 100..8000\n");
+                return EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--view") == 0 && has) {
+            if (!cs_sim_view_parse(argv[++i], &view)) {
+                fprintf(stderr, "curvestep-sim: --view wants top, front, side or iso\n");
                 return EXIT_USAGE;
             }
         } else if (strcmp(a, "--check") == 0) {
@@ -183,11 +210,13 @@ int main(int argc, char **argv)
         perror(trace);
         rc = EXIT_INTERNAL;
     }
-    if (rc == EXIT_OK && svg && cs_sim_draw_svg(svg, &m, &ex, reference ? &ref : NULL) != 0) {
+    if (rc == EXIT_OK && svg &&
+        cs_sim_draw_svg_view(svg, &m, &ex, reference ? &ref : NULL, &view) != 0) {
         perror(svg);
         rc = EXIT_INTERNAL;
     }
-    if (rc == EXIT_OK && png && cs_sim_draw_png(png, &m, &ex, reference ? &ref : NULL, 1600) != 0)
+    if (rc == EXIT_OK && png &&
+        cs_sim_draw_png_view(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width) != 0)
         rc = EXIT_INTERNAL;
     if (rc == EXIT_OK && check && !ok) {
         printf("check: FAILED\n");

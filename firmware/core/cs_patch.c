@@ -132,7 +132,10 @@ static cs_err_t check_patch(const cs_patch_t *p)
     return CS_OK;
 }
 
-cs_err_t cs_patch_derivs(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_patch_derivs_t *out)
+/* What cs_patch_derivs, _eval and _normal share: the checks (out: the caller's output, which
+ * must be set), then P, Pu, Pv, Puv of p at (u, v) into w, in GUARD units. */
+static cs_err_t eval_checked(const cs_patch_t *p, cs_param_t u, cs_param_t v, const void *out,
+                             int64_t w[4][3])
 {
     cs_err_t e = check_patch(p);
     if (e != CS_OK)
@@ -140,9 +143,17 @@ cs_err_t cs_patch_derivs(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_pat
     if (!out || !param_ok(u) || !param_ok(v))
         return CS_ERR_ARG;
     wnet_t net;
-    int64_t w[4][3];
     load_net(p, net);
     eval_wide(net, p->deg_u, p->deg_v, u, v, w);
+    return CS_OK;
+}
+
+cs_err_t cs_patch_derivs(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_patch_derivs_t *out)
+{
+    int64_t w[4][3];
+    cs_err_t e = eval_checked(p, u, v, out, w);
+    if (e != CS_OK)
+        return e;
     cs_patch_derivs_t r;
     if (narrow_vec(w[0], GUARD, &r.p) != CS_OK || narrow_vec(w[1], GUARD, &r.pu) != CS_OK ||
         narrow_vec(w[2], GUARD, &r.pv) != CS_OK || narrow_vec(w[3], GUARD, &r.puv) != CS_OK)
@@ -153,15 +164,10 @@ cs_err_t cs_patch_derivs(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_pat
 
 cs_err_t cs_patch_eval(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_vec3_t *out)
 {
-    cs_err_t e = check_patch(p);
+    int64_t w[4][3];
+    cs_err_t e = eval_checked(p, u, v, out, w);
     if (e != CS_OK)
         return e;
-    if (!out || !param_ok(u) || !param_ok(v))
-        return CS_ERR_ARG;
-    wnet_t net;
-    int64_t w[4][3];
-    load_net(p, net);
-    eval_wide(net, p->deg_u, p->deg_v, u, v, w);
     return narrow_vec(w[0], GUARD, out);
 }
 
@@ -236,15 +242,10 @@ static cs_err_t unit_cross(const int64_t a[3], const int64_t b[3], cs_patch_unit
 
 cs_err_t cs_patch_normal(const cs_patch_t *p, cs_param_t u, cs_param_t v, cs_patch_unit_t *n)
 {
-    cs_err_t e = check_patch(p);
+    int64_t w[4][3];
+    cs_err_t e = eval_checked(p, u, v, n, w);
     if (e != CS_OK)
         return e;
-    if (!n || !param_ok(u) || !param_ok(v))
-        return CS_ERR_ARG;
-    wnet_t net;
-    int64_t w[4][3];
-    load_net(p, net);
-    eval_wide(net, p->deg_u, p->deg_v, u, v, w);
     e = unit_cross(w[1], w[2], n);
     if (e != CS_ERR_DEGENERATE)
         return e;

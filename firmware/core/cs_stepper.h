@@ -25,45 +25,74 @@
 /* What one call asks the port to do: pulse the STEP line of every axis in step_mask (bit i =
  * axis i) with the DIR lines as they are, then set the DIR lines to dir_mask (bit set = line
  * high; already corrected for invert_dir), then call again after next_ticks ticks (0 = idle:
- * stop the timer until cs_stepper_start says otherwise). */
+ * stop the timer until a push restarts it). */
 typedef struct {
     uint8_t step_mask;
     uint8_t dir_mask;
     uint32_t next_ticks;
 } cs_stepper_out_t;
 
+/* A queued segment, prepared by cs_stepper_push (the main loop) so that loading it in the timer
+ * interrupt is a copy: no division there. Calls C, base and rem as in cs_stepper.c. */
 typedef struct {
-    cs_segment_t ring[CS_STEPPER_RING];
+    uint32_t calls; /* DDA calls C = n * 2^k */
+    uint32_t base;  /* ticks per call: base, +1 for rem of the C calls */
+    uint32_t rem;
+    union {
+        uint32_t w[CS_AXES]; /* |steps| per axis, wide segments */
+        uint16_t n[CS_AXES]; /* |steps| per axis, narrow segments (C <= CS_STEPPER_NARROW_CALLS) */
+    } mag;
+    uint8_t neg;  /* axes moving negative */
+    uint8_t dir;  /* DIR levels (invert_dir applied) */
+    uint8_t move; /* axes with steps (bit i = axis i) */
+    uint8_t wide; /* needs the 32-bit DDA */
+} cs_stepper_seg_t;
+
+/* A segment runs on the 16-bit DDA when C <= this and its base period < 0xFFFF: then every
+ * accumulator, count and period of the segment fits 16 bits (8-bit targets do half the work). */
+#define CS_STEPPER_NARROW_CALLS 0x7FFFu
+
+typedef struct {
+    /* ISR state. The common path (a narrow segment) reads only the fields up to n_e/n_mag, 55
+     * bytes: on the AVR all within ldd's 63-byte displacement of one pointer. */
+    volatile bool running; /* a segment is being executed */
+    uint8_t wide;          /* the current segment runs on the 32-bit DDA */
+    uint8_t move;          /* its axes with steps (bit i = axis i): the DDA visits only these */
+    uint8_t neg_mask;      /* axes moving negative in the current segment */
+    uint8_t dir_mask;      /* DIR levels for the current segment */
     volatile uint8_t head; /* written by the ISR only (consumer) */
     volatile uint8_t tail; /* written by the main loop only (producer) */
-    /* ISR state */
-    volatile bool running; /* a segment is being executed */
     uint8_t n_axes;
-    uint8_t invert_mask;  /* axes whose DIR line is inverted */
-    uint8_t dir_mask;     /* DIR levels for the current segment */
-    uint8_t neg_mask;     /* axes moving negative in the current segment */
-    uint32_t calls;       /* DDA calls in the current segment */
-    uint32_t call_idx;    /* calls done */
-    uint32_t period_base; /* ticks per call: base, +1 for rem of the calls (Bresenham) */
-    uint32_t period_rem;
-    uint32_t period_err;
-    uint32_t mag[CS_AXES];         /* |steps| per axis (the DDA adds it every call) */
-    uint32_t acc[CS_AXES];         /* DDA accumulators */
-    volatile int32_t pos[CS_AXES]; /* position in steps */
+    uint8_t invert_mask; /* axes whose DIR line is inverted */
+    /* The current segment's DDA, narrow (16 bits) or wide (32 bits, the w_ fields): left =
+     * calls still to do; the period is base, + 1 when err + rem reaches C (Bresenham); per axis
+     * e = accumulator - C, in [-C, 0): the axis steps when e + |steps| >= 0 (cs_stepper.c). */
+    uint16_t n_left, n_calls, n_base, n_rem, n_err;
     uint32_t steps_done;           /* step pulses issued since init (all axes) */
+    volatile int32_t pos[CS_AXES]; /* position in steps */
+    int16_t n_e[CS_AXES];
+    uint16_t n_mag[CS_AXES];
+    uint32_t w_left, w_calls, w_base, w_rem, w_err;
+    int32_t w_e[CS_AXES];
+    uint32_t w_mag[CS_AXES];
+    cs_stepper_seg_t ring[CS_STEPPER_RING];
 } cs_stepper_t;
 
 /* Empty executor at position 0 for machine *m (axes, DIR inversion). Not ISR-safe. */
 cs_err_t cs_stepper_init(cs_stepper_t *st, const cs_machine_t *m);
-/* Queues a segment. CS_ERR_FULL when the ring is full, CS_ERR_ARG when the segment breaks its
- * invariant (ticks == 0 or > 2^24, |steps| > ticks). Main loop only; ISR-safe against
- * cs_stepper_tick (single producer, single consumer). */
+/* Queues a segment, with its DDA constants computed (one division: a few shift-subtract steps
+ * when the period is under 256 ticks), so the interrupt's load is a copy. CS_ERR_FULL when the
+ * ring is full, CS_ERR_ARG when the segment breaks its invariant (ticks == 0 or > 2^24,
+ * |steps| > ticks). Main loop only; ISR-safe against cs_stepper_tick (single producer, single
+ * consumer). */
 cs_err_t cs_stepper_push(cs_stepper_t *st, const cs_segment_t *seg);
 /* Free slots in the ring. ISR-safe. */
 unsigned cs_stepper_free(const cs_stepper_t *st);
 /* True when nothing is queued or executing. ISR-safe. */
 bool cs_stepper_idle(const cs_stepper_t *st);
-/* The timer call: ISR-safe, constant work per call (one DDA update per axis). */
+/* The timer call: ISR-safe. Work per call: one DDA update per moving axis, on 16 bits (on 32 for
+ * a segment of more than CS_STEPPER_NARROW_CALLS calls or a period of 65535 ticks or more); a
+ * call that ends a segment also loads the next (a copy). */
 void cs_stepper_tick(cs_stepper_t *st, cs_stepper_out_t *out);
 /* Position in steps of axis (0 when out of range). Read it with the timer interrupt masked on
  * targets where a 32-bit read is not atomic. */

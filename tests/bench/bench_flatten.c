@@ -3,15 +3,15 @@
  * Curve sets: 200 random cubics (xorshift, fixed seed, 100 mm box), the hard cases of
  * test_trace, and every curved element of the SVG files in ../shared/data/svg (user unit =
  * 1 mm). Tolerances 0.1, 0.01, 0.001 mm. Usage: bench_flatten [out.csv] [svg files...] (no
- * files: every .svg one folder below ../shared/data/svg, else tests/data/svg); prints a Markdown section on
- * stdout, progress on stderr. */
-#include <glob.h>
+ * files: every .svg one folder below ../shared/data/svg, else tests/data/svg); prints a Markdown
+ * section on stdout, progress on stderr. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "bench_curves.h"
 #include "cs_ref.h"
 #include "cs_svgdoc.h"
 #include "cs_trace.h"
@@ -20,36 +20,11 @@
 #define N_TOLS    3
 #define N_METH    4
 
-typedef struct {
-    const char *name;
-    cs_bezier_t *c;
-    size_t n, cap;
-} curve_set_t;
-
 static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static const char *meth_name[N_METH] = {"FD (uniform, Wang)", "AFD", "subdiv dyadic",
                                         "subdiv reach (CS_TRACE_SUBDIV)"};
 static cs_vec3_t verts[MAX_VERTS];
-
-static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static double unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static void add(curve_set_t *s, const cs_bezier_t *c)
-{
-    if (s->n == s->cap) {
-        s->cap = s->cap ? 2 * s->cap : 64;
-        s->c = realloc(s->c, s->cap * sizeof *s->c);
-        if (!s->c)
-            abort();
-    }
-    s->c[s->n++] = *c;
-}
+static bench_rng_t rng = {BENCH_RNG_SEED};
 
 static cs_bezier_t mk(unsigned n, const double (*p)[3], const double *w)
 {
@@ -65,7 +40,7 @@ static cs_bezier_t mk(unsigned n, const double (*p)[3], const double *w)
     return c;
 }
 
-static void hard_cases(curve_set_t *s)
+static void hard_cases(bench_set_t *s)
 {
     static const double cases[][4][3] = {
         {{0, 0, 0}, {0, 0, 0}, {50, 20, 0}, {50, 20, 0}},                      /* coincident */
@@ -77,23 +52,16 @@ static void hard_cases(curve_set_t *s)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cs_bezier_t c = mk(3, cases[i], NULL);
-        add(s, &c);
+        bench_set_add(s, &c);
     }
     const double q[3][3] = {{50, 0, 0}, {50, 50, 0}, {0, 50, 0}};
     const double wq[3] = {1.0, 0.70710678118654752, 1.0};
     cs_bezier_t c = mk(2, q, wq);
-    add(s, &c);
+    bench_set_add(s, &c);
     const double d7[8][3] = {{0, 0, 0},    {10, 80, 0},   {25, -60, 10}, {40, 90, 0},
                              {55, -70, 0}, {70, 60, -10}, {85, -30, 0},  {100, 0, 0}};
     c = mk(7, d7, NULL);
-    add(s, &c);
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
+    bench_set_add(s, &c);
 }
 
 /* Traces c with method m; returns the vertex count, or 0 on error. */
@@ -121,44 +89,19 @@ static size_t run(const cs_bezier_t *c, cs_pos_t tol, int m)
 int main(int argc, char **argv)
 {
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
-    curve_set_t sets[3] = {
+    bench_set_t sets[3] = {
         {"random cubics", NULL, 0, 0}, {"hard cases", NULL, 0, 0}, {"SVG files", NULL, 0, 0}};
     for (int k = 0; k < 200; k++) {
         double p[4][3];
         for (int i = 0; i < 4; i++)
             for (int a = 0; a < 3; a++)
-                p[i][a] = a == 2 ? 0.0 : (unit() * 2 - 1) * 100.0;
+                p[i][a] = a == 2 ? 0.0 : (bench_rng_unit(&rng) * 2 - 1) * 100.0;
         cs_bezier_t c = mk(3, p, NULL);
-        add(&sets[0], &c);
+        bench_set_add(&sets[0], &c);
     }
     hard_cases(&sets[1]);
-    glob_t g;
-    memset(&g, 0, sizeof g);
-    char **files = argv + 2;
-    size_t nfiles = argc > 2 ? (size_t)(argc - 2) : 0;
-    /* Run from the repository root (make bench): ../shared is the shared data beside it; the
-     * copies in tests/data/svg stand in when it is absent. */
-    if (nfiles == 0 && (glob("../shared/data/svg/*/*.svg", 0, NULL, &g) == 0 ||
-                        glob("tests/data/svg/*/*.svg", 0, NULL, &g) == 0)) {
-        files = g.gl_pathv;
-        nfiles = g.gl_pathc;
-    }
-    for (size_t i = 0; i < nfiles; i++) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_svgdoc_opts_t o;
-        cs_svgdoc_opts_init(&o);
-        o.warn = NULL;
-        cs_path_diag_t d;
-        if (cs_svgdoc_read_file(files[i], &o, &path, &d, NULL) == CS_OK) {
-            for (size_t j = 0; j < path.n; j++)
-                if (path.elems[j].curve.degree > 1)
-                    add(&sets[2], &path.elems[j].curve);
-        } else {
-            cs_path_diag_print(stderr, &d);
-        }
-        cs_path_free(&path);
-    }
+    /* Run from the repository root (make bench): no files named, the SVG corpus. */
+    bench_svg_curves(&sets[2], argv + 2, argc > 2 ? (size_t)(argc - 2) : 0, NULL);
     if (csv)
         fprintf(csv, "set,method,tol_mm,curves,chords,greedy_chords,ratio,max_dev_mm,"
                      "points_per_s,errors\n");
@@ -169,7 +112,7 @@ int main(int argc, char **argv)
            "tracing alone (one core).\n\n");
     double worst_dev_ratio = 0, worst_best_ratio = 0;
     for (int si = 0; si < 3; si++) {
-        curve_set_t *s = &sets[si];
+        bench_set_t *s = &sets[si];
         if (s->n == 0)
             continue;
         printf("### %s (%zu curves)\n\n", s->name, s->n);
@@ -198,11 +141,11 @@ int main(int argc, char **argv)
                 }
                 /* Speed: repeat the whole set until 0.2 s have passed. */
                 size_t done = 0;
-                double t0 = now(), t1;
+                double t0 = bench_now(), t1;
                 do {
                     for (size_t k = 0; k < s->n; k++)
                         done += run(&s->c[k], tol, m);
-                    t1 = now();
+                    t1 = bench_now();
                 } while (t1 - t0 < 0.2);
                 double pps = done / (t1 - t0);
                 double ratio = (double)chords / (double)greedy;
@@ -229,7 +172,6 @@ int main(int argc, char **argv)
            meth_name[N_METH - 1], worst_best_ratio <= 1.15 ? "met" : "MISSED", worst_best_ratio);
     if (csv)
         fclose(csv);
-    globfree(&g);
     for (int si = 0; si < 3; si++)
         free(sets[si].c);
     return 0;

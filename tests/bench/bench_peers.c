@@ -8,7 +8,6 @@
  * the largest distance between each polyline and the exact curve both ways. Throughput is the
  * median of 5 runs. Usage: bench_peers [out.csv]; Markdown on stdout, progress on stderr. */
 #include <cairo.h>
-#include <glob.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +15,7 @@
 #include <time.h>
 
 #include "agg_flat.h"
+#include "bench_curves.h"
 #include "cs_patchfile.h"
 #include "cs_ref.h"
 #include "cs_svgdoc.h"
@@ -38,43 +38,18 @@ typedef struct {
     double x, y;
 } pt2_t;
 
-typedef struct {
-    const char *name;
-    cs_bezier_t *c;
-    size_t n, cap;
-} curve_set_t;
-
 static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static const char *eng_name[N_ENG] = {
     "curvestep FD (uniform, Wang)", "curvestep AFD",
     "curvestep subdiv dyadic",      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
     "cairo copy_path_flat",         "AGG curve4_div"};
 static cs_vec3_t verts[MAX_VERTS];
+static bench_rng_t rng = {BENCH_RNG_SEED};
 static pt2_t poly[MAX_VERTS + 1];
 static cairo_t *cr;
 /* On curvestep's polylines: largest (judge - cs_ref_max_deviation) / tol, and largest
  * cs_ref_max_deviation / tol (the per-chord measure, stricter than Hausdorff). */
 static double judge_gap, ref_worst;
-
-static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static double unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static void add(curve_set_t *s, const cs_bezier_t *c)
-{
-    if (s->n == s->cap) {
-        s->cap = s->cap ? 2 * s->cap : 64;
-        s->c = realloc(s->c, s->cap * sizeof *s->c);
-        if (!s->c)
-            abort();
-    }
-    s->c[s->n++] = *c;
-}
 
 static cs_pos_t mm(double v)
 {
@@ -120,15 +95,15 @@ static bool planar_cubic(const cs_bezier_t *in, cs_bezier_t *out)
     return true;
 }
 
-static void random_and_hard(curve_set_t *s)
+static void random_and_hard(bench_set_t *s)
 {
     for (int k = 0; k < 200; k++) {
         double p[4][2];
         for (int i = 0; i < 4; i++)
             for (int a = 0; a < 2; a++)
-                p[i][a] = (unit() * 2 - 1) * 100.0;
+                p[i][a] = (bench_rng_unit(&rng) * 2 - 1) * 100.0;
         cs_bezier_t c = cubic((const double(*)[2])p);
-        add(s, &c);
+        bench_set_add(s, &c);
     }
     static const double hard[][4][2] = {
         {{0, 0}, {0, 0}, {50, 20}, {50, 20}},                   /* coincident */
@@ -140,45 +115,11 @@ static void random_and_hard(curve_set_t *s)
     };
     for (size_t i = 0; i < sizeof hard / sizeof hard[0]; i++) {
         cs_bezier_t c = cubic(hard[i]);
-        add(s, &c);
+        bench_set_add(s, &c);
     }
 }
 
-static size_t svg_set(curve_set_t *s)
-{
-    glob_t g;
-    memset(&g, 0, sizeof g);
-    size_t skipped = 0;
-    if (glob("../shared/data/svg/*/*.svg", 0, NULL, &g) != 0 &&
-        glob("tests/data/svg/*/*.svg", 0, NULL, &g) != 0)
-        return 0;
-    for (size_t i = 0; i < g.gl_pathc; i++) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_svgdoc_opts_t o;
-        cs_svgdoc_opts_init(&o);
-        o.warn = NULL;
-        cs_path_diag_t d;
-        if (cs_svgdoc_read_file(g.gl_pathv[i], &o, &path, &d, NULL) == CS_OK) {
-            for (size_t j = 0; j < path.n; j++) {
-                cs_bezier_t c;
-                if (path.elems[j].curve.degree < 2)
-                    continue;
-                if (planar_cubic(&path.elems[j].curve, &c))
-                    add(s, &c);
-                else
-                    skipped++;
-            }
-        } else {
-            cs_path_diag_print(stderr, &d);
-        }
-        cs_path_free(&path);
-    }
-    globfree(&g);
-    return skipped;
-}
-
-static void teapot_set(curve_set_t *s)
+static void teapot_set(bench_set_t *s)
 {
     cs_patchfile_t pf;
     cs_path_diag_t d;
@@ -197,17 +138,10 @@ static void teapot_set(curve_set_t *s)
                 if (cs_patch_iso(&p, (cs_patch_iso_t)dir, (cs_param_t)(CS_PARAM_ONE / 8 * k), &c) ==
                         CS_OK &&
                     planar_cubic(&c, &c2))
-                    add(s, &c2);
+                    bench_set_add(s, &c2);
             }
     }
     cs_patchfile_free(&pf);
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 static void ctrl(const cs_bezier_t *c, double p[8])
@@ -396,19 +330,19 @@ static int cmp_d(const void *a, const void *b)
 
 /* Curves per second for the whole set (median of N_RUNS runs, each repeating the set for at
  * least 30 ms); *pps gets the points (chords) per second of the same runs. */
-static double speed(const curve_set_t *s, double tol, int e, double *pps)
+static double speed(const bench_set_t *s, double tol, int e, double *pps)
 {
     double cps[N_RUNS], ps[N_RUNS];
     for (int r = 0; r < N_RUNS; r++) {
         size_t curves = 0, pts = 0;
-        double t0 = now(), t1;
+        double t0 = bench_now(), t1;
         do {
             for (size_t k = 0; k < s->n; k++) {
                 size_t n = flatten(&s->c[k], tol, e, false);
                 pts += n == SIZE_MAX ? 0 : n;
             }
             curves += s->n;
-            t1 = now();
+            t1 = bench_now();
         } while (t1 - t0 < 0.03);
         cps[r] = (double)curves / (t1 - t0);
         ps[r] = (double)pts / (t1 - t0);
@@ -428,7 +362,7 @@ static double fd_floor_pps(void)
     for (int r = 0; r < N_RUNS; r++) {
         int64_t d[3][4] = {{1 << 20, 3, 5, 7}, {2 << 20, -3, 11, 13}, {3 << 20, 1, -2, 3}};
         size_t n = 0;
-        double t0 = now(), t1;
+        double t0 = bench_now(), t1;
         do {
             for (size_t i = 0; i < 4096; i++) {
                 for (int a = 0; a < 3; a++) {
@@ -440,7 +374,7 @@ static double fd_floor_pps(void)
                                       (cs_pos_t)(d[2][0] >> 20));
             }
             n += 4096;
-            t1 = now();
+            t1 = bench_now();
         } while (t1 - t0 < 0.05);
         __asm__ __volatile__("" : : "r"(buf) : "memory");
         best[r] = (double)n / (t1 - t0);
@@ -460,11 +394,11 @@ int main(int argc, char **argv)
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
     cr = cairo_create(surf);
-    curve_set_t sets[3] = {{"random cubics + hard cases", NULL, 0, 0},
+    bench_set_t sets[3] = {{"random cubics + hard cases", NULL, 0, 0},
                            {"SVG files (cubics, quadratics elevated)", NULL, 0, 0},
                            {"teapot iso-curves (projected on z = 0)", NULL, 0, 0}};
     random_and_hard(&sets[0]);
-    size_t skipped = svg_set(&sets[1]);
+    size_t skipped = bench_svg_curves(&sets[1], NULL, 0, planar_cubic);
     teapot_set(&sets[2]);
     static result_t res[3][N_TOLS][N_ENG];
     if (csv)
@@ -497,7 +431,7 @@ int main(int argc, char **argv)
            "teapot iso-curves (tests/data/teapot, 10 mm per unit, t = k/8 both families).\n\n",
            (size_t)200, sets[1].n, skipped, sets[2].n);
     for (int si = 0; si < 3; si++) {
-        curve_set_t *s = &sets[si];
+        bench_set_t *s = &sets[si];
         if (s->n == 0)
             continue;
         printf("### %s (%zu curves)\n\n", s->name, s->n);
@@ -609,7 +543,7 @@ int main(int argc, char **argv)
            "more chords than needed).\n\n");
 
     /* FD rate against the floor: random cubics at 0.001 mm, uniform FD only. */
-    curve_set_t rnd = sets[0];
+    bench_set_t rnd = sets[0];
     rnd.n = 200;
     double fd_pps;
     speed(&rnd, 0.001, 0, &fd_pps);

@@ -4,92 +4,48 @@
 # --help, stdin, --stats (measured deviation within the tolerance) and --svg.
 # Uses $CS_BUILD (the build directory); ends with "cli: N passed, M failed".
 set -u
-BIN=${CS_BUILD:-build}/curvestep
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-pass=0
-fail=0
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 
-ok() { pass=$((pass + 1)); }
-ko() { fail=$((fail + 1)); echo "FAIL: $*"; }
+path() { printf '%s' "$1" >"$T/p.txt"; }
 
-# run NAME EXPECTED_RC ARGS...: runs the program, output in $TMP/out, $TMP/err, status in $rc.
-run() {
-    local name=$1 want=$2
-    shift 2
-    "$BIN" "$@" >"$TMP/out" 2>"$TMP/err"
-    rc=$?
-    if [ "$rc" -ne "$want" ]; then
-        ko "$name: exit $rc, expected $want"
-        sed 's/^/    /' "$TMP/err" | head -5
-        return 1
-    fi
-    ok
-    return 0
-}
-
-# expect_out NAME TEXT: stdout must be exactly TEXT (printf-interpreted).
-expect_out() {
-    local name=$1
-    printf "$2" >"$TMP/want"
-    if cmp -s "$TMP/out" "$TMP/want"; then ok; else
-        ko "$name: output differs"
-        diff "$TMP/want" "$TMP/out" | head -10 | sed 's/^/    /'
-    fi
-}
-
-# expect_err NAME REGEX: stderr must match (grep -E).
-expect_err() {
-    if grep -qE "$2" "$TMP/err"; then ok; else
-        ko "$1: stderr does not match /$2/"
-        head -5 "$TMP/err" | sed 's/^/    /'
-    fi
-}
-
-path() { printf '%s' "$1" >"$TMP/p.txt"; }
-
-if [ ! -x "$BIN" ]; then
-    echo "no $BIN"
-    echo "cli: 0 passed, 1 failed"
-    exit 1
-fi
+need_bin "$CS"
 
 # --- lines: exact vertices ---------------------------------------------------------------
 path 'M0 0 L10 0'
-run "line" 0 flatten "$TMP/p.txt" && expect_out "line" '0.000000 0.000000\n10.000000 0.000000\n'
+run "line" 0 flatten "$T/p.txt" && expect_out "line" '0.000000 0.000000\n10.000000 0.000000\n'
 
 path 'M1 2 h3 v4 H0 V0 z'
-run "h v H V z" 0 flatten "$TMP/p.txt" &&
+run "h v H V z" 0 flatten "$T/p.txt" &&
     expect_out "h v H V z" '1.000000 2.000000\n4.000000 2.000000\n4.000000 6.000000\n0.000000 6.000000\n0.000000 0.000000\n1.000000 2.000000\n'
 
 path 'm 1 1 2 0 0 2 l -2 0'
-run "implicit lineto" 0 flatten "$TMP/p.txt" &&
+run "implicit lineto" 0 flatten "$T/p.txt" &&
     expect_out "implicit lineto" '1.000000 1.000000\n3.000000 1.000000\n3.000000 3.000000\n1.000000 3.000000\n'
 
 path 'M0 0 L1 0 M5 5 L6 5 m 1 1 l 0.5 -0.25'
-run "subpaths" 0 flatten "$TMP/p.txt" &&
+run "subpaths" 0 flatten "$T/p.txt" &&
     expect_out "subpaths" '0.000000 0.000000\n1.000000 0.000000\n\n5.000000 5.000000\n6.000000 5.000000\n\n7.000000 6.000000\n7.500000 5.750000\n'
 
 # z followed by a drawing command: new subpath from the same start.
 path 'M 10 10 L 10 20 L 20 10 z L 100 100'
-run "z then L" 0 flatten "$TMP/p.txt" &&
+run "z then L" 0 flatten "$T/p.txt" &&
     expect_out "z then L" '10.000000 10.000000\n10.000000 20.000000\n20.000000 10.000000\n10.000000 10.000000\n\n10.000000 10.000000\n100.000000 100.000000\n'
 
 # Nothing drawn: no output, success.
 for d in '' 'M 5 5' 'M 30 40 Z' 'M 1 1 M 2 2'; do
     path "$d"
-    run "empty '$d'" 0 flatten "$TMP/p.txt" && expect_out "empty '$d'" ''
+    run "empty '$d'" 0 flatten "$T/p.txt" && expect_out "empty '$d'" ''
 done
 
 # --- curves: first and last vertex exact, more than one chord, every vertex on the curve ------
 # (endpoints, count) per form; the vertices of the half circle are checked against its radius.
 check_curve() { # name d x0 y0 x1 y1 min_vertices
     path "$2"
-    run "$1" 0 flatten "$TMP/p.txt" || return
+    run "$1" 0 flatten "$T/p.txt" || return
     local first last n
-    first=$(head -n1 "$TMP/out")
-    last=$(tail -n1 "$TMP/out")
-    n=$(grep -c . "$TMP/out")
+    first=$(head -n1 "$T/out")
+    last=$(tail -n1 "$T/out")
+    n=$(grep -c . "$T/out")
     if [ "$first" = "$3 $4" ] && [ "$last" = "$5 $6" ] && [ "$n" -ge "$7" ]; then ok; else
         ko "$1: first '$first' last '$last' ($n vertices)"
     fi
@@ -105,65 +61,65 @@ check_curve "a flags" 'M0 0 a10 10 0 00 10 10' 0.000000 0.000000 10.000000 10.00
 # is on the curve within 1 LSB = 1.5e-5 mm; printing rounds to 5e-7) and y >= 0 (sweep 1 goes
 # through +y in SVG's parametrisation).
 path 'M 10 0 A 10 10 0 0 1 -10 0'
-if run "arc radius" 0 flatten --tol 0.001 "$TMP/p.txt"; then
-    bad=$(awk 'NF==2 { r = sqrt($1*$1 + $2*$2); if (r < 10 - 1e-4 || r > 10 + 1e-4 || $2 < -1e-6) print }' "$TMP/out" | wc -l)
-    n=$(grep -c . "$TMP/out")
+if run "arc radius" 0 flatten --tol 0.001 "$T/p.txt"; then
+    bad=$(awk 'NF==2 { r = sqrt($1*$1 + $2*$2); if (r < 10 - 1e-4 || r > 10 + 1e-4 || $2 < -1e-6) print }' "$T/out" | wc -l)
+    n=$(grep -c . "$T/out")
     if [ "$bad" -eq 0 ] && [ "$n" -gt 20 ]; then ok; else ko "arc radius: $bad vertices off, $n vertices"; fi
 fi
 
 # A coarser tolerance gives fewer vertices.
 path 'M 0 0 C 0 100 100 100 100 0'
-run "tol fine" 0 flatten --tol 0.001 "$TMP/p.txt" && nf=$(grep -c . "$TMP/out")
-run "tol coarse" 0 flatten --tol 1 "$TMP/p.txt" && nc=$(grep -c . "$TMP/out")
+run "tol fine" 0 flatten --tol 0.001 "$T/p.txt" && nf=$(grep -c . "$T/out")
+run "tol coarse" 0 flatten --tol 1 "$T/p.txt" && nc=$(grep -c . "$T/out")
 if [ "${nc:-0}" -gt 1 ] && [ "${nc:-0}" -lt "${nf:-0}" ]; then ok; else ko "tolerance: $nc vs $nf vertices"; fi
 
 # Every method ends the cubic at its exact end point.
 for m in fd afd subdiv; do
-    run "method $m" 0 flatten --method "$m" "$TMP/p.txt" &&
-        { [ "$(tail -n1 "$TMP/out")" = "100.000000 0.000000" ] && ok || ko "method $m: last vertex"; }
+    run "method $m" 0 flatten --method "$m" "$T/p.txt" &&
+        { [ "$(tail -n1 "$T/out")" = "100.000000 0.000000" ] && ok || ko "method $m: last vertex"; }
 done
 
 # --- stdin ---------------------------------------------------------------------------------
-if printf 'M0 0 L10 0' | "$BIN" flatten - >"$TMP/out" 2>"$TMP/err"; then
+if printf 'M0 0 L10 0' | "$CS" flatten - >"$T/out" 2>"$T/err"; then
     expect_out "stdin" '0.000000 0.000000\n10.000000 0.000000\n'
 else ko "stdin: exit $?"; fi
-printf 'M0 0\nL10 x' | "$BIN" flatten - >"$TMP/out" 2>"$TMP/err"
+printf 'M0 0\nL10 x' | "$CS" flatten - >"$T/out" 2>"$T/err"
 rc=$?
 [ $rc -eq 1 ] && ok || ko "stdin error: exit $rc"
 expect_err "stdin error" '^<stdin>:2:5: '
 
 # --- bad input: file:line:col: reason, exit 1 --------------------------------------------
 path $'M 10 10\n  L 1e 5'
-run "bad exponent" 1 flatten "$TMP/p.txt" && expect_err "bad exponent" "^$TMP/p.txt:2:7: .*digit"
+run "bad exponent" 1 flatten "$T/p.txt" && expect_err "bad exponent" "^$T/p.txt:2:7: .*digit"
 path 'M 10 10 L 20'
-run "missing number" 1 flatten "$TMP/p.txt" && expect_err "missing number" "^$TMP/p.txt:1:13: .*end of data"
+run "missing number" 1 flatten "$T/p.txt" && expect_err "missing number" "^$T/p.txt:1:13: .*end of data"
 path 'L 10 10'
-run "no moveto" 1 flatten "$TMP/p.txt" && expect_err "no moveto" "^$TMP/p.txt:1:1: .*moveto"
+run "no moveto" 1 flatten "$T/p.txt" && expect_err "no moveto" "^$T/p.txt:1:1: .*moveto"
 run "svg: moveto required" 1 flatten tests/data/svg/resvg/A.svg &&
     expect_err "svg: moveto required" '^tests/data/svg/resvg/A.svg:5:38: '
 # Out of the +/-4096 mm range: refused where the number is.
 path 'M 0 0 L 5000 0'
-run "out of range" 1 flatten "$TMP/p.txt" && expect_err "out of range" "^$TMP/p.txt:1:9: .*4096"
+run "out of range" 1 flatten "$T/p.txt" && expect_err "out of range" "^$T/p.txt:1:9: .*4096"
 path $'M 4000 0\nl 50 0 l 50 0'
-run "out of range, relative" 1 flatten "$TMP/p.txt" && expect_err "out of range, relative" "^$TMP/p.txt:2:10: "
+run "out of range, relative" 1 flatten "$T/p.txt" && expect_err "out of range, relative" "^$T/p.txt:2:10: "
 path 'M 0 0 L 4096 -4096'
-run "range limit itself" 0 flatten "$TMP/p.txt" && expect_out "range limit itself" '0.000000 0.000000\n4096.000000 -4096.000000\n'
-run "missing file" 1 flatten "$TMP/does-not-exist.svg" && expect_err "missing file" "does-not-exist.svg"
+run "range limit itself" 0 flatten "$T/p.txt" && expect_out "range limit itself" '0.000000 0.000000\n4096.000000 -4096.000000\n'
+run "missing file" 1 flatten "$T/does-not-exist.svg" && expect_err "missing file" "does-not-exist.svg"
 # Nothing on stdout for rejected input.
 path 'M 0 0 L 1 1 L 5000 0'
-run "no partial output" 1 flatten "$TMP/p.txt" && expect_out "no partial output" ''
+run "no partial output" 1 flatten "$T/p.txt" && expect_out "no partial output" ''
 
 # --- usage: exit 2 -------------------------------------------------------------------------
-run "unknown option" 2 flatten --frobnicate "$TMP/p.txt" && expect_err "unknown option" 'frobnicate'
+run "unknown option" 2 flatten --frobnicate "$T/p.txt" && expect_err "unknown option" 'frobnicate'
 run "no file" 2 flatten
-run "two files" 2 flatten "$TMP/p.txt" "$TMP/p.txt"
-run "bad tol" 2 flatten --tol abc "$TMP/p.txt"
-run "zero tol" 2 flatten --tol 0 "$TMP/p.txt"
-run "negative tol" 2 flatten --tol -1 "$TMP/p.txt"
+run "two files" 2 flatten "$T/p.txt" "$T/p.txt"
+run "bad tol" 2 flatten --tol abc "$T/p.txt"
+run "zero tol" 2 flatten --tol 0 "$T/p.txt"
+run "negative tol" 2 flatten --tol -1 "$T/p.txt"
 path 'M0 0 L1 1'
-run "tol below the tracers' 4 LSB" 2 flatten --tol 0.00003 "$TMP/p.txt" && expect_out "tol below 4 LSB" ''
-run "tol above the range" 2 flatten --tol 5000 "$TMP/p.txt"
-run "bad method" 2 flatten --method nope "$TMP/p.txt"
+run "tol below the tracers' 4 LSB" 2 flatten --tol 0.00003 "$T/p.txt" && expect_out "tol below 4 LSB" ''
+run "tol above the range" 2 flatten --tol 5000 "$T/p.txt"
+run "bad method" 2 flatten --method nope "$T/p.txt"
 run "tol without value" 2 flatten --tol
 run "unknown command" 2 frobnicate
 run "no command" 2
@@ -172,18 +128,18 @@ run "no command" 2
 if run "flatten --help" 0 flatten --help; then
     for w in --tol --method fd afd subdiv --stats --svg -h --help FILE "'-'" 'Exit status' \
         'bad input' 'usage' 'internal'; do
-        grep -q -- "$w" "$TMP/out" && ok || ko "flatten --help does not mention $w"
+        grep -q -- "$w" "$T/out" && ok || ko "flatten --help does not mention $w"
     done
 fi
-run "help flatten" 0 help flatten && { grep -q -- '--tol' "$TMP/out" && ok || ko "help flatten"; }
-run "--help" 0 --help && { grep -q 'flatten' "$TMP/out" && ok || ko "--help lists flatten"; }
-run "--version" 0 --version && { grep -qE '^curvestep [0-9]+\.[0-9]+' "$TMP/out" && ok || ko "--version"; }
+run "help flatten" 0 help flatten && { grep -q -- '--tol' "$T/out" && ok || ko "help flatten"; }
+run "--help" 0 --help && { grep -q 'flatten' "$T/out" && ok || ko "--help lists flatten"; }
+run "--version" 0 --version && { grep -qE '^curvestep [0-9]+\.[0-9]+' "$T/out" && ok || ko "--version"; }
 
 # --- --stats: measured deviation within the tolerance, for every method --------------------
 for m in fd afd subdiv; do
     for tol in 0.01 0.1; do
         if run "stats $m $tol" 0 flatten --stats --method "$m" --tol "$tol" tests/data/svg/w3c/paths-data-02-t.svg; then
-            dev=$(sed -n 's/.*max deviation \([0-9.]*\) mm.*/\1/p' "$TMP/err")
+            dev=$(sed -n 's/.*max deviation \([0-9.]*\) mm.*/\1/p' "$T/err")
             if [ -n "$dev" ] && awk -v d="$dev" -v t="$tol" 'BEGIN { exit !(d <= t && d > 0) }'; then ok; else
                 ko "stats $m $tol: deviation '$dev'"
             fi
@@ -195,15 +151,14 @@ for m in fd afd subdiv; do
 done
 
 # --- --svg ------------------------------------------------------------------------------------
-if run "svg out" 0 flatten --svg "$TMP/pic.svg" tests/data/svg/w3c/paths-data-01-t.svg; then
-    if [ -s "$TMP/pic.svg" ] && grep -q '<polyline' "$TMP/pic.svg" && grep -q 'id="curves"' "$TMP/pic.svg" &&
-        tail -n1 "$TMP/pic.svg" | grep -q '</svg>'; then ok; else ko "svg out: picture incomplete"; fi
+if run "svg out" 0 flatten --svg "$T/pic.svg" tests/data/svg/w3c/paths-data-01-t.svg; then
+    if [ -s "$T/pic.svg" ] && grep -q '<polyline' "$T/pic.svg" && grep -q 'id="curves"' "$T/pic.svg" &&
+        tail -n1 "$T/pic.svg" | grep -q '</svg>'; then ok; else ko "svg out: picture incomplete"; fi
     # The picture is itself an SVG document this program reads: its curves come back.
-    run "svg out re-read" 0 flatten "$TMP/pic.svg" && { [ -s "$TMP/out" ] && ok || ko "svg out re-read: empty"; }
+    run "svg out re-read" 0 flatten "$T/pic.svg" && { [ -s "$T/out" ] && ok || ko "svg out re-read: empty"; }
 fi
 path 'M0 0 L1 1'
-run "svg out unwritable" 3 flatten --svg "$TMP/no/such/dir/pic.svg" "$TMP/p.txt" &&
+run "svg out unwritable" 3 flatten --svg "$T/no/such/dir/pic.svg" "$T/p.txt" &&
     expect_err "svg out unwritable" 'pic.svg'
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

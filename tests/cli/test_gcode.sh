@@ -6,91 +6,49 @@
 # (copies of shared/data/gcode/cncjs) either reads and flattens or fails where it should.
 # Uses $CS_BUILD (the build directory); ends with "cli: N passed, M failed".
 set -u
-BIN=${CS_BUILD:-build}/curvestep
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 DATA=tests/data/gcode
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-pass=0
-fail=0
-
-ok() { pass=$((pass + 1)); }
-ko() { fail=$((fail + 1)); echo "FAIL: $*"; }
-
-# run NAME EXPECTED_RC ARGS...: runs the program, output in $TMP/out, $TMP/err, status in $rc.
-run() {
-    local name=$1 want=$2
-    shift 2
-    "$BIN" "$@" >"$TMP/out" 2>"$TMP/err"
-    rc=$?
-    if [ "$rc" -ne "$want" ]; then
-        ko "$name: exit $rc, expected $want"
-        sed 's/^/    /' "$TMP/err" | head -5
-        return 1
-    fi
-    ok
-    return 0
-}
-
-expect_out() {
-    local name=$1
-    printf "$2" >"$TMP/want"
-    if cmp -s "$TMP/out" "$TMP/want"; then ok; else
-        ko "$name: output differs"
-        diff "$TMP/want" "$TMP/out" | head -10 | sed 's/^/    /'
-    fi
-}
-
-expect_err() {
-    if grep -qE "$2" "$TMP/err"; then ok; else
-        ko "$1: stderr does not match /$2/"
-        head -5 "$TMP/err" | sed 's/^/    /'
-    fi
-}
 
 expect_empty_out() {
-    if [ ! -s "$TMP/out" ]; then ok; else ko "$1: stdout not empty"; fi
+    if [ ! -s "$T/out" ]; then ok; else ko "$1: stdout not empty"; fi
 }
 
 # expect_dev NAME TOL: --stats's measured max deviation must be <= TOL mm.
 expect_dev() {
     local d
-    d=$(sed -n 's/^flatten: max deviation \([0-9.]*\) mm.*/\1/p' "$TMP/err")
+    d=$(sed -n 's/^flatten: max deviation \([0-9.]*\) mm.*/\1/p' "$T/err")
     if [ -n "$d" ] && awk -v d="$d" -v t="$2" 'BEGIN { exit !(d <= t) }'; then ok; else
         ko "$1: max deviation '$d' not within $2 mm"
     fi
 }
 
-if [ ! -x "$BIN" ]; then
-    echo "no $BIN"
-    echo "cli: 0 passed, 1 failed"
-    exit 1
-fi
+need_bin "$CS"
 
 # --- lines: exact vertices, rapid moves as their own polyline -------------------------------
-printf 'G21 G90\nG0 X1 Y1\nG1 X10 Y1 F600\nY5\nG91 X-2\n' >"$TMP/l.nc"
-run "lines" 0 flatten "$TMP/l.nc" &&
+printf 'G21 G90\nG0 X1 Y1\nG1 X10 Y1 F600\nY5\nG91 X-2\n' >"$T/l.nc"
+run "lines" 0 flatten "$T/l.nc" &&
     expect_out "lines" '0.000000 0.000000\n1.000000 1.000000\n\n1.000000 1.000000\n10.000000 1.000000\n10.000000 5.000000\n8.000000 5.000000\n'
 # inches
 # inches (1.25 in = 31.75 mm and 0.625 in = 15.875 mm are exact in Q15.16)
-printf 'G20 G1 X1.25 Y0.625 F10\n' >"$TMP/in.ngc"
-run "inches" 0 flatten "$TMP/in.ngc" && expect_out "inches" '0.000000 0.000000\n31.750000 15.875000\n'
+printf 'G20 G1 X1.25 Y0.625 F10\n' >"$T/in.ngc"
+run "inches" 0 flatten "$T/in.ngc" && expect_out "inches" '0.000000 0.000000\n31.750000 15.875000\n'
 # stdin: G-code recognised by content
-run "stdin" 0 flatten - <"$TMP/l.nc" &&
+run "stdin" 0 flatten - <"$T/l.nc" &&
     expect_out "stdin" '0.000000 0.000000\n1.000000 1.000000\n\n1.000000 1.000000\n10.000000 1.000000\n10.000000 5.000000\n8.000000 5.000000\n'
 # unknown extension: content
-cp "$TMP/in.ngc" "$TMP/job.dat"
-run "by content" 0 flatten "$TMP/job.dat" && expect_out "by content" '0.000000 0.000000\n31.750000 15.875000\n'
+cp "$T/in.ngc" "$T/job.dat"
+run "by content" 0 flatten "$T/job.dat" && expect_out "by content" '0.000000 0.000000\n31.750000 15.875000\n'
 
 # --- arcs, helices, splines within the tolerance -------------------------------------------
-printf 'G1 X10 Y0 F600\nG3 X10 Y0 I-10 J0\nG2 X0 Y10 R-10\nG5 I0 J3 P0 Q-3 X1 Y1\nG5.1 X5 I2 J-8\n' >"$TMP/a.nc"
-run "arcs" 0 flatten --stats --tol 0.005 "$TMP/a.nc" && expect_dev "arcs" 0.005
-printf 'G1 X10 Y0 F600\nG3 X10 Y0 Z6 I-10 J0 P3\n' >"$TMP/h.nc"
-run "helix" 0 flatten --stats "$TMP/h.nc" && expect_dev "helix" 0.01
+printf 'G1 X10 Y0 F600\nG3 X10 Y0 I-10 J0\nG2 X0 Y10 R-10\nG5 I0 J3 P0 Q-3 X1 Y1\nG5.1 X5 I2 J-8\n' >"$T/a.nc"
+run "arcs" 0 flatten --stats --tol 0.005 "$T/a.nc" && expect_dev "arcs" 0.005
+printf 'G1 X10 Y0 F600\nG3 X10 Y0 Z6 I-10 J0 P3\n' >"$T/h.nc"
+run "helix" 0 flatten --stats "$T/h.nc" && expect_dev "helix" 0.01
 # the last vertex is the programmed end
-run "helix end" 0 flatten "$TMP/h.nc" &&
-    { [ "$(tail -n1 "$TMP/out")" = "10.000000 0.000000" ] && ok || ko "helix end: $(tail -n1 "$TMP/out")"; }
-printf 'G0 X0 Y0\nF10\nG5.2 X0 Y1 P1 L3\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3\n' >"$TMP/n.nc"
-run "nurbs" 0 flatten --stats "$TMP/n.nc" && expect_dev "nurbs" 0.01
+run "helix end" 0 flatten "$T/h.nc" &&
+    { [ "$(tail -n1 "$T/out")" = "10.000000 0.000000" ] && ok || ko "helix end: $(tail -n1 "$T/out")"; }
+printf 'G0 X0 Y0\nF10\nG5.2 X0 Y1 P1 L3\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3\n' >"$T/n.nc"
+run "nurbs" 0 flatten --stats "$T/n.nc" && expect_dev "nurbs" 0.01
 
 # --- the cncjs fixtures ---------------------------------------------------------------------
 for f in arc-xy-plane.nc arc-yz-plane.nc arc-zx-plane.nc one-inch-circle.nc; do
@@ -111,18 +69,18 @@ run "arc-r lenient" 0 flatten --lenient --stats "$DATA/arc-r.nc" &&
     expect_err "arc-r lenient" "^$DATA/arc-r.nc:3:1: warning: G2 without R or I/J: moved in a straight line" &&
     expect_err "arc-r lenient 7" "^$DATA/arc-r.nc:7:1: warning: G3 without R or I/J" &&
     expect_dev "arc-r lenient" 0.01 &&
-    { [ "$(grep -c ': warning: ' "$TMP/err")" = 2 ] && ok || ko "arc-r lenient: not 2 warnings"; }
+    { [ "$(grep -c ': warning: ' "$T/err")" = 2 ] && ok || ko "arc-r lenient: not 2 warnings"; }
 # the straight move keeps the R20 arc's start: (0,0) (0,20) then the arc, ending at (10,0)
-[ "$(sed -n 2p "$TMP/out")" = "0.000000 20.000000" ] && ok || ko "arc-r lenient: second vertex $(sed -n 2p "$TMP/out")"
+[ "$(sed -n 2p "$T/out")" = "0.000000 20.000000" ] && ok || ko "arc-r lenient: second vertex $(sed -n 2p "$T/out")"
 run "motion lenient" 0 flatten --lenient "$DATA/motion.nc" &&
     expect_err "motion lenient G92" "^$DATA/motion.nc:1:1: warning: G92 without X, Y or Z: ignored" &&
     expect_err "motion lenient R0" "^$DATA/motion.nc:4:9: warning: R-form arc ends where it starts.*nothing drawn" &&
     expect_err "motion lenient R0 G3" "^$DATA/motion.nc:5:9: warning: R-form arc ends where it starts" &&
-    { [ "$(grep -c ': warning: ' "$TMP/err")" = 7 ] && ok || ko "motion lenient: not 7 warnings"; }
+    { [ "$(grep -c ': warning: ' "$T/err")" = 7 ] && ok || ko "motion lenient: not 7 warnings"; }
 run "plan motion lenient" 0 plan --lenient "$DATA/motion.nc"
-printf 'N3 T0*57\nG1 X1 F60\n' >"$TMP/t0.gcode"
-run "T0 lenient" 0 flatten --lenient "$TMP/t0.gcode" &&
-    expect_err "T0 lenient" "^$TMP/t0.gcode:1:4: warning: T \\(tool select\\): ignored, there is no tool changer" &&
+printf 'N3 T0*57\nG1 X1 F60\n' >"$T/t0.gcode"
+run "T0 lenient" 0 flatten --lenient "$T/t0.gcode" &&
+    expect_err "T0 lenient" "^$T/t0.gcode:1:4: warning: T \\(tool select\\): ignored, there is no tool changer" &&
     expect_out "T0 lenient" '0.000000 0.000000\n1.000000 0.000000\n'
 # the corrupted line 8 stays an error even with --lenient (after the warnings for lines 3-5)
 run "checksum" 1 flatten --lenient "$DATA/special-fields.gcode" &&
@@ -130,60 +88,55 @@ run "checksum" 1 flatten --lenient "$DATA/special-fields.gcode" &&
     expect_empty_out "checksum"
 
 # --- errors: file:line:col, exit 1 ----------------------------------------------------------
-printf 'G1 X1 F60\nG1 X2 Q\n' >"$TMP/e1.nc"
-run "syntax" 1 flatten "$TMP/e1.nc" && expect_err "syntax" "^$TMP/e1.nc:2:7: Q must be followed by a number"
-printf 'G1 X10 F60\nG2 X0 Y11 I-10\n' >"$TMP/e2.nc"
-run "radius" 1 flatten "$TMP/e2.nc" && expect_err "radius" "^$TMP/e2.nc:2:1: radius to end of arc"
-printf 'G1 X1 F60\nM6 T1\n' >"$TMP/e3.nc"
-run "unsupported" 1 flatten "$TMP/e3.nc" && expect_err "unsupported" "^$TMP/e3.nc:2:4: the T word"
-run "lenient" 0 flatten --lenient "$TMP/e3.nc" && expect_err "lenient" "$TMP/e3.nc:2:1: warning: M6"
-printf 'G1 X5000 F60\n' >"$TMP/e4.nc"
-run "range" 1 flatten "$TMP/e4.nc" && expect_err "range" "^$TMP/e4.nc:1:1: point .* outside"
+printf 'G1 X1 F60\nG1 X2 Q\n' >"$T/e1.nc"
+run "syntax" 1 flatten "$T/e1.nc" && expect_err "syntax" "^$T/e1.nc:2:7: Q must be followed by a number"
+printf 'G1 X10 F60\nG2 X0 Y11 I-10\n' >"$T/e2.nc"
+run "radius" 1 flatten "$T/e2.nc" && expect_err "radius" "^$T/e2.nc:2:1: radius to end of arc"
+printf 'G1 X1 F60\nM6 T1\n' >"$T/e3.nc"
+run "unsupported" 1 flatten "$T/e3.nc" && expect_err "unsupported" "^$T/e3.nc:2:4: the T word"
+run "lenient" 0 flatten --lenient "$T/e3.nc" && expect_err "lenient" "$T/e3.nc:2:1: warning: M6"
+printf 'G1 X5000 F60\n' >"$T/e4.nc"
+run "range" 1 flatten "$T/e4.nc" && expect_err "range" "^$T/e4.nc:1:1: point .* outside"
 
 # --- plan: G-code in, nothing written on error ----------------------------------------------
 run "plan" 0 plan "$DATA/one-inch-circle.nc" && expect_err "plan" "^plan: [0-9]+ elements" &&
-    { head -n1 "$TMP/out" | grep -q '^# curvestep segments' && ok || ko "plan: no header"; }
+    { head -n1 "$T/out" | grep -q '^# curvestep segments' && ok || ko "plan: no header"; }
 run "plan lenient" 0 plan --lenient "$DATA/helical-thread-milling.nc"
-run "plan bad" 1 plan "$TMP/e2.nc" && expect_err "plan bad" "^$TMP/e2.nc:2:1:" &&
+run "plan bad" 1 plan "$T/e2.nc" && expect_err "plan bad" "^$T/e2.nc:2:1:" &&
     expect_empty_out "plan bad"
-run "plan bad -o" 1 plan -o "$TMP/seg.txt" "$TMP/e2.nc" &&
-    { [ ! -s "$TMP/seg.txt" ] && ok || ko "plan bad -o: segments written"; }
+run "plan bad -o" 1 plan -o "$T/seg.txt" "$T/e2.nc" &&
+    { [ ! -s "$T/seg.txt" ] && ok || ko "plan bad -o: segments written"; }
 
 # --- pen lift: [pen] mode = z in the machine file turns M3 / M5 into Z moves -------------------
 # 80 steps/mm: M3 lowers Z 0 -> -1 mm (-80 steps), M5 raises it -1 -> 4 mm (+400 steps); X goes
 # 0 -> 20 -> 0 (net 0); without [pen] Z never moves.
-printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n' >"$TMP/pen.ini"
-printf 'G0 X10\nM3\nG1 X20 F600\nM5\nG0 X0\n' >"$TMP/pen.nc"
-zsum() { awk 'NR > 1 { if ($4 > 0) p += $4; else n += $4; x += $2 } END { print p + 0, n + 0, x + 0 }' "$TMP/out"; }
-run "pen z" 0 plan --machine "$TMP/pen.ini" "$TMP/pen.nc" &&
+printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n' >"$T/pen.ini"
+printf 'G0 X10\nM3\nG1 X20 F600\nM5\nG0 X0\n' >"$T/pen.nc"
+zsum() { awk 'NR > 1 { if ($4 > 0) p += $4; else n += $4; x += $2 } END { print p + 0, n + 0, x + 0 }' "$T/out"; }
+run "pen z" 0 plan --machine "$T/pen.ini" "$T/pen.nc" &&
     { [ "$(zsum)" = "400 -80 0" ] && ok || ko "pen z: z up, z down, net x = $(zsum), expected 400 -80 0"; }
-run "pen none" 0 plan "$TMP/pen.nc" &&
+run "pen none" 0 plan "$T/pen.nc" &&
     { [ "$(zsum)" = "0 0 0" ] && ok || ko "pen none: $(zsum), expected 0 0 0"; }
-printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n[z]\ntravel_min = 0\n' >"$TMP/pen-bad.ini"
-run "pen outside travel" 1 plan --machine "$TMP/pen-bad.ini" "$TMP/pen.nc" &&
-    expect_err "pen outside travel" "^$TMP/pen-bad.ini:0: \\[pen\\] down_z = -1 mm is outside the z travel" &&
+printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n[z]\ntravel_min = 0\n' >"$T/pen-bad.ini"
+run "pen outside travel" 1 plan --machine "$T/pen-bad.ini" "$T/pen.nc" &&
+    expect_err "pen outside travel" "^$T/pen-bad.ini:0: \\[pen\\] down_z = -1 mm is outside the z travel" &&
     expect_empty_out "pen outside travel"
-printf '[pen]\nmode = lift\n' >"$TMP/pen-bad2.ini"
-run "pen bad mode" 1 plan --machine "$TMP/pen-bad2.ini" "$TMP/pen.nc" &&
-    expect_err "pen bad mode" "^$TMP/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
+printf '[pen]\nmode = lift\n' >"$T/pen-bad2.ini"
+run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
+    expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
 
 # stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
 # (320 steps), x back at 0.
-SIM=${CS_BUILD:-build}/curvestep-sim
 if [ -x "$SIM" ]; then
-    timeout 60 "$SIM" --pty --instant --idle-exit 1 --machine "$TMP/pen.ini" >"$TMP/sim.out" \
-        2>"$TMP/sim.err" &
+    timeout 60 "$SIM" --pty --instant --idle-exit 1 --machine "$T/pen.ini" >"$T/sim.out" \
+        2>"$T/sim.err" &
     simpid=$!
-    PTY=
-    for _ in $(seq 100); do
-        PTY=$(head -n1 "$TMP/sim.out" 2>/dev/null)
-        [ -n "$PTY" ] && break
-        sleep 0.05
-    done
-    if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$TMP/pen.ini" --port "$PTY" "$TMP/pen.nc"; then
-        for _ in $(seq 200); do kill -0 "$simpid" 2>/dev/null || break; sleep 0.05; done
+    pids+=($simpid)
+    wait_pty "$T/sim.out" 5
+    if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$T/pen.ini" --port "$PTY" "$T/pen.nc"; then
+        wait_until 10 gone "$simpid"
         grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
-            "$TMP/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$TMP/sim.out")"
+            "$T/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$T/sim.out")"
     else
         [ -n "$PTY" ] || ko "stream pen z: the simulator did not start"
     fi
@@ -192,15 +145,14 @@ if [ -x "$SIM" ]; then
 else
     ko "no $SIM"
 fi
-run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$TMP/out" && ok ||
+run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$T/out" && ok ||
     ko "stream --help lacks [pen]"
 
 # --- help tells the truth -------------------------------------------------------------------
-run "flatten help" 0 flatten --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
+run "flatten help" 0 flatten --help && grep -q -- "--lenient" "$T/out" && grep -q "G-code" "$T/out" &&
     ok || ko "flatten --help lacks G-code or --lenient"
-run "plan help" 0 plan --help && grep -q -- "--lenient" "$TMP/out" && grep -q "G-code" "$TMP/out" &&
+run "plan help" 0 plan --help && grep -q -- "--lenient" "$T/out" && grep -q "G-code" "$T/out" &&
     ok || ko "plan --help lacks G-code or --lenient"
-grep -q "\[pen\] mode = z" "$TMP/out" && ok || ko "plan --help lacks [pen]"
+grep -q "\[pen\] mode = z" "$T/out" && ok || ko "plan --help lacks [pen]"
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

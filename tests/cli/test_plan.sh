@@ -4,19 +4,7 @@
 # file:line:col, bad machine and segment files reported as file:line, and a segments file that
 # breaks the rate limit failing --check. Prints "cli: N passed, M failed".
 set -u
-B=${CS_BUILD:-build}
-CS=$B/curvestep
-SIM=$B/curvestep-sim
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-expect() { # expect NAME CONDITION...
-    local name=$1; shift
-    if "$@"; then ok; else bad "$name"; fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 
 JOB=tests/data/svg/w3c/paths-data-12-t.svg
 
@@ -79,7 +67,7 @@ for f in tests/data/svg/*/*.svg; do
         "$SIM" --replay "$T/s.txt" --reference "$f" --check >"$T/s.out" 2>/dev/null; then
         ok
     else
-        bad "plan + replay --check on $f"
+        ko "plan + replay --check on $f"
         cat "$T/s.out"
     fi
 done
@@ -93,7 +81,7 @@ for f in tests/data/gcode/arc-xy-plane.nc tests/data/gcode/arc-zx-plane.nc \
         "$SIM" --replay "$T/g.txt" --reference "$f" --lenient --check >"$T/g.out" 2>/dev/null; then
         ok
     else
-        bad "plan + replay --check on $f"
+        ko "plan + replay --check on $f"
         cat "$T/g.out"
     fi
 done
@@ -106,5 +94,4 @@ expect "plan --help text" grep -q 'usage: curvestep plan' "$T/h1.txt"
 expect "sim --help" [ $rc -eq 0 ]
 expect "sim --help text" grep -q -- '--replay SEGMENTS' "$T/h2.txt"
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

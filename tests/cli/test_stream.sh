@@ -5,25 +5,7 @@
 # --resume-from; a closed line reported; usage errors. Every process is bounded by `timeout` and
 # killed on exit. Prints "cli: N passed, M failed".
 set -u
-B=${CS_BUILD:-build}
-CS=$B/curvestep
-SIM=$B/curvestep-sim
-T=$(mktemp -d)
-pids=()
-cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-    wait 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-expect() { # expect NAME CONDITION...
-    local name=$1; shift
-    if "$@"; then ok; else bad "$name"; fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 
 JOB=tests/data/svg/w3c/paths-data-12-t.svg
 ARCS=tests/data/svg/resvg/M-L-Z-A.svg
@@ -38,19 +20,11 @@ start_sim() {
     timeout 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     SIMPID=$!
-    PTY=
-    for _ in $(seq 100); do
-        PTY=$(head -n1 "$T/$name.sim" 2>/dev/null)
-        [ -n "$PTY" ] && break
-        sleep 0.05
-    done
+    wait_pty "$T/$name.sim" 5
 }
-# wait_sim: waits (bounded) for the device started last to finish its report.
+# wait_sim: waits (at most 10 s) for the device started last to finish its report.
 wait_sim() {
-    for _ in $(seq 200); do
-        kill -0 "$SIMPID" 2>/dev/null || break
-        sleep 0.05
-    done
+    wait_until 10 gone "$SIMPID"
     kill "$SIMPID" 2>/dev/null
     wait "$SIMPID" 2>/dev/null
 }
@@ -156,5 +130,4 @@ timeout 10 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err";
 expect "bad job: exit 1, nothing opened" [ $rc -eq 1 ]
 expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish

@@ -6,20 +6,13 @@
  * Built and run by scripts/fuzz.sh. Compiled with -DCS_FUZZ_SEED_MAIN it is instead a small
  * program writing the seed corpus (one valid frame of every message type) into argv[1]. */
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
+
+#define FUZZ_NAME "fuzz_frame"
+#include "fuzz_common.h"
 
 #include "cs_frame.h"
 #include "cs_proto.h"
-
-#define FUZZ_CHECK(c)                                                                              \
-    do {                                                                                           \
-        if (!(c)) {                                                                                \
-            fprintf(stderr, "fuzz_frame: check failed: %s (line %d)\n", #c, __LINE__);             \
-            abort();                                                                               \
-        }                                                                                          \
-    } while (0)
 
 static void check_message(const uint8_t *p, size_t n)
 {
@@ -91,13 +84,7 @@ static void write_seed(const char *dir, const char *name, const cs_proto_msg_t *
         fprintf(stderr, "fuzz_frame seed: cannot encode %s\n", name);
         exit(1);
     }
-    char path[4096];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *fp = fopen(path, "wb");
-    if (fp == NULL || fwrite(wire, 1, wl, fp) != wl || fclose(fp) != 0) {
-        perror(path);
-        exit(1);
-    }
+    fuzz_write_file(dir, name, wire, wl);
 }
 
 int main(int argc, char **argv)

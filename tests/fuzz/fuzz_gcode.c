@@ -10,29 +10,20 @@
  * only the core). Seeds: tests/fuzz/corpus_gcode/ (copies of shared/data/gcode) and, with
  * -DCS_FUZZ_SEED_MAIN, the list below written into argv[1]. */
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
+
+#define FUZZ_NAME "fuzz_gcode"
+#include "fuzz_common.h"
 
 #include "../../host/cs_conv.c"
 #include "../../host/cs_err_text.c"
 #include "../../host/cs_gcode.c"
 #include "../../host/cs_path.c"
-#include "cs_trace.h"
+#include "fuzz_path.h"
 
-#define FUZZ_CHECK(c)                                                                              \
-    do {                                                                                           \
-        if (!(c)) {                                                                                \
-            fprintf(stderr, "fuzz_gcode: check failed: %s (line %d)\n", #c, __LINE__);             \
-            abort();                                                                               \
-        }                                                                                          \
-    } while (0)
-
-/* Elements traced per input, vertices allowed per element, elements allowed per job (keeps a
- * many-turn helix per line from exhausting memory; the reader refuses more with CS_ERR_FULL). */
-#define FUZZ_TRACE_ELEMS 8
-#define FUZZ_TRACE_MAX   200000
-#define FUZZ_MAX_ELEMS   100000
+/* Elements allowed per job (keeps a many-turn helix per line from exhausting memory; the reader
+ * refuses more with CS_ERR_FULL). */
+#define FUZZ_MAX_ELEMS 100000
 
 static void quiet(void *ctx, const cs_path_diag_t *w)
 {
@@ -55,23 +46,6 @@ static void check_curve(const cs_path_elem_t *e)
     for (unsigned i = 0; i <= c->degree; i++)
         FUZZ_CHECK(cs_fixed_vec_ok(&c->p[i]));
     FUZZ_CHECK(e->feed_mm_s >= 0 && (!e->rapid || e->feed_mm_s == 0));
-}
-
-static void trace(const cs_bezier_t *c)
-{
-    cs_trace_t tr;
-    cs_pos_t tol = CS_POS_ONE_MM / 100;
-    FUZZ_CHECK(cs_trace_begin(&tr, c, tol, CS_TRACE_SUBDIV) == CS_OK);
-    cs_vec3_t pt, last = c->p[0];
-    cs_err_t e;
-    unsigned n = 0;
-    while ((e = cs_trace_next(&tr, &pt)) == CS_OK) {
-        last = pt;
-        FUZZ_CHECK(++n <= FUZZ_TRACE_MAX);
-    }
-    FUZZ_CHECK(e == CS_END);
-    const cs_vec3_t *end = &c->p[c->degree];
-    FUZZ_CHECK(n == 0 || (last.x == end->x && last.y == end->y && last.z == end->z));
 }
 
 /* FNV-1a over the fields that matter (struct padding is not hashed). */
@@ -122,10 +96,7 @@ static cs_err_t run(const uint8_t *data, size_t size, bool lenient, cs_path_diag
     FUZZ_CHECK(e == CS_OK || e == CS_ERR_PARSE || e == CS_ERR_UNSUPPORTED || e == CS_ERR_RANGE ||
                e == CS_ERR_DEGENERATE || e == CS_ERR_WEIGHT || e == CS_ERR_KNOTS ||
                e == CS_ERR_OVERFLOW || e == CS_ERR_FULL);
-    if (e != CS_OK) {
-        FUZZ_CHECK(d->code == e && d->loc.line >= 1 && d->loc.col >= 1 && d->reason[0] != '\0');
-        FUZZ_CHECK(strcmp(d->loc.file, "fuzz") == 0);
-    }
+    fuzz_check_diag(e, d, true);
     for (size_t i = 0; i < p.n; i++) {
         check_curve(&p.elems[i]);
         if (i > 0) {
@@ -135,7 +106,7 @@ static cs_err_t run(const uint8_t *data, size_t size, bool lenient, cs_path_diag
             FUZZ_CHECK(p.elems[i].subpath >= p.elems[i - 1].subpath);
         }
         if (i < FUZZ_TRACE_ELEMS && !lenient)
-            trace(&p.elems[i].curve);
+            fuzz_trace(&p.elems[i].curve);
     }
     *hash = hash_path(&p);
     *n = p.n;
@@ -182,18 +153,6 @@ static const char *const seeds[] = {
 
 int main(int argc, char **argv)
 {
-    if (argc < 2)
-        return 2;
-    for (size_t i = 0; i < sizeof seeds / sizeof seeds[0]; i++) {
-        char name[4096];
-        snprintf(name, sizeof name, "%s/seed-%02zu", argv[1], i);
-        FILE *f = fopen(name, "wb");
-        if (!f)
-            return 1;
-        fwrite(seeds[i], 1, strlen(seeds[i]), f);
-        fclose(f);
-        LLVMFuzzerTestOneInput((const uint8_t *)seeds[i], strlen(seeds[i]));
-    }
-    return 0;
+    return fuzz_seed_main(argc, argv, seeds, sizeof seeds / sizeof seeds[0], NULL);
 }
 #endif

@@ -4,19 +4,12 @@
  * deliveries strictly consecutive, the window and the credits never exceeded.
  * Built and run by scripts/fuzz.sh; -DCS_FUZZ_SEED_MAIN builds the seed writer instead. */
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "cs_link.h"
+#define FUZZ_NAME "fuzz_link"
+#include "fuzz_common.h"
 
-#define FUZZ_CHECK(c)                                                                              \
-    do {                                                                                           \
-        if (!(c)) {                                                                                \
-            fprintf(stderr, "fuzz_link: check failed: %s (line %d)\n", #c, __LINE__);              \
-            abort();                                                                               \
-        }                                                                                          \
-    } while (0)
+#include "cs_link.h"
 
 static const cs_link_cfg_t cfg = {.rto = 50, .nak_holdoff = 5, .keepalive = 200, .max_retries = 4};
 
@@ -127,13 +120,7 @@ int main(int argc, char **argv)
     m.type = CS_PROTO_HELLO;
     m.u.hello = (cs_proto_hello_t){1, 10, 3, 8, 1000, 1};
     n += frame(0xFFF1, &m, buf + n);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/session", argv[1]);
-    FILE *fp = fopen(path, "wb");
-    if (fp == NULL || fwrite(buf, 1, n, fp) != n || fclose(fp) != 0) {
-        perror(path);
-        return 1;
-    }
+    fuzz_write_file(argv[1], "session", buf, n);
     return 0;
 }
 #endif

@@ -2,7 +2,9 @@
  * server's request protocol on a daemon run in a child process over a pseudo-terminal with no
  * device behind it (the queue is paused first, so no job starts): the socket's mode, STATUS,
  * SUBMIT of a good file (queued, sized as the planner sizes it) and of a bad one (refused with
- * file:line:col), CANCEL of a queued job, unknown requests, and a clean stop on SIGTERM. */
+ * file:line:col), CANCEL of a queued job, unknown requests, and a clean stop on SIGTERM; and a
+ * machine file with [pen] mode = z: a G-code job's M3/M5 become Z moves in the daemon's plan as
+ * in `curvestep plan` / `stream` (it is sized like that plan, not like the plan without pen). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,6 +22,7 @@
 #include <unistd.h>
 
 #include "cs_daemon.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_serial.h"
@@ -155,11 +158,82 @@ static void test_protocol(void **state)
     close(slave);
 }
 
+/* Segments of file planned on the machine of ini with its [pen] (pen_z) or without (the plain
+ * machine and no pen), as `curvestep plan` does. */
+static size_t plan_count(const char *ini, const char *file, bool pen_z)
+{
+    cs_machine_t m;
+    cs_machine_pen_t pen;
+    char err[512];
+    assert_int_equal(cs_machine_ini_load_pen(ini, &m, &pen, err, sizeof err), 0);
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    assert_int_equal(cs_jobplan_read(&jp, file, pen_z ? &pen : NULL, false), CS_OK);
+    assert_int_equal(cs_jobplan_plan(&jp, file, &m, NULL, m.tolerance, CS_TRACE_SUBDIV, 0),
+                     CS_OK);
+    size_t n = jp.mo.segs.n;
+    cs_jobplan_free(&jp);
+    return n;
+}
+
+static void test_pen_machine(void **state)
+{
+    (void)state;
+    int master, slave;
+    char pty[128];
+    assert_int_equal(cs_serial_openpty(&master, &slave, pty, sizeof pty), 0);
+    char dir[] = "/tmp/cs-daemon-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char sock[256], ini[256], job[256];
+    snprintf(sock, sizeof sock, "%s/d.sock", dir);
+    snprintf(ini, sizeof ini, "%s/pen.ini", dir);
+    snprintf(job, sizeof job, "%s/pen.nc", dir);
+    FILE *f = fopen(ini, "w");
+    assert_non_null(f);
+    fputs("[pen]\nmode = z\nup_z = 5\ndown_z = 0\n", f);
+    fclose(f);
+    f = fopen(job, "w");
+    assert_non_null(f);
+    fputs("G21 G90\nG0 X10 Y10\nM3\nG1 X30 Y10 F1200\nM5\nG0 X40 Y20\nM3\nG1 X40 Y40\nM5\nM2\n",
+          f);
+    fclose(f);
+    size_t with_pen = plan_count(ini, job, true), without = plan_count(ini, job, false);
+    assert_true(with_pen != without); /* else this test could not tell the two apart */
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        alarm(20);
+        cs_daemon_cfg_t cfg = {
+            .port = pty, .baud = 115200, .socket_path = sock, .machine_file = ini, .log = NULL};
+        _exit(cs_daemon_serve(&cfg));
+    }
+    struct stat st;
+    int tries = 0;
+    while (stat(sock, &st) != 0 && tries++ < 200)
+        usleep(10000);
+    char buf[4096];
+    assert_int_equal(ask(sock, "PAUSE", buf, sizeof buf), 0);
+    char req[400], want[600];
+    snprintf(req, sizeof req, "SUBMIT %s", job);
+    assert_int_equal(ask(sock, req, buf, sizeof buf), 0);
+    snprintf(want, sizeof want, "OK job 1 queued: %s: %zu segments\n", job, with_pen);
+    assert_string_equal(buf, want);
+    kill(pid, SIGTERM);
+    int ws = 0;
+    assert_int_equal(waitpid(pid, &ws, 0), pid);
+    unlink(ini);
+    unlink(job);
+    rmdir(dir);
+    close(master);
+    close(slave);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_no_daemon_names_the_socket),
         cmocka_unit_test(test_protocol),
+        cmocka_unit_test(test_pen_machine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

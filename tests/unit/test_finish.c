@@ -2,7 +2,10 @@
  * cylinder, convex dome, saddle), checked against a double reference written here: every
  * vertex on the exact offset surface P + R N (2 LSB), every chord within tol of the exact
  * offset curve, the scallop measured densely between neighbouring passes below H, the flat
- * step-over close to w = 2 sqrt(2 R H - H^2), gouge warnings where the concave radius < R. */
+ * step-over close to w = 2 sqrt(2 R H - H^2), gouge warnings where the concave radius < R.
+ * Triangular patches: the collapsed tensor form against the triangle's own barycentric formula
+ * (0.5 LSB), and their finishing checked like the others against a triangle reference whose
+ * normal comes from the barycentric partials Tu x Tv. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -180,7 +183,7 @@ static void check_surface(double (*f)(double, double), const char *name, double 
     cs_patch_t p;
     grid_patch(&p, f, 30);
     coll_t k = {NULL, 0, 0};
-    cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0};
+    cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
     cs_pos_t tol = (cs_pos_t)lround(tol_mm * MM);
     assert_int_equal(cs_finish_patch(&p, r, h, tol, collect, &k, &st), CS_OK);
     assert_true(st.passes >= 2);
@@ -267,7 +270,7 @@ static void test_gouge_warning(void **state)
     cs_patch_t p;
     grid_patch(&p, crease, 30);
     coll_t k = {NULL, 0, 0};
-    cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0};
+    cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
     assert_int_equal(cs_finish_patch(&p, 5, 0.05, 655, collect, &k, &st), CS_OK);
     /* The Bézier through the crease's grid has z = 112.5, 12.5, 12.5, 112.5 along v, so at
      * v = 1/2: z_vv = 6 (1/2 (12.5 - 25 + 112.5) + 1/2 (112.5 - 25 + 12.5)) = 600 mm, y_v = 30 mm,
@@ -282,7 +285,7 @@ static void test_gouge_warning(void **state)
     k.n = 0;
     k.v = NULL;
     k.cap = 0;
-    cs_finish_stats_t st2 = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0};
+    cs_finish_stats_t st2 = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
     assert_int_equal(cs_finish_patch(&p, 3, 0.05, 655, collect, &k, &st2), CS_OK);
     assert_int_equal(st2.gouge_points, 0);
     assert_true(fabs(st2.min_radius - 37.5) < 1e-6);
@@ -292,12 +295,283 @@ static void test_gouge_warning(void **state)
     assert_int_equal(cs_finish_patch(&p, 3, 0.1, 1, collect, &k, &st2), CS_ERR_ARG);
 }
 
+/* --- triangular patches -------------------------------------------------------------------- */
+
+static double fact(int k)
+{
+    return k <= 1 ? 1 : k * fact(k - 1);
+}
+
+/* T(u, v) of degree n (w = 1 - u - v), or with du / dv = 1 its partial derivative in u / v
+ * (w depending on both): dT/du = n sum_{i+j+k=n-1} B_ijk (S_{i+1,j,k} - S_{i,j,k+1}). */
+static void tri_ref(const cs_tripatch_t *t, double u, double v, int du, int dv, double o[3])
+{
+    int n = t->degree, m = n - (du || dv ? 1 : 0);
+    double w = 1 - u - v;
+    o[0] = o[1] = o[2] = 0;
+    for (int i = 0; i <= m; i++)
+        for (int j = 0; i + j <= m; j++) {
+            int k = m - i - j;
+            double b = fact(m) / (fact(i) * fact(j) * fact(k)) * pow(u, i) * pow(v, j) * pow(w, k);
+            const cs_vec3_t *a, *c;
+            if (du) {
+                a = &t->p[cs_tripatch_index((unsigned)n, (unsigned)i + 1, (unsigned)j)];
+                c = &t->p[cs_tripatch_index((unsigned)n, (unsigned)i, (unsigned)j)];
+            } else if (dv) {
+                a = &t->p[cs_tripatch_index((unsigned)n, (unsigned)i, (unsigned)j + 1)];
+                c = &t->p[cs_tripatch_index((unsigned)n, (unsigned)i, (unsigned)j)];
+            } else {
+                a = &t->p[cs_tripatch_index((unsigned)n, (unsigned)i, (unsigned)j)];
+                c = NULL;
+            }
+            double f = (du || dv) ? n : 1;
+            o[0] += f * b * (a->x - (c ? c->x : 0)) * LSB;
+            o[1] += f * b * (a->y - (c ? c->y : 0)) * LSB;
+            o[2] += f * b * (a->z - (c ? c->z : 0)) * LSB;
+        }
+}
+
+/* Reference tool centre over the triangle at (u, v): T + R (Tu x Tv) / |Tu x Tv|. */
+static void tri_centre(const cs_tripatch_t *t, double r, double u, double v, double c[3])
+{
+    double pt[3], tu[3], tv[3], n[3];
+    tri_ref(t, u, v, 0, 0, pt);
+    tri_ref(t, u, v, 1, 0, tu);
+    tri_ref(t, u, v, 0, 1, tv);
+    n[0] = tu[1] * tv[2] - tu[2] * tv[1];
+    n[1] = tu[2] * tv[0] - tu[0] * tv[2];
+    n[2] = tu[0] * tv[1] - tu[1] * tv[0];
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int a = 0; a < 3; a++)
+        c[a] = pt[a] + r * n[a] / l;
+}
+
+/* A curved triangle of degree n over the right triangle (0,0) (30,0) (0,30): z from a dome. */
+static void make_tri(cs_tripatch_t *t, unsigned n)
+{
+    cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
+    for (unsigned i = 0; i <= n; i++)
+        for (unsigned j = 0; i + j <= n; j++) {
+            double x = 30.0 * i / n, y = 30.0 * j / n;
+            double z = 4 - 0.01 * ((x - 10) * (x - 10) + (y - 10) * (y - 10)) + (i == 1 && j == 1);
+            pts[cs_tripatch_index(n, i, j)] = cs_fixed_vec(
+                (int32_t)lround(x * MM), (int32_t)lround(y * MM), (int32_t)lround(z * MM));
+        }
+    assert_int_equal(cs_tripatch_init(t, n, pts), CS_OK);
+}
+
+/* Tensor patch of any degree, own Bernstein evaluation. */
+static void tensor_ref(const cs_patch_t *p, double a, double b, double o[3])
+{
+    o[0] = o[1] = o[2] = 0;
+    for (int i = 0; i <= p->deg_u; i++)
+        for (int j = 0; j <= p->deg_v; j++) {
+            double w = fact(p->deg_u) / (fact(i) * fact(p->deg_u - i)) * pow(a, i) *
+                       pow(1 - a, p->deg_u - i) * fact(p->deg_v) / (fact(j) * fact(p->deg_v - j)) *
+                       pow(b, j) * pow(1 - b, p->deg_v - j);
+            o[0] += w * p->p[i][j].x * LSB;
+            o[1] += w * p->p[i][j].y * LSB;
+            o[2] += w * p->p[i][j].z * LSB;
+        }
+}
+
+static void test_tri_convert(void **state)
+{
+    (void)state;
+    for (unsigned n = 1; n <= 3; n++) {
+        cs_tripatch_t t;
+        make_tri(&t, n);
+        cs_patch_t q;
+        assert_int_equal(cs_finish_tri_patch(&t, &q), CS_OK);
+        assert_int_equal(q.deg_u, n);
+        assert_int_equal(q.deg_v, n);
+        double worst = 0;
+        for (int ia = 0; ia <= 32; ia++)
+            for (int ib = 0; ib <= 32; ib++) {
+                double a = ia / 32.0, b = ib / 32.0, x[3], y[3];
+                tensor_ref(&q, a, b, x);
+                tri_ref(&t, b, (1 - b) * (1 - a), 0, 0, y);
+                for (int k = 0; k < 3; k++)
+                    worst = fmax(worst, fabs(x[k] - y[k]));
+            }
+        char what[64];
+        snprintf(what, sizeof what, "triangle degree %u as a collapsed %ux%u patch", n, n, n);
+        report(what, worst / LSB, "LSB");
+        assert_true(worst <= 0.5 * LSB + 1e-9);
+        /* the edge b = 1 is the corner u = 1 */
+        for (unsigned i = 0; i <= n; i++)
+            assert_memory_equal(&q.p[i][n], &t.p[cs_tripatch_index(n, n, 0)], sizeof(cs_vec3_t));
+    }
+    cs_tripatch_t bad = {0};
+    cs_patch_t q;
+    assert_int_equal(cs_finish_tri_patch(&bad, &q), CS_ERR_DEGREE);
+}
+
+static void test_tri_finish(void **state)
+{
+    (void)state;
+    const double r = 3, h = 0.05, tol_mm = 0.01;
+    for (unsigned n = 2; n <= 3; n++) {
+        cs_tripatch_t t;
+        make_tri(&t, n);
+        cs_patch_t q;
+        assert_int_equal(cs_finish_tri_patch(&t, &q), CS_OK);
+        coll_t k = {NULL, 0, 0};
+        cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
+        assert_int_equal(cs_finish_patch(&q, r, h, (cs_pos_t)lround(tol_mm * MM), collect, &k, &st),
+                         CS_OK);
+        double worst_v = 0, worst_chord = 0, worst_scallop = 0, prev_b = -1;
+        for (size_t i = 0; i < k.n; i++) {
+            /* the finishing's (a, b) is the triangle's (u, v) = (b, (1 - b)(1 - a)) */
+            double a = k.v[i].u, b = k.v[i].v, c[3];
+            if (b > 1 - 1e-9)
+                continue; /* the apex: a limit normal */
+            tri_centre(&t, r, b, (1 - b) * (1 - a), c);
+            worst_v = fmax(
+                worst_v, fmax(fabs(c[0] - k.v[i].c.x * LSB),
+                              fmax(fabs(c[1] - k.v[i].c.y * LSB), fabs(c[2] - k.v[i].c.z * LSB))));
+            if (i > 0 && k.v[i - 1].pass == k.v[i].pass) {
+                double p0[3] = {k.v[i - 1].c.x * LSB, k.v[i - 1].c.y * LSB, k.v[i - 1].c.z * LSB};
+                double p1[3] = {k.v[i].c.x * LSB, k.v[i].c.y * LSB, k.v[i].c.z * LSB};
+                for (int s = 1; s < 32; s++) {
+                    double aa = k.v[i - 1].u + (a - k.v[i - 1].u) * s / 32, qq[3];
+                    tri_centre(&t, r, b, (1 - b) * (1 - aa), qq);
+                    worst_chord = fmax(worst_chord, seg_dist(qq, p0, p1));
+                }
+            }
+            if (b != prev_b && prev_b >= 0) {
+                /* Left over between the passes at u = prev_b and u = b, along the normal, below
+                 * the two balls at the same a (a subset of the swept balls: an upper bound). */
+                for (int ia = 0; ia <= 64; ia++) {
+                    double aa = ia / 64.0, c1[3], c2[3];
+                    tri_centre(&t, r, prev_b, (1 - prev_b) * (1 - aa), c1);
+                    tri_centre(&t, r, b, (1 - b) * (1 - aa), c2);
+                    for (int is = 1; is < 32; is++) {
+                        double uu = prev_b + (b - prev_b) * is / 32, vv = (1 - uu) * (1 - aa);
+                        double sp[3], cc[3], nn[3], best = HUGE_VAL;
+                        tri_ref(&t, uu, vv, 0, 0, sp);
+                        tri_centre(&t, 1.0, uu, vv, cc);
+                        for (int x = 0; x < 3; x++)
+                            nn[x] = cc[x] - sp[x];
+                        const double *cs[2] = {c1, c2};
+                        for (int z = 0; z < 2; z++) {
+                            double d[3] = {sp[0] - cs[z][0], sp[1] - cs[z][1], sp[2] - cs[z][2]};
+                            double bb = d[0] * nn[0] + d[1] * nn[1] + d[2] * nn[2];
+                            double cq = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - r * r;
+                            double disc = bb * bb - cq;
+                            if (cq <= 0)
+                                best = 0;
+                            else if (disc >= 0 && -bb - sqrt(disc) >= 0)
+                                best = fmin(best, -bb - sqrt(disc));
+                        }
+                        worst_scallop = fmax(worst_scallop, best);
+                    }
+                }
+            }
+            prev_b = b;
+        }
+        assert_true(k.v[0].v == 0 && k.v[k.n - 1].v == 1);
+        char what[96];
+        snprintf(what, sizeof what, "triangle degree %u: %zu passes, vertex error", n, st.passes);
+        report(what, worst_v / LSB, "LSB");
+        snprintf(what, sizeof what, "triangle degree %u: chord deviation (tol %g)", n, tol_mm);
+        report(what, worst_chord, "mm");
+        snprintf(what, sizeof what, "triangle degree %u: scallop (H %g)", n, h);
+        report(what, worst_scallop, "mm");
+        assert_true(worst_v <= 2 * LSB);
+        assert_true(worst_chord <= tol_mm);
+        assert_true(worst_scallop < h);
+        free(k.v);
+    }
+}
+
+/* A crease across the passes: z = 0.5 (x - 15)^2, passes along u = x. Where the concave radius
+ * is below R the offset curve C = P + R N runs backwards (C' . P' < 0): the planner counts those
+ * chords and says where the first one starts; the reference computes C' . P' in double. */
+static double crease_x(double x, double y)
+{
+    (void)y;
+    return 0.5 * (x - 15) * (x - 15);
+}
+
+static void test_fold_detection(void **state)
+{
+    (void)state;
+    cs_patch_t p;
+    grid_patch(&p, crease_x, 30);
+    coll_t k = {NULL, 0, 0};
+    cs_finish_stats_t st = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
+    assert_int_equal(cs_finish_patch(&p, 5, 0.5, 655, collect, &k, &st), CS_OK);
+    assert_true(st.folded > 0);
+    /* The reference: C'(u) . P'(u) at v = fold_v, by central differences of ref_centre. */
+    double lo = 2, hi = -1;
+    for (int i = 1; i < 2000; i++) {
+        double u = i / 2000.0, e = 1e-6, c0[3], c1[3], pu[3];
+        ref_centre(&p, 5, u - e, st.fold_v, c0);
+        ref_centre(&p, 5, u + e, st.fold_v, c1);
+        ref_point(&p, u, st.fold_v, 1, 0, pu);
+        double d = (c1[0] - c0[0]) * pu[0] + (c1[1] - c0[1]) * pu[1] + (c1[2] - c0[2]) * pu[2];
+        if (d < 0) {
+            lo = fmin(lo, u);
+            hi = fmax(hi, u);
+        }
+    }
+    report("crease, R 5: folded chords", (double)st.folded, "");
+    report("crease, R 5: first fold at u", st.fold_u, "");
+    report("crease, R 5: reference backwards interval from u", lo, "");
+    report("crease, R 5: reference backwards interval to u", hi, "");
+    /* the first backward chord starts at most one chord (<= 1/8) before the interval */
+    assert_true(lo <= hi && st.fold_u >= lo - 0.125 && st.fold_u <= hi);
+    /* The sections are planar (parabolas in x z), so each pass's loop closes and is cut at its
+     * crossing: no tool centre is then closer than R - tol to the surface section of its pass
+     * (1001 samples over u in [0.25, 0.75]), while the exact offset curve's loop comes far closer
+     * (gouge). */
+    report("crease, R 5: loops cut", (double)st.loops_cut, "");
+    assert_true(st.loops_cut > 0);
+    double closest = HUGE_VAL;
+    for (size_t i = 0; i < k.n; i++) {
+        if (k.v[i].u < 0.3 || k.v[i].u > 0.7)
+            continue; /* away from the crease the path is the plain offset */
+        double c[3] = {k.v[i].c.x * LSB, k.v[i].c.y * LSB, k.v[i].c.z * LSB};
+        for (int j = 0; j <= 1000; j++) { /* u in [0.25, 0.75]: x within 7.5 mm of the crease */
+            double q[3];
+            ref_point(&p, 0.25 + 0.5 * j / 1000.0, k.v[i].v, 0, 0, q);
+            closest =
+                fmin(closest, sqrt((c[0] - q[0]) * (c[0] - q[0]) + (c[1] - q[1]) * (c[1] - q[1]) +
+                                   (c[2] - q[2]) * (c[2] - q[2])));
+        }
+    }
+    double untrimmed = HUGE_VAL; /* the exact offset curve of one pass, untrimmed */
+    for (int i = 0; i <= 100; i++) {
+        double e[3];
+        ref_centre(&p, 5, 0.3 + 0.4 * i / 100.0, 0.5, e);
+        for (int j = 0; j <= 1000; j++) {
+            double q[3];
+            ref_point(&p, 0.25 + 0.5 * j / 1000.0, 0.5, 0, 0, q);
+            untrimmed =
+                fmin(untrimmed, sqrt((e[0] - q[0]) * (e[0] - q[0]) + (e[1] - q[1]) * (e[1] - q[1]) +
+                                     (e[2] - q[2]) * (e[2] - q[2])));
+        }
+    }
+    report("crease, R 5: closest surface point to a trimmed-path centre", closest, "mm");
+    report("crease, R 5: ... to the untrimmed exact offset curve", untrimmed, "mm");
+    assert_true(closest >= 5 - 0.01);
+    assert_true(untrimmed < 5 - 0.5);
+    free(k.v);
+    /* R = 1 below the smallest radius 1.5 mm (see test_gouge_warning): no fold. */
+    k = (coll_t){NULL, 0, 0};
+    cs_finish_stats_t st2 = {0, 0, 0, 0, 0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
+    assert_int_equal(cs_finish_patch(&p, 1, 0.1, 655, collect, &k, &st2), CS_OK);
+    assert_int_equal(st2.folded, 0);
+    free(k.v);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_flat),
-        cmocka_unit_test(test_curved),
-        cmocka_unit_test(test_gouge_warning),
+        cmocka_unit_test(test_flat),          cmocka_unit_test(test_curved),
+        cmocka_unit_test(test_gouge_warning), cmocka_unit_test(test_tri_convert),
+        cmocka_unit_test(test_tri_finish),    cmocka_unit_test(test_fold_detection),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -15,6 +15,7 @@
 #include "cs_motion.h"
 #include "cs_planner.h"
 #include "cs_segment.h"
+#include "ref_xorshift32.h"
 
 #define Q16 65536.0
 
@@ -27,18 +28,7 @@ static int setup(void **state)
     return 0;
 }
 
-static uint32_t rng;
-static uint32_t xorshift(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 17;
-    rng ^= rng << 5;
-    return rng;
-}
-static double urand(double lo, double hi)
-{
-    return lo + (hi - lo) * (xorshift() / 4294967296.0);
-}
+static ref_xorshift32_t rng;
 
 static cs_pos_t mm(double v)
 {
@@ -48,31 +38,33 @@ static cs_pos_t mm(double v)
 static void test_block_totals_exact_on_random_jobs(void **state)
 {
     (void)state;
-    rng = 0x9e3779b9u;
+    rng.s = 0x9e3779b9u;
     for (int job = 0; job < 20; job++) {
         cs_machine_t m = machine;
         /* Uneven resolutions so rounding differs per axis. */
-        m.axis[0].steps_per_mm = (int32_t)lround(urand(5, 160) * Q16);
-        m.axis[1].steps_per_mm = (int32_t)lround(urand(5, 160) * Q16);
-        m.axis[2].steps_per_mm = (int32_t)lround(urand(5, 160) * Q16);
+        m.axis[0].steps_per_mm = (int32_t)lround(ref_xorshift32_uniform(&rng, 5, 160) * Q16);
+        m.axis[1].steps_per_mm = (int32_t)lround(ref_xorshift32_uniform(&rng, 5, 160) * Q16);
+        m.axis[2].steps_per_mm = (int32_t)lround(ref_xorshift32_uniform(&rng, 5, 160) * Q16);
         cs_planner_t pl;
         cs_segment_gen_t g;
         assert_int_equal(cs_planner_init(&pl, &m), CS_OK);
         assert_int_equal(cs_segment_init(&g, &m), CS_OK);
         int64_t sum[CS_AXES] = {0, 0, 0, 0}, blk[CS_AXES] = {0, 0, 0, 0};
         double tx = 0, ty = 0, tz = 0;
-        int moves = 200 + (int)(xorshift() % 200);
+        int moves = 200 + (int)(ref_xorshift32_next(&rng) % 200);
         int blocks_checked = 0;
         for (int k = 0; k <= moves; k++) {
             if (k < moves) {
-                double len = urand(0.001, 30);
-                double ang = urand(-M_PI, M_PI);
+                double len = ref_xorshift32_uniform(&rng, 0.001, 30);
+                double ang = ref_xorshift32_uniform(&rng, -M_PI, M_PI);
                 tx = fmin(fmax(tx + len * cos(ang), -990), 990);
                 ty = fmin(fmax(ty + len * sin(ang), -990), 990);
-                tz = fmin(fmax(tz + urand(-1, 1), -99), 99);
+                tz = fmin(fmax(tz + ref_xorshift32_uniform(&rng, -1, 1), -99), 99);
                 cs_pos_t t[CS_AXES] = {mm(tx), mm(ty), mm(tz), 0};
-                assert_int_equal(cs_planner_line(&pl, t, (int32_t)lround(urand(1, 400) * Q16), 1),
-                                 CS_OK);
+                assert_int_equal(
+                    cs_planner_line(&pl, t,
+                                    (int32_t)lround(ref_xorshift32_uniform(&rng, 1, 400) * Q16), 1),
+                    CS_OK);
             }
             /* Keep the ring full while moves remain, then drain. */
             while (cs_planner_full(&pl) || (k == moves && cs_planner_count(&pl) > 0)) {

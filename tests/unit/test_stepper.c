@@ -18,6 +18,7 @@
 #include "cs_stepper.h"
 #include "cs_trace.h"
 #include "port_posix.h"
+#include "ref_xorshift32.h"
 
 #define Q16 65536.0
 
@@ -30,18 +31,7 @@ static int setup(void **state)
     return 0;
 }
 
-static uint32_t rng;
-static uint32_t xorshift(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 17;
-    rng ^= rng << 5;
-    return rng;
-}
-static double urand(double lo, double hi)
-{
-    return lo + (hi - lo) * (xorshift() / 4294967296.0);
-}
+static ref_xorshift32_t rng;
 
 static void test_ring_full_and_invalid(void **state)
 {
@@ -73,18 +63,18 @@ static void run(const cs_machine_t *m, const cs_segment_t *s, size_t n, cs_sim_e
 static void test_dda_exact_and_even(void **state)
 {
     (void)state;
-    rng = 777;
+    rng.s = 777;
     enum { N = 300 };
     cs_segment_t segs[N];
     int64_t total[CS_AXES] = {0, 0, 0, 0};
     for (int k = 0; k < N; k++) {
-        uint32_t ticks = 1 + xorshift() % 2000;
+        uint32_t ticks = 1 + ref_xorshift32_next(&rng) % 2000;
         segs[k].ticks = ticks;
         for (unsigned i = 0; i < CS_AXES; i++) {
-            int32_t mag = i < 3 ? (int32_t)(xorshift() % (ticks + 1)) : 0;
-            if (xorshift() % 4 == 0)
+            int32_t mag = i < 3 ? (int32_t)(ref_xorshift32_next(&rng) % (ticks + 1)) : 0;
+            if (ref_xorshift32_next(&rng) % 4 == 0)
                 mag = 0;
-            segs[k].steps[i] = (xorshift() & 1) ? -mag : mag;
+            segs[k].steps[i] = (ref_xorshift32_next(&rng) & 1) ? -mag : mag;
             total[i] += segs[k].steps[i];
         }
     }
@@ -201,7 +191,7 @@ static void plan_exec_check(const cs_machine_t *m, cs_motion_t *mo, const cs_sim
 static void test_random_jobs_end_to_end(void **state)
 {
     (void)state;
-    rng = 4242;
+    rng.s = 4242;
     for (int job = 0; job < 6; job++) {
         cs_motion_t mo;
         assert_int_equal(cs_motion_init(&mo, &machine), CS_OK);
@@ -210,13 +200,16 @@ static void test_random_jobs_end_to_end(void **state)
         double p[3] = {0, 0, 0};
         assert_int_equal(cs_sim_ref_move(&ref, p), CS_OK);
         for (int k = 0; k < 150; k++) {
-            double len = urand(0.05, 40), ang = urand(-M_PI, M_PI);
+            double len = ref_xorshift32_uniform(&rng, 0.05, 40),
+                   ang = ref_xorshift32_uniform(&rng, -M_PI, M_PI);
             if (k % 5)
                 ang = sin(0.1 * k) * 0.5; /* gentle turns */
             p[0] = fmin(fmax(p[0] + len * cos(ang), -990), 990);
             p[1] = fmin(fmax(p[1] + len * sin(ang), -990), 990);
-            p[2] = fmin(fmax(p[2] + urand(-0.2, 0.2), -99), 99);
-            assert_int_equal(cs_motion_line_mm(&mo, p[0], p[1], p[2], urand(10, 300), 1), CS_OK);
+            p[2] = fmin(fmax(p[2] + ref_xorshift32_uniform(&rng, -0.2, 0.2), -99), 99);
+            assert_int_equal(
+                cs_motion_line_mm(&mo, p[0], p[1], p[2], ref_xorshift32_uniform(&rng, 10, 300), 1),
+                CS_OK);
             double q[3] = {lround(p[0] * Q16) / Q16, lround(p[1] * Q16) / Q16,
                            lround(p[2] * Q16) / Q16};
             assert_int_equal(cs_sim_ref_line(&ref, q), CS_OK);
@@ -286,22 +279,25 @@ static void test_random_curves_end_to_end(void **state)
      * traced by cs_trace within the machine tolerance and planned by cs_motion_plan_path:
      * executed path within tolerance + one step of the exact curves (double), limits kept,
      * final position exact. */
-    rng = 31337;
+    rng.s = 31337;
     for (int job = 0; job < 4; job++) {
         cs_path_t path;
         cs_path_init(&path);
-        double x = urand(-200, 200), y = urand(-200, 200);
+        double x = ref_xorshift32_uniform(&rng, -200, 200),
+               y = ref_xorshift32_uniform(&rng, -200, 200);
         for (int k = 0; k < 12; k++) {
             double pts[4][2];
             if (k % 4 == 0) {
-                x = urand(-300, 300);
-                y = urand(-300, 300);
+                x = ref_xorshift32_uniform(&rng, -300, 300);
+                y = ref_xorshift32_uniform(&rng, -300, 300);
             }
             pts[0][0] = x;
             pts[0][1] = y;
             for (int i = 1; i < 4; i++) {
-                pts[i][0] = fmin(fmax(pts[i - 1][0] + urand(-40, 40), -900), 900);
-                pts[i][1] = fmin(fmax(pts[i - 1][1] + urand(-40, 40), -900), 900);
+                pts[i][0] =
+                    fmin(fmax(pts[i - 1][0] + ref_xorshift32_uniform(&rng, -40, 40), -900), 900);
+                pts[i][1] =
+                    fmin(fmax(pts[i - 1][1] + ref_xorshift32_uniform(&rng, -40, 40), -900), 900);
             }
             cs_vec3_t cp[4];
             for (int i = 0; i < 4; i++)
@@ -317,8 +313,9 @@ static void test_random_curves_end_to_end(void **state)
         cs_motion_t mo;
         assert_int_equal(cs_motion_init(&mo, &machine), CS_OK);
         cs_path_diag_t diag;
-        cs_err_t e = cs_motion_plan_path(&mo, &path, machine.tolerance, CS_TRACE_SUBDIV,
-                                         cs_motion_speed(urand(20, 200)), &diag);
+        cs_err_t e =
+            cs_motion_plan_path(&mo, &path, machine.tolerance, CS_TRACE_SUBDIV,
+                                cs_motion_speed(ref_xorshift32_uniform(&rng, 20, 200)), &diag);
         if (e != CS_OK)
             cs_path_diag_print(stderr, &diag);
         assert_int_equal(e, CS_OK);
@@ -344,7 +341,7 @@ static void test_starved_streaming_keeps_limits(void **state)
     /* Firmware-style streaming: a new move arrives only every few segments, so the queue runs
      * nearly empty and blocks start executing with one or two behind them (frozen entries,
      * junctions after the executing block). Limits kept, final position exact. */
-    rng = 99;
+    rng.s = 99;
     cs_planner_t pl;
     cs_segment_gen_t g;
     assert_int_equal(cs_planner_init(&pl, &machine), CS_OK);
@@ -354,7 +351,8 @@ static void test_starved_streaming_keeps_limits(void **state)
     assert_non_null(segs);
     double x = 0, y = 0;
     for (int k = 0; k < 300; k++) {
-        double len = urand(0.2, 20), ang = k % 3 ? 0.3 * sin(0.4 * k) : urand(-M_PI, M_PI);
+        double len = ref_xorshift32_uniform(&rng, 0.2, 20),
+               ang = k % 3 ? 0.3 * sin(0.4 * k) : ref_xorshift32_uniform(&rng, -M_PI, M_PI);
         x = fmin(fmax(x + len * cos(ang), -900), 900);
         y = fmin(fmax(y + len * sin(ang), -900), 900);
         cs_pos_t t[CS_AXES] = {(cs_pos_t)lround(x * Q16), (cs_pos_t)lround(y * Q16), 0, 0};
@@ -362,15 +360,18 @@ static void test_starved_streaming_keeps_limits(void **state)
             assert_int_equal(cs_segment_next(&g, &pl, &segs[n]), CS_OK);
             n++;
         }
-        assert_int_equal(cs_planner_line(&pl, t, (int32_t)lround(urand(20, 200) * Q16), 1), CS_OK);
+        assert_int_equal(
+            cs_planner_line(&pl, t, (int32_t)lround(ref_xorshift32_uniform(&rng, 20, 200) * Q16),
+                            1),
+            CS_OK);
         /* Cut until only one or two blocks remain queued (the executing one included), and
          * stop in the middle of a block half of the time. */
-        unsigned keep = 1 + (unsigned)(xorshift() % 2);
+        unsigned keep = 1 + (unsigned)(ref_xorshift32_next(&rng) % 2);
         while (cs_planner_count(&pl) > keep && n < cap) {
             assert_int_equal(cs_segment_next(&g, &pl, &segs[n]), CS_OK);
             n++;
         }
-        for (int c = (int)(xorshift() % 8); c > 0 && n < cap; c--) {
+        for (int c = (int)(ref_xorshift32_next(&rng) % 8); c > 0 && n < cap; c--) {
             cs_err_t e = cs_segment_next(&g, &pl, &segs[n]);
             if (e == CS_ERR_EMPTY)
                 break;

@@ -1,8 +1,21 @@
 /* port_template: the skeleton of a new port. Copy this folder to firmware/ports/<target>/ and
- * fill each function as its comment says; everything here compiles as is (freestanding C99)
- * and does nothing, so a port can be brought up one function at a time. The step interrupt at
- * the bottom is the one piece of glue every port needs: it is written once, here, and a port
- * only renames it to its timer's vector. */
+ * fill each function as its comment says; everything here compiles as is (freestanding C99; `make
+ * firmware` compiles it for the Cortex-M3 so it stays buildable) and does nothing, so a port can be
+ * brought up one function at a time. The step interrupt at the bottom is the one piece of glue
+ * every port needs: it is written once, here, and a port only renames it to its timer's vector.
+ *
+ * What sits on top: the application (firmware/app/cs_fw_app.h) is the whole device (link, queue,
+ * executor feeding, curves); a port adds a main that calls port_init, fills the machine
+ * (cs_fw_machine_default(&m, port_tick_hz())), cs_fw_app_init and then cs_fw_app_poll in a loop
+ * (firmware/app/main.c does exactly that; firmware/ports/cortex-m3/main_m3.c also sleeps and
+ * reports). The host's machine file must say the same (firmware/ports/<target>/machine.ini).
+ *
+ * Bring-up order that works: (1) port_init + port_ticks_now (blink a pin every 2^k ticks);
+ * (2) the UART rings (echo bytes); (3) port_irq_save/restore; (4) the step timer and its interrupt
+ * with port_step_pulse/port_dir_set (a scope, or an emulator's pin trace); (5) the application:
+ * `curvestep stream --port` a job and compare the final position with `curvestep-sim --replay`
+ * (tests/fw/test_fw_m3.sh does this under qemu). A build rule in mk/fw-<target>.mk links the core,
+ * $(FW_APP_SRC) and the port with --gc-sections and runs scripts/fw-check.sh on the image. */
 #include "port.h"
 
 static cs_stepper_t *step_st;
@@ -16,7 +29,9 @@ void port_init(void)
 
 uint32_t port_ticks_now(void)
 {
-    /* Return the free-running counter. Must be callable from interrupts. */
+    /* Return the free-running counter. Must be callable from interrupts, and wrap at 2^32
+     * exactly (the link and the main loop compare ticks with port_ticks_before): a 16-bit
+     * timer is extended by counting its overflows in software, reading both consistently. */
     return 0;
 }
 
@@ -73,7 +88,9 @@ void port_dir_set(uint8_t mask)
 
 size_t port_uart_read(uint8_t *buf, size_t max)
 {
-    /* Copy up to max received bytes from the receive buffer; never block. */
+    /* Copy up to max received bytes from the receive ring (filled by the UART's receive
+     * interrupt: the application reads in its main loop, which may be busy tracing a curve for
+     * longer than the UART's FIFO lasts); never block. */
     (void)buf;
     (void)max;
     return 0;
@@ -81,7 +98,9 @@ size_t port_uart_read(uint8_t *buf, size_t max)
 
 size_t port_uart_write(const uint8_t *buf, size_t len)
 {
-    /* Queue up to len bytes for transmission; return how many fit; never block. */
+    /* Queue up to len bytes for transmission; return how many fit; never block (the
+     * application keeps what did not fit and offers it again). A transmit ring of a few hundred
+     * bytes, emptied by the UART's transmit interrupt, lets a whole frame go at once. */
     (void)buf;
     (void)len;
     return 0;

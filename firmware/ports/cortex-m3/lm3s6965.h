@@ -1,0 +1,90 @@
+/* lm3s6965: the few registers of the Stellaris LM3S6965 (Cortex-M3) this port uses, from the
+ * LM3S6965 data sheet (Texas Instruments DS-LM3S6965) and the ARMv7-M Architecture Reference
+ * Manual (SysTick, NVIC, SCB). Only what qemu's lm3s6965evb board models and a real chip needs. */
+#ifndef LM3S6965_H
+#define LM3S6965_H
+
+#include <stdint.h>
+
+#define REG32(addr) (*(volatile uint32_t *)(uintptr_t)(addr))
+
+/* System control: run-mode clock gating and the clock tree (data sheet 6.4). */
+#define SYSCTL_RIS           REG32(0x400FE050u)
+#define SYSCTL_RCC           REG32(0x400FE060u)
+#define SYSCTL_RCGC1         REG32(0x400FE104u)
+#define SYSCTL_RCGC2         REG32(0x400FE108u)
+#define SYSCTL_RIS_PLLLRIS   (1u << 6)
+#define SYSCTL_RCC_SYSDIV_S  23
+#define SYSCTL_RCC_SYSDIV_M  (0xFu << 23)
+#define SYSCTL_RCC_USESYSDIV (1u << 22)
+#define SYSCTL_RCC_PWRDN     (1u << 13)
+#define SYSCTL_RCC_BYPASS    (1u << 11)
+#define SYSCTL_RCC_XTAL_M    (0xFu << 6)
+#define SYSCTL_RCC_XTAL_8MHZ (0xEu << 6)
+#define SYSCTL_RCC_OSCSRC_M  (0x3u << 4)
+#define SYSCTL_RCGC1_TIMER0  (1u << 16)
+#define SYSCTL_RCGC1_UART0   (1u << 0)
+#define SYSCTL_RCGC2_GPIOA   (1u << 0)
+#define SYSCTL_RCGC2_GPIOD   (1u << 3)
+#define SYSCTL_RCGC2_GPIOG   (1u << 6)
+
+/* GPIO ports (PL061-like): DATA is addressed through a mask in address bits 9:2. */
+#define GPIO_PORTA            0x40004000u
+#define GPIO_PORTD            0x40007000u
+#define GPIO_PORTG            0x40026000u
+#define GPIO_DATA(port, mask) REG32((port) + ((uint32_t)(mask) << 2))
+#define GPIO_DIR(port)        REG32((port) + 0x400u)
+#define GPIO_AFSEL(port)      REG32((port) + 0x420u)
+#define GPIO_DEN(port)        REG32((port) + 0x51Cu)
+
+/* UART0 (ARM PrimeCell PL011), IRQ 5. */
+#define UART0           0x4000C000u
+#define UART_DR         REG32(UART0 + 0x000u)
+#define UART_FR         REG32(UART0 + 0x018u)
+#define UART_IBRD       REG32(UART0 + 0x024u)
+#define UART_FBRD       REG32(UART0 + 0x028u)
+#define UART_LCRH       REG32(UART0 + 0x02Cu)
+#define UART_CTL        REG32(UART0 + 0x030u)
+#define UART_IFLS       REG32(UART0 + 0x034u)
+#define UART_IM         REG32(UART0 + 0x038u)
+#define UART_MIS        REG32(UART0 + 0x040u)
+#define UART_ICR        REG32(UART0 + 0x044u)
+#define UART_FR_RXFE    (1u << 4)
+#define UART_FR_TXFF    (1u << 5)
+#define UART_LCRH_WLEN8 (3u << 5)
+#define UART_LCRH_FEN   (1u << 4)
+#define UART_CTL_UARTEN (1u << 0)
+#define UART_CTL_TXE    (1u << 8)
+#define UART_CTL_RXE    (1u << 9)
+#define UART_INT_RX     (1u << 4)
+#define UART_INT_TX     (1u << 5)
+#define UART_INT_RT     (1u << 6)
+#define UART0_IRQ       5
+
+/* General-purpose timer 0 (GPTM), timer A in 32-bit one-shot mode, IRQ 19. */
+#define TIMER0             0x40030000u
+#define TIMER_CFG          REG32(TIMER0 + 0x00u)
+#define TIMER_TAMR         REG32(TIMER0 + 0x04u)
+#define TIMER_CTL          REG32(TIMER0 + 0x0Cu)
+#define TIMER_IMR          REG32(TIMER0 + 0x18u)
+#define TIMER_ICR          REG32(TIMER0 + 0x24u)
+#define TIMER_TAILR        REG32(TIMER0 + 0x28u)
+#define TIMER_TAMR_ONESHOT 1u
+#define TIMER_CTL_TAEN     (1u << 0)
+#define TIMER_INT_TATO     (1u << 0)
+#define TIMER0A_IRQ        19
+
+/* Cortex-M3 core peripherals (ARMv7-M ARM B3.3, B3.4). */
+#define SYST_CSR           REG32(0xE000E010u)
+#define SYST_RVR           REG32(0xE000E014u)
+#define SYST_CVR           REG32(0xE000E018u)
+#define SYST_CSR_ENABLE    (1u << 0)
+#define SYST_CSR_TICKINT   (1u << 1)
+#define SYST_CSR_CLKSOURCE (1u << 2)
+#define NVIC_ISER(n)       REG32(0xE000E100u + 4u * (n))
+#define NVIC_IPR(n)        (*(volatile uint8_t *)(uintptr_t)(0xE000E400u + (n)))
+#define SCB_ICSR           REG32(0xE000ED04u)
+#define SCB_ICSR_PENDSTSET (1u << 26)
+#define SCB_SHPR3          REG32(0xE000ED20u)
+
+#endif

@@ -1,0 +1,157 @@
+/* main_m3: the Cortex-M3 image's main loop: the application (firmware/app) over the port, sleeping
+ * (WFI) whenever a pass leaves nothing to do. Under a debugger or qemu (semihosting), the image
+ * also prints a report each time a job ends (the device goes idle after executing something) and,
+ * when its command line says exit-idle=MS, ends the session with SYS_EXIT_EXTENDED once it has
+ * executed something and heard nothing for MS milliseconds: status 0, or 1 after an ERROR or a
+ * fault. qemu: -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=500. */
+#include "cs_fw_app.h"
+#include "port_m3.h"
+#include "semihost.h"
+
+static cs_machine_t machine;
+static cs_fw_app_t app;
+static uint32_t exit_idle_ms; /* 0: never exit */
+/* power-up SRAM contents: noise on a real chip, mixed into the boot id */
+__attribute__((section(".noinit"))) static uint32_t noise[32];
+
+static const char axis_name[4] = {'x', 'y', 'z', 'a'};
+
+/* "exit-idle=MS" anywhere on the command line. */
+static uint32_t parse_exit_idle(const char *s)
+{
+    static const char key[] = "exit-idle=";
+    for (; *s != '\0'; s++) {
+        unsigned k = 0;
+        while (key[k] != '\0' && s[k] == key[k])
+            k++;
+        if (key[k] != '\0')
+            continue;
+        uint32_t v = 0;
+        for (s += k; *s >= '0' && *s <= '9' && v < 100000000u; s++)
+            v = v * 10u + (uint32_t)(*s - '0');
+        return v;
+    }
+    return 0;
+}
+
+static void line_axes(const char *label, const int32_t *v, bool is_signed)
+{
+    char b[160];
+    size_t n = 0;
+    semihost_fmt_str(b, sizeof b, &n, label);
+    for (unsigned i = 0; i < machine.n_axes; i++) {
+        char nm[4] = {' ', axis_name[i], '=', '\0'};
+        semihost_fmt_str(b, sizeof b, &n, nm);
+        if (is_signed)
+            semihost_fmt_int(b, sizeof b, &n, v[i]);
+        else
+            semihost_fmt_uint(b, sizeof b, &n, (uint32_t)v[i]);
+    }
+    semihost_fmt_str(b, sizeof b, &n, "\n");
+    semihost_write0(b);
+}
+
+/* The report a test compares with the simulator; one fact per line, "key: values". */
+static void report(void)
+{
+    cs_fw_report_t r;
+    cs_fw_app_report(&app, &r);
+    uint32_t pulses[4];
+    int32_t pins[4];
+    port_m3_pins(pulses, pins);
+    char b[200];
+    size_t n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: executed ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.executed);
+    semihost_fmt_str(b, sizeof b, &n, " messages, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.segments);
+    semihost_fmt_str(b, sizeof b, &n, " step segments, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.curves);
+    semihost_fmt_str(b, sizeof b, &n, " curves, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.errors);
+    semihost_fmt_str(b, sizeof b, &n, " errors, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.holds);
+    semihost_fmt_str(b, sizeof b, &n, " holds, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.aborts);
+    semihost_fmt_str(b, sizeof b, &n, " aborts\n");
+    semihost_write0(b);
+    line_axes("fw: position (executor):", r.pos, true);
+    line_axes("fw: position (STEP/DIR pins):", pins, true);
+    line_axes("fw: step pulses:", (const int32_t *)pulses, false);
+    n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: steps total ");
+    semihost_fmt_uint(b, sizeof b, &n, r.steps);
+    semihost_fmt_str(b, sizeof b, &n, " in ");
+    semihost_fmt_uint(b, sizeof b, &n, port_m3_step_irqs());
+    semihost_fmt_str(b, sizeof b, &n, " step interrupts");
+    semihost_fmt_str(b, sizeof b, &n, "; link: ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.rx_bytes);
+    semihost_fmt_str(b, sizeof b, &n, " bytes in, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.rx.frames);
+    semihost_fmt_str(b, sizeof b, &n, " frames, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.rx.crc_errs);
+    semihost_fmt_str(b, sizeof b, &n, " CRC errors, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.link.duplicates);
+    semihost_fmt_str(b, sizeof b, &n, " duplicates, ");
+    semihost_fmt_uint(b, sizeof b, &n, r.link.retransmits);
+    semihost_fmt_str(b, sizeof b, &n, " resent, ");
+    semihost_fmt_uint(b, sizeof b, &n, port_m3_rx_overruns());
+    semihost_fmt_str(b, sizeof b, &n, " UART overruns\n");
+    semihost_write0(b);
+}
+
+void port_m3_on_fault(cs_err_t code)
+{
+    char b[64];
+    size_t n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: fault, code ");
+    semihost_fmt_uint(b, sizeof b, &n, (uint32_t)code);
+    semihost_fmt_str(b, sizeof b, &n, "\n");
+    semihost_write0(b);
+    report();
+    semihost_exit(1);
+    for (;;) /* no debugger: stay safe, drivers off, until reset */
+        __asm volatile("wfi");
+}
+
+int main(void)
+{
+    port_init();
+    char cmd[96];
+    if (semihost_cmdline(cmd, sizeof cmd))
+        exit_idle_ms = parse_exit_idle(cmd);
+    /* boot id: the host's clock (semihosting), the power-up noise of SRAM, the cycle counter */
+    uint32_t boot = semihost_time() * 2654435761u;
+    for (unsigned i = 0; i < sizeof noise / sizeof noise[0]; i++)
+        boot = (boot ^ noise[i]) * 16777619u;
+    boot ^= port_m3_cycles();
+    noise[0] = boot; /* a warm reset keeps SRAM: the next boot id differs */
+    cs_fw_machine_default(&machine, port_tick_hz());
+    if (cs_fw_app_init(&app, &machine, boot) != CS_OK)
+        port_fault(CS_ERR_ARG);
+    uint32_t reported = 0;
+    uint32_t hz_ms = port_tick_hz() / 1000u;
+    for (;;) {
+        cs_fw_app_poll(&app);
+        if (cs_fw_app_idle(&app) && app.stats.executed != reported) {
+            reported = app.stats.executed;
+            report();
+        }
+        if (exit_idle_ms != 0 && reported != 0 && cs_fw_app_idle(&app) &&
+            port_ticks_now() - cs_fw_app_last_rx(&app) >= exit_idle_ms * hz_ms) {
+            report();
+            semihost_exit(app.stats.errors != 0 ? 1u : 0u);
+            exit_idle_ms = 0; /* no debugger took the exit: go on serving */
+        }
+        /* nothing to do until an interrupt: sleep while no motion runs, spin while it does.
+         * Under qemu each wake-up from WFI costs about 0.1 ms of host time, so sleeping between
+         * step interrupts would make a job several times slower than real time, and the spin
+         * touches no register (docs/firmware.md, "Running under qemu") */
+        if (cs_fw_app_can_sleep(&app)) {
+            if (cs_fw_app_idle(&app))
+                port_m3_sleep();
+            else
+                port_m3_spin();
+        }
+    }
+}

@@ -1,0 +1,44 @@
+/* port_m3: what the Cortex-M3 port (TI Stellaris LM3S6965, qemu's lm3s6965evb board) offers
+ * beyond port.h: the core clock and its cycle counter, the STEP/DIR lines as the pins saw them
+ * (for the report a test compares with the simulator), sleeping until the next interrupt, and a
+ * fault flag. Pin map: STEP x/y/z/a on PD0..PD3, DIR x/y/z/a on PD4..PD7 (high = positive),
+ * driver ENABLE on PG0 (low = enabled), UART0 on PA0 (RX) / PA1 (TX) at 115200 8N1. */
+#ifndef PORT_M3_H
+#define PORT_M3_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "port.h"
+
+#define PORT_M3_SYSCLK_HZ 50000000u /* PLL: 200 MHz / 4 (8 MHz crystal on the EVB) */
+#ifndef PORT_M3_TICK_HZ
+#define PORT_M3_TICK_HZ 100000u /* port_tick_hz(): the executor's tick, 10 us */
+#endif
+#define PORT_M3_BAUD     115200u
+#define PORT_M3_RX_RING  512u /* UART receive ring, bytes (power of two) */
+#define PORT_M3_TX_RING  512u /* UART transmit ring, bytes (power of two) */
+#define PORT_M3_PULSE_US 2u   /* STEP pulse width: machine.ini pulse_us */
+
+/* Core clock cycles since port_init, modulo 2^32 (SysTick extended by its wrap interrupt).
+ * ISR-safe. */
+uint32_t port_m3_cycles(void);
+/* Per axis: STEP pulses issued and the position they made with the DIR level at each pulse
+ * (DIR high = +1). ISR-safe snapshot. */
+void port_m3_pins(uint32_t pulses[4], int32_t pos[4]);
+/* Sleeps (WFI) until the next interrupt unless a received byte waits or transmit bytes are
+ * queued. Main loop only. */
+void port_m3_sleep(void);
+/* Spins (no sleep) until the next interrupt has run, or a bounded while: the wait while motion
+ * runs (see main_m3.c). Main loop only. */
+void port_m3_spin(void);
+/* Step interrupts that ran the executor (one per DDA call). */
+uint32_t port_m3_step_irqs(void);
+/* Bytes the UART received while its ring was full (lost). */
+uint32_t port_m3_rx_overruns(void);
+/* Code passed to port_fault (CS_OK when none). */
+cs_err_t port_m3_fault_code(void);
+/* Called by port_fault after the machine is made safe (main_m3.c: report and exit under qemu). */
+void port_m3_on_fault(cs_err_t code);
+
+#endif

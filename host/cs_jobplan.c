@@ -1,0 +1,131 @@
+/* cs_jobplan: read a job, plan it whole, map its errors (see cs_jobplan.h). */
+#include "cs_jobplan.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_conv.h"
+#include "cs_input.h"
+
+void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
+{
+    memset(o, 0, sizeof *o);
+}
+
+int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o)
+{
+    const char *a = argv[*i];
+    if (*i + 1 >= argc)
+        return 0; /* no value: the caller's "unknown or incomplete option" */
+    char *end;
+    if (strcmp(a, "--machine") == 0) {
+        o->machine_file = argv[++*i];
+    } else if (strcmp(a, "--tol") == 0) {
+        o->tol_mm = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(o->tol_mm > 0)) {
+            fprintf(stderr, "curvestep %s: --tol wants a positive number of mm\n", cmd);
+            return -1;
+        }
+    } else if (strcmp(a, "--feed") == 0) {
+        /* 32768 mm/s: the Q15.16 speed's range (cs_motion_speed) */
+        o->feed_mm_s = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(o->feed_mm_s > 0) || o->feed_mm_s >= 32768) {
+            fprintf(stderr, "curvestep %s: --feed wants a speed in (0, 32768) mm/s\n", cmd);
+            return -1;
+        }
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol)
+{
+    *tol = m->tolerance;
+    return !(tol_mm > 0) || cs_conv_tol_to_pos(tol_mm, tol) == CS_OK;
+}
+
+int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t *m,
+                       cs_machine_pen_t *pen, cs_pos_t *tol)
+{
+    cs_machine_ini_pen_default(pen);
+    char err[512];
+    if (o->machine_file) {
+        if (cs_machine_ini_load_pen(o->machine_file, m, pen, err, sizeof err) != 0) {
+            fprintf(stderr, "%s\n", err);
+            return CS_EXIT_INPUT;
+        }
+    } else {
+        cs_machine_ini_default(m);
+    }
+    if (!cs_jobplan_tol(m, o->tol_mm, tol)) {
+        fprintf(stderr, "curvestep %s: --tol %g mm is outside the accepted range\n", cmd,
+                o->tol_mm);
+        return CS_EXIT_USAGE;
+    }
+    return CS_EXIT_OK;
+}
+
+void cs_jobplan_init(cs_jobplan_t *jp)
+{
+    memset(jp, 0, sizeof *jp);
+    cs_path_init(&jp->path);
+}
+
+cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
+                         bool lenient)
+{
+    cs_input_opts_t iopts;
+    cs_input_opts_init(&iopts);
+    iopts.lenient = lenient;
+    if (pen != NULL) {
+        /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
+        iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
+        iopts.pen_up_z_mm = pen->up_z_mm;
+        iopts.pen_down_z_mm = pen->down_z_mm;
+    }
+    cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
+    jp->read_ok = e == CS_OK;
+    return e;
+}
+
+/* diag "file: reason" for an error that has no place in the file. */
+static cs_err_t fail_whole(cs_jobplan_t *jp, const char *file, cs_err_t e, const char *reason)
+{
+    snprintf(jp->diag.reason, sizeof jp->diag.reason, "%s", reason);
+    jp->diag.loc.file = file;
+    return e;
+}
+
+cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t *m,
+                         const cs_pos_t *start, cs_pos_t tol, int method, int32_t feed)
+{
+    cs_err_t e = cs_motion_init(&jp->mo, m);
+    if (e != CS_OK)
+        return fail_whole(jp, file, e, "machine rejected");
+    jp->have_mo = true;
+    if (start != NULL && (e = cs_planner_set_position(&jp->mo.pl, start)) != CS_OK)
+        return fail_whole(jp, file, e, "the device's position is outside the machine's travel");
+    return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
+}
+
+int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)
+{
+    if (!jp->read_ok)
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    /* CS_ERR_DEPTH: a curve the tracer cannot bring within the tolerance in its bounded depth
+     * is the job's (or the tolerance's) doing, as is a tolerance it cannot meet */
+    return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE || e == CS_ERR_DEPTH)
+               ? CS_EXIT_INPUT
+               : CS_EXIT_INTERNAL;
+}
+
+void cs_jobplan_free(cs_jobplan_t *jp)
+{
+    if (jp->have_mo)
+        cs_motion_free(&jp->mo);
+    jp->have_mo = false;
+    cs_path_free(&jp->path);
+}

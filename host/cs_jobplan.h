@@ -1,0 +1,69 @@
+/* cs_jobplan: the planning that every job command shares (`curvestep plan`, `curvestep stream`,
+ * the daemon's SUBMIT): the options --machine/--tol/--feed, the machine (and its [pen]) from a
+ * machine file, the job read whole by cs_input, planned whole into step segments by cs_motion,
+ * and the exit status an error maps to. Owns the job's path and segments. Host only. */
+#ifndef CS_JOBPLAN_H
+#define CS_JOBPLAN_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cs_machine_ini.h"
+#include "cs_motion.h"
+#include "cs_path.h"
+
+/* The options the job commands share. */
+typedef struct {
+    const char *machine_file; /* --machine FILE.ini; NULL: the built-in machine */
+    double tol_mm;            /* --tol MM; 0: the machine's tolerance */
+    double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
+} cs_jobplan_opts_t;
+
+/* One job: read, then planned. */
+typedef struct {
+    cs_path_t path;      /* the job's elements (cs_jobplan_read) */
+    cs_motion_t mo;      /* its step segments and totals (cs_jobplan_plan, when have_mo) */
+    cs_path_diag_t diag; /* after an error: "file:line:col: reason" (cs_path_diag_print) */
+    bool have_mo;        /* mo was initialised (and must be freed) */
+    bool read_ok;        /* the file was read: a later error is the planner's */
+} cs_jobplan_t;
+
+/* No machine file, no --tol, no --feed. */
+void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
+/* argv[*i] is --machine FILE, --tol MM or --feed MM/S with its value: stores it, moves *i onto
+ * the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
+ * wants ..." on stderr (a usage error). */
+int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);
+/* Chord tolerance: tol_mm (> 0) converted, else the machine's. False when tol_mm is outside
+ * what cs_conv accepts. */
+bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol);
+/* The machine of o->machine_file with its [pen] (cs_machine_ini_load_pen), or the built-in one
+ * with no pen, and the chord tolerance (cs_jobplan_tol). Returns CS_EXIT_OK; CS_EXIT_INPUT after
+ * "file:line: reason" on stderr; CS_EXIT_USAGE after "curvestep CMD: --tol ..." on stderr. */
+int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t *m,
+                       cs_machine_pen_t *pen, cs_pos_t *tol);
+
+/* Empty job: no path, no segments, diag cleared. */
+void cs_jobplan_init(cs_jobplan_t *jp);
+/* Reads file (cs_input_load: SVG, G-code, HP-GL) into jp->path. pen (NULL: none) with mode = z
+ * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z; lenient: unsupported
+ * G-code words are warnings. CS_OK, or an error with jp->diag filled. */
+cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
+                         bool lenient);
+/* Plans jp->path whole on machine m (which must outlive jp; file names it in messages) from
+ * start (cs_pos_t per axis, CS_AXES of them; NULL: the origin), chords within tol by tracer method
+ * (CS_TRACE_*), at feed (mm/s Q15.16 from cs_motion_speed; 0: the machine's default) where the
+ * job gives none. CS_OK with jp->mo's segments, or an error with jp->diag filled (CS_ERR_LIMIT:
+ * the move that leaves the travel, or a start outside it). */
+cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t *m,
+                         const cs_pos_t *start, cs_pos_t tol, int method, int32_t feed);
+/* The exit status for error e of cs_jobplan_read / _plan: a file that cannot be read as a job
+ * (anything but running out of memory, CS_ERR_FULL) and a job the machine cannot do (outside the
+ * travel, a number out of range, a tolerance it cannot meet, a curve too deep for the tracer)
+ * are CS_EXIT_INPUT; the rest
+ * CS_EXIT_INTERNAL. */
+int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e);
+/* Frees the path and the segments (jp may be freed twice). */
+void cs_jobplan_free(cs_jobplan_t *jp);
+
+#endif

@@ -1,0 +1,94 @@
+/* cs_modbus_stream: the host's Modbus link (docs/modbus.md). A libmodbus client (TCP or RTU)
+ * that reads the device's status block, writes one SEGMENT or CURVE per FC16 mailbox write with
+ * its sequence number, retries what timed out (the sequence makes a retry harmless: the device
+ * answers OK and does not execute twice), goes back when the device refuses a gap, turns Modbus
+ * exceptions into sentences, and streams a whole cs_stream job with the outcomes, counters and
+ * progress display of the serial link (cs_stream). Host only. */
+#ifndef CS_MODBUS_STREAM_H
+#define CS_MODBUS_STREAM_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "cs_modbus.h"
+#include "cs_stream.h"
+
+/* Results of one request (after its retries). */
+typedef enum {
+    CS_MB_OK = 0,        /* answered normally */
+    CS_MB_EXCEPTION = 1, /* answered with an exception (cs_mb_client_t.exception) */
+    CS_MB_NO_ANSWER = 2, /* every try timed out or was garbled */
+    CS_MB_IO = 3,        /* the connection or the line failed (errno in last_errno) */
+} cs_mb_rc_t;
+
+typedef struct {
+    void *ctx; /* modbus_t */
+    bool tcp;
+    char where[160]; /* HOST:PORT or the device path, for messages */
+    int unit;
+    uint32_t timeout_ms; /* response timeout of one try */
+    unsigned tries;      /* tries of one request before CS_MB_NO_ANSWER, >= 1 */
+    int exception;       /* code of the last exception answer */
+    int last_errno;      /* errno of the last failed try */
+    /* counters */
+    uint64_t requests;  /* tries sent */
+    uint32_t timeouts;  /* tries that timed out */
+    uint32_t garbled;   /* answers that did not fit the request (late, damaged): retried */
+    uint32_t retries;   /* tries beyond the first of a request */
+    uint64_t bytes_out; /* request frames sent (ADU bytes: MBAP + PDU, or unit + PDU + CRC) */
+    uint64_t bytes_in;  /* answer frames received */
+} cs_mb_client_t;
+
+/* Opens a Modbus TCP client to "HOST:PORT" or an RTU client on the serial device dev (8N1 at
+ * baud), for unit. Timing: one try waits timeout_ms for the answer, tries tries per request.
+ * Returns 0, or -1 with a sentence in why (-2: HOST:PORT is malformed). */
+int cs_mb_open_tcp(cs_mb_client_t *c, const char *hostport, int unit, uint32_t timeout_ms,
+                   unsigned tries, char *why, size_t cap);
+int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, int unit, uint32_t timeout_ms,
+                   unsigned tries, char *why, size_t cap);
+void cs_mb_close(cs_mb_client_t *c);
+
+/* The device's input registers, decoded. */
+typedef struct {
+    uint16_t version, caps, axes, queue_size;
+    uint32_t tick_hz, boot_id;
+    uint16_t state, free_slots, last_exec, next_seq, error, error_seq, refused, refused_seq;
+    int32_t pos[CS_AXES];
+} cs_mb_status_t;
+
+cs_mb_rc_t cs_mb_read_status(cs_mb_client_t *c, cs_mb_status_t *st);
+/* One mailbox write (FC16 of n registers at CS_MODBUS_HR_MAILBOX). */
+cs_mb_rc_t cs_mb_write_mailbox(cs_mb_client_t *c, const uint16_t *regs, size_t n);
+/* One command (FC06 to CS_MODBUS_HR_COMMAND). */
+cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd);
+/* "illegal data value", ... for an exception code. */
+const char *cs_mb_exception_text(int code);
+
+typedef struct {
+    cs_mb_client_t *c;
+    uint8_t axes; /* the machine: the device must announce the same */
+    uint32_t tick_hz;
+    size_t resume_from;               /* messages 1..resume_from were executed already */
+    volatile sig_atomic_t *interrupt; /* > 0: HOLD then ABORT; >= 2: at once */
+    FILE *progress;                   /* NULL: none */
+    bool progress_tty;
+    uint32_t hello_ms;  /* the first status must come within this */
+    uint32_t status_ms; /* poll the status at least this often while streaming (ms) */
+    uint32_t idle_ms;   /* all delivered, device not running, not all executed: give up */
+} cs_mb_stream_opts_t;
+
+/* Defaults: hello 2 s, status every 50 ms, idle 3 s. */
+void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_t axes,
+                               uint32_t tick_hz);
+/* Streams job messages resume_from+1..n; fills *r like cs_stream_run (r->hello from the
+ * status block: version = map version; r->link.retransmits = writes sent again (timeouts,
+ * garbled answers, going back after a refused gap), r->link.timeouts = tries that timed out,
+ * r->link.naks = mailbox writes the device refused and the host sent again (busy, gap)).
+ * CS_OK when it ran to an outcome, CS_ERR_ARG for bad options. */
+cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t *o,
+                          cs_stream_result_t *r);
+
+#endif

@@ -1,0 +1,636 @@
+/* avr_harness: runs a curvestep ATmega328p image in simavr (libsimavr) and checks what its pins
+ * do. USART0 is joined to a pseudo-terminal (the slave's path is the first line of standard
+ * output, as `curvestep-sim --pty` prints it, so `curvestep stream --port PTY` talks to the
+ * firmware); the STEP/DIR lines of Grbl's Uno pin map (port_avr.h: STEP x/y/z = PD2..PD4, DIR =
+ * PD5..PD7) are watched through simavr's pin IRQs, stamped with the exact CPU cycle; the step
+ * interrupt (Timer1 compare A) is timed from its vector fetch to its RETI through simavr's
+ * per-vector "running" IRQ. At the end (idle after activity, a cycle budget, a wall timeout, or
+ * SIGTERM/SIGINT) it prints the step counts and final position per axis, the shortest STEP pulse
+ * and the shortest DIR set-up before a STEP, and the interrupt's cycle counts; it exits non-zero
+ * on a violation. Usage: avr_harness --help. */
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <avr_extint.h>
+#include <avr_ioport.h>
+#include <avr_uart.h>
+#include <sim_avr.h>
+#include <sim_elf.h>
+#include <sim_interrupts.h>
+#include <sim_irq.h>
+
+/* Exit codes */
+enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
+
+#define AXES         3
+#define STEP_BIT0    2 /* PD2 */
+#define DIR_BIT0     5 /* PD5 */
+#define VEC_T1_COMPA 11
+#define HIST_MAX     8192 /* interrupt lengths histogrammed exactly below this many cycles */
+#define SLICE        1024 /* cycles run between two services of the pty and the clocks */
+
+typedef struct {
+    uint64_t steps;   /* rising STEP edges */
+    int64_t pos;      /* signed by the DIR line (and the invert mask) */
+    bool step_high;   /* STEP line level */
+    bool dir_high;    /* DIR line level */
+    uint64_t rise_at; /* cycle of the last STEP rise */
+    uint64_t dir_at;  /* cycle of the last DIR change (0: never changed) */
+    bool dir_changed; /* DIR has changed at least once */
+    uint64_t fall_at; /* cycle of the last STEP fall (0: none yet) */
+    uint64_t min_pulse, min_low, min_setup, min_hold;
+    uint64_t first_rise, last_rise;
+    uint64_t dir_in_pulse; /* DIR changes while STEP was high */
+} axis_t;
+
+static struct {
+    avr_t *avr;
+    axis_t ax[AXES];
+    uint8_t invert;
+    /* interrupt timing */
+    uint64_t isr_enter;
+    bool isr_in;
+    uint64_t isr_n, isr_sum, isr_min, isr_max, isr_over;
+    uint32_t *hist;
+    /* uart */
+    int master, slave;
+    avr_irq_t *uart_in;
+    avr_uart_t *uart;
+    uint8_t inbuf[4096];
+    size_t in_len, in_pos;
+    uint8_t outbuf[65536];
+    size_t out_len;
+    uint64_t bytes_in, bytes_out, bytes_dropped;
+    /* activity */
+    bool active;
+    uint64_t last_activity; /* cycle */
+    uint64_t min_sp;
+    FILE *csv;
+    FILE *isr_csv;  /* --isr-csv: every step interrupt, "entry-cycle,cycles" */
+    uint64_t *prof; /* --profile: cycles spent at each flash word inside the step interrupt */
+} g;
+
+static volatile sig_atomic_t g_stop;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_stop = 1;
+}
+
+static double wall_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* --- pins ---------------------------------------------------------------------------------- */
+
+static void on_step(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    axis_t *a = &g.ax[(intptr_t)param];
+    uint64_t now = g.avr->cycle;
+    bool high = value != 0;
+    if (high == a->step_high)
+        return;
+    a->step_high = high;
+    if (high) {
+        a->rise_at = now;
+        if (a->fall_at != 0 && now - a->fall_at < a->min_low)
+            a->min_low = now - a->fall_at;
+        a->steps++;
+        bool positive = a->dir_high != (((g.invert >> (intptr_t)param) & 1u) != 0);
+        a->pos += positive ? 1 : -1;
+        if (a->first_rise == 0)
+            a->first_rise = now;
+        a->last_rise = now;
+        if (a->dir_changed) {
+            uint64_t setup = now - a->dir_at;
+            if (setup < a->min_setup)
+                a->min_setup = setup;
+        }
+        if (g.csv)
+            fprintf(g.csv, "%llu,%d,%d\n", (unsigned long long)now, (int)(intptr_t)param,
+                    positive ? 1 : -1);
+        g.active = true;
+        g.last_activity = now;
+    } else {
+        uint64_t w = now - a->rise_at;
+        if (w < a->min_pulse)
+            a->min_pulse = w;
+        a->fall_at = now;
+    }
+}
+
+static void on_dir(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    axis_t *a = &g.ax[(intptr_t)param];
+    bool high = value != 0;
+    if (high == a->dir_high)
+        return;
+    uint64_t now = g.avr->cycle;
+    a->dir_high = high;
+    a->dir_at = now;
+    a->dir_changed = true;
+    if (a->step_high)
+        a->dir_in_pulse++;
+    if (a->steps > 0) {
+        uint64_t hold = now - a->rise_at;
+        if (hold < a->min_hold)
+            a->min_hold = hold;
+    }
+}
+
+/* --- the step interrupt ---------------------------------------------------------------------- */
+
+static void on_isr(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)param;
+    uint64_t now = g.avr->cycle;
+    if (value) {
+        g.isr_enter = now;
+        g.isr_in = true;
+        return;
+    }
+    if (!g.isr_in)
+        return;
+    g.isr_in = false;
+    uint64_t d = now - g.isr_enter;
+    g.isr_n++;
+    g.isr_sum += d;
+    if (d < g.isr_min)
+        g.isr_min = d;
+    if (d > g.isr_max)
+        g.isr_max = d;
+    if (g.isr_csv)
+        fprintf(g.isr_csv, "%llu,%llu\n", (unsigned long long)g.isr_enter, (unsigned long long)d);
+    if (d < HIST_MAX)
+        g.hist[d]++;
+    else
+        g.isr_over++;
+}
+
+static uint64_t isr_percentile(double p)
+{
+    uint64_t want = (uint64_t)(p * (double)(g.isr_n - 1)), seen = 0;
+    for (uint64_t c = 0; c < HIST_MAX; c++) {
+        seen += g.hist[c];
+        if (seen > want)
+            return c;
+    }
+    return g.isr_max;
+}
+
+/* --- uart ---------------------------------------------------------------------------------- */
+
+static void on_uart_out(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)param;
+    g.bytes_out++;
+    if (g.out_len < sizeof g.outbuf)
+        g.outbuf[g.out_len++] = (uint8_t)value;
+    else
+        g.bytes_dropped++;
+}
+
+/* The simulated USART0 (found by walking simavr's IO modules: its RX FIFO is needed to feed
+ * bytes no faster than the line takes them). */
+static avr_uart_t *find_uart(avr_t *avr)
+{
+    for (avr_io_t *io = avr->io_port; io; io = io->next)
+        if (io->kind && strcmp(io->kind, "uart") == 0 && ((avr_uart_t *)io)->name == '0')
+            return (avr_uart_t *)io;
+    return NULL;
+}
+
+/* Bytes waiting in simavr's USART input FIFO (its accessors are only declared in the header). */
+static unsigned fifo_fill(const uart_fifo_t *f)
+{
+    return (unsigned)((f->write + uart_fifo_fifo_size) - f->read) & (uart_fifo_fifo_size - 1u);
+}
+
+/* Moves bytes between the pty and the USART. The USART's input FIFO is kept at most a few
+ * bytes deep; simavr hands them to the firmware one per byte time of the configured baud. */
+static void service_uart(void)
+{
+    if (g.master < 0)
+        return;
+    if (g.in_pos == g.in_len) {
+        g.in_pos = g.in_len = 0;
+        ssize_t r = read(g.master, g.inbuf, sizeof g.inbuf);
+        if (r > 0)
+            g.in_len = (size_t)r;
+    }
+    while (g.in_pos < g.in_len && fifo_fill(&g.uart->input) < 4) {
+        avr_raise_irq(g.uart_in, g.inbuf[g.in_pos++]);
+        g.bytes_in++;
+        g.active = true;
+        g.last_activity = g.avr->cycle;
+    }
+    if (g.out_len > 0) {
+        ssize_t w = write(g.master, g.outbuf, g.out_len);
+        if (w > 0) {
+            memmove(g.outbuf, g.outbuf + w, g.out_len - (size_t)w);
+            g.out_len -= (size_t)w;
+        } else if (w < 0 && errno != EAGAIN && errno != EINTR) {
+            g.bytes_dropped += g.out_len; /* nobody on the line: a real UART loses them too */
+            g.out_len = 0;
+        }
+    }
+}
+
+/* simavr's default sleep callback sleeps on the wall clock to keep pace; the main loop below
+ * paces (or not, --fast) itself, and must keep serving the pty while the chip sleeps. */
+static void no_sleep(avr_t *avr, avr_cycle_count_t how_long)
+{
+    (void)avr;
+    (void)how_long;
+}
+
+/* --- main ---------------------------------------------------------------------------------- */
+
+/* A number in [lo, hi] (a bad one ends the program: usage error). */
+static double number(const char *v, double lo, double hi)
+{
+    char *end;
+    double d = strtod(v, &end);
+    if (end == v || *end != '\0' || !(d >= lo && d <= hi)) {
+        fprintf(stderr, "avr_harness: '%s': expected a number in [%g, %g]\n", v, lo, hi);
+        exit(EX_USAGE);
+    }
+    return d;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(
+        f,
+        "usage: avr_harness [--pty] [--cycles N] [--timeout SEC] [--idle-exit SEC] [--fast]\n"
+        "                   [--batch] [--min-pulse-us US] [--min-dir-setup-us US] [--invert MASK]\n"
+        "                   [--steps-csv FILE] [--isr-csv FILE] [--profile FILE] FIRMWARE.elf\n"
+        "Runs FIRMWARE.elf on a simulated ATmega328p at 16 MHz (simavr) and watches its\n"
+        "STEP (PD2..PD4) and DIR (PD5..PD7) pins and its step interrupt (Timer1 COMPA).\n"
+        "  --pty               USART0 on a new pseudo-terminal; its path is the first line\n"
+        "                      of standard output (for curvestep stream --port)\n"
+        "  --cycles N          cycle budget: stop after N cycles (default 16e6 x 120)\n"
+        "  --timeout SEC       wall-clock limit (default 50): reaching it is exit 4\n"
+        "  --idle-exit SEC     after activity (a step or a byte from the host), stop when\n"
+        "                      neither happens for SEC simulated seconds (default 1; 0: never)\n"
+        "  --fast              run as fast as the host can (default: never ahead of the\n"
+        "                      wall clock, as the real chip; the host's timeouts assume it)\n"
+        "  --batch             let simavr run instructions in batches (faster; timing stays\n"
+        "                      cycle-exact, but the lowest SP is only sampled at batch ends\n"
+        "                      and --profile is refused)\n"
+        "  --min-pulse-us US   a STEP pulse, or a STEP low time between two pulses,\n"
+        "                      shorter than US is a violation (default 0)\n"
+        "  --min-dir-setup-us US  a STEP rise less than US after its DIR changed is a\n"
+        "                      violation (default 0); so is DIR changing while STEP is high\n"
+        "  --invert MASK       axes whose DIR line is inverted (bit i = axis i), for signs\n"
+        "  --steps-csv FILE    every STEP rise: cycle,axis,dir\n"
+        "  --isr-csv FILE      every step interrupt: entry-cycle,cycles (vector to RETI)\n"
+        "  --profile FILE      cycles spent at each instruction inside the step interrupt:\n"
+        "                      lines 'byte-address cycles' (avr-addr2line, nm to read)\n"
+        "Prints (after the pty line): the run, the UART traffic, per-axis steps and final\n"
+        "position, the shortest pulse and low time, DIR set-up and hold, the step\n"
+        "interrupt's cycles, the lowest stack pointer.\n"
+        "Exit status: 0 ok, 1 a pulse or DIR violation, 2 usage, 3 emulator error (ELF,\n"
+        "crash), 4 wall timeout.\n");
+}
+
+int main(int argc, char **argv)
+{
+    const char *elf = NULL, *csv = NULL, *prof = NULL, *isr_csv = NULL;
+    bool pty = false, fast = false, batch = false;
+    uint64_t budget = 16000000ull * 120;
+    double timeout = 50, idle_exit = 1, min_pulse_us = 0, min_setup_us = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        bool more = i + 1 < argc;
+        if (strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return EX_OK;
+        } else if (strcmp(a, "--pty") == 0) {
+            pty = true;
+        } else if (strcmp(a, "--fast") == 0) {
+            fast = true;
+        } else if (strcmp(a, "--batch") == 0) {
+            batch = true;
+        } else if (strcmp(a, "--cycles") == 0 && more) {
+            budget = (uint64_t)number(argv[++i], 1, 1e15);
+        } else if (strcmp(a, "--timeout") == 0 && more) {
+            timeout = number(argv[++i], 0.001, 1e6);
+        } else if (strcmp(a, "--idle-exit") == 0 && more) {
+            idle_exit = number(argv[++i], 0, 1e6);
+        } else if (strcmp(a, "--min-pulse-us") == 0 && more) {
+            min_pulse_us = number(argv[++i], 0, 1e6);
+        } else if (strcmp(a, "--min-dir-setup-us") == 0 && more) {
+            min_setup_us = number(argv[++i], 0, 1e6);
+        } else if (strcmp(a, "--invert") == 0 && more) {
+            g.invert = (uint8_t)number(argv[++i], 0, 7);
+        } else if (strcmp(a, "--steps-csv") == 0 && more) {
+            csv = argv[++i];
+        } else if (strcmp(a, "--isr-csv") == 0 && more) {
+            isr_csv = argv[++i];
+        } else if (strcmp(a, "--profile") == 0 && more) {
+            prof = argv[++i];
+        } else if (a[0] == '-' || elf != NULL) {
+            fprintf(stderr, "avr_harness: bad argument '%s'\n", a);
+            usage(stderr);
+            return EX_USAGE;
+        } else {
+            elf = a;
+        }
+    }
+    if (batch && prof != NULL) {
+        fprintf(stderr,
+                "avr_harness: --profile needs one instruction at a time: not with --batch\n");
+        return EX_USAGE;
+    }
+    if (elf == NULL) {
+        usage(stderr);
+        return EX_USAGE;
+    }
+    /* Our report goes to the real standard output; simavr prints its own chatter with printf,
+     * which goes to standard error from here on, so the pty path stays the first line. */
+    int out_fd = dup(STDOUT_FILENO);
+    FILE *out = out_fd >= 0 ? fdopen(out_fd, "w") : NULL;
+    if (out == NULL || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) {
+        perror("avr_harness: stdout");
+        return EX_EMU;
+    }
+    g.master = g.slave = -1;
+    g.isr_min = UINT64_MAX;
+    g.min_sp = UINT64_MAX;
+    g.hist = calloc(HIST_MAX, sizeof *g.hist);
+    for (int i = 0; i < AXES; i++)
+        g.ax[i].min_pulse = g.ax[i].min_low = g.ax[i].min_setup = g.ax[i].min_hold = UINT64_MAX;
+    if (prof != NULL && (g.prof = calloc(0x4000, sizeof *g.prof)) == NULL)
+        return EX_EMU;
+    if (isr_csv != NULL && (g.isr_csv = fopen(isr_csv, "w")) == NULL) {
+        perror(isr_csv);
+        return EX_USAGE;
+    }
+    if (csv != NULL && (g.csv = fopen(csv, "w")) == NULL) {
+        perror(csv);
+        return EX_USAGE;
+    }
+
+    elf_firmware_t fw;
+    memset(&fw, 0, sizeof fw);
+    if (elf_read_firmware(elf, &fw) != 0) {
+        fprintf(stderr, "avr_harness: %s: cannot read the ELF\n", elf);
+        return EX_EMU;
+    }
+    avr_t *avr = avr_make_mcu_by_name("atmega328p");
+    if (avr == NULL || g.hist == NULL) {
+        fprintf(stderr, "avr_harness: no atmega328p in this simavr\n");
+        return EX_EMU;
+    }
+    g.avr = avr;
+    avr_init(avr);
+    avr->log = LOG_ERROR;
+    avr->sleep = no_sleep;
+    /* --batch: simavr runs instructions in batches up to the next timer event or interrupt
+     * (timing stays exact) instead of one per call; only the per-instruction watches (lowest
+     * SP, --profile) then see the batch ends */
+    if (batch)
+        avr->run_cycle_limit = SLICE;
+    /* INT0/INT1 (PD2/PD3, our STEP x/y outputs) are unused; simavr's "strict" level trigger
+     * polls them with a cycle timer every cycle, which makes every cycle a timer event: a
+     * sleeping chip then takes as long to simulate as a running one (10x slower overall) */
+    avr_extint_set_strict_lvl_trig(avr, 0, 0);
+    avr_extint_set_strict_lvl_trig(avr, 1, 0);
+    fw.frequency = 16000000; /* the image carries no .mmcu section: the clock is set here */
+    avr_load_firmware(avr, &fw);
+    avr->frequency = 16000000;
+
+    for (intptr_t i = 0; i < AXES; i++) {
+        avr_irq_register_notify(
+            avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('D'), (int)(STEP_BIT0 + i)), on_step,
+            (void *)i);
+        avr_irq_register_notify(
+            avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('D'), (int)(DIR_BIT0 + i)), on_dir,
+            (void *)i);
+    }
+    avr_irq_t *vec = avr_get_interrupt_irq(avr, VEC_T1_COMPA);
+    if (vec == NULL) {
+        fprintf(stderr, "avr_harness: no vector %d\n", VEC_T1_COMPA);
+        return EX_EMU;
+    }
+    avr_irq_register_notify(vec + AVR_INT_IRQ_RUNNING, on_isr, NULL);
+
+    uint32_t flags = 0; /* no console echo, no usleep when the firmware polls the status */
+    avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+    g.uart = find_uart(avr);
+    g.uart_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
+                            on_uart_out, NULL);
+    if (g.uart == NULL || g.uart_in == NULL) {
+        fprintf(stderr, "avr_harness: USART0 not found\n");
+        return EX_EMU;
+    }
+    if (pty) {
+        char name[256];
+        struct termios t;
+        if (openpty(&g.master, &g.slave, name, NULL, NULL) != 0) {
+            perror("avr_harness: openpty");
+            return EX_EMU;
+        }
+        /* raw, and keep our slave open: no hang-up between hosts; a host flushes what piled
+         * up meanwhile */
+        if (tcgetattr(g.slave, &t) == 0) {
+            cfmakeraw(&t);
+            tcsetattr(g.slave, TCSANOW, &t);
+        }
+        fcntl(g.master, F_SETFL, fcntl(g.master, F_GETFL) | O_NONBLOCK);
+        fprintf(out, "%s\n", name);
+        fflush(out);
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    const char *why = "cycle budget";
+    int rc = EX_OK;
+    double t0 = wall_now();
+    uint64_t idle_cycles = (uint64_t)(idle_exit * 16e6);
+    int state = cpu_Running;
+    for (;;) {
+        /* a slice of SLICE cycles between two services of the pty and the clocks: 64 us of
+         * the chip's time, under a byte time at 115200 baud */
+        uint64_t until = avr->cycle + SLICE;
+        while (avr->cycle < until) {
+            uint32_t pc = avr->pc;
+            uint64_t c0 = avr->cycle;
+            bool in = g.isr_in;
+            state = avr_run(avr);
+            if (g.prof != NULL && in && pc < 0x8000)
+                g.prof[pc >> 1] += avr->cycle - c0;
+            uint16_t sp = (uint16_t)(avr->data[0x5D] | (avr->data[0x5E] << 8));
+            if (sp < g.min_sp && sp >= 0x100)
+                g.min_sp = sp;
+            if (state == cpu_Done || state == cpu_Crashed)
+                break;
+        }
+        if (state == cpu_Done || state == cpu_Crashed) {
+            why = state == cpu_Done ? "the firmware stopped" : "the firmware crashed";
+            rc = state == cpu_Crashed ? EX_EMU : rc;
+            break;
+        }
+        service_uart();
+        if (g_stop) {
+            why = "signal";
+            break;
+        }
+        if (avr->cycle >= budget)
+            break;
+        if (g.active && idle_cycles > 0 && avr->cycle - g.last_activity > idle_cycles) {
+            why = "idle";
+            break;
+        }
+        double wall = wall_now() - t0;
+        if (wall > timeout) {
+            why = "wall timeout";
+            rc = EX_TIMEOUT;
+            break;
+        }
+        /* pacing: a real chip never runs ahead of the clock on the wall */
+        double ahead = (double)avr->cycle / 16e6 - wall;
+        if (!fast && ahead > 0.002) {
+            struct pollfd p = {g.master, POLLIN, 0};
+            int ms = (int)(ahead * 1000);
+            if (g.master >= 0 && g.in_pos == g.in_len)
+                poll(&p, 1, ms);
+            else
+                usleep((useconds_t)ms * 1000u);
+        }
+    }
+    service_uart();
+    double wall = wall_now() - t0;
+    double sim_s = (double)avr->cycle / 16e6;
+    static const char names[] = "xyz";
+
+    fprintf(out,
+            "avr: %llu cycles (%.4f s at 16 MHz) in %.2f s wall (%.1f MHz equivalent); "
+            "stopped: %s\n",
+            (unsigned long long)avr->cycle, sim_s, wall,
+            wall > 0 ? (double)avr->cycle / wall / 1e6 : 0.0, why);
+    fprintf(out, "uart: %llu bytes in, %llu bytes out, %llu dropped\n",
+            (unsigned long long)g.bytes_in, (unsigned long long)g.bytes_out,
+            (unsigned long long)g.bytes_dropped);
+    fprintf(out, "steps:");
+    for (int i = 0; i < AXES; i++)
+        fprintf(out, " %c=%llu", names[i], (unsigned long long)g.ax[i].steps);
+    fprintf(out, "\nposition:");
+    for (int i = 0; i < AXES; i++)
+        fprintf(out, " %c=%lld", names[i], (long long)g.ax[i].pos);
+    fprintf(out, "\n");
+
+    uint64_t mp = UINT64_MAX, ml = UINT64_MAX, ms = UINT64_MAX, mh = UINT64_MAX, in_pulse = 0;
+    for (int i = 0; i < AXES; i++) {
+        mp = g.ax[i].min_pulse < mp ? g.ax[i].min_pulse : mp;
+        ml = g.ax[i].min_low < ml ? g.ax[i].min_low : ml;
+        ms = g.ax[i].min_setup < ms ? g.ax[i].min_setup : ms;
+        mh = g.ax[i].min_hold < mh ? g.ax[i].min_hold : mh;
+        in_pulse += g.ax[i].dir_in_pulse;
+    }
+    bool bad_high = mp != UINT64_MAX && (double)mp < min_pulse_us * 16.0;
+    bool bad_low = ml != UINT64_MAX && (double)ml < min_pulse_us * 16.0;
+    bool bad_setup = ms != UINT64_MAX && (double)ms < min_setup_us * 16.0;
+    if (mp != UINT64_MAX)
+        fprintf(out, "pulse: min %llu cycles (%.3f us), required %.3f us: %s\n",
+                (unsigned long long)mp, (double)mp / 16.0, min_pulse_us,
+                bad_high ? "VIOLATION" : "ok");
+    else
+        fprintf(out, "pulse: none\n");
+    if (ml != UINT64_MAX)
+        fprintf(out,
+                "step-low: min %llu cycles (%.3f us) between two pulses of an axis, "
+                "required %.3f us: %s\n",
+                (unsigned long long)ml, (double)ml / 16.0, min_pulse_us,
+                bad_low ? "VIOLATION" : "ok");
+    if (ms != UINT64_MAX)
+        fprintf(out, "dir-setup: min %llu cycles (%.3f us), required %.3f us: %s\n",
+                (unsigned long long)ms, (double)ms / 16.0, min_setup_us,
+                bad_setup ? "VIOLATION" : "ok");
+    else
+        fprintf(out, "dir-setup: no DIR change before a step\n");
+    if (mh != UINT64_MAX)
+        fprintf(out, "dir-hold: min %llu cycles (%.3f us) from a STEP rise to a DIR change\n",
+                (unsigned long long)mh, (double)mh / 16.0);
+    fprintf(out, "dir-in-pulse: %llu DIR changes while STEP was high: %s\n",
+            (unsigned long long)in_pulse, in_pulse ? "VIOLATION" : "ok");
+    if (g.isr_n > 0)
+        fprintf(out,
+                "isr: vector %d (TIMER1_COMPA): %llu calls; cycles from vector to reti: min "
+                "%llu, median %llu, p99 %llu, max %llu, mean %.1f\n",
+                VEC_T1_COMPA, (unsigned long long)g.isr_n, (unsigned long long)g.isr_min,
+                (unsigned long long)isr_percentile(0.5), (unsigned long long)isr_percentile(0.99),
+                (unsigned long long)g.isr_max, (double)g.isr_sum / (double)g.isr_n);
+    else
+        fprintf(out, "isr: vector %d (TIMER1_COMPA): no calls\n", VEC_T1_COMPA);
+    if (g.min_sp != UINT64_MAX)
+        fprintf(out, "stack: lowest SP 0x%04llx (%llu bytes below the top of RAM 0x08ff)%s\n",
+                (unsigned long long)g.min_sp, (unsigned long long)(0x8ffu - g.min_sp),
+                batch ? ", sampled (--batch)" : "");
+    for (int i = 0; i < AXES; i++)
+        if (g.ax[i].steps > 1)
+            fprintf(out, "rate: %c %.1f steps/s from its first to its last step\n", names[i],
+                    (double)(g.ax[i].steps - 1) * 16e6 /
+                        (double)(g.ax[i].last_rise - g.ax[i].first_rise));
+    if (rc == EX_OK && (bad_high || bad_low || bad_setup || in_pulse))
+        rc = EX_VIOLATION;
+    fprintf(out, "result: %s\n",
+            rc == EX_OK          ? "ok"
+            : rc == EX_VIOLATION ? "VIOLATION"
+            : rc == EX_TIMEOUT   ? "TIMEOUT"
+                                 : "EMULATOR ERROR");
+    fflush(out);
+    if (g.csv)
+        fclose(g.csv);
+    if (g.isr_csv)
+        fclose(g.isr_csv);
+    if (g.prof != NULL) {
+        FILE *f = fopen(prof, "w");
+        for (unsigned w = 0; f != NULL && w < 0x4000; w++)
+            if (g.prof[w])
+                fprintf(f, "0x%04x %llu\n", w * 2, (unsigned long long)g.prof[w]);
+        if (f)
+            fclose(f);
+        free(g.prof);
+    }
+    if (g.master >= 0)
+        close(g.master);
+    if (g.slave >= 0)
+        close(g.slave);
+    avr_terminate(avr);
+    /* what elf_read_firmware allocated is the caller's (avr_load_firmware copied the code) */
+    free(fw.flash);
+    free(fw.eeprom);
+    free(fw.fuse);
+    free(fw.lockbits);
+    for (uint32_t i = 0; fw.symbol != NULL && i < fw.symbolcount; i++)
+        free(fw.symbol[i]);
+    free(fw.symbol);
+    free(g.hist);
+    return rc;
+}
