@@ -110,7 +110,7 @@ echo "- Image: flash $flash of 32768 bytes, RAM $ram of 2048 bytes (.data + .bss
 echo "- Stack while a job streams in: lowest SP 0x$sp_hex, $stack_used bytes used, $margin bytes"
 echo "  above the static data never touched."
 echo "- Step interrupt while \`tests/fw/avr_job.nc\` streams in at 115200 baud: min $jmin, median"
-echo "  $jmed, p99 $jp99, max $jmax cycles (max: a segment load, with its 32-bit divisions)."
+echo "  $jmed, p99 $jp99, max $jmax cycles (max: a call that loads a prepared segment)."
 echo "  Run: \`${job_line#avr: }\`."
 echo
 echo "Sustained step rate (benchmark image \`tests/fw/avr_bench_fw.c\`: no link, the step interrupt"
