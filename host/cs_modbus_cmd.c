@@ -37,8 +37,8 @@ int cs_stream_cmd_modbus(const cs_stream_args_t *a, const cs_stream_plan_t *p,
             uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
             timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / a->baud) + 1u;
         }
-        orc =
-            cs_mb_open_rtu(&c, a->modbus_rtu, a->baud, a->unit, timeout, MB_TRIES, why, sizeof why);
+        orc = cs_mb_open_rtu(&c, a->modbus_rtu, a->baud, a->parity != 0 ? a->parity : 'E', a->unit,
+                             timeout, MB_TRIES, why, sizeof why);
     }
     if (orc != 0) {
         fprintf(stderr, "curvestep stream: %s\n", why);

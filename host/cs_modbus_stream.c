@@ -64,14 +64,20 @@ int cs_mb_open_tcp(cs_mb_client_t *c, const char *hostport, int unit, uint32_t t
     return 0;
 }
 
-int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, int unit, uint32_t timeout_ms,
-                   unsigned tries, char *why, size_t cap)
+int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, char parity, int unit,
+                   uint32_t timeout_ms, unsigned tries, char *why, size_t cap)
 {
     memset(c, 0, sizeof *c);
     c->tcp = false;
     c->unit = unit;
     snprintf(c->where, sizeof c->where, "%s", dev);
-    modbus_t *ctx = modbus_new_rtu(dev, (int)baud, 'N', 8, 1);
+    if (parity != 'N' && parity != 'E' && parity != 'O') {
+        snprintf(why, cap, "%s: parity must be N, E or O", dev);
+        return -2;
+    }
+    /* every character is 11 bits: start, 8 data, parity, stop; without parity a second stop
+     * bit takes the parity bit's place (Modbus over serial line V1.02, 2.5.1) */
+    modbus_t *ctx = modbus_new_rtu(dev, (int)baud, parity, 8, parity == 'N' ? 2 : 1);
     if (ctx == NULL) {
         snprintf(why, cap, "%s: %s", dev, modbus_strerror(errno));
         return -1;

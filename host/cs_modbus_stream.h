@@ -42,13 +42,15 @@ typedef struct {
     uint64_t bytes_in;  /* answer frames received */
 } cs_mb_client_t;
 
-/* Opens a Modbus TCP client to "HOST:PORT" or an RTU client on the serial device dev (8N1 at
- * baud), for unit. Timing: one try waits timeout_ms for the answer, tries tries per request.
- * Returns 0, or -1 with a sentence in why (-2: HOST:PORT is malformed). */
+/* Opens a Modbus TCP client to "HOST:PORT" or an RTU client on the serial device dev at baud
+ * with parity 'E' (8E1), 'O' (8O1) or 'N' (8N2: two stop bits without parity, Modbus over
+ * serial line V1.02, 2.5.1), for unit. Timing: one try waits timeout_ms for the answer, tries
+ * tries per request. Returns 0, or -1 with a sentence in why (-2: HOST:PORT is malformed or
+ * parity is not one of N, E, O). */
 int cs_mb_open_tcp(cs_mb_client_t *c, const char *hostport, int unit, uint32_t timeout_ms,
                    unsigned tries, char *why, size_t cap);
-int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, int unit, uint32_t timeout_ms,
-                   unsigned tries, char *why, size_t cap);
+int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, char parity, int unit,
+                   uint32_t timeout_ms, unsigned tries, char *why, size_t cap);
 void cs_mb_close(cs_mb_client_t *c);
 
 /* The device's input registers, decoded. */

@@ -39,7 +39,8 @@ static void usage(FILE *f)
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
           "                        [--resume-from N] [--line-rate BPS] [--quiet] FILE\n"
           "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
-          "       curvestep stream --modbus-rtu DEV [--baud N] [--unit ID] [options] FILE\n"
+          "       curvestep stream --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
+          "                        [options] FILE\n"
           "       curvestep stream --gpio CHIP [--machine FILE.ini] [options] FILE\n"
           "Plans the job FILE (SVG, G-code or HPGL) for the machine, whole, before sending\n"
           "anything, then streams it to the device on the serial port DEV (a tty, or the pty\n"
@@ -52,6 +53,9 @@ static void usage(FILE *f)
           "  --modbus-tcp H:P   Modbus TCP device at host H, port P (docs/modbus.md)\n"
           "  --modbus-rtu DEV   Modbus RTU device on serial line DEV (docs/modbus.md)\n"
           "  --unit ID          Modbus unit id, 1..247 (default 1)\n"
+          "  --parity P         Modbus RTU character format: even (default: 8E1, the Modbus\n"
+          "                     serial-line default), odd (8O1) or none (8N2: no parity, two\n"
+          "                     stop bits, as the spec asks). Must match the device's setting\n"
           "  --gpio CHIP        run the job here, on the step/dir lines of GPIO chip CHIP\n"
           "                     (the machine file's [gpio] section; README, GPIO).\n"
           "                     --gpio record:FILE runs it on no hardware and writes every\n"
@@ -104,6 +108,7 @@ int cs_cmd_stream(int argc, char **argv)
     cs_jobplan_opts_t jo;
     cs_jobplan_opts_init(&jo);
     bool curves = false, quiet = false;
+    char parity = 0; /* --parity: 0 = not given (even) */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
@@ -131,6 +136,16 @@ int cs_cmd_stream(int argc, char **argv)
         } else if (strcmp(a, "--baud") == 0 && has) {
             if (parse_count(argv[++i], 4000000, &baud) != 0 || !cs_serial_baud_ok((uint32_t)baud)) {
                 fprintf(stderr, "curvestep stream: --baud wants a termios rate (e.g. 115200)\n");
+                return CS_EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--parity") == 0 && has) {
+            const char *v = argv[++i];
+            parity = strcmp(v, "none") == 0   ? 'N'
+                     : strcmp(v, "even") == 0 ? 'E'
+                     : strcmp(v, "odd") == 0  ? 'O'
+                                              : 0;
+            if (parity == 0) {
+                fprintf(stderr, "curvestep stream: --parity wants none, even or odd\n");
                 return CS_EXIT_USAGE;
             }
         } else if (strcmp(a, "--resume-from") == 0 && has) {
@@ -173,6 +188,10 @@ int cs_cmd_stream(int argc, char **argv)
                 : links > 1 ? "--port, --modbus-tcp, --modbus-rtu and --gpio exclude each other"
                             : "no job file");
         usage(stderr);
+        return CS_EXIT_USAGE;
+    }
+    if (parity != 0 && mb_rtu == NULL) {
+        fprintf(stderr, "curvestep stream: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;
     }
     cs_machine_t m;
@@ -231,6 +250,7 @@ int cs_cmd_stream(int argc, char **argv)
         sa.modbus_rtu = mb_rtu;
         sa.gpio_chip = gpio;
         sa.baud = (uint32_t)baud;
+        sa.parity = parity != 0 ? parity : 'E';
         sa.unit = (int)unit;
         sa.resume_from = (size_t)resume;
         sa.line_rate = (uint32_t)line_rate;

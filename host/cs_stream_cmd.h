@@ -34,6 +34,7 @@ typedef struct {
     const char *modbus_rtu;   /* --modbus-rtu DEV */
     const char *gpio_chip;    /* --gpio CHIP */
     uint32_t baud;            /* --baud (serial and Modbus RTU), default 115200 */
+    char parity;              /* --parity (Modbus RTU): 'E' (default, 8E1), 'O' (8O1), 'N' (8N2) */
     int unit;                 /* --unit ID (Modbus), default 1 */
     size_t resume_from;       /* --resume-from N: messages 1..N executed already */
     uint32_t line_rate;       /* --line-rate BPS (0: none) */

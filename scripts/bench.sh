@@ -134,7 +134,7 @@ fw_section() {
         echo "Cortex-M3 takes about 1 to 1.5 cycles per instruction (loads, taken branches)."
         echo
         local out
-        out=$(timeout 60 qemu-system-arm -M lm3s6965evb -kernel "$bench" -display none \
+        out=$(timeout -k 5 60 qemu-system-arm -M lm3s6965evb -kernel "$bench" -display none \
             -monitor none -serial null -icount shift=0 \
             -semihosting-config enable=on,target=native 2>&1) || {
             echo "(fdbench failed: $out)"

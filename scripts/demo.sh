@@ -38,7 +38,7 @@ stream() {
     while [ $# -gt 0 ] && [ "$1" != -- ]; do simargs+=("$1"); shift; done
     [ $# -gt 0 ] && shift
     streamargs=("$@")
-    timeout 300 "$SIM" --pty --speed "$SPEED" --idle-exit 1 --reference "$JOB" --check \
+    timeout -k 5 300 "$SIM" --pty --speed "$SPEED" --idle-exit 1 --reference "$JOB" --check \
         --svg "$OUT/$name.svg" --png "$OUT/$name.png" "${simargs[@]}" \
         >"$OUT/$name.report" 2>"$OUT/$name.simlog" &
     local sim=$!
@@ -55,7 +55,7 @@ stream() {
         return
     fi
     echo "  device on $pty; curvestep stream --mode $mode ${streamargs[*]} $JOB"
-    timeout 300 "$CS" stream --port "$pty" --mode "$mode" "${streamargs[@]}" "$JOB" \
+    timeout -k 5 300 "$CS" stream --port "$pty" --mode "$mode" "${streamargs[@]}" "$JOB" \
         >"$OUT/$name.stream" 2>"$OUT/$name.progress"
     local rc=$?
     for _ in $(seq 600); do kill -0 "$sim" 2>/dev/null || break; sleep 0.05; done
@@ -105,20 +105,20 @@ surface() {
     local name=$1 view=$2
     shift 2
     echo "  curvestep toolpath --patches $TEAPOT --scale 10 $* --gcode $OUT/$name.nc"
-    if ! timeout 120 "$CS" toolpath --patches "$TEAPOT" --scale 10 "$@" --gcode "$OUT/$name.nc" \
+    if ! timeout -k 5 120 "$CS" toolpath --patches "$TEAPOT" --scale 10 "$@" --gcode "$OUT/$name.nc" \
         --stats >"$OUT/$name.txt" 2>"$OUT/$name.toolpath"; then
         echo "  $name: FAILED (toolpath)"
         failures=$((failures + 1))
         return
     fi
     grep -E '^(toolpath: |curvestep toolpath: warning)' "$OUT/$name.toolpath" | sed 's/^/  /'
-    if ! timeout 120 "$CS" plan -o "$OUT/$name.seg" "$OUT/$name.nc" 2>"$OUT/$name.plan"; then
+    if ! timeout -k 5 120 "$CS" plan -o "$OUT/$name.seg" "$OUT/$name.nc" 2>"$OUT/$name.plan"; then
         echo "  $name: FAILED (plan)"
         failures=$((failures + 1))
         return
     fi
     sed 's/^/  /' "$OUT/$name.plan"
-    timeout 120 "$SIM" --replay "$OUT/$name.seg" --reference "$OUT/$name.nc" --check \
+    timeout -k 5 120 "$SIM" --replay "$OUT/$name.seg" --reference "$OUT/$name.nc" --check \
         --view "$view" --svg "$OUT/$name.svg" --png "$OUT/$name.png" >"$OUT/$name.report" 2>&1
     local rc=$?
     grep -E '^(replay|final position|deviation|check)' "$OUT/$name.report" | sed 's/^/  /'

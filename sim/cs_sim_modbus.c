@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -338,7 +339,27 @@ static void rtu_write(cs_serial_t *ser, const uint8_t *b, size_t n)
         ser->lost += n;
 }
 
-static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, double idle_exit,
+/* The character format of a real line: 8 data bits, parity 'E' / 'O' with one stop bit, or 'N'
+ * with two (every character 11 bits, Modbus over serial line V1.02, 2.5.1). Parity errors are
+ * checked (INPCK) and the byte dropped (IGNPAR): the frame then fails its length or CRC and is
+ * not answered, as the spec wants for a character error. */
+static int set_parity(int fd, char parity)
+{
+    struct termios t;
+    if (tcgetattr(fd, &t) != 0)
+        return -1;
+    t.c_cflag &= ~(tcflag_t)(PARENB | PARODD | CSTOPB);
+    t.c_iflag &= ~(tcflag_t)(INPCK | IGNPAR | PARMRK | ISTRIP);
+    if (parity == 'N') {
+        t.c_cflag |= CSTOPB;
+    } else {
+        t.c_cflag |= PARENB | (parity == 'O' ? PARODD : 0);
+        t.c_iflag |= INPCK | IGNPAR;
+    }
+    return tcsetattr(fd, TCSANOW, &t);
+}
+
+static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity, double idle_exit,
                      volatile sig_atomic_t *stop, cs_modbus_rtu_stats_t *rs)
 {
     int fd = -1, keep = -1;
@@ -358,6 +379,11 @@ static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, double idle_exi
             return 1;
         }
         fd = ser.fd;
+        if (set_parity(fd, parity) != 0) {
+            fprintf(stderr, "curvestep-sim: %s: parity: %s\n", dev, strerror(errno));
+            close(fd);
+            return 1;
+        }
     }
     cs_serial_set_lossy(&ser, true);
     cs_modbus_rtu_t *r = calloc(1, sizeof *r);
@@ -445,8 +471,8 @@ static void on_signal(int sig)
 static void usage(FILE *f)
 {
     fputs("usage: curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu pty|DEV [--baud N]\n"
-          "                     [--unit ID] [--machine FILE.ini] [--queue N]\n"
-          "                     [--speed X | --instant] [--faults SPEC] [--tol MM]\n"
+          "                     [--parity none|even|odd] [--unit ID] [--machine FILE.ini]\n"
+          "                     [--queue N] [--speed X | --instant] [--faults SPEC] [--tol MM]\n"
           "                     [--idle-exit S] [--reference JOB] [--check]\n"
           "                     [--svg OUT.svg] [--png OUT.png] [--trace OUT.csv]\n"
           "Runs the simulator as a Modbus device with the register map of docs/modbus.md:\n"
@@ -457,8 +483,12 @@ static void usage(FILE *f)
           "                    output is the address and port bound, e.g. 127.0.0.1:40123\n"
           "  --modbus-rtu pty  serve Modbus RTU (the core's own RTU server) on a new\n"
           "                    pseudo-terminal; the first line of standard output is its path\n"
-          "  --modbus-rtu DEV  serve Modbus RTU on the serial line DEV (raw 8N1 at --baud)\n"
+          "  --modbus-rtu DEV  serve Modbus RTU on the serial line DEV (raw, at --baud and\n"
+          "                    --parity)\n"
           "  --baud N          RTU line speed (default 115200; sets the 3.5-character gap)\n"
+          "  --parity P        RTU character format: even (default, 8E1), odd (8O1) or none\n"
+          "                    (8N2), as `curvestep stream --parity`; a pty has no bits on a\n"
+          "                    wire: there it is accepted and changes nothing\n"
           "  --unit ID         Modbus unit id, 1..247 (default 1); requests for another unit\n"
           "                    are not answered\n"
           "  --machine FILE    machine description (default: the built-in plotter)\n"
@@ -524,6 +554,7 @@ int cs_sim_modbus_main(int argc, char **argv)
     bool instant = false;
     double speed = 1, idle_exit = 0, tol_mm = 0;
     long queue = 32, baud = 115200, unit = 1;
+    char parity = 0;               /* 0: not given (even) */
     for (int i = 1; i < argc; i++) /* `--modbus-tcp --help` too */
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
@@ -540,6 +571,16 @@ int cs_sim_modbus_main(int argc, char **argv)
             tcp = argv[++i];
         } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
             rtu = argv[++i];
+        } else if (strcmp(a, "--parity") == 0 && has) {
+            const char *v = argv[++i];
+            parity = strcmp(v, "none") == 0   ? 'N'
+                     : strcmp(v, "even") == 0 ? 'E'
+                     : strcmp(v, "odd") == 0  ? 'O'
+                                              : 0;
+            if (parity == 0) {
+                fprintf(stderr, "curvestep-sim: --parity wants none, even or odd\n");
+                return USAGE;
+            }
         } else if (strcmp(a, "--machine") == 0 && has) {
             machine_file = argv[++i];
         } else if (strcmp(a, "--reference") == 0 && has) {
@@ -596,6 +637,10 @@ int cs_sim_modbus_main(int argc, char **argv)
     }
     if ((tcp != NULL) == (rtu != NULL)) {
         fprintf(stderr, "curvestep-sim: give exactly one of --modbus-tcp and --modbus-rtu\n");
+        return USAGE;
+    }
+    if (parity != 0 && rtu == NULL) {
+        fprintf(stderr, "curvestep-sim: --parity applies to --modbus-rtu only\n");
         return USAGE;
     }
     if (queue < 1 || queue > CS_SIM_DEVICE_QUEUE_MAX) {
@@ -689,7 +734,8 @@ int cs_sim_modbus_main(int argc, char **argv)
     signal(SIGPIPE, SIG_IGN);
     cs_modbus_rtu_stats_t rs = {0};
     int rc = tcp ? serve_tcp(d, tcp, idle_exit, &g_stop)
-                 : serve_rtu(d, rtu, (uint32_t)baud, idle_exit, &g_stop, &rs);
+                 : serve_rtu(d, rtu, (uint32_t)baud, parity != 0 ? parity : 'E', idle_exit, &g_stop,
+                             &rs);
     res.wall_s = cs_serial_now_s() - start;
     cs_modbus_stats_t ms = d->map.stats;
     e = cs_sim_motion_close(d->mo);

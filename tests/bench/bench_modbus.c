@@ -134,7 +134,7 @@ static row_t run_modbus(const cs_stream_job_t *job, uint64_t want, bool tcp)
     cs_mb_client_t c;
     char why[256];
     int orc = tcp ? cs_mb_open_tcp(&c, d.addr, 1, 200, 6, why, sizeof why)
-                  : cs_mb_open_rtu(&c, d.addr, 115200, 1, 200, 6, why, sizeof why);
+                  : cs_mb_open_rtu(&c, d.addr, 115200, 'E', 1, 200, 6, why, sizeof why);
     cs_stream_result_t r;
     memset(&r, 0, sizeof r);
     cs_err_t e = CS_ERR_IO;

@@ -16,7 +16,7 @@ JOB3=tests/data/svg/w3c/paths-data-12-t.svg
 N1=$("$CS" plan -o /dev/null "$JOB1" 2>&1 | sed -n 's/.* blocks, \([0-9]*\) segments,.*/\1/p')
 S=$T/sock/curvestep.sock
 mkdir "$T/sock"
-C() { timeout 10 "$CS" "$@" --socket "$S"; }
+C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
 
 # 0. no daemon yet: the clients say so, naming the socket.
 C status >/dev/null 2>"$T/nod.err"; rc=$?
@@ -25,12 +25,12 @@ expect "no daemon: socket named" grep -q "no daemon answers on $S" "$T/nod.err"
 
 # 1. the device (5 simulated seconds per second: job 1 takes ~5.2 s, long enough that the pause
 # below lands inside it even under ASan on a loaded machine; the two jobs ~21 s) and the daemon.
-timeout 90 "$SIM" --pty --speed 5 >"$T/sim.out" 2>"$T/sim.err" &
+timeout -k 5 90 "$SIM" --pty --speed 5 >"$T/sim.out" 2>"$T/sim.err" &
 SIMPID=$!
 pids+=($SIMPID)
 wait_pty "$T/sim.out" 5
 expect "sim printed a pty path" [ -c "$PTY" ]
-timeout 90 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve.err" &
+timeout -k 5 90 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve.err" &
 DPID=$!
 pids+=($DPID)
 wait_until 5 [ -S "$S" ]

@@ -128,7 +128,7 @@ run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
 # stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
 # (320 steps), x back at 0.
 if [ -x "$SIM" ]; then
-    timeout 60 "$SIM" --pty --instant --idle-exit 1 --machine "$T/pen.ini" >"$T/sim.out" \
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$T/pen.ini" >"$T/sim.out" \
         2>"$T/sim.err" &
     simpid=$!
     pids+=($simpid)

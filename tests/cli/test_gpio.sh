@@ -98,8 +98,8 @@ check_record() {
 
 # 1. the job through the recorder, checked against the simulator.
 "$CS" plan --machine "$T/m.ini" -o "$T/job.seg" "$T/job.nc" 2>/dev/null
-timeout 60 "$SIM" --replay "$T/job.seg" --machine "$T/m.ini" --trace "$T/job.trace" >"$T/job.sim"
-timeout 60 "$CS" stream --gpio "record:$T/job.rec" --machine "$T/m.ini" "$T/job.nc" \
+timeout -k 5 60 "$SIM" --replay "$T/job.seg" --machine "$T/m.ini" --trace "$T/job.trace" >"$T/job.sim"
+timeout -k 5 60 "$CS" stream --gpio "record:$T/job.rec" --machine "$T/m.ini" "$T/job.nc" \
     >"$T/job.out" 2>"$T/job.err"; rc=$?
 expect "record: exit 0" [ $rc -eq 0 ]
 n=$(grep -vc '^#' "$T/job.seg")
@@ -120,7 +120,7 @@ expect "record: job ends away from the origin" [ "$fin" = "560 -320 160" ]
 "$CS" plan --machine "$T/m.ini" -o "$T/long.seg" "$T/long.nc" 2>/dev/null
 nl=$(grep -vc '^#' "$T/long.seg")
 # (--foreground: timeout would otherwise pass the signal on twice, which means "stop at once")
-timeout --foreground 60 "$CS" stream --gpio "record:$T/int.rec" --machine "$T/m.ini" "$T/long.nc" \
+timeout --foreground -k 5 60 "$CS" stream --gpio "record:$T/int.rec" --machine "$T/m.ini" "$T/long.nc" \
     >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
@@ -140,7 +140,7 @@ got=$(awk -F, '/^[0-9-]/ && $4 == 1 && $3 ~ /_step$/ { split($3, w, "_"); pos[w[
 expect "ctrl-c: position = segments 1..$k ($got)" [ "$got" = "$want" ]
 
 # 3. --resume-from K runs the rest: together they reach the job's end.
-timeout 60 "$CS" stream --gpio "record:$T/res.rec" --machine "$T/m.ini" --resume-from "$k" --quiet \
+timeout -k 5 60 "$CS" stream --gpio "record:$T/res.rec" --machine "$T/m.ini" --resume-from "$k" --quiet \
     "$T/long.nc" >"$T/res.out" 2>"$T/res.err"; rc=$?
 expect "resume: exit 0" [ $rc -eq 0 ]
 expect "resume: all executed" grep -q "^stream: $nl of $nl segments executed" "$T/res.out"
@@ -150,31 +150,31 @@ xr=$(awk -F, '$3 == "x_step" && $4 == 1 { n++ } END { print n + 0 }' "$T/res.rec
 expect "resume: the remaining x steps ($xr = $rest)" [ "$xr" = "$rest" ]
 
 # 4. a chip that is not there: exit 4, the chip named, what to check.
-timeout 20 "$CS" stream --gpio gpiochip9 "$T/job.nc" >/dev/null 2>"$T/nochip.err"; rc=$?
+timeout -k 5 20 "$CS" stream --gpio gpiochip9 "$T/job.nc" >/dev/null 2>"$T/nochip.err"; rc=$?
 expect "no chip: exit 4" [ $rc -eq 4 ]
 expect "no chip: named" grep -q 'cannot open GPIO chip gpiochip9' "$T/nochip.err"
 expect "no chip: what to check" grep -q '/dev/gpiochip9 exists.*label.*gpio group' "$T/nochip.err"
 sed 's/^chip = .*/chip = gpiochip9/' "$T/m.ini" >"$T/m9.ini"
-timeout 20 "$CS" stream --gpio /dev/gpiochip9 --machine "$T/m9.ini" "$T/job.nc" >/dev/null 2>&1; rc=$?
+timeout -k 5 20 "$CS" stream --gpio /dev/gpiochip9 --machine "$T/m9.ini" "$T/job.nc" >/dev/null 2>&1; rc=$?
 expect "no chip by path: exit 4" [ $rc -eq 4 ]
 
 # 5. configuration errors.
-timeout 20 "$CS" stream --gpio gpiochip1 --machine "$T/m.ini" "$T/job.nc" >/dev/null 2>"$T/mis.err"; rc=$?
+timeout -k 5 20 "$CS" stream --gpio gpiochip1 --machine "$T/m.ini" "$T/job.nc" >/dev/null 2>"$T/mis.err"; rc=$?
 expect "chip mismatch: exit 2" [ $rc -eq 2 ]
 expect "chip mismatch: says so" grep -q 'chip = gpiochip0' "$T/mis.err"
 printf '[gpio]\nx_step = 17\nx_dir = 17\n' >"$T/dup.ini"
-timeout 20 "$CS" stream --gpio "record:$T/x.rec" --machine "$T/dup.ini" "$T/job.nc" >/dev/null 2>"$T/dup.err"; rc=$?
+timeout -k 5 20 "$CS" stream --gpio "record:$T/x.rec" --machine "$T/dup.ini" "$T/job.nc" >/dev/null 2>"$T/dup.err"; rc=$?
 expect "duplicate line: exit 1" [ $rc -eq 1 ]
 expect "duplicate line: file:line" grep -q "^$T/dup.ini:3: \[gpio\] x_dir: line 17 is already x_step" "$T/dup.err"
 printf '[gpio]\nx_step = 17\nx_dir = 27\npulse_us = 40\n' >"$T/pulse.ini"
-timeout 20 "$CS" stream --gpio "record:$T/x.rec" --machine "$T/pulse.ini" "$T/job.nc" >/dev/null 2>"$T/pulse.err"; rc=$?
+timeout -k 5 20 "$CS" stream --gpio "record:$T/x.rec" --machine "$T/pulse.ini" "$T/job.nc" >/dev/null 2>"$T/pulse.err"; rc=$?
 expect "long pulse: exit 1" [ $rc -eq 1 ]
 expect "long pulse: explained" grep -q 'pulse_us = 40.000 us does not fit half the shortest step period of axis x' "$T/pulse.err"
-timeout 20 "$CS" stream --gpio "record:$T/x.rec" --mode curves "$T/job.nc" >/dev/null 2>&1; rc=$?
+timeout -k 5 20 "$CS" stream --gpio "record:$T/x.rec" --mode curves "$T/job.nc" >/dev/null 2>&1; rc=$?
 expect "curves mode: exit 2" [ $rc -eq 2 ]
 # 6. the example machine file of contrib/ reads, and its lines drive a job inside its travel.
 printf 'G21 G90\nG1 X10 Y5 F6000\nG1 X2 Y8\n' >"$T/rpi.nc"
-timeout 60 "$CS" stream --gpio "record:$T/rpi.rec" --machine contrib/gpio-rpi.ini --quiet \
+timeout -k 5 60 "$CS" stream --gpio "record:$T/rpi.rec" --machine contrib/gpio-rpi.ini --quiet \
     "$T/rpi.nc" >"$T/rpi.out" 2>"$T/rpi.err"; rc=$?
 expect "contrib/gpio-rpi.ini: exit 0" [ $rc -eq 0 ]
 expect "contrib/gpio-rpi.ini: pulse and set-up read" grep -q 'STEP pulse 2.000 us, DIR set-up 1.000 us' "$T/rpi.err"

@@ -31,7 +31,7 @@ start_dev() {
     tcp) set -- --modbus-tcp 127.0.0.1:0 "$@" ;;
     rtu) set -- --modbus-rtu pty "$@" ;;
     esac
-    timeout 120 "$SIM" "$@" $pace --idle-exit "${IDLE:-0.5}" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    timeout -k 5 120 "$SIM" "$@" $pace --idle-exit "${IDLE:-0.5}" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     devpid[$name]=$!
     wait_pty "$T/$name.sim" 5
@@ -54,7 +54,7 @@ stream_to() {
     local link=--port
     [ "$mode" = tcp ] && link=--modbus-tcp
     [ "$mode" = rtu ] && link=--modbus-rtu
-    timeout 60 "$CS" stream "$link" "$(head -n1 "$T/$name.sim")" "$@" >"$T/$name.out" 2>"$T/$name.err"
+    timeout -k 5 60 "$CS" stream "$link" "$(head -n1 "$T/$name.sim")" "$@" >"$T/$name.out" 2>"$T/$name.err"
     rc=$?
 }
 # launch NAME ser|tcp|rtu "SIM ARGS" HOST ARGS...: a device (with --trace $T/NAME.csv) and a host
@@ -157,13 +157,17 @@ once_as_base() {
 # answers lost after the device acted: the host's retries are answered, not executed again;
 # answers sent late, past the host's 200 ms: the host retries, then meets the late answer;
 # exception 6 (server device busy): nothing taken, the host writes it again
-# (all six at once)
+# (all six at once, and a seventh, fault-free, over RTU in 8N2: both sides --parity none, where
+# the default is 8E1; a pty takes either)
 for mode in tcp rtu; do
     launch "drop_$mode" $mode "--faults drop=0.02,seed=3" "$SMALL"
     launch "late_$mode" $mode "--faults delay=0.02,delay-ms=400,seed=7" "$SMALL"
     launch "busy_$mode" $mode "--faults busy=0.2,seed=5" "$SMALL"
 done
+launch par_rtu rtu "--parity none" --parity none "$SMALL"
 landed
+expect "parity none: exit 0" [ "$(rc_of par_rtu)" = 0 ]
+once_as_base par_rtu
 for mode in tcp rtu; do
     expect "drop $mode: exit 0" [ "$(rc_of "drop_$mode")" = 0 ]
     expect "drop $mode: answers were dropped" grep -qE '^faults: [1-9][0-9]* answers dropped' "$T/drop_$mode.sim"
@@ -208,7 +212,7 @@ done
 start_dev int rtu --speed 0.25
 # (--foreground: timeout would otherwise pass the signal on twice, to the command and to its
 # process group, and a second Ctrl-C means "leave at once")
-timeout --foreground 60 "$CS" stream --modbus-rtu "$ADDR" "$SMALL" >"$T/int.out" 2>"$T/int.err" &
+timeout --foreground -k 5 60 "$CS" stream --modbus-rtu "$ADDR" "$SMALL" >"$T/int.out" 2>"$T/int.err" &
 hp=$!
 pids+=($hp)
 wait_until 10 grep -q '^stream: [1-9][0-9]*/' "$T/int.err"
@@ -231,6 +235,14 @@ run "nobody listening" 4 stream --modbus-tcp 127.0.0.1:1 "$SMALL"
 expect_err "says it cannot connect" 'cannot connect'
 run "no such serial device" 4 stream --modbus-rtu "$T/no-such-tty" "$SMALL"
 run "--line-rate is for --port" 2 stream --modbus-tcp 127.0.0.1:1 --line-rate 9600 "$SMALL"
+run "bad --parity" 2 stream --modbus-rtu "$T/no-such-tty" --parity mark "$SMALL"
+expect_err "says what --parity wants" 'parity wants none, even or odd'
+run "--parity is for --modbus-rtu" 2 stream --modbus-tcp 127.0.0.1:1 --parity even "$SMALL"
+expect_err "says where --parity applies" 'parity applies to --modbus-rtu only'
+"$SIM" --modbus-rtu pty --parity space >"$T/out" 2>"$T/err"
+expect "sim: bad --parity (exit 2)" [ $? -eq 2 ]
+"$SIM" --modbus-tcp 127.0.0.1:0 --parity odd >"$T/out" 2>"$T/err"
+expect "sim: --parity is for --modbus-rtu (exit 2)" [ $? -eq 2 ]
 "$SIM" --modbus-tcp 127.0.0.1:0 --modbus-rtu pty >"$T/out" 2>"$T/err"
 expect "sim: one link only (exit 2)" [ $? -eq 2 ]
 "$SIM" --modbus-tcp 127.0.0.1:0 --faults drop=2 >"$T/out" 2>"$T/err"

@@ -17,7 +17,7 @@ start_sim() {
     local name=$1; shift
     local pace=--instant
     [ "${1:-}" = --speed ] && pace=
-    timeout 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    timeout -k 5 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     SIMPID=$!
     wait_pty "$T/$name.sim" 5
@@ -32,7 +32,7 @@ wait_sim() {
 # 1. segments mode: the whole job executed, the device's check passes.
 start_sim seg --reference "$JOB" --check --svg "$T/seg.svg"
 expect "sim printed a pty path" [ -c "$PTY" ]
-timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/seg.out" 2>"$T/seg.err"; rc=$?
+timeout -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/seg.out" 2>"$T/seg.err"; rc=$?
 wait_sim
 expect "segments: exit 0" [ $rc -eq 0 ]
 n=$(sed -n 's/.* -> \([0-9]*\) segments .*/\1/p' "$T/seg.err")
@@ -48,7 +48,7 @@ expect "segments: picture drawn" grep -q '<polyline' "$T/seg.svg"
 
 # 2. curves mode, with arcs approximated by cubics: same checks on the device.
 start_sim cur --reference "$ARCS" --check
-timeout 60 "$CS" stream --mode curves --port "$PTY" "$ARCS" >"$T/cur.out" 2>"$T/cur.err"; rc=$?
+timeout -k 5 60 "$CS" stream --mode curves --port "$PTY" "$ARCS" >"$T/cur.out" 2>"$T/cur.err"; rc=$?
 wait_sim
 expect "curves: exit 0" [ $rc -eq 0 ]
 expect "curves: job executed" grep -q "job executed" "$T/cur.out"
@@ -60,7 +60,7 @@ expect "curves: final position exact" grep -q 'rounded to steps: exact' "$T/cur.
 # 2b. on a terminal (script(1) gives it one): a progress bar with percent, ETA, rate, retx.
 if command -v script >/dev/null 2>&1; then
     start_sim tty
-    timeout 60 script -qec "'$CS' stream --port '$PTY' '$ARCS'" /dev/null >"$T/tty.out" 2>&1
+    timeout -k 5 60 script -qec "'$CS' stream --port '$PTY' '$ARCS'" /dev/null >"$T/tty.out" 2>&1
     rc=$?
     wait_sim
     expect "tty: exit 0" [ $rc -eq 0 ]
@@ -69,12 +69,12 @@ fi
 
 # 3. a device reset after 500 segments: exit 5, last executed 500; --resume-from 500 finishes.
 start_sim rst --reference "$JOB" --check --faults reset-after=500
-timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/rst.out" 2>"$T/rst.err"; rc=$?
+timeout -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/rst.out" 2>"$T/rst.err"; rc=$?
 expect "reset: exit 5" [ $rc -eq 5 ]
 expect "reset: reported" grep -q 'device reset mid-job (boot id' "$T/rst.out"
 expect "reset: last executed 500" grep -q 'last executed: 500$' "$T/rst.out"
 expect "reset: says how to resume" grep -q -- '--resume-from 500' "$T/rst.out"
-timeout 60 "$CS" stream --resume-from 500 --port "$PTY" "$JOB" >"$T/rst2.out" 2>"$T/rst2.err"; rc=$?
+timeout -k 5 60 "$CS" stream --resume-from 500 --port "$PTY" "$JOB" >"$T/rst2.out" 2>"$T/rst2.err"; rc=$?
 wait_sim
 expect "resume: exit 0" [ $rc -eq 0 ]
 expect "resume: job executed" grep -q "job executed" "$T/rst2.out"
@@ -84,7 +84,7 @@ expect "resume: final position exact" grep -q 'rounded to steps: exact' "$T/rst.
 
 # 4. the device closes the line after 300 segments: exit 6, last executed 300.
 start_sim cls --faults close-after=300
-timeout 60 "$CS" stream --port "$PTY" "$JOB" >"$T/cls.out" 2>"$T/cls.err"; rc=$?
+timeout -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/cls.out" 2>"$T/cls.err"; rc=$?
 wait_sim
 expect "closed: exit 6" [ $rc -eq 6 ]
 expect "closed: reported" grep -q 'link closed' "$T/cls.out"
@@ -94,7 +94,7 @@ expect "closed: last executed 300" grep -q 'last executed: 300$' "$T/cls.out"
 start_sim int --speed 1 --reference "$JOB"
 # (--foreground: timeout would otherwise pass the signal on twice, to the command and to its
 # process group, and a second Ctrl-C means "leave at once")
-timeout --foreground 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
+timeout --foreground -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
 sleep 1
@@ -110,7 +110,7 @@ expect "ctrl-c: host and device agree on what ran" grep -q "^device: .* $k messa
 # 6. a device whose travel is smaller than the host's machine refuses a curve: exit 7, ABORT.
 printf '[x]\ntravel_min = 0\ntravel_max = 100\n' >"$T/small.ini"
 start_sim err --machine "$T/small.ini"
-timeout 60 "$CS" stream --mode curves --port "$PTY" "$JOB" >"$T/err.out" 2>"$T/err.err"; rc=$?
+timeout -k 5 60 "$CS" stream --mode curves --port "$PTY" "$JOB" >"$T/err.out" 2>"$T/err.err"; rc=$?
 wait_sim
 expect "device error: exit 7" [ $rc -eq 7 ]
 expect "device error: reported" grep -qE "device reported an error \(move outside the machine's travel limits, about curve no. [0-9]+\)" "$T/err.out"
@@ -122,11 +122,11 @@ expect "help: exit 0" [ $rc -eq 0 ]
 expect "help: exit codes" grep -q '5 the device reset mid-job' "$T/help.out"
 "$CS" stream "$JOB" >/dev/null 2>&1; rc=$?
 expect "no --port: exit 2" [ $rc -eq 2 ]
-timeout 10 "$CS" stream --port "$T/nope" "$JOB" >/dev/null 2>"$T/nope.err"; rc=$?
+timeout -k 5 10 "$CS" stream --port "$T/nope" "$JOB" >/dev/null 2>"$T/nope.err"; rc=$?
 expect "missing port: exit 4" [ $rc -eq 4 ]
 expect "missing port: named" grep -q "$T/nope" "$T/nope.err"
 printf 'M 0 0 L 10 10 Q\n' >"$T/bad.svg"
-timeout 10 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err"; rc=$?
+timeout -k 5 10 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err"; rc=$?
 expect "bad job: exit 1, nothing opened" [ $rc -eq 1 ]
 expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
 

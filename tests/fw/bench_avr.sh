@@ -33,7 +33,7 @@ RATES="4000 6000 8000 10000 11000 12000 13000 14000 15000 16000 18000 20000 2400
 
 # 1. the benchmark image: every STEP edge and every step interrupt
 echo "bench_avr: benchmark image" >&2
-timeout 300 "$H" --fast --batch --timeout 240 --steps-csv "$T/steps.csv" --isr-csv "$T/isr.csv" \
+timeout -k 5 300 "$H" --fast --batch --timeout 240 --steps-csv "$T/steps.csv" --isr-csv "$T/isr.csv" \
     "$FW/bench.elf" >"$T/bench.out" 2>/dev/null
 # phases: runs of x edges separated by more than 10 ms (160000 cycles); per phase its first and
 # last x edge, its x edges, and whether y moved
@@ -65,7 +65,7 @@ awk -F, 'NR == FNR { lo[$1] = $5; hi[$1] = $6; np = $1; next }
 
 # 2. the production image with a job streamed in: the interrupt under real load, the stack
 echo "bench_avr: streamed job" >&2
-timeout 120 "$H" --pty --idle-exit 0.5 --timeout 100 "$FW/curvestep.elf" >"$T/job.out" \
+timeout -k 5 120 "$H" --pty --idle-exit 0.5 --timeout 100 "$FW/curvestep.elf" >"$T/job.out" \
     2>/dev/null &
 hpid=$!
 pty=
@@ -74,7 +74,7 @@ for _ in $(seq 100); do
     [ -n "$pty" ] && break
     sleep 0.05
 done
-timeout 100 "$CS" stream --quiet --line-rate 115200 --port "$pty" --machine "$INI" "$JOB" \
+timeout -k 5 100 "$CS" stream --quiet --line-rate 115200 --port "$pty" --machine "$INI" "$JOB" \
     >"$T/stream.out" 2>&1 || true
 end=$((SECONDS + 30))
 while kill -0 "$hpid" 2>/dev/null && [ $SECONDS -lt $end ]; do sleep 0.1; done

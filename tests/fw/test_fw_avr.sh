@@ -52,11 +52,11 @@ for f in "$H" "$ELF" "$CS" "$SIM"; do
 done
 
 # 1. the reference: the plan's per-axis step totals, and the simulator's final position
-timeout 30 "$CS" plan --machine "$INI" "$JOB" -o "$T/job.seg" 2>"$T/plan.err"
+timeout -k 5 30 "$CS" plan --machine "$INI" "$JOB" -o "$T/job.seg" 2>"$T/plan.err"
 expect "plan: segments written" grep -q '^# curvestep segments tick_hz=31250 axes=3' "$T/job.seg"
 read -r PX PY PZ < <(awk '!/^#/ { for (i = 2; i <= 4; i++) t[i] += ($i < 0 ? -$i : $i) }
                          END { print t[2] + 0, t[3] + 0, t[4] + 0 }' "$T/job.seg")
-timeout 30 "$SIM" --replay "$T/job.seg" --machine "$INI" >"$T/replay.out" 2>&1
+timeout -k 5 30 "$SIM" --replay "$T/job.seg" --machine "$INI" >"$T/replay.out" 2>&1
 SX=$(sed -n 's/^final position: x=\(-\?[0-9]*\) steps.*/\1/p' "$T/replay.out")
 SY=$(sed -n 's/^final position: .* y=\(-\?[0-9]*\) steps.*/\1/p' "$T/replay.out")
 SZ=$(sed -n 's/^final position: .* z=\(-\?[0-9]*\) steps.*/\1/p' "$T/replay.out")
@@ -64,7 +64,7 @@ expect "replay: final position read" [ -n "$SX" -a -n "$SY" -a -n "$SZ" ]
 expect "plan: every axis moves" [ "$PX" -gt 0 -a "$PY" -gt 0 -a "$PZ" -gt 0 ]
 
 # 2. the image on a pty, the job streamed to it
-timeout 60 "$H" --pty --idle-exit 0.5 --timeout 50 --min-pulse-us "$PULSE_US" \
+timeout -k 5 60 "$H" --pty --idle-exit 0.5 --timeout 50 --min-pulse-us "$PULSE_US" \
     --min-dir-setup-us "$SETUP_US" "$ELF" >"$T/h.out" 2>"$T/h.err" &
 HPID=$!
 pids+=("$HPID")
@@ -77,7 +77,7 @@ done
 expect "harness printed a pty path" [ -c "$PTY" ]
 # --line-rate: the pty moves bytes at memory speed, the AVR's USART at 115200 baud; time the
 # link (and pace the writes) for the real line
-timeout 50 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$INI" "$JOB" \
+timeout -k 5 50 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$INI" "$JOB" \
     >"$T/s.out" 2>"$T/s.err"
 rc=$?
 expect "stream: exit 0" [ $rc -eq 0 ]
@@ -115,7 +115,7 @@ expect "stack stays above the static RAM" [ $above -eq 1 ]
 
 # 3. Ctrl-C mid-job: the host holds, then aborts (HOLD and ABORT on the 2 KB build); the image
 #    stops stepping cleanly (no pulse or DIR violation while it stops) before the job's end
-timeout 60 "$H" --pty --idle-exit 0.5 --timeout 50 --min-pulse-us "$PULSE_US" \
+timeout -k 5 60 "$H" --pty --idle-exit 0.5 --timeout 50 --min-pulse-us "$PULSE_US" \
     --min-dir-setup-us "$SETUP_US" "$ELF" >"$T/i.out" 2>"$T/i.err" &
 HPID=$!
 pids+=("$HPID")
@@ -127,7 +127,7 @@ for _ in $(seq 100); do
 done
 # (--foreground: timeout would otherwise pass the signal on twice, and a second Ctrl-C means
 # "leave at once")
-timeout --foreground 50 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$INI" "$JOB" \
+timeout --foreground -k 5 50 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$INI" "$JOB" \
     >"$T/is.out" 2>"$T/is.err" &
 spid=$!
 pids+=("$spid")
@@ -150,7 +150,7 @@ ix=$(field "$T/i.out" steps x)
 expect "ctrl-c: the job stopped early" [ -n "$ix" -a "${ix:-0}" -lt "$PX" ]
 
 # 4. the 2 KB image takes segments only: its HELLO says so and the host refuses curves (exit 4)
-timeout 30 "$H" --pty --idle-exit 0.5 --timeout 20 "$ELF" >"$T/c.out" 2>/dev/null &
+timeout -k 5 30 "$H" --pty --idle-exit 0.5 --timeout 20 "$ELF" >"$T/c.out" 2>/dev/null &
 HPID=$!
 pids+=("$HPID")
 PTY=
@@ -159,7 +159,7 @@ for _ in $(seq 100); do
     [ -n "$PTY" ] && break
     sleep 0.05
 done
-timeout 20 "$CS" stream --mode curves --quiet --line-rate 115200 --port "$PTY" --machine "$INI" \
+timeout -k 5 20 "$CS" stream --mode curves --quiet --line-rate 115200 --port "$PTY" --machine "$INI" \
     "$JOB" >"$T/cs.out" 2>&1
 rc=$?
 kill "$HPID" 2>/dev/null
@@ -168,12 +168,12 @@ expect "curves: refused, exit 4" [ $rc -eq 4 ]
 expect "curves: the device cannot take them" grep -q 'the device cannot take curves' "$T/cs.out"
 
 # 5. the harness can fail: a pulse requirement above what the port gives is a violation (exit 1)
-timeout 30 "$H" --fast --cycles 4e6 --min-pulse-us 1000 "$FW/bench.elf" >"$T/v.out" 2>/dev/null
+timeout -k 5 30 "$H" --fast --cycles 4e6 --min-pulse-us 1000 "$FW/bench.elf" >"$T/v.out" 2>/dev/null
 rc=$?
 expect "violation: exit 1" [ $rc -eq 1 ]
 expect "violation: reported" grep -q '^pulse: .*: VIOLATION$' "$T/v.out"
 # ... and a silent image (no host, nothing to do) ends at the wall timeout: exit 4
-timeout 30 "$H" --timeout 1 "$ELF" >"$T/w.out" 2>/dev/null
+timeout -k 5 30 "$H" --timeout 1 "$ELF" >"$T/w.out" 2>/dev/null
 rc=$?
 expect "wall timeout: exit 4" [ $rc -eq 4 ]
 expect "wall timeout: reported" grep -q 'stopped: wall timeout$' "$T/w.out"

@@ -49,7 +49,7 @@ value() { sed -n "$2" "$1" | tail -n1; }
 start_fw() {
     local name=$1
     # qemu prints the pty on stdout, the semihosting console goes to stderr: one file
-    timeout 90 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
+    timeout -k 5 90 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
     QPID=$!
     pids+=("$QPID")
     PTY=
@@ -79,12 +79,12 @@ expect "image built" [ -f "$ELF" ]
 
 # The curves-mode reference runs meanwhile: the simulator's device on its own pty, instant.
 (
-    timeout 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
     spid=$!
     spty=
     end=$((SECONDS + 10))
     while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/sim.out" 2>/dev/null); sleep 0.05; done
-    timeout 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --port "$spty" "$JOB" \
+    timeout -k 5 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --port "$spty" "$JOB" \
         >"$T/simcur.out" 2>&1
     wait "$spid"
 ) &
@@ -102,7 +102,7 @@ ref_steps=$(sed -n 's/^replay: [0-9]* segments, \([0-9]*\) steps.*/\1/p' "$T/rep
 expect "reference: plan and replay ran" [ -n "$ref_pos" ] && [ -n "$ref_steps" ] && [ "$nseg" -gt 100 ]
 start_fw seg
 expect "qemu printed the UART's pty" [ -c "$PTY" ]
-timeout 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 --port "$PTY" "$JOB" \
+timeout -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 --port "$PTY" "$JOB" \
     >"$T/seg.out" 2>"$T/seg.err"
 rc=$?
 wait_fw
@@ -125,7 +125,7 @@ sim_steps=$(sed -n 's/^job time: .* simulated, \([0-9]*\) steps$/\1/p' "$T/sim.o
 ncur=$(sed -n 's/^device: .* \([0-9]*\) messages executed .*/\1/p' "$T/sim.out")
 expect "curves reference: simulator ran" [ -n "$sim_pos" ] && [ -n "$sim_steps" ] && [ -n "$ncur" ]
 start_fw cur
-timeout 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --line-rate 115200 \
+timeout -k 5 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --line-rate 115200 \
     --port "$PTY" "$JOB" >"$T/cur.out" 2>"$T/cur.err"
 rc=$?
 wait_fw
@@ -138,7 +138,7 @@ expect "curves: steps in total = simulator" grep -q "^fw: steps total $sim_steps
 
 # 3. Ctrl-C mid-job: HOLD then ABORT reach the image; the host's last executed is the image's.
 start_fw int
-timeout --foreground 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 \
+timeout --foreground -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 \
     --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
@@ -156,7 +156,7 @@ expect "ctrl-c: stopped mid-job" [ "${k:-0}" -gt 0 ] && [ "${k:-0}" -lt "$nseg" 
 # 4. a machine file at another tick rate: the image's HELLO is refused (exit 4), nothing moves.
 sed 's/^tick_hz = .*/tick_hz = 1000000/' "$INI" >"$T/fast.ini"
 start_fw bad
-timeout 30 "$CS" stream --machine "$T/fast.ini" --port "$PTY" "$JOB" >"$T/bad.out" 2>&1
+timeout -k 5 30 "$CS" stream --machine "$T/fast.ini" --port "$PTY" "$JOB" >"$T/bad.out" 2>&1
 rc=$?
 kill "$QPID" 2>/dev/null
 wait_fw

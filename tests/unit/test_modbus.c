@@ -669,7 +669,7 @@ static void test_stream_lost_answers(void **state)
     cs_mb_client_t c;
     char why[200];
     /* 40 ms a try: the server answers within a few ms on a pty */
-    assert_int_equal(cs_mb_open_rtu(&c, path, 115200, 3, 40, 6, why, sizeof why), 0);
+    assert_int_equal(cs_mb_open_rtu(&c, path, 115200, 'E', 3, 40, 6, why, sizeof why), 0);
     cs_mb_stream_opts_t o;
     cs_mb_stream_opts_default(&o, &c, 3, 100000);
     cs_stream_result_t r;
@@ -699,7 +699,7 @@ static void test_stream_wrong_unit(void **state)
     assert_int_equal(cs_stream_job_add_segments(&job, &sg, 1), CS_OK);
     cs_mb_client_t c;
     char why[200];
-    assert_int_equal(cs_mb_open_rtu(&c, path, 115200, 9, 40, 2, why, sizeof why), 0);
+    assert_int_equal(cs_mb_open_rtu(&c, path, 115200, 'E', 9, 40, 2, why, sizeof why), 0);
     cs_mb_stream_opts_t o;
     cs_mb_stream_opts_default(&o, &c, 3, 100000);
     o.hello_ms = 300;
