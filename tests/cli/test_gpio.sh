@@ -13,22 +13,8 @@ set -u
 B=${CS_BUILD:-build}
 CS=$B/curvestep
 SIM=$B/curvestep-sim
-T=$(mktemp -d)
-pids=()
-cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-    wait 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-expect() { # expect NAME CONDITION...
-    local name=$1; shift
-    if "$@"; then ok; else bad "$name"; fi
-}
+# the shared harness: T, pids (killed on exit), ok / ko / expect (tests/cli/lib/common.sh)
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 
 # A short job (about 1 s) with reversals on x, y and z, ending away from the origin.
 cat >"$T/job.nc" <<'EOF'

@@ -23,29 +23,15 @@ JOB=tests/fw/avr_job.nc
 # 0.65 us)
 PULSE_US=$(sed -n 's/^pulse_us *= *\([0-9.]*\).*/\1/p' "$INI" | sort -n | tail -n1)
 SETUP_US=1
-T=$(mktemp -d)
-pids=()
-cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-    wait 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-expect() { # expect NAME CONDITION...
-    local name=$1; shift
-    if "$@"; then ok; else bad "$name"; fi
-}
+# the shared harness: T, pids (killed on exit), ok / ko / expect (tests/cli/lib/common.sh)
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
 field() { # field FILE KEY AXIS: the number after "AXIS=" on the line starting with "KEY:"
     sed -n "s/^$2:.* $3=\\(-\\?[0-9]*\\).*/\\1/p" "$1" | head -n1
 }
 
 for f in "$H" "$ELF" "$CS" "$SIM"; do
     if [ ! -x "$f" ] && [ ! -f "$f" ]; then
-        bad "missing $f (make firmware)"
+        ko "missing $f (make firmware)"
         echo "cli: $pass passed, $fail failed"
         exit 1
     fi

@@ -26,22 +26,8 @@ FEED=400                             # mm/s: the job takes 4.4 s of machine time
 QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
     -icount shift=4
     -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=500)
-T=$(mktemp -d)
-pids=()
-cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
-    wait 2>/dev/null
-    rm -rf "$T"
-}
-trap cleanup EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-expect() { # expect NAME CONDITION...
-    local name=$1; shift
-    if "$@"; then ok; else bad "$name"; fi
-}
+# the shared harness: T, pids (killed on exit), ok / ko / expect (tests/cli/lib/common.sh)
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
 # value NAME FILE SED-EXPR: the last match of a report line (for messages).
 value() { sed -n "$2" "$1" | tail -n1; }
 
