@@ -18,10 +18,10 @@
 #include "cs_stream_cmd.h"
 #include "cs_trace.h"
 
-#define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
-#define EXIT_RESET CS_EXIT_RESET
-#define EXIT_CLOSED CS_EXIT_CLOSED
-#define EXIT_DEV_ERROR CS_EXIT_DEV_ERROR
+#define EXIT_NO_DEVICE   CS_EXIT_NO_DEVICE
+#define EXIT_RESET       CS_EXIT_RESET
+#define EXIT_CLOSED      CS_EXIT_CLOSED
+#define EXIT_DEV_ERROR   CS_EXIT_DEV_ERROR
 #define EXIT_INTERRUPTED CS_EXIT_INTERRUPTED
 
 static volatile sig_atomic_t interrupted;

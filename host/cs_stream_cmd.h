@@ -17,9 +17,10 @@
 
 /* Exit statuses of `stream` beyond the shared ones (cs_cmd.h); every link uses them. */
 enum {
-    CS_EXIT_NO_DEVICE = 4,  /* the port cannot be opened, no device answered, or it is incompatible */
-    CS_EXIT_RESET = 5,      /* the device reset mid-job */
-    CS_EXIT_CLOSED = 6,     /* the link closed or the device stopped answering mid-job */
+    CS_EXIT_NO_DEVICE =
+        4,              /* the port cannot be opened, no device answered, or it is incompatible */
+    CS_EXIT_RESET = 5,  /* the device reset mid-job */
+    CS_EXIT_CLOSED = 6, /* the link closed or the device stopped answering mid-job */
     CS_EXIT_DEV_ERROR = 7,  /* the device refused a message (ERROR) */
     CS_EXIT_INTERRUPTED = 8 /* Ctrl-C: held, then aborted */
 };

@@ -169,8 +169,7 @@ static size_t plan_count(const char *ini, const char *file, bool pen_z)
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     assert_int_equal(cs_jobplan_read(&jp, file, pen_z ? &pen : NULL, false), CS_OK);
-    assert_int_equal(cs_jobplan_plan(&jp, file, &m, NULL, m.tolerance, CS_TRACE_SUBDIV, 0),
-                     CS_OK);
+    assert_int_equal(cs_jobplan_plan(&jp, file, &m, NULL, m.tolerance, CS_TRACE_SUBDIV, 0), CS_OK);
     size_t n = jp.mo.segs.n;
     cs_jobplan_free(&jp);
     return n;
@@ -194,8 +193,7 @@ static void test_pen_machine(void **state)
     fclose(f);
     f = fopen(job, "w");
     assert_non_null(f);
-    fputs("G21 G90\nG0 X10 Y10\nM3\nG1 X30 Y10 F1200\nM5\nG0 X40 Y20\nM3\nG1 X40 Y40\nM5\nM2\n",
-          f);
+    fputs("G21 G90\nG0 X10 Y10\nM3\nG1 X30 Y10 F1200\nM5\nG0 X40 Y20\nM3\nG1 X40 Y40\nM5\nM2\n", f);
     fclose(f);
     size_t with_pen = plan_count(ini, job, true), without = plan_count(ini, job, false);
     assert_true(with_pen != without); /* else this test could not tell the two apart */
