@@ -903,18 +903,80 @@ static int parse_faults(const char *spec, cs_sim_device_cfg_t *c)
     return (c->reset_after != 0) + (c->hang_after != 0) + (c->close_after != 0) <= 1 ? 0 : -1;
 }
 
+void cs_sim_device_opts_default(cs_sim_device_opts_t *o)
+{
+    memset(o, 0, sizeof *o);
+    o->speed = 1;
+    o->queue = 32;
+    o->baud = 115200;
+}
+
+int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o)
+{
+    const char *a = argv[*i];
+    bool has = *i + 1 < argc;
+    char *end = NULL;
+    const char **str = strcmp(a, "--machine") == 0     ? &o->machine_file
+                       : strcmp(a, "--reference") == 0 ? &o->out.reference
+                       : strcmp(a, "--svg") == 0       ? &o->out.svg
+                       : strcmp(a, "--png") == 0       ? &o->out.png
+                       : strcmp(a, "--trace") == 0     ? &o->out.trace
+                       : strcmp(a, "--faults") == 0    ? &o->faults
+                                                       : NULL;
+    if (str != NULL && has) {
+        *str = argv[++*i];
+    } else if (strcmp(a, "--check") == 0) {
+        o->out.check = true;
+    } else if (strcmp(a, "--instant") == 0) {
+        o->instant = true;
+    } else if (strcmp(a, "--speed") == 0 && has) {
+        o->speed = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(o->speed > 0) || o->speed > 1e6) {
+            fprintf(stderr, "curvestep-sim: --speed wants a factor in (0, 1e6]\n");
+            return -1;
+        }
+    } else if (strcmp(a, "--idle-exit") == 0 && has) {
+        o->idle_exit = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(o->idle_exit > 0)) {
+            fprintf(stderr, "curvestep-sim: --idle-exit wants seconds > 0\n");
+            return -1;
+        }
+    } else if (strcmp(a, "--tol") == 0 && has) {
+        o->tol_mm = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(o->tol_mm > 0)) {
+            fprintf(stderr, "curvestep-sim: --tol wants a positive number of mm\n");
+            return -1;
+        }
+    } else if ((strcmp(a, "--queue") == 0 || strcmp(a, "--baud") == 0) && has) {
+        long v = strtol(argv[++*i], &end, 10);
+        if (*end != '\0' || v < 0) {
+            fprintf(stderr, "curvestep-sim: %s wants a number\n", a);
+            return -1;
+        }
+        *(a[2] == 'q' ? &o->queue : &o->baud) = v;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
 int cs_sim_device_main(int argc, char **argv)
 {
     enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3, CHECK = 4 };
-    const char *port = NULL, *machine_file = NULL, *reference = NULL, *svg = NULL, *png = NULL,
-               *trace = NULL, *faults = NULL;
-    bool pty = false, check = false, instant = false;
-    double speed = 1, idle_exit = 0, tol_mm = 0;
-    long queue = 32, baud = 115200, line_rate = 0;
+    const char *port = NULL;
+    bool pty = false;
+    long line_rate = 0;
+    cs_sim_device_opts_t o;
+    cs_sim_device_opts_default(&o);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
         char *end = NULL;
+        int took = cs_sim_device_opt(argc, argv, &i, &o);
+        if (took < 0)
+            return USAGE;
+        if (took > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             device_usage(stdout);
             return OK;
@@ -922,60 +984,23 @@ int cs_sim_device_main(int argc, char **argv)
             pty = true;
         } else if (strcmp(a, "--port") == 0 && has) {
             port = argv[++i];
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            machine_file = argv[++i];
-        } else if (strcmp(a, "--reference") == 0 && has) {
-            reference = argv[++i];
-        } else if (strcmp(a, "--svg") == 0 && has) {
-            svg = argv[++i];
-        } else if (strcmp(a, "--png") == 0 && has) {
-            png = argv[++i];
-        } else if (strcmp(a, "--trace") == 0 && has) {
-            trace = argv[++i];
-        } else if (strcmp(a, "--faults") == 0 && has) {
-            faults = argv[++i];
-        } else if (strcmp(a, "--check") == 0) {
-            check = true;
-        } else if (strcmp(a, "--instant") == 0) {
-            instant = true;
-        } else if (strcmp(a, "--speed") == 0 && has) {
-            speed = strtod(argv[++i], &end);
-            if (*end != '\0' || !(speed > 0) || speed > 1e6) {
-                fprintf(stderr, "curvestep-sim: --speed wants a factor in (0, 1e6]\n");
-                return USAGE;
-            }
-        } else if (strcmp(a, "--idle-exit") == 0 && has) {
-            idle_exit = strtod(argv[++i], &end);
-            if (*end != '\0' || !(idle_exit > 0)) {
-                fprintf(stderr, "curvestep-sim: --idle-exit wants seconds > 0\n");
-                return USAGE;
-            }
-        } else if (strcmp(a, "--tol") == 0 && has) {
-            tol_mm = strtod(argv[++i], &end);
-            if (*end != '\0' || !(tol_mm > 0)) {
-                fprintf(stderr, "curvestep-sim: --tol wants a positive number of mm\n");
-                return USAGE;
-            }
-        } else if ((strcmp(a, "--queue") == 0 || strcmp(a, "--baud") == 0 ||
-                    strcmp(a, "--line-rate") == 0) &&
-                   has) {
-            long v = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || v < 0) {
+        } else if (strcmp(a, "--line-rate") == 0 && has) {
+            line_rate = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || line_rate < 0) {
                 fprintf(stderr, "curvestep-sim: %s wants a number\n", a);
                 return USAGE;
             }
-            if (a[2] == 'q')
-                queue = v;
-            else if (a[2] == 'b')
-                baud = v;
-            else
-                line_rate = v;
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             device_usage(stderr);
             return USAGE;
         }
     }
+    const char *machine_file = o.machine_file, *reference = o.out.reference, *svg = o.out.svg,
+               *png = o.out.png, *trace = o.out.trace, *faults = o.faults;
+    bool check = o.out.check, instant = o.instant;
+    double speed = o.speed, idle_exit = o.idle_exit, tol_mm = o.tol_mm;
+    long queue = o.queue, baud = o.baud;
     if (pty == (port != NULL)) {
         fprintf(stderr, "curvestep-sim: give exactly one of --pty and --port DEV\n");
         return USAGE;

@@ -120,6 +120,20 @@ int cs_sim_device_report(const cs_machine_t *m, const cs_sim_device_cfg_t *cfg,
                          const cs_sim_device_result_t *res, const cs_sim_device_out_t *o, bool ok,
                          int rc);
 
+/* The options every device front end takes (the serial device here, the Modbus device in
+ * cs_sim_modbus.c): machine, checks and pictures, faults, pacing, queue, baud. */
+typedef struct {
+    const char *machine_file, *faults; /* NULL: the built-in machine, no faults */
+    cs_sim_device_out_t out;           /* --reference --svg --png --trace --check */
+    bool instant;                      /* --instant */
+    double speed, idle_exit, tol_mm;   /* --speed (default 1), --idle-exit s, --tol mm (0: none) */
+    long queue, baud;                  /* --queue (default 32), --baud (default 115200) */
+} cs_sim_device_opts_t;
+void cs_sim_device_opts_default(cs_sim_device_opts_t *o);
+/* Takes argv[*i] (and its value, advancing *i) when it is one of those options: 1 taken, 0 not
+ * one of them, -1 a bad value (the sentence printed on stderr). */
+int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o);
+
 /* The `curvestep-sim --pty | --port DEV ...` command line (sim/main.c hands these over). */
 int cs_sim_device_main(int argc, char **argv);
 

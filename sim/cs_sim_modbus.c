@@ -549,12 +549,11 @@ static int parse_faults(const char *spec, mb_faults_t *f)
 int cs_sim_modbus_main(int argc, char **argv)
 {
     enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3 };
-    const char *tcp = NULL, *rtu = NULL, *machine_file = NULL, *faults = NULL;
-    cs_sim_device_out_t out = {0};
-    bool instant = false;
-    double speed = 1, idle_exit = 0, tol_mm = 0;
-    long queue = 32, baud = 115200, unit = 1;
-    char parity = 0;               /* 0: not given (even) */
+    const char *tcp = NULL, *rtu = NULL;
+    long unit = 1;
+    char parity = 0;        /* 0: not given (even) */
+    cs_sim_device_opts_t o; /* the options the serial device takes too */
+    cs_sim_device_opts_default(&o);
     for (int i = 1; i < argc; i++) /* `--modbus-tcp --help` too */
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
@@ -564,10 +563,12 @@ int cs_sim_modbus_main(int argc, char **argv)
         const char *a = argv[i];
         bool has = i + 1 < argc;
         char *end = NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return OK;
-        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
+        int took = cs_sim_device_opt(argc, argv, &i, &o);
+        if (took < 0)
+            return USAGE;
+        if (took > 0)
+            continue;
+        if (strcmp(a, "--modbus-tcp") == 0 && has) {
             tcp = argv[++i];
         } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
             rtu = argv[++i];
@@ -581,60 +582,23 @@ int cs_sim_modbus_main(int argc, char **argv)
                 fprintf(stderr, "curvestep-sim: --parity wants none, even or odd\n");
                 return USAGE;
             }
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            machine_file = argv[++i];
-        } else if (strcmp(a, "--reference") == 0 && has) {
-            out.reference = argv[++i];
-        } else if (strcmp(a, "--svg") == 0 && has) {
-            out.svg = argv[++i];
-        } else if (strcmp(a, "--png") == 0 && has) {
-            out.png = argv[++i];
-        } else if (strcmp(a, "--trace") == 0 && has) {
-            out.trace = argv[++i];
-        } else if (strcmp(a, "--faults") == 0 && has) {
-            faults = argv[++i];
-        } else if (strcmp(a, "--check") == 0) {
-            out.check = true;
-        } else if (strcmp(a, "--instant") == 0) {
-            instant = true;
-        } else if (strcmp(a, "--speed") == 0 && has) {
-            speed = strtod(argv[++i], &end);
-            if (*end != '\0' || !(speed > 0) || speed > 1e6) {
-                fprintf(stderr, "curvestep-sim: --speed wants a factor in (0, 1e6]\n");
-                return USAGE;
-            }
-        } else if (strcmp(a, "--idle-exit") == 0 && has) {
-            idle_exit = strtod(argv[++i], &end);
-            if (*end != '\0' || !(idle_exit > 0)) {
-                fprintf(stderr, "curvestep-sim: --idle-exit wants seconds > 0\n");
-                return USAGE;
-            }
-        } else if (strcmp(a, "--tol") == 0 && has) {
-            tol_mm = strtod(argv[++i], &end);
-            if (*end != '\0' || !(tol_mm > 0)) {
-                fprintf(stderr, "curvestep-sim: --tol wants a positive number of mm\n");
-                return USAGE;
-            }
-        } else if ((strcmp(a, "--queue") == 0 || strcmp(a, "--baud") == 0 ||
-                    strcmp(a, "--unit") == 0) &&
-                   has) {
-            long v = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || v < 0) {
+        } else if (strcmp(a, "--unit") == 0 && has) {
+            unit = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || unit < 0) {
                 fprintf(stderr, "curvestep-sim: %s wants a number\n", a);
                 return USAGE;
             }
-            if (a[2] == 'q')
-                queue = v;
-            else if (a[2] == 'b')
-                baud = v;
-            else
-                unit = v;
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             usage(stderr);
             return USAGE;
         }
     }
+    const char *machine_file = o.machine_file, *faults = o.faults;
+    cs_sim_device_out_t out = o.out;
+    bool instant = o.instant;
+    double speed = o.speed, idle_exit = o.idle_exit, tol_mm = o.tol_mm;
+    long queue = o.queue, baud = o.baud;
     if ((tcp != NULL) == (rtu != NULL)) {
         fprintf(stderr, "curvestep-sim: give exactly one of --modbus-tcp and --modbus-rtu\n");
         return USAGE;
