@@ -17,6 +17,20 @@ typedef enum {
     CS_INPUT_HPGL = 3,
 } cs_input_format_t;
 
+/* G-code dialect (--dialect): whose modal defaults, words and error behaviour apply
+ * (docs/inputs.md lists each difference). */
+typedef enum {
+    CS_DIALECT_LINUXCNC = 0, /* the default: LinuxCNC's G-code reference */
+    CS_DIALECT_GRBL = 1,     /* Grbl 1.1 */
+} cs_dialect_t;
+
+/* Units a program starts in (--units) until it says G20 or G21. */
+typedef enum {
+    CS_UNITS_DEFAULT = 0, /* the dialect's own: millimetres */
+    CS_UNITS_MM = 1,
+    CS_UNITS_INCH = 2,
+} cs_units_t;
+
 /* Receives each warning of any reader (code CS_OK, loc and reason filled). */
 typedef void (*cs_input_warn_fn)(void *ctx, const cs_path_diag_t *w);
 
@@ -26,6 +40,10 @@ typedef struct {
     double helix_tol_mm;      /* G-code helices (default CS_GCODE_HELIX_TOL_MM) */
     bool pen_z; /* G-code M3/M4/M5 also move Z (cs_gcode_opts_t); plan/stream: [pen] mode = z */
     double pen_down_z_mm, pen_up_z_mm;
+    cs_dialect_t dialect;  /* --dialect (G-code) */
+    cs_units_t units;      /* --units (G-code) */
+    const char *font_file; /* --font: stroke font for SVG <text> and HP-GL LB; NULL: default */
+    size_t max_bytes;      /* input size limit in bytes; 0: the default (docs/inputs.md) */
     cs_input_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_input_opts_t;
