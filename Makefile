@@ -1,15 +1,42 @@
 # curvestep build. Every module is picked up by wildcard: add a .c file in the right folder and
 # it is built; add tests/unit/test_<module>.c and it becomes a test binary.
 #   make            core library, host program, simulator, freestanding + cross checks of the core
+#   make host       host program and simulator, built and tested with the host's packages only
 #   make test       every unit test, once plain and once under ASan+UBSan
 #   make demo       the main job (see README.md)
 #   make bench      benchmarks -> docs/benchmarks.md and build/bench/*.csv
 #   make firmware   cross-compiled core for each target, sizes printed
+#   make install    PREFIX (/usr/local) and DESTDIR; make uninstall removes the same files
+#   make deb        the Debian package, build/curvestep_*.deb (docs/install.md)
 #   make format     clang-format -i on every source
 #   make clean
 .DEFAULT_GOAL := all
 SHELL := /bin/bash
 
+# --- stage 1: install what the goals need, then build them in a fresh parse -----------------
+# This file reads pkg-config when make parses it (PKG_CFLAGS here, SIMAVR_CFLAGS in mk/fw-avr.mk,
+# AGG_CFLAGS below), so on a fresh machine the packages must be there before that parse, not
+# merely before the first recipe. Stage 1 maps the goals to scripts/deps.sh groups, runs it, then
+# runs make again with CS_DEPS_DONE=1: the rest of this file (stage 2), parsed with the packages
+# installed. tests/cli/test_firstrun.sh fails if a goal reads pkg-config before deps has run.
+BUILD ?= build
+ifndef CS_DEPS_DONE
+CS_GOALS := $(or $(MAKECMDGOALS),$(.DEFAULT_GOAL))
+cs_group = $(strip \
+  $(if $(filter clean format uninstall,$(1)),,\
+  $(if $(filter deb,$(1)),host deb,\
+  $(if $(filter fuzz,$(1)),host fuzz,\
+  $(if $(filter bench,$(1)),host firmware bench,\
+  $(if $(filter all deps test demo firmware cross fw-test $(BUILD)/fw/% $(BUILD)/cross/% build/fw/%,$(1)),\
+    host firmware,host))))))
+CS_GROUPS := $(sort $(foreach g,$(CS_GOALS),$(call cs_group,$(g))))
+.PHONY: $(CS_GOALS) cs-stage1
+$(CS_GOALS): cs-stage1 ; @:
+cs-stage1:
+	$(if $(CS_GROUPS),@sh scripts/deps.sh $(CS_GROUPS))
+	@$(MAKE) --no-print-directory CS_DEPS_DONE=1 CS_DEPS_GROUPS='$(CS_GROUPS)' $(MAKECMDGOALS)
+else
+# --- stage 2: the build ---------------------------------------------------------------------
 BUILD    ?= build
 VARIANT  ?= plain
 CC       ?= cc
@@ -55,13 +82,15 @@ HOST_LIB := $(OUT)/libcshost.a
 
 .SECONDARY:
 
-.PHONY: fw-test all deps test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
+.PHONY: fw-test all deps host test test-plain test-asan unit-run demo bench firmware core-check cross clean format fuzz
 
 all: deps $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) core-check cross \
      firmware
 
+# Stage 1 has installed the packages; `make CS_DEPS_DONE=1 deps` runs deps.sh here, after the
+# parse (how the Makefile worked before stage 1; tests/cli/test_firstrun.sh shows it failing).
 deps:
-	@sh scripts/deps.sh
+	@sh scripts/deps.sh $(if $(CS_DEPS_GROUPS),$(CS_DEPS_GROUPS),host firmware)
 
 # --- objects --------------------------------------------------------------------------------
 $(OUT)/obj/firmware/core/%.o: firmware/core/%.c $(wildcard firmware/core/*.h)
@@ -98,6 +127,11 @@ test: deps
 	$(MAKE) --no-print-directory VARIANT=asan test-variant
 	@$(MAKE) --no-print-directory core-check cross
 	$(MAKE) --no-print-directory fw-test
+
+# Host only: the host program and simulator, built and tested (unit and CLI tests, plain), and
+# the freestanding check of the core, with no cross toolchain, emulator or clang.
+host: core-check
+	$(MAKE) --no-print-directory VARIANT=plain test-variant
 
 test-variant: $(OUT)/curvestep $(if $(wildcard sim/main.c),$(OUT)/curvestep-sim) $(UNIT_BIN)
 	@CS_BUILD=$(OUT) bash scripts/run-tests.sh $(VARIANT) $(UNIT_BIN)
@@ -168,3 +202,5 @@ format:
 
 clean:
 	rm -rf $(BUILD)
+
+endif # stage 2

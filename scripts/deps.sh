@@ -1,20 +1,46 @@
 #!/bin/sh
-# Install the Debian packages the build, tests, demo and benchmarks need.
+# Install the Debian packages a group of make targets needs.
+# Usage: deps.sh [GROUP...]   GROUP: host firmware bench fuzz deb all (none given: all)
+#   host      the host program, simulator, unit and CLI tests (make host, make install)
+#   firmware  cross compilers and emulators (make firmware, make cross, make fw-test)
+#   bench     the peer libraries of the benchmarks (make bench)
+#   fuzz      clang's libFuzzer (make fuzz)
+#   deb       the Debian tooling (make deb)
 # Only what is missing is installed; when everything is present this is a no-op
-# (one dpkg-query, no network). Safe to run as often as make likes.
+# (one dpkg-query, no network). Safe to run as often as make likes. The Makefile runs it before
+# it reads pkg-config (see "stage 1" at the top of the Makefile).
 set -eu
 
-PKGS="make gcc libc6-dev pkg-config \
+HOST="make gcc libc6-dev pkg-config git \
 libcmocka-dev libexpat1-dev libinih-dev libcairo2-dev \
-gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi \
+librsvg2-bin libmodbus-dev libgpiod-dev"
+FIRMWARE="gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi \
 gcc-avr avr-libc binutils-avr \
-clang llvm libclang-rt-14-dev libagg-dev \
-librsvg2-bin \
-libmodbus-dev libgpiod-dev \
 qemu-system-arm simavr libsimavr-dev libelf-dev"
+BENCH="g++ libagg-dev"
+FUZZ="clang llvm libclang-rt-14-dev"
+DEB="debhelper devscripts lintian fakeroot dpkg-dev adduser systemd"
+
+case "${1:-}" in -h|--help)
+    sed -n '2,11s/^# \{0,1\}//p' "$0"; exit 0 ;;
+esac
+[ $# -eq 0 ] && set -- all
+PKGS=""
+for g in "$@"; do
+    case "$g" in
+        host) PKGS="$PKGS $HOST" ;;
+        firmware) PKGS="$PKGS $FIRMWARE" ;;
+        bench) PKGS="$PKGS $BENCH" ;;
+        fuzz) PKGS="$PKGS $FUZZ" ;;
+        deb) PKGS="$PKGS $DEB" ;;
+        all) PKGS="$PKGS $HOST $FIRMWARE $BENCH $FUZZ $DEB" ;;
+        *) echo "deps: unknown group '$g' (host firmware bench fuzz deb all)" >&2; exit 2 ;;
+    esac
+done
 
 missing=""
 for p in $PKGS; do
+    case " $missing " in *" $p "*) continue ;; esac
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed"; then
         missing="$missing $p"
     fi
