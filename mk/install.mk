@@ -48,3 +48,20 @@ install: $(BUILD)/curvestep $(BUILD)/curvestep-sim $(BUILD)/curvestep.service
 uninstall:
 	rm -f $(addprefix $(DESTDIR),$(CS_INSTALLED))
 	rmdir $(DESTDIR)$(DOCDIR)/img $(DESTDIR)$(DOCDIR) $(DESTDIR)$(SAMPLEDIR) 2>/dev/null || true
+
+# make deb (docs/install.md): the Debian package, built by dpkg-buildpackage (debhelper, debian/)
+# in a copy of the source tree under $(BUILD)/deb, so its by-products stay in build/; the
+# package lands in $(BUILD)/ and lintian's verdict is printed (each remaining tag is explained in
+# docs/install.md). Not part of make test (about a minute).
+CS_DEB_VERSION = $(shell dpkg-parsechangelog -S Version 2>/dev/null)
+.PHONY: deb
+deb:
+	rm -rf $(BUILD)/deb && mkdir -p $(BUILD)/deb/curvestep
+	if git rev-parse --git-dir >/dev/null 2>&1; then git ls-files -co --exclude-standard -z; \
+	  else find . -path ./$(BUILD) -prune -o -type f -print0; fi \
+	  | tar --null -T - -cf - | tar -xf - -C $(BUILD)/deb/curvestep
+	cd $(BUILD)/deb/curvestep && dpkg-buildpackage --build=binary --no-sign >../dpkg-buildpackage.log 2>&1 \
+	  || { tail -30 ../dpkg-buildpackage.log; exit 1; }
+	mv $(BUILD)/deb/curvestep_$(CS_DEB_VERSION)_*.deb $(BUILD)/
+	lintian --info $(BUILD)/curvestep_$(CS_DEB_VERSION)_*.deb || true
+	@ls -l $(BUILD)/curvestep_$(CS_DEB_VERSION)_*.deb
