@@ -11,6 +11,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "bench_curves.h"
 #include "cs_ref.h"
 #include "cs_svgdoc.h"
@@ -88,6 +89,13 @@ static size_t run(const cs_bezier_t *c, cs_pos_t tol, int m)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_flatten [OUT.csv] [FILE.svg...]\n"
+        "Chords per curve, accuracy and speed of every tracing method against the greedy\n"
+        "double-precision reference; a Markdown section on stdout, the figures in OUT.csv.\n"
+        "No SVG named: the corpus under ../shared/data/svg (else tests/data/svg).\n";
+    int usage_rc = bench_args_check(argc, argv, usage, -1);
+    if (usage_rc >= 0)
+        return usage_rc;
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
     bench_set_t sets[3] = {
         {"random cubics", NULL, 0, 0}, {"hard cases", NULL, 0, 0}, {"SVG files", NULL, 0, 0}};

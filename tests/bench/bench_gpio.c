@@ -14,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "cs_gpio_cfg.h"
 #include "cs_gpio_io.h"
 #include "cs_gpio_run.h"
@@ -154,6 +155,12 @@ static const char *granted(int err)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_gpio [OUT.csv]\n"
+        "Timing of the GPIO step thread on a recorded job; a Markdown section on stdout,\n"
+        "the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
     /* 1. drawing job */
     cs_machine_t m;

@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench_args.h"
 #include "cs_conv.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
@@ -101,6 +102,12 @@ static double path_length(const cs_path_t *p)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_link OUT.csv\n"
+        "Throughput of the serial link protocol against the simulator on a pseudo-terminal;\n"
+        "a Markdown section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     if (argc < 2) {
         fprintf(stderr, "usage: bench_link OUT.csv\n");
         return 2;

@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench_args.h"
 #include "cs_machine_ini.h"
 #include "cs_modbus.h"
 #include "cs_modbus_stream.h"
@@ -158,6 +159,12 @@ static row_t run_modbus(const cs_stream_job_t *job, uint64_t want, bool tcp)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_modbus OUT.csv\n"
+        "Throughput of streaming over Modbus TCP and RTU to the simulator; a Markdown\n"
+        "section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     if (argc < 2) {
         fprintf(stderr, "usage: bench_modbus OUT.csv\n");
         return 2;

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "cs_machine_ini.h"
 #include "cs_planner.h"
 #include "cs_segment.h"
@@ -113,6 +114,12 @@ static void run(const cs_machine_t *m, double (*p)[2], size_t n, result_t *r)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_motion [OUT.csv]\n"
+        "Planner and step-segment throughput and job times, trapezoid and S-curve; a\n"
+        "Markdown section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     enum { N = 50000 };
     static double p[N][2];
     result_t res[4];

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "agg_flat.h"
 #include "bench_curves.h"
 #include "cs_patchfile.h"
@@ -391,6 +392,12 @@ typedef struct {
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_peers [OUT.csv]\n"
+        "curvestep's tracers beside cairo and AGG on one corpus of cubics; a Markdown\n"
+        "section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
     cr = cairo_create(surf);
