@@ -26,8 +26,8 @@ cs_group = $(strip \
   $(if $(filter clean format uninstall,$(1)),,\
   $(if $(filter deb,$(1)),host deb,\
   $(if $(filter fuzz,$(1)),host fuzz,\
-  $(if $(filter bench,$(1)),host firmware bench,\
-  $(if $(filter all deps test demo firmware cross fw-test $(BUILD)/fw/% $(BUILD)/cross/% build/fw/%,$(1)),\
+  $(if $(filter bench test,$(1)),host firmware bench,\
+  $(if $(filter all deps demo firmware cross fw-test $(BUILD)/fw/% $(BUILD)/cross/% build/fw/%,$(1)),\
     host firmware,host))))))
 CS_GROUPS := $(sort $(foreach g,$(CS_GOALS),$(call cs_group,$(g))))
 .PHONY: $(CS_GOALS) cs-stage1

@@ -3,6 +3,8 @@
 # Each program gets the CSV path it must write (build/bench/<name>.csv) as its first argument
 # and prints its Markdown section on stdout (progress goes to stderr).
 set -euo pipefail
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/bench.sh BENCH...\nmake bench: runs each benchmark program (build/bench/bench_*) and the firmware\nfigures, and writes docs/benchmarks.md and build/bench/*.csv." -1 "$@"
 # --- Firmware (make bench, after make firmware) ----------------------------------------------
 # hex -> decimal in (m)awk, which has no strtonum
 AWK_HEX='function hex(h,  i, c, v) { v = 0; h = tolower(h); sub(/^0x/, "", h);

@@ -2,6 +2,8 @@
 # Cross-compile the freestanding core for each firmware target and print its size.
 # Usage: cross-size.sh OUTDIR core-sources...   (fails if a compiler is missing or a file fails)
 set -eu
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/cross-size.sh OUTDIR CORE-SOURCE...   (make cross)\nCompiles the core for each firmware target and prints its code size." -1 "$@"
 out=$1; shift
 common="-std=c99 -ffreestanding -Wall -Wextra -Werror -Wconversion -Os -ffunction-sections -fdata-sections -Ifirmware/core"
 declare -A cc=( [cortex-m0plus]=arm-none-eabi-gcc [cortex-m3]=arm-none-eabi-gcc [avr]=avr-gcc )

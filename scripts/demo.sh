@@ -9,6 +9,8 @@
 # which checks and draws them. Exits non-zero when any check fails. Every background process
 # is bounded by `timeout` and killed on exit.
 set -u
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/demo.sh   (make demo; BUILD=DIR: where the programs are, default build)\nStreams a drawing to the simulated device, then the teapot jobs; prints the\nchecks and where the pictures are. Exit non-zero when a check fails." 0 "$@"
 BUILD=${BUILD:-build}
 CS=$BUILD/curvestep
 SIM=$BUILD/curvestep-sim

@@ -7,6 +7,8 @@
 # $BUILD/fuzz/corpus_<name>/ across runs.
 # Usage: scripts/fuzz.sh [target-name...]   (default: every tests/fuzz/fuzz_*.c)
 set -eu
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/fuzz.sh [TARGET...]   (make fuzz; default: every tests/fuzz/fuzz_*.c)\nEach target under libFuzzer + ASan + UBSan for FUZZ_SECONDS (60) seconds." -1 "$@"
 secs=${FUZZ_SECONDS:-60}
 out=${BUILD:-build}/fuzz
 CLANG=${CLANG:-clang}

@@ -4,6 +4,8 @@
 # __addsf3-style routines on AVR) and the heap (malloc, free, ...). Prints the offending symbols
 # and exits 1. Usage: fw-check.sh NM IMAGE.elf   (NM: arm-none-eabi-nm, avr-nm, ...)
 set -eu
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/fw-check.sh NM IMAGE.elf   (NM: arm-none-eabi-nm, avr-nm, ...)\nFails when the image links software floating point or the heap." 2 "$@"
 nm=$1
 img=$2
 syms=$("$nm" "$img" | awk 'NF >= 2 {print $NF}' | sort -u)

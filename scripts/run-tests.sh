@@ -3,6 +3,8 @@
 # $CLI_DIR/test_*.sh), and
 # print one closing line "<variant>: N passed, N failed" summed from cmocka's own counts.
 set -u
+. "$(dirname "$0")/args.sh"
+cs_args "usage: scripts/run-tests.sh VARIANT [TEST-BINARY...]\nRuns each binary, then tests/cli/test_*.sh (or CLI_DIR/test_*.sh) with\nCS_BUILD; prints \"VARIANT: N passed, M failed\"." -1 "$@"
 variant=$1; shift
 # A hung test must fail with its name, never hang the run (CI gives the whole `make test` 90
 # minutes): each binary gets UNIT_TIMEOUT seconds, each CLI script CLI_TIMEOUT (ASan runs ~4x

@@ -8,6 +8,8 @@
 # default build/bench/bench_avr.csv). Usage: bash tests/fw/bench_avr.sh [CSV] (after make
 # firmware). `make bench` runs it (scripts/bench.sh); `make fw-test` runs only tests/fw/test_*.sh.
 set -euo pipefail
+. "$(dirname "$0")/../../scripts/args.sh"
+cs_args "usage: tests/fw/bench_avr.sh [CSV]   (make bench, after make firmware)\nThe ATmega328p figures measured in simavr; CSV default build/bench/bench_avr.csv." 1 "$@"
 B=${CS_BUILD:-build}
 FW=$B/fw/avr
 H=$FW/avr_harness
