@@ -24,7 +24,7 @@ ifndef CS_DEPS_DONE
 CS_GOALS := $(or $(MAKECMDGOALS),$(.DEFAULT_GOAL))
 cs_group = $(strip \
   $(if $(filter clean format uninstall,$(1)),,\
-  $(if $(filter deb,$(1)),host deb,\
+  $(if $(filter deb deb-check,$(1)),host deb,\
   $(if $(filter fuzz,$(1)),host fuzz,\
   $(if $(filter bench test,$(1)),host firmware bench,\
   $(if $(filter all deps demo firmware cross fw-test $(BUILD)/fw/% $(BUILD)/cross/% build/fw/%,$(1)),\

@@ -65,3 +65,9 @@ deb:
 	mv $(BUILD)/deb/curvestep_$(CS_DEB_VERSION)_*.deb $(BUILD)/
 	lintian --info $(BUILD)/curvestep_$(CS_DEB_VERSION)_*.deb || true
 	@ls -l $(BUILD)/curvestep_$(CS_DEB_VERSION)_*.deb
+
+# make deb-check: install the package with apt, check it, purge it (scripts/deb-check.sh; changes
+# the system, so never part of make test).
+.PHONY: deb-check
+deb-check: deb
+	@bash scripts/deb-check.sh $(BUILD)/curvestep_$(CS_DEB_VERSION)_*.deb
