@@ -21,6 +21,17 @@ unman() { sed -e 's/\\-/-/g' -e 's/\\f[BIRP]//g'; }
 # the long options defined by .TP entries (the line after .TP) of man text on stdin
 tp_opts() { awk 'tp {print; tp = 0} /^\.TP/ {tp = 1}' | opts; }
 has_word() { grep -qE -- "(^|[^a-z0-9-])$1([^a-z0-9-]|\$)"; }
+# same_opts HELP MANTEXT WHAT PAGE: the options of the help file are in the man text, and the
+# options the man text's .TP entries define are in the help
+same_opts() {
+    local o
+    for o in $(opts <"$1"); do
+        has_word "$o" <"$2" && ok || ko "$3 prints $o, $4 does not"
+    done
+    for o in $(tp_opts <"$2"); do
+        has_word "$o" <"$1" && ok || ko "$4 defines $o, $3 does not"
+    done
+}
 
 cmds=$("$CS" --help | awk '/^Commands:/ {on = 1; next} on && /^  [a-z]/ {print $1} on && /^$/ {on = 0}' |
     grep -vx help)
@@ -30,12 +41,7 @@ for c in $cmds; do
     awk -v c="$c" '$0 == ".SS " c {on = 1; next} /^\.S[SH] / {on = 0} on' "$T/cs.txt" >"$T/sec"
     if [ ! -s "$T/sec" ]; then ko "man/curvestep.1 has no .SS $c"; continue; fi
     "$CS" "$c" --help >"$T/help" 2>&1
-    for o in $(opts <"$T/help"); do
-        has_word "$o" <"$T/sec" && ok || ko "curvestep $c --help prints $o, man/curvestep.1 (.SS $c) does not"
-    done
-    for o in $(tp_opts <"$T/sec"); do
-        has_word "$o" <"$T/help" && ok || ko "man/curvestep.1 (.SS $c) defines $o, curvestep $c --help does not"
-    done
+    same_opts "$T/help" "$T/sec" "curvestep $c --help" "man/curvestep.1 (.SS $c)"
 done
 for s in $(awk '/^\.SH COMMANDS/ {on = 1; next} /^\.SH / {on = 0} on && /^\.SS / {print $2}' "$T/cs.txt"); do
     [ "$s" = help ] && continue
@@ -47,12 +53,7 @@ for sub in $(grep -oE -- '--[a-z][a-z0-9-]* --help' "$T/simhelp" | awk '{print $
     "$SIM" "$sub" --help >>"$T/simhelp" 2>&1
 done
 unman <"$M/curvestep-sim.1" >"$T/sim.txt"
-for o in $(opts <"$T/simhelp"); do
-    has_word "$o" <"$T/sim.txt" && ok || ko "curvestep-sim's help prints $o, man/curvestep-sim.1 does not"
-done
-for o in $(tp_opts <"$T/sim.txt"); do
-    has_word "$o" <"$T/simhelp" && ok || ko "man/curvestep-sim.1 defines $o, curvestep-sim's help does not"
-done
+same_opts "$T/simhelp" "$T/sim.txt" "curvestep-sim's help" man/curvestep-sim.1
 
 # The machine file: keys the code compares against (strcasecmp(name, "key")), every one a .B.
 unman <"$M/curvestep-machine.5" >"$T/m5.txt"
