@@ -158,6 +158,7 @@ cross:
 # Each target's rules live in mk/fw-<target>.mk (one file a target). Each appends its images
 # (ELF, HEX, BIN) to FW_IMAGES; its emulator tests are tests/fw/*.sh, run by `make fw-test`
 # (part of `make test`) with the plain host build, printing "cli: N passed, M failed".
+# mk/install.mk (not a target): make install, uninstall, deb, deb-check (docs/install.md).
 FW_IMAGES :=
 -include $(sort $(wildcard mk/*.mk))
 
