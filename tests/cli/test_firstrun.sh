@@ -13,7 +13,9 @@
 #      prerequisite installs the package, but the flags were read at parse time, before that;
 #   2. this Makefile with stage 1 bypassed (CS_DEPS_DONE=1, deps as a prerequisite again) must
 #      fail the same way: the check can fail, and does when pkg-config goes back to parse time;
-#   3. this Makefile, as a newcomer runs it, must install the package and build the program.
+#   3. this Makefile, as a newcomer runs it, must install the package and build.
+# What is built: one object that includes <cairo.h> (the flags pkg-config gives decide whether it
+# compiles), so the check takes seconds; `make host` and `make demo` build the rest the same way.
 # Plus: `make -n host` names no cross toolchain, emulator or clang (host packages only).
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -32,6 +34,9 @@ else
     (cd "$root" && tar --exclude=./build -cf - .) | tar -xf - -C "$src"
 fi
 [ -f "$src/Makefile" ] || { ko "copy of the source tree"; finish; exit; }
+obj=$(cd "$root" && grep -l '#include <cairo.h>' host/*.c sim/*.c | head -n1)
+[ -n "$obj" ] || { ko "no source includes <cairo.h>: the check has nothing to build"; finish; exit; }
+obj=build/obj/${obj%.c}.o
 
 shim=$T/shim
 marker=$T/installed
@@ -69,7 +74,7 @@ fresh_make() {
     local log=$1
     shift
     rm -rf "$src/build" "$marker"
-    (cd "$src" && PATH=$P timeout -k 10 600 make -j2 "$@") >"$T/$log" 2>&1 </dev/null
+    (cd "$src" && PATH=$P timeout -k 10 600 make "$@") >"$T/$log" 2>&1 </dev/null
 }
 # failed_like_before LOG RC: make failed after deps had "installed" the package, on a header
 # the parse-time flags lacked.
@@ -81,7 +86,7 @@ failed_like_before() {
 if git -C "$root" cat-file -e 413a65b:Makefile 2>/dev/null; then
     cp "$src/Makefile" "$T/Makefile.new"
     git -C "$root" show 413a65b:Makefile >"$src/Makefile"
-    fresh_make old.log -j1 deps build/curvestep
+    fresh_make old.log deps "$obj"
     rc=$?
     expect "old Makefile (413a65b) fails its first run under the shims (rc $rc)" failed_like_before old.log $rc
     cp "$T/Makefile.new" "$src/Makefile"
@@ -90,19 +95,18 @@ else
 fi
 
 # 2. Stage 1 bypassed: deps as a prerequisite, pkg-config read at parse time.
-fresh_make bypass.log -j1 CS_DEPS_DONE=1 deps build/curvestep
+fresh_make bypass.log CS_DEPS_DONE=1 deps "$obj"
 rc=$?
 expect "parse-time pkg-config fails the first run (rc $rc)" failed_like_before bypass.log $rc
 
 # 3. The newcomer's run.
-fresh_make new.log build/curvestep
+fresh_make new.log "$obj"
 rc=$?
-if [ "$rc" -eq 0 ]; then ok; else
-    ko "first run of make build/curvestep: exit $rc"
+if [ "$rc" -eq 0 ] && [ -s "$src/$obj" ]; then ok; else
+    ko "first run of make $obj: exit $rc"
     tail -15 "$T/new.log" | sed 's/^/    /'
 fi
 expect "deps installed the missing package (apt-get called)" grep -q 'install.*libcairo2-dev' "$T/apt.log"
-expect "the program runs" bash -c "'$src/build/curvestep' --version >/dev/null"
 
 # 4. make host needs only the host's packages.
 (cd "$src" && PATH=$P make -n host) >"$T/host.log" 2>&1
