@@ -73,7 +73,7 @@ P="$shim:$PATH"
 fresh_make() {
     local log=$1
     shift
-    rm -rf "$src/build" "$marker"
+    rm -rf "$src/build" "$marker" "$T/apt.log"
     (cd "$src" && PATH=$P timeout -k 10 600 make "$@") >"$T/$log" 2>&1 </dev/null
 }
 # failed_like_before LOG RC: make failed after deps had "installed" the package, on a header
@@ -106,7 +106,7 @@ if [ "$rc" -eq 0 ] && [ -s "$src/$obj" ]; then ok; else
     ko "first run of make $obj: exit $rc"
     tail -15 "$T/new.log" | sed 's/^/    /'
 fi
-expect "deps installed the missing package (apt-get called)" grep -q 'install.*libcairo2-dev' "$T/apt.log"
+expect "the first run installed the missing package (apt-get called)" grep -q "install.*libcairo2-dev" "$T/apt.log"
 
 # 4. make host needs only the host's packages.
 (cd "$src" && PATH=$P make -n host) >"$T/host.log" 2>&1
