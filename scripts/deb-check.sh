@@ -32,6 +32,37 @@ if systemd-analyze verify /lib/systemd/system/curvestep.service >"${TMPDIR:-/tmp
     ko "systemd-analyze verify: $(cat "${TMPDIR:-/tmp}/deb-check.$$")"
 fi
 rm -f "${TMPDIR:-/tmp}/deb-check.$$"
+# The unit's command as the unit runs it (systemd is not here to start it): as the user
+# curvestep, on a serial device that belongs to the group dialout (the simulator's pty, given to
+# dialout with mode 0660 like /dev/ttyUSB0), the socket in a directory only curvestep may enter
+# (RuntimeDirectory=, mode 0700). The daemon must open the port and answer `status`.
+run=$(mktemp -d)
+/usr/bin/curvestep-sim --pty --idle-exit 30 >"$run/sim.out" 2>&1 &
+simpid=$!
+for _ in $(seq 100); do [ -s "$run/sim.out" ] && break; sleep 0.1; done
+pty=$(head -n1 "$run/sim.out")
+chgrp dialout "$pty" && chmod 0660 "$pty"
+mkdir -p "$run/rt" && chown curvestep:curvestep "$run/rt" && chmod 0700 "$run/rt"
+chmod 0755 "$run"
+cmd=$(sed -n 's/^ExecStart=//p' /lib/systemd/system/curvestep.service |
+    sed "s|/dev/ttyUSB0|$pty|; s|/run/curvestep/|$run/rt/|")
+runuser -u curvestep -- $cmd 2>"$run/serve.err" &
+servepid=$!
+answered=no
+for _ in $(seq 100); do
+    if runuser -u curvestep -- /usr/bin/curvestep status --socket "$run/rt/curvestep.sock" >"$run/status.out" 2>&1; then
+        answered=yes; break
+    fi
+    sleep 0.1
+done
+if [ $answered = yes ]; then ok "the unit's command, as curvestep, opens a dialout device and answers status"; else
+    ko "the unit's command as curvestep: $(head -3 "$run/serve.err") $(head -2 "$run/status.out")"
+fi
+check "a user outside the unit cannot reach the socket (mode 0700 directory)" \
+    bash -c "! runuser -u nobody -- /usr/bin/curvestep status --socket '$run/rt/curvestep.sock'"
+kill "$servepid" "$simpid" 2>/dev/null
+wait "$servepid" "$simpid" 2>/dev/null
+rm -rf "$run"
 check "apt purge curvestep" apt-get purge -y curvestep
 left=""
 for f in $files; do [ -e "$f" ] || [ -L "$f" ] && left="$left $f"; done
