@@ -132,6 +132,8 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
         o = &dflt;
     }
     cs_input_format_t f = o->format != CS_INPUT_AUTO ? o->format : cs_input_detect(name, buf, len);
+    if (o->detected != NULL)
+        *o->detected = f;
     switch (f) {
     case CS_INPUT_GCODE: {
         cs_gcode_opts_t go;

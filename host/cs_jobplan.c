@@ -8,6 +8,7 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_input.h"
+#include "cs_pen.h"
 
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
 {
@@ -80,13 +81,21 @@ cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pe
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    cs_input_format_t fmt = CS_INPUT_AUTO;
+    iopts.detected = &fmt;
+    cs_machine_ini_pen_default(&jp->pen);
     if (pen != NULL) {
+        jp->pen = *pen;
         /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
         iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
         iopts.pen_up_z_mm = pen->up_z_mm;
         iopts.pen_down_z_mm = pen->down_z_mm;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
+    /* SVG and HP-GL have no pen height of their own: lift between strokes (G-code did, above) */
+    jp->pen_raise = e == CS_OK && fmt != CS_INPUT_GCODE && jp->pen.mode == CS_MACHINE_PEN_Z;
+    if (jp->pen_raise)
+        e = cs_pen_lift_z(&jp->path, &jp->pen, &jp->diag);
     jp->read_ok = e == CS_OK;
     return e;
 }
@@ -108,6 +117,14 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
     jp->have_mo = true;
     if (start != NULL && (e = cs_planner_set_position(&jp->mo.pl, start)) != CS_OK)
         return fail_whole(jp, file, e, "the device's position is outside the machine's travel");
+    if (jp->pen_raise) { /* the pen up where the machine stands, before the first travel */
+        const cs_pos_t *p = jp->mo.pl.pos;
+        double up = jp->pen.up_z_mm;
+        e = cs_motion_line_mm(&jp->mo, cs_conv_pos_to_mm(p[0]), cs_conv_pos_to_mm(p[1]), up,
+                              jp->pen.z_feed_mm_s, 0);
+        if (e != CS_OK)
+            return fail_whole(jp, file, e, "raising the pen failed");
+    }
     return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
 }
 

@@ -26,6 +26,8 @@ typedef struct {
     cs_path_diag_t diag; /* after an error: "file:line:col: reason" (cs_path_diag_print) */
     bool have_mo;        /* mo was initialised (and must be freed) */
     bool read_ok;        /* the file was read: a later error is the planner's */
+    cs_machine_pen_t pen; /* the [pen] the job was read with (cs_jobplan_read) */
+    bool pen_raise;       /* cs_pen lifted the job: the plan starts by raising the pen in place */
 } cs_jobplan_t;
 
 /* No machine file, no --tol, no --feed. */
@@ -46,12 +48,13 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
 /* Empty job: no path, no segments, diag cleared. */
 void cs_jobplan_init(cs_jobplan_t *jp);
 /* Reads file (cs_input_load: SVG, G-code, HP-GL) into jp->path. pen (NULL: none) with mode = z
- * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z; lenient: unsupported
- * G-code words are warnings. CS_OK, or an error with jp->diag filled. */
+ * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z, and lifts the pen between
+ * the strokes of SVG and HP-GL drawings (cs_pen_lift_z); lenient: unsupported G-code words are
+ * warnings. CS_OK, or an error with jp->diag filled. */
 cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
                          bool lenient);
 /* Plans jp->path whole on machine m (which must outlive jp; file names it in messages) from
- * start (cs_pos_t per axis, CS_AXES of them; NULL: the origin), chords within tol by tracer method
+ * start (after raising the pen there to up_z when jp->pen_raise) (cs_pos_t per axis, CS_AXES of them; NULL: the origin), chords within tol by tracer method
  * (CS_TRACE_*), at feed (mm/s Q15.16 from cs_motion_speed; 0: the machine's default) where the
  * job gives none. CS_OK with jp->mo's segments, or an error with jp->diag filled (CS_ERR_LIMIT:
  * the move that leaves the travel, or a start outside it). */

@@ -92,7 +92,7 @@ void cs_machine_ini_pen_default(cs_machine_pen_t *pen)
     pen->mode = CS_MACHINE_PEN_NONE;
 }
 
-/* [pen]: mode = none | z, up_z, down_z (mm). */
+/* [pen]: mode = none | z, up_z, down_z (mm), z_feed (mm/s). */
 static int pen_key(ini_ctx_t *c, const char *section, const char *name, const char *value)
 {
     double d;
@@ -106,9 +106,17 @@ static int pen_key(ini_ctx_t *c, const char *section, const char *name, const ch
             return fail(c, "[%s] %s: expected none or z", section, name);
         return 1;
     }
+    if (strcasecmp(name, "z_feed") == 0) {
+        /* 32768 mm/s: the Q15.16 speed's range (cs_motion_speed), as --feed */
+        if (!parse_num(value, &d) || !(d >= 0) || d >= 32768)
+            return fail(c, "[%s] %s: must be a speed in [0, 32768) mm/s (0: rapid)", section, name);
+        c->pen.z_feed_mm_s = d;
+        return 1;
+    }
     bool up = strcasecmp(name, "up_z") == 0;
     if (!up && strcasecmp(name, "down_z") != 0)
-        return fail(c, "[%s] %s: unknown key (expected mode, up_z or down_z)", section, name);
+        return fail(c, "[%s] %s: unknown key (expected mode, up_z, down_z or z_feed)", section,
+                    name);
     if (!parse_num(value, &d) || cs_conv_mm_to_pos(d, &q) != CS_OK)
         return fail(c, "[%s] %s: must be a number in [-4096, 4096] mm", section, name);
     if (up) {

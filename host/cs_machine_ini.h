@@ -21,6 +21,7 @@ typedef struct {
     cs_machine_pen_mode_t mode;
     double up_z_mm;   /* machine Z of the raised pen (mode z), inside [z] travel */
     double down_z_mm; /* machine Z of the lowered pen (mode z), inside [z] travel */
+    double z_feed_mm_s; /* speed of the pen's Z moves (mode z), mm/s; 0: rapid (the default) */
 } cs_machine_pen_t;
 
 /* The default [pen]: mode none (heights 0). */

@@ -8,9 +8,11 @@
 #include <string.h>
 
 #include "cs_err_text.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_sim.h"
+#include "cs_sim_check.h"
 #include "cs_sim_device.h"
 #include "cs_sim_draw.h"
 #include "cs_sim_modbus.h"
@@ -50,6 +52,57 @@ static void usage(FILE *f)
         "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
         "3 internal error, 4 a check failed (with --check).\n",
         f);
+}
+
+/* The job as `plan` reads it with the machine's [pen] (cs_jobplan_read: pen lifts included),
+ * as dense reference polylines; *end gets its last point. */
+static cs_err_t read_reference(const char *file, const cs_machine_pen_t *pen, bool lenient,
+                               cs_sim_ref_t *ref, double end[3])
+{
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    cs_err_t e = cs_jobplan_read(&jp, file, pen, lenient);
+    if (e == CS_OK)
+        e = cs_sim_ref_from_path(ref, &jp.path, end);
+    else
+        cs_path_diag_print(stderr, &jp.diag);
+    cs_jobplan_free(&jp);
+    return e;
+}
+
+/* Prints the geometric check (cs_sim_check) and the final position; true when both pass. */
+static bool report_check(const cs_machine_t *m, const cs_motion_segs_t *segs,
+                         const cs_sim_exec_t *ex, const cs_sim_ref_t *ref,
+                         const cs_machine_pen_t *pen, const double end[3])
+{
+    cs_sim_check_t c;
+    if (cs_sim_check(m, segs->v, segs->n, ex, ref, pen, &c) != CS_OK) {
+        fprintf(stderr, "curvestep-sim: out of memory in the check\n");
+        return false;
+    }
+    double bound = cs_machine_ini_to_double(m->tolerance) + cs_sim_step_mm(m);
+    bool dev_ok = c.dev <= bound, drawn_ok = !c.pen || c.undrawn <= bound;
+    printf("deviation%s: %.5f mm at (%.4f, %.4f, %.4f), segment %zu (tolerance + one step = "
+           "%.5f mm) %s\n",
+           c.pen ? " of pen-down motion (x y)" : "", c.dev, c.dev_at[0], c.dev_at[1], c.dev_at[2],
+           c.dev_seg, bound, dev_ok ? "ok" : c.pen ? "OVER: a pen-down travel" : "OVER");
+    if (c.pen)
+        printf("pen: %zu pen-downs; drawn strokes reached pen down within %.5f mm, worst at "
+               "(%.4f, %.4f) %s\n",
+               c.pen_downs, c.undrawn, c.undrawn_at[0], c.undrawn_at[1],
+               drawn_ok ? "ok" : "NOT DRAWN");
+    if (!drawn_ok)
+        printf("pen: segment %zu moves pen up over a stroke the job draws\n", c.undrawn_seg);
+    bool end_ok = true;
+    for (unsigned i = 0; i < 3; i++) {
+        double spm = (double)m->axis[i].steps_per_mm / CS_MOTION_ONE;
+        long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
+        if (want != ex->pos[i])
+            end_ok = false;
+    }
+    printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0], end[1],
+           end[2], end_ok ? "exact" : "DIFFERENT");
+    return dev_ok && drawn_ok && end_ok;
 }
 
 int main(int argc, char **argv)
@@ -119,9 +172,11 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return EXIT_INPUT;
         }
@@ -174,37 +229,12 @@ int main(int argc, char **argv)
     cs_sim_ref_init(&ref);
     int rc = EXIT_OK;
     if (reference) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_path_diag_t diag;
-        e = cs_motion_read_job_ex(reference, lenient, &path, &diag);
         double end[3];
-        if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &path, end);
-        else
-            cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
-        if (e != CS_OK) {
+        e = read_reference(reference, &pen, lenient, &ref, end);
+        if (e != CS_OK)
             rc = EXIT_INPUT;
-        } else {
-            double where[3];
-            double dev = cs_sim_deviation(&m, &ex, &ref, where);
-            double bound = cs_machine_ini_to_double(m.tolerance) + cs_sim_step_mm(&m);
-            bool dev_ok = dev <= bound;
-            printf("deviation: %.5f mm at (%.4f, %.4f, %.4f) (tolerance + one step = %.5f mm) "
-                   "%s\n",
-                   dev, where[0], where[1], where[2], bound, dev_ok ? "ok" : "OVER");
-            bool end_ok = true;
-            for (unsigned i = 0; i < 3; i++) {
-                double spm = (double)m.axis[i].steps_per_mm / CS_MOTION_ONE;
-                long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
-                if (want != ex.pos[i])
-                    end_ok = false;
-            }
-            printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0],
-                   end[1], end[2], end_ok ? "exact" : "DIFFERENT");
-            ok = ok && dev_ok && end_ok;
-        }
+        else
+            ok = report_check(&m, &segs, &ex, &ref, &pen, end) && ok;
     }
     if (rc == EXIT_OK && trace && cs_sim_write_trace(trace, &m, &ex) != 0) {
         perror(trace);
