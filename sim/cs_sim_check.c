@@ -141,9 +141,10 @@ static cs_err_t measure_run(walk_t *w, cs_sim_grid_t *g, const cs_machine_pen_t 
     return CS_OK;
 }
 
-/* Pass 2 (pen): each drawn reference point against the pen-down positions. */
+/* Pass 2 (pen): points along the drawn reference pieces, spacing mm apart (so a stretch drawn
+ * pen up longer than about spacing + 2 * the bound is seen), against the pen-down positions. */
 static cs_err_t measure_drawn(const cs_sim_ref_t *r, const size_t *pc, size_t npc, pts_t *down,
-                              cs_sim_check_t *out)
+                              double spacing, cs_sim_check_t *out)
 {
     out->undrawn = 0;
     if (npc == 0)
@@ -163,12 +164,19 @@ static cs_err_t measure_drawn(const cs_sim_ref_t *r, const size_t *pc, size_t np
     free(idx);
     if (e != CS_OK)
         return e;
-    for (size_t j = 0; j < 2 * npc; j++) {
-        const double *q = &r->xyz[3 * pc[j]];
-        double d = cs_sim_grid_nearest(&g, q, out->undrawn, NULL);
-        if (d > out->undrawn) {
-            out->undrawn = d;
-            memcpy(out->undrawn_at, q, sizeof out->undrawn_at);
+    for (size_t j = 0; j < npc; j++) { /* along each drawn piece, every `spacing` mm */
+        const double *a = &r->xyz[3 * pc[2 * j]], *b = &r->xyz[3 * pc[2 * j + 1]];
+        double len = hypot(b[0] - a[0], b[1] - a[1]);
+        size_t steps = (size_t)ceil(len / spacing);
+        for (size_t i = 0; i <= steps; i++) {
+            double t = steps ? (double)i / (double)steps : 0, q[3];
+            for (int c = 0; c < 3; c++)
+                q[c] = a[c] + t * (b[c] - a[c]);
+            double d = cs_sim_grid_nearest(&g, q, out->undrawn, NULL);
+            if (d > out->undrawn) {
+                out->undrawn = d;
+                memcpy(out->undrawn_at, q, sizeof out->undrawn_at);
+            }
         }
     }
     cs_sim_grid_free(&g);
@@ -200,6 +208,8 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_segment_t *s, size_t n,
     if (pen != NULL && pen->mode != CS_MACHINE_PEN_Z)
         pen = NULL;
     out->pen = pen != NULL;
+    /* tolerance + one step: the check's own bound (curvestep-sim) */
+    double spacing = (double)m->tolerance / CS_POS_ONE_MM + cs_sim_step_mm(m);
     walk_t w;
     size_t npc = 0;
     size_t *pc = ref_pieces(ref, pen, &npc);
@@ -218,7 +228,7 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_segment_t *s, size_t n,
         e = measure_run(&w, &g, pen, &down, out);
     cs_sim_grid_free(&g);
     if (e == CS_OK && pen != NULL)
-        e = measure_drawn(ref, pc, npc, &down, out);
+        e = measure_drawn(ref, pc, npc, &down, spacing, out);
     if (e == CS_OK && pen != NULL && out->undrawn > 0)
         out->undrawn_seg = nearest_seg(&w, out->undrawn_at);
     free(down.v);
