@@ -52,14 +52,11 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
                        cs_machine_pen_t *pen, cs_pos_t *tol)
 {
     cs_machine_ini_pen_default(pen);
-    char err[512];
-    if (o->machine_file) {
-        if (cs_machine_ini_load_pen(o->machine_file, m, pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(m);
+    char err[512], who[64];
+    snprintf(who, sizeof who, "curvestep %s", cmd);
+    if (cs_machine_ini_open(who, o->machine_file, m, pen, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return CS_EXIT_INPUT;
     }
     if (!cs_jobplan_tol(m, o->tol_mm, tol)) {
         fprintf(stderr, "curvestep %s: --tol %g mm is outside the accepted range\n", cmd,
@@ -115,6 +112,7 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
     if (e != CS_OK)
         return fail_whole(jp, file, e, "machine rejected");
     jp->have_mo = true;
+    jp->mo.pen = &jp->pen; /* mode servo: pen events between the strokes */
     if (start != NULL && (e = cs_planner_set_position(&jp->mo.pl, start)) != CS_OK)
         return fail_whole(jp, file, e, "the device's position is outside the machine's travel");
     if (jp->pen_raise) { /* the pen up where the machine stands, before the first travel */
@@ -128,13 +126,23 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
     return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
 }
 
+cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file)
+{
+    if (jp->mo.segs.npens == 0)
+        return CS_OK;
+    return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
+                      "[pen] mode = servo: the device link does not carry pen events yet (plan "
+                      "and curvestep-sim --replay do); use mode = z or a G-code M3/M5 spindle pen");
+}
+
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)
 {
     if (!jp->read_ok)
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
     /* CS_ERR_DEPTH: a curve the tracer cannot bring within the tolerance in its bounded depth
      * is the job's (or the tolerance's) doing, as is a tolerance it cannot meet */
-    return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE || e == CS_ERR_DEPTH)
+    return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE || e == CS_ERR_DEPTH ||
+            e == CS_ERR_UNSUPPORTED)
                ? CS_EXIT_INPUT
                : CS_EXIT_INTERNAL;
 }

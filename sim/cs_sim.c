@@ -184,7 +184,7 @@ double cs_sim_deviation(const cs_machine_t *m, const cs_sim_exec_t *ex, const cs
     if (r->n == 0)
         return HUGE_VAL;
     cs_sim_check_t c; /* the 3D check through the grid (cs_sim_check), segments unnamed */
-    if (cs_sim_check(m, NULL, 0, ex, r, NULL, &c) != CS_OK)
+    if (cs_sim_check(m, NULL, ex, r, NULL, &c) != CS_OK)
         return HUGE_VAL;
     if (where)
         memcpy(where, c.dev_at, sizeof c.dev_at);

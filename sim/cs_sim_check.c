@@ -57,11 +57,25 @@ static bool walk_next(walk_t *w, double p[3], size_t *seg)
     return true;
 }
 
-/* Reference pieces to measure against: all (pen NULL) or the drawn ones (pen-down, not travel). */
+/* Pen down at height z: mode z, nearer down_z than up_z; mode servo, always (the events say). */
 static bool pen_is_down(const cs_machine_pen_t *pen, double z)
 {
-    return fabs(z - pen->down_z_mm) < fabs(z - pen->up_z_mm);
+    return pen->mode != CS_MACHINE_PEN_Z || fabs(z - pen->down_z_mm) < fabs(z - pen->up_z_mm);
 }
+
+/* Pen down at a position of segment seg (1-based) of the run: by height (mode z), or by the last
+ * servo event before that segment (events[*cur..] not yet passed). */
+static bool run_pen_down(const cs_machine_pen_t *pen, const cs_motion_segs_t *segs, size_t *cur,
+                         bool *servo_down, size_t seg, double z)
+{
+    if (pen->mode == CS_MACHINE_PEN_Z)
+        return pen_is_down(pen, z);
+    for (; segs != NULL && *cur < segs->npens && segs->pens[*cur].seg < seg; (*cur)++)
+        *servo_down = segs->pens[*cur].pulse_us == pen->down_us;
+    return *servo_down;
+}
+
+/* Reference pieces to measure against: all (pen NULL) or the drawn ones (pen-down, not travel). */
 
 static size_t *ref_pieces(const cs_sim_ref_t *r, const cs_machine_pen_t *pen, size_t *count)
 {
@@ -108,17 +122,17 @@ static cs_err_t pts_add(pts_t *a, const double p[3])
 }
 
 /* Pass 1: each measured position against the reference grid g; pen-down positions into *down. */
-static cs_err_t measure_run(walk_t *w, cs_sim_grid_t *g, const cs_machine_pen_t *pen, pts_t *down,
-                            cs_sim_check_t *out)
+static cs_err_t measure_run(walk_t *w, cs_sim_grid_t *g, const cs_machine_pen_t *pen,
+                            const cs_motion_segs_t *segs, pts_t *down, cs_sim_check_t *out)
 {
     double p[3], prev[3] = {NAN, NAN, NAN};
-    size_t seg;
-    bool was_down = false, first = true;
+    size_t seg, cur = 0;
+    bool was_down = false, first = true, servo_down = false;
     out->dev = -1;
     while (walk_next(w, p, &seg)) {
         bool measure = true;
         if (pen != NULL) { /* drawing: an x y move pen down (the start is no move) */
-            bool d = pen_is_down(pen, p[2]);
+            bool d = run_pen_down(pen, segs, &cur, &servo_down, seg, p[2]);
             out->pen_downs += d && !was_down && !first;
             measure = d && !first && (p[0] != prev[0] || p[1] != prev[1]);
             first = false;
@@ -200,12 +214,11 @@ static size_t nearest_seg(walk_t *w, const double at[3])
     return which;
 }
 
-cs_err_t cs_sim_check(const cs_machine_t *m, const cs_segment_t *s, size_t n,
-                      const cs_sim_exec_t *ex, const cs_sim_ref_t *ref, const cs_machine_pen_t *pen,
-                      cs_sim_check_t *out)
+cs_err_t cs_sim_check(const cs_machine_t *m, const cs_motion_segs_t *segs, const cs_sim_exec_t *ex,
+                      const cs_sim_ref_t *ref, const cs_machine_pen_t *pen, cs_sim_check_t *out)
 {
     memset(out, 0, sizeof *out);
-    if (pen != NULL && pen->mode != CS_MACHINE_PEN_Z)
+    if (pen != NULL && pen->mode == CS_MACHINE_PEN_NONE)
         pen = NULL;
     out->pen = pen != NULL;
     /* tolerance + one step: the check's own bound (curvestep-sim) */
@@ -213,7 +226,7 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_segment_t *s, size_t n,
     walk_t w;
     size_t npc = 0;
     size_t *pc = ref_pieces(ref, pen, &npc);
-    cs_err_t e = pc == NULL ? CS_ERR_FULL : walk_init(&w, m, s, n, ex);
+    cs_err_t e = pc == NULL ? CS_ERR_FULL : walk_init(&w, m, segs ? segs->v : NULL, segs ? segs->n : 0, ex);
     if (e != CS_OK) {
         free(pc);
         return e;
@@ -225,7 +238,7 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_segment_t *s, size_t n,
         e = cs_sim_grid_build(&g, ref->xyz, pc, npc, pen ? 2 : 3, 0.05);
     pts_t down = {NULL, 0, 0};
     if (e == CS_OK)
-        e = measure_run(&w, &g, pen, &down, out);
+        e = measure_run(&w, &g, pen, segs, &down, out);
     cs_sim_grid_free(&g);
     if (e == CS_OK && pen != NULL)
         e = measure_drawn(ref, pc, npc, &down, spacing, out);

@@ -76,7 +76,7 @@ static bool report_check(const cs_machine_t *m, const cs_motion_segs_t *segs,
                          const cs_machine_pen_t *pen, const double end[3])
 {
     cs_sim_check_t c;
-    if (cs_sim_check(m, segs->v, segs->n, ex, ref, pen, &c) != CS_OK) {
+    if (cs_sim_check(m, segs, ex, ref, pen, &c) != CS_OK) {
         fprintf(stderr, "curvestep-sim: out of memory in the check\n");
         return false;
     }
@@ -175,13 +175,9 @@ int main(int argc, char **argv)
     cs_machine_pen_t pen;
     cs_machine_ini_pen_default(&pen);
     char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(&m);
+    if (cs_machine_ini_open("curvestep-sim", machine_file, &m, &pen, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return EXIT_INPUT;
     }
     FILE *f = strcmp(replay, "-") == 0 ? stdin : fopen(replay, "r");
     if (f == NULL) {
@@ -194,14 +190,14 @@ int main(int argc, char **argv)
         fclose(f);
     if (r != 0) {
         fprintf(stderr, "%s\n", err);
-        free(segs.v);
+        cs_motion_segs_free(&segs);
         return EXIT_INPUT;
     }
     cs_sim_exec_t ex;
     cs_err_t e = cs_sim_execute(&m, segs.v, segs.n, &ex);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep-sim: execution failed: %s\n", cs_err_text(e));
-        free(segs.v);
+        cs_motion_segs_free(&segs);
         return EXIT_INTERNAL;
     }
     bool ok = true;
@@ -256,6 +252,6 @@ int main(int argc, char **argv)
     }
     cs_sim_ref_free(&ref);
     cs_sim_exec_free(&ex);
-    free(segs.v);
+    cs_motion_segs_free(&segs);
     return rc;
 }

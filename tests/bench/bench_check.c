@@ -102,7 +102,7 @@ static void run(const char *name, cs_path_t *path, const cs_machine_pen_t *pen, 
     r->ref_points = ref.n;
     double t1 = now();
     cs_sim_check_t c;
-    if (cs_sim_check(&m, mo.segs.v, mo.segs.n, &ex, &ref, pen, &c) != CS_OK)
+    if (cs_sim_check(&m, &mo.segs, &ex, &ref, pen, &c) != CS_OK)
         exit(3);
     r->ref_s = t1 - t0;
     r->check_s = now() - t1;

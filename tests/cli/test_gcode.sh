@@ -124,7 +124,7 @@ run "pen outside travel" 1 plan --machine "$T/pen-bad.ini" "$T/pen.nc" &&
     expect_empty_out "pen outside travel"
 printf '[pen]\nmode = lift\n' >"$T/pen-bad2.ini"
 run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
-    expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
+    expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none, z or servo"
 
 # stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
 # (320 steps), x back at 0.

@@ -82,6 +82,41 @@ expect "pen-up stroke named with its segment" \
     >/dev/null 2>&1
 expect "gcode pen job passes" [ $? -eq 0 ]
 
+# [pen] mode = servo: "pen US" lines in the segments; each followed by the settle wait (100 ms =
+# 10000 ticks, no steps); x y moves only after a pen event (the first one raises the pen);
+# lowerings counted as for z.
+printf '[pen]\nmode = servo\nup_us = 1900\ndown_us = 1200\nsettle_ms = 100\n' >"$T/servo.ini"
+servo_replay() {
+    awk '/^#/ {next}
+        /^pen / { pen = $2; if (pen == 1200) lowers++; wait = 1; next }
+        { if (wait && !($1 == 10000 && $2 == 0 && $3 == 0 && $4 == 0)) bad = bad " settle@" NR
+          if (!wait && pen == "" && ($2 != 0 || $3 != 0)) bad = bad " before-pen@" NR
+          if ($4 != 0) bad = bad " z@" NR
+          wait = 0 }
+        END { if (bad != "") print "BAD" bad; else print lowers + 0 }' "$1"
+}
+for kind in svg plt nc; do
+    want=$([ $kind = svg ] && echo 4 || echo 2)
+    run "$kind servo plan" 0 plan --machine "$T/servo.ini" "$T/job.$kind" -o "$T/$kind.sv"
+    got=$(servo_replay "$T/$kind.sv")
+    expect "$kind servo: $want pen lowerings, each followed by its settle wait (got $got)" \
+        [ "$got" = "$want" ]
+    expect "$kind servo: ends with the pen raised" [ "$(grep '^pen' "$T/$kind.sv" | tail -n1)" = "pen 1900" ]
+    "$SIM" --replay "$T/$kind.sv" --machine "$T/servo.ini" --reference "$T/job.$kind" --check \
+        >"$T/$kind.svsim" 2>/dev/null
+    expect "$kind servo: simulator check passes" grep -q '^check: ok$' "$T/$kind.svsim"
+done
+"$SIM" --replay "$T/nopen.seg" --machine "$T/servo.ini" --reference "$T/job.svg" --check \
+    >"$T/svbad.sim" 2>/dev/null; rc=$?
+expect "servo: a plan without pen events fails the check" [ $rc -eq 4 ]
+expect "servo: names the segment" grep -qE '^pen: segment [0-9]+ moves pen up over a stroke' "$T/svbad.sim"
+# The device link does not carry pen events yet: stream refuses before opening the port.
+run "servo stream refused" 1 stream --machine "$T/servo.ini" --port /dev/null "$T/job.svg"
+expect_err "servo stream says why" 'mode = servo: the device link does not carry pen events'
+printf '[pen]\nmode = servo\nup_us = 1900\n' >"$T/bad2.ini"
+run "servo needs both widths" 1 plan --machine "$T/bad2.ini" "$T/job.svg"
+expect_err "servo needs both widths: says so" 'mode = servo needs up_us and down_us'
+
 # [pen] z_feed is checked.
 printf '[pen]\nmode = z\nup_z = 5\ndown_z = 0\nz_feed = -1\n' >"$T/bad.ini"
 run "bad z_feed" 1 plan --machine "$T/bad.ini" "$T/job.svg"
