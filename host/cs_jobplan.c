@@ -23,6 +23,8 @@ int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan
     char *end;
     if (strcmp(a, "--machine") == 0) {
         o->machine_file = argv[++*i];
+    } else if (strcmp(a, "--font") == 0) {
+        o->font_file = argv[++*i];
     } else if (strcmp(a, "--tol") == 0) {
         o->tol_mm = strtod(argv[++*i], &end);
         if (*end != '\0' || !(o->tol_mm > 0)) {
@@ -78,6 +80,7 @@ cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pe
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    iopts.font_file = jp->font_file;
     cs_input_format_t fmt = CS_INPUT_AUTO;
     iopts.detected = &fmt;
     cs_machine_ini_pen_default(&jp->pen);

@@ -17,6 +17,7 @@ typedef struct {
     const char *machine_file; /* --machine FILE.ini; NULL: the built-in machine */
     double tol_mm;            /* --tol MM; 0: the machine's tolerance */
     double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
+    const char *font_file;    /* --font FILE.jhf: stroke font for text; NULL: the default */
 } cs_jobplan_opts_t;
 
 /* One job: read, then planned. */
@@ -28,11 +29,12 @@ typedef struct {
     bool read_ok;        /* the file was read: a later error is the planner's */
     cs_machine_pen_t pen; /* the [pen] the job was read with (cs_jobplan_read) */
     bool pen_raise;       /* cs_pen lifted the job: the plan starts by raising the pen in place */
+    const char *font_file; /* stroke font for text (set before cs_jobplan_read); NULL: default */
 } cs_jobplan_t;
 
 /* No machine file, no --tol, no --feed. */
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
-/* argv[*i] is --machine FILE, --tol MM or --feed MM/S with its value: stores it, moves *i onto
+/* argv[*i] is --machine FILE, --tol MM, --feed MM/S or --font FILE with its value: stores it, moves *i onto
  * the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
  * wants ..." on stderr (a usage error). */
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);

@@ -24,7 +24,8 @@ static void usage(FILE *f)
     fputs(
         "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
         "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-        "                     [--window MS] [--lenient] [--view top|front|side|iso]\n"
+        "                     [--window MS] [--lenient] [--font FILE.jhf]\n"
+        "                     [--view top|front|side|iso]\n"
         "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
         "       curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu ...  (the device behind\n"
         "                     Modbus: --modbus-tcp --help)\n"
@@ -36,9 +37,13 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    --lenient as for plan), the largest distance from any position the\n"
-        "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
-        "    plus one step, and whether the final position is the job's end rounded to steps.\n"
+        "    --lenient and --font as for plan; the machine's [pen] lifts included), the\n"
+        "    largest distance from any position the steps visit to the exact geometry\n"
+        "    (evaluated in double), against the tolerance plus one step, and whether the final\n"
+        "    position is the job's end rounded to steps. With a [pen] (mode z: the pen is down\n"
+        "    nearer down_z than up_z; mode servo: by the segments' \"pen US\" lines) only\n"
+        "    pen-down x y motion is measured (in x y), and every drawn stroke must be reached\n"
+        "    pen down: a pen-down travel or a stroke passed pen up fails, naming the segment.\n"
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
         "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
         "                    with --reference, executed travel moves (the job's G0 moves and\n"
@@ -56,11 +61,12 @@ static void usage(FILE *f)
 
 /* The job as `plan` reads it with the machine's [pen] (cs_jobplan_read: pen lifts included),
  * as dense reference polylines; *end gets its last point. */
-static cs_err_t read_reference(const char *file, const cs_machine_pen_t *pen, bool lenient,
-                               cs_sim_ref_t *ref, double end[3])
+static cs_err_t read_reference(const char *file, const char *font, const cs_machine_pen_t *pen,
+                               bool lenient, cs_sim_ref_t *ref, double end[3])
 {
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    jp.font_file = font;
     cs_err_t e = cs_jobplan_read(&jp, file, pen, lenient);
     if (e == CS_OK)
         e = cs_sim_ref_from_path(ref, &jp.path, end);
@@ -116,6 +122,7 @@ int main(int argc, char **argv)
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
     bool check = false, lenient = false;
+    const char *font = NULL;
     double window_ms = 50;
     long png_width = 1600;
     cs_sim_view_t view;
@@ -161,6 +168,8 @@ int main(int argc, char **argv)
             check = true;
         } else if (strcmp(a, "--lenient") == 0) {
             lenient = true;
+        } else if (strcmp(a, "--font") == 0 && has) {
+            font = argv[++i];
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             usage(stderr);
@@ -226,7 +235,7 @@ int main(int argc, char **argv)
     int rc = EXIT_OK;
     if (reference) {
         double end[3];
-        e = read_reference(reference, &pen, lenient, &ref, end);
+        e = read_reference(reference, font, &pen, lenient, &ref, end);
         if (e != CS_OK)
             rc = EXIT_INPUT;
         else
