@@ -56,14 +56,10 @@ static bool field(rd_t *r, int w, long *out)
 
 static cs_err_t add_vertex(cs_hershey_font_t *f, size_t *cap, int x, int y, bool move)
 {
-    if (f->nv == *cap) {
-        size_t ncap = *cap ? *cap * 2 : 1024;
-        cs_hershey_vertex_t *v = realloc(f->v, ncap * sizeof *v);
-        if (v == NULL)
-            return CS_ERR_FULL;
-        f->v = v;
-        *cap = ncap;
-    }
+    void *b = f->v;
+    if (!cs_path_grow(&b, cap, f->nv + 1, sizeof *f->v))
+        return CS_ERR_FULL;
+    f->v = b;
     f->v[f->nv].x = (signed char)x;
     f->v[f->nv].y = (signed char)y;
     f->v[f->nv++].move = move;

@@ -36,14 +36,10 @@ void cs_motion_free(cs_motion_t *mo)
 /* Records a pen event before segment seg. */
 static cs_err_t add_pen(cs_motion_segs_t *v, size_t seg, uint16_t pulse_us)
 {
-    if (v->npens == v->cappens) {
-        size_t cap = v->cappens ? v->cappens * 2 : 64;
-        cs_motion_pen_t *p = realloc(v->pens, cap * sizeof *p);
-        if (p == NULL)
-            return CS_ERR_FULL;
-        v->pens = p;
-        v->cappens = cap;
-    }
+    void *b = v->pens;
+    if (!cs_path_grow(&b, &v->cappens, v->npens + 1, sizeof *v->pens))
+        return CS_ERR_FULL;
+    v->pens = b;
     v->pens[v->npens].seg = seg;
     v->pens[v->npens++].pulse_us = pulse_us;
     return CS_OK;

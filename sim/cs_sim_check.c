@@ -109,14 +109,10 @@ typedef struct {
 
 static cs_err_t pts_add(pts_t *a, const double p[3])
 {
-    if (a->n == a->cap) {
-        size_t cap = a->cap ? 2 * a->cap : 4096;
-        double *v = realloc(a->v, 3 * cap * sizeof *v);
-        if (v == NULL)
-            return CS_ERR_FULL;
-        a->v = v;
-        a->cap = cap;
-    }
+    void *b = a->v;
+    if (!cs_path_grow(&b, &a->cap, a->n + 1, 3 * sizeof *a->v))
+        return CS_ERR_FULL;
+    a->v = b;
     memcpy(&a->v[3 * a->n++], p, 3 * sizeof *p);
     return CS_OK;
 }
