@@ -199,6 +199,9 @@ int cs_cmd_stream(int argc, char **argv)
     cs_machine_t m;
     cs_machine_pen_t pen;
     cs_pos_t tol;
+    char found[4096]; /* the default machine file, named for the Modbus and GPIO links too */
+    if (jo.machine_file == NULL && cs_machine_ini_find(found, sizeof found))
+        jo.machine_file = found;
     int mrc = cs_jobplan_machine("stream", &jo, &m, &pen, &tol);
     if (mrc != CS_EXIT_OK)
         return mrc;
