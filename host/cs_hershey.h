@@ -3,7 +3,8 @@
  * strokes. Format (one glyph per record, records may wrap at 72 columns): columns 1-5 the glyph
  * number, 6-8 the number of coordinate pairs, then the pairs as two characters each, value =
  * character - 'R'; the first pair is the left and right bearing, " R" lifts the pen; y points
- * down. The glyphs are ASCII 32 .. 32 + n - 1 in file order. Owns the font's vertices. Host only. */
+ * down. The glyphs are ASCII 32 .. 32 + n - 1 in file order. Owns the font's vertices. Host only.
+ */
 #ifndef CS_HERSHEY_H
 #define CS_HERSHEY_H
 
@@ -27,8 +28,8 @@ typedef struct {
 } cs_hershey_vertex_t;
 
 typedef struct {
-    int left, right;   /* bearings: the glyph spans left .. right (advance = right - left) */
-    size_t first, n;   /* its vertices in the font's array */
+    int left, right; /* bearings: the glyph spans left .. right (advance = right - left) */
+    size_t first, n; /* its vertices in the font's array */
 } cs_hershey_glyph_t;
 
 typedef struct {

@@ -95,8 +95,7 @@ cs_err_t cs_pen_lift_z(cs_path_t *path, const cs_machine_pen_t *pen, cs_path_dia
         e = lift_one(path, k, &out, z, pen->z_feed_mm_s, &down, diag);
     if (e == CS_OK && down) {
         const cs_path_elem_t *pv = &out.elems[out.n - 1];
-        e = add_z_move(&out, &pv->curve.p[pv->curve.degree], z[1], z[0], pen->z_feed_mm_s,
-                       pv->loc);
+        e = add_z_move(&out, &pv->curve.p[pv->curve.degree], z[1], z[0], pen->z_feed_mm_s, pv->loc);
     }
     if (e != CS_OK) {
         cs_path_free(&out);

@@ -222,7 +222,8 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_motion_segs_t *segs, const
     walk_t w;
     size_t npc = 0;
     size_t *pc = ref_pieces(ref, pen, &npc);
-    cs_err_t e = pc == NULL ? CS_ERR_FULL : walk_init(&w, m, segs ? segs->v : NULL, segs ? segs->n : 0, ex);
+    cs_err_t e =
+        pc == NULL ? CS_ERR_FULL : walk_init(&w, m, segs ? segs->v : NULL, segs ? segs->n : 0, ex);
     if (e != CS_OK) {
         free(pc);
         return e;

@@ -18,14 +18,14 @@
 #include "cs_sim.h"
 
 typedef struct {
-    double dev;          /* largest distance of a measured position to the (drawn) reference */
-    double dev_at[3];    /* where (mm) */
-    size_t dev_seg;      /* in which segment (1-based; 0: the start) */
-    bool pen;            /* a plotter check (the two below are filled) */
-    double undrawn;      /* largest distance of a drawn reference point to any pen-down position */
+    double dev;       /* largest distance of a measured position to the (drawn) reference */
+    double dev_at[3]; /* where (mm) */
+    size_t dev_seg;   /* in which segment (1-based; 0: the start) */
+    bool pen;         /* a plotter check (the two below are filled) */
+    double undrawn;   /* largest distance of a drawn reference point to any pen-down position */
     double undrawn_at[3];
-    size_t undrawn_seg;  /* the segment that passes nearest to it (1-based) */
-    size_t pen_downs;    /* pen lowerings seen in the run */
+    size_t undrawn_seg; /* the segment that passes nearest to it (1-based) */
+    size_t pen_downs;   /* pen lowerings seen in the run */
 } cs_sim_check_t;
 
 /* Measures run ex of the segments segs on m against ref with pen (NULL or mode none: the 3D

@@ -140,8 +140,7 @@ void cs_sim_grid_free(cs_sim_grid_t *g)
 
 static double seg_dist(const cs_sim_grid_t *g, const double *p, size_t s)
 {
-    return cs_sim_grid_dist(p, &g->pts[3 * g->seg[2 * s]], &g->pts[3 * g->seg[2 * s + 1]],
-                            g->dims);
+    return cs_sim_grid_dist(p, &g->pts[3 * g->seg[2 * s]], &g->pts[3 * g->seg[2 * s + 1]], g->dims);
 }
 
 /* Visits the cells of ring r (Chebyshev distance r in cells) around cell c; keeps the best. */

@@ -19,10 +19,10 @@ typedef struct {
     size_t nseg;
     unsigned dims; /* 2: x y only; 3: x y z */
     double lo[3], cell;
-    size_t n[3];    /* cells per axis (n[2] = 1 in 2D) */
-    size_t *head;   /* per cell, its first entry in idx (n cells + 1) */
-    size_t *idx;    /* segment numbers, cell by cell */
-    size_t last;    /* the segment the previous query found nearest (tried first) */
+    size_t n[3];  /* cells per axis (n[2] = 1 in 2D) */
+    size_t *head; /* per cell, its first entry in idx (n cells + 1) */
+    size_t *idx;  /* segment numbers, cell by cell */
+    size_t last;  /* the segment the previous query found nearest (tried first) */
 } cs_sim_grid_t;
 
 /* Builds the grid over nseg segments seg[2k], seg[2k+1] of pts, in dims (2 or 3) dimensions,

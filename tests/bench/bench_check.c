@@ -142,13 +142,13 @@ int main(int argc, char **argv)
            "| job | moves | segments | step edges | reference points | reference (s) | "
            "check (s) | deviation (mm) |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int k = 0; k < 2; k++) {
-        printf("| %s | %zu | %zu | %zu | %zu | %.2f | %.2f | %.4f |\n", res[k].job,
-               res[k].moves, res[k].segments, res[k].edges, res[k].ref_points, res[k].ref_s,
-               res[k].check_s, res[k].dev);
+        printf("| %s | %zu | %zu | %zu | %zu | %.2f | %.2f | %.4f |\n", res[k].job, res[k].moves,
+               res[k].segments, res[k].edges, res[k].ref_points, res[k].ref_s, res[k].check_s,
+               res[k].dev);
         if (f)
             fprintf(f, "\"%s\",%zu,%zu,%zu,%zu,%.3f,%.3f,%.5f\n", res[k].job, res[k].moves,
-                    res[k].segments, res[k].edges, res[k].ref_points, res[k].ref_s,
-                    res[k].check_s, res[k].dev);
+                    res[k].segments, res[k].edges, res[k].ref_points, res[k].ref_s, res[k].check_s,
+                    res[k].dev);
     }
     if (f)
         fclose(f);

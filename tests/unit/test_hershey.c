@@ -39,7 +39,7 @@ static void test_reads_shipped_font(void **state)
     assert_int_equal(h->left, -11);
     assert_int_equal(h->right, 11);
     assert_int_equal(h->n, 6);
-    static const int want[6][3] = {{-7, -12, 1}, {-7, 9, 0}, {7, -12, 1},
+    static const int want[6][3] = {{-7, -12, 1}, {-7, 9, 0},  {7, -12, 1},
                                    {7, 9, 0},    {-7, -2, 1}, {7, -2, 0}};
     for (size_t k = 0; k < 6; k++) {
         const cs_hershey_vertex_t *v = &f.v[h->first + k];
@@ -60,8 +60,8 @@ static void bad_font(const char *text, unsigned line, unsigned col)
     memset(&d, 0, sizeof d);
     assert_int_equal(cs_hershey_parse("bad.jhf", text, strlen(text), &f, &d), CS_ERR_PARSE);
     if (d.loc.line != line || d.loc.col != col)
-        print_error("'%s': got %u:%u (%s), expected %u:%u\n", text, d.loc.line, d.loc.col,
-                    d.reason, line, col);
+        print_error("'%s': got %u:%u (%s), expected %u:%u\n", text, d.loc.line, d.loc.col, d.reason,
+                    line, col);
     assert_int_equal(d.loc.line, line);
     assert_int_equal(d.loc.col, col);
     assert_string_equal(d.loc.file, "bad.jhf");
@@ -71,12 +71,12 @@ static void bad_font(const char *text, unsigned line, unsigned col)
 static void test_bad_fonts_located(void **state)
 {
     (void)state;
-    bad_font("<svg/>\n", 1, 1);                              /* not a number in columns 1-5 */
-    bad_font("12345  9G]KFK[ RYFY[ RKPYP\nhello\n", 2, 1);   /* second record not a record */
-    bad_font("12345  0G]\n", 1, 8);                          /* no pairs at all */
-    bad_font("12345  9G]KFK[\n", 2, 1);                      /* ends before its 9 pairs */
-    bad_font("12345  2]GKF\n", 1, 12);                       /* right bearing left of left */
-    bad_font("", 1, 1);                                      /* empty: no glyph */
+    bad_font("<svg/>\n", 1, 1);                            /* not a number in columns 1-5 */
+    bad_font("12345  9G]KFK[ RYFY[ RKPYP\nhello\n", 2, 1); /* second record not a record */
+    bad_font("12345  0G]\n", 1, 8);                        /* no pairs at all */
+    bad_font("12345  9G]KFK[\n", 2, 1);                    /* ends before its 9 pairs */
+    bad_font("12345  2]GKF\n", 1, 12);                     /* right bearing left of left */
+    bad_font("", 1, 1);                                    /* empty: no glyph */
     cs_hershey_font_t f;
     cs_path_diag_t d;
     assert_int_equal(cs_hershey_load("tests/data/nonexistent.jhf", &f, &d), CS_ERR_IO);
@@ -121,35 +121,47 @@ static void expect_h(size_t k, double x, double y, double s, double sx, double s
                 y + sy * s * (-2 - 9));
 }
 
-#define SVG_HEAD "<svg xmlns='http://www.w3.org/2000/svg' width='100mm' height='50mm' " \
-                 "viewBox='0 0 100 50'>"
+#define SVG_HEAD                                                                                   \
+    "<svg xmlns='http://www.w3.org/2000/svg' width='100mm' height='50mm' "                         \
+    "viewBox='0 0 100 50'>"
 
 static void test_svg_text_positions(void **state)
 {
     (void)state;
     /* font-size 16 user units = 16 mm here: s = 0.5 mm per font unit */
-    assert_int_equal(parse("t.svg", SVG_HEAD "<text x='10' y='30' font-size='16'>H</text></svg>",
-                           FONT), CS_OK);
+    assert_int_equal(
+        parse("t.svg", SVG_HEAD "<text x='10' y='30' font-size='16'>H</text></svg>", FONT), CS_OK);
     assert_int_equal(P.n, 3);
     assert_int_equal(P.nsubpaths, 3); /* three strokes: each its own subpath */
     expect_h(0, 10, 30, 0.5, 0.5, 1);
     /* text-anchor middle: the 22-unit advance (11 mm) centred on x */
-    assert_int_equal(parse("t.svg", SVG_HEAD "<text x='10' y='30' font-size='16' "
-                                    "text-anchor='middle'>H</text></svg>", FONT), CS_OK);
+    assert_int_equal(parse("t.svg",
+                           SVG_HEAD "<text x='10' y='30' font-size='16' "
+                                    "text-anchor='middle'>H</text></svg>",
+                           FONT),
+                     CS_OK);
     expect_h(0, 10 - 5.5, 30, 0.5, 0.5, 1);
     /* end, in a style attribute, under a translate */
-    assert_int_equal(parse("t.svg", SVG_HEAD "<g transform='translate(5,2)'><text x='20' y='30' "
+    assert_int_equal(parse("t.svg",
+                           SVG_HEAD "<g transform='translate(5,2)'><text x='20' y='30' "
                                     "style='font-size:16px;text-anchor:end'>H</text></g></svg>",
-                           FONT), CS_OK);
+                           FONT),
+                     CS_OK);
     expect_h(0, 25 - 11, 32, 0.5, 0.5, 1);
     /* "HA": A's first stroke starts at advance 22: (x + s (22 + 0 + 9), y + s (-12 - 9)) */
-    assert_int_equal(parse("t.svg", SVG_HEAD "<text x='10' y='30' font-size='16'>  H\n A</text>"
-                                    "</svg>", FONT), CS_OK);
+    assert_int_equal(parse("t.svg",
+                           SVG_HEAD "<text x='10' y='30' font-size='16'>  H\n A</text>"
+                                    "</svg>",
+                           FONT),
+                     CS_OK);
     /* white space collapsed: "H A", the space's advance is 16 units (futural " ": J Z) */
     expect_line(3, 10 + 0.5 * (22 + 16 + 9), 30 - 10.5, 10 + 0.5 * (22 + 16 + 1), 30);
     /* a tspan with its own x, y and size: 'H' at 40, 45 with s = 8 / 32 */
-    assert_int_equal(parse("t.svg", SVG_HEAD "<text x='10' y='30' font-size='16'>H<tspan x='40' "
-                                    "y='45' font-size='8'>H</tspan></text></svg>", FONT), CS_OK);
+    assert_int_equal(parse("t.svg",
+                           SVG_HEAD "<text x='10' y='30' font-size='16'>H<tspan x='40' "
+                                    "y='45' font-size='8'>H</tspan></text></svg>",
+                           FONT),
+                     CS_OK);
     assert_int_equal(P.n, 6);
     expect_h(3, 40, 45, 0.25, 0.25, 1);
 }
@@ -157,8 +169,9 @@ static void test_svg_text_positions(void **state)
 static void test_svg_text_without_font_or_bad_font(void **state)
 {
     (void)state;
-    assert_int_equal(parse("t.svg", SVG_HEAD "<text x='1' y='1'>H</text></svg>",
-                           "tests/data/SOURCES.md"), CS_ERR_PARSE);
+    assert_int_equal(
+        parse("t.svg", SVG_HEAD "<text x='1' y='1'>H</text></svg>", "tests/data/SOURCES.md"),
+        CS_ERR_PARSE);
 }
 
 static void test_hpgl_label(void **state)

@@ -147,7 +147,8 @@ static void test_pen_keys(void **state)
 {
     (void)state;
     expect_ini_error("[pen]\nmode = servo\nup_us = 1900\n", "bad.ini:0: [pen] mode = servo needs");
-    expect_ini_error("[pen]\nmode = servo\nup_us = 1500\ndown_us = 1500\n", "needs up_us and down_us, different");
+    expect_ini_error("[pen]\nmode = servo\nup_us = 1500\ndown_us = 1500\n",
+                     "needs up_us and down_us, different");
     expect_ini_error("[pen]\nup_us = 3000\n", "bad.ini:2: [pen] up_us: must be a whole number");
     expect_ini_error("[pen]\ndown_us = 1500.5\n", "bad.ini:2: [pen] down_us: must be a whole");
     expect_ini_error("[pen]\nsettle_ms = -1\n", "bad.ini:2: [pen] settle_ms: must be a time");
