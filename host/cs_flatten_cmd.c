@@ -47,7 +47,8 @@ static void flatten_usage(FILE *f)
             "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
             "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
             "fills are drawn as outlines; <text> is drawn in a stroke font; <use> is not drawn:\n"
-            "a warning on stderr names it) or a file holding bare SVG path data (M L H V C S Q T A Z, absolute\n"
+            "a warning on stderr names it) or a file holding bare SVG path data (M L H V C S Q T A "
+            "Z, absolute\n"
             "and relative); other names and '-' (standard input) are recognised by their\n"
             "content. SVG without width/height and bare path data: 1 user unit = 1 mm. Axes\n"
             "as in the file (SVG's y points down, HP-GL's up); coordinates must stay within\n"
@@ -102,14 +103,10 @@ static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
 int cs_cmd_flatten(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"tol", required_argument, NULL, 't'},
-        {"method", required_argument, NULL, 'm'},
-        {"stats", no_argument, NULL, 's'},
-        {"svg", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'},
-        {"lenient", no_argument, NULL, 'l'},
-        {"font", required_argument, NULL, 'f'},
-        {NULL, 0, NULL, 0},
+        {"tol", required_argument, NULL, 't'},  {"method", required_argument, NULL, 'm'},
+        {"stats", no_argument, NULL, 's'},      {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},       {"lenient", no_argument, NULL, 'l'},
+        {"font", required_argument, NULL, 'f'}, {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
     size_t method = FLATTEN_DEFAULT_METHOD;

@@ -714,8 +714,8 @@ static cs_err_t label(hp_t *h, const char *mn, size_t off)
         size_t j = i;
         while (j < e_ && h->buf[j] != '\r' && h->buf[j] != '\n')
             j++;
-        cs_err_t e = cs_hershey_layout(h->o->font, h->buf + i, j - i, x, y, sx, -sy,
-                                       label_vertex, &l);
+        cs_err_t e =
+            cs_hershey_layout(h->o->font, h->buf + i, j - i, x, y, sx, -sy, label_vertex, &l);
         if (e != CS_OK)
             return e;
         x += cs_hershey_width(h->o->font, h->buf + i, j - i) * sx;

@@ -140,9 +140,8 @@ static cs_err_t load_font(const cs_input_opts_t *o, cs_hershey_font_t *f, bool *
 }
 
 /* SVG and HP-GL: the drawing readers, with the stroke font for their text. */
-static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const char *buf,
-                              size_t len, const cs_input_opts_t *o, cs_path_t *path,
-                              cs_path_diag_t *diag)
+static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const char *buf, size_t len,
+                              const cs_input_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
 {
     cs_hershey_font_t font;
     bool have;

@@ -402,8 +402,10 @@ int cs_machine_ini_open(const char *who, const char *given, cs_machine_t *m, cs_
     if (file == NULL && cs_machine_ini_find(found, sizeof found))
         file = found;
     if (file == NULL) {
-        fprintf(stderr, "%s: machine: the built-in machine (no --machine, no machine.ini found; "
-                        "see docs/plotting.md)\n", who);
+        fprintf(stderr,
+                "%s: machine: the built-in machine (no --machine, no machine.ini found; "
+                "see docs/plotting.md)\n",
+                who);
         cs_machine_ini_default(m);
         if (pen)
             cs_machine_ini_pen_default(pen);

@@ -15,8 +15,8 @@
 /* How the pen (or spindle) is raised and lowered. Mode z is host-only (Z moves); mode servo
  * becomes pen events in the step segments (cs_motion_segs_t.pens). */
 typedef enum {
-    CS_MACHINE_PEN_NONE = 0, /* no pen axis: pen up / down only split the job into subpaths */
-    CS_MACHINE_PEN_Z = 1,    /* pen up / down are rapid moves of Z to up_z_mm / down_z_mm */
+    CS_MACHINE_PEN_NONE = 0,  /* no pen axis: pen up / down only split the job into subpaths */
+    CS_MACHINE_PEN_Z = 1,     /* pen up / down are rapid moves of Z to up_z_mm / down_z_mm */
     CS_MACHINE_PEN_SERVO = 2, /* pen up / down set an RC servo's pulse width, then wait settle_ms */
 } cs_machine_pen_mode_t;
 
@@ -24,14 +24,14 @@ typedef struct {
     cs_machine_pen_mode_t mode;
     double up_z_mm;   /* machine Z of the raised pen (mode z), inside [z] travel */
     double down_z_mm; /* machine Z of the lowered pen (mode z), inside [z] travel */
-    double z_feed_mm_s; /* speed of the pen's Z moves (mode z), mm/s; 0: rapid (the default) */
+    double z_feed_mm_s;      /* speed of the pen's Z moves (mode z), mm/s; 0: rapid (the default) */
     unsigned up_us, down_us; /* servo pulse widths of the raised / lowered pen (mode servo), us */
     double settle_ms;        /* wait after each servo move before the motion goes on (mode servo) */
 } cs_machine_pen_t;
 
 /* RC servo pulse range (the common 1..2 ms with margin) and the longest settle wait. */
-#define CS_MACHINE_SERVO_MIN_US 400
-#define CS_MACHINE_SERVO_MAX_US 2600
+#define CS_MACHINE_SERVO_MIN_US        400
+#define CS_MACHINE_SERVO_MAX_US        2600
 #define CS_MACHINE_SERVO_MAX_SETTLE_MS 5000
 
 /* The default [pen]: mode none (heights 0). */
@@ -52,7 +52,8 @@ int cs_machine_ini_parse(const char *text, const char *name, cs_machine_t *m, ch
 /* As cs_machine_ini_load / cs_machine_ini_parse, also filling *pen from the [pen] section
  * (cs_machine_ini_pen_default when absent). mode = z needs up_z and down_z, different, both
  * inside the z axis travel; mode = servo needs up_us and down_us (CS_MACHINE_SERVO_MIN_US ..
- * _MAX_US, different), settle_ms (0 .. CS_MACHINE_SERVO_MAX_SETTLE_MS) defaults to 150. (The plain functions read and check [pen] too, and drop it.) */
+ * _MAX_US, different), settle_ms (0 .. CS_MACHINE_SERVO_MAX_SETTLE_MS) defaults to 150. (The plain
+ * functions read and check [pen] too, and drop it.) */
 int cs_machine_ini_load_pen(const char *path, cs_machine_t *m, cs_machine_pen_t *pen, char *err,
                             size_t errlen);
 int cs_machine_ini_parse_pen(const char *text, const char *name, cs_machine_t *m,

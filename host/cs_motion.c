@@ -214,8 +214,8 @@ int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_s
         if (strncmp(p, "pen", 3) == 0) { /* a servo pen event before the next segment */
             if (sscanf(p, "pen %u %c", &us, &tail) != 1 || us < CS_MACHINE_SERVO_MIN_US ||
                 us > CS_MACHINE_SERVO_MAX_US) {
-                snprintf(err, errlen, "%s:%u: expected \"pen PULSE_US\" with 400..2600 us",
-                         name, lineno);
+                snprintf(err, errlen, "%s:%u: expected \"pen PULSE_US\" with 400..2600 us", name,
+                         lineno);
                 return -1;
             }
             if (add_pen(out, out->n, (uint16_t)us) != CS_OK) {

@@ -65,7 +65,8 @@ cs_err_t cs_motion_finish(cs_motion_t *mo);
  * per segment, "ticks dx dy dz" (and " da" with 4 axes). Returns 0, -1 on a write error. */
 int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_t n);
 /* Reads that format (lines starting with '#' are comments; a header's tick_hz and axes must
- * match *m; "pen PULSE_US" lines become pen events). Appends to *out. Returns 0, or -1 with "name:line: reason" in err. */
+ * match *m; "pen PULSE_US" lines become pen events). Appends to *out. Returns 0, or -1 with
+ * "name:line: reason" in err. */
 int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_segs_t *out,
                    char *err, size_t errlen);
 /* Reads a job file into *path with the host's input loader (cs_input: SVG, G-code, HPGL, by
@@ -76,10 +77,10 @@ cs_err_t cs_motion_read_job_ex(const char *file, bool lenient, cs_path_t *path,
                                cs_path_diag_t *diag);
 /* Plans a whole path: from the current position a rapid move to each element that does not start
  * where the previous one ended (with mo->pen in mode servo: the pen raised before it and lowered
- * after it, cs_pen_stroke_starts, and raised at the end), then the element's chords (cs_trace, tolerance tol, method) at
- * the element's own feed (G-code F), or rapid for a rapid element (G0), or else at feed (mm/s
- * Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error *diag names the
- * element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
+ * after it, cs_pen_stroke_starts, and raised at the end), then the element's chords (cs_trace,
+ * tolerance tol, method) at the element's own feed (G-code F), or rapid for a rapid element (G0),
+ * or else at feed (mm/s Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error
+ * *diag names the element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag);
 /* mm/s -> Q15.16 (<= 0 stays 0: rapid). */

@@ -111,8 +111,8 @@ int cs_cmd_plan(int argc, char **argv)
             perror(out_file);
             rc = CS_EXIT_INTERNAL;
         } else {
-            if (cs_motion_write_segs(f, &m, &jp.mo.segs) != 0 ||
-                (out_file && fclose(f) != 0) || (!out_file && fflush(f) != 0)) {
+            if (cs_motion_write_segs(f, &m, &jp.mo.segs) != 0 || (out_file && fclose(f) != 0) ||
+                (!out_file && fflush(f) != 0)) {
                 fprintf(stderr, "curvestep plan: write error\n");
                 rc = CS_EXIT_INTERNAL;
             }

@@ -1336,7 +1336,8 @@ static void XMLCALL on_chars(void *ud, const XML_Char *s, int len)
         size_t cap = (d->tcap ? d->tcap * 2 : 256) + (size_t)len;
         char *nb = realloc(d->tbuf, cap);
         if (!nb) {
-            d->err = cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
+            d->err =
+                cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
             XML_StopParser(d->xp, XML_FALSE);
             return;
         }
@@ -1431,7 +1432,7 @@ static const struct {
     {"marker", on_hidden},    {"pattern", on_hidden},    {"rect", on_rect},
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
     {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
-    {"use", on_unsupported},  {"image", on_unsupported},  {"tspan", on_tspan},
+    {"use", on_unsupported},  {"image", on_unsupported}, {"tspan", on_tspan},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */

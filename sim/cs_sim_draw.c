@@ -276,8 +276,9 @@ static void svg_legend(FILE *f, const legend_t *lg, double vmax, double lw, bool
     for (int k = 0; k < 20; k++) {
         double rgb[3];
         speed_rgb((k + 0.5) / 20, rgb);
-        fprintf(f, "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
-                   "fill=\"#%02x%02x%02x\"/>\n",
+        fprintf(f,
+                "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
+                "fill=\"#%02x%02x%02x\"/>\n",
                 x + bar * k / 20, y - lg->u * 0.4, bar / 20 + lw, lg->u * 0.8, (int)(rgb[0] * 255),
                 (int)(rgb[1] * 255), (int)(rgb[2] * 255));
     }
@@ -285,19 +286,22 @@ static void svg_legend(FILE *f, const legend_t *lg, double vmax, double lw, bool
             y + 1.3 * lg->u, vmax);
     x = legend_x(lg, 1);
     if (travel)
-        fprintf(f, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"#999999\" "
-                   "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\"/>\n"
-                   "<text x=\"%.4f\" y=\"%.4f\">pen-up travel</text>\n",
+        fprintf(f,
+                "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"#999999\" "
+                "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\"/>\n"
+                "<text x=\"%.4f\" y=\"%.4f\">pen-up travel</text>\n",
                 x, y, x + 3 * lg->u, y, lw, 6 * lw, 4 * lw, x + 3.5 * lg->u, y + 0.35 * lg->u);
     double bx = x; /* the bed's note goes under the travel sample */
     x = legend_x(lg, 2);
-    fprintf(f, "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"black\" "
-               "stroke-width=\"%.4f\"/>\n<text x=\"%.4f\" y=\"%.4f\">exact geometry</text>\n",
+    fprintf(f,
+            "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"black\" "
+            "stroke-width=\"%.4f\"/>\n<text x=\"%.4f\" y=\"%.4f\">exact geometry</text>\n",
             x, y, x + 3 * lg->u, y, lw, x + 3.5 * lg->u, y + 0.35 * lg->u);
     double blo[2], bhi[2];
     if (bed_box(m, view, blo, bhi))
-        fprintf(f, "<text x=\"%.4f\" y=\"%.4f\">grey box: the machine's x y travel; "
-                   "x right, y %s</text>\n",
+        fprintf(f,
+                "<text x=\"%.4f\" y=\"%.4f\">grey box: the machine's x y travel; "
+                "x right, y %s</text>\n",
                 bx, y + 1.3 * lg->u, view->y_down ? "down" : "up");
     fprintf(f, "</g>\n");
 }
@@ -387,8 +391,9 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
             lo[0], lo[1], w, h);
     double blo[2], bhi[2];
     if (bed_box(m, view, blo, bhi))
-        fprintf(f, "<rect class=\"bed\" x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
-                   "fill=\"none\" stroke=\"#bbbbbb\" stroke-width=\"%.4f\"/>\n",
+        fprintf(f,
+                "<rect class=\"bed\" x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
+                "fill=\"none\" stroke=\"#bbbbbb\" stroke-width=\"%.4f\"/>\n",
                 blo[0], blo[1], bhi[0] - blo[0], bhi[1] - blo[1], 2 * lw);
     svg_legend(f, &lg, vmax, 2 * lw, travel, m, view);
     /* Travel first (underneath): runs of travel samples as dashed grey polylines. */

@@ -91,7 +91,10 @@ static bool report_check(const cs_machine_t *m, const cs_motion_segs_t *segs,
     printf("deviation%s: %.5f mm at (%.4f, %.4f, %.4f), segment %zu (tolerance + one step = "
            "%.5f mm) %s\n",
            c.pen ? " of pen-down motion (x y)" : "", c.dev, c.dev_at[0], c.dev_at[1], c.dev_at[2],
-           c.dev_seg, bound, dev_ok ? "ok" : c.pen ? "OVER: a pen-down travel" : "OVER");
+           c.dev_seg, bound,
+           dev_ok  ? "ok"
+           : c.pen ? "OVER: a pen-down travel"
+                   : "OVER");
     if (c.pen)
         printf("pen: %zu pen-downs; drawn strokes reached pen down within %.5f mm, worst at "
                "(%.4f, %.4f) %s\n",
