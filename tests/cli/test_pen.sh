@@ -117,6 +117,23 @@ printf '[pen]\nmode = servo\nup_us = 1900\n' >"$T/bad2.ini"
 run "servo needs both widths" 1 plan --machine "$T/bad2.ini" "$T/job.svg"
 expect_err "servo needs both widths: says so" 'mode = servo needs up_us and down_us'
 
+# End to end: a page with a frame and text (drawn in the stroke font: many small strokes) on the
+# contrib servo A4 and z-pen machines plans, and the simulator's pen check passes with one
+# lowering per stroke: the frame, and each stroke of the glyphs ("Hi." is H: 3, i: 2, '.': 1).
+cat >"$T/text.svg" <<'SVG'
+<svg xmlns="http://www.w3.org/2000/svg" width="297mm" height="210mm" viewBox="0 0 297 210">
+<rect fill="none" stroke="black" x="20" y="20" width="100" height="50"/>
+<text x="148.5" y="120" font-size="20" text-anchor="middle" transform="rotate(-5 148.5 120)">Hi.</text>
+</svg>
+SVG
+for mc in servo-a4 zpen-plotter; do
+    run "text on $mc" 0 plan --machine contrib/machines/$mc.ini "$T/text.svg" -o "$T/text.seg"
+    "$SIM" --replay "$T/text.seg" --machine contrib/machines/$mc.ini --reference "$T/text.svg" \
+        --check >"$T/text.sim" 2>/dev/null
+    expect "text on $mc: check passes" grep -q '^check: ok$' "$T/text.sim"
+    expect "text on $mc: 7 pen lowerings" grep -q '^pen: 7 pen-downs' "$T/text.sim"
+done
+
 # [pen] z_feed is checked.
 printf '[pen]\nmode = z\nup_z = 5\ndown_z = 0\nz_feed = -1\n' >"$T/bad.ini"
 run "bad z_feed" 1 plan --machine "$T/bad.ini" "$T/job.svg"
