@@ -671,6 +671,7 @@ typedef struct {
     hp_t *h;
     size_t off;
     cs_vec3_t prev;
+    bool draw; /* a pen is selected (SP0: the label only moves the current point) */
 } label_t;
 
 static cs_err_t label_vertex(void *ctx, double x, double y, bool move)
@@ -682,6 +683,8 @@ static cs_err_t label_vertex(void *ctx, double x, double y, bool move)
         return e;
     q[0] = l->prev;
     l->prev = q[1];
+    if (!l->draw)
+        return CS_OK;
     if (move) {
         cs_path_new_subpath(l->h->path);
         return CS_OK;
@@ -693,7 +696,7 @@ static cs_err_t label_vertex(void *ctx, double x, double y, bool move)
  * its strokes whatever its state (as a plotter does); cap height = SI height (default 0.27 cm,
  * width 0.19 cm: the HP 7475A's defaults, HP 7475A Interfacing and Programming Manual, SI);
  * CR returns to the label's start, LF moves down two cap heights. The current point ends after
- * the last character. Without a font the label is skipped with a warning. */
+ * the last character (also with no pen selected, when nothing is drawn). Without a font the label is skipped with a warning. */
 static cs_err_t label(hp_t *h, const char *mn, size_t off)
 {
     size_t b = h->pos;
@@ -703,12 +706,10 @@ static cs_err_t label(hp_t *h, const char *mn, size_t off)
         warn_mnemonic(h, mn, off, "labels are not drawn (no stroke font: --font FILE.jhf)");
         return CS_OK;
     }
-    if (!drawing(h, off))
-        return CS_OK;
     double hh = (h->si_h > 0 ? h->si_h : 0.27) * 10.0 * CS_HPGL_PLU_PER_MM;
     double ww = (h->si_w > 0 ? h->si_w : 0.19) * 10.0 * CS_HPGL_PLU_PER_MM;
     double sy = hh / CS_HERSHEY_CAP, sx = sy * (ww / hh) / (0.19 / 0.27);
-    label_t l = {h, off, h->cur};
+    label_t l = {h, off, h->cur, drawing(h, off)};
     double x0 = h->x, x = h->x, y = h->y;
     for (size_t i = b; i < e_;) {
         size_t j = i;

@@ -185,6 +185,11 @@ static void test_hpgl_label(void **state)
     expect_h(0, 10, 10, s, sx, -1);
     /* the pen continues from the label's end: x + 22 sx */
     expect_line(3, 10 + 22 * sx, 10, 20, 10);
+    /* no pen (SP0): nothing drawn, but the label still moves the current point */
+    assert_int_equal(parse("l.plt", "IN;SP1;PU400,400;SI0.5,0.7;SP0;LBH\003;SP1;PD800,400;", FONT),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_line(0, 10 + 22 * sx, 10, 20, 10);
     /* DT: another terminator; default size 0.19 x 0.27 cm: s = 2.7 / 21, sx = s */
     assert_int_equal(parse("l.plt", "IN;SP1;DT#;PU0,0;LBH#;", FONT), CS_OK);
     assert_int_equal(P.n, 3);
