@@ -222,6 +222,8 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
         e = cs_jobplan_plan(&jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
                             CS_TRACE_SUBDIV, feed_q);
     if (e == CS_OK)
+        e = cs_jobplan_linkable(&jp, file);
+    if (e == CS_OK)
         e = curves ? cs_stream_job_add_path(job, &jp.path, feed_q > 0 ? feed_q : d->m.default_feed,
                                             tol, &jp.diag)
                    : cs_stream_job_add_segments(job, jp.mo.segs.v, jp.mo.segs.n);
@@ -691,15 +693,11 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
         d->clients[k].fd = -1;
     int rc = 0;
     char err[512];
-    if (cfg->machine_file) {
-        if (cs_machine_ini_load_pen(cfg->machine_file, &d->m, &d->pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            free(d);
-            return 1;
-        }
-    } else {
-        cs_machine_ini_default(&d->m);
-        cs_machine_ini_pen_default(&d->pen);
+    if (cs_machine_ini_open("curvestep serve", cfg->machine_file, &d->m, &d->pen, err,
+                            sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        free(d);
+        return 1;
     }
     if (cs_serial_open(&d->ser, cfg->port, cfg->baud) != 0) {
         fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));

@@ -36,7 +36,7 @@ static void flatten_usage(FILE *f)
 {
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-            "\n                         [--lenient] FILE\n"
+            "\n                         [--lenient] [--font FILE.jhf] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -46,8 +46,9 @@ static void flatten_usage(FILE *f)
             "docs/inputs.md), HP-GL (.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
             "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
             "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
-            "fills are drawn as outlines; text and <use> are not drawn: a warning on stderr\n"
-            "names them) or a file holding bare SVG path data (M L H V C S Q T A Z, absolute\n"
+            "fills are drawn as outlines; <text> is drawn in a stroke font; <use> is not drawn:\n"
+            "a warning on stderr names it) or a file holding bare SVG path data (M L H V C S Q T A "
+            "Z, absolute\n"
             "and relative); other names and '-' (standard input) are recognised by their\n"
             "content. SVG without width/height and bare path data: 1 user unit = 1 mm. Axes\n"
             "as in the file (SVG's y points down, HP-GL's up); coordinates must stay within\n"
@@ -63,6 +64,8 @@ static void flatten_usage(FILE *f)
             "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
             "  --lenient       G-code: a word curvestep does not carry out is a warning (and is\n"
             "                  ignored) instead of an error\n"
+            "  --font FILE.jhf Hershey stroke font for SVG <text> and HP-GL LB labels (default:\n"
+            "                  share/fonts/futural.jhf; a file that is not a font is an error)\n"
             "  -h, --help      show this help\n"
             "\n"
             "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
@@ -100,19 +103,17 @@ static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
 int cs_cmd_flatten(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"tol", required_argument, NULL, 't'},
-        {"method", required_argument, NULL, 'm'},
-        {"stats", no_argument, NULL, 's'},
-        {"svg", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'},
-        {"lenient", no_argument, NULL, 'l'},
-        {NULL, 0, NULL, 0},
+        {"tol", required_argument, NULL, 't'},  {"method", required_argument, NULL, 'm'},
+        {"stats", no_argument, NULL, 's'},      {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},       {"lenient", no_argument, NULL, 'l'},
+        {"font", required_argument, NULL, 'f'}, {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
     size_t method = FLATTEN_DEFAULT_METHOD;
     bool stats = false;
     const char *svg_out = NULL;
     bool lenient = false;
+    const char *font = NULL;
     int c;
     optind = 1;
     opterr = 0;
@@ -156,6 +157,9 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'l':
             lenient = true;
             break;
+        case 'f':
+            font = optarg;
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -186,6 +190,7 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    iopts.font_file = font;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);

@@ -1219,6 +1219,8 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
     g.unit = 1.0;
     g.plane = 17;
     g.motion = MOT_NONE;
+    if (o->pen_z) /* the pen starts up: moves before the first M3 are travel (cs_pen, z mode) */
+        g.pos[2] = o->pen_up_z_mm;
     cs_path_new_subpath(path);
     cs_err_t e = CS_OK;
     size_t i = 0;

@@ -26,7 +26,7 @@ typedef struct {
     size_t max_elements;   /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
     bool pen_z;            /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
     double pen_down_z_mm;  /* to this machine Z on M3/M4 */
-    double pen_up_z_mm;    /* to this machine Z on M5 */
+    double pen_up_z_mm;    /* to this machine Z on M5, and where the program starts */
     cs_gcode_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_gcode_opts_t;

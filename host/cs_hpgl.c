@@ -45,6 +45,7 @@ typedef struct {
     bool relative, pen_down;
     long pen;        /* selected pen; 0 = none (nothing is drawn) */
     char label_term; /* LB/BL/WD text terminator (DT) */
+    double si_w, si_h; /* SI character width and height, cm (HP default 0.19 x 0.27) */
     bool warned[26 * 26];
     bool warned_esc, warned_nopen, warned_big_sweep;
 } hp_t;
@@ -663,6 +664,79 @@ static void skip_label(hp_t *h)
         h->pos++;
 }
 
+static void warn_mnemonic(hp_t *h, const char *mn, size_t off, const char *why);
+
+/* Where a label's strokes go: plotter units -> path lines. */
+typedef struct {
+    hp_t *h;
+    size_t off;
+    cs_vec3_t prev;
+    bool draw; /* a pen is selected (SP0: the label only moves the current point) */
+} label_t;
+
+static cs_err_t label_vertex(void *ctx, double x, double y, bool move)
+{
+    label_t *l = ctx;
+    cs_vec3_t q[2];
+    cs_err_t e = convert(l->h, x, y, l->off, &q[1]);
+    if (e != CS_OK)
+        return e;
+    q[0] = l->prev;
+    l->prev = q[1];
+    if (!l->draw)
+        return CS_OK;
+    if (move) {
+        cs_path_new_subpath(l->h->path);
+        return CS_OK;
+    }
+    return emit(l->h, CS_PATH_LINE, 1, q, l->off);
+}
+
+/* LB text<terminator>: the label in the stroke font from the current point, the pen lowered for
+ * its strokes whatever its state (as a plotter does); cap height = SI height (default 0.27 cm,
+ * width 0.19 cm: the HP 7475A's defaults, HP 7475A Interfacing and Programming Manual, SI);
+ * CR returns to the label's start, LF moves down two cap heights. The current point ends after
+ * the last character (also with no pen selected, when nothing is drawn). Without a font the label is skipped with a warning. */
+static cs_err_t label(hp_t *h, const char *mn, size_t off)
+{
+    size_t b = h->pos;
+    skip_label(h);
+    size_t e_ = h->pos > b && h->buf[h->pos - 1] == h->label_term ? h->pos - 1 : h->pos;
+    if (h->o->font == NULL) {
+        warn_mnemonic(h, mn, off, "labels are not drawn (no stroke font: --font FILE.jhf)");
+        return CS_OK;
+    }
+    double hh = (h->si_h > 0 ? h->si_h : 0.27) * 10.0 * CS_HPGL_PLU_PER_MM;
+    double ww = (h->si_w > 0 ? h->si_w : 0.19) * 10.0 * CS_HPGL_PLU_PER_MM;
+    double sy = hh / CS_HERSHEY_CAP, sx = sy * (ww / hh) / (0.19 / 0.27);
+    label_t l = {h, off, h->cur, drawing(h, off)};
+    double x0 = h->x, x = h->x, y = h->y;
+    for (size_t i = b; i < e_;) {
+        size_t j = i;
+        while (j < e_ && h->buf[j] != '\r' && h->buf[j] != '\n')
+            j++;
+        cs_err_t e =
+            cs_hershey_layout(h->o->font, h->buf + i, j - i, x, y, sx, -sy, label_vertex, &l);
+        if (e != CS_OK)
+            return e;
+        x += cs_hershey_width(h->o->font, h->buf + i, j - i) * sx;
+        if (j < e_ && h->buf[j] == '\r')
+            x = x0;
+        else if (j < e_)
+            y -= 2.0 * hh;
+        i = j < e_ ? j + 1 : j;
+    }
+    cs_path_new_subpath(h->path);
+    cs_vec3_t end;
+    cs_err_t e = convert(h, x, y, off, &end);
+    if (e == CS_OK) {
+        h->x = x;
+        h->y = y;
+        h->cur = end;
+    }
+    return e;
+}
+
 /* What skipping an instruction costs the drawing, for its one warning. */
 static const struct {
     const char *mn;
@@ -692,11 +766,10 @@ static const struct {
     {"PT", "pen thickness ignored"},
     {"PW", "pen width ignored"},
     {"VS", "velocity ignored (the planner sets speeds)"},
-    {"SI", "text setting ignored (text is not drawn)"},
     {"SL", "text setting ignored (text is not drawn)"},
-    {"SR", "text setting ignored (text is not drawn)"},
-    {"DI", "text setting ignored (text is not drawn)"},
-    {"DR", "text setting ignored (text is not drawn)"},
+    {"SR", "relative character size ignored: labels use SI (absolute) sizes"},
+    {"DI", "label direction ignored: labels are drawn horizontally"},
+    {"DR", "label direction ignored: labels are drawn horizontally"},
     {"CS", "text setting ignored (text is not drawn)"},
     {"CA", "text setting ignored (text is not drawn)"},
     {"SA", "text setting ignored (text is not drawn)"},
@@ -811,8 +884,15 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
     case ('P' << 8) | 'E':
         return polyline_encoded(h, off);
     case ('L' << 8) | 'B':
-        warn_mnemonic(h, mn, off, "labels are not drawn (text is not supported)");
-        skip_label(h);
+        return label(h, mn, off);
+    case ('S' << 8) | 'I':
+        /* SI w,h: character size in cm; SI; the default */
+        if ((e = get_params(h, mn, off, v, vo, 0, 2, &n, "SI[width,height]")) != CS_OK)
+            return e;
+        if (n == 1)
+            return fail(h, off, CS_ERR_PARSE, "SI: width and height, or none");
+        h->si_w = n == 2 ? v[0] : 0;
+        h->si_h = n == 2 ? v[1] : 0;
         return CS_OK;
     case ('B' << 8) | 'L':
     case ('W' << 8) | 'D':

@@ -9,6 +9,7 @@
 
 #include <stddef.h>
 
+#include "cs_hershey.h"
 #include "cs_path.h"
 
 /* Plotter units per millimetre (1 plu = 0.025 mm). */
@@ -19,6 +20,7 @@ typedef void (*cs_hpgl_warn_fn)(void *ctx, const cs_path_diag_t *w);
 
 typedef struct {
     cs_hpgl_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    const cs_hershey_font_t *font; /* stroke font for LB labels (cs_hershey); NULL: skipped */
     void *warn_ctx;
 } cs_hpgl_opts_t;
 

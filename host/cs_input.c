@@ -123,6 +123,51 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
     return CS_INPUT_SVG;
 }
 
+/* The stroke font for text: --font FILE (an error when it is not a font), else the shipped
+ * default when found (else none: text is skipped with a warning). *have: f was loaded. */
+static cs_err_t load_font(const cs_input_opts_t *o, cs_hershey_font_t *f, bool *have,
+                          cs_path_diag_t *diag)
+{
+    char def[4096];
+    *have = false;
+    if (o->font_file != NULL) {
+        cs_err_t e = cs_hershey_load(o->font_file, f, diag);
+        *have = e == CS_OK;
+        return e;
+    }
+    *have = cs_hershey_default_path(def, sizeof def) && cs_hershey_load(def, f, diag) == CS_OK;
+    return CS_OK;
+}
+
+/* SVG and HP-GL: the drawing readers, with the stroke font for their text. */
+static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const char *buf, size_t len,
+                              const cs_input_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
+{
+    cs_hershey_font_t font;
+    bool have;
+    cs_err_t e = load_font(o, &font, &have, diag);
+    if (e != CS_OK)
+        return e;
+    if (fmt == CS_INPUT_HPGL) {
+        cs_hpgl_opts_t ho;
+        cs_hpgl_opts_init(&ho);
+        ho.warn = o->warn;
+        ho.warn_ctx = o->warn_ctx;
+        ho.font = have ? &font : NULL;
+        e = cs_hpgl_read(name, buf, len, &ho, path, diag);
+    } else {
+        cs_svgdoc_opts_t so;
+        cs_svgdoc_opts_init(&so);
+        so.warn = o->warn;
+        so.warn_ctx = o->warn_ctx;
+        so.font = have ? &font : NULL;
+        e = cs_svgdoc_read(buf, len, name, &so, path, diag, NULL);
+    }
+    if (have)
+        cs_hershey_free(&font);
+    return e;
+}
+
 cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
                         cs_path_t *path, cs_path_diag_t *diag)
 {
@@ -132,6 +177,8 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
         o = &dflt;
     }
     cs_input_format_t f = o->format != CS_INPUT_AUTO ? o->format : cs_input_detect(name, buf, len);
+    if (o->detected != NULL)
+        *o->detected = f;
     switch (f) {
     case CS_INPUT_GCODE: {
         cs_gcode_opts_t go;
@@ -146,20 +193,9 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
         go.warn_ctx = o->warn_ctx;
         return cs_gcode_read(name, buf, len, &go, path, diag, NULL);
     }
-    case CS_INPUT_HPGL: {
-        cs_hpgl_opts_t ho;
-        cs_hpgl_opts_init(&ho);
-        ho.warn = o->warn;
-        ho.warn_ctx = o->warn_ctx;
-        return cs_hpgl_read(name, buf, len, &ho, path, diag);
-    }
-    default: {
-        cs_svgdoc_opts_t so;
-        cs_svgdoc_opts_init(&so);
-        so.warn = o->warn;
-        so.warn_ctx = o->warn_ctx;
-        return cs_svgdoc_read(buf, len, name, &so, path, diag, NULL);
-    }
+    case CS_INPUT_HPGL:
+    default:
+        return parse_drawing(f, name, buf, len, o, path, diag);
     }
 }
 

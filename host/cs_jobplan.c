@@ -8,6 +8,7 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_input.h"
+#include "cs_pen.h"
 
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
 {
@@ -22,6 +23,8 @@ int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan
     char *end;
     if (strcmp(a, "--machine") == 0) {
         o->machine_file = argv[++*i];
+    } else if (strcmp(a, "--font") == 0) {
+        o->font_file = argv[++*i];
     } else if (strcmp(a, "--tol") == 0) {
         o->tol_mm = strtod(argv[++*i], &end);
         if (*end != '\0' || !(o->tol_mm > 0)) {
@@ -51,14 +54,11 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
                        cs_machine_pen_t *pen, cs_pos_t *tol)
 {
     cs_machine_ini_pen_default(pen);
-    char err[512];
-    if (o->machine_file) {
-        if (cs_machine_ini_load_pen(o->machine_file, m, pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(m);
+    char err[512], who[64];
+    snprintf(who, sizeof who, "curvestep %s", cmd);
+    if (cs_machine_ini_open(who, o->machine_file, m, pen, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return CS_EXIT_INPUT;
     }
     if (!cs_jobplan_tol(m, o->tol_mm, tol)) {
         fprintf(stderr, "curvestep %s: --tol %g mm is outside the accepted range\n", cmd,
@@ -80,13 +80,22 @@ cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pe
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    iopts.font_file = jp->font_file;
+    cs_input_format_t fmt = CS_INPUT_AUTO;
+    iopts.detected = &fmt;
+    cs_machine_ini_pen_default(&jp->pen);
     if (pen != NULL) {
+        jp->pen = *pen;
         /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
         iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
         iopts.pen_up_z_mm = pen->up_z_mm;
         iopts.pen_down_z_mm = pen->down_z_mm;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
+    /* SVG and HP-GL have no pen height of their own: lift between strokes (G-code did, above) */
+    jp->pen_raise = e == CS_OK && fmt != CS_INPUT_GCODE && jp->pen.mode == CS_MACHINE_PEN_Z;
+    if (jp->pen_raise)
+        e = cs_pen_lift_z(&jp->path, &jp->pen, &jp->diag);
     jp->read_ok = e == CS_OK;
     return e;
 }
@@ -106,9 +115,27 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
     if (e != CS_OK)
         return fail_whole(jp, file, e, "machine rejected");
     jp->have_mo = true;
+    jp->mo.pen = &jp->pen; /* mode servo: pen events between the strokes */
     if (start != NULL && (e = cs_planner_set_position(&jp->mo.pl, start)) != CS_OK)
         return fail_whole(jp, file, e, "the device's position is outside the machine's travel");
+    if (jp->pen_raise) { /* the pen up where the machine stands, before the first travel */
+        const cs_pos_t *p = jp->mo.pl.pos;
+        double up = jp->pen.up_z_mm;
+        e = cs_motion_line_mm(&jp->mo, cs_conv_pos_to_mm(p[0]), cs_conv_pos_to_mm(p[1]), up,
+                              jp->pen.z_feed_mm_s, 0);
+        if (e != CS_OK)
+            return fail_whole(jp, file, e, "raising the pen failed");
+    }
     return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
+}
+
+cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file)
+{
+    if (jp->mo.segs.npens == 0)
+        return CS_OK;
+    return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
+                      "[pen] mode = servo: the device link does not carry pen events yet (plan "
+                      "and curvestep-sim --replay do); use mode = z or a G-code M3/M5 spindle pen");
 }
 
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)
@@ -117,7 +144,8 @@ int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
     /* CS_ERR_DEPTH: a curve the tracer cannot bring within the tolerance in its bounded depth
      * is the job's (or the tolerance's) doing, as is a tolerance it cannot meet */
-    return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE || e == CS_ERR_DEPTH)
+    return (e == CS_ERR_LIMIT || e == CS_ERR_RANGE || e == CS_ERR_TOLERANCE || e == CS_ERR_DEPTH ||
+            e == CS_ERR_UNSUPPORTED)
                ? CS_EXIT_INPUT
                : CS_EXIT_INTERNAL;
 }

@@ -17,6 +17,7 @@ typedef struct {
     const char *machine_file; /* --machine FILE.ini; NULL: the built-in machine */
     double tol_mm;            /* --tol MM; 0: the machine's tolerance */
     double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
+    const char *font_file;    /* --font FILE.jhf: stroke font for text; NULL: the default */
 } cs_jobplan_opts_t;
 
 /* One job: read, then planned. */
@@ -26,12 +27,15 @@ typedef struct {
     cs_path_diag_t diag; /* after an error: "file:line:col: reason" (cs_path_diag_print) */
     bool have_mo;        /* mo was initialised (and must be freed) */
     bool read_ok;        /* the file was read: a later error is the planner's */
+    cs_machine_pen_t pen;  /* the [pen] the job was read with (cs_jobplan_read) */
+    bool pen_raise;        /* cs_pen lifted the job: the plan starts by raising the pen in place */
+    const char *font_file; /* stroke font for text (set before cs_jobplan_read); NULL: default */
 } cs_jobplan_t;
 
 /* No machine file, no --tol, no --feed. */
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
-/* argv[*i] is --machine FILE, --tol MM or --feed MM/S with its value: stores it, moves *i onto
- * the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
+/* argv[*i] is --machine FILE, --tol MM, --feed MM/S or --font FILE with its value: stores it, moves
+ * *i onto the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
  * wants ..." on stderr (a usage error). */
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);
 /* Chord tolerance: tol_mm (> 0) converted, else the machine's. False when tol_mm is outside
@@ -46,17 +50,23 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
 /* Empty job: no path, no segments, diag cleared. */
 void cs_jobplan_init(cs_jobplan_t *jp);
 /* Reads file (cs_input_load: SVG, G-code, HP-GL) into jp->path. pen (NULL: none) with mode = z
- * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z; lenient: unsupported
- * G-code words are warnings. CS_OK, or an error with jp->diag filled. */
+ * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z, and lifts the pen between
+ * the strokes of SVG and HP-GL drawings (cs_pen_lift_z); lenient: unsupported G-code words are
+ * warnings. CS_OK, or an error with jp->diag filled. */
 cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
                          bool lenient);
 /* Plans jp->path whole on machine m (which must outlive jp; file names it in messages) from
- * start (cs_pos_t per axis, CS_AXES of them; NULL: the origin), chords within tol by tracer method
- * (CS_TRACE_*), at feed (mm/s Q15.16 from cs_motion_speed; 0: the machine's default) where the
- * job gives none. CS_OK with jp->mo's segments, or an error with jp->diag filled (CS_ERR_LIMIT:
- * the move that leaves the travel, or a start outside it). */
+ * start (after raising the pen there to up_z when jp->pen_raise) (cs_pos_t per axis, CS_AXES of
+ * them; NULL: the origin), chords within tol by tracer method (CS_TRACE_*), at feed (mm/s Q15.16
+ * from cs_motion_speed; 0: the machine's default) where the job gives none. CS_OK with jp->mo's
+ * segments, or an error with jp->diag filled (CS_ERR_LIMIT: the move that leaves the travel, or a
+ * start outside it). */
 cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t *m,
                          const cs_pos_t *start, cs_pos_t tol, int method, int32_t feed);
+/* The planned job can go down a device link (serial, the daemon): CS_OK, or CS_ERR_UNSUPPORTED
+ * with jp->diag "file: ..." when it holds servo pen events, which the wire protocol does not
+ * carry yet (plan and the simulator do). */
+cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file);
 /* The exit status for error e of cs_jobplan_read / _plan: a file that cannot be read as a job
  * (anything but running out of memory, CS_ERR_FULL) and a job the machine cannot do (outside the
  * travel, a number out of range, a tolerance it cannot meet, a curve too deep for the tracer)

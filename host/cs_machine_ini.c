@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "cs_conv.h"
 #include "cs_err_text.h"
@@ -20,7 +21,7 @@ typedef struct {
     double segment_ms;
     bool has_a;
     cs_machine_pen_t pen;
-    bool has_up_z, has_down_z;
+    bool has_up_z, has_down_z, has_up_us, has_down_us;
     char reason[200];
     int bad_line;
 } ini_ctx_t;
@@ -90,9 +91,33 @@ void cs_machine_ini_pen_default(cs_machine_pen_t *pen)
 {
     memset(pen, 0, sizeof *pen);
     pen->mode = CS_MACHINE_PEN_NONE;
+    pen->settle_ms = 150; /* a hobby servo's 60-degree move at 0.1-0.15 s, plus margin */
 }
 
-/* [pen]: mode = none | z, up_z, down_z (mm). */
+/* [pen] servo keys: up_us, down_us (pulse widths), settle_ms. -1: not one of them. */
+static int servo_key(ini_ctx_t *c, const char *section, const char *name, const char *value)
+{
+    double d;
+    bool up = strcasecmp(name, "up_us") == 0, down = strcasecmp(name, "down_us") == 0;
+    if (up || down) {
+        if (!parse_num(value, &d) || d < CS_MACHINE_SERVO_MIN_US || d > CS_MACHINE_SERVO_MAX_US ||
+            d != floor(d))
+            return fail(c, "[%s] %s: must be a whole number of microseconds in [400, 2600]",
+                        section, name);
+        *(up ? &c->pen.up_us : &c->pen.down_us) = (unsigned)d;
+        *(up ? &c->has_up_us : &c->has_down_us) = true;
+        return 1;
+    }
+    if (strcasecmp(name, "settle_ms") == 0) {
+        if (!parse_num(value, &d) || !(d >= 0) || d > CS_MACHINE_SERVO_MAX_SETTLE_MS)
+            return fail(c, "[%s] %s: must be a time in [0, 5000] ms", section, name);
+        c->pen.settle_ms = d;
+        return 1;
+    }
+    return -1;
+}
+
+/* [pen]: mode = none | z | servo, up_z, down_z (mm), z_feed (mm/s), servo keys above. */
 static int pen_key(ini_ctx_t *c, const char *section, const char *name, const char *value)
 {
     double d;
@@ -102,13 +127,28 @@ static int pen_key(ini_ctx_t *c, const char *section, const char *name, const ch
             c->pen.mode = CS_MACHINE_PEN_NONE;
         else if (strcasecmp(value, "z") == 0)
             c->pen.mode = CS_MACHINE_PEN_Z;
+        else if (strcasecmp(value, "servo") == 0)
+            c->pen.mode = CS_MACHINE_PEN_SERVO;
         else
-            return fail(c, "[%s] %s: expected none or z", section, name);
+            return fail(c, "[%s] %s: expected none, z or servo", section, name);
+        return 1;
+    }
+    int servo = servo_key(c, section, name, value);
+    if (servo >= 0)
+        return servo;
+    if (strcasecmp(name, "z_feed") == 0) {
+        /* 32768 mm/s: the Q15.16 speed's range (cs_motion_speed), as --feed */
+        if (!parse_num(value, &d) || !(d >= 0) || d >= 32768)
+            return fail(c, "[%s] %s: must be a speed in [0, 32768) mm/s (0: rapid)", section, name);
+        c->pen.z_feed_mm_s = d;
         return 1;
     }
     bool up = strcasecmp(name, "up_z") == 0;
     if (!up && strcasecmp(name, "down_z") != 0)
-        return fail(c, "[%s] %s: unknown key (expected mode, up_z or down_z)", section, name);
+        return fail(c,
+                    "[%s] %s: unknown key (expected mode, up_z, down_z, z_feed, up_us, down_us "
+                    "or settle_ms)",
+                    section, name);
     if (!parse_num(value, &d) || cs_conv_mm_to_pos(d, &q) != CS_OK)
         return fail(c, "[%s] %s: must be a number in [-4096, 4096] mm", section, name);
     if (up) {
@@ -269,6 +309,14 @@ static int finish(ini_ctx_t *c, int rc, const char *name, char *err, size_t errl
                 return -1;
             }
     }
+    if (c->pen.mode == CS_MACHINE_PEN_SERVO) {
+        /* No default pulse widths: the wrong one could drive the pen into the paper. */
+        if (!c->has_up_us || !c->has_down_us || c->pen.up_us == c->pen.down_us) {
+            snprintf(err, errlen, "%s:0: [pen] mode = servo needs up_us and down_us, different",
+                     name);
+            return -1;
+        }
+    }
     cs_planner_t pl;
     cs_err_t e = cs_planner_init(&pl, m);
     if (e != CS_OK) {
@@ -323,4 +371,46 @@ int cs_machine_ini_parse(const char *text, const char *name, cs_machine_t *m, ch
                          size_t errlen)
 {
     return cs_machine_ini_parse_pen(text, name, m, NULL, err, errlen);
+}
+
+#ifndef CS_SYSCONFDIR
+#define CS_SYSCONFDIR "/etc"
+#endif
+
+/* dir/rest into out when dir is set and the file is there. */
+static bool found_in(const char *dir, const char *rest, char *out, size_t outlen)
+{
+    if (dir == NULL || dir[0] == '\0')
+        return false;
+    int n = snprintf(out, outlen, "%s/%s", dir, rest);
+    return n > 0 && (size_t)n < outlen && access(out, R_OK) == 0;
+}
+
+bool cs_machine_ini_find(char *out, size_t outlen)
+{
+    /* XDG Base Directory Specification: $XDG_CONFIG_HOME, else $HOME/.config */
+    return found_in(getenv("XDG_CONFIG_HOME"), "curvestep/machine.ini", out, outlen) ||
+           found_in(getenv("HOME"), ".config/curvestep/machine.ini", out, outlen) ||
+           found_in(CS_SYSCONFDIR, "curvestep/machine.ini", out, outlen);
+}
+
+int cs_machine_ini_open(const char *who, const char *given, cs_machine_t *m, cs_machine_pen_t *pen,
+                        char *err, size_t errlen)
+{
+    char found[4096];
+    const char *file = given;
+    if (file == NULL && cs_machine_ini_find(found, sizeof found))
+        file = found;
+    if (file == NULL) {
+        fprintf(stderr,
+                "%s: machine: the built-in machine (no --machine, no machine.ini found; "
+                "see docs/plotting.md)\n",
+                who);
+        cs_machine_ini_default(m);
+        if (pen)
+            cs_machine_ini_pen_default(pen);
+        return 0;
+    }
+    fprintf(stderr, "%s: machine: %s%s\n", who, file, given ? "" : " (found)");
+    return cs_machine_ini_load_pen(file, m, pen, err, errlen);
 }

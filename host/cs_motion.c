@@ -8,6 +8,7 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_input.h"
+#include "cs_pen.h"
 #include "cs_trace.h"
 
 cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m)
@@ -20,11 +21,28 @@ cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m)
     return e;
 }
 
+void cs_motion_segs_free(cs_motion_segs_t *s)
+{
+    free(s->v);
+    free(s->pens);
+    memset(s, 0, sizeof *s);
+}
+
 void cs_motion_free(cs_motion_t *mo)
 {
-    free(mo->segs.v);
-    mo->segs.v = NULL;
-    mo->segs.n = mo->segs.cap = 0;
+    cs_motion_segs_free(&mo->segs);
+}
+
+/* Records a pen event before segment seg. */
+static cs_err_t add_pen(cs_motion_segs_t *v, size_t seg, uint16_t pulse_us)
+{
+    void *b = v->pens;
+    if (!cs_path_grow(&b, &v->cappens, v->npens + 1, sizeof *v->pens))
+        return CS_ERR_FULL;
+    v->pens = b;
+    v->pens[v->npens].seg = seg;
+    v->pens[v->npens++].pulse_us = pulse_us;
+    return CS_OK;
 }
 
 static cs_err_t push(cs_motion_t *mo, const cs_segment_t *s)
@@ -77,6 +95,21 @@ cs_err_t cs_motion_line(cs_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t
     return e;
 }
 
+cs_err_t cs_motion_pen(cs_motion_t *mo, uint16_t pulse_us, double settle_ms)
+{
+    cs_err_t e = cs_motion_finish(mo);
+    if (e == CS_OK)
+        e = add_pen(&mo->segs, mo->segs.n, pulse_us);
+    /* the wait, in segments of at most 2^24 ticks (cs_segment_t's limit), at least one tick */
+    double left = fmax(1.0, ceil(settle_ms * mo->m->tick_hz / 1000.0));
+    while (e == CS_OK && left > 0) {
+        cs_segment_t s = {(uint32_t)fmin(left, (double)(1u << 24)), {0, 0, 0, 0}};
+        left -= s.ticks;
+        e = push(mo, &s);
+    }
+    return e;
+}
+
 int32_t cs_motion_speed(double mm_s)
 {
     if (!(mm_s > 0))
@@ -106,17 +139,35 @@ cs_err_t cs_motion_finish(cs_motion_t *mo)
     return CS_OK;
 }
 
+static void write_seg(FILE *f, const cs_machine_t *m, const cs_segment_t *s)
+{
+    fprintf(f, "%u %d %d %d", (unsigned)s->ticks, (int)s->steps[0], (int)s->steps[1],
+            (int)s->steps[2]);
+    if (m->n_axes > 3)
+        fprintf(f, " %d", (int)s->steps[3]);
+    fputc('\n', f);
+}
+
 int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_t n)
 {
     fprintf(f, "# curvestep segments tick_hz=%u axes=%u\n", (unsigned)m->tick_hz,
             (unsigned)m->n_axes);
-    for (size_t k = 0; k < n; k++) {
-        fprintf(f, "%u %d %d %d", (unsigned)s[k].ticks, (int)s[k].steps[0], (int)s[k].steps[1],
-                (int)s[k].steps[2]);
-        if (m->n_axes > 3)
-            fprintf(f, " %d", (int)s[k].steps[3]);
-        fputc('\n', f);
+    for (size_t k = 0; k < n; k++)
+        write_seg(f, m, &s[k]);
+    return ferror(f) ? -1 : 0;
+}
+
+int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s)
+{
+    cs_motion_write(f, m, s->v, 0); /* the header */
+    size_t p = 0;
+    for (size_t k = 0; k < s->n; k++) {
+        for (; p < s->npens && s->pens[p].seg == k; p++)
+            fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
+        write_seg(f, m, &s->v[k]);
     }
+    for (; p < s->npens; p++)
+        fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
     return ferror(f) ? -1 : 0;
 }
 
@@ -155,6 +206,21 @@ int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_s
                              name, lineno, hz, axes, (unsigned)m->tick_hz, (unsigned)m->n_axes);
                     return -1;
                 }
+            }
+            continue;
+        }
+        unsigned us;
+        char tail;
+        if (strncmp(p, "pen", 3) == 0) { /* a servo pen event before the next segment */
+            if (sscanf(p, "pen %u %c", &us, &tail) != 1 || us < CS_MACHINE_SERVO_MIN_US ||
+                us > CS_MACHINE_SERVO_MAX_US) {
+                snprintf(err, errlen, "%s:%u: expected \"pen PULSE_US\" with 400..2600 us", name,
+                         lineno);
+                return -1;
+            }
+            if (add_pen(out, out->n, (uint16_t)us) != CS_OK) {
+                snprintf(err, errlen, "%s:%u: out of memory", name, lineno);
+                return -1;
             }
             continue;
         }
@@ -239,15 +305,44 @@ static cs_err_t move_to(cs_motion_t *mo, const cs_vec3_t *p, int32_t feed, cs_pa
     return CS_OK;
 }
 
+/* [pen] mode = servo: raise the pen before a stroke starts (or a rapid), lower it before a
+ * drawn element while it is up; the first raise happens before the first travel. */
+static cs_err_t servo_before(cs_motion_t *mo, const cs_path_t *path, size_t k, bool *down,
+                             cs_path_diag_t *diag)
+{
+    const cs_path_elem_t *el = &path->elems[k];
+    const cs_machine_pen_t *pen = mo->pen;
+    if (pen == NULL || pen->mode != CS_MACHINE_PEN_SERVO)
+        return CS_OK;
+    cs_err_t e = CS_OK;
+    if ((k == 0 || *down) && cs_pen_stroke_starts(path, k)) {
+        e = cs_motion_pen(mo, (uint16_t)pen->up_us, pen->settle_ms);
+        *down = false;
+    }
+    if (e == CS_OK && !*down && !el->rapid) {
+        /* the travel to the element's start, then the pen comes down there */
+        e = move_to(mo, &el->curve.p[0], 0, el->loc, diag);
+        if (e != CS_OK)
+            return e;
+        e = cs_motion_pen(mo, (uint16_t)pen->down_us, pen->settle_ms);
+        *down = e == CS_OK;
+    }
+    return e != CS_OK ? cs_path_diag_set(diag, e, el->loc, "pen event: %s", cs_err_text(e)) : e;
+}
+
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag)
 {
     if (feed <= 0)
         feed = mo->m->default_feed;
     cs_vec3_t cur = {mo->pl.pos[0], mo->pl.pos[1], mo->pl.pos[2]};
+    bool down = false;
     for (size_t k = 0; k < path->n; k++) {
         const cs_path_elem_t *el = &path->elems[k];
         const cs_bezier_t *c = &el->curve;
+        cs_err_t pe = servo_before(mo, path, k, &down, diag);
+        if (pe != CS_OK)
+            return pe;
         /* The job's own feed (G-code F) wins; rapid moves (G0) run at the axes' max rates. */
         int32_t el_feed = el->rapid ? 0 : el->feed_mm_s > 0 ? cs_motion_speed(el->feed_mm_s) : feed;
         if (c->p[0].x != cur.x || c->p[0].y != cur.y || c->p[0].z != cur.z) {
@@ -269,7 +364,9 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
             return cs_path_diag_set(diag, e, el->loc, "tracing failed: %s", cs_err_text(e));
         cur = c->p[c->degree];
     }
-    cs_err_t e = cs_motion_finish(mo);
+    cs_err_t e = down ? cs_motion_pen(mo, (uint16_t)mo->pen->up_us, mo->pen->settle_ms) : CS_OK;
+    if (e == CS_OK)
+        e = cs_motion_finish(mo);
     if (e != CS_OK) {
         cs_path_loc_t loc = {path->n ? path->elems[path->n - 1].loc.file : "job", 0, 0};
         return cs_path_diag_set(diag, e, loc, "cutting segments failed: %s", cs_err_text(e));

@@ -10,17 +10,28 @@
 #include <stdio.h>
 #include <stdint.h>
 
+#include "cs_machine_ini.h"
 #include "cs_path.h"
 #include "cs_planner.h"
 #include "cs_segment.h"
 
+/* A servo pen event: before segment `seg` runs, the pen servo's pulse becomes pulse_us (that
+ * segment is the settle wait: no steps). In a segments file, a line "pen PULSE_US". */
+typedef struct {
+    size_t seg;
+    uint16_t pulse_us;
+} cs_motion_pen_t;
+
 typedef struct {
     cs_segment_t *v;
     size_t n, cap;
+    cs_motion_pen_t *pens; /* in segment order ([pen] mode = servo; none otherwise) */
+    size_t npens, cappens;
 } cs_motion_segs_t;
 
 typedef struct {
     const cs_machine_t *m;
+    const cs_machine_pen_t *pen; /* NULL or mode none / z: no pen events; servo: see plan_path */
     cs_planner_t pl;
     cs_segment_gen_t gen;
     cs_motion_segs_t segs;
@@ -34,6 +45,13 @@ typedef struct {
 cs_err_t cs_motion_init(cs_motion_t *mo, const cs_machine_t *m);
 /* Frees the segments. */
 void cs_motion_free(cs_motion_t *mo);
+/* Frees a segment list (and its pen events); empty afterwards. */
+void cs_motion_segs_free(cs_motion_segs_t *s);
+/* Appends a servo pen event: an exact stop (cs_motion_finish), then settle_ms of rest (one or
+ * more segments without steps) that begins with the pulse pulse_us. CS_ERR_FULL on OOM. */
+cs_err_t cs_motion_pen(cs_motion_t *mo, uint16_t pulse_us, double settle_ms);
+/* As cs_motion_write, with the "pen PULSE_US" line before each pen event's segment. */
+int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s);
 /* Queues a straight move to target (mm) at feed (mm/s Q15.16, <= 0 rapid); cuts segments first
  * when the ring is full. Planner errors pass through (CS_ERR_LIMIT: nothing was queued). */
 cs_err_t cs_motion_line(cs_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t feed,
@@ -47,7 +65,8 @@ cs_err_t cs_motion_finish(cs_motion_t *mo);
  * per segment, "ticks dx dy dz" (and " da" with 4 axes). Returns 0, -1 on a write error. */
 int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_t n);
 /* Reads that format (lines starting with '#' are comments; a header's tick_hz and axes must
- * match *m). Appends to *out. Returns 0, or -1 with "name:line: reason" in err. */
+ * match *m; "pen PULSE_US" lines become pen events). Appends to *out. Returns 0, or -1 with
+ * "name:line: reason" in err. */
 int cs_motion_read(FILE *f, const char *name, const cs_machine_t *m, cs_motion_segs_t *out,
                    char *err, size_t errlen);
 /* Reads a job file into *path with the host's input loader (cs_input: SVG, G-code, HPGL, by
@@ -57,10 +76,11 @@ cs_err_t cs_motion_read_job(const char *file, cs_path_t *path, cs_path_diag_t *d
 cs_err_t cs_motion_read_job_ex(const char *file, bool lenient, cs_path_t *path,
                                cs_path_diag_t *diag);
 /* Plans a whole path: from the current position a rapid move to each element that does not start
- * where the previous one ended, then the element's chords (cs_trace, tolerance tol, method) at
- * the element's own feed (G-code F), or rapid for a rapid element (G0), or else at feed (mm/s
- * Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error *diag names the
- * element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
+ * where the previous one ended (with mo->pen in mode servo: the pen raised before it and lowered
+ * after it, cs_pen_stroke_starts, and raised at the end), then the element's chords (cs_trace,
+ * tolerance tol, method) at the element's own feed (G-code F), or rapid for a rapid element (G0),
+ * or else at feed (mm/s Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error
+ * *diag names the element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag);
 /* mm/s -> Q15.16 (<= 0 stays 0: rapid). */

@@ -24,8 +24,7 @@ void cs_path_free(cs_path_t *p)
     cs_path_init(p);
 }
 
-/* Grows *buf (of elements of size sz) to hold at least need; false when out of memory. */
-static bool grow(void **buf, size_t *cap, size_t need, size_t sz)
+bool cs_path_grow(void **buf, size_t *cap, size_t need, size_t sz)
 {
     if (need <= *cap)
         return true;
@@ -49,7 +48,7 @@ const char *cs_path_intern(cs_path_t *p, const char *name)
         if (strcmp(p->files[i], name) == 0)
             return p->files[i];
     void *buf = p->files;
-    if (!grow(&buf, &p->capfiles, p->nfiles + 1, sizeof *p->files))
+    if (!cs_path_grow(&buf, &p->capfiles, p->nfiles + 1, sizeof *p->files))
         return NULL;
     p->files = buf;
     size_t len = strlen(name) + 1;
@@ -75,7 +74,7 @@ cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t
                           cs_path_loc_t loc, double feed_mm_s, bool rapid)
 {
     void *buf = p->elems;
-    if (!grow(&buf, &p->cap, p->n + 1, sizeof *p->elems))
+    if (!cs_path_grow(&buf, &p->cap, p->n + 1, sizeof *p->elems))
         return CS_ERR_FULL;
     p->elems = buf;
     if (p->pending_subpath || p->nsubpaths == 0) {
@@ -209,11 +208,11 @@ void cs_path_poly_free(cs_path_poly_t *s)
 cs_err_t cs_path_poly_move(cs_path_poly_t *s, double x, double y)
 {
     void *b = s->starts;
-    if (!grow(&b, &s->caplines, s->nlines + 1, sizeof *s->starts))
+    if (!cs_path_grow(&b, &s->caplines, s->nlines + 1, sizeof *s->starts))
         return CS_ERR_FULL;
     s->starts = b;
     b = s->pts;
-    if (!grow(&b, &s->cap, s->n + 1, sizeof *s->pts))
+    if (!cs_path_grow(&b, &s->cap, s->n + 1, sizeof *s->pts))
         return CS_ERR_FULL;
     s->pts = b;
     s->starts[s->nlines++] = s->n;
@@ -228,7 +227,7 @@ cs_err_t cs_path_poly_line(cs_path_poly_t *s, double x, double y)
     if (s->nlines == 0)
         return cs_path_poly_move(s, x, y);
     void *b = s->pts;
-    if (!grow(&b, &s->cap, s->n + 1, sizeof *s->pts))
+    if (!cs_path_grow(&b, &s->cap, s->n + 1, sizeof *s->pts))
         return CS_ERR_FULL;
     s->pts = b;
     s->pts[s->n].x = x;

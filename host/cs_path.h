@@ -46,6 +46,9 @@ typedef struct {
     bool pending_subpath; /* the next element added starts a new subpath */
 } cs_path_t;
 
+/* Grows the array *buf of elements of sz bytes (capacity *cap, doubled from 16) to hold at
+ * least need; false when out of memory (*buf unchanged). The host's one growable-array step. */
+bool cs_path_grow(void **buf, size_t *cap, size_t need, size_t sz);
 /* Empty path. */
 void cs_path_init(cs_path_t *p);
 /* Frees every element and interned name; the path is empty (and reusable) afterwards. */

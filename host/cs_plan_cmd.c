@@ -23,15 +23,20 @@ static void usage(FILE *f)
           "The machine starts at 0 and moves in straight rapid travel to each subpath start;\n"
           "G-code G0 moves are rapid too (each axis at its max_rate), G1/G2/G3 use their F.\n"
           "A summary goes to standard error: blocks, segments, steps, job time.\n"
-          "  --machine FILE.ini  machine description (default: built-in 3-axis plotter,\n"
-          "                      80 steps/mm; keys in docs/motion.md); with [pen] mode = z\n"
-          "                      G-code M3/M4 (pen down) and M5 (pen up) move Z, rapid, to\n"
-          "                      its down_z / up_z\n"
+          "  --machine FILE.ini  machine description (default: the first machine.ini found in\n"
+          "                      $XDG_CONFIG_HOME/curvestep, ~/.config/curvestep,\n"
+          "                      /etc/curvestep, else a built-in 3-axis plotter, 80 steps/mm;\n"
+          "                      keys in docs/motion.md); its [pen] lifts the pen between\n"
+          "                      strokes: [pen] mode = z moves Z to up_z / down_z (G-code\n"
+          "                      M5 / M3); [pen] mode = servo writes \"pen US\" lines, each\n"
+          "                      followed by the settle wait (docs/plotting.md)\n"
           "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
           "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
           "                      any F; default: the machine's default_feed)\n"
           "  --lenient           G-code: unsupported words are warnings (ignored), not errors\n"
+          "  --font FILE.jhf     Hershey stroke font for SVG <text> and HP-GL LB (default:\n"
+          "                      share/fonts/futural.jhf, docs/plotting.md)\n"
           "  -o OUT              write segments to OUT\n"
           "Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
           "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
@@ -94,6 +99,7 @@ int cs_cmd_plan(int argc, char **argv)
         return rc;
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    jp.font_file = jo.font_file;
     cs_err_t e = cs_jobplan_read(&jp, job, &pen, lenient);
     if (e == CS_OK)
         e = cs_jobplan_plan(&jp, job, &m, NULL, tol, method, cs_motion_speed(jo.feed_mm_s));
@@ -106,8 +112,8 @@ int cs_cmd_plan(int argc, char **argv)
             perror(out_file);
             rc = CS_EXIT_INTERNAL;
         } else {
-            if (cs_motion_write(f, &m, jp.mo.segs.v, jp.mo.segs.n) != 0 ||
-                (out_file && fclose(f) != 0) || (!out_file && fflush(f) != 0)) {
+            if (cs_motion_write_segs(f, &m, &jp.mo.segs) != 0 || (out_file && fclose(f) != 0) ||
+                (!out_file && fflush(f) != 0)) {
                 fprintf(stderr, "curvestep plan: write error\n");
                 rc = CS_EXIT_INTERNAL;
             }

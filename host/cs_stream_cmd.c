@@ -37,7 +37,8 @@ static void usage(FILE *f)
 {
     fputs("usage: curvestep stream --port DEV [--baud N] [--machine FILE.ini]\n"
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
-          "                        [--resume-from N] [--line-rate BPS] [--quiet] FILE\n"
+          "                        [--resume-from N] [--line-rate BPS] [--font FILE.jhf]\n"
+          "                        [--quiet] FILE\n"
           "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
           "       curvestep stream --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
           "                        [options] FILE\n"
@@ -50,6 +51,7 @@ static void usage(FILE *f)
           "keeping the device's queue full without ever overflowing it, resending what the\n"
           "line lost or damaged.\n"
           "  --port DEV         serial device\n"
+          "  --font FILE.jhf    Hershey stroke font for SVG <text> and HP-GL LB\n"
           "  --modbus-tcp H:P   Modbus TCP device at host H, port P (docs/modbus.md)\n"
           "  --modbus-rtu DEV   Modbus RTU device on serial line DEV (docs/modbus.md)\n"
           "  --unit ID          Modbus unit id, 1..247 (default 1)\n"
@@ -197,6 +199,9 @@ int cs_cmd_stream(int argc, char **argv)
     cs_machine_t m;
     cs_machine_pen_t pen;
     cs_pos_t tol;
+    char found[4096]; /* the default machine file, named for the Modbus and GPIO links too */
+    if (jo.machine_file == NULL && cs_machine_ini_find(found, sizeof found))
+        jo.machine_file = found;
     int mrc = cs_jobplan_machine("stream", &jo, &m, &pen, &tol);
     if (mrc != CS_EXIT_OK)
         return mrc;
@@ -204,6 +209,7 @@ int cs_cmd_stream(int argc, char **argv)
      * limits in curves mode, where the device plans again itself) */
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    jp.font_file = jo.font_file;
     cs_err_t e = cs_jobplan_read(&jp, job_file, &pen, false);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp.diag);
@@ -213,6 +219,8 @@ int cs_cmd_stream(int argc, char **argv)
     }
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
     e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_SUBDIV, feed_q);
+    if (e == CS_OK)
+        e = cs_jobplan_linkable(&jp, job_file);
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)

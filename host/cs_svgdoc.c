@@ -424,6 +424,8 @@ typedef struct {
     bool invisible;     /* visibility hidden/collapse (inherited, a child may override) */
     bool stroke, fill;  /* stroke / fill paint other than none (inherited properties) */
     double vw, vh;      /* nearest viewport's size in user units (percentages); 0 = unknown */
+    double font_size;   /* inherited font-size, user units (initial: medium = 16) */
+    int anchor;         /* inherited text-anchor: 0 start, 1 middle, 2 end */
 } frame_t;
 
 typedef struct doc doc_t;
@@ -446,6 +448,13 @@ struct doc {
     cs_err_t err;
     const char *warned[MAX_WARNED];
     size_t nwarned;
+    /* the <text> being read: its current run's characters, pen position and frame */
+    bool in_text;
+    size_t text_depth, text_tag;
+    double tx, ty;
+    frame_t tframe;
+    char *tbuf;
+    size_t tn, tcap;
 };
 
 /* Cursor at raw offset raw: forward from the moving cursor, or (for an attribute written
@@ -838,6 +847,15 @@ static void read_style(const char **atts, frame_t *f)
         f->stroke = strcmp(v, "none") != 0;
     if (get_prop(atts, "fill", v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
         f->fill = strcmp(v, "none") != 0;
+    char *end;
+    /* font-size as a number of user units (px); other forms keep the inherited size */
+    if (get_prop(atts, "font-size", v, sizeof v)) {
+        double fs = strtod(v, &end);
+        if (end != v && (*end == '\0' || strcmp(end, "px") == 0) && fs > 0)
+            f->font_size = fs;
+    }
+    if (get_prop(atts, "text-anchor", v, sizeof v) && strcmp(v, "inherit") != 0)
+        f->anchor = strcmp(v, "middle") == 0 ? 1 : strcmp(v, "end") == 0 ? 2 : 0;
 }
 
 /* --- elements ---------------------------------------------------------------------------- */
@@ -964,16 +982,21 @@ static void note_fill(doc_t *d, size_t tag)
 
 /* Parses path data text[0..n) in the current element's user space; positions come from
  * locate/ctx (into an attribute, or the element's tag for generated data). */
-static cs_err_t draw_data(doc_t *d, const char *text, size_t n, cs_svgpath_locate_fn locate,
-                          void *ctx)
+static cs_err_t draw_data_in(doc_t *d, const cs_path_affine_t *m, const char *text, size_t n,
+                             cs_svgpath_locate_fn locate, void *ctx)
 {
-    frame_t *f = &d->stack[d->depth - 1];
     cs_svgpath_opts_t po;
     cs_svgpath_opts_init(&po, d->name);
-    po.xform = cs_path_affine_mul(d->o->xform, f->m);
+    po.xform = cs_path_affine_mul(d->o->xform, *m);
     po.locate = locate;
     po.locate_ctx = ctx;
     return cs_svgpath_parse(text, n, &po, d->path, d->diag);
+}
+
+static cs_err_t draw_data(doc_t *d, const char *text, size_t n, cs_svgpath_locate_fn locate,
+                          void *ctx)
+{
+    return draw_data_in(d, &d->stack[d->depth - 1].m, text, n, locate, ctx);
 }
 
 static cs_err_t on_path(doc_t *d, const char *local, const char **atts, size_t tag)
@@ -1244,6 +1267,145 @@ static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t t
     return e;
 }
 
+/* --- text (cs_hershey stroke font) ------------------------------------------------------ */
+
+/* The first number of an x / y attribute (a list gives each character a position: only the
+ * first is used), user units; false when absent. */
+static bool first_number(const char **atts, const char *name, double *out)
+{
+    const char *v = att_get(atts, name);
+    if (!v)
+        return false;
+    char *end;
+    double x = strtod(v, &end);
+    if (end == v)
+        return false;
+    *out = x;
+    return true;
+}
+
+static cs_err_t gen_vertex(void *ctx, double x, double y, bool move)
+{
+    gen_put(ctx, "%s%.17g %.17g ", move ? "M" : "L", x, y);
+    return CS_OK;
+}
+
+/* Draws the run read so far (white space collapsed, SVG 1.1 §10.15 xml:space default) at the pen
+ * position in the run's frame, anchored, and moves the pen past it. */
+static cs_err_t text_flush(doc_t *d)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < d->tn; i++) {
+        char c = d->tbuf[i] == '\t' || d->tbuf[i] == '\n' || d->tbuf[i] == '\r' ? ' ' : d->tbuf[i];
+        if (c == ' ' && (n == 0 || d->tbuf[n - 1] == ' '))
+            continue;
+        d->tbuf[n++] = c;
+    }
+    while (n > 0 && d->tbuf[n - 1] == ' ')
+        n--;
+    d->tn = 0;
+    if (n == 0)
+        return CS_OK;
+    const frame_t *f = &d->tframe;
+    double s = f->font_size / CS_HERSHEY_BODY; /* font units -> user units */
+    double w = cs_hershey_width(d->o->font, d->tbuf, n) * s;
+    double x0 = d->tx - (f->anchor == 1 ? w / 2 : f->anchor == 2 ? w : 0);
+    gen_t g = {NULL, 0, 0, false};
+    cs_hershey_layout(d->o->font, d->tbuf, n, x0, d->ty, s, s, gen_vertex, &g);
+    d->tx = x0 + w;
+    if (g.oom) {
+        free(g.s);
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
+    }
+    attr_t a; /* positions: the <text> tag */
+    memset(&a, 0, sizeof a);
+    a.raw_start = a.raw_end = d->text_tag;
+    a.base = cursor_at(d, d->text_tag);
+    a.cur = a.base;
+    cs_err_t e = g.n ? draw_data_in(d, &f->m, g.s, g.n, attr_locate, &a) : CS_OK;
+    free(g.s);
+    return e;
+}
+
+static void XMLCALL on_chars(void *ud, const XML_Char *s, int len)
+{
+    doc_t *d = ud;
+    if (!d->in_text || d->err != CS_OK || len <= 0)
+        return;
+    if (d->tn + (size_t)len > d->tcap) {
+        size_t cap = (d->tcap ? d->tcap * 2 : 256) + (size_t)len;
+        char *nb = realloc(d->tbuf, cap);
+        if (!nb) {
+            d->err =
+                cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
+            XML_StopParser(d->xp, XML_FALSE);
+            return;
+        }
+        d->tbuf = nb;
+        d->tcap = cap;
+    }
+    memcpy(d->tbuf + d->tn, s, (size_t)len);
+    d->tn += (size_t)len;
+}
+
+static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, size_t tag);
+
+/* <text>: its characters (and those of its <tspan>s) in the stroke font, at x, y (font-size,
+ * text-anchor, transform); without a font, ignored with a warning as before. */
+static cs_err_t on_text(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    if (d->o->font == NULL)
+        return on_unsupported(d, local, atts, tag);
+    frame_t *f = &d->stack[d->depth - 1];
+    if (!drawn(d, local, tag, false))
+        return CS_OK;
+    cs_err_t e = element_transform(d, atts, tag, &f->m);
+    if (e != CS_OK)
+        return e;
+    d->tx = d->ty = 0;
+    first_number(atts, "x", &d->tx);
+    first_number(atts, "y", &d->ty);
+    d->in_text = true;
+    d->text_depth = d->depth;
+    d->text_tag = tag;
+    d->tframe = *f;
+    d->tn = 0;
+    return CS_OK;
+}
+
+/* <tspan> inside <text>: the run so far is drawn, then x / y (absolute) and its font apply. */
+static cs_err_t on_tspan(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    (void)local;
+    if (!d->in_text)
+        return CS_OK;
+    cs_err_t e = text_flush(d);
+    frame_t *f = &d->stack[d->depth - 1];
+    if (e == CS_OK)
+        e = element_transform(d, atts, tag, &f->m);
+    first_number(atts, "x", &d->tx);
+    first_number(atts, "y", &d->ty);
+    d->tframe = *f;
+    return e;
+}
+
+/* The end of <text> or of one of its <tspan>s: draws the run; after a tspan, its parent's frame
+ * applies again. */
+static void text_end(doc_t *d)
+{
+    if (!d->in_text || d->err != CS_OK)
+        return;
+    cs_err_t e = text_flush(d);
+    if (d->depth == d->text_depth)
+        d->in_text = false;
+    else if (d->depth >= 2)
+        d->tframe = d->stack[d->depth - 2];
+    if (e != CS_OK) {
+        d->err = e;
+        XML_StopParser(d->xp, XML_FALSE);
+    }
+}
+
 static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     (void)atts;
@@ -1269,8 +1431,8 @@ static const struct {
     {"symbol", on_hidden},    {"clipPath", on_hidden},   {"mask", on_hidden},
     {"marker", on_hidden},    {"pattern", on_hidden},    {"rect", on_rect},
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
-    {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_unsupported},
-    {"use", on_unsupported},  {"image", on_unsupported},
+    {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
+    {"use", on_unsupported},  {"image", on_unsupported}, {"tspan", on_tspan},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */
@@ -1308,6 +1470,7 @@ static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **atts
         memset(&d->stack[0], 0, sizeof d->stack[0]);
         d->stack[0].m = cs_path_affine_identity();
         d->stack[0].fill = true; /* SVG initial values: fill black, stroke none */
+        d->stack[0].font_size = 16; /* font-size: medium (CSS: 16 px) */
     }
     d->depth++;
     XML_Index bi = XML_GetCurrentByteIndex(d->xp);
@@ -1340,6 +1503,7 @@ static void XMLCALL on_end(void *ud, const XML_Char *el)
 {
     doc_t *d = ud;
     (void)el;
+    text_end(d);
     if (d->depth > 0)
         d->depth--;
 }
@@ -1388,6 +1552,7 @@ cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs
     }
     XML_SetUserData(d.xp, &d);
     XML_SetElementHandler(d.xp, on_start, on_end);
+    XML_SetCharacterDataHandler(d.xp, on_chars);
     enum XML_Status st = XML_Parse(d.xp, buf, (int)len, XML_TRUE);
     cs_err_t e = d.err;
     if (e == CS_OK && st != XML_STATUS_OK) {
@@ -1398,6 +1563,7 @@ cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs
     }
     XML_ParserFree(d.xp);
     free(d.stack);
+    free(d.tbuf);
     return e;
 }
 

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cs_sim_check.h"
 #include "cs_stepper.h"
 
 cs_err_t cs_sim_execute(const cs_machine_t *m, const cs_segment_t *s, size_t n, cs_sim_exec_t *ex)
@@ -177,167 +178,17 @@ double cs_sim_step_mm(const cs_machine_t *m)
     return sqrt(s);
 }
 
-static double dist_point_seg(const double *p, const double *a, const double *b)
-{
-    double ab[3], ap[3], l2 = 0, t = 0;
-    for (int i = 0; i < 3; i++) {
-        ab[i] = b[i] - a[i];
-        ap[i] = p[i] - a[i];
-        l2 += ab[i] * ab[i];
-        t += ab[i] * ap[i];
-    }
-    t = l2 > 0 ? t / l2 : 0;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    double d2 = 0;
-    for (int i = 0; i < 3; i++) {
-        double d = ap[i] - t * ab[i];
-        d2 += d * d;
-    }
-    return sqrt(d2);
-}
-
-/* A uniform 2D grid (x, y) over the reference segments, each listed in every cell its box
- * touches; a query looks at its cell and the 8 around it, so it finds every segment within one
- * cell size, and falls back to all segments when none is that close. */
-typedef struct {
-    double x0, y0, cell;
-    size_t nx, ny;
-    size_t *head; /* per cell, start in idx */
-    size_t *idx;  /* segment ids (index of its first point) */
-} grid_t;
-
-static bool seg_ok(const cs_sim_ref_t *r, size_t k, size_t *line_end)
-{
-    (void)r;
-    return k + 1 < *line_end;
-}
-
-static void each_seg_end(const cs_sim_ref_t *r, size_t li, size_t *b, size_t *e)
-{
-    *b = r->starts[li];
-    *e = li + 1 < r->nlines ? r->starts[li + 1] : r->n;
-}
-
-static int grid_build(grid_t *g, const cs_sim_ref_t *r, double cell)
-{
-    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
-    for (size_t k = 0; k < r->n; k++)
-        for (int i = 0; i < 2; i++) {
-            lo[i] = fmin(lo[i], r->xyz[3 * k + i]);
-            hi[i] = fmax(hi[i], r->xyz[3 * k + i]);
-        }
-    g->cell = cell;
-    g->x0 = lo[0];
-    g->y0 = lo[1];
-    g->nx = (size_t)((hi[0] - lo[0]) / cell) + 1;
-    g->ny = (size_t)((hi[1] - lo[1]) / cell) + 1;
-    while (g->nx * g->ny > 4000000) {
-        g->cell *= 2;
-        g->nx = (size_t)((hi[0] - lo[0]) / g->cell) + 1;
-        g->ny = (size_t)((hi[1] - lo[1]) / g->cell) + 1;
-    }
-    size_t ncell = g->nx * g->ny;
-    g->head = calloc(ncell + 1, sizeof *g->head);
-    if (g->head == NULL)
-        return -1;
-    for (int pass = 0; pass < 2; pass++) {
-        for (size_t li = 0; li < r->nlines; li++) {
-            size_t b, e;
-            each_seg_end(r, li, &b, &e);
-            for (size_t k = b; seg_ok(r, k, &e); k++) {
-                const double *p = &r->xyz[3 * k], *q = &r->xyz[3 * k + 3];
-                size_t cx0 = (size_t)((fmin(p[0], q[0]) - g->x0) / g->cell);
-                size_t cx1 = (size_t)((fmax(p[0], q[0]) - g->x0) / g->cell);
-                size_t cy0 = (size_t)((fmin(p[1], q[1]) - g->y0) / g->cell);
-                size_t cy1 = (size_t)((fmax(p[1], q[1]) - g->y0) / g->cell);
-                for (size_t cy = cy0; cy <= cy1 && cy < g->ny; cy++)
-                    for (size_t cx = cx0; cx <= cx1 && cx < g->nx; cx++) {
-                        size_t c = cy * g->nx + cx;
-                        if (pass == 0)
-                            g->head[c + 1]++;
-                        else
-                            g->idx[g->head[c]++] = k;
-                    }
-            }
-        }
-        if (pass == 0) {
-            for (size_t c = 0; c < ncell; c++)
-                g->head[c + 1] += g->head[c];
-            g->idx = malloc((g->head[ncell] + 1) * sizeof *g->idx);
-            if (g->idx == NULL)
-                return -1;
-        } else {
-            /* head[c] now points at the end of cell c: shift back to starts. */
-            for (size_t c = ncell; c > 0; c--)
-                g->head[c] = g->head[c - 1];
-            g->head[0] = 0;
-        }
-    }
-    return 0;
-}
-
-static double brute(const cs_sim_ref_t *r, const double *p)
-{
-    double best = HUGE_VAL;
-    for (size_t li = 0; li < r->nlines; li++) {
-        size_t b, e;
-        each_seg_end(r, li, &b, &e);
-        if (e - b == 1)
-            best = fmin(best, dist_point_seg(p, &r->xyz[3 * b], &r->xyz[3 * b]));
-        for (size_t k = b; k + 1 < e; k++)
-            best = fmin(best, dist_point_seg(p, &r->xyz[3 * k], &r->xyz[3 * k + 3]));
-    }
-    return best;
-}
-
-static double grid_query(const grid_t *g, const cs_sim_ref_t *r, const double *p)
-{
-    double best = HUGE_VAL;
-    long cx = (long)floor((p[0] - g->x0) / g->cell), cy = (long)floor((p[1] - g->y0) / g->cell);
-    for (long y = cy - 1; y <= cy + 1; y++)
-        for (long x = cx - 1; x <= cx + 1; x++) {
-            if (x < 0 || y < 0 || x >= (long)g->nx || y >= (long)g->ny)
-                continue;
-            size_t c = (size_t)y * g->nx + (size_t)x;
-            for (size_t j = g->head[c]; j < g->head[c + 1]; j++) {
-                size_t k = g->idx[j];
-                best = fmin(best, dist_point_seg(p, &r->xyz[3 * k], &r->xyz[3 * k + 3]));
-            }
-        }
-    if (best > g->cell)
-        best = brute(r, p); /* nothing within one cell: look everywhere */
-    return best;
-}
-
 double cs_sim_deviation(const cs_machine_t *m, const cs_sim_exec_t *ex, const cs_sim_ref_t *r,
                         double where[3])
 {
     if (r->n == 0)
         return HUGE_VAL;
-    grid_t g = {0};
-    bool use_grid = grid_build(&g, r, 1.0) == 0;
-    double spm[CS_AXES];
-    for (unsigned i = 0; i < CS_AXES; i++)
-        spm[i] = i < m->n_axes ? (double)m->axis[i].steps_per_mm / CS_MOTION_ONE : 1.0;
-    int64_t pos[CS_AXES] = {0, 0, 0, 0};
-    double worst = -1;
-    for (size_t e = 0; e <= ex->n; e++) {
-        if (e > 0)
-            pos[ex->edges[e - 1].axis] += ex->edges[e - 1].dir;
-        /* Several axes stepping at the same tick move together: measure after the last. */
-        if (e < ex->n && e > 0 && ex->edges[e].t == ex->edges[e - 1].t)
-            continue;
-        double p[3] = {(double)pos[0] / spm[0], (double)pos[1] / spm[1], (double)pos[2] / spm[2]};
-        double d = use_grid ? grid_query(&g, r, p) : brute(r, p);
-        if (d > worst) {
-            worst = d;
-            if (where)
-                memcpy(where, p, sizeof p);
-        }
-    }
-    free(g.head);
-    free(g.idx);
-    return worst;
+    cs_sim_check_t c; /* the 3D check through the grid (cs_sim_check), segments unnamed */
+    if (cs_sim_check(m, NULL, ex, r, NULL, &c) != CS_OK)
+        return HUGE_VAL;
+    if (where)
+        memcpy(where, c.dev_at, sizeof c.dev_at);
+    return c.dev;
 }
 
 cs_err_t cs_sim_ref_from_path(cs_sim_ref_t *r, const cs_path_t *path, double end[3])

@@ -192,8 +192,36 @@ static double top_speed(const sample_t *s, size_t n)
     return vmax;
 }
 
-static void bounds(const sample_t *s, size_t n, const cs_sim_ref_t *ref, const cs_sim_view_t *view,
-                   double lo[2], double hi[2])
+/* The page outline: the machine's x y travel as drawn in the picture, for the default and top
+ * views, when it is a real bed (both spans under 2 m: not the built-in machine's 2 m box). */
+static bool bed_box(const cs_machine_t *m, const cs_sim_view_t *view, double lo[2], double hi[2])
+{
+    double x0 = (double)m->axis[0].travel_min / CS_POS_ONE_MM;
+    double x1 = (double)m->axis[0].travel_max / CS_POS_ONE_MM;
+    double y0 = (double)m->axis[1].travel_min / CS_POS_ONE_MM;
+    double y1 = (double)m->axis[1].travel_max / CS_POS_ONE_MM;
+    if (view->m[0][2] != 0 || view->m[1][2] != 0 || view->m[0][1] != 0 || x1 - x0 >= 2000 ||
+        y1 - y0 >= 2000)
+        return false; /* a view with z in it, or no bed to speak of */
+    double a[2], b[2], p[3] = {x0, y0, 0}, q[3] = {x1, y1, 0};
+    cs_sim_view_project(view, p, a);
+    cs_sim_view_project(view, q, b);
+    lo[0] = fmin(a[0], b[0]);
+    lo[1] = fmin(a[1], b[1]);
+    hi[0] = fmax(a[0], b[0]);
+    hi[1] = fmax(a[1], b[1]);
+    return true;
+}
+
+static void speed_rgb(double f, double rgb[3]);
+
+/* The legend band under the drawing: its top y and text size (picture mm). */
+typedef struct {
+    double x0, y, u, w;
+} legend_t;
+
+static void bounds(const cs_machine_t *m, const sample_t *s, size_t n, const cs_sim_ref_t *ref,
+                   const cs_sim_view_t *view, double lo[2], double hi[2], legend_t *lg)
 {
     lo[0] = lo[1] = HUGE_VAL;
     hi[0] = hi[1] = -HUGE_VAL;
@@ -215,11 +243,67 @@ static void bounds(const sample_t *s, size_t n, const cs_sim_ref_t *ref, const c
         lo[0] = lo[1] = 0;
         hi[0] = hi[1] = 1;
     }
+    double blo[2], bhi[2];
+    if (bed_box(m, view, blo, bhi))
+        for (int i = 0; i < 2; i++) {
+            lo[i] = fmin(lo[i], blo[i]);
+            hi[i] = fmax(hi[i], bhi[i]);
+        }
     double pad = fmax(hi[0] - lo[0], hi[1] - lo[1]) * 0.03 + 1;
     lo[0] -= pad;
     lo[1] -= pad;
     hi[0] += pad;
     hi[1] += pad;
+    /* the legend: a band 6 % of the width tall under everything, text a third of it */
+    lg->x0 = lo[0] + pad;
+    lg->w = hi[0] - lo[0] - 2 * pad;
+    lg->u = (hi[0] - lo[0]) * 0.06 / 3;
+    lg->y = hi[1];
+    hi[1] += 3 * lg->u;
+}
+
+/* x positions of the legend's three items: speed bar, travel, exact geometry. */
+static double legend_x(const legend_t *lg, int item)
+{
+    return lg->x0 + lg->w * (item == 0 ? 0.0 : item == 1 ? 0.4 : 0.7);
+}
+
+static void svg_legend(FILE *f, const legend_t *lg, double vmax, double lw, bool travel,
+                       const cs_machine_t *m, const cs_sim_view_t *view)
+{
+    double y = lg->y + 1.5 * lg->u, bar = lg->w * 0.3, x = legend_x(lg, 0);
+    fprintf(f, "<g class=\"legend\" font-family=\"sans-serif\" font-size=\"%.4f\">\n", lg->u);
+    for (int k = 0; k < 20; k++) {
+        double rgb[3];
+        speed_rgb((k + 0.5) / 20, rgb);
+        fprintf(f,
+                "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
+                "fill=\"#%02x%02x%02x\"/>\n",
+                x + bar * k / 20, y - lg->u * 0.4, bar / 20 + lw, lg->u * 0.8, (int)(rgb[0] * 255),
+                (int)(rgb[1] * 255), (int)(rgb[2] * 255));
+    }
+    fprintf(f, "<text x=\"%.4f\" y=\"%.4f\">speed 0 .. %.1f mm/s (drawing)</text>\n", x,
+            y + 1.3 * lg->u, vmax);
+    x = legend_x(lg, 1);
+    if (travel)
+        fprintf(f,
+                "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"#999999\" "
+                "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\"/>\n"
+                "<text x=\"%.4f\" y=\"%.4f\">pen-up travel</text>\n",
+                x, y, x + 3 * lg->u, y, lw, 6 * lw, 4 * lw, x + 3.5 * lg->u, y + 0.35 * lg->u);
+    double bx = x; /* the bed's note goes under the travel sample */
+    x = legend_x(lg, 2);
+    fprintf(f,
+            "<line x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" stroke=\"black\" "
+            "stroke-width=\"%.4f\"/>\n<text x=\"%.4f\" y=\"%.4f\">exact geometry</text>\n",
+            x, y, x + 3 * lg->u, y, lw, x + 3.5 * lg->u, y + 0.35 * lg->u);
+    double blo[2], bhi[2];
+    if (bed_box(m, view, blo, bhi))
+        fprintf(f,
+                "<text x=\"%.4f\" y=\"%.4f\">grey box: the machine's x y travel; "
+                "x right, y %s</text>\n",
+                bx, y + 1.3 * lg->u, view->y_down ? "down" : "up");
+    fprintf(f, "</g>\n");
 }
 
 /* Speed fraction f in [0, 1] -> blue (slow) .. green .. red (fast). */
@@ -293,7 +377,8 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
         free(s);
         return -1;
     }
-    bounds(s, n, ref, view, lo, hi);
+    legend_t lg;
+    bounds(m, s, n, ref, view, lo, hi, &lg);
     double w = hi[0] - lo[0], h = hi[1] - lo[1], lw = fmax(w, h) / 1500;
     fprintf(f,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -304,6 +389,13 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
             "<rect x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" fill=\"white\"/>\n",
             w, h, lo[0], lo[1], w, h, view->name, vmax, travel ? ", travel moves dashed grey" : "",
             lo[0], lo[1], w, h);
+    double blo[2], bhi[2];
+    if (bed_box(m, view, blo, bhi))
+        fprintf(f,
+                "<rect class=\"bed\" x=\"%.4f\" y=\"%.4f\" width=\"%.4f\" height=\"%.4f\" "
+                "fill=\"none\" stroke=\"#bbbbbb\" stroke-width=\"%.4f\"/>\n",
+                blo[0], blo[1], bhi[0] - blo[0], bhi[1] - blo[1], 2 * lw);
+    svg_legend(f, &lg, vmax, 2 * lw, travel, m, view);
     /* Travel first (underneath): runs of travel samples as dashed grey polylines. */
     for (size_t k = 1; k < n;) {
         if (!s[k].travel) {
@@ -355,6 +447,53 @@ static void png_ref_run(void *ctx, const cs_sim_ref_t *ref, size_t b, size_t n,
     cairo_stroke(cr);
 }
 
+/* The PNG's page outline and legend (as svg_legend). */
+static void png_bed_legend(cairo_t *cr, const legend_t *lg, double vmax, double scale, bool travel,
+                           const cs_machine_t *m, const cs_sim_view_t *view)
+{
+    double blo[2], bhi[2], y = lg->y + 1.5 * lg->u, bar = lg->w * 0.3, x = legend_x(lg, 0);
+    char t[96];
+    cairo_set_line_width(cr, 2.0 / scale);
+    cairo_set_source_rgb(cr, 0.73, 0.73, 0.73);
+    bool bed = bed_box(m, view, blo, bhi);
+    if (bed) {
+        cairo_rectangle(cr, blo[0], blo[1], bhi[0] - blo[0], bhi[1] - blo[1]);
+        cairo_stroke(cr);
+    }
+    for (int k = 0; k < 20; k++) {
+        double rgb[3];
+        speed_rgb((k + 0.5) / 20, rgb);
+        cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+        cairo_rectangle(cr, x + bar * k / 20, y - lg->u * 0.4, bar / 20 + 1 / scale, lg->u * 0.8);
+        cairo_fill(cr);
+    }
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, lg->u);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    snprintf(t, sizeof t, "speed 0 .. %.1f mm/s (drawing)", vmax);
+    cairo_move_to(cr, x, y + 1.3 * lg->u);
+    cairo_show_text(cr, t);
+    for (int item = travel ? 1 : 2; item <= 2; item++) {
+        x = legend_x(lg, item);
+        double dash[2] = {6.0 / scale, 4.0 / scale};
+        cairo_set_dash(cr, dash, item == 1 ? 2 : 0, 0);
+        cairo_set_source_rgb(cr, item == 1 ? 0.6 : 0, item == 1 ? 0.6 : 0, item == 1 ? 0.6 : 0);
+        cairo_move_to(cr, x, y);
+        cairo_line_to(cr, x + 3 * lg->u, y);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, NULL, 0, 0);
+        cairo_set_source_rgb(cr, 0, 0, 0);
+        cairo_move_to(cr, x + 3.5 * lg->u, y + 0.35 * lg->u);
+        cairo_show_text(cr, item == 1 ? "pen-up travel" : "exact geometry");
+    }
+    if (bed) {
+        snprintf(t, sizeof t, "grey box: the machine's x y travel; x right, y %s",
+                 view->y_down ? "down" : "up");
+        cairo_move_to(cr, legend_x(lg, 1), y + 1.3 * lg->u);
+        cairo_show_text(cr, t);
+    }
+}
+
 int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                          const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px)
 {
@@ -363,9 +502,10 @@ int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_e
     sample_t *s = exec_samples(m, ex, view, &n);
     if (s == NULL)
         return -1;
-    classify(s, n, ref);
+    bool travel = classify(s, n, ref);
     double vmax = top_speed(s, n);
-    bounds(s, n, ref, view, lo, hi);
+    legend_t lg;
+    bounds(m, s, n, ref, view, lo, hi, &lg);
     double w = hi[0] - lo[0], h = hi[1] - lo[1];
     double scale = width_px / w;
     int height_px = (int)ceil(h * scale);
@@ -380,6 +520,7 @@ int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_e
     cairo_scale(cr, scale, scale);
     cairo_translate(cr, -lo[0], -lo[1]);
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+    png_bed_legend(cr, &lg, vmax, scale, travel, m, view);
     /* Travel: thin dashed grey, underneath. */
     double dash[2] = {6.0 / scale, 4.0 / scale};
     cairo_set_dash(cr, dash, 2, 0);

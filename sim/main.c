@@ -8,9 +8,11 @@
 #include <string.h>
 
 #include "cs_err_text.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_sim.h"
+#include "cs_sim_check.h"
 #include "cs_sim_device.h"
 #include "cs_sim_draw.h"
 #include "cs_sim_modbus.h"
@@ -22,7 +24,8 @@ static void usage(FILE *f)
     fputs(
         "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
         "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-        "                     [--window MS] [--lenient] [--view top|front|side|iso]\n"
+        "                     [--window MS] [--lenient] [--font FILE.jhf]\n"
+        "                     [--view top|front|side|iso]\n"
         "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
         "       curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu ...  (the device behind\n"
         "                     Modbus: --modbus-tcp --help)\n"
@@ -34,9 +37,13 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    --lenient as for plan), the largest distance from any position the\n"
-        "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
-        "    plus one step, and whether the final position is the job's end rounded to steps.\n"
+        "    --lenient and --font as for plan; the machine's [pen] lifts included), the\n"
+        "    largest distance from any position the steps visit to the exact geometry\n"
+        "    (evaluated in double), against the tolerance plus one step, and whether the final\n"
+        "    position is the job's end rounded to steps. With a [pen] (mode z: the pen is down\n"
+        "    nearer down_z than up_z; mode servo: by the segments' \"pen US\" lines) only\n"
+        "    pen-down x y motion is measured (in x y), and every drawn stroke must be reached\n"
+        "    pen down: a pen-down travel or a stroke passed pen up fails, naming the segment.\n"
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
         "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
         "                    with --reference, executed travel moves (the job's G0 moves and\n"
@@ -52,6 +59,61 @@ static void usage(FILE *f)
         f);
 }
 
+/* The job as `plan` reads it with the machine's [pen] (cs_jobplan_read: pen lifts included),
+ * as dense reference polylines; *end gets its last point. */
+static cs_err_t read_reference(const char *file, const char *font, const cs_machine_pen_t *pen,
+                               bool lenient, cs_sim_ref_t *ref, double end[3])
+{
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    jp.font_file = font;
+    cs_err_t e = cs_jobplan_read(&jp, file, pen, lenient);
+    if (e == CS_OK)
+        e = cs_sim_ref_from_path(ref, &jp.path, end);
+    else
+        cs_path_diag_print(stderr, &jp.diag);
+    cs_jobplan_free(&jp);
+    return e;
+}
+
+/* Prints the geometric check (cs_sim_check) and the final position; true when both pass. */
+static bool report_check(const cs_machine_t *m, const cs_motion_segs_t *segs,
+                         const cs_sim_exec_t *ex, const cs_sim_ref_t *ref,
+                         const cs_machine_pen_t *pen, const double end[3])
+{
+    cs_sim_check_t c;
+    if (cs_sim_check(m, segs, ex, ref, pen, &c) != CS_OK) {
+        fprintf(stderr, "curvestep-sim: out of memory in the check\n");
+        return false;
+    }
+    double bound = cs_machine_ini_to_double(m->tolerance) + cs_sim_step_mm(m);
+    bool dev_ok = c.dev <= bound, drawn_ok = !c.pen || c.undrawn <= bound;
+    printf("deviation%s: %.5f mm at (%.4f, %.4f, %.4f), segment %zu (tolerance + one step = "
+           "%.5f mm) %s\n",
+           c.pen ? " of pen-down motion (x y)" : "", c.dev, c.dev_at[0], c.dev_at[1], c.dev_at[2],
+           c.dev_seg, bound,
+           dev_ok  ? "ok"
+           : c.pen ? "OVER: a pen-down travel"
+                   : "OVER");
+    if (c.pen)
+        printf("pen: %zu pen-downs; drawn strokes reached pen down within %.5f mm, worst at "
+               "(%.4f, %.4f) %s\n",
+               c.pen_downs, c.undrawn, c.undrawn_at[0], c.undrawn_at[1],
+               drawn_ok ? "ok" : "NOT DRAWN");
+    if (!drawn_ok)
+        printf("pen: segment %zu moves pen up over a stroke the job draws\n", c.undrawn_seg);
+    bool end_ok = true;
+    for (unsigned i = 0; i < 3; i++) {
+        double spm = (double)m->axis[i].steps_per_mm / CS_MOTION_ONE;
+        long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
+        if (want != ex->pos[i])
+            end_ok = false;
+    }
+    printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0], end[1],
+           end[2], end_ok ? "exact" : "DIFFERENT");
+    return dev_ok && drawn_ok && end_ok;
+}
+
 int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++) /* device mode: the simulator behind a serial line */
@@ -63,6 +125,7 @@ int main(int argc, char **argv)
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
     bool check = false, lenient = false;
+    const char *font = NULL;
     double window_ms = 50;
     long png_width = 1600;
     cs_sim_view_t view;
@@ -108,6 +171,8 @@ int main(int argc, char **argv)
             check = true;
         } else if (strcmp(a, "--lenient") == 0) {
             lenient = true;
+        } else if (strcmp(a, "--font") == 0 && has) {
+            font = argv[++i];
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             usage(stderr);
@@ -119,14 +184,12 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_machine_ini_pen_default(&pen);
     char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return EXIT_INPUT;
-        }
-    } else {
-        cs_machine_ini_default(&m);
+    if (cs_machine_ini_open("curvestep-sim", machine_file, &m, &pen, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return EXIT_INPUT;
     }
     FILE *f = strcmp(replay, "-") == 0 ? stdin : fopen(replay, "r");
     if (f == NULL) {
@@ -139,14 +202,14 @@ int main(int argc, char **argv)
         fclose(f);
     if (r != 0) {
         fprintf(stderr, "%s\n", err);
-        free(segs.v);
+        cs_motion_segs_free(&segs);
         return EXIT_INPUT;
     }
     cs_sim_exec_t ex;
     cs_err_t e = cs_sim_execute(&m, segs.v, segs.n, &ex);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep-sim: execution failed: %s\n", cs_err_text(e));
-        free(segs.v);
+        cs_motion_segs_free(&segs);
         return EXIT_INTERNAL;
     }
     bool ok = true;
@@ -174,37 +237,12 @@ int main(int argc, char **argv)
     cs_sim_ref_init(&ref);
     int rc = EXIT_OK;
     if (reference) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_path_diag_t diag;
-        e = cs_motion_read_job_ex(reference, lenient, &path, &diag);
         double end[3];
-        if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &path, end);
-        else
-            cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
-        if (e != CS_OK) {
+        e = read_reference(reference, font, &pen, lenient, &ref, end);
+        if (e != CS_OK)
             rc = EXIT_INPUT;
-        } else {
-            double where[3];
-            double dev = cs_sim_deviation(&m, &ex, &ref, where);
-            double bound = cs_machine_ini_to_double(m.tolerance) + cs_sim_step_mm(&m);
-            bool dev_ok = dev <= bound;
-            printf("deviation: %.5f mm at (%.4f, %.4f, %.4f) (tolerance + one step = %.5f mm) "
-                   "%s\n",
-                   dev, where[0], where[1], where[2], bound, dev_ok ? "ok" : "OVER");
-            bool end_ok = true;
-            for (unsigned i = 0; i < 3; i++) {
-                double spm = (double)m.axis[i].steps_per_mm / CS_MOTION_ONE;
-                long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
-                if (want != ex.pos[i])
-                    end_ok = false;
-            }
-            printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0],
-                   end[1], end[2], end_ok ? "exact" : "DIFFERENT");
-            ok = ok && dev_ok && end_ok;
-        }
+        else
+            ok = report_check(&m, &segs, &ex, &ref, &pen, end) && ok;
     }
     if (rc == EXIT_OK && trace && cs_sim_write_trace(trace, &m, &ex) != 0) {
         perror(trace);
@@ -226,6 +264,6 @@ int main(int argc, char **argv)
     }
     cs_sim_ref_free(&ref);
     cs_sim_exec_free(&ex);
-    free(segs.v);
+    cs_motion_segs_free(&segs);
     return rc;
 }

@@ -108,13 +108,14 @@ run "plan bad -o" 1 plan -o "$T/seg.txt" "$T/e2.nc" &&
     { [ ! -s "$T/seg.txt" ] && ok || ko "plan bad -o: segments written"; }
 
 # --- pen lift: [pen] mode = z in the machine file turns M3 / M5 into Z moves -------------------
-# 80 steps/mm: M3 lowers Z 0 -> -1 mm (-80 steps), M5 raises it -1 -> 4 mm (+400 steps); X goes
-# 0 -> 20 -> 0 (net 0); without [pen] Z never moves.
+# 80 steps/mm: the program starts pen up (Z 0 -> 4 mm, +320 steps, before G0 X10 travels), M3
+# lowers Z 4 -> -1 mm (-400 steps), M5 raises it -1 -> 4 mm (+400 steps); X goes 0 -> 20 -> 0
+# (net 0); without [pen] Z never moves.
 printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n' >"$T/pen.ini"
 printf 'G0 X10\nM3\nG1 X20 F600\nM5\nG0 X0\n' >"$T/pen.nc"
 zsum() { awk 'NR > 1 { if ($4 > 0) p += $4; else n += $4; x += $2 } END { print p + 0, n + 0, x + 0 }' "$T/out"; }
 run "pen z" 0 plan --machine "$T/pen.ini" "$T/pen.nc" &&
-    { [ "$(zsum)" = "400 -80 0" ] && ok || ko "pen z: z up, z down, net x = $(zsum), expected 400 -80 0"; }
+    { [ "$(zsum)" = "720 -400 0" ] && ok || ko "pen z: z up, z down, net x = $(zsum), expected 720 -400 0"; }
 run "pen none" 0 plan "$T/pen.nc" &&
     { [ "$(zsum)" = "0 0 0" ] && ok || ko "pen none: $(zsum), expected 0 0 0"; }
 printf '[pen]\nmode = z\nup_z = 4\ndown_z = -1\n[z]\ntravel_min = 0\n' >"$T/pen-bad.ini"
@@ -123,7 +124,7 @@ run "pen outside travel" 1 plan --machine "$T/pen-bad.ini" "$T/pen.nc" &&
     expect_empty_out "pen outside travel"
 printf '[pen]\nmode = lift\n' >"$T/pen-bad2.ini"
 run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
-    expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
+    expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none, z or servo"
 
 # stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
 # (320 steps), x back at 0.

@@ -247,7 +247,8 @@ static void test_pen_z_moves(void **state)
     const char *t = "G0 X5\nM3\nG1 X10 F60\nM5\nG0 X0\n";
     assert_int_equal(cs_gcode_read("t.nc", t, strlen(t), &o, &P, &D, NULL), CS_OK);
     assert_int_equal(P.n, 5);
-    expect_pt(1, 0, 5, 0, 0, PT_TOL);
+    expect_pt(0, 0, 0, 0, 2.5, PT_TOL); /* the program starts pen up: G0 X5 travels at Z2.5 */
+    expect_pt(1, 0, 5, 0, 2.5, PT_TOL);
     expect_pt(1, 1, 5, 0, -1, PT_TOL); /* M3: down to Z-1, rapid */
     assert_true(P.elems[1].rapid);
     expect_pt(2, 1, 10, 0, -1, PT_TOL);

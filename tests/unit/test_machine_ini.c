@@ -168,7 +168,7 @@ static void test_pen_section(void **state)
         cs_machine_ini_parse_pen("[pen]\nmode = none\n", "p.ini", &m, &pen, err, sizeof err), 0);
     assert_int_equal(pen.mode, CS_MACHINE_PEN_NONE);
 
-    expect_error("[pen]\nmode = lift\n", "bad.ini:2: [pen] mode: expected none or z");
+    expect_error("[pen]\nmode = lift\n", "bad.ini:2: [pen] mode: expected none, z or servo");
     expect_error("[pen]\nmode = z\nheight = 3\n", "bad.ini:3: [pen] height: unknown key");
     expect_error("[pen]\nup_z = high\n", "bad.ini:2: [pen] up_z: must be a number");
     expect_error("[pen]\ndown_z = 5000\n", "bad.ini:2: [pen] down_z: must be a number in");
