@@ -11,7 +11,9 @@
 #include "cs_arc.h"
 #include "cs_conv.h"
 #include "cs_err_text.h"
-#include "cs_nurbs.h"
+#include "cs_gexpr.h"
+#include "cs_gflow.h"
+#include "cs_gnurbs.h"
 
 #define MM_PER_INCH 25.4
 /* pi, spelled out: M_PI is POSIX, not C99 (the fuzz build uses plain -std=c99). */
@@ -26,15 +28,16 @@
 #define ARC_TOL_MM      (2 * 0.01 * SQRT2)
 #define ARC_TOL_INCH    (2 * 0.001 * SQRT2)
 #define ARC_REL_TOL     0.001
+#define ARC_TOL_HARD    100.0 /* beyond 100 x the absolute tolerance: refused whatever the radius */
 #define RADIUS_TOL_INCH 0.00005
+/* Grbl 1.1 (gcode.c, the I/J/K arc's final error checks): the end radius may differ from the
+ * start radius by 0.005 mm; beyond that, an error if over 0.5 mm or over 0.1 % of the radius. */
+#define GRBL_ARC_TOL_MM      0.005
+#define GRBL_ARC_HARD_MM     0.5
 /* Largest sweep of one arc piece: under 90 degrees, so cs_arc_gcode returns exactly one piece. */
 #define ARC_PIECE_MAX (0.999 * GC_PI / 2.0)
 /* Most pieces one G2/G3 may become (a helix of many turns at a fine tolerance). */
 #define ARC_MAX_PIECES 100000u
-/* Most control points in one G5.2 block (the knots 0..n-k+2 must fit cs_nurbs_knot_t). */
-#define NURBS_MAX_POINTS 10000u
-#define NURBS_MAX_ORDER  (CS_NURBS_MAX_DEGREE + 1)
-#define NUM_MAX_CHARS    64
 
 /* Motion modes: the G number times ten. */
 enum {
@@ -46,7 +49,8 @@ enum {
     MOT_G3 = 30,
     MOT_G5 = 50,
     MOT_G51 = 51,
-    MOT_G52 = 52
+    MOT_G52 = 52,
+    MOT_G62 = 62
 };
 
 typedef struct {
@@ -54,10 +58,6 @@ typedef struct {
     double v;
     unsigned col;
 } word_t;
-
-typedef struct {
-    double x, y, w;
-} nurbs_cp_t;
 
 typedef struct {
     const char *name;
@@ -74,17 +74,20 @@ typedef struct {
     bool ijk_abs;  /* G90.1 */
     int plane;     /* 17, 18, 19 */
     int motion;    /* MOT_* */
+    int dropped_code; /* --lenient: the unsupported motion code MOT_DROPPED stands for */
     double feed;   /* F in program units per minute; 0 = none given */
     bool g5_prev;  /* the last move was a G5: its P, Q continue */
     double g5_pq[2];
     bool last_rapid;
     bool ended; /* M2 / M30 */
-    /* open G5.2 block */
-    nurbs_cp_t *cps;
-    size_t ncps, capcps;
-    unsigned nurbs_order;
+    /* open NURBS block: G5.2 (until G5.3) or G6.2 (until a line without K) */
+    cs_gnurbs_t nb;
+    int nurbs;          /* 0 (none), MOT_G52 or MOT_G62 */
+    bool g62_knots;     /* the G6.2 block has reached its knot-only lines */
+    bool emit_failed;   /* a NURBS segment could not be added (diag set) */
     cs_path_loc_t nurbs_loc;
     double nurbs_feed;
+    cs_gexpr_store_t st; /* parameters (LinuxCNC) */
 } gc_t;
 
 /* One line's words. */
@@ -262,6 +265,11 @@ static cs_err_t emit_arc(gc_t *g, const double c[3], const double t[3], double s
     unsigned n = (unsigned)ceil(asw / ARC_PIECE_MAX);
     if (n < 1)
         n = 1;
+    /* A spiral (r0 != r1, within LinuxCNC's tolerance): each piece is a circular arc whose end
+     * is snapped onto the spiral, so a piece may change the radius by at most half the helix
+     * tolerance. */
+    while (fabs(r1 - r0) / n > g->o->helix_tol_mm / 2 && n < ARC_MAX_PIECES)
+        n = n * 2 > ARC_MAX_PIECES ? ARC_MAX_PIECES : n * 2;
     if (dz != 0.0) {
         if (g->stats)
             g->stats->helices++;
@@ -369,6 +377,28 @@ static double radius_tol(void)
     return RADIUS_TOL_INCH * MM_PER_INCH; /* LinuxCNC: the same length in either unit */
 }
 
+/* The end radius r1 of an I/J/K arc against its start radius r0 (mm). LinuxCNC (interp_arc.cc):
+ * refused when the difference exceeds 100 times the absolute tolerance, or exceeds it while
+ * also over 0.1 % of the radius (a spiral within those is cut as one). Grbl 1.1 (gcode.c):
+ * refused over 0.005 mm when also over 0.5 mm or 0.1 % of the start radius. */
+static cs_err_t arc_radius_check(gc_t *g, double r0, double r1, unsigned col)
+{
+    double ae = fabs(r0 - r1), rel = ae / fmax(r0, r1);
+    bool grbl = g->o->dialect == CS_GCODE_GRBL;
+    double tol = grbl ? GRBL_ARC_TOL_MM : arc_tol(g);
+    double hard = grbl ? GRBL_ARC_HARD_MM : ARC_TOL_HARD * tol;
+    if (grbl)
+        rel = ae / r0;
+    if (ae > hard || (ae > tol && rel > ARC_REL_TOL))
+        return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, col),
+                                "radius to end of arc (%.4f mm) differs from radius to start "
+                                "(%.4f mm) by %.4f mm (%.3f%%); %s accepts up to %.4f mm, or up "
+                                "to %.4f mm within 0.1%%%s",
+                                r1, r0, ae, 100 * rel, grbl ? "Grbl" : "LinuxCNC", tol, hard,
+                                grbl ? " (Grbl: error:33)" : "");
+    return CS_OK;
+}
+
 /* G2 / G3. */
 static cs_err_t do_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
 {
@@ -416,7 +446,7 @@ static cs_err_t do_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
                                     "P (turns) must be a whole number from 1 to 1000");
         turns = (int)pw->v;
     }
-    double tol = arc_tol(g), rtol = radius_tol();
+    double rtol = radius_tol();
     const double *s = g->pos;
     double s0 = s[ax[0]], s1 = s[ax[1]], e0 = t[ax[0]], e1 = t[ax[1]];
     double c[3] = {0, 0, 0};
@@ -475,13 +505,9 @@ static cs_err_t do_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
         if (r0 < rtol || r1 < rtol)
             return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, col),
                                     "zero-radius arc (start or end on the centre)");
-        double ae = fabs(r0 - r1), rel = ae / fmax(r0, r1);
-        if (ae > tol || rel > ARC_REL_TOL)
-            return cs_path_diag_set(g->diag, CS_ERR_DEGENERATE, loc_at(g, col),
-                                    "radius to end of arc (%.4f mm) differs from radius to "
-                                    "start (%.4f mm) by %.4f mm (%.3f%%); at most %.4f mm and "
-                                    "0.1%% are accepted",
-                                    r1, r0, ae, 100 * rel, tol);
+        cs_err_t ea = arc_radius_check(g, r0, r1, col);
+        if (ea != CS_OK)
+            return ea;
     }
     double a0 = atan2(s1 - c[ax[1]], s0 - c[ax[0]]);
     double a1 = atan2(e1 - c[ax[1]], e0 - c[ax[0]]);
@@ -572,182 +598,192 @@ static cs_err_t do_spline(gc_t *g, block_t *b, bool quad, unsigned col)
     return e;
 }
 
-/* G5.3: the open G5.2 block becomes Bézier segments (cs_nurbs), LinuxCNC's uniform clamped knot
- * vector of order k over n+1 points: k zeros, 1 .. n-k+1, k times n-k+2. */
-static cs_err_t nurbs_close(gc_t *g)
+/* ---- NURBS blocks: G5.2 ... G5.3 and G6.2 (cs_gnurbs) ------------------------------------ */
+
+static cs_err_t nurbs_emit(void *ctx, const cs_bezier_t *seg)
 {
-    unsigned k = g->nurbs_order;
-    size_t cnt = g->ncps;
-    cs_path_loc_t loc = g->nurbs_loc;
-    if (cnt < k)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc,
-                                "G5.2 block of order %u needs at least %u control points "
-                                "(has %zu)",
-                                k, k, cnt);
-    size_t n = cnt - 1;
-    cs_vec3_t *pts = malloc(cnt * sizeof *pts);
-    int32_t *w = malloc(cnt * sizeof *w);
-    cs_nurbs_knot_t *kn = malloc((cnt + k) * sizeof *kn);
-    cs_err_t e = CS_OK;
-    if (!pts || !w || !kn) {
-        e = cs_path_diag_set(g->diag, CS_ERR_FULL, loc, "out of memory");
-        goto out;
-    }
-    double wmax = 0;
-    for (size_t i = 0; i < cnt; i++)
-        wmax = fmax(wmax, g->cps[i].w);
-    for (size_t i = 0; i < cnt; i++) {
-        double p[3] = {g->cps[i].x, g->cps[i].y, g->pos[2]};
-        if ((e = to_vec(g, p, loc.col, &pts[i])) != CS_OK)
-            goto out;
-        double wq = nearbyint(g->cps[i].w / wmax * (double)CS_PARAM_ONE);
-        if (!(wq >= 1)) {
-            e = cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc,
-                                 "weight P%g is too small next to the largest weight P%g",
-                                 g->cps[i].w, wmax);
-            goto out;
-        }
-        w[i] = (int32_t)wq;
-    }
-    for (size_t i = 0; i <= n + k; i++) {
-        size_t v = i < k ? 0 : i <= n ? i - k + 1 : n - k + 2;
-        kn[i] = (cs_nurbs_knot_t)v * CS_NURBS_KNOT_ONE;
-    }
-    cs_nurbs_t nc;
-    e = cs_nurbs_init(&nc, k - 1, pts, w, cnt, kn, cnt + k);
-    if (e != CS_OK) {
-        e = cs_path_diag_set(g->diag, e, loc, "bad G5.2 block: %s", cs_err_text(e));
-        goto out;
-    }
-    cs_nurbs_iter_t it;
-    cs_nurbs_iter_begin(&nc, &it);
-    cs_bezier_t seg;
-    cs_vec3_t prev = pts[0];
-    double save_feed = g->feed;
-    g->feed = g->nurbs_feed;
-    size_t nseg = cs_nurbs_segments(&nc), iseg = 0;
-    while ((e = cs_nurbs_next(&nc, &it, &seg, NULL, NULL)) == CS_OK) {
-        /* Consecutive segments share their end point to within 1 LSB: snap them together (and
-         * the block's ends onto its first and last control points, where a clamped curve ends). */
-        seg.p[0] = prev;
-        if (++iseg == nseg)
-            seg.p[seg.degree] = pts[cnt - 1];
-        prev = seg.p[seg.degree];
-        cs_err_t ea = add(g, &seg, CS_PATH_OTHER, loc.col, false);
-        if (ea != CS_OK) {
-            g->feed = save_feed;
-            e = ea;
-            goto out;
-        }
-    }
-    g->feed = save_feed;
-    if (e != CS_END) {
-        e = cs_path_diag_set(g->diag, e, loc, "cannot convert this G5.2 block: %s", cs_err_text(e));
-        goto out;
-    }
-    e = CS_OK;
-    g->pos[0] = g->cps[cnt - 1].x;
-    g->pos[1] = g->cps[cnt - 1].y;
-out:
-    free(pts);
-    free(w);
-    free(kn);
-    g->ncps = 0;
+    gc_t *g = ctx;
+    cs_err_t e = add(g, seg, CS_PATH_OTHER, g->nurbs_loc.col, false);
+    g->emit_failed = e != CS_OK;
     return e;
 }
 
-static cs_err_t nurbs_push(gc_t *g, double x, double y, double w)
+/* The open block becomes Bézier segments, at the feed of its first line. */
+static cs_err_t nurbs_close(gc_t *g)
 {
-    if (g->ncps >= NURBS_MAX_POINTS)
-        return cs_path_diag_set(g->diag, CS_ERR_FULL, g->nurbs_loc,
-                                "G5.2 block with more than %u control points", NURBS_MAX_POINTS);
-    if (g->ncps == g->capcps) {
-        size_t nc = g->capcps ? 2 * g->capcps : 16;
-        nurbs_cp_t *p = realloc(g->cps, nc * sizeof *p);
-        if (!p)
-            return cs_path_diag_set(g->diag, CS_ERR_FULL, g->nurbs_loc, "out of memory");
-        g->cps = p;
-        g->capcps = nc;
-    }
-    g->cps[g->ncps].x = x;
-    g->cps[g->ncps].y = y;
-    g->cps[g->ncps].w = w;
-    g->ncps++;
+    const char *gname = g->nurbs == MOT_G62 ? "G6.2" : "G5.2";
+    char why[160];
+    double save_feed = g->feed;
+    g->feed = g->nurbs_feed;
+    g->emit_failed = false;
+    cs_err_t e = cs_gnurbs_build(&g->nb, nurbs_emit, g, why, sizeof why);
+    g->feed = save_feed;
+    g->nurbs = 0;
+    if (e != CS_OK)
+        return g->emit_failed ? e : cs_path_diag_set(g->diag, e, g->nurbs_loc, "%s block: %s",
+                                                     gname, why);
+    memcpy(g->pos, g->nb.cps[g->nb.n - 1].p, sizeof g->pos);
     return CS_OK;
+}
+
+static cs_err_t nurbs_push(gc_t *g, const double p[3], double w)
+{
+    if (cs_gnurbs_push(&g->nb, p, w) != CS_OK)
+        return cs_path_diag_set(g->diag, CS_ERR_FULL, g->nurbs_loc,
+                                "NURBS block with more than %u control points (or out of memory)",
+                                CS_GNURBS_MAX_POINTS);
+    return CS_OK;
+}
+
+/* A control point's axis words: the two of the plane (G5.2 works in G17, G18 and G19 as
+ * LinuxCNC runs it), none of its normal. */
+static cs_err_t nurbs_plane_words(gc_t *g, block_t *b, bool *has)
+{
+    int ax[3];
+    plane_axes(g->plane, ax);
+    const word_t *A = &b->w['X' - 'A' + ax[0]], *B = &b->w['X' - 'A' + ax[1]];
+    const word_t *N = &b->w['X' - 'A' + ax[2]];
+    if (N->has)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, N->col),
+                                "G5.2 control points in G%d are in %c and %c (no %c word)",
+                                g->plane, 'X' + ax[0], 'X' + ax[1], 'X' + ax[2]);
+    if (A->has != B->has)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, (A->has ? A : B)->col),
+                                "a G5.2 control point in G%d needs both %c and %c", g->plane,
+                                'X' + ax[0], 'X' + ax[1]);
+    *has = A->has;
+    return CS_OK;
+}
+
+/* The G5.2 line: opens the block with the tool's position as its first control point. */
+static cs_err_t nurbs_open52(gc_t *g, block_t *b, unsigned col, bool has)
+{
+    const word_t *P = &b->w['P' - 'A'], *L = &b->w['L' - 'A'];
+    if (g->incr)
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col),
+                                "G5.2 control points in G91 (incremental) mode are not "
+                                "supported");
+    g->nurbs = MOT_G52;
+    g->nurbs_loc = loc_at(g, col);
+    g->nurbs_feed = g->feed;
+    cs_gnurbs_begin(&g->nb, 3);
+    if (L->has) {
+        b->used |= BIT('L');
+        if (L->v != floor(L->v))
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, L->col),
+                                    "L (order) must be a whole number");
+        /* LinuxCNC takes L only when it is above 3 (the default order). */
+        if (L->v > CS_GNURBS_MAX_ORDER)
+            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, L->col),
+                                    "NURBS order L%g: at most %d (cubic) is supported", L->v,
+                                    CS_GNURBS_MAX_ORDER);
+        if (L->v > 3)
+            g->nb.order = (unsigned)L->v;
+    }
+    double w0 = (!has && P->has) ? P->v : 1.0;
+    if (!(w0 > 0))
+        return cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc_at(g, P->col),
+                                "G5.2 weight P must be positive");
+    return nurbs_push(g, g->pos, w0);
 }
 
 /* A G5.2 line (first = the line that carries G5.2) or a control point line inside the block. */
 static cs_err_t do_nurbs_line(gc_t *g, block_t *b, bool first, unsigned col)
 {
-    const word_t *X = &b->w['X' - 'A'], *Y = &b->w['Y' - 'A'], *P = &b->w['P' - 'A'];
-    const word_t *L = &b->w['L' - 'A'];
-    if (first) {
-        if (g->plane != 17)
-            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col),
-                                    "G5.2 works in the G17 (XY) plane only");
-        if (g->incr)
-            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col),
-                                    "G5.2 control points in G91 (incremental) mode are not "
-                                    "supported");
-        g->nurbs_loc = loc_at(g, col);
-        g->nurbs_order = 3;
-        g->nurbs_feed = g->feed;
-        g->ncps = 0;
-        double w0 = (!X->has && !Y->has && P->has) ? P->v : 1.0;
-        if (!(w0 > 0))
-            return cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc_at(g, P->col),
-                                    "G5.2 weight P must be positive");
-        cs_err_t e = nurbs_push(g, g->pos[0], g->pos[1], w0);
-        if (e != CS_OK)
-            return e;
-    }
-    if (L->has) {
-        b->used |= BIT('L');
-        if (!first)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, L->col),
-                                    "L (order) belongs on the G5.2 line");
-        if (L->v != floor(L->v))
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, L->col),
-                                    "L (order) must be a whole number");
-        /* LinuxCNC takes L only when it is above 3 (the default order). */
-        if (L->v > NURBS_MAX_ORDER)
-            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, L->col),
-                                    "NURBS order L%g: at most %d (cubic) is supported", L->v,
-                                    NURBS_MAX_ORDER);
-        if (L->v > 3)
-            g->nurbs_order = (unsigned)L->v;
-    }
-    if (b->w['Z' - 'A'].has)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, b->w['Z' - 'A'].col),
-                                "G5.2 control points are in X and Y only (no Z word)");
-    if (X->has != Y->has)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, (X->has ? X : Y)->col),
-                                "a G5.2 control point needs both X and Y");
+    const word_t *P = &b->w['P' - 'A'], *L = &b->w['L' - 'A'];
+    bool has = false;
+    cs_err_t e = nurbs_plane_words(g, b, &has);
+    if (e != CS_OK)
+        return e;
+    if (first && (e = nurbs_open52(g, b, col, has)) != CS_OK)
+        return e;
+    if (L->has && !first)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, L->col),
+                                "L (order) belongs on the G5.2 line");
     if (P->has)
         b->used |= BIT('P');
-    if (!X->has)
+    if (!has)
         return CS_OK;
     if (!P->has || !(P->v > 0))
-        return cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc_at(g, P->has ? P->col : X->col),
+        return cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc_at(g, P->has ? P->col : col),
                                 "each G5.2 control point needs a positive weight P");
     double t[3];
     target_of(g, b, t);
-    return nurbs_push(g, t[0], t[1], P->v);
+    return nurbs_push(g, t, P->v);
+}
+
+/* A G6.2 line (first) or a line of its block: "G6.2 P<order> K<knot> X.. Y.. Z.. R<weight>",
+ * then "K.. X.. Y.. Z.. R.." per control point, then "K.." alone for the last order knots (the
+ * block form of Fanuc's G06.2 that LinuxCNC's G6.2 follows). Axis words left out keep the
+ * previous control point's value; R defaults to 1. */
+static cs_err_t do_g62_line(gc_t *g, block_t *b, bool first, unsigned col)
+{
+    const word_t *P = &b->w['P' - 'A'], *K = &b->w['K' - 'A'], *R = &b->w['R' - 'A'];
+    if (first) {
+        if (!P->has || P->v != floor(P->v) || P->v < 2 || P->v > CS_GNURBS_MAX_ORDER)
+            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, P->has ? P->col : col),
+                                    "G6.2 needs P, the order: 2 to %d (cubic) are supported",
+                                    CS_GNURBS_MAX_ORDER);
+        if (g->incr)
+            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col),
+                                    "G6.2 control points in G91 (incremental) mode are not "
+                                    "supported");
+        b->used |= BIT('P');
+        g->nurbs = MOT_G62;
+        g->g62_knots = false;
+        g->nurbs_loc = loc_at(g, col);
+        g->nurbs_feed = g->feed;
+        cs_gnurbs_begin(&g->nb, (unsigned)P->v);
+    }
+    if (!K->has)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                "each line of a G6.2 block needs its knot K");
+    b->used |= BIT('K') | BIT('R');
+    if (cs_gnurbs_knot(&g->nb, K->v) != CS_OK)
+        return cs_path_diag_set(g->diag, CS_ERR_FULL, loc_at(g, K->col), "too many G6.2 knots");
+    if (!any_axis(b) && !R->has && !first) {
+        g->g62_knots = true;
+        return g->nb.nknots == g->nb.n + g->nb.order ? nurbs_close(g) : CS_OK;
+    }
+    if (g->g62_knots)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                "G6.2 control point after the knot-only lines that end the block");
+    if (R->has && !(R->v > 0))
+        return cs_path_diag_set(g->diag, CS_ERR_WEIGHT, loc_at(g, R->col),
+                                "G6.2 weight R must be positive");
+    double t[3];
+    memcpy(t, g->nb.n ? g->nb.cps[g->nb.n - 1].p : g->pos, sizeof t);
+    for (int a = 0; a < 3; a++) {
+        const word_t *w = &b->w['X' - 'A' + a];
+        if (w->has) {
+            b->used |= BIT('X' + a);
+            t[a] = w->v * g->unit + g->off[a];
+        }
+    }
+    cs_vec3_t v0, v1;
+    if (first && (to_vec(g, g->pos, col, &v0) != CS_OK || to_vec(g, t, col, &v1) != CS_OK ||
+                  !vec_eq(&v0, &v1)))
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                "the first G6.2 control point must be where the tool is "
+                                "(%.4f, %.4f, %.4f) mm", g->pos[0], g->pos[1], g->pos[2]);
+    return nurbs_push(g, t, R->has ? R->v : 1.0);
 }
 
 /* ---- one block --------------------------------------------------------------------------- */
 
-static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
+/* Letters this reader does not carry out (each once), then F and S. */
+static cs_err_t run_letters(gc_t *g, block_t *b)
 {
-    cs_err_t e;
-    /* Unsupported letters first (each once). */
     static const char supported[] = "FGIJKLMNPQRSXYZ";
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || strchr(supported, 'A' + i))
             continue;
         char what[48];
         snprintf(what, sizeof what, "the %c word", 'A' + i);
-        if (i == 'T' - 'A' && g->o->lenient) {
+        cs_err_t e;
+        if (i == 'T' - 'A' && g->o->dialect == CS_GCODE_GRBL) {
+            /* Grbl 1.1 reads T and changes nothing (it has no tool changer). */
+        } else if (i == 'T' - 'A' && g->o->lenient) {
             /* No tool changer: the tool in the machine stays, nothing moves. */
             warn(g, b->w[i].col, "T (tool select): ignored, there is no tool changer (--lenient)");
         } else if ((e = unsupported(g, b->w[i].col, what)) != CS_OK) {
@@ -771,12 +807,26 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, b->w['S' - 'A'].col),
                                     "S (spindle speed) must not be negative");
     }
-    /* M words (pen / spindle before the motion, program end after it). */
-    bool end = false;
+    return CS_OK;
+}
+
+/* A G or M code's name ("G5.2", "M30"). */
+static void code_name(char *out, size_t cap, char letter, int v)
+{
+    if (v % 10)
+        snprintf(out, cap, "%c%d.%d", letter, v / 10, v % 10);
+    else
+        snprintf(out, cap, "%c%d", letter, v / 10);
+}
+
+/* M words: pen / spindle before the motion; *end for M2 / M30. */
+static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
+{
+    cs_err_t e;
     for (unsigned i = 0; i < b->nm; i++) {
         int m = b->m[i];
         if (m == 20 || m == 300) {
-            end = true;
+            *end = true;
         } else if (m == 30 || m == 40 || m == 50) {
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
              * with opts->pen_z a rapid Z move to the pen height. */
@@ -789,203 +839,285 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
                 memcpy(g->pos, t, sizeof g->pos);
                 cs_path_new_subpath(g->path);
             }
+        } else if (m == 70 || m == 80 || m == 90) {
+            /* Coolant mist / flood / off (LinuxCNC and Grbl): nothing to draw or move. */
         } else {
             char what[32];
-            if (m % 10)
-                snprintf(what, sizeof what, "M%d.%d", m / 10, m % 10);
-            else
-                snprintf(what, sizeof what, "M%d", m / 10);
+            code_name(what, sizeof what, 'M', m);
             if ((e = unsupported(g, b->mcol[i], what)) != CS_OK)
                 return e;
         }
     }
-    /* Modal G words, then the motion. */
-    int motion = -2; /* none on this line */
-    unsigned mcol = first_col;
-    bool g92 = false, drop_words = false;
-    unsigned g92col = 0;
-    for (unsigned i = 0; i < b->ng; i++) {
+    return CS_OK;
+}
+
+/* What the G words of one line ask for. */
+typedef struct {
+    int motion; /* MOT_*, 53 (G5.3), or -2: no motion word on the line */
+    unsigned mcol;
+    bool g92, g64, drop;
+    int drop_code;
+    unsigned g92col, g64col, dropcol;
+} gline_t;
+
+/* G codes this reader carries out in LinuxCNC's dialect that Grbl 1.1 does not have. */
+static bool grbl_lacks(int v)
+{
+    return v == 50 || v == 51 || v == 52 || v == 53 || v == 62 || v == 640 || v == 611 ||
+           v == 901;
+}
+
+/* Codes that move (threading, probing, canned cycles...) or read the line's axis words for
+ * another purpose (G4 dwell, G10, G28/G30 home, G52, G53, G92.2/3): when --lenient drops one, the
+ * whole block goes with it; moving to its axis words as an ordinary move could plunge the tool. */
+static bool moves_or_takes_axes(int v, bool *motion)
+{
+    *motion = v == 330 || v == 331 || (v >= 382 && v <= 385) || v == 730 || v == 740 ||
+              v == 760 || (v >= 810 && v <= 890) || (v >= 50 && v <= 53) || v == 62;
+    return *motion || v == 40 || v == 100 || v == 280 || v == 281 || v == 300 || v == 301 ||
+           v == 520 || v == 530 || v == 922 || v == 923;
+}
+
+static cs_err_t set_motion(gc_t *g, gline_t *l, int v, unsigned c)
+{
+    if (l->motion != -2)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, c),
+                                "two motion words on one line");
+    l->motion = v;
+    l->mcol = c;
+    return CS_OK;
+}
+
+/* An unsupported G code: an error, or (lenient) dropped, with its block when it moves. */
+static cs_err_t drop_g(gc_t *g, gline_t *l, int v, unsigned c)
+{
+    char what[48];
+    code_name(what, sizeof what, 'G', v);
+    if (g->o->dialect == CS_GCODE_GRBL && grbl_lacks(v))
+        strcat(what, " (not in Grbl 1.1)");
+    if (!g->o->lenient)
+        return unsupported(g, c, what);
+    bool motion;
+    if (!moves_or_takes_axes(v, &motion)) {
+        warn(g, c, "%s is not supported: ignored (--lenient)", what);
+        return CS_OK;
+    }
+    l->drop = true;
+    l->drop_code = v;
+    l->dropcol = c;
+    return motion ? set_motion(g, l, MOT_DROPPED, c) : CS_OK;
+}
+
+/* G64 [P tolerance] [Q]: blending; P (program units) is the path tolerance the program asks for. */
+static cs_err_t run_g64(gc_t *g, block_t *b, unsigned col)
+{
+    const word_t *P = &b->w['P' - 'A'], *Q = &b->w['Q' - 'A'];
+    if (Q->has)
+        b->used |= BIT('Q'); /* LinuxCNC's naive-CAM merge tolerance: every point is kept */
+    if (!P->has)
+        return CS_OK;
+    b->used |= BIT('P');
+    if (P->v < 0)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, P->col),
+                                "G64 P (path tolerance) must not be negative");
+    double mm = P->v * g->unit;
+    (void)col;
+    if (mm > 0 && (g->path->blend_tol_mm == 0 || mm < g->path->blend_tol_mm))
+        g->path->blend_tol_mm = mm;
+    return CS_OK;
+}
+
+/* The modal G words of a line into the state, the motion word and the specials into *l. */
+static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
+{
+    cs_err_t e = CS_OK;
+    for (unsigned i = 0; i < b->ng && e == CS_OK; i++) {
         int v = b->g[i];
         unsigned c = b->gcol[i];
+        if (g->o->dialect == CS_GCODE_GRBL && grbl_lacks(v)) {
+            e = drop_g(g, l, v, c);
+            continue;
+        }
         switch (v) {
-        case 0:
-        case 10:
-        case 20:
-        case 30:
-        case 50:
-        case 51:
-        case 52:
-        case 53:
-        case 800:
-            if (motion != -2)
-                return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, c),
-                                        "two motion words on one line");
-            motion = v == 800 ? MOT_NONE : v;
-            mcol = c;
+        case 0: case 10: case 20: case 30: case 50: case 51: case 52: case 53: case 62:
+            e = set_motion(g, l, v, c);
             break;
-        case 170:
-        case 180:
-        case 190:
-            g->plane = v / 10;
-            break;
-        case 200:
-            g->unit = MM_PER_INCH;
-            break;
-        case 210:
-            g->unit = 1.0;
-            break;
-        case 900:
-            g->incr = false;
-            break;
-        case 910:
-            g->incr = true;
-            break;
-        case 901:
-            g->ijk_abs = true;
-            break;
-        case 911:
-            g->ijk_abs = false;
-            break;
-        case 920:
-            g92 = true;
-            g92col = c;
-            break;
-        case 921:
-            memset(g->off, 0, sizeof g->off);
-            break;
+        case 800: e = set_motion(g, l, MOT_NONE, c); break;
+        case 170: case 180: case 190: g->plane = v / 10; break;
+        case 200: g->unit = MM_PER_INCH; break;
+        case 210: g->unit = 1.0; break;
+        case 900: g->incr = false; break;
+        case 910: g->incr = true; break;
+        case 901: g->ijk_abs = true; break;
+        case 911: g->ijk_abs = false; break;
+        case 920: l->g92 = true; l->g92col = c; break;
+        case 921: memset(g->off, 0, sizeof g->off); break;
+        case 640: l->g64 = true; l->g64col = c; break;
+        case 610: /* exact path, */
+        case 611: /* exact stop: curvestep never rounds a corner off, so the path is the same */
         case 940: /* feed in units per minute: the only feed mode */
         case 540: /* the first work coordinate system: the only one */
         case 400: /* cutter radius compensation off */
         case 490: /* tool length offset off */
             break;
-        default: {
-            char what[32];
-            if (v % 10)
-                snprintf(what, sizeof what, "G%d.%d", v / 10, v % 10);
-            else
-                snprintf(what, sizeof what, "G%d", v / 10);
-            if ((e = unsupported(g, c, what)) != CS_OK)
-                return e;
-            /* Lenient: a dropped code that moves (threading, probing, canned cycles) takes its
-             * motion mode with it, and one that reads the line's axis words for another purpose
-             * (G4 dwell, G10, G28/G30 home, G52, G53 machine coordinates, G92.2/3) takes the
-             * words: moving to them as if they were an ordinary move could plunge the tool. */
-            if (v == 330 || v == 331 || (v >= 382 && v <= 385) || v == 730 || v == 740 ||
-                v == 760 || (v >= 810 && v <= 890)) {
-                if (motion != -2)
-                    return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, c),
-                                            "two motion words on one line");
-                motion = MOT_DROPPED;
-                mcol = c;
-                drop_words = true;
-            } else if (v == 40 || v == 100 || v == 280 || v == 281 || v == 300 || v == 301 ||
-                       v == 520 || v == 530 || v == 922 || v == 923) {
-                drop_words = true;
-            }
-        }
+        default:
+            e = drop_g(g, l, v, c);
         }
     }
-    if (drop_words) {
-        bool any = false;
-        for (const char *q = "XYZIJKRPQL"; *q; q++) {
-            any = any || b->w[*q - 'A'].has;
-            b->w[*q - 'A'].has = false;
-        }
-        if (any)
-            warn(g, first_col,
-                 "the line's axis and arc words go with the unsupported code: "
-                 "ignored (--lenient)");
+    return e;
+}
+
+/* Lenient: the dropped code's block is skipped whole; one warning names it and its words. */
+static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
+{
+    char what[32], words[160] = "";
+    size_t k = 0;
+    code_name(what, sizeof what, 'G', code);
+    for (const char *q = "XYZIJKRPQL"; *q; q++) {
+        word_t *w = &b->w[*q - 'A'];
+        if (w->has && k < sizeof words - 24)
+            k += (size_t)snprintf(words + k, sizeof words - k, " %c%g", *q, w->v);
+        w->has = false;
     }
-    if (g->ncps > 0 && motion != -2 && motion != MOT_G52 && motion != 53)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, mcol),
-                                "motion word inside a G5.2 block (close it with G5.3 first)");
-    if (g92) {
-        if (motion != -2)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, g92col),
-                                    "G92 and a motion word on one line");
-        if (!any_axis(b)) {
-            /* LinuxCNC refuses a bare G92; so do we unless lenient (RepRap's "G92 E0" is bare
-             * once its E word was dropped as unsupported). */
-            if (!g->o->lenient)
-                return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, g92col),
-                                        "G92 needs axis words (the coordinates to give the "
-                                        "current position)");
-            warn(g, g92col, "G92 without X, Y or Z: ignored, offsets unchanged (--lenient)");
+    if (modal)
+        warn(g, col, "move in the unsupported motion mode %s skipped, with its words%s "
+             "(--lenient)", what, words);
+    else
+        warn(g, col, "%s is not supported: its block skipped, with its words%s (--lenient)",
+             what, k ? words : " (none)");
+}
+
+/* G92: the current position gets the coordinates of the axis words. */
+static cs_err_t run_g92(gc_t *g, block_t *b, const gline_t *l)
+{
+    if (l->motion != -2)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, l->g92col),
+                                "G92 and a motion word on one line");
+    if (!any_axis(b)) {
+        /* LinuxCNC refuses a bare G92; so do we unless lenient (RepRap's "G92 E0" is bare
+         * once its E word was dropped as unsupported). */
+        if (!g->o->lenient)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, l->g92col),
+                                    "G92 needs axis words (the coordinates to give the "
+                                    "current position)");
+        warn(g, l->g92col, "G92 without X, Y or Z: ignored, offsets unchanged (--lenient)");
+    }
+    for (int a = 0; a < 3; a++) {
+        const word_t *w = &b->w['X' - 'A' + a];
+        if (w->has) {
+            g->off[a] = g->pos[a] - w->v * g->unit;
+            b->used |= BIT('X' + a);
         }
-        for (int a = 0; a < 3; a++) {
-            const word_t *w = &b->w['X' - 'A' + a];
-            if (w->has) {
-                g->off[a] = g->pos[a] - w->v * g->unit;
-                b->used |= BIT('X' + a);
-            }
-        }
-    } else if (motion == 53) {
-        /* G5.3 ends the open G5.2 block. */
-        if (g->ncps == 0)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, mcol),
+    }
+    return CS_OK;
+}
+
+/* NURBS lines: G5.3, G5.2, G6.2 and the lines of an open block. *done when the line was one. */
+static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_col, bool *done)
+{
+    cs_err_t e;
+    *done = true;
+    if (g->nurbs == MOT_G62 && !b->w['K' - 'A'].has && (e = nurbs_close(g)) != CS_OK)
+        return e; /* a line without K ends a G6.2 block; the line then runs as usual */
+    if (g->nurbs && l->motion != -2 && l->motion != MOT_G52 && l->motion != 53)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, l->mcol),
+                                g->nurbs == MOT_G62
+                                    ? "motion word inside a G6.2 block (it ends with its last "
+                                      "K-only line)"
+                                    : "motion word inside a G5.2 block (close it with G5.3 first)");
+    if (l->motion == 53) {
+        if (g->nurbs != MOT_G52)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, l->mcol),
                                     "G5.3 without an open G5.2 block");
         g->motion = MOT_NONE;
-        if ((e = nurbs_close(g)) != CS_OK)
-            return e;
         g->g5_prev = false;
-    } else if (motion == MOT_G52) {
-        if (g->ncps > 0)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, mcol),
-                                    "G5.2 inside an open G5.2 block");
-        g->motion = MOT_G52;
-        if ((e = do_nurbs_line(g, b, true, mcol)) != CS_OK)
-            return e;
-    } else if (g->ncps > 0) {
-        if ((e = do_nurbs_line(g, b, false, first_col)) != CS_OK)
-            return e;
-    } else {
-        if (motion != -2)
-            g->motion = motion;
-        /* A move happens when the line has axis words or arc / spline words; a motion word
-         * alone ("G2" on its own line) only sets the mode. */
-        bool go = any_axis(b);
-        for (const char *q = "IJKRPQ"; *q; q++)
-            go = go || b->w[*q - 'A'].has;
-        if (go && g->motion == MOT_NONE)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, first_col),
-                                    "axis words with no motion mode (G0, G1, G2...) in effect");
-        if (go && g->motion == MOT_DROPPED) {
-            /* Only reached when lenient: the mode was dropped, so are its moves. */
-            warn(g, first_col,
-                 "move in an unsupported motion mode (a canned cycle...): ignored (--lenient)");
-            for (const char *q = "XYZIJKRPQL"; *q; q++)
-                b->w[*q - 'A'].has = false;
-            go = false;
-        }
-        if (go && g->motion != MOT_NONE) {
-            double t[3];
-            switch (g->motion) {
-            case MOT_G0:
-            case MOT_G1:
-                target_of(g, b, t);
-                e = add_line(g, g->pos, t, mcol, g->motion == MOT_G0);
-                if (e != CS_OK)
-                    return e;
-                memcpy(g->pos, t, sizeof g->pos);
-                g->g5_prev = false;
-                break;
-            case MOT_G2:
-            case MOT_G3:
-                if ((e = do_arc(g, b, g->motion == MOT_G3, mcol)) != CS_OK)
-                    return e;
-                g->g5_prev = false;
-                break;
-            case MOT_G5:
-            case MOT_G51:
-                if ((e = do_spline(g, b, g->motion == MOT_G51, mcol)) != CS_OK)
-                    return e;
-                g->g5_prev = g->motion == MOT_G5;
-                break;
-            default:
-                break;
-            }
-        }
+        return nurbs_close(g);
     }
+    if (l->motion == MOT_G52 || l->motion == MOT_G62) {
+        if (g->nurbs)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, l->mcol),
+                                    "G%s inside an open NURBS block",
+                                    l->motion == MOT_G52 ? "5.2" : "6.2");
+        g->motion = l->motion;
+        g->g5_prev = false;
+        return l->motion == MOT_G52 ? do_nurbs_line(g, b, true, l->mcol)
+                                    : do_g62_line(g, b, true, l->mcol);
+    }
+    if (g->nurbs)
+        return g->nurbs == MOT_G52 ? do_nurbs_line(g, b, false, first_col)
+                                   : do_g62_line(g, b, false, first_col);
+    *done = false;
+    return CS_OK;
+}
+
+/* The motion of a line (modal: the mode in effect when the line has none). */
+static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first_col)
+{
+    if (l->motion != -2)
+        g->motion = l->motion;
+    /* A move happens when the line has axis words or arc / spline words; a motion word alone
+     * ("G2" on its own line) only sets the mode. */
+    bool go = any_axis(b);
+    for (const char *q = "IJKRPQ"; *q; q++)
+        go = go || b->w[*q - 'A'].has;
+    if (!go)
+        return CS_OK;
+    if (g->motion == MOT_NONE)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, first_col),
+                                "axis words with no motion mode (G0, G1, G2...) in effect");
+    if (g->motion == MOT_DROPPED) { /* only when lenient: the mode's moves are dropped too */
+        drop_block(g, b, g->dropped_code, first_col, true);
+        return CS_OK;
+    }
+    double t[3];
+    cs_err_t e = CS_OK;
+    switch (g->motion) {
+    case MOT_G0:
+    case MOT_G1:
+        target_of(g, b, t);
+        if ((e = add_line(g, g->pos, t, l->mcol, g->motion == MOT_G0)) == CS_OK)
+            memcpy(g->pos, t, sizeof g->pos);
+        g->g5_prev = false;
+        break;
+    case MOT_G2:
+    case MOT_G3:
+        e = do_arc(g, b, g->motion == MOT_G3, l->mcol);
+        g->g5_prev = false;
+        break;
+    case MOT_G5:
+    case MOT_G51:
+        e = do_spline(g, b, g->motion == MOT_G51, l->mcol);
+        g->g5_prev = g->motion == MOT_G5;
+        break;
+    default: /* G5.2 / G6.2 mode after its block: axis words alone start nothing */
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, first_col),
+                                "axis words after a closed NURBS block: give G0, G1... first");
+    }
+    return e;
+}
+
+static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
+{
+    bool end = false, done;
+    gline_t l = {-2, first_col, false, false, false, 0, 0, 0, 0};
+    cs_err_t e = run_letters(g, b);
+    if (e == CS_OK)
+        e = run_m(g, b, &end);
+    if (e == CS_OK)
+        e = run_g(g, b, &l);
+    if (e != CS_OK)
+        return e;
+    if (l.drop) {
+        if (l.motion == MOT_DROPPED)
+            g->dropped_code = l.drop_code;
+        drop_block(g, b, l.drop_code, l.dropcol, false);
+    }
+    if (l.g64 && (e = run_g64(g, b, l.g64col)) != CS_OK)
+        return e;
+    if ((e = run_nurbs(g, b, &l, first_col, &done)) != CS_OK)
+        return e;
+    if (!done && (e = l.g92 ? run_g92(g, b, &l) : run_motion(g, b, &l, first_col)) != CS_OK)
+        return e;
     /* Words given but not used by anything on the line. */
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || (b->used & (1u << i)))
@@ -1003,38 +1135,46 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
 
 /* ---- lexing ------------------------------------------------------------------------------ */
 
-/* Number at s[*i] (line s[0..n)): [+-] digits [. digits]; spaces are not allowed inside. */
-static bool read_number(const char *s, size_t n, size_t *i, double *out)
+/* The value of word `letter` (at column col) at s[*i]: a number, or in LinuxCNC's dialect any
+ * real value (#parameter, [expression], function) read by cs_gexpr. */
+static cs_err_t read_value(gc_t *g, const char *s, size_t n, size_t *i, char letter, unsigned col,
+                           double *v)
 {
-    char tmp[NUM_MAX_CHARS];
-    size_t k = 0, j = *i;
-    bool digits = false;
-    if (j < n && (s[j] == '+' || s[j] == '-'))
-        tmp[k++] = s[j++];
-    while (j < n && s[j] >= '0' && s[j] <= '9' && k < NUM_MAX_CHARS - 2) {
-        tmp[k++] = s[j++];
-        digits = true;
-    }
-    if (j < n && s[j] == '.' && k < NUM_MAX_CHARS - 2) {
-        tmp[k++] = s[j++];
-        while (j < n && s[j] >= '0' && s[j] <= '9' && k < NUM_MAX_CHARS - 1) {
-            tmp[k++] = s[j++];
-            digits = true;
-        }
-    }
-    if (!digits || (j < n && s[j] >= '0' && s[j] <= '9'))
-        return false;
-    tmp[k] = '\0';
-    *out = strtod(tmp, NULL);
-    *i = j;
-    return true;
+    cs_gexpr_fail_t f;
+    size_t start = *i;
+    bool grbl = g->o->dialect == CS_GCODE_GRBL;
+    if (grbl && *i < n && (s[*i] == '#' || s[*i] == '['))
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col_of(s, *i)),
+                                "%s are LinuxCNC's: Grbl 1.1 has none (--dialect grbl)",
+                                s[*i] == '#' ? "parameters (#)" : "expressions ([...])");
+    cs_err_t e = grbl ? cs_gexpr_number(s, n, i, v, &f) : cs_gexpr_real(&g->st, s, n, i, v, &f);
+    if (e == CS_OK)
+        return CS_OK;
+    if (f.at == start && strcmp(f.reason, "expected a number") == 0)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                "%c must be followed by a number", letter);
+    return cs_path_diag_set(g->diag, e, loc_at(g, col_of(s, f.at)), "%s", f.reason);
+}
+
+/* "#... = value" at s[*i]: read now, set at the end of the line (cs_gexpr_commit). */
+static cs_err_t read_assign(gc_t *g, const char *s, size_t n, size_t *i)
+{
+    cs_gexpr_fail_t f;
+    if (g->o->dialect == CS_GCODE_GRBL)
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col_of(s, *i)),
+                                "parameters (#) are LinuxCNC's: Grbl 1.1 has none "
+                                "(--dialect grbl)");
+    cs_err_t e = cs_gexpr_assign(&g->st, s, n, i, &f);
+    if (e != CS_OK)
+        return cs_path_diag_set(g->diag, e, loc_at(g, col_of(s, f.at)), "%s", f.reason);
+    return CS_OK;
 }
 
 /* One line s[0..n) (without its end of line). */
 static cs_err_t do_line(gc_t *g, const char *s, size_t n)
 {
     /* Comments out, checksum found: pass 1. */
-    size_t star = n, code_end = n;
+    size_t star = n, code_end = n, depth = 0;
     for (size_t i = 0; i < n; i++) {
         char c = s[i];
         if (c == '(') {
@@ -1048,7 +1188,12 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
         } else if (c == ';') {
             code_end = i;
             break;
-        } else if (c == '*' && star == n) {
+        } else if (c == '[') {
+            depth++;
+        } else if (c == ']') {
+            depth -= depth > 0;
+        } else if (c == '*' && star == n && depth == 0) {
+            /* Inside [...] '*' multiplies (LinuxCNC); outside it starts a checksum. */
             star = i;
         } else if (c == '\0') {
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col_of(s, i)),
@@ -1115,12 +1260,24 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
             continue;
         }
         unsigned col = col_of(s, i);
-        if (c == '#' || c == '[' || c == 'o' || c == 'O')
-            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col),
-                                    "%s are not supported",
-                                    c == '#'   ? "parameters (#)"
-                                    : c == '[' ? "expressions ([...])"
-                                               : "O-word subroutines and control flow");
+        if (c == '#') {
+            cs_err_t e = read_assign(g, s, code_end, &i);
+            if (e != CS_OK)
+                return e;
+            continue;
+        }
+        if (c == '[')
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
+                                    "an expression [...] must be the value of a word (X[...])");
+        if (c == 'o' || c == 'O')
+            return cs_path_diag_set(g->diag, g->o->dialect == CS_GCODE_GRBL ? CS_ERR_UNSUPPORTED
+                                                                            : CS_ERR_PARSE,
+                                    loc_at(g, col),
+                                    g->o->dialect == CS_GCODE_GRBL
+                                        ? "O-words are LinuxCNC's: Grbl 1.1 has none "
+                                          "(--dialect grbl)"
+                                        : "an O-word must begin its line (only a line number "
+                                          "may come before it)");
         int li = letter_index(c);
         if (li < 0) {
             if ((unsigned char)c < 0x20 || (unsigned char)c >= 0x7F)
@@ -1135,13 +1292,9 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
         while (i < code_end && (s[i] == ' ' || s[i] == '\t'))
             i++;
         double v;
-        if (i < code_end && (s[i] == '#' || s[i] == '['))
-            return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, loc_at(g, col_of(s, i)),
-                                    "%s are not supported",
-                                    s[i] == '#' ? "parameters (#)" : "expressions ([...])");
-        if (!read_number(s, code_end, &i, &v))
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, loc_at(g, col),
-                                    "%c must be followed by a number", 'A' + li);
+        cs_err_t ev = read_value(g, s, code_end, &i, (char)('A' + li), col, &v);
+        if (ev != CS_OK)
+            return ev;
         if (!any)
             first_col = col;
         any = true;
@@ -1192,6 +1345,32 @@ void cs_gcode_opts_init(cs_gcode_opts_t *o)
     o->helix_tol_mm = CS_GCODE_HELIX_TOL_MM;
 }
 
+/* Runs the program line by line in the order its O-words decide (cs_gflow). */
+static cs_err_t run_program(gc_t *g, cs_gflow_t *fl, const char *buf)
+{
+    cs_err_t e = CS_OK;
+    size_t k = 0;
+    while (k < fl->n && !g->ended && e == CS_OK) {
+        size_t next = k + 1;
+        g->line = (unsigned)(k + 1);
+        if (g->stats)
+            g->stats->lines++;
+        if (fl->lines[k].kind != CS_GFLOW_NONE) {
+            e = cs_gflow_exec(fl, g->name, buf, k, &g->st, &next, g->diag);
+        } else if ((e = do_line(g, buf + fl->lines[k].start, fl->lines[k].len)) == CS_OK &&
+                   cs_gexpr_commit(&g->st) != CS_OK) {
+            e = cs_path_diag_set(g->diag, CS_ERR_FULL, loc_at(g, 1), "out of memory");
+        }
+        k = next;
+    }
+    if (e == CS_OK && g->nurbs == MOT_G62)
+        e = nurbs_close(g); /* a G6.2 block at the end of the program */
+    if (e == CS_OK && g->nurbs)
+        e = cs_path_diag_set(g->diag, CS_ERR_PARSE, g->nurbs_loc,
+                             "G5.2 block not closed by G5.3 before the end of the program");
+    return e;
+}
+
 cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_gcode_opts_t *o,
                        cs_path_t *path, cs_path_diag_t *diag, cs_gcode_stats_t *stats)
 {
@@ -1216,28 +1395,20 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
     g.stats = stats;
     if (stats)
         memset(stats, 0, sizeof *stats);
-    g.unit = 1.0;
+    g.unit = o->start_inch ? MM_PER_INCH : 1.0;
     g.plane = 17;
-    g.motion = MOT_NONE;
+    /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
+    g.motion = o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
     cs_path_new_subpath(path);
-    cs_err_t e = CS_OK;
-    size_t i = 0;
-    while (i < len && !g.ended) {
-        size_t j = i;
-        while (j < len && buf[j] != '\n' && buf[j] != '\r')
-            j++;
-        g.line++;
-        if (stats)
-            stats->lines++;
-        if ((e = do_line(&g, buf + i, j - i)) != CS_OK)
-            break;
-        if (j < len && buf[j] == '\r' && j + 1 < len && buf[j + 1] == '\n')
-            j++;
-        i = j + 1;
-    }
-    if (e == CS_OK && g.ncps > 0)
-        e = cs_path_diag_set(diag, CS_ERR_PARSE, g.nurbs_loc,
-                             "G5.2 block not closed by G5.3 before the end of the program");
-    free(g.cps);
+    if (cs_gexpr_init(&g.st) != CS_OK)
+        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
+    cs_gflow_t fl;
+    cs_err_t e = cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops,
+                               diag);
+    if (e == CS_OK)
+        e = run_program(&g, &fl, buf);
+    cs_gflow_free(&fl);
+    cs_gexpr_free(&g.st);
+    cs_gnurbs_free(&g.nb);
     return e;
 }
