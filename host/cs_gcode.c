@@ -1059,7 +1059,7 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
      * ("G2" on its own line) only sets the mode. */
     bool go = any_axis(b);
     for (const char *q = "IJKRPQ"; *q; q++)
-        go = go || b->w[*q - 'A'].has;
+        go = go || (b->w[*q - 'A'].has && !(b->used & BIT(*q))); /* G64's P and Q are its own */
     if (!go)
         return CS_OK;
     if (g->motion == MOT_NONE)
