@@ -480,12 +480,16 @@ static cs_err_t gf_loop(gf_run_t *r, size_t *next)
     }
     default: { /* break / continue: l->next is the loop's first line */
         const cs_gflow_line_t *o = &f->lines[l->next];
-        if (l->kind == CS_GFLOW_CONTINUE) {
+        bool cont = l->kind == CS_GFLOW_CONTINUE;
+        /* Leaving the inner repeats (and, on break, the loop's own count). */
+        while (f->nreps && f->reps[f->nreps - 1].line < o->next &&
+               (f->reps[f->nreps - 1].line > l->next ||
+                (!cont && f->reps[f->nreps - 1].line == l->next)))
+            f->nreps--;
+        if (cont) {
             *next = o->kind == CS_GFLOW_WHILE ? l->next : o->next;
             return o->kind == CS_GFLOW_WHILE ? gf_iterate(r) : CS_OK;
         }
-        if (o->kind == CS_GFLOW_REPEAT && f->nreps && f->reps[f->nreps - 1].line == l->next)
-            f->nreps--;
         *next = o->next + 1;
         return CS_OK;
     }
