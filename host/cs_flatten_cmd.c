@@ -36,13 +36,14 @@ static void flatten_usage(FILE *f)
 {
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-            "\n                         [--lenient] FILE\n"
+            "\n                         [--lenient] [--dialect linuxcnc|grbl] [--units mm|inch] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
             "decimals), a blank line between subpaths.\n"
             "\n"
-            "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2, see\n"
+            "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2 G6.2, LinuxCNC\n"
+            "parameters, expressions and O-words; see\n"
             "docs/inputs.md), HP-GL (.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
             "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
             "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
@@ -63,6 +64,9 @@ static void flatten_usage(FILE *f)
             "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
             "  --lenient       G-code: a word curvestep does not carry out is a warning (and is\n"
             "                  ignored) instead of an error\n"
+            "  --dialect D     G-code: linuxcnc (the default) or grbl (Grbl 1.1: starts in G0,\n"
+            "                  no parameters or O-words, Grbl's arc check; docs/inputs.md)\n"
+            "  --units U       G-code: mm (the default) or inch, the units a program starts in\n"
             "  -h, --help      show this help\n"
             "\n"
             "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
@@ -106,6 +110,8 @@ int cs_cmd_flatten(int argc, char **argv)
         {"svg", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},
         {"lenient", no_argument, NULL, 'l'},
+        {"dialect", required_argument, NULL, 'd'},
+        {"units", required_argument, NULL, 'u'},
         {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
@@ -113,6 +119,8 @@ int cs_cmd_flatten(int argc, char **argv)
     bool stats = false;
     const char *svg_out = NULL;
     bool lenient = false;
+    cs_dialect_t dialect = CS_DIALECT_LINUXCNC;
+    cs_units_t units = CS_UNITS_DEFAULT;
     int c;
     optind = 1;
     opterr = 0;
@@ -156,6 +164,20 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'l':
             lenient = true;
             break;
+        case 'd': /* G-code: --dialect linuxcnc | grbl (docs/inputs.md) */
+        case 'u': /* G-code: --units mm | inch, the units the program starts in */
+            if (strcmp(optarg, c == 'd' ? "linuxcnc" : "mm") != 0 &&
+                strcmp(optarg, c == 'd' ? "grbl" : "inch") != 0) {
+                fprintf(stderr, "curvestep flatten: --%s '%s': expected %s\n",
+                        c == 'd' ? "dialect" : "units", optarg,
+                        c == 'd' ? "linuxcnc or grbl" : "mm or inch");
+                return CS_EXIT_USAGE;
+            }
+            if (c == 'd')
+                dialect = strcmp(optarg, "grbl") == 0 ? CS_DIALECT_GRBL : CS_DIALECT_LINUXCNC;
+            else
+                units = strcmp(optarg, "inch") == 0 ? CS_UNITS_INCH : CS_UNITS_MM;
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -186,6 +208,8 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    iopts.dialect = dialect;
+    iopts.units = units;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);

@@ -29,11 +29,12 @@ static unsigned gf_col(const char *s, size_t i)
     return c;
 }
 
+/* "o<label> <keyword><tail>" at line k + 1, column col. */
 static cs_err_t gf_err(cs_path_diag_t *d, cs_err_t e, const char *name, size_t k, unsigned col,
-                       const char *what, const cs_gflow_line_t *l, const char *tail)
+                       const cs_gflow_line_t *l, const char *tail)
 {
     cs_path_loc_t loc = {name, (unsigned)(k + 1), col};
-    return cs_path_diag_set(d, e, loc, "%s o%s %s%s", what, l->label,
+    return cs_path_diag_set(d, e, loc, "o%s %s%s", l->label,
                             l->kind == CS_GFLOW_DOWHILE ? "while" : gf_words[l->kind], tail);
 }
 
@@ -161,17 +162,17 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
         if (l->kind == CS_GFLOW_SUB)
             for (size_t q = 0; q < k; q++)
                 if (f->lines[q].kind == CS_GFLOW_SUB && strcmp(f->lines[q].label, l->label) == 0)
-                    return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, "", l,
+                    return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l,
                                   ": a subroutine of that name is already defined");
         if (*nst >= CS_GFLOW_MAX_OPEN)
-            return gf_err(d, CS_ERR_FULL, name, k, l->ocol, "", l, ": nested too deep");
+            return gf_err(d, CS_ERR_FULL, name, k, l->ocol, l, ": nested too deep");
         st[*nst].line = st[*nst].last = k;
         (*nst)++;
         return CS_OK;
     case CS_GFLOW_ELSEIF:
     case CS_GFLOW_ELSE:
         if (!same || top->kind != CS_GFLOW_IF || f->lines[st[*nst - 1].last].kind == CS_GFLOW_ELSE)
-            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, "", l, " without a matching if");
+            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l, " without a matching if");
         f->lines[st[*nst - 1].last].next = k;
         st[*nst - 1].last = k;
         return CS_OK;
@@ -180,7 +181,7 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
     case CS_GFLOW_ENDREPEAT:
     case CS_GFLOW_ENDIF:
         if (!same || top->kind != opener)
-            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, "", l,
+            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l,
                           opener == CS_GFLOW_IF ? " without a matching if"
                           : opener == CS_GFLOW_SUB ? " without a matching sub"
                                                    : " without the loop it ends");
@@ -201,7 +202,7 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
         gf_open_t *o = ret ? gf_find(f, st, *nst, NULL, subs, 1)
                            : gf_find(f, st, *nst, l->label, loops, 3);
         if (!o)
-            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, "", l,
+            return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l,
                           ret ? " outside a subroutine" : " outside a loop of that label");
         l->next = o->line;
         return CS_OK;
@@ -251,7 +252,7 @@ cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t 
     }
     if (e == CS_OK && nst > 0) {
         const cs_gflow_line_t *o = &f->lines[st[nst - 1].line];
-        e = gf_err(diag, CS_ERR_PARSE, name, st[nst - 1].line, o->ocol, "", o,
+        e = gf_err(diag, CS_ERR_PARSE, name, st[nst - 1].line, o->ocol, o,
                    " is not closed before the end of the program");
     }
     free(st);
@@ -307,7 +308,7 @@ static cs_err_t gf_args(gf_run_t *r, size_t i, double *v, size_t max, size_t *go
     }
     if (required && m == 0) {
         const cs_gflow_line_t *l = &r->f->lines[r->k];
-        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, "", l,
+        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, l,
                       " needs a condition or count: [expression]");
     }
     *got = m;
@@ -322,7 +323,7 @@ static cs_err_t gf_iterate(gf_run_t *r)
         char tail[96];
         snprintf(tail, sizeof tail, ": more than %lu loop passes in the program (a runaway loop?)",
                  r->f->max_iterations);
-        return gf_err(r->diag, CS_ERR_RANGE, r->name, r->k, l->ocol, "", l, tail);
+        return gf_err(r->diag, CS_ERR_RANGE, r->name, r->k, l->ocol, l, tail);
     }
     return CS_OK;
 }
@@ -388,7 +389,7 @@ static cs_err_t gf_return(gf_run_t *r, size_t *next)
     if (e != CS_OK)
         return e;
     if (f->ncalls == 0)
-        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, "", l,
+        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, l,
                       " reached outside a call");
     f->ncalls--;
     f->nreps = f->calls[f->ncalls].loops;
@@ -397,7 +398,7 @@ static cs_err_t gf_return(gf_run_t *r, size_t *next)
     if ((e = cs_gexpr_set_named(r->st, "_value", got ? v : 0.0)) == CS_OK)
         e = cs_gexpr_set_named(r->st, "_value_returned", got ? 1.0 : 0.0);
     if (e != CS_OK)
-        return gf_err(r->diag, e, r->name, r->k, l->ocol, "", l, ": out of memory");
+        return gf_err(r->diag, e, r->name, r->k, l->ocol, l, ": out of memory");
     *next = f->calls[f->ncalls].ret;
     return CS_OK;
 }
@@ -459,7 +460,7 @@ static cs_err_t gf_loop(gf_run_t *r, size_t *next)
             return CS_OK;
         }
         if (f->nreps >= CS_GFLOW_MAX_OPEN)
-            return gf_err(r->diag, CS_ERR_RANGE, r->name, r->k, l->ocol, "", l,
+            return gf_err(r->diag, CS_ERR_RANGE, r->name, r->k, l->ocol, l,
                           ": repeats nested too deep");
         f->reps[f->nreps].line = r->k;
         f->reps[f->nreps++].remaining = c;
@@ -468,7 +469,7 @@ static cs_err_t gf_loop(gf_run_t *r, size_t *next)
     case CS_GFLOW_ENDREPEAT: {
         cs_gflow_rep_t *p = f->nreps ? &f->reps[f->nreps - 1] : NULL;
         if (!p || p->line != l->next)
-            return gf_err(r->diag, CS_ERR_STATE, r->name, r->k, l->ocol, "", l,
+            return gf_err(r->diag, CS_ERR_STATE, r->name, r->k, l->ocol, l,
                           " reached without its repeat");
         if (--p->remaining >= 1) {
             *next = l->next + 1;
