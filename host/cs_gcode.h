@@ -27,20 +27,20 @@ typedef enum {
 } cs_gcode_dialect_t;
 
 typedef struct {
-    bool lenient;          /* unsupported words: a warning and the word is ignored (not an error);
-                            * also (each warned) bare G92 = no-op, G2/G3 without R or I/J/K = a
-                            * straight feed move to its end, R arc ending on its start = nothing
-                            * drawn in the plane, T = ignored. Checksums stay errors. */
-    double helix_tol_mm;   /* > 0: bound on the helix approximation (see docs/inputs.md) */
-    size_t max_elements;   /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
-    bool pen_z;            /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
-    double pen_down_z_mm;  /* to this machine Z on M3/M4 */
-    double pen_up_z_mm;    /* to this machine Z on M5 */
+    bool lenient;         /* unsupported words: a warning and the word is ignored (not an error);
+                           * also (each warned) bare G92 = no-op, G2/G3 without R or I/J/K = a
+                           * straight feed move to its end, R arc ending on its start = nothing
+                           * drawn in the plane, T = ignored. Checksums stay errors. */
+    double helix_tol_mm;  /* > 0: bound on the helix approximation (see docs/inputs.md) */
+    size_t max_elements;  /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
+    bool pen_z;           /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
+    double pen_down_z_mm; /* to this machine Z on M3/M4 */
+    double pen_up_z_mm;   /* to this machine Z on M5 */
     cs_gcode_dialect_t dialect;
-    bool start_inch;          /* the program starts in G20 (inches) instead of G21 (mm) */
-    unsigned long max_loops;  /* O-word loop passes allowed in one program; 0: the default
-                               * CS_GFLOW_MAX_LOOPS (a runaway loop is a located error) */
-    cs_gcode_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    bool start_inch;         /* the program starts in G20 (inches) instead of G21 (mm) */
+    unsigned long max_loops; /* O-word loop passes allowed in one program; 0: the default
+                              * CS_GFLOW_MAX_LOOPS (a runaway loop is a located error) */
+    cs_gcode_warn_fn warn;   /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_gcode_opts_t;
 

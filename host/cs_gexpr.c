@@ -7,15 +7,31 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GX_PI          3.14159265358979323846
-#define GX_NUM_CHARS   64
-#define GX_INT_TOL     0.0001 /* an index within this of a whole number is that number */
-#define GX_WORD_MAX    8      /* longest operator or function name */
+#define GX_PI        3.14159265358979323846
+#define GX_NUM_CHARS 64
+#define GX_INT_TOL   0.0001 /* an index within this of a whole number is that number */
+#define GX_WORD_MAX  8      /* longest operator or function name */
 
 /* Binary operators; precedence from LinuxCNC's reference: "** / * / MOD / + - / EQ NE GT GE LT
  * LE / AND OR XOR", highest first, and "the operation on the left is performed first". */
-typedef enum { GX_NONE, GX_POW, GX_MUL, GX_DIV, GX_MOD, GX_ADD, GX_SUB, GX_EQ, GX_NE, GX_GT,
-               GX_GE, GX_LT, GX_LE, GX_AND, GX_OR, GX_XOR } gx_op_t;
+typedef enum {
+    GX_NONE,
+    GX_POW,
+    GX_MUL,
+    GX_DIV,
+    GX_MOD,
+    GX_ADD,
+    GX_SUB,
+    GX_EQ,
+    GX_NE,
+    GX_GT,
+    GX_GE,
+    GX_LT,
+    GX_LE,
+    GX_AND,
+    GX_OR,
+    GX_XOR
+} gx_op_t;
 
 typedef struct {
     cs_gexpr_store_t *st;
@@ -92,8 +108,8 @@ cs_err_t cs_gexpr_number(const char *s, size_t n, size_t *i, double *out, cs_gex
     /* "1e3", "2.5E-2": G-code has no exponent form; reading the E as a word would move
      * somewhere else than the writer meant. */
     if (j + 1 < n && (s[j] == 'e' || s[j] == 'E') &&
-        (gx_digit(s[j + 1]) || ((s[j + 1] == '-' || s[j + 1] == '+') && j + 2 < n &&
-                                gx_digit(s[j + 2]))))
+        (gx_digit(s[j + 1]) ||
+         ((s[j + 1] == '-' || s[j + 1] == '+') && j + 2 < n && gx_digit(s[j + 2]))))
         return gx_fail(f, CS_ERR_PARSE, j,
                        "number in exponent form ('%.*s%c...'): G-code has no exponents "
                        "(LinuxCNC: a number is digits with at most one decimal point); write it "
@@ -222,8 +238,8 @@ static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out);
 /* A unary function at s[*i] (letters). */
 static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
 {
-    static const char *const names[] = {"ABS", "ACOS", "ASIN", "ATAN", "COS",   "EXP",   "FIX",
-                                        "FUP", "LN",   "ROUND", "SIN", "SQRT", "TAN", "EXISTS"};
+    static const char *const names[] = {"ABS", "ACOS", "ASIN",  "ATAN", "COS",  "EXP", "FIX",
+                                        "FUP", "LN",   "ROUND", "SIN",  "SQRT", "TAN", "EXISTS"};
     char w[GX_WORD_MAX + 1];
     size_t at = *i, len = gx_word(x, *i, w);
     int fn = -1;
@@ -242,7 +258,8 @@ static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
         char name[CS_GEXPR_NAME_MAX];
         double v;
         if (j + 1 >= x->n || x->s[j] != '#' || x->s[j + 1] != '<')
-            return gx_fail(x->f, CS_ERR_PARSE, j, "EXISTS takes a named parameter: EXISTS[#<name>]");
+            return gx_fail(x->f, CS_ERR_PARSE, j,
+                           "EXISTS takes a named parameter: EXISTS[#<name>]");
         j++;
         cs_err_t e = gx_name(x, &j, name);
         if (e != CS_OK)
@@ -261,11 +278,14 @@ static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
     double r = 0;
     const double deg = GX_PI / 180.0; /* LinuxCNC: angles in degrees, in and out */
     switch (fn) {
-    case 0: r = fabs(a); break;
+    case 0:
+        r = fabs(a);
+        break;
     case 1:
     case 2:
         if (a < -1.0 || a > 1.0)
-            return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g]: the argument must be from -1 to 1", w, a);
+            return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g]: the argument must be from -1 to 1", w,
+                           a);
         r = (fn == 1 ? acos(a) : asin(a)) / deg;
         break;
     case 3: { /* ATAN[y]/[x] */
@@ -282,23 +302,38 @@ static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
         r = atan2(a, b) / deg;
         break;
     }
-    case 4: r = cos(a * deg); break;
-    case 5: r = exp(a); break;
-    case 6: r = floor(a); break;
-    case 7: r = ceil(a); break;
+    case 4:
+        r = cos(a * deg);
+        break;
+    case 5:
+        r = exp(a);
+        break;
+    case 6:
+        r = floor(a);
+        break;
+    case 7:
+        r = ceil(a);
+        break;
     case 8:
         if (!(a > 0))
             return gx_fail(x->f, CS_ERR_RANGE, at, "LN[%g]: the argument must be positive", a);
         r = log(a);
         break;
-    case 9: r = a < 0 ? -floor(-a + 0.5) : floor(a + 0.5); break; /* halves away from zero */
-    case 10: r = sin(a * deg); break;
+    case 9:
+        r = a < 0 ? -floor(-a + 0.5) : floor(a + 0.5);
+        break; /* halves away from zero */
+    case 10:
+        r = sin(a * deg);
+        break;
     case 11:
         if (a < 0)
-            return gx_fail(x->f, CS_ERR_RANGE, at, "SQRT[%g]: the argument must not be negative", a);
+            return gx_fail(x->f, CS_ERR_RANGE, at, "SQRT[%g]: the argument must not be negative",
+                           a);
         r = sqrt(a);
         break;
-    default: r = tan(a * deg); break;
+    default:
+        r = tan(a * deg);
+        break;
     }
     if (!isfinite(r))
         return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g] is not a finite number", w, a);
@@ -312,9 +347,8 @@ static gx_op_t gx_peek_op(const gx_t *x, size_t i, size_t *len)
     static const struct {
         const char *w;
         gx_op_t op;
-    } words[] = {{"MOD", GX_MOD}, {"EQ", GX_EQ}, {"NE", GX_NE},   {"GT", GX_GT},
-                 {"GE", GX_GE},   {"LT", GX_LT}, {"LE", GX_LE},   {"AND", GX_AND},
-                 {"OR", GX_OR},   {"XOR", GX_XOR}};
+    } words[] = {{"MOD", GX_MOD}, {"EQ", GX_EQ}, {"NE", GX_NE},   {"GT", GX_GT}, {"GE", GX_GE},
+                 {"LT", GX_LT},   {"LE", GX_LE}, {"AND", GX_AND}, {"OR", GX_OR}, {"XOR", GX_XOR}};
     if (i >= x->n)
         return GX_NONE;
     char c = x->s[i];
@@ -344,12 +378,28 @@ static gx_op_t gx_peek_op(const gx_t *x, size_t i, size_t *len)
 static int gx_prec(gx_op_t op)
 {
     switch (op) {
-    case GX_POW: return 5;
-    case GX_MUL: case GX_DIV: case GX_MOD: return 4;
-    case GX_ADD: case GX_SUB: return 3;
-    case GX_EQ: case GX_NE: case GX_GT: case GX_GE: case GX_LT: case GX_LE: return 2;
-    case GX_AND: case GX_OR: case GX_XOR: return 1;
-    default: return 0;
+    case GX_POW:
+        return 5;
+    case GX_MUL:
+    case GX_DIV:
+    case GX_MOD:
+        return 4;
+    case GX_ADD:
+    case GX_SUB:
+        return 3;
+    case GX_EQ:
+    case GX_NE:
+    case GX_GT:
+    case GX_GE:
+    case GX_LT:
+    case GX_LE:
+        return 2;
+    case GX_AND:
+    case GX_OR:
+    case GX_XOR:
+        return 1;
+    default:
+        return 0;
     }
 }
 
@@ -359,10 +409,13 @@ static cs_err_t gx_apply(gx_t *x, gx_op_t op, size_t at, double a, double b, dou
     switch (op) {
     case GX_POW:
         if (a < 0 && b != floor(b))
-            return gx_fail(x->f, CS_ERR_RANGE, at, "%g ** %g: a negative number to a fractional power", a, b);
+            return gx_fail(x->f, CS_ERR_RANGE, at,
+                           "%g ** %g: a negative number to a fractional power", a, b);
         r = pow(a, b);
         break;
-    case GX_MUL: r = a * b; break;
+    case GX_MUL:
+        r = a * b;
+        break;
     case GX_DIV:
     case GX_MOD:
         if (b == 0.0)
@@ -372,17 +425,39 @@ static cs_err_t gx_apply(gx_t *x, gx_op_t op, size_t at, double a, double b, dou
         if (op == GX_MOD && r < 0)
             r += fabs(b);
         break;
-    case GX_ADD: r = a + b; break;
-    case GX_SUB: r = a - b; break;
-    case GX_EQ: r = fabs(a - b) < CS_GEXPR_EQ_TOL; break;
-    case GX_NE: r = !(fabs(a - b) < CS_GEXPR_EQ_TOL); break;
-    case GX_GT: r = a > b; break;
-    case GX_GE: r = a >= b; break;
-    case GX_LT: r = a < b; break;
-    case GX_LE: r = a <= b; break;
-    case GX_AND: r = a != 0.0 && b != 0.0; break;
-    case GX_OR: r = a != 0.0 || b != 0.0; break;
-    default: r = (a != 0.0) != (b != 0.0); break;
+    case GX_ADD:
+        r = a + b;
+        break;
+    case GX_SUB:
+        r = a - b;
+        break;
+    case GX_EQ:
+        r = fabs(a - b) < CS_GEXPR_EQ_TOL;
+        break;
+    case GX_NE:
+        r = !(fabs(a - b) < CS_GEXPR_EQ_TOL);
+        break;
+    case GX_GT:
+        r = a > b;
+        break;
+    case GX_GE:
+        r = a >= b;
+        break;
+    case GX_LT:
+        r = a < b;
+        break;
+    case GX_LE:
+        r = a <= b;
+        break;
+    case GX_AND:
+        r = a != 0.0 && b != 0.0;
+        break;
+    case GX_OR:
+        r = a != 0.0 || b != 0.0;
+        break;
+    default:
+        r = (a != 0.0) != (b != 0.0);
+        break;
     }
     if (!isfinite(r))
         return gx_fail(x->f, CS_ERR_RANGE, at, "the expression's value is not a finite number");
@@ -417,7 +492,8 @@ static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out)
 {
     size_t at = *i;
     if (++x->nest > CS_GEXPR_MAX_NEST)
-        return gx_fail(x->f, CS_ERR_PARSE, at, "expression nested more than %d deep", CS_GEXPR_MAX_NEST);
+        return gx_fail(x->f, CS_ERR_PARSE, at, "expression nested more than %d deep",
+                       CS_GEXPR_MAX_NEST);
     (*i)++;
     cs_err_t e = gx_binary(x, i, 1, out);
     if (e == CS_OK) {
@@ -425,8 +501,10 @@ static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out)
         if (*i >= x->n || x->s[*i] != ']') {
             size_t len;
             e = gx_peek_op(x, *i, &len) == GX_NONE && *i < x->n
-                    ? gx_fail(x->f, CS_ERR_PARSE, *i, "unexpected '%c' in an expression (expected "
-                              "an operator or ']')", x->s[*i])
+                    ? gx_fail(x->f, CS_ERR_PARSE, *i,
+                              "unexpected '%c' in an expression (expected "
+                              "an operator or ']')",
+                              x->s[*i])
                     : gx_fail(x->f, CS_ERR_PARSE, at, "'[' not closed by ']' on its line");
         } else {
             (*i)++;
@@ -443,7 +521,8 @@ static cs_err_t gx_real(gx_t *x, size_t *i, double *out)
         return gx_fail(x->f, CS_ERR_PARSE, *i, "expected a number");
     char c = x->s[*i];
     if (++x->nest > CS_GEXPR_MAX_NEST)
-        return gx_fail(x->f, CS_ERR_PARSE, *i, "expression nested more than %d deep", CS_GEXPR_MAX_NEST);
+        return gx_fail(x->f, CS_ERR_PARSE, *i, "expression nested more than %d deep",
+                       CS_GEXPR_MAX_NEST);
     cs_err_t e;
     if (c == '[') {
         e = gx_bracket(x, i, out);

@@ -13,12 +13,12 @@
 
 #include "cs_err.h"
 
-#define CS_GEXPR_NUM_PARAMS  5400 /* numbered parameters #1..#5399 (index 0 unused) */
-#define CS_GEXPR_LOCALS      30   /* #1..#30: a call's arguments, restored on return */
-#define CS_GEXPR_NAME_MAX    64   /* longest parameter name kept, with its NUL */
-#define CS_GEXPR_MAX_PENDING 64   /* parameter settings on one line */
-#define CS_GEXPR_MAX_CALLS   10   /* LinuxCNC: "The maximum subroutine nesting level is 10" */
-#define CS_GEXPR_MAX_NEST    32   /* brackets and functions nested in one real value */
+#define CS_GEXPR_NUM_PARAMS  5400   /* numbered parameters #1..#5399 (index 0 unused) */
+#define CS_GEXPR_LOCALS      30     /* #1..#30: a call's arguments, restored on return */
+#define CS_GEXPR_NAME_MAX    64     /* longest parameter name kept, with its NUL */
+#define CS_GEXPR_MAX_PENDING 64     /* parameter settings on one line */
+#define CS_GEXPR_MAX_CALLS   10     /* LinuxCNC: "The maximum subroutine nesting level is 10" */
+#define CS_GEXPR_MAX_NEST    32     /* brackets and functions nested in one real value */
 #define CS_GEXPR_EQ_TOL      0.0001 /* EQ and NE compare to this (LinuxCNC's TOLERANCE_EQUAL) */
 
 /* Where and why a read failed: byte index into the line, and a reason. */

@@ -12,11 +12,21 @@ typedef struct {
 } gf_open_t;
 
 static const char *const gf_words[] = {
-    [CS_GFLOW_SUB] = "sub",         [CS_GFLOW_ENDSUB] = "endsub", [CS_GFLOW_CALL] = "call",
-    [CS_GFLOW_RETURN] = "return",   [CS_GFLOW_IF] = "if",         [CS_GFLOW_ELSEIF] = "elseif",
-    [CS_GFLOW_ELSE] = "else",       [CS_GFLOW_ENDIF] = "endif",   [CS_GFLOW_WHILE] = "while",
-    [CS_GFLOW_ENDWHILE] = "endwhile", [CS_GFLOW_DO] = "do",       [CS_GFLOW_REPEAT] = "repeat",
-    [CS_GFLOW_ENDREPEAT] = "endrepeat", [CS_GFLOW_BREAK] = "break", [CS_GFLOW_CONTINUE] = "continue",
+    [CS_GFLOW_SUB] = "sub",
+    [CS_GFLOW_ENDSUB] = "endsub",
+    [CS_GFLOW_CALL] = "call",
+    [CS_GFLOW_RETURN] = "return",
+    [CS_GFLOW_IF] = "if",
+    [CS_GFLOW_ELSEIF] = "elseif",
+    [CS_GFLOW_ELSE] = "else",
+    [CS_GFLOW_ENDIF] = "endif",
+    [CS_GFLOW_WHILE] = "while",
+    [CS_GFLOW_ENDWHILE] = "endwhile",
+    [CS_GFLOW_DO] = "do",
+    [CS_GFLOW_REPEAT] = "repeat",
+    [CS_GFLOW_ENDREPEAT] = "endrepeat",
+    [CS_GFLOW_BREAK] = "break",
+    [CS_GFLOW_CONTINUE] = "continue",
 };
 
 /* Column (1-based, UTF-8 continuation bytes not counted) of s[i]. */
@@ -99,7 +109,8 @@ static cs_err_t gf_parse(cs_gflow_line_t *l, const char *s, const char *name, si
     gf_blanks(s, n, &j);
     char kw[12];
     size_t m = 0, at = j;
-    while (j < n && ((s[j] >= 'a' && s[j] <= 'z') || (s[j] >= 'A' && s[j] <= 'Z')) && m + 1 < sizeof kw)
+    while (j < n && ((s[j] >= 'a' && s[j] <= 'z') || (s[j] >= 'A' && s[j] <= 'Z')) &&
+           m + 1 < sizeof kw)
         kw[m++] = (char)(s[j++] | 0x20);
     kw[m] = '\0';
     for (int q = CS_GFLOW_SUB; q <= CS_GFLOW_CONTINUE; q++)
@@ -141,10 +152,10 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
     bool same = top && strcmp(top->label, l->label) == 0;
     static const cs_gflow_kind_t loops[] = {CS_GFLOW_WHILE, CS_GFLOW_DO, CS_GFLOW_REPEAT};
     static const cs_gflow_kind_t subs[] = {CS_GFLOW_SUB};
-    cs_gflow_kind_t opener = l->kind == CS_GFLOW_ENDSUB     ? CS_GFLOW_SUB
-                             : l->kind == CS_GFLOW_ENDWHILE ? CS_GFLOW_WHILE
+    cs_gflow_kind_t opener = l->kind == CS_GFLOW_ENDSUB      ? CS_GFLOW_SUB
+                             : l->kind == CS_GFLOW_ENDWHILE  ? CS_GFLOW_WHILE
                              : l->kind == CS_GFLOW_ENDREPEAT ? CS_GFLOW_REPEAT
-                                                            : CS_GFLOW_IF;
+                                                             : CS_GFLOW_IF;
     if (l->kind == CS_GFLOW_WHILE && same && top->kind == CS_GFLOW_DO) {
         /* LinuxCNC: a while whose label is an open do ends that do loop. */
         l->kind = CS_GFLOW_DOWHILE;
@@ -182,7 +193,7 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
     case CS_GFLOW_ENDIF:
         if (!same || top->kind != opener)
             return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l,
-                          opener == CS_GFLOW_IF ? " without a matching if"
+                          opener == CS_GFLOW_IF    ? " without a matching if"
                           : opener == CS_GFLOW_SUB ? " without a matching sub"
                                                    : " without the loop it ends");
         if (opener == CS_GFLOW_IF) {
@@ -199,8 +210,8 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
     case CS_GFLOW_CONTINUE:
     case CS_GFLOW_RETURN: {
         bool ret = l->kind == CS_GFLOW_RETURN;
-        gf_open_t *o = ret ? gf_find(f, st, *nst, NULL, subs, 1)
-                           : gf_find(f, st, *nst, l->label, loops, 3);
+        gf_open_t *o =
+            ret ? gf_find(f, st, *nst, NULL, subs, 1) : gf_find(f, st, *nst, l->label, loops, 3);
         if (!o)
             return gf_err(d, CS_ERR_PARSE, name, k, l->ocol, l,
                           ret ? " outside a subroutine" : " outside a loop of that label");
@@ -360,13 +371,15 @@ static cs_err_t gf_call(gf_run_t *r, size_t *next)
     if (sub == f->n)
         return cs_path_diag_set(r->diag, CS_ERR_PARSE, loc,
                                 "o%s call: no subroutine o%s in this file (subroutine files are "
-                                "not read)", label, label);
+                                "not read)",
+                                label, label);
     /* LinuxCNC: "If the subroutine is defined in the same file as the main program that calls
      * the subroutine, it must be defined before the call statement." */
     if (!f->lines[sub].defined)
         return cs_path_diag_set(r->diag, CS_ERR_PARSE, loc,
                                 "o%s call: the subroutine is defined after the call (line %zu); "
-                                "LinuxCNC needs it defined first", label, sub + 1);
+                                "LinuxCNC needs it defined first",
+                                label, sub + 1);
     if (f->ncalls >= CS_GEXPR_MAX_CALLS || cs_gexpr_call(r->st, args, nargs) != CS_OK)
         return cs_path_diag_set(r->diag, CS_ERR_RANGE, loc,
                                 "o%s call: subroutines nested more than %d deep", label,
@@ -389,8 +402,7 @@ static cs_err_t gf_return(gf_run_t *r, size_t *next)
     if (e != CS_OK)
         return e;
     if (f->ncalls == 0)
-        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, l,
-                      " reached outside a call");
+        return gf_err(r->diag, CS_ERR_PARSE, r->name, r->k, l->ocol, l, " reached outside a call");
     f->ncalls--;
     f->nreps = f->calls[f->ncalls].loops;
     cs_gexpr_return(r->st);

@@ -38,20 +38,20 @@ typedef enum {
 } cs_gflow_kind_t;
 
 typedef struct {
-    size_t start, len;      /* the line's bytes in the buffer (no end of line) */
-    cs_gflow_kind_t kind;   /* CS_GFLOW_NONE for ordinary lines */
+    size_t start, len;    /* the line's bytes in the buffer (no end of line) */
+    cs_gflow_kind_t kind; /* CS_GFLOW_NONE for ordinary lines */
     char label[CS_GFLOW_LABEL_MAX];
-    size_t args;            /* offset in the line just past the keyword */
-    unsigned ocol;          /* column of the 'o' */
-    size_t next;            /* if/elseif/else: the next branch line; loops: their other end;
-                             * break/continue/return: the loop or sub start */
-    size_t end;             /* if branches: the endif line */
-    bool defined;           /* sub: execution has passed its definition */
+    size_t args;   /* offset in the line just past the keyword */
+    unsigned ocol; /* column of the 'o' */
+    size_t next;   /* if/elseif/else: the next branch line; loops: their other end;
+                    * break/continue/return: the loop or sub start */
+    size_t end;    /* if branches: the endif line */
+    bool defined;  /* sub: execution has passed its definition */
 } cs_gflow_line_t;
 
 typedef struct {
-    size_t ret;    /* line to go on with after the call */
-    size_t loops;  /* repeat frames open when called */
+    size_t ret;   /* line to go on with after the call */
+    size_t loops; /* repeat frames open when called */
 } cs_gflow_call_t;
 
 typedef struct {

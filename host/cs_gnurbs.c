@@ -82,18 +82,19 @@ static cs_err_t gn_knots(const cs_gnurbs_t *nb, cs_nurbs_knot_t *kn, char *why, 
     double span = K[cnt + k - 1] - K[0];
     for (size_t i = 1; i < cnt + k; i++)
         if (K[i] < K[i - 1])
-            return gn_why(CS_ERR_PARSE, why, len, "knot %zu (K%g) is below the one before it", i + 1,
-                          K[i]);
+            return gn_why(CS_ERR_PARSE, why, len, "knot %zu (K%g) is below the one before it",
+                          i + 1, K[i]);
     if (!(span > 0))
         return gn_why(CS_ERR_PARSE, why, len, "the knots span nothing");
     for (size_t i = 1; i < k; i++)
         if (K[i] != K[0] || K[cnt + k - 1 - i] != K[cnt + k - 1])
             return gn_why(CS_ERR_PARSE, why, len,
                           "the first and the last %zu knots must be equal (a clamped curve, "
-                          "starting where the tool is)", k);
+                          "starting where the tool is)",
+                          k);
     for (size_t i = 0; i < cnt + k; i++) {
-        kn[i] = (cs_nurbs_knot_t)nearbyint((K[i] - K[0]) / span * GN_KNOT_RANGE *
-                                           CS_NURBS_KNOT_ONE);
+        kn[i] =
+            (cs_nurbs_knot_t)nearbyint((K[i] - K[0]) / span * GN_KNOT_RANGE * CS_NURBS_KNOT_ONE);
         if (i > 0 && K[i] > K[i - 1] && kn[i] == kn[i - 1])
             return gn_why(CS_ERR_RANGE, why, len, "knots %g and %g are too close together",
                           K[i - 1], K[i]);
@@ -111,12 +112,16 @@ static cs_err_t gn_convert(const cs_gnurbs_t *nb, cs_vec3_t *pts, int32_t *w, cs
     for (size_t i = 0; i < cnt; i++) {
         const double *p = nb->cps[i].p;
         if (cs_conv_mm_to_vec(p[0], p[1], p[2], &pts[i]) != CS_OK)
-            return gn_why(CS_ERR_RANGE, why, len, "control point (%.4f, %.4f, %.4f) mm is outside "
-                          "+/-%d mm", p[0], p[1], p[2], CS_POS_LIMIT_MM);
+            return gn_why(CS_ERR_RANGE, why, len,
+                          "control point (%.4f, %.4f, %.4f) mm is outside "
+                          "+/-%d mm",
+                          p[0], p[1], p[2], CS_POS_LIMIT_MM);
         double wq = nearbyint(nb->cps[i].w / wmax * (double)CS_PARAM_ONE);
         if (!(wq >= 1))
-            return gn_why(CS_ERR_WEIGHT, why, len, "weight %g is too small next to the largest "
-                          "weight %g", nb->cps[i].w, wmax);
+            return gn_why(CS_ERR_WEIGHT, why, len,
+                          "weight %g is too small next to the largest "
+                          "weight %g",
+                          nb->cps[i].w, wmax);
         w[i] = (int32_t)wq;
     }
     cs_err_t e = gn_knots(nb, kn, why, len);

@@ -20,6 +20,8 @@
 #include "../../host/cs_conv.c"
 #include "../../host/cs_err_text.c"
 #include "../../host/cs_gcode.c"
+#include "../../host/cs_gcode_arc.c"
+#include "../../host/cs_gcode_nurbs.c"
 #include "../../host/cs_gexpr.c"
 #include "../../host/cs_gflow.c"
 #include "../../host/cs_gnurbs.c"
@@ -160,7 +162,8 @@ static const char *const seeds[] = {
     "G1 X10 F1\nG2 X0 Y11 I-10\n",
     "G1 (unclosed\n",
     "#3=15\n#3=6 G1 x#3 F60\n#<_a>=[2**3 MOD 5]\nG1 Y[#<_a>*SIN[30]+ATAN[1]/[1]-FIX[-2.5]]\n",
-    "#1=[1 EQ 1 AND 2 GT 1 OR 0 XOR 1]\nG1 X[ROUND[2.5]+FUP[0.1]+ABS[-1]+SQRT[4]+EXP[0]+LN[1]] F9\n",
+    "#1=[1 EQ 1 AND 2 GT 1 OR 0 XOR 1]\nG1 X[ROUND[2.5]+FUP[0.1]+ABS[-1]+SQRT[4]+EXP[0]+LN[1]] "
+    "F9\n",
     "o<sq> sub\nG1 X#1 Y0\nG1 X#1 Y#1\no<sq> endsub\nF60\no<sq> call [10]\no<sq> call [5]\n",
     "F60\n#1=1\no1 while [#1 LT 4]\nG1 X#1\n#1=[#1+1]\no1 endwhile\no2 repeat [2]\nG91 X1\n"
     "o2 endrepeat\nG90\n#2=0\no3 do\n#2=[#2+1]\no4 if [#2 EQ 2]\no3 continue\no4 elseif [#2 GT "

@@ -1046,14 +1046,15 @@ static void test_oword_sub_call(void **state)
 static void test_oword_loops_and_ifs(void **state)
 {
     (void)state;
-    assert_int_equal(parse("F60\n#1=1\no101 while [#1 LT 4]\nG1 X#1\n#1=[#1+1]\no101 endwhile\n"
-                           "o102 repeat [2]\nG91 G1 X10\no102 endrepeat\nG90\n"
-                           "#2=0\no103 do\n#2=[#2+1]\no104 if [#2 EQ 2]\no103 continue\no104 endif\n"
-                           "G1 X[100+#2]\no105 if [#2 GE 4]\no103 break\no105 endif\n"
-                           "o103 while [#2 LT 10]\n"
-                           "o106 repeat [0]\nG1 X999\no106 endrepeat\n"
-                           "o107 while [0]\nG1 X999\no107 endwhile\n"),
-                     CS_OK);
+    assert_int_equal(
+        parse("F60\n#1=1\no101 while [#1 LT 4]\nG1 X#1\n#1=[#1+1]\no101 endwhile\n"
+              "o102 repeat [2]\nG91 G1 X10\no102 endrepeat\nG90\n"
+              "#2=0\no103 do\n#2=[#2+1]\no104 if [#2 EQ 2]\no103 continue\no104 endif\n"
+              "G1 X[100+#2]\no105 if [#2 GE 4]\no103 break\no105 endif\n"
+              "o103 while [#2 LT 10]\n"
+              "o106 repeat [0]\nG1 X999\no106 endrepeat\n"
+              "o107 while [0]\nG1 X999\no107 endwhile\n"),
+        CS_OK);
     static const double xs[] = {1, 2, 3, 13, 23, 101, 103, 104};
     assert_int_equal(P.n, 8);
     for (size_t k = 0; k < 8; k++)
@@ -1062,8 +1063,10 @@ static void test_oword_loops_and_ifs(void **state)
      * code following the else keyword is executed." */
     for (int v = 0; v < 4; v++) {
         char t[256];
-        snprintf(t, sizeof t, "#2=%d\no102 if [#2 GT 2]\nG1 X1 F1\no102 elseif [#2 LT 1]\nG1 X2 F1\n"
-                 "o102 elseif [#2 EQ 1]\nG1 X3 F1\no102 else\nG1 X4 F1\no102 endif\n", v);
+        snprintf(t, sizeof t,
+                 "#2=%d\no102 if [#2 GT 2]\nG1 X1 F1\no102 elseif [#2 LT 1]\nG1 X2 F1\n"
+                 "o102 elseif [#2 EQ 1]\nG1 X3 F1\no102 else\nG1 X4 F1\no102 endif\n",
+                 v);
         assert_int_equal(parse(t), CS_OK);
         assert_int_equal(P.n, 1);
         expect_pt(0, 1, v == 3 ? 1 : v == 0 ? 2 : v == 1 ? 3 : 4, 0, 0, PT_TOL);
@@ -1128,16 +1131,16 @@ static void test_arc_radius_rules(void **state)
         double r0, r1;
         bool linuxcnc_ok, grbl_ok;
     } c[] = {
-        {10, 10.028, true, false},     /* 0.028 mm <= abs; 0.28 %: Grbl refuses */
-        {10, 10.029, false, false},    /* 0.029 mm > abs and 0.29 % */
-        {10, 10.004, true, true},      /* under both absolute tolerances */
-        {10, 10.006, true, true},      /* 0.06 %: within Grbl's 0.1 % */
-        {100, 100.09, true, true},     /* 0.0899 % */
-        {100, 100.11, false, false},   /* 0.1099 % */
-        {1000, 1000.6, true, false},   /* 0.06 %; over Grbl's 0.5 mm */
-        {1000, 1000.4, true, true},    /* 0.04 %, under 0.5 mm */
-        {4000, 4002.8, true, false},   /* 2.8 mm < 100 abs, 0.07 % */
-        {4000, 4002.9, false, false},  /* 2.9 mm > 100 abs although only 0.0725 % */
+        {10, 10.028, true, false},    /* 0.028 mm <= abs; 0.28 %: Grbl refuses */
+        {10, 10.029, false, false},   /* 0.029 mm > abs and 0.29 % */
+        {10, 10.004, true, true},     /* under both absolute tolerances */
+        {10, 10.006, true, true},     /* 0.06 %: within Grbl's 0.1 % */
+        {100, 100.09, true, true},    /* 0.0899 % */
+        {100, 100.11, false, false},  /* 0.1099 % */
+        {1000, 1000.6, true, false},  /* 0.06 %; over Grbl's 0.5 mm */
+        {1000, 1000.4, true, true},   /* 0.04 %, under 0.5 mm */
+        {4000, 4002.8, true, false},  /* 2.8 mm < 100 abs, 0.07 % */
+        {4000, 4002.9, false, false}, /* 2.9 mm > 100 abs although only 0.0725 % */
     };
     for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
         char t[128];

@@ -90,13 +90,13 @@ static void test_precedence(void **state)
 {
     (void)state;
     expect_val("[2.0 / 3 * 1.5 - 5.5 / 11.0]", 0.5);
-    expect_val("[2 + 3 * 2 ** 2]", 14);          /* 2 + (3 * 4) */
-    expect_val("[2 ** 3 ** 2]", 64);             /* left first: (2**3)**2 */
-    expect_val("[10 - 4 - 3]", 3);               /* left first */
-    expect_val("[1 + 1 EQ 2]", 1);               /* (1 + 1) EQ 2 */
-    expect_val("[1 LT 2 AND 3 GT 4]", 0);        /* (1 < 2) AND (3 > 4) */
-    expect_val("[0 OR 2 XOR 1]", 0);             /* (0 OR 2) = 1, 1 XOR 1 = 0 */
-    expect_val("[7 MOD 3 * 2]", 2);              /* MOD and * share a level: (7 MOD 3) * 2 */
+    expect_val("[2 + 3 * 2 ** 2]", 14);                 /* 2 + (3 * 4) */
+    expect_val("[2 ** 3 ** 2]", 64);                    /* left first: (2**3)**2 */
+    expect_val("[10 - 4 - 3]", 3);                      /* left first */
+    expect_val("[1 + 1 EQ 2]", 1);                      /* (1 + 1) EQ 2 */
+    expect_val("[1 LT 2 AND 3 GT 4]", 0);               /* (1 < 2) AND (3 > 4) */
+    expect_val("[0 OR 2 XOR 1]", 0);                    /* (0 OR 2) = 1, 1 XOR 1 = 0 */
+    expect_val("[7 MOD 3 * 2]", 2);                     /* MOD and * share a level: (7 MOD 3) * 2 */
     expect_val("[ 1 + acos[0] - [#3 ** [4.0/2]]]", 91); /* #3 = 0 */
 }
 
@@ -228,12 +228,9 @@ static void test_settings_and_scope(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_numbers),
-        cmocka_unit_test(test_precedence),
-        cmocka_unit_test(test_logic_and_mod),
-        cmocka_unit_test(test_functions),
-        cmocka_unit_test(test_parameters),
-        cmocka_unit_test(test_settings_and_scope),
+        cmocka_unit_test(test_numbers),       cmocka_unit_test(test_precedence),
+        cmocka_unit_test(test_logic_and_mod), cmocka_unit_test(test_functions),
+        cmocka_unit_test(test_parameters),    cmocka_unit_test(test_settings_and_scope),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
