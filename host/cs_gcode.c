@@ -54,17 +54,6 @@ static int letter_index(char c)
     return -1;
 }
 
-/* Column (1-based, in characters: UTF-8 continuation bytes do not count) of s[i] on a line that
- * starts at s[0]. */
-static unsigned col_of(const char *s, size_t i)
-{
-    unsigned c = 1;
-    for (size_t k = 0; k < i; k++)
-        if (((unsigned char)s[k] & 0xC0) != 0x80)
-            c++;
-    return c;
-}
-
 /* ---- geometry helpers -------------------------------------------------------------------- */
 
 cs_err_t cs_gcode_to_vec(gc_t *g, const double p[3], unsigned col, cs_vec3_t *out)
@@ -623,7 +612,7 @@ static cs_err_t read_value(gc_t *g, const char *s, size_t n, size_t *i, char let
     size_t start = *i;
     bool grbl = g->o->dialect == CS_GCODE_GRBL;
     if (grbl && *i < n && (s[*i] == '#' || s[*i] == '['))
-        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col_of(s, *i)),
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, cs_gflow_col(s, *i)),
                                 "%s are LinuxCNC's: Grbl 1.1 has none (--dialect grbl)",
                                 s[*i] == '#' ? "parameters (#)" : "expressions ([...])");
     cs_err_t e = grbl ? cs_gexpr_number(s, n, i, v, &f) : cs_gexpr_real(&g->st, s, n, i, v, &f);
@@ -632,7 +621,7 @@ static cs_err_t read_value(gc_t *g, const char *s, size_t n, size_t *i, char let
     if (f.at == start && strcmp(f.reason, "expected a number") == 0)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                                 "%c must be followed by a number", letter);
-    return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, col_of(s, f.at)), "%s", f.reason);
+    return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, cs_gflow_col(s, f.at)), "%s", f.reason);
 }
 
 /* "#... = value" at s[*i]: read now, set at the end of the line (cs_gexpr_commit). */
@@ -640,12 +629,12 @@ static cs_err_t read_assign(gc_t *g, const char *s, size_t n, size_t *i)
 {
     cs_gexpr_fail_t f;
     if (g->o->dialect == CS_GCODE_GRBL)
-        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col_of(s, *i)),
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, cs_gflow_col(s, *i)),
                                 "parameters (#) are LinuxCNC's: Grbl 1.1 has none "
                                 "(--dialect grbl)");
     cs_err_t e = cs_gexpr_assign(&g->st, s, n, i, &f);
     if (e != CS_OK)
-        return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, col_of(s, f.at)), "%s", f.reason);
+        return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, cs_gflow_col(s, f.at)), "%s", f.reason);
     return CS_OK;
 }
 
@@ -662,7 +651,7 @@ static cs_err_t code_of_line(gc_t *g, const char *s, size_t n, size_t *code_end)
             while (j < n && s[j] != ')')
                 j++;
             if (j == n)
-                return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col_of(s, i)),
+                return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, cs_gflow_col(s, i)),
                                         "comment not closed on its line (missing ')')");
             i = j;
         } else if (c == ';') {
@@ -676,7 +665,7 @@ static cs_err_t code_of_line(gc_t *g, const char *s, size_t n, size_t *code_end)
             /* Inside [...] '*' multiplies (LinuxCNC); outside it starts a checksum. */
             star = i;
         } else if (c == '\0') {
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col_of(s, i)),
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, cs_gflow_col(s, i)),
                                     "NUL byte in the input");
         }
     }
@@ -701,10 +690,10 @@ static cs_err_t code_of_line(gc_t *g, const char *s, size_t n, size_t *code_end)
             k++;
     }
     if (nd == 0 || nd > 3 || v > 255 || k < *code_end)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col_of(s, star)),
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, cs_gflow_col(s, star)),
                                 "'*' must end the line with a checksum from 0 to 255");
     if (v != x)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col_of(s, star)),
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, cs_gflow_col(s, star)),
                                 "checksum *%u does not match the line (the XOR of the "
                                 "bytes before '*' is %u)",
                                 v, x);
@@ -804,7 +793,7 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
             i++;
             continue;
         }
-        unsigned col = col_of(s, i);
+        unsigned col = cs_gflow_col(s, i);
         if (c == '#') {
             if ((e = read_assign(g, s, code_end, &i)) != CS_OK)
                 return e;

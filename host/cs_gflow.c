@@ -29,8 +29,7 @@ static const char *const gf_words[] = {
     [CS_GFLOW_CONTINUE] = "continue",
 };
 
-/* Column (1-based, UTF-8 continuation bytes not counted) of s[i]. */
-static unsigned gf_col(const char *s, size_t i)
+unsigned cs_gflow_col(const char *s, size_t i)
 {
     unsigned c = 1;
     for (size_t k = 0; k < i; k++)
@@ -70,7 +69,7 @@ static cs_err_t gf_parse(cs_gflow_line_t *l, const char *s, const char *name, si
     }
     if (i >= n || (s[i] != 'o' && s[i] != 'O'))
         return CS_OK;
-    l->ocol = gf_col(s, i);
+    l->ocol = cs_gflow_col(s, i);
     cs_path_loc_t loc = {name, (unsigned)(k + 1), l->ocol};
     size_t j = ++i, w = 0;
     while (j < n && (s[j] == ' ' || s[j] == '\t'))
@@ -116,7 +115,7 @@ static cs_err_t gf_parse(cs_gflow_line_t *l, const char *s, const char *name, si
     for (int q = CS_GFLOW_SUB; q <= CS_GFLOW_CONTINUE; q++)
         if (gf_words[q] && strcmp(kw, gf_words[q]) == 0)
             l->kind = (cs_gflow_kind_t)q;
-    loc.col = gf_col(s, at);
+    loc.col = cs_gflow_col(s, at);
     if (l->kind == CS_GFLOW_NONE)
         return cs_path_diag_set(d, CS_ERR_PARSE, loc,
                                 "o%s: expected sub, endsub, call, return, if, elseif, else, "
@@ -291,7 +290,7 @@ typedef struct {
 
 static cs_err_t gf_expr_err(gf_run_t *r, cs_err_t e, const cs_gexpr_fail_t *fl)
 {
-    cs_path_loc_t loc = {r->name, (unsigned)(r->k + 1), gf_col(r->s, fl->at)};
+    cs_path_loc_t loc = {r->name, (unsigned)(r->k + 1), cs_gflow_col(r->s, fl->at)};
     return cs_path_diag_set(r->diag, e, loc, "%s", fl->reason);
 }
 

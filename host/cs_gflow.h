@@ -77,6 +77,10 @@ cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t 
                        unsigned long max_iterations, cs_path_diag_t *diag);
 void cs_gflow_free(cs_gflow_t *f);
 
+/* Column (1-based, in characters: UTF-8 continuation bytes do not count) of s[i] on a line that
+ * starts at s[0]; the column every G-code diagnostic gives. */
+unsigned cs_gflow_col(const char *s, size_t i);
+
 /* Runs O-word line k (f->lines[k].kind != NONE) of buf, evaluating its arguments with st, and
  * sets *next to the line to run next. Errors (CS_ERR_PARSE, CS_ERR_RANGE, CS_ERR_FULL) with
  * *diag: a call to a sub not defined before it, too deep a call, a runaway loop... */

@@ -2,6 +2,7 @@
 #include "cs_gnurbs.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +23,18 @@ static cs_err_t gn_why(cs_err_t e, char *why, size_t len, const char *fmt, ...)
     return e;
 }
 
+/* Doubles the array *p of *cap elements of size sz (16 at first); false without memory. */
+static bool gn_grow(void **p, size_t *cap, size_t sz)
+{
+    size_t nc = *cap ? 2 * *cap : 16;
+    void *q = realloc(*p, nc * sz);
+    if (!q)
+        return false;
+    *p = q;
+    *cap = nc;
+    return true;
+}
+
 void cs_gnurbs_begin(cs_gnurbs_t *nb, unsigned order)
 {
     nb->n = 0;
@@ -33,14 +46,8 @@ cs_err_t cs_gnurbs_push(cs_gnurbs_t *nb, const double p[3], double w)
 {
     if (nb->n >= CS_GNURBS_MAX_POINTS)
         return CS_ERR_FULL;
-    if (nb->n == nb->cap) {
-        size_t nc = nb->cap ? 2 * nb->cap : 16;
-        cs_gnurbs_cp_t *q = realloc(nb->cps, nc * sizeof *q);
-        if (!q)
-            return CS_ERR_FULL;
-        nb->cps = q;
-        nb->cap = nc;
-    }
+    if (nb->n == nb->cap && !gn_grow((void **)&nb->cps, &nb->cap, sizeof *nb->cps))
+        return CS_ERR_FULL;
     memcpy(nb->cps[nb->n].p, p, sizeof nb->cps[0].p);
     nb->cps[nb->n++].w = w;
     return CS_OK;
@@ -50,14 +57,9 @@ cs_err_t cs_gnurbs_knot(cs_gnurbs_t *nb, double k)
 {
     if (nb->nknots >= CS_GNURBS_MAX_POINTS + CS_GNURBS_MAX_ORDER)
         return CS_ERR_FULL;
-    if (nb->nknots == nb->capknots) {
-        size_t nc = nb->capknots ? 2 * nb->capknots : 16;
-        double *q = realloc(nb->knots, nc * sizeof *q);
-        if (!q)
-            return CS_ERR_FULL;
-        nb->knots = q;
-        nb->capknots = nc;
-    }
+    if (nb->nknots == nb->capknots &&
+        !gn_grow((void **)&nb->knots, &nb->capknots, sizeof *nb->knots))
+        return CS_ERR_FULL;
     nb->knots[nb->nknots++] = k;
     return CS_OK;
 }
