@@ -173,6 +173,19 @@ run "probe lenient" 0 flatten --lenient "$T/probe.nc" &&
     expect_err "probe lenient" "^$T/probe.nc:2:1: warning: G38.2 is not supported: its block skipped, with its words Z-5" &&
     expect_out "probe lenient" '0.000000 0.000000\n1.000000 0.000000\n2.000000 0.000000\n'
 
+# G64 P is the program's path tolerance: planning uses the smaller of it and --tol, so a circle
+# with G64 P0.001 plans exactly as with --tol 0.001, and a tighter --tol wins over it.
+printf 'G0 X10\nG3 X10 Y0 I-10 J0 F600\n' >"$T/circ.nc"
+printf 'G64 P0.001\nG0 X10\nG3 X10 Y0 I-10 J0 F600\n' >"$T/circ64.nc"
+blocks() { sed -n 's/^plan: [0-9]* elements, \([0-9]*\) blocks.*/\1/p' "$T/err"; }
+run "g64 plain" 0 plan "$T/circ.nc" && b0=$(blocks)
+run "g64 --tol" 0 plan --tol 0.001 "$T/circ.nc" && b1=$(blocks)
+run "g64 P" 0 plan "$T/circ64.nc" && b2=$(blocks)
+run "g64 P tighter tol" 0 plan --tol 0.0005 "$T/circ64.nc" && b3=$(blocks)
+run "g64 tighter tol" 0 plan --tol 0.0005 "$T/circ.nc" && b4=$(blocks)
+[ -n "$b2" ] && [ "$b2" = "$b1" ] && [ "$b2" -gt "$b0" ] && [ "$b3" = "$b4" ] && ok ||
+    ko "g64: blocks plain $b0, --tol 0.001 $b1, G64 P0.001 $b2, both $b3, --tol 0.0005 $b4"
+
 # --- CAM output: Fusion 360 for Grbl, CamBam ------------------------------------------------
 # The Fusion 360 program positions with "X5 Y5" before any G0: Grbl starts in G0. LinuxCNC's
 # dialect refuses it (at its T1 first: a tool change curvestep does not do).
