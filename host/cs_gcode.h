@@ -61,9 +61,11 @@ void cs_gcode_opts_init(cs_gcode_opts_t *o);
  * in G17 G21 (G20 with start_inch) G90 G91.1 G94, with no motion mode (Grbl: G0). O-words run
  * as LinuxCNC runs them; G64 P (the program's path tolerance, mm) lowers path->blend_tol_mm.
  * The whole input is read before returning.
- * CS_ERR_PARSE (syntax, checksum, inconsistent words), CS_ERR_UNSUPPORTED (a word this reader
- * does not carry out, unless lenient), CS_ERR_DEGENERATE / CS_ERR_RANGE (bad arcs, coordinates
- * outside +/-4096 mm), CS_ERR_FULL (out of memory), each with *diag. stats may be NULL. */
+ * CS_ERR_PARSE (syntax, checksum, exponent form, inconsistent words, an undefined parameter, an
+ * O-word that does not pair), CS_ERR_UNSUPPORTED (a word this reader or the dialect does not carry
+ * out, unless lenient), CS_ERR_DEGENERATE / CS_ERR_RANGE (bad arcs, coordinates outside +/-4096
+ * mm, a math error in an expression, calls nested past 10, a runaway loop), CS_ERR_WEIGHT /
+ * CS_ERR_KNOTS (NURBS blocks), CS_ERR_FULL (out of memory), each with *diag. stats may be NULL. */
 cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_gcode_opts_t *o,
                        cs_path_t *path, cs_path_diag_t *diag, cs_gcode_stats_t *stats);
 

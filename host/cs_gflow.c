@@ -222,6 +222,34 @@ static cs_err_t gf_pair(cs_gflow_t *f, gf_open_t *st, size_t *nst, size_t k, con
     }
 }
 
+/* The sub table, and each call with a written label linked to its sub (once, not per call). */
+static cs_err_t gf_link_calls(cs_gflow_t *f, const char *name, cs_path_diag_t *diag)
+{
+    for (size_t k = 0; k < f->n; k++)
+        f->nsubs += f->lines[k].kind == CS_GFLOW_SUB;
+    f->subs = malloc((f->nsubs ? f->nsubs : 1) * sizeof *f->subs);
+    if (!f->subs) {
+        cs_path_loc_t l0 = {name, 0, 0};
+        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
+    }
+    size_t m = 0;
+    for (size_t k = 0; k < f->n; k++)
+        if (f->lines[k].kind == CS_GFLOW_SUB)
+            f->subs[m++] = k;
+    for (size_t k = 0; k < f->n; k++)
+        if (f->lines[k].kind == CS_GFLOW_CALL && f->lines[k].label[0] != '[')
+            f->lines[k].next = cs_gflow_find_sub(f, f->lines[k].label);
+    return CS_OK;
+}
+
+size_t cs_gflow_find_sub(const cs_gflow_t *f, const char *label)
+{
+    for (size_t q = 0; q < f->nsubs; q++)
+        if (strcmp(f->lines[f->subs[q]].label, label) == 0)
+            return f->subs[q];
+    return f->n;
+}
+
 cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t len, bool o_words,
                        unsigned long max_iterations, cs_path_diag_t *diag)
 {
@@ -260,6 +288,8 @@ cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t 
         if (e == CS_OK && f->lines[k].kind != CS_GFLOW_NONE)
             e = gf_pair(f, st, &nst, k, name, diag);
     }
+    if (e == CS_OK)
+        e = gf_link_calls(f, name, diag);
     if (e == CS_OK && nst > 0) {
         const cs_gflow_line_t *o = &f->lines[st[nst - 1].line];
         e = gf_err(diag, CS_ERR_PARSE, name, st[nst - 1].line, o->ocol, o,
@@ -271,6 +301,9 @@ cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t 
 
 void cs_gflow_free(cs_gflow_t *f)
 {
+    free(f->subs);
+    f->subs = NULL;
+    f->nsubs = 0;
     free(f->lines);
     f->lines = NULL;
     f->n = 0;
@@ -362,10 +395,7 @@ static cs_err_t gf_call(gf_run_t *r, size_t *next)
     cs_err_t e = gf_args(r, i, args, CS_GEXPR_LOCALS, &nargs, false);
     if (e != CS_OK)
         return e;
-    size_t sub = f->n;
-    for (size_t q = 0; q < f->n; q++)
-        if (f->lines[q].kind == CS_GFLOW_SUB && strcmp(f->lines[q].label, label) == 0)
-            sub = q;
+    size_t sub = l->label[0] == '[' ? cs_gflow_find_sub(f, label) : l->next;
     cs_path_loc_t loc = {r->name, (unsigned)(r->k + 1), l->ocol};
     if (sub == f->n)
         return cs_path_diag_set(r->diag, CS_ERR_PARSE, loc,

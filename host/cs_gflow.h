@@ -62,6 +62,8 @@ typedef struct {
 typedef struct {
     cs_gflow_line_t *lines;
     size_t n;
+    size_t *subs; /* the sub lines, in file order (a call looks its sub up here) */
+    size_t nsubs;
     cs_gflow_call_t calls[CS_GEXPR_MAX_CALLS];
     unsigned ncalls;
     cs_gflow_rep_t reps[CS_GFLOW_MAX_OPEN];
@@ -76,6 +78,9 @@ typedef struct {
 cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t len, bool o_words,
                        unsigned long max_iterations, cs_path_diag_t *diag);
 void cs_gflow_free(cs_gflow_t *f);
+
+/* The line of sub o<label> ("100", "<name>"), or f->n when the file has none. */
+size_t cs_gflow_find_sub(const cs_gflow_t *f, const char *label);
 
 /* Column (1-based, in characters: UTF-8 continuation bytes do not count) of s[i] on a line that
  * starts at s[0]; the column every G-code diagnostic gives. */
