@@ -147,6 +147,23 @@ if [ -x "$SIM" ]; then
 else
     ko "no $SIM"
 fi
+# A LinuxCNC program with a subroutine and loops streams to the simulator and ends where its
+# last move does: X75 Y5 (80 steps/mm: 6000 and 400 steps).
+if [ -x "$SIM" ]; then
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 >"$T/sim2.out" 2>"$T/sim2.err" &
+    simpid=$!
+    pids+=($simpid)
+    wait_pty "$T/sim2.out" 5
+    if [ -n "$PTY" ] && run "stream sub-loop" 0 stream --quiet --port "$PTY" "$DATA/linuxcnc-sub-loop.ngc"; then
+        wait_until 10 gone "$simpid"
+        grep -q '^final position: x=6000 steps (75.0000 mm) y=400 steps (5.0000 mm) z=0 steps' \
+            "$T/sim2.out" && ok || ko "stream sub-loop: $(grep '^final position' "$T/sim2.out")"
+    else
+        [ -n "$PTY" ] || ko "stream sub-loop: the simulator did not start"
+    fi
+    kill "$simpid" 2>/dev/null
+    wait "$simpid" 2>/dev/null
+fi
 run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$T/out" && ok ||
     ko "stream --help lacks [pen]"
 
