@@ -490,10 +490,7 @@ static cs_err_t gx_binary(gx_t *x, size_t *i, int minprec, double *out)
 /* "[expression]" at s[*i] == '['. */
 static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out)
 {
-    size_t at = *i;
-    if (++x->nest > CS_GEXPR_MAX_NEST)
-        return gx_fail(x->f, CS_ERR_PARSE, at, "expression nested more than %d deep",
-                       CS_GEXPR_MAX_NEST);
+    size_t at = *i; /* the depth is counted by gx_real, which every operand goes through */
     (*i)++;
     cs_err_t e = gx_binary(x, i, 1, out);
     if (e == CS_OK) {
@@ -510,7 +507,6 @@ static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out)
             (*i)++;
         }
     }
-    x->nest--;
     return e;
 }
 
