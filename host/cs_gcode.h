@@ -46,7 +46,7 @@ typedef struct {
 
 /* What a read found (for tests and --stats). */
 typedef struct {
-    unsigned lines;    /* lines read (up to M2/M30 or the end) */
+    unsigned lines;    /* lines run (up to M2/M30 or the end; a line in a loop counts each pass) */
     unsigned warnings; /* warnings issued (lenient mode) */
     unsigned arcs;     /* G2/G3 moves */
     unsigned helices;  /* of which with a third-axis move */
