@@ -258,6 +258,13 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
         int m = b->m[i];
         if (m == 20 || m == 300) {
             *end = true;
+        } else if ((m == 30 || m == 40 || m == 50) && g->nurbs) {
+            /* The block's curve starts where it opened: a pen or spindle change (and its Z
+             * move) cannot come between its control points. */
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->mcol[i]),
+                                    "M%d inside a NURBS block: start or stop the spindle (pen) "
+                                    "before the G5.2 or after its G5.3",
+                                    m / 10);
         } else if (m == 30 || m == 40 || m == 50) {
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
              * with opts->pen_z a rapid Z move to the pen height. */
@@ -483,10 +490,7 @@ static cs_err_t run_g92(gc_t *g, block_t *b, const gline_t *l)
 /* NURBS lines: G5.3, G5.2, G6.2 and the lines of an open block. *done when the line was one. */
 static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_col, bool *done)
 {
-    cs_err_t e;
     *done = true;
-    if (g->nurbs == MOT_G62 && !b->w['K' - 'A'].has && (e = cs_gcode_nurbs_close(g)) != CS_OK)
-        return e; /* a line without K ends a G6.2 block; the line then runs as usual */
     if (g->nurbs && l->motion != -2 && l->motion != MOT_G52 && l->motion != 53)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->mcol),
                                 g->nurbs == MOT_G62
@@ -569,6 +573,9 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
     bool end = false, done;
     gline_t l = {-2, first_col, false, false, false, 0, 0, 0, 0};
     cs_err_t e = run_letters(g, b);
+    /* A line without K ends a G6.2 block before anything on it runs. */
+    if (e == CS_OK && g->nurbs == MOT_G62 && !b->w['K' - 'A'].has)
+        e = cs_gcode_nurbs_close(g);
     if (e == CS_OK)
         e = run_m(g, b, &end);
     if (e == CS_OK)

@@ -743,6 +743,19 @@ static void test_g52_errors(void **state)
     expect_diag(parse("G5.3\n"), CS_ERR_PARSE, 1, 1);
     expect_diag(parse("G5.2 X1 Y1 P1\nG1 X2\n"), CS_ERR_PARSE, 2, 1);
     expect_diag(parse("G5.2 X1 P1\n"), CS_ERR_PARSE, 1, 6);
+    /* Found by fuzz_gcode: with the pen heights on, M4 between the control points moved Z away
+     * from the block's first point, so the curve did not start where the path was. A pen or
+     * spindle change inside a block is refused, at the M word. */
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.pen_z = true;
+    o.pen_down_z_mm = -1;
+    o.pen_up_z_mm = 2;
+    expect_diag(parse_with("G5.2 X0 Y10 P1 L3\nX20 Y20 P1\nM4 X20 Y0 P1\nX0 Y0 P2\nG5.3\n", &o),
+                CS_ERR_PARSE, 3, 1);
+    assert_int_equal(parse_with("M3\nG5.2 X0 Y10 P1 L3\nX20 Y20 P1\nX0 Y0 P2\nG5.3\nM5\n", &o),
+                     CS_OK);
+    expect_continuous();
 }
 
 /* ---- the cncjs fixtures ------------------------------------------------------------------ */
