@@ -1134,9 +1134,10 @@ static void test_grbl_dialect(void **state)
     expect_diag(parse_dialect("G64 P0.1\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 1);
 }
 
-/* The arc radius rules, each region from both sides. LinuxCNC (abs = 2 * 0.01 * sqrt 2 =
- * 0.028284 mm): refused if |r1 - r0| > 100 abs = 2.8284 mm, or > abs while > 0.1 % of the larger
- * radius. Grbl 1.1: refused if > 0.005 mm and (> 0.5 mm or > 0.1 % of the start radius). */
+/* The arc radius rules, each region from both sides. LinuxCNC (interp_arc.cc, whose error reads
+ * "Radius to end of arc differs from radius to start"; abs = CENTER_ARC_RADIUS_TOLERANCE_MM =
+ * 2 * 0.01 * sqrt 2 = 0.028284 mm, relative = SPIRAL_RELATIVE_TOLERANCE = 0.1 %): refused if
+ * |r1 - r0| > 100 abs = 2.8284 mm, or > abs while > 0.1 % of the larger radius. Grbl 1.1: refused if > 0.005 mm and (> 0.5 mm or > 0.1 % of the start radius). */
 static void test_arc_radius_rules(void **state)
 {
     (void)state;
