@@ -127,42 +127,38 @@ printf '[pen]\nmode = lift\n' >"$T/pen-bad2.ini"
 run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
     expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none or z"
 
-# stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
-# (320 steps), x back at 0.
-if [ -x "$SIM" ]; then
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$T/pen.ini" >"$T/sim.out" \
+# stream_final NAME FINAL MACHINE_ARGS... -- FILE: streams FILE to curvestep-sim on a pty (with
+# the machine arguments, given to both) and expects the simulator's "final position: FINAL".
+stream_final() {
+    local name=$1 final=$2 margs=() simpid
+    shift 2
+    while [ "$1" != "--" ]; do margs+=("$1"); shift; done
+    shift
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 "${margs[@]}" >"$T/sim.out" \
         2>"$T/sim.err" &
     simpid=$!
     pids+=($simpid)
     wait_pty "$T/sim.out" 5
-    if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$T/pen.ini" --port "$PTY" "$T/pen.nc"; then
+    if [ -n "$PTY" ] && run "$name" 0 stream --quiet "${margs[@]}" --port "$PTY" "$1"; then
         wait_until 10 gone "$simpid"
-        grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
-            "$T/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$T/sim.out")"
+        grep -q "^final position: $final" "$T/sim.out" && ok ||
+            ko "$name: $(grep '^final position' "$T/sim.out")"
     else
-        [ -n "$PTY" ] || ko "stream pen z: the simulator did not start"
+        [ -n "$PTY" ] || ko "$name: the simulator did not start"
     fi
     kill "$simpid" 2>/dev/null
     wait "$simpid" 2>/dev/null
+}
+if [ -x "$SIM" ]; then
+    # The device ends with the pen up, at z = up_z = 4 mm (320 steps), x back at 0.
+    stream_final "stream pen z" 'x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
+        --machine "$T/pen.ini" -- "$T/pen.nc"
+    # A LinuxCNC program with a subroutine and loops ends where its last move does: X75 Y5
+    # (80 steps/mm: 6000 and 400 steps).
+    stream_final "stream sub-loop" 'x=6000 steps (75.0000 mm) y=400 steps (5.0000 mm) z=0 steps' \
+        -- "$DATA/linuxcnc-sub-loop.ngc"
 else
     ko "no $SIM"
-fi
-# A LinuxCNC program with a subroutine and loops streams to the simulator and ends where its
-# last move does: X75 Y5 (80 steps/mm: 6000 and 400 steps).
-if [ -x "$SIM" ]; then
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 >"$T/sim2.out" 2>"$T/sim2.err" &
-    simpid=$!
-    pids+=($simpid)
-    wait_pty "$T/sim2.out" 5
-    if [ -n "$PTY" ] && run "stream sub-loop" 0 stream --quiet --port "$PTY" "$DATA/linuxcnc-sub-loop.ngc"; then
-        wait_until 10 gone "$simpid"
-        grep -q '^final position: x=6000 steps (75.0000 mm) y=400 steps (5.0000 mm) z=0 steps' \
-            "$T/sim2.out" && ok || ko "stream sub-loop: $(grep '^final position' "$T/sim2.out")"
-    else
-        [ -n "$PTY" ] || ko "stream sub-loop: the simulator did not start"
-    fi
-    kill "$simpid" 2>/dev/null
-    wait "$simpid" 2>/dev/null
 fi
 run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$T/out" && ok ||
     ko "stream --help lacks [pen]"
