@@ -36,14 +36,16 @@ static void flatten_usage(FILE *f)
 {
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-            "\n                         [--lenient] [--font FILE.jhf] FILE\n"
+            "\n                         [--lenient] [--font FILE.jhf] [--dialect linuxcnc|grbl]"
+            "\n                         [--units mm|inch] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
             "decimals), a blank line between subpaths.\n"
             "\n"
-            "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2, see\n"
-            "docs/inputs.md), HP-GL (.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
+            "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2 G6.2,\n"
+            "LinuxCNC parameters, expressions and O-words; see docs/inputs.md), HP-GL\n"
+            "(.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
             "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
             "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
             "fills are drawn as outlines; <text> is drawn in a stroke font; <use> is not drawn:\n"
@@ -66,6 +68,9 @@ static void flatten_usage(FILE *f)
             "                  ignored) instead of an error\n"
             "  --font FILE.jhf Hershey stroke font for SVG <text> and HP-GL LB labels (default:\n"
             "                  share/fonts/futural.jhf; a file that is not a font is an error)\n"
+            "  --dialect D     G-code: linuxcnc (the default) or grbl (Grbl 1.1: starts in G0,\n"
+            "                  no parameters or O-words, Grbl's arc check; docs/inputs.md)\n"
+            "  --units U       G-code: mm (the default) or inch, the units a program starts in\n"
             "  -h, --help      show this help\n"
             "\n"
             "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
@@ -103,10 +108,16 @@ static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
 int cs_cmd_flatten(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"tol", required_argument, NULL, 't'},  {"method", required_argument, NULL, 'm'},
-        {"stats", no_argument, NULL, 's'},      {"svg", required_argument, NULL, 'o'},
-        {"help", no_argument, NULL, 'h'},       {"lenient", no_argument, NULL, 'l'},
-        {"font", required_argument, NULL, 'f'}, {NULL, 0, NULL, 0},
+        {"tol", required_argument, NULL, 't'},
+        {"method", required_argument, NULL, 'm'},
+        {"stats", no_argument, NULL, 's'},
+        {"svg", required_argument, NULL, 'o'},
+        {"help", no_argument, NULL, 'h'},
+        {"lenient", no_argument, NULL, 'l'},
+        {"dialect", required_argument, NULL, 'd'},
+        {"units", required_argument, NULL, 'u'},
+        {"font", required_argument, NULL, 'f'},
+        {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
     size_t method = FLATTEN_DEFAULT_METHOD;
@@ -114,6 +125,8 @@ int cs_cmd_flatten(int argc, char **argv)
     const char *svg_out = NULL;
     bool lenient = false;
     const char *font = NULL;
+    cs_dialect_t dialect = CS_DIALECT_LINUXCNC;
+    cs_units_t units = CS_UNITS_DEFAULT;
     int c;
     optind = 1;
     opterr = 0;
@@ -160,6 +173,20 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'f':
             font = optarg;
             break;
+        case 'd': /* G-code: --dialect linuxcnc | grbl (docs/inputs.md) */
+        case 'u': /* G-code: --units mm | inch, the units the program starts in */
+            if (strcmp(optarg, c == 'd' ? "linuxcnc" : "mm") != 0 &&
+                strcmp(optarg, c == 'd' ? "grbl" : "inch") != 0) {
+                fprintf(stderr, "curvestep flatten: --%s '%s': expected %s\n",
+                        c == 'd' ? "dialect" : "units", optarg,
+                        c == 'd' ? "linuxcnc or grbl" : "mm or inch");
+                return CS_EXIT_USAGE;
+            }
+            if (c == 'd')
+                dialect = strcmp(optarg, "grbl") == 0 ? CS_DIALECT_GRBL : CS_DIALECT_LINUXCNC;
+            else
+                units = strcmp(optarg, "inch") == 0 ? CS_UNITS_INCH : CS_UNITS_MM;
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -191,6 +218,8 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
     iopts.font_file = font;
+    iopts.dialect = dialect;
+    iopts.units = units;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);

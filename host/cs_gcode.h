@@ -1,7 +1,9 @@
-/* cs_gcode: the G-code reader. Turns RS274/NGC text (LinuxCNC's semantics where dialects differ)
- * into path elements with their feed and rapid flag: G0/G1 lines, G2/G3 arcs and helices, G5
- * cubic and G5.1 quadratic splines, G5.2/G5.3 NURBS blocks. Owns the modal state (plane, units,
- * distance modes, G92 offsets, feed) and the checks that refuse bad input "file:line:col". */
+/* cs_gcode: the G-code reader. Turns RS274/NGC text (LinuxCNC's semantics by default, Grbl 1.1's
+ * with CS_GCODE_GRBL) into path elements with their feed and rapid flag: G0/G1 lines, G2/G3 arcs
+ * and helices, G5 cubic and G5.1 quadratic splines, G5.2/G5.3 and G6.2 NURBS blocks. Owns the
+ * modal state (plane, units, distance modes, G92 offsets, feed) and the checks that refuse bad
+ * input "file:line:col"; parameters and expressions are cs_gexpr's, O-word control flow
+ * cs_gflow's, NURBS blocks cs_gnurbs's. */
 #ifndef CS_GCODE_H
 #define CS_GCODE_H
 
@@ -17,38 +19,53 @@ typedef void (*cs_gcode_warn_fn)(void *ctx, const cs_path_diag_t *w);
  * quadratic pieces that carry it. */
 #define CS_GCODE_HELIX_TOL_MM 0.001
 
+/* Whose G-code (docs/inputs.md, "Dialects", lists each difference). */
+typedef enum {
+    CS_GCODE_LINUXCNC = 0, /* LinuxCNC's G-code reference (the default) */
+    CS_GCODE_GRBL = 1,     /* Grbl 1.1: starts in G0; no parameters, expressions, O-words,
+                            * splines or NURBS; Grbl's arc radius check */
+} cs_gcode_dialect_t;
+
 typedef struct {
-    bool lenient;          /* unsupported words: a warning and the word is ignored (not an error);
-                            * also (each warned) bare G92 = no-op, G2/G3 without R or I/J/K = a
-                            * straight feed move to its end, R arc ending on its start = nothing
-                            * drawn in the plane, T = ignored. Checksums stay errors. */
-    double helix_tol_mm;   /* > 0: bound on the helix approximation (see docs/inputs.md) */
-    size_t max_elements;   /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
-    bool pen_z;            /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
-    double pen_down_z_mm;  /* to this machine Z on M3/M4 */
-    double pen_up_z_mm;    /* to this machine Z on M5, and where the program starts */
-    cs_gcode_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    bool lenient;         /* unsupported words: a warning and the word is ignored (not an error);
+                           * also (each warned) bare G92 = no-op, G2/G3 without R or I/J/K = a
+                           * straight feed move to its end, R arc ending on its start = nothing
+                           * drawn in the plane, T = ignored. Checksums stay errors. */
+    double helix_tol_mm;  /* > 0: bound on the helix approximation (see docs/inputs.md) */
+    size_t max_elements;  /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
+    bool pen_z;           /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
+    double pen_down_z_mm; /* to this machine Z on M3/M4 */
+    double pen_up_z_mm;   /* to this machine Z on M5, and where the program starts */
+    cs_gcode_dialect_t dialect;
+    bool start_inch;         /* the program starts in G20 (inches) instead of G21 (mm) */
+    unsigned long max_loops; /* O-word loop passes allowed in one program; 0: the default
+                              * CS_GFLOW_MAX_LOOPS (a runaway loop is a located error) */
+    cs_gcode_warn_fn warn;   /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_gcode_opts_t;
 
 /* What a read found (for tests and --stats). */
 typedef struct {
-    unsigned lines;    /* lines read (up to M2/M30 or the end) */
+    unsigned lines;    /* lines run (up to M2/M30 or the end; a line in a loop counts each pass) */
     unsigned warnings; /* warnings issued (lenient mode) */
     unsigned arcs;     /* G2/G3 moves */
     unsigned helices;  /* of which with a third-axis move */
 } cs_gcode_stats_t;
 
-/* Strict mode, helix tolerance CS_GCODE_HELIX_TOL_MM, warnings to stderr. */
+/* Strict LinuxCNC, millimetres, helix tolerance CS_GCODE_HELIX_TOL_MM, warnings to stderr. */
 void cs_gcode_opts_init(cs_gcode_opts_t *o);
 
 /* Parses G-code in buf[0..len) (need not be NUL-terminated) named name; appends its moves to
  * *path (each element's feed_mm_s from F, rapid for G0; pen/spindle on or off (M3/M4/M5) and
  * each change between rapid and feed moves start a new subpath). The machine starts at 0, 0, 0
- * in G17 G21 G90 G91.1 G94 with no motion mode. The whole input is read before returning.
- * CS_ERR_PARSE (syntax, checksum, inconsistent words), CS_ERR_UNSUPPORTED (a word this reader
- * does not carry out, unless lenient), CS_ERR_DEGENERATE / CS_ERR_RANGE (bad arcs, coordinates
- * outside +/-4096 mm), CS_ERR_FULL (out of memory), each with *diag. stats may be NULL. */
+ * in G17 G21 (G20 with start_inch) G90 G91.1 G94, with no motion mode (Grbl: G0). O-words run
+ * as LinuxCNC runs them; G64 P (the program's path tolerance, mm) lowers path->blend_tol_mm.
+ * The whole input is read before returning.
+ * CS_ERR_PARSE (syntax, checksum, exponent form, inconsistent words, an undefined parameter, an
+ * O-word that does not pair), CS_ERR_UNSUPPORTED (a word this reader or the dialect does not carry
+ * out, unless lenient), CS_ERR_DEGENERATE / CS_ERR_RANGE (bad arcs, coordinates outside +/-4096
+ * mm, a math error in an expression, calls nested past 10, a runaway loop), CS_ERR_WEIGHT /
+ * CS_ERR_KNOTS (NURBS blocks), CS_ERR_FULL (out of memory), each with *diag. stats may be NULL. */
 cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_gcode_opts_t *o,
                        cs_path_t *path, cs_path_diag_t *diag, cs_gcode_stats_t *stats);
 

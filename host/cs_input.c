@@ -189,6 +189,8 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
         go.pen_z = o->pen_z;
         go.pen_down_z_mm = o->pen_down_z_mm;
         go.pen_up_z_mm = o->pen_up_z_mm;
+        go.dialect = o->dialect == CS_DIALECT_GRBL ? CS_GCODE_GRBL : CS_GCODE_LINUXCNC;
+        go.start_inch = o->units == CS_UNITS_INCH;
         go.warn = o->warn;
         go.warn_ctx = o->warn_ctx;
         return cs_gcode_read(name, buf, len, &go, path, diag, NULL);

@@ -126,6 +126,12 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
         if (e != CS_OK)
             return fail_whole(jp, file, e, "raising the pen failed");
     }
+    /* G64 P: the program asks for its path to be kept within P; curvestep never blends
+     * corners away, so that bounds the chords when it is tighter than the tolerance in use. */
+    cs_pos_t ptol;
+    if (jp->path.blend_tol_mm > 0 && cs_conv_tol_to_pos(jp->path.blend_tol_mm, &ptol) == CS_OK &&
+        ptol < tol)
+        tol = ptol;
     return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
 }
 

@@ -44,6 +44,8 @@ typedef struct {
     size_t nfiles, capfiles;
     unsigned nsubpaths;
     bool pending_subpath; /* the next element added starts a new subpath */
+    double blend_tol_mm;  /* the job's own path tolerance (G-code G64 P, the smallest given), mm;
+                           * 0: none. Planning keeps chords within the smaller of it and its own */
 } cs_path_t;
 
 /* Grows the array *buf of elements of sz bytes (capacity *cap, doubled from 16) to hold at

@@ -3,7 +3,9 @@
 # G-code files (by extension, by content on stdin), exact vertices of lines, separated rapid
 # moves, the measured deviation of arcs and helices within the tolerance, --lenient, errors as
 # file:line:col with exit 1 and nothing written by plan, --help. Every file of tests/data/gcode
-# (copies of shared/data/gcode/cncjs) either reads and flattens or fails where it should.
+# (copies of shared/data/gcode/cncjs, LinuxCNC-style programs with parameters, O-words and NURBS
+# in every plane, CAM output) either reads and flattens or fails where it should; --dialect and
+# --units.
 # Uses $CS_BUILD (the build directory); ends with "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -126,28 +128,99 @@ printf '[pen]\nmode = lift\n' >"$T/pen-bad2.ini"
 run "pen bad mode" 1 plan --machine "$T/pen-bad2.ini" "$T/pen.nc" &&
     expect_err "pen bad mode" "^$T/pen-bad2.ini:2: \\[pen\\] mode: expected none, z or servo"
 
-# stream: the device (curvestep-sim on a pty) ends with the pen up, at z = up_z = 4 mm
-# (320 steps), x back at 0.
-if [ -x "$SIM" ]; then
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$T/pen.ini" >"$T/sim.out" \
+# stream_final NAME FINAL MACHINE_ARGS... -- FILE: streams FILE to curvestep-sim on a pty (with
+# the machine arguments, given to both) and expects the simulator's "final position: FINAL".
+stream_final() {
+    local name=$1 final=$2 margs=() simpid
+    shift 2
+    while [ "$1" != "--" ]; do margs+=("$1"); shift; done
+    shift
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 "${margs[@]}" >"$T/sim.out" \
         2>"$T/sim.err" &
     simpid=$!
     pids+=($simpid)
     wait_pty "$T/sim.out" 5
-    if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$T/pen.ini" --port "$PTY" "$T/pen.nc"; then
+    if [ -n "$PTY" ] && run "$name" 0 stream --quiet "${margs[@]}" --port "$PTY" "$1"; then
         wait_until 10 gone "$simpid"
-        grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
-            "$T/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$T/sim.out")"
+        grep -q "^final position: $final" "$T/sim.out" && ok ||
+            ko "$name: $(grep '^final position' "$T/sim.out")"
     else
-        [ -n "$PTY" ] || ko "stream pen z: the simulator did not start"
+        [ -n "$PTY" ] || ko "$name: the simulator did not start"
     fi
     kill "$simpid" 2>/dev/null
     wait "$simpid" 2>/dev/null
+}
+if [ -x "$SIM" ]; then
+    # The device ends with the pen up, at z = up_z = 4 mm (320 steps), x back at 0.
+    stream_final "stream pen z" 'x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
+        --machine "$T/pen.ini" -- "$T/pen.nc"
+    # A LinuxCNC program with a subroutine and loops ends where its last move does: X75 Y5
+    # (80 steps/mm: 6000 and 400 steps).
+    stream_final "stream sub-loop" 'x=6000 steps (75.0000 mm) y=400 steps (5.0000 mm) z=0 steps' \
+        -- "$DATA/linuxcnc-sub-loop.ngc"
 else
     ko "no $SIM"
 fi
 run "stream help" 0 stream --help && grep -q "\[pen\] mode = z" "$T/out" && ok ||
     ko "stream --help lacks [pen]"
+
+# --- LinuxCNC programs: parameters, subroutines, loops, NURBS in every plane, G6.2 -----------------
+# Vertices listed by hand from the program text: three 10 mm squares at (0,0), (20,5), (40,10)
+# drawn by o<square> from a while loop, rapids between them, three G91 steps of 5 from X60, then
+# Y5 because the loop ran three times.
+run "sub-loop" 0 flatten "$DATA/linuxcnc-sub-loop.ngc" &&
+    expect_out "sub-loop" '0.000000 0.000000\n10.000000 0.000000\n10.000000 10.000000\n0.000000 10.000000\n0.000000 0.000000\n\n0.000000 0.000000\n20.000000 5.000000\n\n20.000000 5.000000\n30.000000 5.000000\n30.000000 15.000000\n20.000000 15.000000\n20.000000 5.000000\n\n20.000000 5.000000\n40.000000 10.000000\n\n40.000000 10.000000\n50.000000 10.000000\n50.000000 20.000000\n40.000000 20.000000\n40.000000 10.000000\n\n40.000000 10.000000\n60.000000 0.000000\n\n60.000000 0.000000\n65.000000 0.000000\n70.000000 0.000000\n75.000000 0.000000\n75.000000 5.000000\n'
+run "nurbs planes" 0 flatten --stats "$DATA/linuxcnc-nurbs-planes.ngc" && expect_dev "nurbs planes" 0.01
+# G6.2 quarter circle of radius 10 (weights 1, 1/sqrt 2, 1): every chord vertex on the circle.
+run "g6.2" 0 flatten --stats "$DATA/linuxcnc-g62.ngc" && expect_dev "g6.2" 0.01
+run "g6.2 radius" 0 flatten "$DATA/linuxcnc-g62.ngc" &&
+    { awk 'NF == 2 && !($1 == 0 && $2 == 0) && NR > 3 { r = sqrt($1 * $1 + $2 * $2); if (r < 9.9999 || r > 10.0001) bad++ } END { exit bad > 0 }' "$T/out" &&
+        ok || ko "g6.2 radius: a vertex off the radius-10 circle"; }
+printf '#1 = 0\no1 while [#1 GE 0]\n#1 = [#1 + 1]\no1 endwhile\n' >"$T/runaway.ngc"
+run "runaway loop" 1 flatten "$T/runaway.ngc" &&
+    expect_err "runaway loop" "^$T/runaway.ngc:4:1: o1 endwhile: more than 1000000 loop passes"
+printf 'G1 X1e3 F60\n' >"$T/exp.nc"
+run "exponent" 1 flatten --lenient "$T/exp.nc" &&
+    expect_err "exponent" "^$T/exp.nc:1:6: number in exponent form .*no exponents"
+printf 'G1 X1 F60\nG38.2 Z-5 F10\nG1 X2\n' >"$T/probe.nc"
+run "probe lenient" 0 flatten --lenient "$T/probe.nc" &&
+    expect_err "probe lenient" "^$T/probe.nc:2:1: warning: G38.2 is not supported: its block skipped, with its words Z-5" &&
+    expect_out "probe lenient" '0.000000 0.000000\n1.000000 0.000000\n2.000000 0.000000\n'
+
+# G64 P is the program's path tolerance: planning uses the smaller of it and --tol, so a circle
+# with G64 P0.001 plans exactly as with --tol 0.001, and a tighter --tol wins over it.
+printf 'G0 X10\nG3 X10 Y0 I-10 J0 F600\n' >"$T/circ.nc"
+printf 'G64 P0.001\nG0 X10\nG3 X10 Y0 I-10 J0 F600\n' >"$T/circ64.nc"
+blocks() { sed -n 's/^plan: [0-9]* elements, \([0-9]*\) blocks.*/\1/p' "$T/err"; }
+run "g64 plain" 0 plan "$T/circ.nc" && b0=$(blocks)
+run "g64 --tol" 0 plan --tol 0.001 "$T/circ.nc" && b1=$(blocks)
+run "g64 P" 0 plan "$T/circ64.nc" && b2=$(blocks)
+run "g64 P tighter tol" 0 plan --tol 0.0005 "$T/circ64.nc" && b3=$(blocks)
+run "g64 tighter tol" 0 plan --tol 0.0005 "$T/circ.nc" && b4=$(blocks)
+[ -n "$b2" ] && [ "$b2" = "$b1" ] && [ "$b2" -gt "$b0" ] && [ "$b3" = "$b4" ] && ok ||
+    ko "g64: blocks plain $b0, --tol 0.001 $b1, G64 P0.001 $b2, both $b3, --tol 0.0005 $b4"
+
+# --- CAM output: Fusion 360 for Grbl, CamBam ------------------------------------------------
+# The Fusion 360 program positions with "X5 Y5" before any G0: Grbl starts in G0. LinuxCNC's
+# dialect refuses it (at its T1 first: a tool change curvestep does not do).
+run "fusion linuxcnc" 1 flatten "$DATA/fusion360-grbl.nc" &&
+    expect_err "fusion linuxcnc" "^$DATA/fusion360-grbl.nc:12:1: the T word is not supported"
+run "fusion grbl" 0 flatten --dialect grbl --stats "$DATA/fusion360-grbl.nc" &&
+    expect_dev "fusion grbl" 0.01
+# rapid to (5,5), the contour 25,5 / 25,15 / the G3 arc to 15,25 / 5,25 / 5,5
+run "fusion grbl path" 0 flatten --dialect grbl "$DATA/fusion360-grbl.nc" &&
+    { grep -qx '25.000000 15.000000' "$T/out" && grep -qx '15.000000 25.000000' "$T/out" &&
+        grep -qx '5.000000 25.000000' "$T/out" && [ "$(sed -n 2p "$T/out")" = "5.000000 5.000000" ] &&
+        ok || ko "fusion grbl path: $(tr '\n' ' ' <"$T/out" | cut -c1-200)"; }
+run "dialect bad" 2 flatten --dialect fanuc "$DATA/fusion360-grbl.nc" &&
+    expect_err "dialect bad" "expected linuxcnc or grbl"
+printf 'G1 X1.25 F10\n' >"$T/units.nc"
+run "units inch" 0 flatten --units inch "$T/units.nc" && expect_out "units inch" '0.000000 0.000000\n31.750000 0.000000\n'
+# CamBam: T0 M6 refused where it stands; with --lenient the part reads (G64 without P, G91.1, G40).
+run "cambam strict" 1 flatten "$DATA/cambam-router.nc" &&
+    expect_err "cambam strict" "^$DATA/cambam-router.nc:7:1: the T word is not supported"
+run "cambam lenient" 0 flatten --lenient --stats "$DATA/cambam-router.nc" && expect_dev "cambam lenient" 0.01
+run "plan cambam lenient" 0 plan --lenient "$DATA/cambam-router.nc"
 
 # --- help tells the truth -------------------------------------------------------------------
 run "flatten help" 0 flatten --help && grep -q -- "--lenient" "$T/out" && grep -q "G-code" "$T/out" &&

@@ -1,5 +1,7 @@
 /* libFuzzer target: arbitrary bytes as G-code into the host reader (host/cs_gcode.c), strict and
- * lenient, then the first elements it produces through the core tracer. Asserts (abort =
+ * lenient (one input in four in Grbl's dialect), with LinuxCNC's parameters, expressions and
+ * O-word control flow (loops bounded by FUZZ_MAX_LOOPS), then the first elements it produces
+ * through the core tracer. Asserts (abort =
  * finding): no out-of-bounds access or undefined behaviour (ASan, UBSan); only the documented
  * status codes; a diagnostic always has a line >= 1, a column >= 1 and a reason; every element
  * is a valid cs_bezier_t (degree 1..3; rational only for arc pieces and NURBS segments, weights
@@ -18,12 +20,19 @@
 #include "../../host/cs_conv.c"
 #include "../../host/cs_err_text.c"
 #include "../../host/cs_gcode.c"
+#include "../../host/cs_gcode_arc.c"
+#include "../../host/cs_gcode_nurbs.c"
+#include "../../host/cs_gexpr.c"
+#include "../../host/cs_gflow.c"
+#include "../../host/cs_gnurbs.c"
 #include "../../host/cs_path.c"
 #include "fuzz_path.h"
 
 /* Elements allowed per job (keeps a many-turn helix per line from exhausting memory; the reader
  * refuses more with CS_ERR_FULL). */
 #define FUZZ_MAX_ELEMS 100000
+/* O-word loop passes allowed per input (a runaway loop ends quickly, as a located error). */
+#define FUZZ_MAX_LOOPS 20000
 
 static void quiet(void *ctx, const cs_path_diag_t *w)
 {
@@ -84,6 +93,9 @@ static cs_err_t run(const uint8_t *data, size_t size, bool lenient, cs_path_diag
     cs_gcode_opts_init(&o);
     o.lenient = lenient;
     o.max_elements = FUZZ_MAX_ELEMS;
+    o.max_loops = FUZZ_MAX_LOOPS;
+    o.dialect = size % 4 == 1 ? CS_GCODE_GRBL : CS_GCODE_LINUXCNC;
+    o.start_inch = size % 7 == 3;
     /* One input in three also moves Z on M3/M4/M5 (the pen heights of a plotter). */
     o.pen_z = size % 3 == 0;
     o.pen_down_z_mm = -1.0;
@@ -149,6 +161,24 @@ static const char *const seeds[] = {
     "G1 X5000\n",
     "G1 X10 F1\nG2 X0 Y11 I-10\n",
     "G1 (unclosed\n",
+    "#3=15\n#3=6 G1 x#3 F60\n#<_a>=[2**3 MOD 5]\nG1 Y[#<_a>*SIN[30]+ATAN[1]/[1]-FIX[-2.5]]\n",
+    "#1=[1 EQ 1 AND 2 GT 1 OR 0 XOR 1]\nG1 X[ROUND[2.5]+FUP[0.1]+ABS[-1]+SQRT[4]+EXP[0]+LN[1]] "
+    "F9\n",
+    "o<sq> sub\nG1 X#1 Y0\nG1 X#1 Y#1\no<sq> endsub\nF60\no<sq> call [10]\no<sq> call [5]\n",
+    "F60\n#1=1\no1 while [#1 LT 4]\nG1 X#1\n#1=[#1+1]\no1 endwhile\no2 repeat [2]\nG91 X1\n"
+    "o2 endrepeat\nG90\n#2=0\no3 do\n#2=[#2+1]\no4 if [#2 EQ 2]\no3 continue\no4 elseif [#2 GT "
+    "3]\no3 break\no4 else\nG1 Y#2\no4 endif\no3 while [#2 LT 9]\n",
+    "o2 sub\no3 if [#1 GT 0]\nG91 G1 X1 F60\no2 call [#1-1]\no3 endif\no2 return [#1*2]\n"
+    "o2 endsub\no2 call [4]\nG90 G1 Y#<_value>\n",
+    "o1 while [1]\nG91 G1 X0.001 F1\no1 endwhile\n",
+    "G18 G0 Z0 X0\nF10\nG5.2 Z0 X1 P1 L3\nZ2 X2 P1\nZ2 X0 P1\nZ0 X0 P2\nG5.3\nG19 G5.2 Y1 Z1 P1\n"
+    "Y2 Z0 P1\nG5.3\n",
+    "F60\nG6.2 P4 K0 X0 Y0\nK0 X1 Y4 R2\nK0 X5 Y5\nK0 X8 Y1 R0.5\nK1 X9 Y3\nK3\nK3\nK3\nK3\n"
+    "G1 X1\n",
+    "G64 P0.01 Q0.005\nG61\nG1 X1e3 F60\n",
+    "G90 G94\nG17\nG21\nX10 Y5\nG1 Z-1 F300\nG2 X20 Y5 I5 J0\nM8\nM9\nM30\n",
+    "G0 X100\nG3 X0 Y100.09 I-100 F100\nG0 X4000 Y0\nG3 X0 Y4002.9 I-4000\n",
+    "G81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG38.2 Z-5\n",
 };
 
 int main(int argc, char **argv)
