@@ -12,11 +12,15 @@
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
 {
     memset(o, 0, sizeof *o);
+    cs_jobopts_init(&o->in);
 }
 
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o)
 {
     const char *a = argv[*i];
+    int r = cs_jobopts_option(cmd, argc, argv, i, &o->in);
+    if (r != 0)
+        return r;
     if (*i + 1 >= argc)
         return 0; /* no value: the caller's "unknown or incomplete option" */
     char *end;
@@ -51,6 +55,8 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
                        cs_machine_pen_t *pen, cs_pos_t *tol)
 {
     cs_machine_ini_pen_default(pen);
+    if (cs_jobopts_check(cmd, &o->in) != 0)
+        return CS_EXIT_USAGE;
     char err[512];
     if (o->machine_file) {
         if (cs_machine_ini_load_pen(o->machine_file, m, pen, err, sizeof err) != 0) {
@@ -77,9 +83,18 @@ void cs_jobplan_init(cs_jobplan_t *jp)
 cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
                          bool lenient)
 {
+    cs_jobopts_t in;
+    cs_jobopts_init(&in);
+    in.lenient = lenient;
+    return cs_jobplan_read_opts(jp, file, pen, &in);
+}
+
+cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
+                              const cs_jobopts_t *in)
+{
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
-    iopts.lenient = lenient;
+    cs_jobopts_input(in, &iopts);
     if (pen != NULL) {
         /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
         iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
@@ -87,6 +102,17 @@ cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pe
         iopts.pen_down_z_mm = pen->down_z_mm;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
+    jp->read_ok = e == CS_OK;
+    return e;
+}
+
+cs_err_t cs_jobplan_prepare(cs_jobplan_t *jp, const char *cmd, const cs_jobopts_t *in,
+                            const cs_machine_t *m, const cs_machine_pen_t *pen, cs_pos_t tol,
+                            FILE *report)
+{
+    bool plotter = pen != NULL && pen->mode != CS_MACHINE_PEN_NONE;
+    cs_err_t e = cs_jobopts_prepare(in, cmd, m, plotter, cs_conv_pos_to_mm(tol), &jp->path,
+                                    &jp->diag, report);
     jp->read_ok = e == CS_OK;
     return e;
 }

@@ -44,6 +44,10 @@ typedef struct {
     size_t nfiles, capfiles;
     unsigned nsubpaths;
     bool pending_subpath; /* the next element added starts a new subpath */
+    /* An SVG document's page (set by cs_svgdoc): its y axis points down the page, which is
+     * page_h_mm high (0: no height given). cs_layout turns it to the machine's y-up frame. */
+    bool page_y_down;
+    double page_h_mm;
 } cs_path_t;
 
 /* Empty path. */
