@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cs_err_text.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_sim.h"
@@ -22,7 +23,8 @@ static void usage(FILE *f)
     fputs(
         "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
         "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-        "                     [--window MS] [--lenient] [--view top|front|side|iso]\n"
+        "                     [--window MS] [--view top|front|side|iso]\n"
+        "                     [input and layout options, for --reference]\n"
         "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
         "       curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu ...  (the device behind\n"
         "                     Modbus: --modbus-tcp --help)\n"
@@ -34,7 +36,8 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    --lenient as for plan), the largest distance from any position the\n"
+        "    the input and layout options below as given to plan), the largest distance\n"
+        "    from any position the\n"
         "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
         "    plus one step, and whether the final position is the job's end rounded to steps.\n"
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
@@ -46,8 +49,10 @@ static void usage(FILE *f)
         "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
         "                    (orthographic from (1,-1,1)), y up, as `curvestep toolpath --view`;\n"
         "                    default: machine x y with y down (as SVG jobs are written)\n"
-        "  --check           exit 4 when a limit, the deviation or the final position fails\n"
-        "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
+        "  --check           exit 4 when a limit, the deviation or the final position fails\n",
+        f);
+    cs_jobopts_help(f);
+    fputs("Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
         "3 internal error, 4 a check failed (with --check).\n",
         f);
 }
@@ -62,7 +67,9 @@ int main(int argc, char **argv)
             return cs_sim_modbus_main(argc, argv);
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
-    bool check = false, lenient = false;
+    bool check = false;
+    cs_jobopts_t in; /* --reference is read, laid out, merged and sorted as plan does */
+    cs_jobopts_init(&in);
     double window_ms = 50;
     long png_width = 1600;
     cs_sim_view_t view;
@@ -70,6 +77,11 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
+        int r = cs_jobopts_option("sim", argc, argv, &i, &in);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return EXIT_OK;
@@ -106,22 +118,22 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(a, "--check") == 0) {
             check = true;
-        } else if (strcmp(a, "--lenient") == 0) {
-            lenient = true;
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             usage(stderr);
             return EXIT_USAGE;
         }
     }
-    if (replay == NULL) {
+    if (replay == NULL || cs_jobopts_check("sim", &in) != 0) {
         usage(stderr);
         return EXIT_USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen; /* [pen]: the job is read as plan reads it */
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return EXIT_INPUT;
         }
@@ -174,16 +186,17 @@ int main(int argc, char **argv)
     cs_sim_ref_init(&ref);
     int rc = EXIT_OK;
     if (reference) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_path_diag_t diag;
-        e = cs_motion_read_job_ex(reference, lenient, &path, &diag);
+        cs_jobplan_t jp;
+        cs_jobplan_init(&jp);
+        e = cs_jobplan_read_opts(&jp, reference, &pen, &in);
+        if (e == CS_OK)
+            e = cs_jobplan_prepare(&jp, "sim", &in, &m, &pen, m.tolerance, NULL);
         double end[3];
         if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &path, end);
+            e = cs_sim_ref_from_path(&ref, &jp.path, end);
         else
-            cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
+            cs_path_diag_print(stderr, &jp.diag);
+        cs_jobplan_free(&jp);
         if (e != CS_OK) {
             rc = EXIT_INPUT;
         } else {

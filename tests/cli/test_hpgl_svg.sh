@@ -53,8 +53,13 @@ cat >"$T/s.svg" <<'EOF'
   <polyline points="0,0 200,100" stroke="black"/>
 </svg>
 EOF
+# The page is turned y-up (y' = 50 - y, docs/plotting.md "Layout"): it looks as a browser shows it.
 run "svg shapes" 0 flatten "$T/s.svg" &&
-    expect_out "svg shapes" '10.000000 5.000000\n30.000000 5.000000\n30.000000 15.000000\n10.000000 15.000000\n10.000000 5.000000\n\n0.000000 0.000000\n100.000000 50.000000\n'
+    expect_out "svg shapes" '10.000000 45.000000\n30.000000 45.000000\n30.000000 35.000000\n10.000000 35.000000\n10.000000 45.000000\n\n0.000000 50.000000\n100.000000 0.000000\n'
+# --flip-y mirrors that about the drawing's box, which is the whole page here: SVG's own y-down
+# coordinates again.
+run "svg shapes flip-y" 0 flatten --flip-y "$T/s.svg" &&
+    expect_out "svg shapes flip-y" '10.000000 5.000000\n30.000000 5.000000\n30.000000 15.000000\n10.000000 15.000000\n10.000000 5.000000\n\n0.000000 0.000000\n100.000000 50.000000\n'
 # Filled shapes without stroke: drawn as outlines, said once.
 printf '<svg><rect width="5" height="5" fill="red"/><circle r="3"/></svg>' >"$T/f.svg"
 run "svg fills" 0 flatten "$T/f.svg" &&
