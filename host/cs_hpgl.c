@@ -43,16 +43,16 @@ typedef struct {
     double x, y;   /* current position, plotter units, absolute */
     cs_vec3_t cur; /* the same, converted */
     bool relative, pen_down;
-    long pen;        /* selected pen; 0 = none (nothing is drawn) */
-    char label_term; /* LB/BL/WD text terminator (DT) */
-    cs_path_affine_t map;   /* user units -> physical plotter units (RO, IP/IR, SC), y up */
-    double frame[2];        /* picture frame (PS), plotter units: x, y before rotation */
-    double p1[2], p2[2];    /* scaling points, in rotated plotter units */
-    int ro;                 /* RO: 0, 90, 180 or 270 */
-    bool sc_on;             /* SC in effect */
-    double sc[7];           /* SC xmin,xmax|xfactor,ymin,ymax|yfactor,type,left,bottom */
-    bool win_on;            /* IW window in effect */
-    double win[4];          /* IW window, physical plotter units: x0, y0, x1, y1 */
+    long pen;             /* selected pen; 0 = none (nothing is drawn) */
+    char label_term;      /* LB/BL/WD text terminator (DT) */
+    cs_path_affine_t map; /* user units -> physical plotter units (RO, IP/IR, SC), y up */
+    double frame[2];      /* picture frame (PS), plotter units: x, y before rotation */
+    double p1[2], p2[2];  /* scaling points, in rotated plotter units */
+    int ro;               /* RO: 0, 90, 180 or 270 */
+    bool sc_on;           /* SC in effect */
+    double sc[7];         /* SC xmin,xmax|xfactor,ymin,ymax|yfactor,type,left,bottom */
+    bool win_on;          /* IW window in effect */
+    double win[4];        /* IW window, physical plotter units: x0, y0, x1, y1 */
     bool warned[26 * 26];
     bool warned_esc, warned_nopen, warned_big_sweep;
 } hp_t;

@@ -109,8 +109,8 @@ static const struct {
     const char *name, *arg, *flag, *want, *help;
     bool (*set)(cs_jobopts_t *o, const char *v);
 } table[] = {
-    {"lenient", NULL, "", NULL,
-     "G-code: an unsupported word is a warning, not an error", set_lenient},
+    {"lenient", NULL, "", NULL, "G-code: an unsupported word is a warning, not an error",
+     set_lenient},
     {"dialect", "D", NULL, "linuxcnc or grbl",
      "G-code dialect: linuxcnc (default) or grbl (docs/inputs.md)", set_dialect},
     {"units", "U", NULL, "mm or inch", "units a G-code program starts in: mm (default) or inch",
@@ -129,10 +129,11 @@ static const struct {
      set_translate},
     {"rotate", "DEG", NULL, "90, 180 or 270",
      "turn the drawing counter-clockwise, keeping its lower-left\ncorner", set_rotate},
-    {"flip-y", NULL, "", NULL, "mirror the drawing top to bottom (SVG pages are already\nturned y-up)",
-     set_flip_y},
-    {"merge", NULL, "1", NULL, "join lines whose ends meet within the tolerance (default: on\n"
-                                "for a machine with a [pen] mode, docs/plotting.md)",
+    {"flip-y", NULL, "", NULL,
+     "mirror the drawing top to bottom (SVG pages are already\nturned y-up)", set_flip_y},
+    {"merge", NULL, "1", NULL,
+     "join lines whose ends meet within the tolerance (default: on\n"
+     "for a machine with a [pen] mode, docs/plotting.md)",
      set_merge},
     {"no-merge", NULL, "0", NULL, "keep the lines as drawn", set_merge},
     {"sort", NULL, "1", NULL,
@@ -163,8 +164,8 @@ static int find(const char *name, size_t len)
 static bool record(cs_jobopts_t *o, const char *name, const char *v)
 {
     size_t len = strlen(o->words);
-    int k = snprintf(o->words + len, sizeof o->words - len, " %s%s%s", name, v ? "=" : "",
-                     v ? v : "");
+    int k =
+        snprintf(o->words + len, sizeof o->words - len, " %s%s%s", name, v ? "=" : "", v ? v : "");
     return k > 0 && (size_t)k < sizeof o->words - len && (v == NULL || strpbrk(v, " \t\n") == NULL);
 }
 
@@ -191,7 +192,8 @@ bool cs_jobopts_word(const char *word, cs_jobopts_t *o)
     int k = find(word, eq ? (size_t)(eq - word) : strlen(word));
     if (k < 0 || (table[k].arg != NULL) != (eq != NULL))
         return false;
-    return table[k].set(o, eq ? eq + 1 : table[k].flag) && record(o, table[k].name, eq ? eq + 1 : NULL);
+    return table[k].set(o, eq ? eq + 1 : table[k].flag) &&
+           record(o, table[k].name, eq ? eq + 1 : NULL);
 }
 
 int cs_jobopts_check(const char *cmd, const cs_jobopts_t *o)

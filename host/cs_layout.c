@@ -143,8 +143,8 @@ cs_err_t cs_layout_transform(cs_path_t *p, const cs_path_affine_t *m, cs_path_di
         cs_bezier_t *c = &p->elems[i].curve;
         for (unsigned k = 0; k <= c->degree && k < CS_BEZIER_MAX_POINTS; k++) {
             double x, y;
-            cs_path_affine_point(m, cs_conv_pos_to_mm(c->p[k].x), cs_conv_pos_to_mm(c->p[k].y),
-                                 &x, &y);
+            cs_path_affine_point(m, cs_conv_pos_to_mm(c->p[k].x), cs_conv_pos_to_mm(c->p[k].y), &x,
+                                 &y);
             if (cs_conv_mm_to_pos(x, &c->p[k].x) != CS_OK ||
                 cs_conv_mm_to_pos(y, &c->p[k].y) != CS_OK)
                 return cs_path_diag_set(diag, CS_ERR_RANGE, p->elems[i].loc,

@@ -16,14 +16,14 @@
 #define CS_LAYOUT_SCALE_MIN 1e-4
 
 typedef struct {
-    double scale;          /* --scale F (> 0); 1 = as drawn */
-    bool fit;              /* --fit: bounding box to the area (machine travel or page) */
-    double page_w_mm;      /* --page: area 0..W x 0..H mm (0: the machine's travel) */
+    double scale;     /* --scale F (> 0); 1 = as drawn */
+    bool fit;         /* --fit: bounding box to the area (machine travel or page) */
+    double page_w_mm; /* --page: area 0..W x 0..H mm (0: the machine's travel) */
     double page_h_mm;
-    double margin_mm;      /* --margin: kept free on every side of the area when fitting */
-    double tx_mm, ty_mm;   /* --translate X,Y, applied last */
-    int rotate_deg;        /* --rotate: 0, 90, 180 or 270, counter-clockwise */
-    bool flip_y;           /* --flip-y: mirror top to bottom (after the SVG page turn) */
+    double margin_mm;    /* --margin: kept free on every side of the area when fitting */
+    double tx_mm, ty_mm; /* --translate X,Y, applied last */
+    int rotate_deg;      /* --rotate: 0, 90, 180 or 270, counter-clockwise */
+    bool flip_y;         /* --flip-y: mirror top to bottom (after the SVG page turn) */
 } cs_layout_opts_t;
 
 /* The area --fit fills, in machine mm (the travel of x and y, or the page at the origin). */

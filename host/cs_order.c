@@ -573,12 +573,10 @@ cs_err_t cs_order_apply(cs_path_t *p, const cs_order_opts_t *o, cs_order_stats_t
         return CS_OK;
     size_t ns = 0;
     size_t *sf = strokes(p, &ns);
-    order_t ord = {p, malloc((p->n + 1) * sizeof(ref_t)), malloc((ns + 1) * sizeof(item_t)), 0,
-                   0};
+    order_t ord = {p, malloc((p->n + 1) * sizeof(ref_t)), malloc((ns + 1) * sizeof(item_t)), 0, 0};
     size_t *order = malloc((ns + 1) * sizeof *order);
-    cs_err_t e = sf && ord.refs && ord.items && order
-                     ? run(&ord, o, sf, ns, order, &st->bridges)
-                     : CS_ERR_FULL;
+    cs_err_t e = sf && ord.refs && ord.items && order ? run(&ord, o, sf, ns, order, &st->bridges)
+                                                      : CS_ERR_FULL;
     free(sf);
     free(ord.refs);
     free(ord.items);

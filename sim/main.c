@@ -36,10 +36,10 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    the input and layout options below as given to plan), the largest distance\n"
-        "    from any position the\n"
-        "    steps visit to the exact geometry (evaluated in double), against the tolerance\n"
-        "    plus one step, and whether the final position is the job's end rounded to steps.\n"
+        "    give it the input and layout options given to plan), the largest distance from\n"
+        "    any position the steps visit to the exact geometry (evaluated in double), against\n"
+        "    the tolerance plus one step, and whether the final position is the job's end\n"
+        "    rounded to steps.\n"
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
         "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
         "                    with --reference, executed travel moves (the job's G0 moves and\n"
@@ -53,8 +53,8 @@ static void usage(FILE *f)
         f);
     cs_jobopts_help(f);
     fputs("Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
-        "3 internal error, 4 a check failed (with --check).\n",
-        f);
+          "3 internal error, 4 a check failed (with --check).\n",
+          f);
 }
 
 int main(int argc, char **argv)

@@ -45,8 +45,8 @@ static void expect_box(const cs_path_t *p, double x0, double y0, double x1, doub
     assert_true(cs_layout_bbox(p, lo, hi));
     if (fabs(lo[0] - x0) > LSB || fabs(lo[1] - y0) > LSB || fabs(hi[0] - x1) > LSB ||
         fabs(hi[1] - y1) > LSB)
-        fail_msg("box %.6f %.6f .. %.6f %.6f, expected %.6f %.6f .. %.6f %.6f", lo[0], lo[1],
-                 hi[0], hi[1], x0, y0, x1, y1);
+        fail_msg("box %.6f %.6f .. %.6f %.6f, expected %.6f %.6f .. %.6f %.6f", lo[0], lo[1], hi[0],
+                 hi[1], x0, y0, x1, y1);
 }
 
 /* The box (10..30) x (5..15) drawn as its two diagonals' lower-left to upper-right and

@@ -47,7 +47,8 @@ static cs_order_opts_t opts(bool merge, bool sort)
 static void expect_start(const cs_path_t *p, size_t i, double x, double y)
 {
     const cs_vec3_t *v = &p->elems[i].curve.p[0];
-    assert_true(fabs(cs_conv_pos_to_mm(v->x) - x) < 1e-4 && fabs(cs_conv_pos_to_mm(v->y) - y) < 1e-4);
+    assert_true(fabs(cs_conv_pos_to_mm(v->x) - x) < 1e-4 &&
+                fabs(cs_conv_pos_to_mm(v->y) - y) < 1e-4);
 }
 
 static void test_travel_count(void **state)
@@ -291,9 +292,9 @@ static void test_random_both(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_travel_count),  cmocka_unit_test(test_merge),
+        cmocka_unit_test(test_travel_count),   cmocka_unit_test(test_merge),
         cmocka_unit_test(test_closed_rotated), cmocka_unit_test(test_random_sort),
-        cmocka_unit_test(test_random_merge),  cmocka_unit_test(test_random_both),
+        cmocka_unit_test(test_random_merge),   cmocka_unit_test(test_random_both),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
