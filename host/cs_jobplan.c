@@ -117,6 +117,20 @@ cs_err_t cs_jobplan_prepare(cs_jobplan_t *jp, const char *cmd, const cs_jobopts_
     return e;
 }
 
+cs_err_t cs_jobplan_reference(cs_jobplan_t *jp, const char *file, const cs_jobopts_t *in,
+                              const char *machine_file, const cs_machine_t *m)
+{
+    cs_machine_pen_t pen;
+    cs_machine_t scratch;
+    char err[512];
+    cs_machine_ini_pen_default(&pen);
+    if (machine_file != NULL &&
+        cs_machine_ini_load_pen(machine_file, &scratch, &pen, err, sizeof err) != 0)
+        cs_machine_ini_pen_default(&pen); /* the caller loaded (and checked) it already */
+    cs_err_t e = cs_jobplan_read_opts(jp, file, &pen, in);
+    return e == CS_OK ? cs_jobplan_prepare(jp, "sim", in, m, &pen, m->tolerance, NULL) : e;
+}
+
 /* diag "file: reason" for an error that has no place in the file. */
 static cs_err_t fail_whole(cs_jobplan_t *jp, const char *file, cs_err_t e, const char *reason)
 {

@@ -62,6 +62,11 @@ cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machi
 cs_err_t cs_jobplan_prepare(cs_jobplan_t *jp, const char *cmd, const cs_jobopts_t *in,
                             const cs_machine_t *m, const cs_machine_pen_t *pen, cs_pos_t tol,
                             FILE *report);
+/* The job as plan reads and lays it out, for a check against it (curvestep-sim --reference):
+ * the machine file's [pen] (NULL file: none), cs_jobplan_read_opts, then cs_jobplan_prepare
+ * with m's tolerance and no report. CS_OK, or an error with jp->diag filled. */
+cs_err_t cs_jobplan_reference(cs_jobplan_t *jp, const char *file, const cs_jobopts_t *in,
+                              const char *machine_file, const cs_machine_t *m);
 /* Plans jp->path whole on machine m (which must outlive jp; file names it in messages) from
  * start (cs_pos_t per axis, CS_AXES of them; NULL: the origin), chords within tol by tracer method
  * (CS_TRACE_*), at feed (mm/s Q15.16 from cs_motion_speed; 0: the machine's default) where the

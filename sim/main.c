@@ -129,11 +129,9 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     cs_machine_t m;
-    cs_machine_pen_t pen; /* [pen]: the job is read as plan reads it */
-    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
+        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return EXIT_INPUT;
         }
@@ -188,9 +186,7 @@ int main(int argc, char **argv)
     if (reference) {
         cs_jobplan_t jp;
         cs_jobplan_init(&jp);
-        e = cs_jobplan_read_opts(&jp, reference, &pen, &in);
-        if (e == CS_OK)
-            e = cs_jobplan_prepare(&jp, "sim", &in, &m, &pen, m.tolerance, NULL);
+        e = cs_jobplan_reference(&jp, reference, &in, machine_file, &m);
         double end[3];
         if (e == CS_OK)
             e = cs_sim_ref_from_path(&ref, &jp.path, end);
