@@ -13,19 +13,17 @@
 
 #include "cs_conv.h"
 #include "cs_order.h"
+#include "ref_xorshift32.h"
 
 #define SUBPATHS 100000
 #define RUNS     3
 #define GOAL_S   2.0
 
-static uint64_t rng;
+static ref_xorshift32_t rng; /* the tests' one generator (tests/support) */
 
 static double urand(double lo, double hi)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return lo + (hi - lo) * (double)(rng >> 11) / 9007199254740992.0;
+    return ref_xorshift32_uniform(&rng, lo, hi);
 }
 
 static int add_line(cs_path_t *p, double x0, double y0, double x1, double y1, int new_sub)
@@ -44,7 +42,7 @@ static int add_line(cs_path_t *p, double x0, double y0, double x1, double y1, in
 static void drawing(cs_path_t *p)
 {
     cs_path_init(p);
-    rng = 0x9E3779B97F4A7C15ull;
+    rng.s = 0x9E3779B9u;
     double lx = 0, ly = 0;
     for (size_t i = 0; i < SUBPATHS; i++) {
         int chain = i > 0 && urand(0, 1) < 1.0 / 3.0;

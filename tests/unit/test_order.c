@@ -18,6 +18,7 @@
 
 #include "cs_conv.h"
 #include "cs_order.h"
+#include "ref_xorshift32.h"
 
 static void add_curve(cs_path_t *p, unsigned deg, const double (*pt)[2], bool new_sub)
 {
@@ -143,21 +144,18 @@ static void test_closed_rotated(void **state)
 
 /* --- random drawings: geometry unchanged, travel reduced, deterministic -------------------- */
 
-static uint64_t rng;
+static ref_xorshift32_t rng; /* the tests' one generator (tests/support) */
 
 static double urand(double lo, double hi)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return lo + (hi - lo) * (double)(rng >> 11) / 9007199254740992.0;
+    return ref_xorshift32_uniform(&rng, lo, hi);
 }
 
 /* Random polylines and cubics; some strokes share end points (chains to merge). */
 static void random_path(cs_path_t *p, size_t n)
 {
     cs_path_init(p);
-    rng = 0x2545F4914F6CDD1Dull;
+    rng.s = 0x2545F491u;
     double lx = 0, ly = 0;
     for (size_t i = 0; i < n; i++) {
         bool chain = i > 0 && urand(0, 1) < 0.3; /* start where the last stroke ended */
