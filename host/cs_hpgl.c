@@ -992,8 +992,8 @@ static const struct {
            "polygon later filled or edged shows as its outline; one never used would not have "
            "been drawn by a plotter)"},
     {"LT", "line types ignored: dashed lines are drawn solid"},
-    {"DF", "defaults instruction skipped (text, fill, line type and scaling settings are not "
-           "used here)"},
+    {"DF", "defaults: scaling (SC) and the window (IW) reset; text, fill and line type "
+           "settings are not used here"},
     {"FT", "fill type ignored (fills are not drawn)"},
     {"PT", "pen thickness ignored"},
     {"PW", "pen width ignored"},
@@ -1138,6 +1138,14 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
         warn_mnemonic(h, mn, off, "text instruction skipped (text is not drawn)");
         skip_label(h);
         return CS_OK;
+    case ('D' << 8) | 'F':
+        /* DF: scaling off and the window gone, as IN does; P1, P2 and RO stay (HP-GL/2
+         * reference, DF's default-values table) */
+        warn_mnemonic(h, mn, off, NULL);
+        h->sc_on = false;
+        h->win_on = false;
+        update_map(h);
+        return skip_params(h, mn);
     case ('D' << 8) | 'T':
         /* DT t[,mode]: the label terminator is the next character ("DT;" = ETX again). */
         if (h->pos < h->len && h->buf[h->pos] != ';')

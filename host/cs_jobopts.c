@@ -19,7 +19,8 @@ static bool num(const char *s, double *v)
 static bool set_lenient(cs_jobopts_t *o, const char *v)
 {
     (void)v;
-    return o->lenient = true;
+    o->lenient = true;
+    return true;
 }
 
 static bool set_dialect(cs_jobopts_t *o, const char *v)
@@ -47,7 +48,8 @@ static bool set_scale(cs_jobopts_t *o, const char *v)
 static bool set_fit(cs_jobopts_t *o, const char *v)
 {
     (void)v;
-    return o->layout.fit = true;
+    o->layout.fit = true;
+    return true;
 }
 
 static bool set_page(cs_jobopts_t *o, const char *v)
@@ -88,7 +90,8 @@ static bool set_rotate(cs_jobopts_t *o, const char *v)
 static bool set_flip_y(cs_jobopts_t *o, const char *v)
 {
     (void)v;
-    return o->layout.flip_y = true;
+    o->layout.flip_y = true;
+    return true;
 }
 
 static bool set_merge(cs_jobopts_t *o, const char *v)

@@ -410,6 +410,9 @@ static void test_sc_ip_ir_ps(void **state)
     /* SC; ends scaling: plotter units again. */
     assert_int_equal(rd("IN;IP0,0,100,100;SC0,1,0,1;SC;PU0,0;PD10,10;"), CS_OK);
     expect_line(0, 0, 0, 10, 10);
+    /* DF ends scaling too (P1, P2 stay): 10,10 is plotter units again. */
+    assert_int_equal(rd("IN;IP0,0,400,400;SC0,10,0,10;DF;PU0,0;PD10,10;"), CS_OK);
+    expect_line(0, 0, 0, 10, 10);
     /* Arcs under anisotropic scaling become ellipses: CI 10 with x 40, y 20 plu per unit. */
     assert_int_equal(rd("IN;IP0,0,400,200;SC0,10,0,10;PU0,0;CI10;"), CS_OK);
     for (size_t i = 0; i < P.n; i++)
