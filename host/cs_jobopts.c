@@ -121,11 +121,11 @@ static const struct {
     {"scale", "F", NULL, "a factor in [0.0001, 10000]",
      "scale the drawing by F about the origin (control points,\nexactly)", set_scale},
     {"fit", NULL, "", NULL,
-     "scale and centre the drawing's box in the machine's x y travel\n"
-     "(or --page), keeping aspect",
+     "scale and centre the drawing's box in the machine's x y\n"
+     "travel (or --page), keeping aspect",
      set_fit},
     {"page", "P", NULL, "A3, A4, A5, letter or WxH[mm]",
-     "--fit onto a page at the origin: A3 A4 A5 letter (portrait) or WxHmm", set_page},
+     "--fit onto a page at the origin: A3 A4 A5 letter (portrait)\nor WxHmm", set_page},
     {"margin", "MM", NULL, "a length in mm, >= 0", "free border kept by --fit (default 0)",
      set_margin},
     {"translate", "X,Y", NULL, "two lengths in mm, X,Y", "move the drawing by X,Y mm (last)",
