@@ -48,7 +48,8 @@ static void usage(FILE *f)
         "  --png-width PX    width of that picture, 100..8000 px (default 1600)\n"
         "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
         "                    (orthographic from (1,-1,1)), y up, as `curvestep toolpath --view`;\n"
-        "                    default: machine x y with y down (as SVG jobs are written)\n"
+        "                    default: machine x y, y up, seen from above (SVG pages are\n"
+        "                    turned y-up when read, so a drawing looks as in a browser)\n"
         "  --check           exit 4 when a limit, the deviation or the final position fails\n",
         f);
     cs_jobopts_help(f);
