@@ -342,7 +342,10 @@ static cs_err_t add_curve(hp_t *h, const cs_bezier_t *c, cs_path_kind_t kind, si
             in = now;
         }
     }
-    return in ? add_piece(h, c, start, 1.0, kind, off) : CS_OK;
+    if (in)
+        return add_piece(h, c, start, 1.0, kind, off);
+    cs_path_new_subpath(h->path); /* the pen ends outside: whatever is drawn next starts anew */
+    return CS_OK;
 }
 
 static cs_err_t emit(hp_t *h, cs_path_kind_t kind, unsigned degree, const cs_vec3_t *pts,

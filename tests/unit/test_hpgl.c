@@ -457,6 +457,13 @@ static void test_iw(void **state)
     assert_int_equal(P.n, 2);
     expect_line(0, 200, 500, 800, 500);
     expect_line(1, 0, 600, 1000, 600);
+    /* The pen left the window; with the window gone the next line starts a new stroke where
+     * the pen is (found by the fuzzer: the two were once one subpath with a gap). */
+    assert_int_equal(rd("IN;IW1000,1000,2000,2000;PU0,1500;PD3000,1500;IW;PD3000,2500;"), CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_line(0, 1000, 1500, 2000, 1500);
+    expect_line(1, 3000, 1500, 3000, 2500);
+    assert_true(P.elems[0].subpath != P.elems[1].subpath);
     /* A polyline leaving and re-entering: two strokes. */
     assert_int_equal(rd("IN;IW0,0,1000,1000;PU500,500;PD1500,500,1500,700,500,700;"), CS_OK);
     assert_int_equal(P.n, 2);
