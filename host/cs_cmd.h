@@ -17,10 +17,12 @@ enum {
 /* A command: argc/argv start at the command's name; returns a CS_EXIT_* status. */
 typedef int (*cs_cmd_fn)(int argc, char **argv);
 
-/* curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg] FILE */
+/* curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg] [JOBOPTS] FILE
+ * (JOBOPTS: the input and layout options every job command shares, host/cs_jobopts.h) */
 int cs_cmd_flatten(int argc, char **argv);
 
-/* curvestep plan [--machine FILE.ini] [--tol MM] [--method M] [--feed MM/S] [-o OUT] FILE */
+/* curvestep plan [--machine FILE.ini] [--tol MM] [--method M] [--feed MM/S] [JOBOPTS] [-o OUT]
+ * FILE */
 int cs_cmd_plan(int argc, char **argv);
 
 /* curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM] [--svg OUT.svg]
@@ -28,12 +30,12 @@ int cs_cmd_plan(int argc, char **argv);
 int cs_cmd_toolpath(int argc, char **argv);
 
 /* curvestep stream --port DEV [--baud N] [--machine FILE.ini] [--mode segments|curves]
- * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] FILE */
+ * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] [JOBOPTS] FILE */
 int cs_cmd_stream(int argc, char **argv);
 
 /* curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH] */
 int cs_cmd_serve(int argc, char **argv);
-/* curvestep submit [--socket PATH] [--mode M] [--tol MM] [--feed MM/S] FILE */
+/* curvestep submit [--socket PATH] [--mode M] [--tol MM] [--feed MM/S] [JOBOPTS] FILE */
 int cs_cmd_submit(int argc, char **argv);
 /* curvestep status | pause | resume [--socket PATH]; curvestep cancel [--socket PATH] [JOB] */
 int cs_cmd_status(int argc, char **argv);

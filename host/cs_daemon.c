@@ -42,6 +42,7 @@ typedef struct {
     cs_stream_job_t job; /* freed once the job ended */
     bool curves;         /* what SUBMIT asked, to plan it again from the device's position */
     double tol_mm, feed;
+    cs_jobopts_t in; /* the shared input and layout options SUBMIT gave */
     job_state_t state;
     size_t executed;
     size_t n;
@@ -199,7 +200,8 @@ static void job_release(djob_t *j)
 
 /* Plans the file whole as `curvestep stream` does; on error a "file:line:col: reason" in err. */
 static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, double feed,
-                     const int32_t *start_steps, cs_stream_job_t *job, char *err, size_t errcap)
+                     const cs_jobopts_t *in, const int32_t *start_steps, cs_stream_job_t *job,
+                     char *err, size_t errcap)
 {
     cs_pos_t tol;
     if (!cs_jobplan_tol(&d->m, tol_mm, &tol)) {
@@ -209,7 +211,9 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     cs_stream_job_init(job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
-    cs_err_t e = cs_jobplan_read(&jp, file, &d->pen, false);
+    cs_err_t e = cs_jobplan_read_opts(&jp, file, &d->pen, in);
+    if (e == CS_OK)
+        e = cs_jobplan_prepare(&jp, "serve", in, &d->m, &d->pen, tol, d->cfg->log);
     /* step segments are relative: plan them from where the device is (the position the
      * previous job left it at), rounded to the nearest LSB (far below half a step) */
     cs_pos_t start[CS_AXES] = {0};
@@ -254,11 +258,14 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
     return false;
 }
 
-/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] /ABS/PATH" */
+/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [shared option words] /ABS/PATH"
+ * (the shared words: cs_jobopts_word, e.g. lenient, dialect=grbl, fit, rotate=90) */
 static void req_submit(daemon_t *d, char *args, FILE *out)
 {
     bool curves = false;
     double tol = 0, feed = 0;
+    cs_jobopts_t in;
+    cs_jobopts_init(&in);
     while (*args == ' ')
         args++;
     while (*args != '\0' && *args != '/') {
@@ -279,6 +286,8 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
         else if (strncmp(args, "feed=", 5) == 0 &&
                  ((feed = strtod(args + 5, &end)), *end == '\0' && feed > 0 && feed < 32768))
             ;
+        else if (cs_jobopts_word(args, &in))
+            ;
         else {
             fprintf(out, "ERR bad option %s\n", args);
             return;
@@ -293,7 +302,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     }
     char err[600];
     cs_stream_job_t job;
-    if (!plan_job(d, args, curves, tol, feed, NULL, &job, err, sizeof err)) {
+    if (!plan_job(d, args, curves, tol, feed, &in, NULL, &job, err, sizeof err)) {
         fprintf(out, "ERR %s\n", err);
         dlog(d, "refused %s: %s", args, err);
         return;
@@ -323,6 +332,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     j->curves = curves;
     j->tol_mm = tol;
     j->feed = feed;
+    j->in = in;
     j->state = JOB_QUEUED;
     d->njobs++;
     const char *what = curves ? "curves" : "segments";
@@ -470,7 +480,8 @@ static void start_next(daemon_t *d)
     if (!j->curves && moved) {
         char err[600];
         cs_stream_job_t job;
-        if (!plan_job(d, j->path, false, j->tol_mm, j->feed, d->dev_pos, &job, err, sizeof err)) {
+        if (!plan_job(d, j->path, false, j->tol_mm, j->feed, &j->in, d->dev_pos, &job, err,
+                      sizeof err)) {
             j->state = JOB_FAILED;
             snprintf(j->end, sizeof j->end, "planning from the device's position: %.160s", err);
             dlog(d, "job %u failed: %s", j->id, j->end);

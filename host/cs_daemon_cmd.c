@@ -8,6 +8,7 @@
 
 #include "cs_cmd.h"
 #include "cs_daemon.h"
+#include "cs_jobopts.h"
 #include "cs_serial.h"
 
 /* Exit status of the clients beyond the shared ones: no daemon answers on the socket. */
@@ -89,7 +90,7 @@ static void client_usage(FILE *f, const char *name)
     cs_daemon_default_socket(sock, sizeof sock);
     if (strcmp(name, "submit") == 0)
         fprintf(f, "usage: curvestep submit [--socket PATH] [--mode segments|curves] [--tol MM]\n"
-                   "                        [--feed MM/S] FILE\n"
+                   "                        [--feed MM/S] [input and layout options] FILE\n"
                    "Queues the job FILE (SVG, G-code or HPGL) on the daemon (`curvestep serve`).\n"
                    "The daemon reads and plans it whole now: a bad file is refused at once with\n"
                    "file:line:col: reason. Prints the job's number. Options as for `stream`.\n");
@@ -110,6 +111,8 @@ static void client_usage(FILE *f, const char *name)
                    "Cancels job number JOB (default: the running one): a queued job is dropped;\n"
                    "the running one is held, then aborted (the device flushes its queue) and the\n"
                    "next job starts.\n");
+    if (strcmp(name, "submit") == 0)
+        cs_jobopts_help(f); /* sent along; the daemon's machine decides --fit and the defaults */
     fprintf(f,
             "  --socket PATH   the daemon's socket (default %s)\n"
             "Exit status: 0 the daemon said OK; 1 it refused the request (the reason is\n"
@@ -125,9 +128,16 @@ static int client(int argc, char **argv, const char *verb)
     const char *socket_path = cs_daemon_default_socket(sock, sizeof sock);
     const char *file = NULL, *mode = NULL, *tol = NULL, *feed = NULL, *job = NULL;
     bool submit = strcmp(name, "submit") == 0, cancel = strcmp(name, "cancel") == 0;
+    cs_jobopts_t in; /* sent as SUBMIT words; the daemon reads and lays out the job */
+    cs_jobopts_init(&in);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
+        int r = submit ? cs_jobopts_option(name, argc, argv, &i, &in) : 0;
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             client_usage(stdout, name);
             return CS_EXIT_OK;
@@ -186,9 +196,11 @@ static int client(int argc, char **argv, const char *verb)
             fprintf(stderr, "%s:0:0: cannot open the job file (%s)\n", file, strerror(errno));
             return CS_EXIT_INPUT;
         }
-        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s %s", mode ? " mode=" : "",
+        if (cs_jobopts_check(name, &in) != 0)
+            return CS_EXIT_USAGE;
+        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s%s %s", mode ? " mode=" : "",
                          mode ? mode : "", tol ? " tol=" : "", tol ? tol : "", feed ? " feed=" : "",
-                         feed ? feed : "", abs);
+                         feed ? feed : "", in.words, abs);
         if (k < 0 || (size_t)k >= sizeof req || strchr(abs, '\n')) {
             fprintf(stderr, "%s:0:0: path too long or not on one line\n", file);
             return CS_EXIT_INPUT;

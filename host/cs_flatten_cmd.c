@@ -12,6 +12,8 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_input.h"
+#include "cs_jobopts.h"
+#include "cs_machine_ini.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -36,8 +38,7 @@ static void flatten_usage(FILE *f)
 {
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-            "\n                         [--lenient] [--font FILE.jhf] [--dialect linuxcnc|grbl]"
-            "\n                         [--units mm|inch] FILE\n"
+            "\n                         [--font FILE.jhf] [input and layout options] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -52,9 +53,10 @@ static void flatten_usage(FILE *f)
             "a warning on stderr names it) or a file holding bare SVG path data (M L H V C S Q T A "
             "Z, absolute\n"
             "and relative); other names and '-' (standard input) are recognised by their\n"
-            "content. SVG without width/height and bare path data: 1 user unit = 1 mm. Axes\n"
-            "as in the file (SVG's y points down, HP-GL's up); coordinates must stay within\n"
-            "+/-%d mm.\n"
+            "content. SVG without width/height and bare path data: 1 user unit = 1 mm. An SVG\n"
+            "document's page is turned y-up (y' = page height - y: the drawing as a browser\n"
+            "shows it); G-code, HP-GL and bare path data keep their axes. Coordinates must\n"
+            "stay within +/-%d mm.\n"
             "\n"
             "Options:\n"
             "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
@@ -64,20 +66,19 @@ static void flatten_usage(FILE *f)
             "                  deviation of a chord from its exact curve, measured in double on\n"
             "                  the host\n"
             "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
-            "  --lenient       G-code: a word curvestep does not carry out is a warning (and is\n"
-            "                  ignored) instead of an error\n"
             "  --font FILE.jhf Hershey stroke font for SVG <text> and HP-GL LB labels (default:\n"
             "                  share/fonts/futural.jhf; a file that is not a font is an error)\n"
-            "  --dialect D     G-code: linuxcnc (the default) or grbl (Grbl 1.1: starts in G0,\n"
-            "                  no parameters or O-words, Grbl's arc check; docs/inputs.md)\n"
-            "  --units U       G-code: mm (the default) or inch, the units a program starts in\n"
-            "  -h, --help      show this help\n"
+            "  -h, --help      show this help\n",
+            CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
+            CS_POS_LIMIT_MM);
+    cs_jobopts_help(f);
+    fprintf(f,
+            "--fit uses the built-in machine's travel (or --page); merge and sort are off\n"
+            "unless asked for. The chords printed are those of the laid-out drawing.\n"
             "\n"
             "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
             "coordinates outside the range); 2 usage error; 3 internal error (arithmetic overflow\n"
-            "or depth limit while tracing, out of memory, write error).\n",
-            CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
-            CS_POS_LIMIT_MM);
+            "or depth limit while tracing, out of memory, write error).\n");
 }
 
 /* Exit status for a code met while reading input. */
@@ -105,6 +106,27 @@ static bool vbuf_push(vbuf_t *b, cs_vec3_t p)
     return true;
 }
 
+/* Takes the shared input options (cs_jobopts) out of argv (getopt sees the rest): 0, or the
+ * exit status of a bad value or combination. */
+static int take_jobopts(int *argc, char **argv, cs_jobopts_t *in)
+{
+    int k = 1;
+    for (int i = 1; i < *argc; i++) {
+        int r = cs_jobopts_option("flatten", *argc, argv, &i, in);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
+        bool valued = strcmp(argv[i], "--tol") == 0 || strcmp(argv[i], "--method") == 0 ||
+                      strcmp(argv[i], "--svg") == 0;
+        argv[k++] = argv[i];
+        if (valued && i + 1 < *argc)
+            argv[k++] = argv[++i];
+    }
+    *argc = k;
+    return cs_jobopts_check("flatten", in) != 0 ? CS_EXIT_USAGE : 0;
+}
+
 int cs_cmd_flatten(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -113,9 +135,6 @@ int cs_cmd_flatten(int argc, char **argv)
         {"stats", no_argument, NULL, 's'},
         {"svg", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},
-        {"lenient", no_argument, NULL, 'l'},
-        {"dialect", required_argument, NULL, 'd'},
-        {"units", required_argument, NULL, 'u'},
         {"font", required_argument, NULL, 'f'},
         {NULL, 0, NULL, 0},
     };
@@ -123,10 +142,12 @@ int cs_cmd_flatten(int argc, char **argv)
     size_t method = FLATTEN_DEFAULT_METHOD;
     bool stats = false;
     const char *svg_out = NULL;
-    bool lenient = false;
     const char *font = NULL;
-    cs_dialect_t dialect = CS_DIALECT_LINUXCNC;
-    cs_units_t units = CS_UNITS_DEFAULT;
+    cs_jobopts_t in;
+    cs_jobopts_init(&in);
+    int r = take_jobopts(&argc, argv, &in);
+    if (r != 0)
+        return r;
     int c;
     optind = 1;
     opterr = 0;
@@ -167,25 +188,8 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'o':
             svg_out = optarg;
             break;
-        case 'l':
-            lenient = true;
-            break;
         case 'f':
             font = optarg;
-            break;
-        case 'd': /* G-code: --dialect linuxcnc | grbl (docs/inputs.md) */
-        case 'u': /* G-code: --units mm | inch, the units the program starts in */
-            if (strcmp(optarg, c == 'd' ? "linuxcnc" : "mm") != 0 &&
-                strcmp(optarg, c == 'd' ? "grbl" : "inch") != 0) {
-                fprintf(stderr, "curvestep flatten: --%s '%s': expected %s\n",
-                        c == 'd' ? "dialect" : "units", optarg,
-                        c == 'd' ? "linuxcnc or grbl" : "mm or inch");
-                return CS_EXIT_USAGE;
-            }
-            if (c == 'd')
-                dialect = strcmp(optarg, "grbl") == 0 ? CS_DIALECT_GRBL : CS_DIALECT_LINUXCNC;
-            else
-                units = strcmp(optarg, "inch") == 0 ? CS_UNITS_INCH : CS_UNITS_MM;
             break;
         case 'h':
             flatten_usage(stdout);
@@ -216,11 +220,13 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_path_diag_t diag;
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
-    iopts.lenient = lenient;
+    cs_jobopts_input(&in, &iopts);
     iopts.font_file = font;
-    iopts.dialect = dialect;
-    iopts.units = units;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
+    cs_machine_t m;
+    cs_machine_ini_default(&m); /* --fit: the built-in machine's travel */
+    if (e == CS_OK)
+        e = cs_jobopts_prepare(&in, "flatten", &m, false, tol_mm, &path, &diag, stderr);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);
         cs_path_free(&path);

@@ -43,9 +43,17 @@ typedef struct {
     double x, y;   /* current position, plotter units, absolute */
     cs_vec3_t cur; /* the same, converted */
     bool relative, pen_down;
-    long pen;        /* selected pen; 0 = none (nothing is drawn) */
-    char label_term; /* LB/BL/WD text terminator (DT) */
     double si_w, si_h; /* SI character width and height, cm (HP default 0.19 x 0.27) */
+    long pen;             /* selected pen; 0 = none (nothing is drawn) */
+    char label_term;      /* LB/BL/WD text terminator (DT) */
+    cs_path_affine_t map; /* user units -> physical plotter units (RO, IP/IR, SC), y up */
+    double frame[2];      /* picture frame (PS), plotter units: x, y before rotation */
+    double p1[2], p2[2];  /* scaling points, in rotated plotter units */
+    int ro;               /* RO: 0, 90, 180 or 270 */
+    bool sc_on;           /* SC in effect */
+    double sc[7];         /* SC xmin,xmax|xfactor,ymin,ymax|yfactor,type,left,bottom */
+    bool win_on;          /* IW window in effect */
+    double win[4];        /* IW window, physical plotter units: x0, y0, x1, y1 */
     bool warned[26 * 26];
     bool warned_esc, warned_nopen, warned_big_sweep;
 } hp_t;
@@ -243,7 +251,9 @@ static cs_err_t skip_params(hp_t *h, const char *mn)
 /* Plotter units -> cs_vec3_t in mm; CS_ERR_RANGE reported at off. */
 static cs_err_t convert(hp_t *h, double x, double y, size_t off, cs_vec3_t *out)
 {
-    double mx = x / CS_HPGL_PLU_PER_MM, my = y / CS_HPGL_PLU_PER_MM;
+    double px, py;
+    cs_path_affine_point(&h->map, x, y, &px, &py);
+    double mx = px / CS_HPGL_PLU_PER_MM, my = py / CS_HPGL_PLU_PER_MM;
     if (cs_conv_mm_to_vec(mx, my, 0.0, out) != CS_OK)
         return fail(h, off, CS_ERR_RANGE,
                     "point (%.6g, %.6g) plotter units = (%.6g, %.6g) mm is outside the accepted "
@@ -263,6 +273,82 @@ static bool drawing(hp_t *h, size_t off)
     return false;
 }
 
+/* --- IW: the clipping window ------------------------------------------------------------- */
+
+static bool in_window(const hp_t *h, const double p[3])
+{
+    /* half an LSB of slack: a point on the edge, rounded, is inside */
+    double eps = 0.5 / CS_POS_ONE_MM;
+    double x = p[0] * CS_HPGL_PLU_PER_MM, y = p[1] * CS_HPGL_PLU_PER_MM;
+    return x >= h->win[0] - eps && x <= h->win[2] + eps && y >= h->win[1] - eps &&
+           y <= h->win[3] + eps;
+}
+
+static bool in_window_at(const hp_t *h, const cs_bezier_t *c, double t)
+{
+    double p[3];
+    cs_path_eval_mm(c, t, p);
+    return in_window(h, p);
+}
+
+/* Appends c's piece over [t0, t1] (cs_bezier_split, each new point rounded once). */
+static cs_err_t add_piece(hp_t *h, const cs_bezier_t *c, double t0, double t1, cs_path_kind_t kind,
+                          size_t off)
+{
+    cs_bezier_t a = *c, b;
+    cs_param_t q;
+    if (t0 > 0 && cs_conv_to_param(t0, &q) == CS_OK && q > 0 && q < CS_PARAM_ONE &&
+        cs_bezier_split(c, q, NULL, &a) != CS_OK)
+        return fail(h, off, CS_ERR_RANGE, "IW: cannot clip this curve");
+    double u = t0 > 0 ? (t1 - t0) / (1 - t0) : t1;
+    if (u < 1 && cs_conv_to_param(u, &q) == CS_OK && q > 0 && q < CS_PARAM_ONE) {
+        if (cs_bezier_split(&a, q, &b, NULL) != CS_OK)
+            return fail(h, off, CS_ERR_RANGE, "IW: cannot clip this curve");
+        a = b;
+    }
+    if (cs_path_add(h->path, &a, kind, loc_at(h, off)) != CS_OK)
+        return fail(h, off, CS_ERR_FULL, "out of memory");
+    return CS_OK;
+}
+
+/* The curve clipped to the window: the parameter runs inside it, found on a grid of
+ * HP_CLIP_GRID and refined by bisection on the exact curve, each appended as its own piece;
+ * anything cut away lifts the pen (a new subpath). */
+#define HP_CLIP_GRID 64
+static cs_err_t add_curve(hp_t *h, const cs_bezier_t *c, cs_path_kind_t kind, size_t off)
+{
+    if (!h->win_on) {
+        if (cs_path_add(h->path, c, kind, loc_at(h, off)) != CS_OK)
+            return fail(h, off, CS_ERR_FULL, "out of memory");
+        return CS_OK;
+    }
+    bool in = in_window_at(h, c, 0.0);
+    double start = 0.0; /* where the current inside run began */
+    for (int k = 1; k <= HP_CLIP_GRID; k++) {
+        double lo = (double)(k - 1) / HP_CLIP_GRID, hi = (double)k / HP_CLIP_GRID;
+        bool now = in_window_at(h, c, hi);
+        if (now != in) {
+            for (int it = 0; it < 50; it++) { /* the crossing, bracketed: lo as before */
+                double mid = (lo + hi) / 2;
+                *(in_window_at(h, c, mid) == in ? &lo : &hi) = mid;
+            }
+            if (in) { /* leaving: the run ends at lo, the last point inside */
+                cs_err_t e = add_piece(h, c, start, lo, kind, off);
+                if (e != CS_OK)
+                    return e;
+            } else { /* entering at hi: a new stroke, the pen was lifted outside */
+                cs_path_new_subpath(h->path);
+                start = hi;
+            }
+            in = now;
+        }
+    }
+    if (in)
+        return add_piece(h, c, start, 1.0, kind, off);
+    cs_path_new_subpath(h->path); /* the pen ends outside: whatever is drawn next starts anew */
+    return CS_OK;
+}
+
 static cs_err_t emit(hp_t *h, cs_path_kind_t kind, unsigned degree, const cs_vec3_t *pts,
                      size_t off)
 {
@@ -273,9 +359,7 @@ static cs_err_t emit(hp_t *h, cs_path_kind_t kind, unsigned degree, const cs_vec
         c.p[i] = pts[i];
         c.w[i] = CS_WEIGHT_ONE;
     }
-    if (cs_path_add(h->path, &c, kind, loc_at(h, off)) != CS_OK)
-        return fail(h, off, CS_ERR_FULL, "out of memory");
-    return CS_OK;
+    return add_curve(h, &c, kind, off);
 }
 
 /* Moves the pen to (x, y) plotter units (absolute), drawing a line when the pen is down. A
@@ -342,8 +426,15 @@ static cs_err_t arc(hp_t *h, double cx, double cy, double sweep, bool draw, size
         h->cur = endf;
         return CS_OK;
     }
-    if (cs_conv_mm_to_vec(ux / CS_HPGL_PLU_PER_MM, uy / CS_HPGL_PLU_PER_MM, 0.0, &U) != CS_OK ||
-        cs_conv_mm_to_vec(-uy / CS_HPGL_PLU_PER_MM, ux / CS_HPGL_PLU_PER_MM, 0.0, &V) != CS_OK)
+    /* U and V through the linear part of the map: the image of the circle is the ellipse with
+     * those conjugate semi-axes, exactly (an affine map of a rational Bézier is the Bézier of
+     * the mapped points, same weights) */
+    double mu[2], mv[2];
+    cs_path_affine_vector(&h->map, ux, uy, &mu[0], &mu[1]);
+    cs_path_affine_vector(&h->map, -uy, ux, &mv[0], &mv[1]);
+    if (cs_conv_mm_to_vec(mu[0] / CS_HPGL_PLU_PER_MM, mu[1] / CS_HPGL_PLU_PER_MM, 0.0, &U) !=
+            CS_OK ||
+        cs_conv_mm_to_vec(mv[0] / CS_HPGL_PLU_PER_MM, mv[1] / CS_HPGL_PLU_PER_MM, 0.0, &V) != CS_OK)
         return fail(h, off, CS_ERR_RANGE, "arc radius too large for the +/-%d mm range",
                     CS_POS_LIMIT_MM);
     cs_param_t c1, s1;
@@ -373,8 +464,8 @@ static cs_err_t arc(hp_t *h, double cx, double cy, double sweep, bool draw, size
     seg[0].p[0] = h->cur; /* continuous to the LSB with the neighbours */
     seg[n - 1].p[2] = endf;
     for (unsigned i = 0; i < n; i++)
-        if (cs_path_add(h->path, &seg[i], CS_PATH_ARC, loc_at(h, off)) != CS_OK)
-            return fail(h, off, CS_ERR_FULL, "out of memory");
+        if ((e = add_curve(h, &seg[i], CS_PATH_ARC, off)) != CS_OK)
+            return e;
     h->x = ex;
     h->y = ey;
     h->cur = endf;
@@ -430,6 +521,214 @@ static cs_err_t get_params(hp_t *h, const char *mn, size_t mn_off, double *v, si
     if (*n < min)
         return fail(h, mn_off, CS_ERR_PARSE, "%s: too few parameters (%s)", mn, usage);
     return end_instr(h, mn);
+}
+
+/* --- scaling: SC, IP, IR, RO, PS (HP-GL/2 reference, "The Configuration and Status Group") -- */
+
+/* The picture frame's size in the rotated coordinate system (RO 90 / 270 swap its sides). */
+static void frame_rotated(const hp_t *h, double *w, double *fh)
+{
+    bool swap = h->ro == 90 || h->ro == 270;
+    *w = swap ? h->frame[1] : h->frame[0];
+    *fh = swap ? h->frame[0] : h->frame[1];
+}
+
+/* Default P1, P2: the lower-left and upper-right corners of the (rotated) frame. */
+static void default_p1p2(hp_t *h)
+{
+    h->p1[0] = h->p1[1] = 0.0;
+    frame_rotated(h, &h->p2[0], &h->p2[1]);
+}
+
+/* User units -> rotated plotter units by SC: type 0 P1..P2 anisotropic, type 1 isotropic
+ * (the smaller factor, the extra space split left/bottom %), type 2 point factor. */
+static cs_path_affine_t scale_map(const hp_t *h)
+{
+    cs_path_affine_t m = cs_path_affine_identity();
+    if (!h->sc_on)
+        return m;
+    const double *v = h->sc;
+    int type = (int)v[4];
+    double sx, sy, ox = 0, oy = 0;
+    if (type == 2) {
+        sx = v[1];
+        sy = v[3];
+        m.a = sx;
+        m.d = sy;
+        m.e = h->p1[0] - v[0] * sx;
+        m.f = h->p1[1] - v[2] * sy;
+        return m;
+    }
+    sx = (h->p2[0] - h->p1[0]) / (v[1] - v[0]);
+    sy = (h->p2[1] - h->p1[1]) / (v[3] - v[2]);
+    if (type == 1) {
+        double k = fmin(fabs(sx), fabs(sy));
+        sx = copysign(k, sx);
+        sy = copysign(k, sy);
+        ox = ((h->p2[0] - h->p1[0]) - (v[1] - v[0]) * sx) * v[5] / 100.0;
+        oy = ((h->p2[1] - h->p1[1]) - (v[3] - v[2]) * sy) * v[6] / 100.0;
+    }
+    m.a = sx;
+    m.d = sy;
+    m.e = h->p1[0] + ox - v[0] * sx;
+    m.f = h->p1[1] + oy - v[2] * sy;
+    return m;
+}
+
+/* Rotated plotter units -> physical (the unrotated frame, origin lower left): RO turns the
+ * coordinate system counter-clockwise and shifts it so the frame stays in its first quadrant. */
+static cs_path_affine_t rotate_map(const hp_t *h)
+{
+    cs_path_affine_t m = cs_path_affine_identity();
+    double w = h->frame[0], fh = h->frame[1];
+    if (h->ro == 90) { /* X = W - y, Y = x */
+        m.a = 0, m.b = 1, m.c = -1, m.d = 0, m.e = w;
+    } else if (h->ro == 180) { /* X = W - x, Y = H - y */
+        m.a = -1, m.d = -1, m.e = w, m.f = fh;
+    } else if (h->ro == 270) { /* X = y, Y = H - x */
+        m.a = 0, m.b = -1, m.c = 1, m.d = 0, m.f = fh;
+    }
+    return m;
+}
+
+/* Rebuilds the map after a change of SC, P1/P2, RO or the frame. The pen does not move on the
+ * paper: its user coordinates are recomputed through the new map's inverse. */
+static void update_map(hp_t *h)
+{
+    double px, py;
+    cs_path_affine_point(&h->map, h->x, h->y, &px, &py);
+    h->map = cs_path_affine_mul(rotate_map(h), scale_map(h));
+    const cs_path_affine_t *m = &h->map;
+    double det = m->a * m->d - m->b * m->c;
+    if (det != 0.0) {
+        double dx = px - m->e, dy = py - m->f;
+        h->x = (m->d * dx - m->c * dy) / det;
+        h->y = (m->a * dy - m->b * dx) / det;
+    }
+}
+
+/* IN (and the start): frame kept, no rotation, default P1/P2, no scaling, no window. */
+static void reset_scaling(hp_t *h)
+{
+    h->ro = 0;
+    h->sc_on = false;
+    h->win_on = false;
+    default_p1p2(h);
+    update_map(h);
+}
+
+/* SC [xmin,xmax,ymin,ymax[,type[,left,bottom]]] */
+static cs_err_t instr_sc(hp_t *h, const char *mn, size_t off)
+{
+    double v[7] = {0, 0, 0, 0, 0, 50, 50};
+    size_t vo[7];
+    unsigned n;
+    const char *use = "SC xmin,xmax,ymin,ymax[,type[,left,bottom]]";
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 7, &n, use);
+    if (e != CS_OK)
+        return e;
+    if (n != 0 && n != 4 && n != 5 && n != 7)
+        return fail(h, off, CS_ERR_PARSE, "SC: %u parameters (%s)", n, use);
+    int type = (int)v[4];
+    if (n >= 5 && (v[4] != type || type < 0 || type > 2))
+        return fail(h, vo[4], CS_ERR_PARSE, "SC: type must be 0, 1 or 2");
+    if (n && (type == 2 ? (v[1] == 0 || v[3] == 0) : (v[0] == v[1] || v[2] == v[3])))
+        return fail(h, vo[0], CS_ERR_PARSE, "SC: %s",
+                    type == 2 ? "a scale factor of 0" : "xmin = xmax or ymin = ymax");
+    if (n == 7 && (v[5] < 0 || v[5] > 100 || v[6] < 0 || v[6] > 100))
+        return fail(h, vo[5], CS_ERR_PARSE, "SC: left and bottom are percentages, 0..100");
+    h->sc_on = n != 0;
+    memcpy(h->sc, v, sizeof v);
+    update_map(h);
+    return CS_OK;
+}
+
+/* IP [p1x,p1y[,p2x,p2y]] (plotter units) and IR (percentages of the frame): P2 keeps its
+ * offset from P1 when only P1 is given. */
+static cs_err_t instr_ip(hp_t *h, const char *mn, size_t off, bool rel)
+{
+    double v[4];
+    size_t vo[4];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 4, &n,
+                            rel ? "IR p1x,p1y[,p2x,p2y] in %" : "IP p1x,p1y[,p2x,p2y]");
+    if (e != CS_OK)
+        return e;
+    if (n == 1 || n == 3)
+        return fail(h, off, CS_ERR_PARSE, "%s: coordinates come in pairs", mn);
+    double w, fh;
+    frame_rotated(h, &w, &fh);
+    for (unsigned i = 0; rel && i < n; i++)
+        v[i] = v[i] / 100.0 * (i % 2 ? fh : w);
+    if (n == 0) {
+        default_p1p2(h);
+    } else {
+        double d[2] = {h->p2[0] - h->p1[0], h->p2[1] - h->p1[1]};
+        h->p1[0] = v[0];
+        h->p1[1] = v[1];
+        h->p2[0] = n == 4 ? v[2] : v[0] + d[0];
+        h->p2[1] = n == 4 ? v[3] : v[1] + d[1];
+    }
+    update_map(h);
+    return CS_OK;
+}
+
+/* RO [0|90|180|270]: P1 and P2 keep their coordinate values (they turn with the system). */
+static cs_err_t instr_ro(hp_t *h, const char *mn, size_t off)
+{
+    double v[1] = {0};
+    size_t vo[1];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 1, &n, "RO [0|90|180|270]");
+    if (e != CS_OK)
+        return e;
+    if (v[0] != 0 && v[0] != 90 && v[0] != 180 && v[0] != 270)
+        return fail(h, vo[0], CS_ERR_PARSE, "RO: the angle must be 0, 90, 180 or 270");
+    h->ro = (int)v[0];
+    update_map(h);
+    return CS_OK;
+}
+
+/* PS [length[,width]]: the frame's size (plotter units); P1/P2 go to its corners. */
+static cs_err_t instr_ps(hp_t *h, const char *mn, size_t off)
+{
+    double v[2];
+    size_t vo[2];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 2, &n, "PS [length[,width]]");
+    if (e != CS_OK)
+        return e;
+    if ((n >= 1 && !(v[0] > 0)) || (n == 2 && !(v[1] > 0)))
+        return fail(h, vo[0], CS_ERR_PARSE, "PS: sizes must be positive plotter units");
+    h->frame[0] = n >= 1 ? v[0] : CS_HPGL_FRAME_W;
+    h->frame[1] = n == 2 ? v[1] : n == 1 ? h->frame[1] : CS_HPGL_FRAME_H;
+    default_p1p2(h);
+    update_map(h);
+    return CS_OK;
+}
+
+/* IW [x0,y0,x1,y1] (current units): the window, kept on the paper (physical units). */
+static cs_err_t instr_iw(hp_t *h, const char *mn, size_t off)
+{
+    double v[4];
+    size_t vo[4];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 4, &n, "IW x0,y0,x1,y1");
+    if (e != CS_OK)
+        return e;
+    if (n != 0 && n != 4)
+        return fail(h, off, CS_ERR_PARSE, "IW: four numbers or none");
+    h->win_on = n == 4;
+    if (n == 4) {
+        double ax, ay, bx, by;
+        cs_path_affine_point(&h->map, v[0], v[1], &ax, &ay);
+        cs_path_affine_point(&h->map, v[2], v[3], &bx, &by);
+        h->win[0] = fmin(ax, bx);
+        h->win[1] = fmin(ay, by);
+        h->win[2] = fmax(ax, bx);
+        h->win[3] = fmax(ay, by);
+    }
+    return CS_OK;
 }
 
 static void select_pen(hp_t *h, double v)
@@ -578,6 +877,22 @@ static int pe_value(hp_t *h, bool seven, int64_t *v, cs_err_t *e)
     return 0;
 }
 
+/* Where a flag or a coordinate pair may start: the next instruction begins here. HP's reference
+ * asks for ';' after PE, but AutoCAD's HP-GL/2 output ends it with the next mnemonic: two
+ * letters followed by a byte no encoded value can hold next (a digit, ',', ';', a flag, a
+ * blank, the end) -- the two letters then cannot be a value's digits, which need a terminating
+ * digit (191..254, 95..126 in 7-bit mode) after their continuation digits. */
+static bool pe_ends(const hp_t *h)
+{
+    size_t i = h->pos;
+    if (i + 1 >= h->len || !is_letter(h->buf[i]) || !is_letter(h->buf[i + 1]))
+        return false;
+    if (i + 2 >= h->len)
+        return true;
+    unsigned char c = (unsigned char)h->buf[i + 2];
+    return !((c >= 63 && c <= 126) || (c >= 191 && c <= 254));
+}
+
 /* PE: flags ':' pen, '<' next move pen up, '>' fractional bits, '=' next point absolute, '7'
  * 7-bit mode; coordinates are relative pen-down moves unless flagged. The pen state after PE is
  * that of its last move. */
@@ -587,7 +902,7 @@ static cs_err_t polyline_encoded(hp_t *h, size_t mn_off)
     int64_t frac = 0;
     cs_err_t e = CS_OK;
     for (;;) {
-        while (h->pos < h->len && h->buf[h->pos] != ';') {
+        while (h->pos < h->len && h->buf[h->pos] != ';' && !pe_ends(h)) {
             unsigned char c = (unsigned char)h->buf[h->pos];
             if ((c >= 63 && c <= 126) || (c >= 191 && c <= 254))
                 break;
@@ -624,7 +939,7 @@ static cs_err_t polyline_encoded(hp_t *h, size_t mn_off)
                 break; /* other bytes are ignored */
             }
         }
-        if (h->pos >= h->len || h->buf[h->pos] == ';')
+        if (h->pos >= h->len || h->buf[h->pos] == ';' || pe_ends(h))
             break;
         int64_t a, b;
         size_t off = h->pos;
@@ -650,8 +965,8 @@ static cs_err_t polyline_encoded(hp_t *h, size_t mn_off)
         next_up = next_abs = false;
     }
     (void)mn_off;
-    if (h->pos < h->len)
-        h->pos++; /* ';' */
+    if (h->pos < h->len && h->buf[h->pos] == ';')
+        h->pos++; /* ';' (or the next instruction, left in place) */
     return CS_OK;
 }
 
@@ -753,15 +1068,9 @@ static const struct {
     {"PM", "polygon mode ignored: pen-down moves inside it are drawn as ordinary lines (a "
            "polygon later filled or edged shows as its outline; one never used would not have "
            "been drawn by a plotter)"},
-    {"IW", "clipping window ignored: lines outside it ARE drawn"},
-    {"RO", "rotation ignored: the drawing is NOT rotated"},
-    {"SC", "scaling ignored: coordinates are read as plotter units (0.025 mm), the drawing's "
-           "size and position differ from the plotter's"},
-    {"IP", "scaling points ignored: coordinates are read as plotter units (0.025 mm)"},
-    {"IR", "scaling points ignored: coordinates are read as plotter units (0.025 mm)"},
     {"LT", "line types ignored: dashed lines are drawn solid"},
-    {"DF", "defaults instruction skipped (text, fill, line type and scaling settings are not "
-           "used here)"},
+    {"DF", "defaults: scaling (SC) and the window (IW) reset; text, fill and line type "
+           "settings are not used here"},
     {"FT", "fill type ignored (fills are not drawn)"},
     {"PT", "pen thickness ignored"},
     {"PW", "pen width ignored"},
@@ -850,6 +1159,7 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
         h->relative = false;
         h->pen_down = false;
         h->label_term = HP_ETX;
+        reset_scaling(h);
         if ((e = move_to(h, 0.0, 0.0, off)) != CS_OK)
             return e;
         return CS_OK;
@@ -883,6 +1193,18 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
         return bezier(h, mn, true);
     case ('P' << 8) | 'E':
         return polyline_encoded(h, off);
+    case ('S' << 8) | 'C':
+        return instr_sc(h, mn, off);
+    case ('I' << 8) | 'P':
+        return instr_ip(h, mn, off, false);
+    case ('I' << 8) | 'R':
+        return instr_ip(h, mn, off, true);
+    case ('R' << 8) | 'O':
+        return instr_ro(h, mn, off);
+    case ('P' << 8) | 'S':
+        return instr_ps(h, mn, off);
+    case ('I' << 8) | 'W':
+        return instr_iw(h, mn, off);
     case ('L' << 8) | 'B':
         return label(h, mn, off);
     case ('S' << 8) | 'I':
@@ -899,6 +1221,14 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
         warn_mnemonic(h, mn, off, "text instruction skipped (text is not drawn)");
         skip_label(h);
         return CS_OK;
+    case ('D' << 8) | 'F':
+        /* DF: scaling off and the window gone, as IN does; P1, P2 and RO stay (HP-GL/2
+         * reference, DF's default-values table) */
+        warn_mnemonic(h, mn, off, NULL);
+        h->sc_on = false;
+        h->win_on = false;
+        update_map(h);
+        return skip_params(h, mn);
     case ('D' << 8) | 'T':
         /* DT t[,mode]: the label terminator is the next character ("DT;" = ETX again). */
         if (h->pos < h->len && h->buf[h->pos] != ';')
@@ -956,6 +1286,10 @@ cs_err_t cs_hpgl_read(const char *name, const char *buf, size_t len, const cs_hp
     h->loc_line = h->loc_col = 1;
     h->pen = 1; /* files that never say SP still draw */
     h->label_term = HP_ETX;
+    h->map = cs_path_affine_identity();
+    h->frame[0] = CS_HPGL_FRAME_W;
+    h->frame[1] = CS_HPGL_FRAME_H;
+    reset_scaling(h);
     h->file = cs_path_intern(path, name ? name : "-");
     cs_err_t e = CS_OK;
     if (!h->file) {

@@ -1,8 +1,9 @@
 /* cs_hpgl: reads HP-GL and HP-GL/2 plotter files into a cs_path_t. Owns the instruction
  * lexer (two-letter mnemonics, ';' or the next mnemonic as terminator, commas/blanks between
- * parameters), the plotter state (pen up/down, absolute/relative, pen number, label terminator)
- * and the geometry of IN PU PD PA PR SP CI AA AR BZ BR PE; everything else is skipped with one
- * warning per mnemonic. Plotter units are 0.025 mm (40 per mm); Y points up, as on the plotter
+ * parameters), the plotter state (pen up/down, absolute/relative, pen number, label terminator,
+ * scaling SC IP IR, rotation RO, plot size PS, clipping window IW) and the geometry of IN PU PD
+ * PA PR SP CI AA AR BZ BR PE, mapped exactly (affine map of the control points) from user units
+ * to the paper; everything else is skipped with one warning per mnemonic. Plotter units are 0.025 mm (40 per mm); Y points up, as on the plotter
  * and in the machine frame, so no axis is flipped. See docs/inputs.md "## HPGL". */
 #ifndef CS_HPGL_H
 #define CS_HPGL_H
@@ -14,6 +15,10 @@
 
 /* Plotter units per millimetre (1 plu = 0.025 mm). */
 #define CS_HPGL_PLU_PER_MM 40.0
+/* The picture frame until PS says otherwise: ISO A4 landscape, 297 x 210 mm in plotter units.
+ * P1/P2 default to its corners; RO turns about it; IR is relative to it. */
+#define CS_HPGL_FRAME_W 11880.0
+#define CS_HPGL_FRAME_H 8400.0
 
 /* Receives each warning (code CS_OK, loc and reason filled). */
 typedef void (*cs_hpgl_warn_fn)(void *ctx, const cs_path_diag_t *w);

@@ -13,11 +13,15 @@
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
 {
     memset(o, 0, sizeof *o);
+    cs_jobopts_init(&o->in);
 }
 
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o)
 {
     const char *a = argv[*i];
+    int r = cs_jobopts_option(cmd, argc, argv, i, &o->in);
+    if (r != 0)
+        return r;
     if (*i + 1 >= argc)
         return 0; /* no value: the caller's "unknown or incomplete option" */
     char *end;
@@ -54,6 +58,8 @@ int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t
                        cs_machine_pen_t *pen, cs_pos_t *tol)
 {
     cs_machine_ini_pen_default(pen);
+    if (cs_jobopts_check(cmd, &o->in) != 0)
+        return CS_EXIT_USAGE;
     char err[512], who[64];
     snprintf(who, sizeof who, "curvestep %s", cmd);
     if (cs_machine_ini_open(who, o->machine_file, m, pen, err, sizeof err) != 0) {
@@ -74,12 +80,24 @@ void cs_jobplan_init(cs_jobplan_t *jp)
     cs_path_init(&jp->path);
 }
 
+static cs_err_t pen_lift(cs_jobplan_t *jp);
+
 cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
                          bool lenient)
 {
+    cs_jobopts_t in;
+    cs_jobopts_init(&in);
+    in.lenient = lenient;
+    cs_err_t e = cs_jobplan_read_opts(jp, file, pen, &in);
+    return e == CS_OK ? pen_lift(jp) : e;
+}
+
+cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
+                              const cs_jobopts_t *in)
+{
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
-    iopts.lenient = lenient;
+    cs_jobopts_input(in, &iopts);
     iopts.font_file = jp->font_file;
     cs_input_format_t fmt = CS_INPUT_AUTO;
     iopts.detected = &fmt;
@@ -92,12 +110,49 @@ cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pe
         iopts.pen_down_z_mm = pen->down_z_mm;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
-    /* SVG and HP-GL have no pen height of their own: lift between strokes (G-code did, above) */
-    jp->pen_raise = e == CS_OK && fmt != CS_INPUT_GCODE && jp->pen.mode == CS_MACHINE_PEN_Z;
-    if (jp->pen_raise)
-        e = cs_pen_lift_z(&jp->path, &jp->pen, &jp->diag);
+    jp->gcode = fmt == CS_INPUT_GCODE;
     jp->read_ok = e == CS_OK;
     return e;
+}
+
+/* SVG and HP-GL have no pen height of their own: with [pen] mode = z the pen is lifted between
+ * their strokes (G-code's M3/M5 did it while reading). After layout, merge and sort, which
+ * work on the drawn strokes alone. */
+static cs_err_t pen_lift(cs_jobplan_t *jp)
+{
+    jp->pen_raise = !jp->gcode && jp->pen.mode == CS_MACHINE_PEN_Z;
+    cs_err_t e = jp->pen_raise ? cs_pen_lift_z(&jp->path, &jp->pen, &jp->diag) : CS_OK;
+    jp->read_ok = e == CS_OK;
+    return e;
+}
+
+cs_err_t cs_jobplan_prepare(cs_jobplan_t *jp, const char *cmd, const cs_jobopts_t *in,
+                            const cs_machine_t *m, const cs_machine_pen_t *pen, cs_pos_t tol,
+                            FILE *report)
+{
+    bool plotter = pen != NULL && pen->mode != CS_MACHINE_PEN_NONE;
+    cs_err_t e = cs_jobopts_prepare(in, cmd, m, plotter, cs_conv_pos_to_mm(tol), &jp->path,
+                                    &jp->diag, report);
+    jp->read_ok = e == CS_OK;
+    return e == CS_OK ? pen_lift(jp) : e;
+}
+
+cs_err_t cs_jobplan_reference(cs_jobplan_t *jp, const char *file, const cs_jobopts_t *in,
+                              const char *machine_file, const cs_machine_t *m)
+{
+    cs_machine_pen_t pen;
+    cs_machine_t scratch;
+    char err[512];
+    char found[4096];
+    cs_machine_ini_pen_default(&pen);
+    /* The same file the caller's cs_machine_ini_open used: given, or the default one found. */
+    if (machine_file == NULL && cs_machine_ini_find(found, sizeof found))
+        machine_file = found;
+    if (machine_file != NULL &&
+        cs_machine_ini_load_pen(machine_file, &scratch, &pen, err, sizeof err) != 0)
+        cs_machine_ini_pen_default(&pen); /* the caller loaded (and checked) it already */
+    cs_err_t e = cs_jobplan_read_opts(jp, file, &pen, in);
+    return e == CS_OK ? cs_jobplan_prepare(jp, "sim", in, m, &pen, m->tolerance, NULL) : e;
 }
 
 /* diag "file: reason" for an error that has no place in the file. */

@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "cs_jobopts.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_path.h"
@@ -18,6 +19,7 @@ typedef struct {
     double tol_mm;            /* --tol MM; 0: the machine's tolerance */
     double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
     const char *font_file;    /* --font FILE.jhf: stroke font for text; NULL: the default */
+    cs_jobopts_t in;          /* the shared input and layout options (cs_jobopts) */
 } cs_jobplan_opts_t;
 
 /* One job: read, then planned. */
@@ -29,21 +31,24 @@ typedef struct {
     bool read_ok;        /* the file was read: a later error is the planner's */
     cs_machine_pen_t pen;  /* the [pen] the job was read with (cs_jobplan_read) */
     bool pen_raise;        /* cs_pen lifted the job: the plan starts by raising the pen in place */
+    bool gcode;            /* the job was G-code (its own M3/M5 lift the pen) */
     const char *font_file; /* stroke font for text (set before cs_jobplan_read); NULL: default */
 } cs_jobplan_t;
 
-/* No machine file, no --tol, no --feed. */
+/* No machine file, no --tol, no --feed, cs_jobopts_init. */
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
-/* argv[*i] is --machine FILE, --tol MM, --feed MM/S or --font FILE with its value: stores it, moves
- * *i onto the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
- * wants ..." on stderr (a usage error). */
+/* argv[*i] is --machine FILE, --tol MM, --feed MM/S or --font FILE with its value, or one of the
+ * shared input options (cs_jobopts_option): stores it, moves *i onto the value and returns 1; any
+ * other word: 0; a bad value: -1, after "curvestep CMD: --tol wants ..." on stderr (a usage
+ * error). */
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);
 /* Chord tolerance: tol_mm (> 0) converted, else the machine's. False when tol_mm is outside
  * what cs_conv accepts. */
 bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol);
 /* The machine of o->machine_file with its [pen] (cs_machine_ini_load_pen), or the built-in one
  * with no pen, and the chord tolerance (cs_jobplan_tol). Returns CS_EXIT_OK; CS_EXIT_INPUT after
- * "file:line: reason" on stderr; CS_EXIT_USAGE after "curvestep CMD: --tol ..." on stderr. */
+ * "file:line: reason" on stderr; CS_EXIT_USAGE after "curvestep CMD: --tol ..." (or a bad
+ * combination of the shared options, cs_jobopts_check) on stderr. */
 int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t *m,
                        cs_machine_pen_t *pen, cs_pos_t *tol);
 
@@ -55,6 +60,22 @@ void cs_jobplan_init(cs_jobplan_t *jp);
  * warnings. CS_OK, or an error with jp->diag filled. */
 cs_err_t cs_jobplan_read(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
                          bool lenient);
+/* cs_jobplan_read with the shared input options in (lenient, dialect, units), without the pen
+ * lifts between SVG and HP-GL strokes: cs_jobplan_prepare adds them after layout and order. */
+cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machine_pen_t *pen,
+                              const cs_jobopts_t *in);
+/* After a read: the layout, merge and sort of in (cs_jobopts_prepare) on machine m, then the
+ * pen lifts of a [pen] mode = z drawing (cs_pen_lift_z); merge
+ * distance tol, plotter defaults when pen has a mode; the merge/sort line to report (NULL:
+ * none), prefixed cmd. CS_OK, or an error with jp->diag filled (an input error). */
+cs_err_t cs_jobplan_prepare(cs_jobplan_t *jp, const char *cmd, const cs_jobopts_t *in,
+                            const cs_machine_t *m, const cs_machine_pen_t *pen, cs_pos_t tol,
+                            FILE *report);
+/* The job as plan reads and lays it out, for a check against it (curvestep-sim --reference):
+ * the machine file's [pen] (NULL file: none), cs_jobplan_read_opts, then cs_jobplan_prepare
+ * with m's tolerance and no report. CS_OK, or an error with jp->diag filled. */
+cs_err_t cs_jobplan_reference(cs_jobplan_t *jp, const char *file, const cs_jobopts_t *in,
+                              const char *machine_file, const cs_machine_t *m);
 /* Plans jp->path whole on machine m (which must outlive jp; file names it in messages) from
  * start (after raising the pen there to up_z when jp->pen_raise) (cs_pos_t per axis, CS_AXES of
  * them; NULL: the origin), chords within tol by tracer method (CS_TRACE_*), at feed (mm/s Q15.16

@@ -46,6 +46,10 @@ typedef struct {
     bool pending_subpath; /* the next element added starts a new subpath */
     double blend_tol_mm;  /* the job's own path tolerance (G-code G64 P, the smallest given), mm;
                            * 0: none. Planning keeps chords within the smaller of it and its own */
+    /* An SVG document's page (set by cs_svgdoc): its y axis points down the page, which is
+     * page_h_mm high (0: no height given). cs_layout turns it to the machine's y-up frame. */
+    bool page_y_down;
+    double page_h_mm;
 } cs_path_t;
 
 /* Grows the array *buf of elements of sz bytes (capacity *cap, doubled from 16) to hold at

@@ -13,7 +13,7 @@
 static void usage(FILE *f)
 {
     fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv]\n"
-          "                      [--feed MM/S] [--lenient] [-o OUT] FILE\n"
+          "                      [--feed MM/S] [input and layout options] [-o OUT] FILE\n"
           "Plans the job FILE (G-code .nc .gcode .ngc .g .tap .cnc, HP-GL .plt .hpgl .hgl .hpg,\n"
           "SVG document or bare SVG path data; other names and '-' by content) on the machine\n"
           "and writes its step segments to OUT (default: standard output): a header line\n"
@@ -34,11 +34,12 @@ static void usage(FILE *f)
           "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
           "                      any F; default: the machine's default_feed)\n"
-          "  --lenient           G-code: unsupported words are warnings (ignored), not errors\n"
           "  --font FILE.jhf     Hershey stroke font for SVG <text> and HP-GL LB (default:\n"
           "                      share/fonts/futural.jhf, docs/plotting.md)\n"
-          "  -o OUT              write segments to OUT\n"
-          "Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
+          "  -o OUT              write segments to OUT\n",
+          f);
+    cs_jobopts_help(f);
+    fputs("Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
           "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
           f);
 }
@@ -49,7 +50,6 @@ int cs_cmd_plan(int argc, char **argv)
     cs_jobplan_opts_t jo;
     cs_jobplan_opts_init(&jo);
     int method = CS_TRACE_SUBDIV;
-    bool lenient = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int r = cs_jobplan_option("plan", argc, argv, &i, &jo);
@@ -60,8 +60,6 @@ int cs_cmd_plan(int argc, char **argv)
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--lenient") == 0) {
-            lenient = true;
         } else if (strcmp(a, "-o") == 0 && i + 1 < argc) {
             out_file = argv[++i];
         } else if (strcmp(a, "--method") == 0 && i + 1 < argc) {
@@ -100,7 +98,9 @@ int cs_cmd_plan(int argc, char **argv)
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     jp.font_file = jo.font_file;
-    cs_err_t e = cs_jobplan_read(&jp, job, &pen, lenient);
+    cs_err_t e = cs_jobplan_read_opts(&jp, job, &pen, &jo.in);
+    if (e == CS_OK)
+        e = cs_jobplan_prepare(&jp, "plan", &jo.in, &m, &pen, tol, stderr);
     if (e == CS_OK)
         e = cs_jobplan_plan(&jp, job, &m, NULL, tol, method, cs_motion_speed(jo.feed_mm_s));
     if (e != CS_OK) {

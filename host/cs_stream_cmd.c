@@ -38,7 +38,7 @@ static void usage(FILE *f)
     fputs("usage: curvestep stream --port DEV [--baud N] [--machine FILE.ini]\n"
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
           "                        [--resume-from N] [--line-rate BPS] [--font FILE.jhf]\n"
-          "                        [--quiet] FILE\n"
+          "                        [--quiet] [input and layout options] FILE\n"
           "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
           "       curvestep stream --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
           "                        [options] FILE\n"
@@ -82,8 +82,10 @@ static void usage(FILE *f)
           "Progress goes to standard error: a bar (percent, ETA, messages per second,\n"
           "retransmissions) on a terminal, else one line a second. Ctrl-C holds the motion,\n"
           "then aborts it (the device's queue is flushed); a second Ctrl-C leaves at once.\n"
-          "The summary line names the last executed message, to use with --resume-from.\n"
-          "Exit status: 0 the whole job was executed; 1 bad input (file:line:col: reason);\n"
+          "The summary line names the last executed message, to use with --resume-from.\n",
+          f);
+    cs_jobopts_help(f);
+    fputs("Exit status: 0 the whole job was executed; 1 bad input (file:line:col: reason);\n"
           "2 bad command line; 3 internal error; 4 the port cannot be opened, no device\n"
           "answered or it does not match the machine; 5 the device reset mid-job; 6 the link\n"
           "closed or the device stopped answering; 7 the device refused a message; 8\n"
@@ -210,7 +212,9 @@ int cs_cmd_stream(int argc, char **argv)
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     jp.font_file = jo.font_file;
-    cs_err_t e = cs_jobplan_read(&jp, job_file, &pen, false);
+    cs_err_t e = cs_jobplan_read_opts(&jp, job_file, &pen, &jo.in);
+    if (e == CS_OK)
+        e = cs_jobplan_prepare(&jp, "stream", &jo.in, &m, &pen, tol, stderr);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp.diag);
         int rc = cs_jobplan_exit(&jp, e);

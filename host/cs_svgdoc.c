@@ -891,6 +891,9 @@ static cs_err_t on_svg(doc_t *d, const char *local, const char **atts, size_t ta
                 hw = true;
             }
         }
+        /* the page is y-down, h mm high (0: unknown); cs_layout turns it y-up */
+        d->path->page_y_down = true;
+        d->path->page_h_mm = hh ? h : 0.0;
         if ((hw && w == 0.0) || (hh && h == 0.0)) {
             f->none = true; /* a zero-sized viewport disables rendering (SVG 1.1 §7.10) */
             return CS_OK;

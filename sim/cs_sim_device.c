@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cs_jobplan.h"
 #include "cs_planner.h"
 #include "cs_segment.h"
 #include "cs_stepper.h"
@@ -855,7 +856,9 @@ static void device_usage(FILE *f)
           "  --tol MM          chord tolerance for CURVE messages (default: the machine's)\n"
           "  --idle-exit S     stop S seconds after the last byte received, once something was\n"
           "                    executed and the queue is empty (default: run until a signal)\n"
-          "  --reference JOB   the job (SVG): measure the deviation and the final position\n"
+          "  --reference JOB   the job: measure the deviation and the final position; give it\n"
+          "                    the input and layout options given to stream (--lenient,\n"
+          "                    --fit, --merge ...: curvestep-sim --help lists them)\n"
           "  --check           exit 4 when a check of the report fails\n"
           "  --svg/--png/--trace  drawings and the CSV of every step edge, as with --replay\n"
           "SIGINT or SIGTERM ends the service: what the executor holds is finished, then the\n"
@@ -909,10 +912,14 @@ void cs_sim_device_opts_default(cs_sim_device_opts_t *o)
     o->speed = 1;
     o->queue = 32;
     o->baud = 115200;
+    cs_jobopts_init(&o->in);
 }
 
 int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o)
 {
+    int r = cs_jobopts_option("sim", argc, argv, i, &o->in);
+    if (r != 0)
+        return r;
     const char *a = argv[*i];
     bool has = *i + 1 < argc;
     char *end = NULL;
@@ -1043,15 +1050,14 @@ int cs_sim_device_main(int argc, char **argv)
     cs_sim_ref_init(&ref);
     double end_mm[3] = {0, 0, 0};
     if (reference) {
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_path_diag_t diag;
-        cs_err_t e = cs_motion_read_job(reference, &path, &diag);
+        cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
+        cs_jobplan_init(&jp);
+        cs_err_t e = cs_jobplan_reference(&jp, reference, &o.in, machine_file, &m);
         if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &path, end_mm);
+            e = cs_sim_ref_from_path(&ref, &jp.path, end_mm);
         else
-            cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
+            cs_path_diag_print(stderr, &jp.diag);
+        cs_jobplan_free(&jp);
         if (e != CS_OK) {
             cs_sim_ref_free(&ref);
             return INPUT;

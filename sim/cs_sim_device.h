@@ -12,6 +12,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "cs_jobopts.h"
 #include "cs_link.h"
 #include "cs_machine.h"
 #include "cs_serial.h"
@@ -128,6 +129,7 @@ typedef struct {
     bool instant;                      /* --instant */
     double speed, idle_exit, tol_mm;   /* --speed (default 1), --idle-exit s, --tol mm (0: none) */
     long queue, baud;                  /* --queue (default 32), --baud (default 115200) */
+    cs_jobopts_t in; /* the shared input and layout options, for --reference (cs_jobopts) */
 } cs_sim_device_opts_t;
 void cs_sim_device_opts_default(cs_sim_device_opts_t *o);
 /* Takes argv[*i] (and its value, advancing *i) when it is one of those options: 1 taken, 0 not

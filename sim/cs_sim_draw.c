@@ -23,7 +23,7 @@ void cs_sim_view_default(cs_sim_view_t *v)
 {
     *v = views[0];
     v->name = "xy";
-    v->y_down = true;
+    v->y_down = false; /* the machine seen from above: jobs are y-up (SVG pages turned, cs_layout) */
 }
 
 bool cs_sim_view_parse(const char *s, cs_sim_view_t *v)

@@ -14,10 +14,10 @@
 typedef struct {
     const char *name;
     double m[2][4];
-    bool y_down; /* the default picture: machine y drawn downwards (as SVG inputs are written) */
+    bool y_down; /* machine y drawn downwards (no view does now: SVG pages are turned y-up) */
 } cs_sim_view_t;
 
-/* The default: machine x, y, y down (name "xy"). */
+/* The default: machine x, y, y up, seen from above (name "xy"). */
 void cs_sim_view_default(cs_sim_view_t *v);
 /* top (x y), front (x z), side (y z), iso (orthographic from (1, -1, 1)), y up; the same as
  * `curvestep toolpath --view`. false for anything else. */

@@ -22,6 +22,7 @@
 
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_modbus.h"
 #include "cs_motion.h"
@@ -648,15 +649,14 @@ int cs_sim_modbus_main(int argc, char **argv)
     cs_sim_ref_init(&ref);
     out.ref = &ref;
     if (out.reference) { /* a bad job is reported before anything is served */
-        cs_path_t path;
-        cs_path_init(&path);
-        cs_path_diag_t diag;
-        cs_err_t e = cs_motion_read_job(out.reference, &path, &diag);
+        cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
+        cs_jobplan_init(&jp);
+        cs_err_t e = cs_jobplan_reference(&jp, out.reference, &o.in, machine_file, &m);
         if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &path, out.end_mm);
+            e = cs_sim_ref_from_path(&ref, &jp.path, out.end_mm);
         else
-            cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
+            cs_path_diag_print(stderr, &jp.diag);
+        cs_jobplan_free(&jp);
         if (e != CS_OK) {
             cs_sim_ref_free(&ref);
             return INPUT;

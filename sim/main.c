@@ -24,8 +24,8 @@ static void usage(FILE *f)
     fputs(
         "usage: curvestep-sim --replay SEGMENTS [--machine FILE.ini] [--reference FILE]\n"
         "                     [--trace OUT.csv] [--svg OUT.svg] [--png OUT.png] [--check]\n"
-        "                     [--window MS] [--lenient] [--font FILE.jhf]\n"
-        "                     [--view top|front|side|iso]\n"
+        "                     [--window MS] [--font FILE.jhf] [--view top|front|side|iso]\n"
+        "                     [input and layout options, for --reference]\n"
         "       curvestep-sim --pty | --port DEV ...  (the device on a serial line: --pty --help)\n"
         "       curvestep-sim --modbus-tcp ADDR:PORT | --modbus-rtu ...  (the device behind\n"
         "                     Modbus: --modbus-tcp --help)\n"
@@ -37,7 +37,7 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    --lenient and --font as for plan; the machine's [pen] lifts included), the\n"
+        "    --font and the input and layout options as for plan; the machine's [pen] lifts included), the\n"
         "    largest distance from any position the steps visit to the exact geometry\n"
         "    (evaluated in double), against the tolerance plus one step, and whether the final\n"
         "    position is the job's end rounded to steps. With a [pen] (mode z: the pen is down\n"
@@ -52,22 +52,26 @@ static void usage(FILE *f)
         "  --png-width PX    width of that picture, 100..8000 px (default 1600)\n"
         "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
         "                    (orthographic from (1,-1,1)), y up, as `curvestep toolpath --view`;\n"
-        "                    default: machine x y with y down (as SVG jobs are written)\n"
-        "  --check           exit 4 when a limit, the deviation or the final position fails\n"
-        "Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
-        "3 internal error, 4 a check failed (with --check).\n",
+        "                    default: machine x y, y up, seen from above (SVG pages are\n"
+        "                    turned y-up when read, so a drawing looks as in a browser)\n"
+        "  --check           exit 4 when a limit, the deviation or the final position fails\n",
         f);
+    cs_jobopts_help(f);
+    fputs("Exit status: 0 ok, 1 bad input (file:line: reason), 2 bad command line,\n"
+          "3 internal error, 4 a check failed (with --check).\n",
+          f);
 }
 
-/* The job as `plan` reads it with the machine's [pen] (cs_jobplan_read: pen lifts included),
- * as dense reference polylines; *end gets its last point. */
-static cs_err_t read_reference(const char *file, const char *font, const cs_machine_pen_t *pen,
-                               bool lenient, cs_sim_ref_t *ref, double end[3])
+/* The job as `plan` reads and lays it out with the machine's [pen] (cs_jobplan_reference: pen
+ * lifts included), as dense reference polylines; *end gets its last point. */
+static cs_err_t read_reference(const char *file, const char *font, const cs_jobopts_t *in,
+                               const char *machine_file, const cs_machine_t *m, cs_sim_ref_t *ref,
+                               double end[3])
 {
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     jp.font_file = font;
-    cs_err_t e = cs_jobplan_read(&jp, file, pen, lenient);
+    cs_err_t e = cs_jobplan_reference(&jp, file, in, machine_file, m);
     if (e == CS_OK)
         e = cs_sim_ref_from_path(ref, &jp.path, end);
     else
@@ -124,8 +128,10 @@ int main(int argc, char **argv)
             return cs_sim_modbus_main(argc, argv);
     const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
                *png = NULL;
-    bool check = false, lenient = false;
     const char *font = NULL;
+    bool check = false;
+    cs_jobopts_t in; /* --reference is read, laid out, merged and sorted as plan does */
+    cs_jobopts_init(&in);
     double window_ms = 50;
     long png_width = 1600;
     cs_sim_view_t view;
@@ -133,6 +139,11 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
+        int r = cs_jobopts_option("sim", argc, argv, &i, &in);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return EXIT_OK;
@@ -169,8 +180,6 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(a, "--check") == 0) {
             check = true;
-        } else if (strcmp(a, "--lenient") == 0) {
-            lenient = true;
         } else if (strcmp(a, "--font") == 0 && has) {
             font = argv[++i];
         } else {
@@ -179,7 +188,7 @@ int main(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (replay == NULL) {
+    if (replay == NULL || cs_jobopts_check("sim", &in) != 0) {
         usage(stderr);
         return EXIT_USAGE;
     }
@@ -238,7 +247,7 @@ int main(int argc, char **argv)
     int rc = EXIT_OK;
     if (reference) {
         double end[3];
-        e = read_reference(reference, font, &pen, lenient, &ref, end);
+        e = read_reference(reference, font, &in, machine_file, &m, &ref, end);
         if (e != CS_OK)
             rc = EXIT_INPUT;
         else

@@ -42,6 +42,14 @@ printf 'M 0 0 L 10 10 Q\n' >"$T/bad.svg"
 C submit "$T/bad.svg" >"$T/bad.out" 2>"$T/bad.err"; rc=$?
 expect "bad job: exit 1" [ $rc -eq 1 ]
 expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
+# The shared input options travel as SUBMIT words: --lenient reaches the daemon's G-code reader
+# (the unsupported G64 becomes a warning) and --fit --margin its layout (no room: refused).
+printf 'G21\nG1 X1 Y1 F600\nG64 Q9\nG1 X2\n' >"$T/lenient.nc"
+C submit "$T/lenient.nc" >"$T/len.out" 2>&1; rc=$?
+expect "strict: G64 refused" grep -q 'G64 is not supported' "$T/len.out"
+C submit --lenient --fit --margin 1500 "$T/lenient.nc" >"$T/len.out" 2>&1; rc=$?
+expect "--lenient --fit --margin reach the daemon: exit 1, layout refused" [ $rc -eq 1 ]
+expect "--lenient --fit --margin reach the daemon: the layout's reason" grep -q 'fit: no room' "$T/len.out"
 
 # 3. two jobs and a third; status shows the queue.
 C submit "$JOB1" >"$T/s1.out" 2>&1; r1=$?

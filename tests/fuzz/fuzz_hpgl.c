@@ -71,6 +71,11 @@ static const char *const seeds[] = {
     "IN;AA0,0;",
     "IN;PD10,10@;",
     "IN;BZ1,2,3,4,5;",
+    /* scaling, rotation, plot size, window; PE ended by the next instruction (AutoCAD) */
+    "IN;IP1000,1000,5000,3000;SC0,100,0,50;PU0,0;PD100,50;SC0,100,0,100,1,0,100;CI10;",
+    "IN;PS8000,6000;IR10,20,60,70;SC0,2,0,3,2;RO90;PU1,1;PD5,5;RO180;AR1,1,90;RO270;IP;SC;",
+    "IN;IW1000,1000,2000,2000;PU0,1500;PD3000,1500;CI700;BZ1,2,3000,4,5,6;IW;DF;PD0,0;",
+    "IN;SP1;PE7<=__?x__?x@x_PU0,0;PE<=\xbf\xbf_\xcb\xbfSP2;PD0,0;",
 };
 
 /* Real files too (seeded from ../shared/data when it is there). */

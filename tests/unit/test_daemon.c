@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "cs_daemon.h"
+#include "cs_jobopts.h"
 #include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
@@ -89,6 +90,10 @@ static void test_protocol(void **state)
     cs_path_init(&path);
     cs_path_diag_t diag;
     assert_int_equal(cs_motion_read_job(abs, &path, &diag), CS_OK);
+    /* laid out as every job command does by default (the SVG page turned y-up, no merge) */
+    cs_jobopts_t in;
+    cs_jobopts_init(&in);
+    assert_int_equal(cs_jobopts_prepare(&in, "test", &m, false, 0.01, &path, &diag, NULL), CS_OK);
     cs_motion_t mo;
     assert_int_equal(cs_motion_init(&mo, &m), CS_OK);
     assert_int_equal(cs_motion_plan_path(&mo, &path, m.tolerance, CS_TRACE_SUBDIV, 0, &diag),

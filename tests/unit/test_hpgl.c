@@ -331,13 +331,10 @@ static void test_terminators_and_skipped(void **state)
     assert_int_equal(nwarn, 4); /* LT, ZZ, LB, SM */
     assert_non_null(strstr(warns, "1:4: LT: line types ignored"));
     assert_non_null(strstr(warns, "ZZ: not supported"));
-    /* Geometry the reader does not draw says so. */
+    /* Geometry the reader does not draw says so; RO, IW and SC are carried out (no warning). */
     assert_int_equal(rd("IN;EA10,10;RO90;IW0,0,5,5;SC0,100,0,100;"), CS_OK);
-    assert_int_equal(nwarn, 4);
+    assert_int_equal(nwarn, 1);
     assert_non_null(strstr(warns, "geometry is missing"));
-    assert_non_null(strstr(warns, "NOT rotated"));
-    assert_non_null(strstr(warns, "ARE drawn"));
-    assert_non_null(strstr(warns, "scaling ignored"));
     /* Escape sequences are skipped (one warning). */
     assert_int_equal(rd("\x1b.(\x1b.I81;;17:\x1b%-1BIN;PD10,10;\x1b"
                         "E"),
@@ -386,6 +383,113 @@ static void test_errors(void **state)
 
 /* --- the real file ------------------------------------------------------------------------ */
 
+/* --- scaling, rotation, window (HP-GL/2 reference: SC, IP, IR, PS, RO, IW) ---------------- */
+
+static void test_sc_ip_ir_ps(void **state)
+{
+    (void)state;
+    /* SC type 0: user (0,0) -> P1, (100,50) -> P2. */
+    assert_int_equal(rd("IN;IP1000,1000,5000,3000;SC0,100,0,50;PU0,0;PD100,50;"), CS_OK);
+    expect_line(0, 1000, 1000, 5000, 3000);
+    /* Type 1, isotropic: factor min(4000/100, 2000/100) = 20; the extra 2000 in x split 50 %. */
+    assert_int_equal(rd("IN;IP0,0,4000,2000;SC0,100,0,100,1;PU0,0;PD100,100;"), CS_OK);
+    expect_line(0, 1000, 0, 3000, 2000);
+    assert_int_equal(rd("IN;IP0,0,4000,2000;SC0,100,0,100,1,0,0;PU0,0;PD100,100;"), CS_OK);
+    expect_line(0, 0, 0, 2000, 2000);
+    assert_int_equal(rd("IN;IP0,0,4000,2000;SC0,100,0,100,1,100,100;PU0,0;PD100,100;"), CS_OK);
+    expect_line(0, 2000, 0, 4000, 2000);
+    /* Type 2, point factor: user 0 at P1 = (500, 500), 2 and 3 plotter units per user unit. */
+    assert_int_equal(rd("IN;IP500,500;SC0,2,0,3,2;PU0,0;PD10,10;"), CS_OK);
+    expect_line(0, 500, 500, 520, 530);
+    /* IR: percentages of the default frame, 11880 x 8400 (A4 landscape). */
+    assert_int_equal(rd("IN;IR10,20,60,70;SC0,1,0,1;PU0,0;PD1,1;"), CS_OK);
+    expect_line(0, 1188, 1680, 7128, 5880);
+    /* PS sets the frame that IR refers to. */
+    assert_int_equal(rd("IN;PS8000,6000;IR0,0,50,50;SC0,1,0,1;PU0,0;PD1,1;"), CS_OK);
+    expect_line(0, 0, 0, 4000, 3000);
+    /* SC; ends scaling: plotter units again. */
+    assert_int_equal(rd("IN;IP0,0,100,100;SC0,1,0,1;SC;PU0,0;PD10,10;"), CS_OK);
+    expect_line(0, 0, 0, 10, 10);
+    /* DF ends scaling too (P1, P2 stay): 10,10 is plotter units again. */
+    assert_int_equal(rd("IN;IP0,0,400,400;SC0,10,0,10;DF;PU0,0;PD10,10;"), CS_OK);
+    expect_line(0, 0, 0, 10, 10);
+    /* Arcs under anisotropic scaling become ellipses: CI 10 with x 40, y 20 plu per unit. */
+    assert_int_equal(rd("IN;IP0,0,400,200;SC0,10,0,10;PU0,0;CI10;"), CS_OK);
+    for (size_t i = 0; i < P.n; i++)
+        for (int k = 0; k <= 16; k++) {
+            cs_ref_vec_t q = cs_ref_eval(&P.elems[i].curve, k / 16.0);
+            double ex = q.x / (400 * PLU), ey = q.y / (200 * PLU); /* back to unit circle */
+            assert_true(fabs(hypot(ex, ey) - 1.0) < 1e-5);
+        }
+    assert_int_equal(rd("IN;SC0,0,0,1;"), CS_ERR_PARSE);
+    assert_int_equal(rd("IN;SC0,1,0,1,3;"), CS_ERR_PARSE);
+    assert_int_equal(rd("IN;IP1,2,3;"), CS_ERR_PARSE);
+}
+
+static void test_ro(void **state)
+{
+    (void)state;
+    /* RO turns the system counter-clockwise about the frame (11880 x 8400):
+     * 90: X = W - y, Y = x; 180: X = W - x, Y = H - y; 270: X = y, Y = H - x. */
+    assert_int_equal(rd("IN;RO90;PU100,200;PD300,200;"), CS_OK);
+    expect_line(0, 11680, 100, 11680, 300);
+    assert_int_equal(rd("IN;RO180;PU100,200;PD300,200;"), CS_OK);
+    expect_line(0, 11780, 8200, 11580, 8200);
+    assert_int_equal(rd("IN;RO270;PU100,200;PD300,200;"), CS_OK);
+    expect_line(0, 200, 8300, 200, 8100);
+    /* The pen does not move on the paper; a relative +x move after RO90 goes up the page. */
+    assert_int_equal(rd("IN;PU100,200;RO90;PR;PD10,0;"), CS_OK);
+    expect_line(0, 100, 200, 100, 210);
+    assert_int_equal(rd("IN;RO45;"), CS_ERR_PARSE);
+}
+
+static void test_iw(void **state)
+{
+    (void)state;
+    /* A line across the window keeps its inside part; one outside is dropped. */
+    assert_int_equal(rd("IN;IW1000,1000,2000,2000;PU0,1500;PD3000,1500;PU1500,0;PD1500,500;"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_line(0, 1000, 1500, 2000, 1500);
+    /* The window is in user units when SC is on: 2..8 of 0..10 on 0..1000 plu. IW; ends it. */
+    assert_int_equal(rd("IN;IP0,0,1000,1000;SC0,10,0,10;IW2,2,8,8;PU0,5;PD10,5;IW;PU0,6;PD10,6;"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_line(0, 200, 500, 800, 500);
+    expect_line(1, 0, 600, 1000, 600);
+    /* The pen left the window; with the window gone the next line starts a new stroke where
+     * the pen is (found by the fuzzer: the two were once one subpath with a gap). */
+    assert_int_equal(rd("IN;IW1000,1000,2000,2000;PU0,1500;PD3000,1500;IW;PD3000,2500;"), CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_line(0, 1000, 1500, 2000, 1500);
+    expect_line(1, 3000, 1500, 3000, 2500);
+    assert_true(P.elems[0].subpath != P.elems[1].subpath);
+    /* A polyline leaving and re-entering: two strokes. */
+    assert_int_equal(rd("IN;IW0,0,1000,1000;PU500,500;PD1500,500,1500,700,500,700;"), CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_line(0, 500, 500, 1000, 500);
+    expect_line(1, 1000, 700, 500, 700);
+    assert_true(P.elems[0].subpath != P.elems[1].subpath);
+}
+
+static void test_pe_next_instruction(void **state)
+{
+    (void)state;
+    /* AutoCAD ends PE with the next instruction. 7-bit values (base 32, sign in the low bit,
+     * continuation 63..94, last digit 95..126): "_" = 0, "?x" = 400, "@x" = -400. */
+    assert_int_equal(rd("IN;SP1;PE7<=__?x__?x@x_PU0,0;PD0,-400;"), CS_OK);
+    assert_int_equal(P.n, 4);
+    expect_line(0, 0, 0, 400, 0);
+    expect_line(1, 400, 0, 400, 400);
+    expect_line(2, 400, 400, 0, 400);
+    expect_line(3, 0, 0, 0, -400);
+    /* 8-bit: 0 = 0xBF, 400 = '_' 0xCB (800 = 32 + 12 * 64), ended by SP. */
+    assert_int_equal(rd("IN;SP1;PE<=\xbf\xbf_\xcb\xbfSP2;PD0,0;"), CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_line(0, 0, 0, 400, 0);
+    expect_line(1, 400, 0, 0, 0);
+}
+
 static void test_feature_exercise(void **state)
 {
     (void)state;
@@ -424,13 +528,22 @@ static void test_feature_exercise(void **state)
     expect_line(19, 7700, 3650, 8600, 3650);
     expect_line(22, 7700, 4150, 7700, 3650);
     /* SM* then PA moves with the pen up: symbols only, no lines. Then the clip demo. */
-    expect_arc(23, 27, 3550, 1100, 500, 0, 360);
-    expect_line(27, 4200, 700, 5800, 1500);
-    expect_line(28, 5800, 1500, 4200, 1500);
+    /* IW3000,700,4100,1500 clips the circle at y = 1500 and y = 700: sin(a) = +-400/500, so
+     * a = 53.13, 126.87, 233.13, 306.87 degrees; three runs, each its own stroke. */
+    double a = atan2(400.0, 300.0) * 180.0 / M_PI;
+    expect_arc(23, 24, 3550, 1100, 500, 0, a);
+    expect_arc(24, 26, 3550, 1100, 500, 180 - a, 2 * a);
+    expect_arc(26, 27, 3550, 1100, 500, 360 - a, a);
+    assert_true(P.elems[24].subpath != P.elems[23].subpath);
+    assert_true(P.elems[26].subpath != P.elems[25].subpath);
+    /* IW4400,700,5600,1500: the line (4200,700)-(5800,1500), slope 1/2, enters at x = 4400
+     * (y = 800) and leaves at x = 5600 (y = 1400); the top edge y = 1500 keeps 4400..5600. */
+    expect_line(27, 4400, 800, 5600, 1400);
+    expect_line(28, 5600, 1500, 4400, 1500);
     assert_int_equal(P.n, 29);
     /* Each skipped instruction that changes the drawing is reported, once each. */
     static const char *const must[] = {
-        "LB:", "LT:", "EW:", "WG:", "EA:", "RA:", "RR:", "PM:", "FP:", "EP:", "IW:", "RO:", "SM:"};
+        "LB:", "LT:", "EW:", "WG:", "EA:", "RA:", "RR:", "PM:", "FP:", "EP:", "SM:"};
     for (size_t i = 0; i < sizeof must / sizeof must[0]; i++)
         if (!strstr(warns, must[i]))
             fail_msg("no warning for %s", must[i]);
@@ -460,6 +573,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_pe, setup, teardown),
         cmocka_unit_test_setup_teardown(test_terminators_and_skipped, setup, teardown),
         cmocka_unit_test_setup_teardown(test_errors, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_sc_ip_ir_ps, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ro, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_iw, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_pe_next_instruction, setup, teardown),
         cmocka_unit_test_setup_teardown(test_feature_exercise, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
