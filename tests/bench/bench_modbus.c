@@ -67,7 +67,7 @@ static void stop_modbus(mbdev_t_ *d, unsigned long long *executed, unsigned long
     *executed = 0, *hash = 0;
     while (fgets(line, sizeof line, d->out) != NULL) {
         sscanf(line, "device: served %*f s; %llu messages executed", executed);
-        sscanf(line, "executed step segments' hash (FNV-1a 64, in order): %llx", hash);
+        sscanf(line, "executed step segments' hash (FNV-1a 32, in order): %llx", hash);
     }
     fclose(d->out);
     int st;

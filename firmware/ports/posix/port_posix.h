@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cs_exlog.h"
 #include "port.h"
 
 /* One recorded step: rising STEP edge at tick t on axis, dir = +1 or -1 (DIR line level after
@@ -43,5 +44,12 @@ int64_t port_posix_position(unsigned axis);
 cs_err_t port_posix_fault(void);
 /* The UART: file descriptors (non-blocking reads); -1 disables. */
 void port_posix_uart(int fd_in, int fd_out);
+/* The UART through functions instead (the simulator's line with its faults): port_uart_read and
+ * port_uart_write call rd / wr with ctx; NULL rd and wr go back to the file descriptors. */
+void port_posix_uart_hooks(size_t (*rd)(void *ctx, uint8_t *buf, size_t max),
+                           size_t (*wr)(void *ctx, const uint8_t *buf, size_t len), void *ctx);
+/* The STEP edges logged by the step interrupt on the executor's clock since reset (cs_exlog, as
+ * the Cortex-M3 port logs them). */
+cs_exlog_edges_t port_posix_edge_log(void);
 
 #endif
