@@ -9,6 +9,9 @@
 #     position, steps) and summed per axis here with awk (pulses per axis, messages);
 #   curves mode (the device traces and plans): the simulator's device `curvestep-sim --pty` fed
 #     the same stream (final position, steps in total);
+#   one device application: the simulator's device runs the image's application (firmware/app)
+#     on the POSIX port; fed the same segments it logs the same executed segments and the same
+#     STEP edges, tick for tick on the executor's clock (cs_exlog: count and FNV-1a hash of each);
 #   Ctrl-C: hold then abort reach the image, and it executed exactly what the host says;
 #   a machine file whose tick rate is not the image's is refused at the HELLO.
 # Every process is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
@@ -76,6 +79,18 @@ expect "image built" [ -f "$ELF" ]
 ) &
 REFPID=$!
 pids+=("$REFPID")
+# The segments-mode twin: the simulator's device fed the plan the image gets in case 1.
+(
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
+    spid=$!
+    spty=
+    end=$((SECONDS + 10))
+    while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/simseg.out" 2>/dev/null); sleep 0.05; done
+    timeout -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --port "$spty" "$JOB" >"$T/simseg.stream" 2>&1
+    wait "$spid"
+) &
+SEGPID=$!
+pids+=("$SEGPID")
 
 # 1. segments mode: the host plans, the image executes; everything equals the plan's replay.
 "$CS" plan --machine "$INI" --feed $FEED "$JOB" -o "$T/job.seg" 2>/dev/null
@@ -102,6 +117,14 @@ expect "segments: STEP pulses per axis = the plan's" grep -q "^fw: step pulses: 
 expect "segments: steps in total = replay" grep -q "^fw: steps total $ref_steps " "$T/seg.fw"
 expect "segments: no UART byte lost" grep -q " 0 UART overruns$" "$T/seg.fw"
 [ $fail -eq 0 ] || { echo "--- image report:"; tail -n 6 "$T/seg.fw"; tail -n 3 "$T/seg.out"; }
+# 1b. the same application in the simulator: the same executed segments and step edges
+wait "$SEGPID"
+simlog=$(sed -n 's/^log: //p' "$T/simseg.out" | tail -n1)
+fwlog=$(sed -n 's/^fw: log: //p' "$T/seg.fw" | tail -n1)
+expect "one application: simulator logged $nseg segments" grep -q "^log: $nseg segments hash " "$T/simseg.out"
+expect "one application: simulator = image, segments and step edges tick for tick" \
+    [ -n "$simlog" ] && [ "$simlog" = "$fwlog" ]
+echo "note: simulator log: ${simlog:-none}; image log: ${fwlog:-none}"
 
 # 2. curves mode: the image traces and plans each cubic itself; the simulator's device, fed the
 # same stream (run in the background during case 1), is the reference (same core, same machine).
