@@ -135,8 +135,11 @@ static void advance(sim_dev_t *d, double wall)
     uint32_t seg0 = mo->stats.segments;
     uint64_t target = UINT64_MAX;
     int passes = 256; /* instant: a bounded amount of work a call */
+    /* held at rest mid-job: simulated time goes on (the trace shows the pause); otherwise an
+     * idle executor restarts the clock's anchor (time spent waiting for the host is skipped) */
+    bool held_rest = cs_stepper_idle(&mo->st) && mo->hold.hold && !cs_fw_motion_done(mo);
     if (d->cfg->speed > 0) {
-        if (cs_stepper_idle(&mo->st)) {
+        if (cs_stepper_idle(&mo->st) && !held_rest) {
             d->anchor_wall = wall;
             d->anchor_ticks = port_posix_now();
         }
@@ -144,6 +147,8 @@ static void advance(sim_dev_t *d, double wall)
                    (wall - d->anchor_wall) * d->cfg->speed * (double)d->m->tick_hz;
         target = t >= 1.8e19 ? UINT64_MAX : (uint64_t)t;
         passes = 4096;
+        if (held_rest)
+            port_posix_idle_until(target);
     }
     for (int k = 0; k < passes; k++) {
         cs_fw_motion_poll(mo);

@@ -220,8 +220,11 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
 }
 
 /* Hands one segment to the executor, starting the step timer when it was idle (the step
- * interrupt stops it when the ring runs dry: idle <=> stopped, checked with interrupts masked). */
-static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, uint32_t done)
+ * interrupt stops it when the ring runs dry: idle <=> stopped, checked with interrupts masked).
+ * The log gets the segment as planned (orig: before a hold re-timed it), so that a job logs the
+ * same segments whether it was held or not. */
+static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segment_t *orig,
+                         uint32_t done)
 {
     uint32_t irq = port_irq_save();
     bool was_idle = cs_stepper_idle(&a->st);
@@ -238,7 +241,7 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, uint32_t done
         return;
     }
     a->stats.segments++;
-    cs_exlog_segment(&a->log, s);
+    cs_exlog_segment(&a->log, orig);
     for (unsigned i = 0; i < CS_AXES; i++)
         a->steps_pos[i] += s->steps[i];
 }
@@ -254,10 +257,11 @@ static void feed(cs_fw_motion_t *a)
                 break;
             a->has_pend = true;
         }
+        cs_segment_t orig = a->pend;
         if (!cs_hold_admit(&a->hold, &a->pend))
             break;
         a->has_pend = false;
-        push_segment(a, &a->pend, a->pend_done);
+        push_segment(a, &a->pend, &orig, a->pend_done);
     }
 }
 

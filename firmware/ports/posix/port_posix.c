@@ -191,6 +191,12 @@ bool port_posix_run(uint64_t until)
     }
 }
 
+void port_posix_idle_until(uint64_t until)
+{
+    if (!g.armed && (g.st == NULL || cs_stepper_idle(g.st)) && until > g.now)
+        g.now = until;
+}
+
 bool port_posix_step(void)
 {
     if (g.st == NULL || g.fault != CS_OK)

@@ -30,6 +30,9 @@ uint64_t port_posix_now(void);
  * in the past runs nothing and leaves the time as it is). Returns false when a fault was raised
  * or no stepper is attached. */
 bool port_posix_run(uint64_t until);
+/* Lets simulated time pass to `until` with the step timer stopped (a device at rest, e.g. held):
+ * nothing happens when the timer is armed or work is queued, or when `until` is not ahead. */
+void port_posix_idle_until(uint64_t until);
 /* Runs exactly one step interrupt (starting the timer if work is queued): advances time to its
  * deadline. false when the stepper is idle with the timer stopped, or after a fault. */
 bool port_posix_step(void);
