@@ -13,6 +13,9 @@
 #     on the POSIX port; fed the same segments it logs the same executed segments and the same
 #     STEP edges, tick for tick on the executor's clock (cs_exlog: count and FNV-1a hash of each);
 #   Ctrl-C: hold then abort reach the image, and it executed exactly what the host says;
+#   feed hold (the core's cs_hold, run by the application): paused mid-job through
+#     `curvestep serve`, held, resumed; the image executed every segment once (its log of the
+#     segments as planned equals case 1's), counted one hold, and ended where the replay ends;
 #   a machine file whose tick rate is not the image's is refused at the HELLO.
 # Every process is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
 set -u
@@ -161,6 +164,45 @@ expect "ctrl-c: exit 8" [ $rc -eq 8 ]
 expect "ctrl-c: image held and aborted" grep -q "^fw: executed [0-9]* messages, .* 1 holds, 1 aborts$" "$T/int.fw"
 expect "ctrl-c: host and image agree on what ran" grep -q "^fw: executed ${k:-x} messages" "$T/int.fw"
 expect "ctrl-c: stopped mid-job" [ "${k:-0}" -gt 0 ] && [ "${k:-0}" -lt "$nseg" ]
+
+# 3b. feed hold and resume through the daemon: every segment once, the position exact.
+S=$T/sock/cs.sock
+mkdir -p "$T/sock"
+C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
+progress() { C status 2>/dev/null | sed -n "s/^job 1 running: .*: \([0-9]*\)\/$nseg segments.*/\1/p"; }
+quarter() { p=$(progress); [ "${p:-0}" -ge $((nseg / 4)) ]; }
+still() { a=$(progress); sleep 1.2; b=$(progress); [ -n "$a" ] && [ "$a" = "$b" ]; }
+finished() { C status 2>/dev/null | grep -qE "^job 1 (done|failed|cancelled)"; }
+start_fw hold
+timeout -k 5 90 "$CS" serve --port "$PTY" --machine "$INI" --socket "$S" 2>"$T/serve.err" &
+DPID=$!
+pids+=("$DPID")
+wait_until 5 [ -S "$S" ]
+C submit --feed $FEED "$JOB" >"$T/hsub.out" 2>&1
+expect "hold: submitted" grep -q "^OK job 1 queued: .*: $nseg segments$" "$T/hsub.out"
+expect "hold: a quarter ran" wait_until 40 quarter
+C pause >"$T/hp.out"
+expect "hold: device held" grep -q "^OK paused (device held)" "$T/hp.out"
+expect "hold: progress stands still" wait_until 20 still
+C resume >/dev/null
+expect "hold: job ended" wait_until 60 finished
+C status >"$T/hst.out" 2>&1
+expect "hold: every segment executed" grep -q "^job 1 done: .*: $nseg/$nseg segments executed" "$T/hst.out"
+kill -TERM "$DPID"
+wait "$DPID"
+wait_fw
+holdlog=$(sed -n 's/^fw: log: \([0-9]* segments hash [0-9]*\),.*/\1/p' "$T/hold.fw" | tail -n1)
+expect "hold: image exit status 0" [ $QRC -eq 0 ]
+expect "hold: one hold, no abort" grep -q "^fw: executed $nseg messages, $nseg step segments, .* 1 holds, 0 aborts$" "$T/hold.fw"
+expect "hold: the same segments as without the hold, each once" \
+    [ -n "$holdlog" ] && [ "$holdlog" = "$(echo "$fwlog" | sed 's/,.*//')" ]
+# the ramps re-timed segments on the image: its executor's clock ran longer than case 1's
+tick1=$(echo "$fwlog" | sed -n 's/.* at executor tick \([0-9]*\)$/\1/p')
+tickh=$(sed -n 's/^fw: log: .* at executor tick \([0-9]*\)$/\1/p' "$T/hold.fw" | tail -n1)
+expect "hold: the image ramped (executor clock ${tickh:-?} > ${tick1:-?} ticks)" \
+    [ "${tickh:-0}" -gt "${tick1:-0}" ]
+expect "hold: executor position = replay" grep -q "^fw: position (executor): $ref_pos$" "$T/hold.fw"
+expect "hold: STEP/DIR pins position = replay" grep -q "^fw: position (STEP/DIR pins): $ref_pos$" "$T/hold.fw"
 
 # 4. a machine file at another tick rate: the image's HELLO is refused (exit 4), nothing moves.
 sed 's/^tick_hz = .*/tick_hz = 1000000/' "$INI" >"$T/fast.ini"
