@@ -358,6 +358,11 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     return CS_OK;
 }
 
+cs_fw_motion_t *cs_sim_motion_fw(sim_dev_t *d)
+{
+    return &d->app.mo;
+}
+
 cs_err_t cs_sim_motion_queue(sim_dev_t *d, const cs_proto_msg_t *m, uint16_t seq)
 {
     return cs_fw_motion_queue(&d->app.mo, m, seq);

@@ -90,6 +90,8 @@ typedef struct cs_sim_motion cs_sim_motion_t;
  * filled as it runs. CS_ERR_ARG for a bad cfg, CS_ERR_FULL out of memory. */
 cs_err_t cs_sim_motion_open(cs_sim_motion_t **d, const cs_sim_device_cfg_t *cfg,
                             cs_sim_device_result_t *res);
+/* The firmware's motion side it runs (for a front end of the firmware's own, cs_fw_modbus). */
+cs_fw_motion_t *cs_sim_motion_fw(cs_sim_motion_t *d);
 /* Queues a SEGMENT or CURVE with its sequence: CS_ERR_FULL when no slot is free,
  * CS_ERR_UNSUPPORTED for another type. */
 cs_err_t cs_sim_motion_queue(cs_sim_motion_t *d, const cs_proto_msg_t *m, uint16_t seq);
