@@ -11,13 +11,6 @@
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
 
-/* One try's answer timeout: 200 ms on TCP and on a pty (a loaded CI machine under ASan answers
- * well within it; the device answers within a few ms), plus on a real RTU line the time the
- * longest request and its answer take on the wire (11 bits a character). Six tries: a device
- * silent for about 1.2 s is declared gone. */
-#define MB_TIMEOUT_MS 200u
-#define MB_TRIES      6u
-
 int cs_stream_cmd_modbus(const cs_stream_args_t *a, const cs_stream_plan_t *p,
                          volatile sig_atomic_t *interrupted)
 {
@@ -29,18 +22,8 @@ int cs_stream_cmd_modbus(const cs_stream_args_t *a, const cs_stream_plan_t *p,
     char why[256];
     int orc;
     const char *where = a->modbus_tcp ? a->modbus_tcp : a->modbus_rtu;
-    if (a->modbus_tcp) {
-        orc = cs_mb_open_tcp(&c, a->modbus_tcp, a->unit, MB_TIMEOUT_MS, MB_TRIES, why, sizeof why);
-    } else {
-        uint32_t timeout = MB_TIMEOUT_MS;
-        if (strncmp(a->modbus_rtu, "/dev/pts/", 9) != 0 && a->baud > 0) {
-            /* request of CS_MODBUS_MAILBOX_REGS registers + its answer, 11 bits a byte */
-            uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
-            timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / a->baud) + 1u;
-        }
-        orc = cs_mb_open_rtu(&c, a->modbus_rtu, a->baud, a->parity != 0 ? a->parity : 'E', a->unit,
-                             timeout, MB_TRIES, why, sizeof why);
-    }
+    orc = cs_mb_open_link(&c, a->modbus_tcp, a->modbus_rtu, a->baud, a->parity, a->unit, why,
+                          sizeof why);
     if (orc != 0) {
         fprintf(stderr, "curvestep stream: %s\n", why);
         return orc == -2 ? CS_EXIT_USAGE : CS_EXIT_NO_DEVICE;
