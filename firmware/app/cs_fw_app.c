@@ -204,10 +204,7 @@ cs_err_t cs_fw_app_init_cfg(cs_fw_app_t *app, const cs_machine_t *m, uint32_t bo
 {
     if (app == NULL || m == NULL || c == NULL || c->clock == NULL || c->clock_hz < 1000u)
         return CS_ERR_ARG;
-    /* zero everything without memset (freestanding: the compiler may still call it) */
-    uint8_t *p = (uint8_t *)app;
-    for (size_t i = 0; i < sizeof *app; i++)
-        p[i] = 0;
+    cs_fw_motion_zero(app, sizeof *app);
     app->m = m;
     app->cfg = *c;
     app->nonce = boot_id ^ 0x9E3779B9u;

@@ -279,6 +279,13 @@ static void update_state(cs_fw_motion_t *a)
 
 /* --- the API ------------------------------------------------------------------------------- */
 
+void cs_fw_motion_zero(void *p, size_t n)
+{
+    uint8_t *b = p;
+    for (size_t i = 0; i < n; i++)
+        b[i] = 0;
+}
+
 void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m)
 {
     c->queue_size = CS_FW_QUEUE;
@@ -295,10 +302,7 @@ cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_f
     if (mo == NULL || m == NULL || c == NULL || c->queue_size < 1 ||
         c->queue_size > CS_FW_QUEUE || c->tol <= 0)
         return CS_ERR_ARG;
-    /* zero everything without memset (freestanding: the compiler may still call it) */
-    uint8_t *p = (uint8_t *)mo;
-    for (size_t i = 0; i < sizeof *mo; i++)
-        p[i] = 0;
+    cs_fw_motion_zero(mo, sizeof *mo);
     mo->m = m;
     mo->cfg = *c;
     cs_err_t e = cs_stepper_init(&mo->st, m);

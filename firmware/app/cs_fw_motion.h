@@ -11,6 +11,7 @@
 #define CS_FW_MOTION_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "cs_err.h"
@@ -120,6 +121,9 @@ typedef struct {
     cs_fw_stats_t stats;
 } cs_fw_motion_t;
 
+/* Zeroes n bytes at p without memset (freestanding: no libc; the application's structs are
+ * zeroed before they are set up). */
+void cs_fw_motion_zero(void *p, size_t n);
 /* Defaults: CS_FW_QUEUE slots, the machine's tolerance, CS_FW_TRACE (or subdivision). */
 void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m);
 /* Empty queue, executor at 0, attached to the port's step timer (port_stepper_attach); the last

@@ -9,20 +9,13 @@
 # `timeout` and killed on exit. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/lib/daemon.sh"
 need_bin "$CS" "$SIM"
 
-JOB=$T/line.nc
-printf 'G21 G90\nG1 X300 Y100 F9000\n' >"$JOB"
-N=$("$CS" plan -o /dev/null "$JOB" 2>&1 | sed -n 's/.* blocks, \([0-9]*\) segments,.*/\1/p')
-expect "plan: the job has segments" [ "${N:-0}" -gt 100 ]
+dmn_job 'G1 X300 Y100 F9000'
 
 for mode in tcp rtu; do
     S=$T/$mode.sock
-    C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
-    progress() { C status 2>/dev/null | sed -n "s/^job 1 running: .*: \([0-9]*\)\/$N segments.*/\1/p"; }
-    quarter() { p=$(progress); [ "${p:-0}" -ge $((N / 4)) ]; }
-    still() { a=$(progress); sleep 1.2; b=$(progress); [ -n "$a" ] && [ "$a" = "$b" ]; }
-    finished() { C status 2>/dev/null | grep -qE "^job 1 (done|failed|cancelled)"; }
     if [ $mode = tcp ]; then dev=(--modbus-tcp 127.0.0.1:0); else dev=(--modbus-rtu pty); fi
     timeout -k 5 120 "$SIM" "${dev[@]}" --speed 1 --reference "$JOB" --check >"$T/$mode.sim" \
         2>"$T/$mode.simerr" &
@@ -31,20 +24,17 @@ for mode in tcp rtu; do
     wait_pty "$T/$mode.sim" 5
     ADDR=$PTY
     expect "$mode: device started" [ -n "$ADDR" ]
-    timeout -k 5 120 "$CS" serve "--modbus-$mode" "$ADDR" --socket "$S" 2>"$T/$mode.serve" &
-    DPID=$!
-    pids+=($DPID)
-    wait_until 5 [ -S "$S" ]
+    dmn_start "--modbus-$mode" "$ADDR"
     C status >"$T/$mode.st0" 2>&1
     expect "$mode: status names the link" grep -q "^OK device $ADDR, queue running$" "$T/$mode.st0"
     C submit "$JOB" >"$T/$mode.sub" 2>&1
     expect "$mode: submitted" grep -q "^OK job 1 queued: .*: $N segments$" "$T/$mode.sub"
-    expect "$mode: a quarter ran" wait_until 30 quarter
+    expect "$mode: a quarter ran" wait_until 30 dmn_quarter
     C pause >"$T/$mode.p"
     expect "$mode: paused, device held" grep -q "^OK paused (device held)" "$T/$mode.p"
-    expect "$mode: held: progress stands still" wait_until 20 still
+    expect "$mode: held: progress stands still" wait_until 20 dmn_still
     C resume >/dev/null
-    expect "$mode: job ended" wait_until 60 finished
+    expect "$mode: job ended" wait_until 60 dmn_finished
     C status >"$T/$mode.st" 2>&1
     expect "$mode: every segment executed" \
         grep -q "^job 1 done: .*: $N/$N segments executed (job executed)$" "$T/$mode.st"

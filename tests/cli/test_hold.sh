@@ -19,15 +19,12 @@
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/lib/daemon.sh"
 need_bin "$CS" "$SIM"
 
-JOB=$T/line.nc
-printf 'G21 G90\nG1 X400 F12000\n' >"$JOB"
-N=$("$CS" plan -o /dev/null "$JOB" 2>&1 | sed -n 's/.* blocks, \([0-9]*\) segments,.*/\1/p')
-expect "plan: the job has segments" [ "${N:-0}" -gt 100 ]
+dmn_job 'G1 X400 F12000'
 S=$T/sock/cs.sock
 mkdir "$T/sock"
-C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
 logline() { sed -n 's/^log: \([0-9]* segments hash [0-9]*\),.*/\1/p' "$1"; }
 
 # 1. the reference: the same job without a hold (instant)
@@ -45,25 +42,18 @@ SIMPID=$!
 pids+=($SIMPID)
 wait_pty "$T/sim.out" 5
 expect "sim printed a pty path" [ -c "$PTY" ]
-timeout -k 5 120 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve.err" &
-DPID=$!
-pids+=($DPID)
-wait_until 5 [ -S "$S" ]
+dmn_start --port "$PTY"
 C submit "$JOB" >"$T/s.out" 2>&1
 expect "submit: exit 0" [ $? -eq 0 ]
 # pause once a quarter of the job has run (mid-cruise: the ramp up is the first 5 %)
-progress() { C status 2>/dev/null | sed -n "s/^job 1 running: .*: \([0-9]*\)\/$N segments.*/\1/p"; }
-quarter() { p=$(progress); [ "${p:-0}" -ge $((N / 4)) ]; }
-expect "job reached a quarter" wait_until 30 quarter
+expect "job reached a quarter" wait_until 30 dmn_quarter
 C pause >"$T/p.out"
 expect "pause: device held" grep -q "^OK paused (device held)" "$T/p.out"
 # held: the progress stands still across the once-a-second status line
-still() { a=$(progress); sleep 1.2; b=$(progress); [ -n "$a" ] && [ "$a" = "$b" ]; }
-expect "held: progress stands still" wait_until 20 still
+expect "held: progress stands still" wait_until 20 dmn_still
 C resume >"$T/r.out"
 expect "resume: exit 0" [ $? -eq 0 ]
-finished() { C status 2>/dev/null | grep -qE "^job 1 (done|failed|cancelled)"; }
-expect "job ended" wait_until 60 finished
+expect "job ended" wait_until 60 dmn_finished
 C status >"$T/st.out" 2>&1
 expect "job done, every segment executed" grep -q "^job 1 done: .*: $N/$N segments executed" "$T/st.out"
 kill -TERM "$DPID"

@@ -34,6 +34,7 @@ QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none 
     -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=500)
 # the shared harness: T, pids (killed on exit), ok / ko / expect (tests/cli/lib/common.sh)
 . "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/daemon.sh"
 # value NAME FILE SED-EXPR: the last match of a report line (for messages).
 value() { sed -n "$2" "$1" | tail -n1; }
 
@@ -167,25 +168,18 @@ expect "ctrl-c: stopped mid-job" [ "${k:-0}" -gt 0 ] && [ "${k:-0}" -lt "$nseg" 
 
 # 3b. feed hold and resume through the daemon: every segment once, the position exact.
 S=$T/sock/cs.sock
+N=$nseg
 mkdir -p "$T/sock"
-C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
-progress() { C status 2>/dev/null | sed -n "s/^job 1 running: .*: \([0-9]*\)\/$nseg segments.*/\1/p"; }
-quarter() { p=$(progress); [ "${p:-0}" -ge $((nseg / 4)) ]; }
-still() { a=$(progress); sleep 1.2; b=$(progress); [ -n "$a" ] && [ "$a" = "$b" ]; }
-finished() { C status 2>/dev/null | grep -qE "^job 1 (done|failed|cancelled)"; }
 start_fw hold
-timeout -k 5 90 "$CS" serve --port "$PTY" --machine "$INI" --socket "$S" 2>"$T/serve.err" &
-DPID=$!
-pids+=("$DPID")
-wait_until 5 [ -S "$S" ]
+dmn_start --port "$PTY" --machine "$INI"
 C submit --feed $FEED "$JOB" >"$T/hsub.out" 2>&1
 expect "hold: submitted" grep -q "^OK job 1 queued: .*: $nseg segments$" "$T/hsub.out"
-expect "hold: a quarter ran" wait_until 40 quarter
+expect "hold: a quarter ran" wait_until 40 dmn_quarter
 C pause >"$T/hp.out"
 expect "hold: device held" grep -q "^OK paused (device held)" "$T/hp.out"
-expect "hold: progress stands still" wait_until 20 still
+expect "hold: progress stands still" wait_until 20 dmn_still
 C resume >/dev/null
-expect "hold: job ended" wait_until 60 finished
+expect "hold: job ended" wait_until 60 dmn_finished
 C status >"$T/hst.out" 2>&1
 expect "hold: every segment executed" grep -q "^job 1 done: .*: $nseg/$nseg segments executed" "$T/hst.out"
 kill -TERM "$DPID"

@@ -12,6 +12,7 @@
 
 #include "cs_fw_app.h"
 #include "cs_fw_modbus.h"
+#include "fw_test.h"
 #include "port_posix.h"
 
 static cs_machine_t machine;
@@ -22,12 +23,7 @@ static cs_modbus_app_t app;
 static int setup(void **state)
 {
     (void)state;
-    cs_fw_machine_default(&machine, 100000);
-    port_posix_reset(machine.tick_hz, 0);
-    cs_fw_motion_cfg_t c;
-    cs_fw_motion_cfg_default(&c, &machine);
-    c.queue_size = 4;
-    if (cs_fw_motion_init(&mo, &machine, &c) != CS_OK)
+    if (fw_test_motion(&machine, &mo, 4) != 0)
         return -1;
     cs_fw_modbus_init(&fm, &mo, 0x1234u, &app);
     return 0;

@@ -13,6 +13,7 @@
 
 #include "cs_fw_app.h"
 #include "cs_fw_motion.h"
+#include "fw_test.h"
 #include "port_posix.h"
 
 #define NSEG 120
@@ -33,12 +34,7 @@ static cs_proto_msg_t job_msg(unsigned k)
 static int setup(void **state)
 {
     (void)state;
-    cs_fw_machine_default(&machine, 100000);
-    port_posix_reset(machine.tick_hz, 0);
-    cs_fw_motion_cfg_t c;
-    cs_fw_motion_cfg_default(&c, &machine);
-    c.queue_size = NSEG;
-    return cs_fw_motion_init(&mo, &machine, &c) == CS_OK ? 0 : -1;
+    return fw_test_motion(&machine, &mo, NSEG);
 }
 
 static void queue_job(unsigned n)
