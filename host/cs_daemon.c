@@ -434,8 +434,8 @@ static void child_run(daemon_t *d, djob_t *j, int wfd)
     if (f == NULL)
         _exit(3);
     cs_stream_result_t r;
-    cs_err_t e = cs_daemon_link_run(d->cfg, &d->ser, &d->m, &j->job, &child_interrupt,
-                                    &child_pause, f, &r);
+    cs_err_t e =
+        cs_daemon_link_run(d->cfg, &d->ser, &d->m, &j->job, &child_interrupt, &child_pause, f, &r);
     if (e != CS_OK)
         fprintf(f, "RESULT -1 %zu %s\n", r.executed, cs_err_text(e));
     else

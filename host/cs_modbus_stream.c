@@ -231,8 +231,8 @@ cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd)
     return request(c, 2, CS_MODBUS_HR_COMMAND, 1, &cmd, NULL);
 }
 
-int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud,
-                    char parity, int unit, char *why, size_t cap)
+int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
+                    int unit, char *why, size_t cap)
 {
     if (tcp != NULL)
         return cs_mb_open_tcp(c, tcp, unit, CS_MB_TIMEOUT_MS, CS_MB_TRIES, why, cap);
@@ -242,8 +242,8 @@ int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_
         uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
         timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / baud) + 1u;
     }
-    return cs_mb_open_rtu(c, rtu, baud, parity != 0 ? parity : 'E', unit, timeout, CS_MB_TRIES,
-                          why, cap);
+    return cs_mb_open_rtu(c, rtu, baud, parity != 0 ? parity : 'E', unit, timeout, CS_MB_TRIES, why,
+                          cap);
 }
 
 /* --- streaming ------------------------------------------------------------------------------ */

@@ -60,8 +60,8 @@ void cs_mb_close(cs_mb_client_t *c);
 #define CS_MB_TRIES      6u
 /* The client every command uses: TCP to tcp ("HOST:PORT") when it is not NULL, else RTU on the
  * device rtu at baud with parity (0: 'E') for unit, with the timing above. As cs_mb_open_*. */
-int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud,
-                    char parity, int unit, char *why, size_t cap);
+int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
+                    int unit, char *why, size_t cap);
 
 /* The device's input registers, decoded. */
 typedef struct {

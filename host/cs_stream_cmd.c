@@ -19,7 +19,7 @@
 #include "cs_stream_report.h"
 #include "cs_trace.h"
 
-#define EXIT_NO_DEVICE   CS_EXIT_NO_DEVICE
+#define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
 
 static volatile sig_atomic_t interrupted;
 

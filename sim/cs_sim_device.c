@@ -224,7 +224,7 @@ static void arm_faults(sim_dev_t *d)
                     : cfg->hang_after  ? FAULT_HANG
                     : cfg->close_after ? FAULT_CLOSE
                                        : FAULT_NONE;
-    d->fault_at = cfg->reset_after ? cfg->reset_after
+    d->fault_at = cfg->reset_after  ? cfg->reset_after
                   : cfg->hang_after ? cfg->hang_after
                                     : cfg->close_after;
     if (d->fault_kind != FAULT_NONE)

@@ -59,10 +59,10 @@ typedef struct {
     cs_link_stats_t link;    /* the device's link counters (duplicates, out of order, ...) */
     cs_frame_stats_t frames; /* frames decoded, CRC errors, malformed */
     uint64_t bytes_in, bytes_out;
-    uint64_t ticks;       /* simulated time at the end (executor ticks) */
-    double wall_s;        /* wall time served */
-    int64_t pos[CS_AXES]; /* final position from the STEP/DIR lines, steps */
-    cs_sim_exec_t ex;     /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
+    uint64_t ticks;             /* simulated time at the end (executor ticks) */
+    double wall_s;              /* wall time served */
+    int64_t pos[CS_AXES];       /* final position from the STEP/DIR lines, steps */
+    cs_sim_exec_t ex;           /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
     cs_exlog_segs_t log_segs;   /* the execution log, as a board keeps it (cs_exlog) */
     cs_exlog_edges_t log_edges; /* the STEP edges on the executor's clock (cs_exlog) */
 } cs_sim_device_result_t;

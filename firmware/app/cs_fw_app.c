@@ -157,7 +157,8 @@ static void send_errors(cs_fw_app_t *a)
 {
     cs_proto_msg_t em;
     em.type = CS_PROTO_ERROR;
-    while (cs_link_can_send(&a->link, CS_PROTO_ERROR) && cs_fw_motion_peek_error(&a->mo, &em.u.error)) {
+    while (cs_link_can_send(&a->link, CS_PROTO_ERROR) &&
+           cs_fw_motion_peek_error(&a->mo, &em.u.error)) {
         if (cs_link_send_msg(&a->link, &em, NULL) != CS_OK)
             break;
         cs_fw_motion_drop_error(&a->mo);

@@ -8,12 +8,13 @@
  *
  * Build-time sizes (-D on the compiler command line). RAM = sizeof(cs_fw_app_t), the one static
  * the application needs (arm-none-eabi-gcc / avr-gcc, measured with nm -S, docs/firmware.md):
- *   defaults (curves, queue 32, window 8)                           14736 B M3, 14488 B AVR
- *   -DCS_FW_CURVES=0                                                  2564 B M3,  2479 B AVR
+ *   defaults (curves, queue 32, window 8)                           14880 B M3, 14609 B AVR
+ *   -DCS_FW_CURVES=0                                                  2720 B M3,  2616 B AVR
  *   -DCS_FW_CURVES=0 -DCS_FW_QUEUE=8 -DCS_LINK_WINDOW=2
- *     -DCS_FRAME_PAYLOAD_MAX=27 -DCS_STEPPER_RING=8                    1036 B M3,  1005 B AVR
+ *     -DCS_FRAME_PAYLOAD_MAX=27 -DCS_STEPPER_RING=8                    1196 B M3,  1142 B AVR
  * The macros:
- *   CS_FW_QUEUE       motion-queue slots (HELLO queue_size = link credits), 1..1024 (the most a run may offer), default 32;
+ *   CS_FW_QUEUE       motion-queue slots (HELLO queue_size = link credits; the most a run may
+ *                     offer, cs_fw_app_cfg_t), 1..1024, default 32;
  *                     one slot is 56 B with curves, 24 B without.
  *   CS_FW_CURVES      1 (default): accept CURVE messages, traced and planned on board: adds
  *                     cs_trace_t (6464 B: the subdivision stack), cs_planner_t (4408 B with

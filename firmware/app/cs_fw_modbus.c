@@ -56,9 +56,9 @@ void cs_fw_modbus_status(void *ctx, cs_modbus_status_t *st)
     st->tick_hz = mo->m->tick_hz;
     st->boot_id = fm->boot;
     /* an execution error stops the job: FAULT until the host resets */
-    st->state = (uint8_t)(fm->error != 0 && ps.state != CS_PROTO_STATE_RUNNING
-                              ? CS_PROTO_STATE_FAULT
-                              : ps.state);
+    st->state =
+        (uint8_t)(fm->error != 0 && ps.state != CS_PROTO_STATE_RUNNING ? CS_PROTO_STATE_FAULT
+                                                                       : ps.state);
     st->free_slots = cs_fw_motion_free(mo);
     st->last_exec = ps.last_seq;
     st->error = fm->error;

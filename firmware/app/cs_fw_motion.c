@@ -267,10 +267,10 @@ static void feed(cs_fw_motion_t *a)
 
 static void update_state(cs_fw_motion_t *a)
 {
-    uint8_t st = a->hold.hold               ? CS_PROTO_STATE_HELD
-                 : !cs_fw_motion_done(a)    ? CS_PROTO_STATE_RUNNING
-                 : a->aborted               ? CS_PROTO_STATE_ABORTED
-                                            : CS_PROTO_STATE_IDLE;
+    uint8_t st = a->hold.hold            ? CS_PROTO_STATE_HELD
+                 : !cs_fw_motion_done(a) ? CS_PROTO_STATE_RUNNING
+                 : a->aborted            ? CS_PROTO_STATE_ABORTED
+                                         : CS_PROTO_STATE_IDLE;
     if (st != a->state) {
         a->state = st;
         a->news = true;
@@ -299,8 +299,8 @@ void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m)
 
 cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_fw_motion_cfg_t *c)
 {
-    if (mo == NULL || m == NULL || c == NULL || c->queue_size < 1 ||
-        c->queue_size > CS_FW_QUEUE || c->tol <= 0)
+    if (mo == NULL || m == NULL || c == NULL || c->queue_size < 1 || c->queue_size > CS_FW_QUEUE ||
+        c->tol <= 0)
         return CS_ERR_ARG;
     cs_fw_motion_zero(mo, sizeof *mo);
     mo->m = m;

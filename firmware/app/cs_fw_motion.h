@@ -100,7 +100,7 @@ typedef struct {
     uint32_t take_max;  /* take no item past this number (0: no limit) */
     uint32_t exec_item; /* items executed */
     uint16_t item_seq[CS_FW_SEQMAP];
-    uint16_t exec_seq; /* sequence of the last item executed */
+    uint16_t exec_seq;          /* sequence of the last item executed */
     int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
 #if CS_FW_CURVES
     cs_planner_t pl;
@@ -111,10 +111,10 @@ typedef struct {
     int32_t tr_feed;
     uint32_t tr_item;
 #endif
-    uint8_t state;   /* cs_proto_state_t */
+    uint8_t state; /* cs_proto_state_t */
     bool aborted;
-    bool news;       /* state or hold changed since cs_fw_motion_news */
-    bool more;       /* the last poll stopped with work left */
+    bool news; /* state or hold changed since cs_fw_motion_news */
+    bool more; /* the last poll stopped with work left */
     cs_proto_error_t errs[CS_FW_ERRQ];
     uint8_t nerr;
     cs_exlog_segs_t log; /* every segment handed to the executor */

@@ -2,8 +2,8 @@
  * application, hence the simulator, and the host's GPIO runner). A hold does not change a single
  * step: it re-times the step segments still to be handed to the executor, stretching each by
  * 1/s, where the speed scale s falls linearly in real time from 1 to 0 over the ramp time
- * T = 5/4 x the longest max_rate / max_accel of the axes, each segment run at its mean scale; the device
- * stops after the segment in which s reaches 0 (the rest waits, untouched). RESUME ramps s
+ * T = 5/4 x the longest max_rate / max_accel of the axes, each segment run at its mean scale; the
+ * device stops after the segment in which s reaches 0 (the rest waits, untouched). RESUME ramps s
  * back up from 0 to 1 at the same slope. Every axis moves at s times the job's speed, so the
  * ramp itself decelerates an axis by at most v ds/dt <= max_rate / T = 0.8 max_accel: the 20 %
  * left covers the staircase of constant-speed segments around the ramp's line, whose steps grow
@@ -53,8 +53,8 @@ bool cs_hold_stopped(const cs_hold_t *h);
 /* True when s is below full speed (ramping down, stopped, or ramping up). */
 bool cs_hold_active(const cs_hold_t *h);
 /* Asks to hand *s to the executor now: true with s->ticks stretched for the scale's ramp over
- * the segment (run at its mean scale; the scale advanced to the segment's end), false when the hold has brought the
- * device to rest (keep *s, untouched, for after the resume). Main loop. */
+ * the segment (run at its mean scale; the scale advanced to the segment's end), false when the hold
+ * has brought the device to rest (keep *s, untouched, for after the resume). Main loop. */
 bool cs_hold_admit(cs_hold_t *h, cs_segment_t *s);
 
 #endif

@@ -24,9 +24,12 @@ struct posix_state {
     void *io_ctx;
     cs_exlog_edges_t elog;
 };
-static struct posix_state g = {
-    .hz = 100000, .record = true, .record_ok = true, .fd_in = -1, .fd_out = -1,
-    .elog = {0, CS_EXLOG_HASH0, 0, 0}};
+static struct posix_state g = {.hz = 100000,
+                               .record = true,
+                               .record_ok = true,
+                               .fd_in = -1,
+                               .fd_out = -1,
+                               .elog = {0, CS_EXLOG_HASH0, 0, 0}};
 
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
 {
