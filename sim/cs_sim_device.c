@@ -46,24 +46,6 @@ struct cs_sim_motion {
 };
 typedef struct cs_sim_motion sim_dev_t;
 
-uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s)
-{
-    uint8_t b[4 + 4 * CS_AXES];
-    uint32_t v = s->ticks;
-    for (unsigned k = 0; k < 4; k++)
-        b[k] = (uint8_t)(v >> (8 * k));
-    for (unsigned i = 0; i < CS_AXES; i++) {
-        uint32_t u = (uint32_t)s->steps[i];
-        for (unsigned k = 0; k < 4; k++)
-            b[4 + 4 * i + k] = (uint8_t)(u >> (8 * k));
-    }
-    for (size_t k = 0; k < sizeof b; k++) {
-        h ^= b[k];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
 {
     memset(cfg, 0, sizeof *cfg);

@@ -75,10 +75,6 @@ void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m);
  * CS_ERR_FULL when out of memory. Not reentrant (uses the process-wide POSIX port). */
 cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile sig_atomic_t *stop,
                              cs_sim_device_result_t *res);
-/* FNV-1a 64 of one segment (ticks, then each of the CS_AXES steps, little-endian), chained from
- * h (start with CS_SIM_DEVICE_HASH0): what the tests compare with the host's own sum. */
-#define CS_SIM_DEVICE_HASH0 0xcbf29ce484222325ull
-uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s);
 
 /* The device's motion side, shared by the serial device above and the Modbus device
  * (cs_sim_modbus): the motion queue, the planner and tracer for CURVE, the executor on the POSIX

@@ -13,3 +13,10 @@ int fw_test_motion(cs_machine_t *m, cs_fw_motion_t *mo, uint16_t queue)
     c.queue_size = queue;
     return cs_fw_motion_init(mo, m, &c) == CS_OK ? 0 : -1;
 }
+
+uint64_t fw_test_hash(uint64_t h, const cs_segment_t *s)
+{
+    cs_exlog_segs_t l = {0, (uint32_t)h};
+    cs_exlog_segment(&l, s);
+    return l.hash;
+}
