@@ -57,16 +57,22 @@ SUP_SRC   := $(sort $(wildcard tests/support/*.c))
 UNIT_SRC  := $(sort $(wildcard tests/unit/test_*.c))
 BENCH_SRC := $(sort $(wildcard tests/bench/bench_*.c))
 PORT_POSIX_SRC := $(sort $(wildcard firmware/ports/posix/*.c))
+# The device application (firmware/app) without its bare-metal main: linked into the host
+# library so that the simulator and the unit tests run the firmware's own code on the POSIX port.
+FW_HOST_SRC := $(sort $(filter-out firmware/app/main.c,$(wildcard firmware/app/*.c)))
 
 PKGS      := cairo expat libmodbus libgpiod
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lpthread -lm
 
-INCLUDES  := -Ifirmware/core -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim -Itests/support
+INCLUDES  := -Ifirmware/core -Ifirmware/app -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim \
+             -Itests/support
+# The host's build of the application offers the simulator's largest queue (--queue 1..256).
+FW_HOST_DEFS := -DCS_FW_QUEUE=256
 WARN      := -Wall -Wextra -Werror
 CORE_CFLAGS := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS) $(INCLUDES)
 HOST_CFLAGS := -std=c99 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L $(WARN) $(OPT) $(SANFLAGS) \
-               $(INCLUDES) $(PKG_CFLAGS)
+               $(INCLUDES) $(FW_HOST_DEFS) $(PKG_CFLAGS)
 LDFLAGS_ALL := $(SANFLAGS)
 
 CORE_OBJ := $(CORE_SRC:%.c=$(OUT)/obj/%.o)
@@ -74,6 +80,7 @@ HOST_OBJ := $(HOST_SRC:%.c=$(OUT)/obj/%.o)
 SIM_OBJ  := $(SIM_SRC:%.c=$(OUT)/obj/%.o)
 SUP_OBJ  := $(SUP_SRC:%.c=$(OUT)/obj/%.o)
 PORT_POSIX_OBJ := $(PORT_POSIX_SRC:%.c=$(OUT)/obj/%.o)
+FW_HOST_OBJ := $(FW_HOST_SRC:%.c=$(OUT)/obj/%.o)
 UNIT_BIN := $(UNIT_SRC:tests/unit/%.c=$(OUT)/tests/%)
 BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
 
@@ -97,7 +104,12 @@ $(OUT)/obj/firmware/core/%.o: firmware/core/%.c $(wildcard firmware/core/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
 
-$(OUT)/obj/%.o: %.c $(wildcard firmware/core/*.h host/*.h sim/*.h tests/support/*.h firmware/ports/*.h firmware/ports/posix/*.h)
+# the application under the core's rules (-Wconversion), with the host's sizes
+$(OUT)/obj/firmware/app/%.o: firmware/app/%.c $(wildcard firmware/core/*.h firmware/app/*.h firmware/ports/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(CORE_CFLAGS) $(FW_HOST_DEFS) -c $< -o $@
+
+$(OUT)/obj/%.o: %.c $(wildcard firmware/core/*.h firmware/app/*.h host/*.h sim/*.h tests/support/*.h firmware/ports/*.h firmware/ports/posix/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -c $< -o $@
 
@@ -105,7 +117,7 @@ $(CORE_LIB): $(CORE_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
-$(HOST_LIB): $(HOST_OBJ) $(SIM_OBJ) $(PORT_POSIX_OBJ)
+$(HOST_LIB): $(HOST_OBJ) $(SIM_OBJ) $(PORT_POSIX_OBJ) $(FW_HOST_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^ $(if $^,,/dev/null)
 

@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "cs_conv.h"
+#include "cs_daemon_link.h"
 #include "cs_err_text.h"
 #include "cs_jobplan.h"
 #include "cs_machine_ini.h"
@@ -342,7 +343,8 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
 
 static void req_status(daemon_t *d, FILE *out)
 {
-    fprintf(out, "OK device %s, queue %s\n", d->cfg->port, d->paused ? "paused" : "running");
+    fprintf(out, "OK device %s, queue %s\n", cs_daemon_link_name(d->cfg),
+            d->paused ? "paused" : "running");
     for (size_t i = 0; i < d->njobs; i++) {
         const djob_t *j = &d->jobs[i];
         const char *what = j->job.mode == CS_STREAM_CURVES ? "curves" : "segments";
@@ -443,16 +445,9 @@ static void child_run(daemon_t *d, djob_t *j, int wfd)
     FILE *f = fdopen(wfd, "w");
     if (f == NULL)
         _exit(3);
-    tcflush(d->ser.fd, TCIFLUSH); /* what the device said between jobs */
-    cs_stream_opts_t o;
-    cs_stream_opts_default(&o, &d->ser, d->m.n_axes, d->m.tick_hz);
-    cs_stream_link_timing(&o.link, strncmp(d->cfg->port, "/dev/pts/", 9) == 0 ? 0 : d->cfg->baud);
-    o.interrupt = &child_interrupt;
-    o.pause = &child_pause;
-    o.progress = f;
-    o.progress_tty = false;
     cs_stream_result_t r;
-    cs_err_t e = cs_stream_run(&j->job, &o, &r);
+    cs_err_t e =
+        cs_daemon_link_run(d->cfg, &d->ser, &d->m, &j->job, &child_interrupt, &child_pause, f, &r);
     if (e != CS_OK)
         fprintf(f, "RESULT -1 %zu %s\n", r.executed, cs_err_text(e));
     else
@@ -710,7 +705,7 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
         free(d);
         return 1;
     }
-    if (cs_serial_open(&d->ser, cfg->port, cfg->baud) != 0) {
+    if (cs_daemon_link_open(cfg, &d->ser) != 0) {
         fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
         free(d);
         return 4;
@@ -729,7 +724,7 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
     sigaction(SIGINT, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     stop_serving = 0;
-    dlog(d, "serving %s on %s", cfg->port, cfg->socket_path);
+    dlog(d, "serving %s on %s", cs_daemon_link_name(cfg), cfg->socket_path);
     bool told_child = false;
     while (!(stop_serving && d->running == SIZE_MAX)) {
         if (stop_serving && d->running != SIZE_MAX && !told_child) {

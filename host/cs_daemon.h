@@ -1,6 +1,7 @@
 /* cs_daemon: the streaming daemon (`curvestep serve`) and its client side. The daemon keeps one
- * serial port open, plans every submitted job whole at submit time, and streams the jobs one at a
- * time (each in a child process running cs_stream_run on the inherited port); clients talk to it
+ * link (a serial port kept open, or a Modbus TCP/RTU device: cs_daemon_link), plans every
+ * submitted job whole at submit time, and streams the jobs one at a time (each in a child process
+ * running the link's stream); clients talk to it
  * over a UNIX socket (mode 0600) with the one-line text protocol of docs/streaming.md. Host only.
  */
 #ifndef CS_DAEMON_H
@@ -14,8 +15,13 @@
 #define CS_DAEMON_LINE_MAX 4400
 
 typedef struct {
+    /* the link: exactly one of port, modbus_tcp, modbus_rtu (cs_daemon_link) */
     const char *port;         /* serial device, opened once and kept open */
-    uint32_t baud;            /* termios rate */
+    const char *modbus_tcp;   /* HOST:PORT of a Modbus TCP device (a connection a job) */
+    const char *modbus_rtu;   /* a Modbus RTU device's serial line (opened a job) */
+    char parity;              /* Modbus RTU: 'E' (0: E), 'O' or 'N' */
+    int unit;                 /* Modbus unit id */
+    uint32_t baud;            /* termios rate (serial and Modbus RTU) */
     const char *socket_path;  /* UNIX socket to create (0600); removed on exit */
     const char *machine_file; /* NULL: the built-in machine */
     FILE *log;                /* one line per event (job queued, started, ended); NULL: none */

@@ -18,15 +18,21 @@ static void serve_usage(FILE *f)
 {
     char sock[256];
     fprintf(f,
-            "usage: curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH]\n"
-            "Keeps the serial port DEV open and streams the jobs submitted to it, one at a\n"
-            "time, in the order they came (as `curvestep stream` does: planned whole at submit\n"
-            "time, then streamed with the protocol of docs/protocol.md). Clients talk to it on\n"
-            "the UNIX socket PATH, created with mode 0600 (owner only): curvestep submit,\n"
-            "status, pause, resume, cancel. One line per event on standard error.\n"
+            "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
+            "                       [--baud N] [--parity none|even|odd] [--unit ID]\n"
+            "                       [--machine FILE.ini] [--socket PATH]\n"
+            "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
+            "came (as `curvestep stream` does: planned whole at submit time, then streamed with\n"
+            "the protocol of docs/protocol.md, or over Modbus as in docs/modbus.md). Clients\n"
+            "talk to it on the UNIX socket PATH, created with mode 0600 (owner only): curvestep\n"
+            "submit, status, pause, resume, cancel. One line per event on standard error.\n"
             "SIGTERM or SIGINT stops it: the running job is held, then aborted.\n"
-            "  --port DEV      serial device (required)\n"
-            "  --baud N        line speed (default 115200)\n"
+            "  --port DEV      serial device, kept open (one link is required)\n"
+            "  --modbus-tcp HOST:PORT  a Modbus TCP device (connected for each job)\n"
+            "  --modbus-rtu DEV        a Modbus RTU device on serial line DEV (opened each job)\n"
+            "  --baud N        line speed of --port and --modbus-rtu (default 115200)\n"
+            "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
+            "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
             "  --socket PATH   the socket (default %s)\n"
             "Exit status: 0 stopped by a signal; 1 bad machine file; 2 bad command line;\n"
@@ -50,7 +56,7 @@ static int parse_baud(const char *s, uint32_t *out)
 int cs_cmd_serve(int argc, char **argv)
 {
     char sock[256];
-    cs_daemon_cfg_t cfg = {.baud = 115200, .log = stderr};
+    cs_daemon_cfg_t cfg = {.baud = 115200, .unit = 1, .log = stderr};
     cfg.socket_path = cs_daemon_default_socket(sock, sizeof sock);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -60,6 +66,28 @@ int cs_cmd_serve(int argc, char **argv)
             return CS_EXIT_OK;
         } else if (strcmp(a, "--port") == 0 && has) {
             cfg.port = argv[++i];
+        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
+            cfg.modbus_tcp = argv[++i];
+        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
+            cfg.modbus_rtu = argv[++i];
+        } else if (strcmp(a, "--parity") == 0 && has) {
+            const char *v = argv[++i];
+            cfg.parity = strcmp(v, "none") == 0   ? 'N'
+                         : strcmp(v, "even") == 0 ? 'E'
+                         : strcmp(v, "odd") == 0  ? 'O'
+                                                  : 0;
+            if (cfg.parity == 0) {
+                fprintf(stderr, "curvestep serve: --parity wants none, even or odd\n");
+                return CS_EXIT_USAGE;
+            }
+        } else if (strcmp(a, "--unit") == 0 && has) {
+            char *end;
+            long v = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || v < 1 || v > 247) {
+                fprintf(stderr, "curvestep serve: --unit wants a Modbus unit id, 1..247\n");
+                return CS_EXIT_USAGE;
+            }
+            cfg.unit = (int)v;
         } else if (strcmp(a, "--socket") == 0 && has) {
             cfg.socket_path = argv[++i];
         } else if (strcmp(a, "--machine") == 0 && has) {
@@ -75,8 +103,9 @@ int cs_cmd_serve(int argc, char **argv)
             return CS_EXIT_USAGE;
         }
     }
-    if (cfg.port == NULL) {
-        fprintf(stderr, "curvestep serve: --port DEV is required\n");
+    if ((cfg.port != NULL) + (cfg.modbus_tcp != NULL) + (cfg.modbus_rtu != NULL) != 1) {
+        fprintf(stderr, "curvestep serve: give one link: --port DEV, --modbus-tcp HOST:PORT or "
+                        "--modbus-rtu DEV\n");
         serve_usage(stderr);
         return CS_EXIT_USAGE;
     }

@@ -15,6 +15,7 @@
 #include "cs_gpio_io.h"
 #include "cs_gpio_run.h"
 #include "cs_stream_cmd.h"
+#include "cs_stream_report.h"
 
 static const char *const axis_names[CS_AXES] = {"x", "y", "z", "a"};
 
@@ -300,8 +301,7 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
     }
     size_t ex = cs_gpio_run_executed(&r);
     printf("stream: %s: %s%s\n", link, what, why);
-    printf("stream: %zu of %zu segments executed, %zu delivered, %zu sent; last executed: %zu\n",
-           ex, p->nsegs, ex, ex, ex);
+    cs_stream_report_counts(stdout, ex, p->nsegs, ex, ex, "segments");
     printf("stream: %llu steps (",
            (unsigned long long)(r.steps[0] + r.steps[1] + r.steps[2] + r.steps[3]));
     for (unsigned i = 0; i < m->n_axes; i++)
@@ -311,9 +311,7 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
            wall, (double)r.ticks / m->tick_hz, (double)cs_gpio_run_late_quantile(&r, 0.5) / 1000.0,
            (double)cs_gpio_run_late_quantile(&r, 0.99) / 1000.0, (double)r.late_max_ns / 1000.0);
     if (exit_rc != CS_EXIT_OK && ex < p->nsegs && r.outcome != CS_GPIO_RUN_STOPPED)
-        printf("stream: to continue once the machine is where segment no. %zu left it: "
-               "curvestep stream --resume-from %zu ...\n",
-               ex, ex);
+        cs_stream_report_resume(stdout, "segment", ex);
     if (r.outcome == CS_GPIO_RUN_STOPPED)
         printf("stream: (stopped mid-segment: the machine is past segment no. %zu, re-home it "
                "before resuming)\n",

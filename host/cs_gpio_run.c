@@ -5,6 +5,8 @@
  * machine is tens of microseconds) and drives the lines (docs/gpio.md "The step thread"). */
 #include "cs_gpio_run.h"
 
+#include "cs_hold.h"
+
 #include <errno.h>
 #include <sched.h>
 #include <string.h>
@@ -20,8 +22,6 @@
 #endif
 #endif
 
-/* Hold: the executor's clock slows linearly to HOLD_MIN_RATE of real time. */
-#define HOLD_MIN_RATE 0.05
 /* At least this long between starting the thread and tick 0 (the first DIR levels settle). */
 #define START_LEAD_NS 1000000
 /* Sleeps are cut into pieces of at most this, to see a stop-at-once request. */
@@ -114,15 +114,10 @@ static void *thread_main(void *arg)
 
     uint32_t all_step = step_lines(o, 0xff), all_dir = dir_lines(o, 0xff);
     uint32_t en = o->enable_line >= 0 ? 1u << o->enable_line : 0;
-    /* The hold ramp: from full speed to HOLD_MIN_RATE over the longest max_rate / max_accel of
-     * the axes, so the ramp itself asks no more than max_accel of any axis at its max_rate. */
-    double ramp_ns = 0;
-    for (unsigned i = 0; i < o->m->n_axes; i++) {
-        double t = (double)o->m->axis[i].max_rate / (double)o->m->axis[i].max_accel * 1e9;
-        if (t > ramp_ns)
-            ramp_ns = t;
-    }
-
+    /* The hold: the core's ramp (cs_hold), the one every device runs: segments re-timed along
+     * the job's own path down to rest, then feeding stops at a segment end. */
+    cs_hold_t hold;
+    (void)cs_hold_init(&hold, o->m); /* the executor accepted the machine: so does the ramp */
     int64_t t, t_dir = INT64_MIN / 2;
     bool ok = true;
     if (en)
@@ -149,13 +144,12 @@ static void *thread_main(void *arg)
         dir = want;
     }
     uint64_t vt = 0;
-    bool holding = false;
-    int64_t planned = r->t0_ns, hold_t0 = 0;
+    int64_t planned = r->t0_ns;
     bool unsent = false; /* stopped with a call's steps computed but not on the lines */
     int32_t unsent_pos[CS_AXES];
     while (ok && oc == CS_GPIO_RUN_DONE) {
         if (out.next_ticks == 0) {
-            oc = holding ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
+            oc = hold.hold ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
             break;
         }
         int h = load_hold(r);
@@ -163,39 +157,23 @@ static void *thread_main(void *arg)
             oc = CS_GPIO_RUN_STOPPED;
             break;
         }
-        if (h == 1 && !holding) {
-            holding = true;
-            hold_t0 = planned;
-        }
-        uint64_t prev_vt = vt;
+        if (h == 1 && !hold.hold)
+            cs_hold_set(&hold, true);
         vt += out.next_ticks;
-        bool feeding = true;
-        if (!holding) {
-            planned = r->t0_ns + ticks_to_ns(vt, hz);
-        } else {
-            /* The executor's clock runs at rate s of real time, s falling linearly from 1 to
-             * HOLD_MIN_RATE over ramp_ns: the path is the job's own, its speed scaled by s
-             * (the slow-down itself adds v ds/dt <= max_rate / ramp <= max_accel to each axis).
-             * The next call comes after the virtual interval divided by s (s at the previous
-             * call). Feeding goes on during the ramp and stops at its end. */
-            double s = ramp_ns > 0 ? 1.0 - (double)(planned - hold_t0) / ramp_ns : 0;
-            if (s <= HOLD_MIN_RATE) {
-                s = HOLD_MIN_RATE;
-                feeding = false;
-            }
-            int64_t dv = ticks_to_ns(vt, hz) - ticks_to_ns(prev_vt, hz);
-            planned += (int64_t)((double)dv / s);
-        }
+        planned = r->t0_ns + ticks_to_ns(vt, hz);
         /* one segment queued behind the running one is enough (this thread refills before
-         * every call); once the hold stops feeding, at most that one more segment runs */
-        if (feeding && next < o->nsegs && cs_stepper_free(st) == CS_STEPPER_RING) {
-            if (cs_stepper_push(st, &o->segs[next]) != CS_OK) {
-                oc = CS_GPIO_RUN_BAD_SEGMENT; /* the executor refused it: stop here */
-                r->bad_segment = next + 1;
-                break;
+         * every call); once the hold has come to rest, nothing more is fed */
+        if (next < o->nsegs && cs_stepper_free(st) == CS_STEPPER_RING) {
+            cs_segment_t sg = o->segs[next];
+            if (cs_hold_admit(&hold, &sg)) {
+                if (cs_stepper_push(st, &sg) != CS_OK) {
+                    oc = CS_GPIO_RUN_BAD_SEGMENT; /* the executor refused it: stop here */
+                    r->bad_segment = next + 1;
+                    break;
+                }
+                next++;
+                pushed++;
             }
-            next++;
-            pushed++;
         }
         int32_t before[CS_AXES]; /* the executor's position without this call's steps */
         for (unsigned i = 0; i < CS_AXES; i++)

@@ -3,7 +3,7 @@
  * line changes through the cs_gpio_io seam at absolute deadlines on CLOCK_MONOTONIC (planned
  * time = start + ticks / tick_hz): DIR changes, then after the DIR set-up time the STEP lines
  * rise for the call's mask, stay up the pulse width, fall. It asks for SCHED_FIFO and locked
- * memory, holds on request (slows its clock down, then stops at a segment end) and leaves
+ * memory, holds on request (decelerates along the path, cs_hold, then stops at a segment end) and leaves
  * the lines safe (STEP inactive, ENABLE off). The main thread starts it, polls progress, asks
  * for a hold, joins. Host only. */
 #ifndef CS_GPIO_RUN_H
@@ -77,9 +77,9 @@ typedef struct {
  * mlock_err and runs anyway (the caller warns). Returns 0, or an errno when the thread cannot be
  * created or the executor refuses the machine. Not real-time; main thread only. */
 int cs_gpio_run_start(cs_gpio_run_t *r, const cs_gpio_run_opts_t *opts);
-/* Asks the thread to hold (level 1: slow the executor's clock down to 5 % of real time over
- * the machine's longest max_rate / max_accel, along the job's own path, then stop feeding and
- * finish what the executor holds: at most two segments) or to stop at once (2). Any thread. */
+/* Asks the thread to hold (level 1: decelerate along the job's own path to rest with the
+ * core's ramp, cs_hold, every axis within its max_accel, then stop at a segment end) or to stop
+ * at once (2). Any thread. */
 void cs_gpio_run_hold(cs_gpio_run_t *r, int level);
 /* Segments executed so far, job numbering (includes opts->first). Any thread. */
 size_t cs_gpio_run_executed(const cs_gpio_run_t *r);

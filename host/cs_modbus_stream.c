@@ -231,6 +231,21 @@ cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd)
     return request(c, 2, CS_MODBUS_HR_COMMAND, 1, &cmd, NULL);
 }
 
+int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
+                    int unit, char *why, size_t cap)
+{
+    if (tcp != NULL)
+        return cs_mb_open_tcp(c, tcp, unit, CS_MB_TIMEOUT_MS, CS_MB_TRIES, why, cap);
+    uint32_t timeout = CS_MB_TIMEOUT_MS;
+    if (strncmp(rtu, "/dev/pts/", 9) != 0 && baud > 0) {
+        /* request of CS_MODBUS_MAILBOX_REGS registers + its answer, 11 bits a byte */
+        uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
+        timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / baud) + 1u;
+    }
+    return cs_mb_open_rtu(c, rtu, baud, parity != 0 ? parity : 'E', unit, timeout, CS_MB_TRIES, why,
+                          cap);
+}
+
 /* --- streaming ------------------------------------------------------------------------------ */
 
 void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_t axes,
@@ -260,6 +275,7 @@ typedef struct {
     cs_stream_progress_t prog;
     double t_first;
     uint32_t resent, refused;
+    bool held; /* HOLD sent for o->pause, RESUME not yet */
 } mrun_t;
 
 static void finish(mrun_t *s, cs_stream_outcome_t oc)
@@ -524,6 +540,13 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
             }
             finish(s, CS_STREAM_INTERRUPTED);
             break;
+        }
+        if (o->pause != NULL && (*o->pause != 0) != s->held) {
+            s->held = !s->held; /* the daemon's pause: the queue is kept */
+            control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
+                    s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
+                    2000);
+            t_all_sent = 0;
         }
         double now = cs_serial_now_s();
         bool wrote = false;

@@ -52,6 +52,16 @@ int cs_mb_open_tcp(cs_mb_client_t *c, const char *hostport, int unit, uint32_t t
 int cs_mb_open_rtu(cs_mb_client_t *c, const char *dev, uint32_t baud, char parity, int unit,
                    uint32_t timeout_ms, unsigned tries, char *why, size_t cap);
 void cs_mb_close(cs_mb_client_t *c);
+/* One try's answer timeout: 200 ms on TCP and on a pty (a loaded CI machine under ASan answers
+ * well within it; the device answers within a few ms), plus on a real RTU line the time the
+ * longest request and its answer take on the wire (11 bits a character). Six tries: a device
+ * silent for about 1.2 s is declared gone. */
+#define CS_MB_TIMEOUT_MS 200u
+#define CS_MB_TRIES      6u
+/* The client every command uses: TCP to tcp ("HOST:PORT") when it is not NULL, else RTU on the
+ * device rtu at baud with parity (0: 'E') for unit, with the timing above. As cs_mb_open_*. */
+int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
+                    int unit, char *why, size_t cap);
 
 /* The device's input registers, decoded. */
 typedef struct {
@@ -75,6 +85,7 @@ typedef struct {
     uint32_t tick_hz;
     size_t resume_from;               /* messages 1..resume_from were executed already */
     volatile sig_atomic_t *interrupt; /* > 0: HOLD then ABORT; >= 2: at once */
+    volatile sig_atomic_t *pause;     /* NULL: never; != 0: HOLD (queue kept), back to 0: RESUME */
     FILE *progress;                   /* NULL: none */
     bool progress_tty;
     uint32_t hello_ms;  /* the first status must come within this */

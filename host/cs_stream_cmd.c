@@ -16,13 +16,10 @@
 #include "cs_serial.h"
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
+#include "cs_stream_report.h"
 #include "cs_trace.h"
 
-#define EXIT_NO_DEVICE   CS_EXIT_NO_DEVICE
-#define EXIT_RESET       CS_EXIT_RESET
-#define EXIT_CLOSED      CS_EXIT_CLOSED
-#define EXIT_DEV_ERROR   CS_EXIT_DEV_ERROR
-#define EXIT_INTERRUPTED CS_EXIT_INTERRUPTED
+#define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
 
 static volatile sig_atomic_t interrupted;
 
@@ -321,51 +318,7 @@ int cs_cmd_stream(int argc, char **argv)
         cs_stream_job_free(&job);
         return CS_EXIT_INTERNAL;
     }
-    int rc = CS_EXIT_OK;
-    switch (r.outcome) {
-    case CS_STREAM_DONE:
-        rc = CS_EXIT_OK;
-        break;
-    case CS_STREAM_NO_DEVICE:
-    case CS_STREAM_INCOMPATIBLE:
-        rc = EXIT_NO_DEVICE;
-        break;
-    case CS_STREAM_RESET:
-        rc = EXIT_RESET;
-        break;
-    case CS_STREAM_CLOSED:
-        rc = EXIT_CLOSED;
-        break;
-    case CS_STREAM_DEVICE_ERROR:
-        rc = EXIT_DEV_ERROR;
-        break;
-    case CS_STREAM_INTERRUPTED:
-        rc = EXIT_INTERRUPTED;
-        break;
-    }
-    printf("stream: %s: %s", port, cs_stream_outcome_text(r.outcome));
-    if (r.why[0])
-        printf(" (%s)", r.why);
-    if (r.outcome == CS_STREAM_RESET)
-        printf(" (boot id %08x -> %08x; %u messages were in flight)", (unsigned)r.old_boot,
-               (unsigned)r.new_boot, (unsigned)r.unacked);
-    if (r.outcome == CS_STREAM_DEVICE_ERROR)
-        printf(" (%s, about %s no. %zu)", cs_err_text((cs_err_t)r.dev_error.code),
-               curves ? "curve" : "segment", r.dev_error_msg);
-    printf("\n");
-    printf("stream: %zu of %zu %s executed, %zu delivered, %zu sent; last executed: %zu\n",
-           r.executed, job.n, what, r.delivered, r.sent, r.executed);
-    printf("stream: %llu bytes sent, %llu received in %.2f s; %u retransmissions (%u timeouts, "
-           "%u NAKs); %.0f %s/s\n",
-           (unsigned long long)r.bytes_out, (unsigned long long)r.bytes_in, r.wall_s,
-           (unsigned)r.link.retransmits, (unsigned)r.link.timeouts, (unsigned)r.link.naks,
-           r.stream_s > 0 ? (double)(r.executed - o.resume_from) / r.stream_s : 0.0, what);
-    if (rc != CS_EXIT_OK && r.executed < job.n && r.outcome != CS_STREAM_NO_DEVICE &&
-        r.outcome != CS_STREAM_INCOMPATIBLE)
-        printf("stream: to continue once the machine is where %s no. %zu left it: "
-               "curvestep stream --resume-from %zu ...\n",
-               curves ? "curve" : "segment", r.executed, r.executed);
-    fflush(stdout);
+    int rc = cs_stream_report(stdout, port, &job, &r, o.resume_from, curves);
     cs_stream_job_free(&job);
     return rc;
 }

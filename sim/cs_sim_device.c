@@ -1,5 +1,9 @@
-/* cs_sim_device: the simulated device behind a serial line. See cs_sim_device.h and
- * docs/streaming.md ("The device's pacing"). */
+/* cs_sim_device: the simulated device behind a serial line or Modbus. The device itself is the
+ * firmware's application (firmware/app: cs_fw_app, the framed-serial front end, over cs_fw_motion,
+ * the motion side) running on the POSIX port (firmware/ports/posix); this file adds only what a
+ * simulator is for: pacing simulated time against the wall clock (--speed, --instant), fault
+ * injection on the line and scheduled resets/hangs/closes, and the results for the report. See
+ * cs_sim_device.h and docs/streaming.md ("The device's pacing"). */
 #include "cs_sim_device.h"
 
 #include <errno.h>
@@ -9,106 +13,39 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cs_fw_app.h"
 #include "cs_jobplan.h"
-#include "cs_planner.h"
-#include "cs_segment.h"
-#include "cs_stepper.h"
 #include "cs_stream.h"
-#include "cs_trace.h"
 #include "port_posix.h"
 
-/* Items whose sequence is remembered between leaving the queue and being executed: more than
- * the planner ring + the executor ring + the curve being traced. */
-#define SEQ_MAP   1024
-#define SEQ_MASK  (SEQ_MAP - 1)
-#define ERR_QUEUE 8
+/* bytes read from the line a pass, handed to the application CS_FW_RX_CHUNK at a time */
+#define RX_BUF 4096
 
-typedef struct {
-    cs_proto_msg_t msg;
-    uint16_t seq;
-} qitem_t;
-
-typedef struct {
-    uint64_t item; /* device item number (1-based) the segment belongs to */
-    bool item_end; /* last segment of that item (SEGMENT messages: always) */
-} tag_t;
+enum { FAULT_NONE, FAULT_RESET, FAULT_HANG, FAULT_CLOSE };
 
 struct cs_sim_motion {
     const cs_sim_device_cfg_t *cfg;
     const cs_machine_t *m;
     cs_sim_device_result_t *res;
+    cs_fw_app_t app; /* the device (the Modbus device uses its motion side only) */
     cs_serial_t ser;
-    cs_link_t link;
-    uint32_t boot;
-    uint32_t nonce;
-    /* motion queue */
-    qitem_t q[CS_SIM_DEVICE_QUEUE_MAX];
-    unsigned qhead, qcount;
-    /* executor */
-    cs_stepper_t st;
-    tag_t tags[CS_STEPPER_RING];
-    uint64_t pushed, completed;
-    /* curves */
-    cs_planner_t pl;
-    cs_segment_gen_t gen;
-    bool gen_busy; /* a block is being cut */
-    bool tracing;
-    bool rapid_pending; /* travel to the curve's P0 still to queue */
-    cs_vec3_t rapid_to;
-    cs_trace_t tr;
-    int32_t tr_feed;
-    uint64_t tr_item;
-    bool pl_stale; /* SEGMENT messages moved the machine: planner position to refresh */
-    int64_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
-    /* items */
-    uint64_t popped;            /* items taken from the queue since serve started */
-    uint16_t item_seq[SEQ_MAP]; /* sequence of item k at [k & SEQ_MASK] */
-    uint64_t exec_item;         /* items executed */
-    uint16_t exec_seq;          /* sequence of the last item executed */
-    bool have_prev;
-    uint16_t prev_seq;
-    /* state */
-    uint8_t state; /* cs_proto_state_t */
-    bool held, aborted;
-    uint8_t sent_state;
-    bool status_due;
-    uint32_t status_at;
+    /* what the line gave and the application has not read yet */
+    uint8_t rx[RX_BUF];
+    size_t rx_len, rx_off;
     /* fault at N: stop taking items after N, drain, report, then act */
     uint64_t fault_at;
-    int fault_kind;  /* 0 none, 1 reset, 2 hang, 3 close */
-    int fault_phase; /* 0 waiting, 1 draining, 2 status sent */
+    int fault_kind;
+    int fault_phase; /* 0 waiting, 1 status sent */
     uint32_t fault_status_at;
     bool hung;
-    /* errors to send */
-    cs_proto_error_t errs[ERR_QUEUE];
-    unsigned nerr;
     /* pacing */
     double anchor_wall;
     uint64_t anchor_ticks;
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
-    double last_rx_s;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
 };
 typedef struct cs_sim_motion sim_dev_t;
-
-uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s)
-{
-    uint8_t b[4 + 4 * CS_AXES];
-    uint32_t v = s->ticks;
-    for (unsigned k = 0; k < 4; k++)
-        b[k] = (uint8_t)(v >> (8 * k));
-    for (unsigned i = 0; i < CS_AXES; i++) {
-        uint32_t u = (uint32_t)s->steps[i];
-        for (unsigned k = 0; k < 4; k++)
-            b[4 + 4 * i + k] = (uint8_t)(u >> (8 * k));
-    }
-    for (size_t k = 0; k < sizeof b; k++) {
-        h ^= b[k];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
 
 void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
 {
@@ -120,427 +57,136 @@ void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
     cfg->status_ms = 50;
 }
 
-/* --- link plumbing ------------------------------------------------------------------------ */
+/* --- the POSIX port's UART, through the simulated line -------------------------------------- */
 
-static uint16_t free_slots(const sim_dev_t *d)
+static size_t uart_read(void *ctx, uint8_t *buf, size_t max)
 {
-    return (uint16_t)(d->cfg->queue_size - d->qcount);
-}
-
-static uint32_t new_nonce(sim_dev_t *d)
-{
-    d->nonce = d->nonce * 1664525u + 1013904223u;
-    return d->nonce ? d->nonce : 1u;
-}
-
-static void push_error(sim_dev_t *d, cs_err_t code, uint16_t seq)
-{
-    if (d->nerr < ERR_QUEUE)
-        d->errs[d->nerr++] = (cs_proto_error_t){(uint8_t)code, seq};
-}
-
-static void send_hello(sim_dev_t *d)
-{
-    cs_proto_msg_t h = {.type = CS_PROTO_HELLO};
-    h.u.hello.version = CS_PROTO_VERSION;
-    h.u.hello.boot_id = d->boot;
-    h.u.hello.axes = d->m->n_axes;
-    h.u.hello.queue_size = d->cfg->queue_size;
-    h.u.hello.tick_hz = d->m->tick_hz;
-    h.u.hello.caps = CS_PROTO_CAP_ALL;
-    cs_link_send_msg(&d->link, &h, NULL); /* first message of a fresh sender: room is there */
-    d->status_due = true;
-}
-
-static void send_status(sim_dev_t *d, uint32_t now)
-{
-    if (!cs_link_can_send(&d->link, CS_PROTO_STATUS))
-        return;
-    cs_proto_msg_t s = {.type = CS_PROTO_STATUS};
-    s.u.status.state = d->state;
-    s.u.status.boot_id = d->boot;
-    s.u.status.queue_fill = (uint16_t)d->qcount;
-    s.u.status.last_seq = d->exec_seq;
-    s.u.status.axes = d->m->n_axes;
-    for (unsigned i = 0; i < d->m->n_axes; i++)
-        s.u.status.pos[i] = cs_stepper_position(&d->st, i);
-    if (cs_link_send_msg(&d->link, &s, NULL) == CS_OK) {
-        d->status_due = false;
-        d->status_at = now;
-        d->sent_state = d->state;
-    }
-}
-
-static void write_out(sim_dev_t *d, const uint8_t *b, size_t n)
-{
-    if (cs_serial_write(&d->ser, b, n) != 0)
-        d->ser.lost += n; /* a device UART never blocks: bytes nobody takes are gone */
-}
-
-static void flush_link(sim_dev_t *d, uint32_t now)
-{
-    for (int k = 0; k < 64; k++) {
-        const uint8_t *b;
-        size_t n;
-        cs_err_t e = cs_link_poll(&d->link, now, free_slots(d), &b, &n);
-        if (e == CS_END)
-            return;
-        if (e == CS_ERR_TIMEOUT) { /* the host went away: wait for the next one */
-            cs_link_restart(&d->link, new_nonce(d), now);
-            continue;
-        }
-        if (e == CS_OK)
-            write_out(d, b, n);
-    }
-}
-
-/* --- motion -------------------------------------------------------------------------------- */
-
-/* Everything taken from the queue has been executed (the queue itself may hold more). */
-static bool drained(const sim_dev_t *d)
-{
-    return !d->tracing && !d->gen_busy && cs_planner_count(&d->pl) == 0 && cs_stepper_idle(&d->st);
-}
-
-static bool everything_done(const sim_dev_t *d)
-{
-    return d->qcount == 0 && drained(d);
-}
-
-static bool may_take_item(const sim_dev_t *d)
-{
-    if (d->held || d->hung)
-        return false;
-    if (d->fault_kind != 0 && d->popped >= d->fault_at)
-        return false;
-    return true;
-}
-
-static void note_completed(sim_dev_t *d)
-{
-    uint8_t inring = (uint8_t)(d->st.tail - d->st.head);
-    uint64_t done = d->pushed - inring - (d->st.running ? 1u : 0u);
-    while (d->completed < done) {
-        const tag_t *t = &d->tags[d->completed & (CS_STEPPER_RING - 1)];
-        uint64_t item = t->item_end ? t->item : t->item - 1;
-        if (item > d->exec_item) {
-            d->res->executed += item - d->exec_item;
-            d->exec_item = item;
-            d->exec_seq = d->item_seq[item & SEQ_MASK];
-        }
-        d->completed++;
-    }
-    if (drained(d) && d->exec_item < d->popped) {
-        d->res->executed += d->popped - d->exec_item;
-        d->exec_item = d->popped;
-        d->exec_seq = d->item_seq[d->popped & SEQ_MASK];
-    }
-}
-
-static cs_pos_t steps_to_pos(int64_t steps, int32_t spm)
-{
-    /* mm Q16 = steps * 2^16 / (spm Q16 / 2^16), rounded to nearest */
-    int64_t num = steps * ((int64_t)1 << 32);
-    int64_t q = num >= 0 ? (num + spm / 2) / spm : -((-num + spm / 2) / spm);
-    return (cs_pos_t)q;
-}
-
-static void refresh_planner(sim_dev_t *d)
-{
-    if (!d->pl_stale || cs_planner_count(&d->pl) != 0)
-        return;
-    cs_pos_t p[CS_AXES] = {0, 0, 0, 0};
-    for (unsigned i = 0; i < d->m->n_axes; i++)
-        p[i] = steps_to_pos(d->steps_pos[i], d->m->axis[i].steps_per_mm);
-    cs_planner_set_position(&d->pl, p);
-    d->pl_stale = false;
-}
-
-static void pop_item(sim_dev_t *d, qitem_t *out)
-{
-    *out = d->q[d->qhead];
-    d->qhead = (d->qhead + 1) % CS_SIM_DEVICE_QUEUE_MAX;
-    d->qcount--;
-    d->popped++;
-    d->item_seq[d->popped & SEQ_MASK] = out->seq;
-}
-
-static void start_curve(sim_dev_t *d, const qitem_t *it)
-{
-    refresh_planner(d);
-    cs_bezier_t c;
-    cs_err_t e = cs_bezier_init(&c, 3, it->msg.u.curve.p);
-    cs_pos_t tol = d->cfg->tol > 0 ? d->cfg->tol : d->m->tolerance;
-    if (e == CS_OK)
-        e = cs_trace_begin(&d->tr, &c, tol, (cs_trace_method_t)d->cfg->method);
-    if (e != CS_OK) {
-        push_error(d, e, it->seq);
-        return;
-    }
-    d->tracing = true;
-    d->tr_feed = it->msg.u.curve.feed;
-    d->tr_item = d->popped;
-    const cs_vec3_t *p0 = &it->msg.u.curve.p[0];
-    d->rapid_pending = p0->x != d->pl.pos[0] || p0->y != d->pl.pos[1] || p0->z != d->pl.pos[2];
-    d->rapid_to = *p0;
-    d->res->curves++;
-}
-
-/* Next step segment for the executor: 1 with *s and *t set, 0 when nothing is ready. */
-static int next_segment(sim_dev_t *d, cs_segment_t *s, tag_t *t)
-{
-    for (int guard = 0; guard < 4096; guard++) {
-        bool feeding = d->tracing || (d->qcount > 0 && may_take_item(d) &&
-                                      d->q[d->qhead].msg.type == CS_PROTO_CURVE);
-        /* Cut when the look-ahead is full or nothing more can be added now (the planner
-         * always plans its last block to end at rest, so cutting early is safe). */
-        if (d->gen_busy ||
-            (cs_planner_count(&d->pl) > 0 && (cs_planner_full(&d->pl) || !feeding))) {
-            if (d->held)
-                return 0;
-            cs_err_t e = cs_segment_next(&d->gen, &d->pl, s);
-            if (e == CS_ERR_EMPTY) {
-                d->gen_busy = false;
-                continue;
-            }
-            if (e != CS_OK) {
-                push_error(d, e, d->item_seq[d->gen.line & SEQ_MASK]);
-                d->gen_busy = false;
-                cs_planner_init(&d->pl, d->m);
-                d->pl_stale = true;
-                return 0;
-            }
-            d->gen_busy = !cs_segment_block_end(&d->gen);
-            /* blocks carry their item number as "line" (32-bit): rebuild the 64-bit one */
-            *t = (tag_t){(d->popped & ~(uint64_t)0xFFFFFFFFu) | d->gen.line, false};
-            if (t->item > d->popped)
-                t->item -= (uint64_t)1 << 32;
-            return 1;
-        }
-        if (d->tracing) {
-            cs_vec3_t pt;
-            cs_err_t e;
-            if (d->rapid_pending) {
-                pt = d->rapid_to;
-                e = cs_planner_line3(&d->pl, &pt, 0, (uint32_t)d->tr_item);
-                d->rapid_pending = false;
-            } else {
-                e = cs_trace_next(&d->tr, &pt);
-                if (e == CS_END) {
-                    d->tracing = false;
-                    continue;
-                }
-                if (e == CS_OK)
-                    e = cs_planner_line3(&d->pl, &pt, d->tr_feed, (uint32_t)d->tr_item);
-            }
-            if (e != CS_OK) {
-                push_error(d, e, d->item_seq[d->tr_item & SEQ_MASK]);
-                d->tracing = false;
-            }
-            continue;
-        }
-        if (d->qcount == 0 || !may_take_item(d))
-            return 0;
-        if (d->q[d->qhead].msg.type == CS_PROTO_CURVE) {
-            qitem_t it;
-            pop_item(d, &it);
-            start_curve(d, &it);
-            continue;
-        }
-        qitem_t it;
-        pop_item(d, &it);
-        *s = it.msg.u.segment;
-        *t = (tag_t){d->popped, true};
-        d->pl_stale = true;
-        return 1;
-    }
-    return 0;
-}
-
-/* Keeps the executor's ring full. Returns segments pushed. */
-static unsigned feed(sim_dev_t *d)
-{
-    unsigned n = 0;
-    while (cs_stepper_free(&d->st) > 0) {
-        cs_segment_t s;
-        tag_t t;
-        if (next_segment(d, &s, &t) != 1)
-            break;
-        cs_err_t e = cs_stepper_push(&d->st, &s);
-        if (e != CS_OK) { /* cs_proto checked the invariant already; keep going */
-            push_error(d, e, d->item_seq[t.item & SEQ_MASK]);
-            continue;
-        }
-        d->tags[d->pushed & (CS_STEPPER_RING - 1)] = t;
-        d->pushed++;
-        n++;
-        d->res->segments++;
-        if (t.item_end)
-            d->res->seg_hash = cs_sim_device_hash(d->res->seg_hash, &s);
-        for (unsigned i = 0; i < CS_AXES; i++)
-            d->steps_pos[i] += s.steps[i];
-    }
+    sim_dev_t *d = ctx;
+    size_t n = d->rx_len - d->rx_off;
+    if (n > max)
+        n = max;
+    memcpy(buf, d->rx + d->rx_off, n);
+    d->rx_off += n;
     return n;
 }
 
+static size_t uart_write(void *ctx, const uint8_t *buf, size_t n)
+{
+    sim_dev_t *d = ctx;
+    if (cs_serial_write(&d->ser, buf, n) != 0)
+        d->ser.lost += n; /* a device UART never blocks: bytes nobody takes are gone */
+    return n;
+}
+
+/* The same xorshift as the write side (cs_serial): corrupts what arrives too. */
+static void corrupt_in(sim_dev_t *d)
+{
+    for (size_t k = d->rx_off; k < d->rx_len; k++) {
+        uint64_t x = d->ser.rng;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        d->ser.rng = x;
+        if ((double)(x >> 11) * (1.0 / 9007199254740992.0) < d->cfg->corrupt_in) {
+            d->rx[k] ^= (uint8_t)(1u + (uint8_t)((x >> 3) % 255u));
+            d->ser.corrupted++;
+        }
+    }
+}
+
+/* --- pacing ---------------------------------------------------------------------------------- */
+
+static void sync_res(sim_dev_t *d)
+{
+    const cs_fw_stats_t *s = &d->app.mo.stats;
+    cs_sim_device_result_t *r = d->res;
+    r->executed = s->executed;
+    r->segments = s->segments;
+    r->curves = s->curves;
+    r->holds = s->holds;
+    r->aborts = s->aborts;
+    r->errors_sent = s->errors_sent;
+    r->seg_hash = d->app.mo.log.hash;
+    r->out_of_order = d->app.out_of_order;
+}
+
+/* Runs the executor up to wall time `wall` (simulated time = speed x wall time since the executor
+ * last started), feeding it from the motion side between runs as the main loop would. */
 static void advance(sim_dev_t *d, double wall)
 {
-    double hz = (double)d->m->tick_hz;
-    unsigned pushed_now = 0;
-    if (d->cfg->speed <= 0) {
-        /* instant: run everything available, a bounded amount per call */
-        for (int k = 0; k < 256; k++) {
-            pushed_now += feed(d);
-            if (cs_stepper_idle(&d->st))
-                break;
-            port_posix_run(UINT64_MAX);
-            note_completed(d);
-        }
-    } else {
-        if (cs_stepper_idle(&d->st)) {
+    cs_fw_motion_t *mo = &d->app.mo;
+    uint32_t seg0 = mo->stats.segments;
+    uint64_t target = UINT64_MAX;
+    int passes = 256; /* instant: a bounded amount of work a call */
+    /* held at rest mid-job: simulated time goes on (the trace shows the pause); otherwise an
+     * idle executor restarts the clock's anchor (time spent waiting for the host is skipped) */
+    bool held_rest = cs_stepper_idle(&mo->st) && mo->hold.hold && !cs_fw_motion_done(mo);
+    if (d->cfg->speed > 0) {
+        if (cs_stepper_idle(&mo->st) && !held_rest) {
             d->anchor_wall = wall;
             d->anchor_ticks = port_posix_now();
         }
-        double t = (double)d->anchor_ticks + (wall - d->anchor_wall) * d->cfg->speed * hz;
-        uint64_t target = t >= 1.8e19 ? UINT64_MAX : (uint64_t)t;
-        for (int k = 0; k < 4096; k++) {
-            pushed_now += feed(d);
-            if (cs_stepper_idle(&d->st))
-                break;
-            port_posix_run(target);
-            note_completed(d);
-            if (port_posix_now() >= target)
-                break;
-        }
+        double t = (double)d->anchor_ticks +
+                   (wall - d->anchor_wall) * d->cfg->speed * (double)d->m->tick_hz;
+        target = t >= 1.8e19 ? UINT64_MAX : (uint64_t)t;
+        passes = 4096;
+        if (held_rest)
+            port_posix_idle_until(target);
     }
-    note_completed(d);
-    if (pushed_now > 0 && d->dry) {
+    for (int k = 0; k < passes; k++) {
+        cs_fw_motion_poll(mo);
+        if (cs_stepper_idle(&mo->st))
+            break;
+        port_posix_run(target);
+        if (port_posix_now() >= target)
+            break;
+    }
+    cs_fw_motion_poll(mo);
+    if (mo->stats.segments != seg0 && d->dry) {
         d->res->exec_gaps++;
         d->res->gap_wall_s += wall - d->dry_since;
         d->dry = false;
     }
-    if (cs_stepper_idle(&d->st) && !d->dry && d->exec_item > 0 && !d->held) {
+    if (cs_stepper_idle(&mo->st) && !d->dry && mo->stats.executed > 0 && !mo->hold.hold) {
         d->dry = true;
         d->dry_since = wall;
     }
-    uint8_t st = d->held               ? CS_PROTO_STATE_HELD
-                 : !everything_done(d) ? CS_PROTO_STATE_RUNNING
-                 : d->aborted          ? CS_PROTO_STATE_ABORTED
-                                       : CS_PROTO_STATE_IDLE;
-    if (st != d->state) {
-        d->state = st;
-        d->status_due = true;
-    }
+    sync_res(d);
 }
 
-static void do_abort(sim_dev_t *d)
+/* --- faults: after item N is executed and reported, act ------------------------------------- */
+
+static uint32_t next_boot_id(uint32_t boot)
 {
-    d->qcount = 0;
-    d->tracing = false;
-    d->rapid_pending = false;
-    /* the executor's ring finishes (at most CS_STEPPER_RING segments), the rest is dropped */
-    if (d->gen_busy || cs_planner_count(&d->pl) > 0) {
-        cs_planner_init(&d->pl, d->m);
-        cs_segment_init(&d->gen, d->m);
-        d->gen_busy = false;
-    }
-    d->pl_stale = true;
-    /* items taken and dropped count as done for the executed sequence */
-    d->held = false;
-    d->aborted = true;
-    d->res->aborts++;
+    uint32_t id = boot * 2654435761u + 0x9E3779B9u;
+    return id == 0 || id == boot ? boot + 1u : id;
 }
 
-static void on_deliver(sim_dev_t *d, const cs_link_event_t *ev)
-{
-    if (d->have_prev && ev->seq != (uint16_t)(d->prev_seq + 1u))
-        d->res->out_of_order++;
-    d->have_prev = true;
-    d->prev_seq = ev->seq;
-    cs_proto_msg_t m;
-    cs_err_t e = cs_proto_decode(ev->payload, ev->len, &m);
-    if (e != CS_OK) {
-        push_error(d, e == CS_ERR_ARG ? CS_ERR_FRAME : e, ev->seq);
-        return;
-    }
-    switch (m.type) {
-    case CS_PROTO_SEGMENT:
-    case CS_PROTO_CURVE:
-        if (cs_sim_motion_queue(d, &m, ev->seq) != CS_OK) /* cs_link refuses it first */
-            push_error(d, CS_ERR_FULL, ev->seq);
-        break;
-    case CS_PROTO_HOLD:
-        d->held = true;
-        d->res->holds++;
-        d->status_due = true;
-        break;
-    case CS_PROTO_RESUME:
-        d->held = false;
-        d->status_due = true;
-        break;
-    case CS_PROTO_ABORT:
-        do_abort(d);
-        d->status_due = true;
-        break;
-    default:
-        push_error(d, CS_ERR_UNSUPPORTED, ev->seq);
-        break;
-    }
-}
-
-/* (Re)boots the device's link: a new boot id (id, or a fresh one when 0), the receiver back at
- * sequence 0, the queue lost. The executor and its position are kept (a machine that homes). */
-static void boot(sim_dev_t *d, uint32_t now, uint32_t id)
-{
-    if (id == 0) {
-        id = d->boot * 2654435761u + 0x9E3779B9u + new_nonce(d);
-        if (id == 0 || id == d->boot)
-            id = d->boot + 1u;
-    }
-    d->boot = id;
-    /* link timing in microseconds for the device's line rate (cs_stream_link_timing): the NAK
-     * hold-off must stay below a round trip, a fraction of a millisecond on a pty */
-    cs_link_cfg_t lc = {.keepalive = 0, .max_retries = 20};
-    cs_stream_link_timing(&lc, d->cfg->line_rate);
-    cs_link_init(&d->link, &lc, d->boot, new_nonce(d), 0, now);
-    d->qcount = 0;
-    d->qhead = 0;
-    /* nothing of this boot executed yet: the last executed sequence is the one before the
-     * receiver's first (a host reads STATUS.last_seq against its own first sequence) */
-    d->exec_seq = 0xFFFFu;
-    d->item_seq[d->popped & SEQ_MASK] = 0xFFFFu;
-    d->have_prev = false;
-    d->held = false;
-    d->aborted = false;
-    d->nerr = 0;
-    d->res->boot_id = d->boot;
-}
-
-/* The fault scheduled at item N: after item N is executed and reported, act. Returns true when
- * serve must return (close). */
+/* Returns true when serve must return (close). */
 static bool run_fault(sim_dev_t *d, uint32_t now)
 {
-    if (d->fault_kind == 0 || d->popped < d->fault_at || !drained(d))
+    cs_fw_motion_t *mo = &d->app.mo;
+    if (d->fault_kind == FAULT_NONE || mo->popped < d->fault_at || !cs_fw_motion_drained(mo))
         return false;
     if (d->fault_phase == 0) {
-        d->status_due = true;
-        send_status(d, now);
-        if (!d->status_due) {
+        if (cs_fw_app_send_status(&d->app)) {
             d->fault_phase = 1;
             d->fault_status_at = now;
         }
         return false;
     }
     /* wait until the STATUS saying so was acknowledged (or 500 ms; times in us) */
-    if (cs_link_unacked(&d->link) != 0 && (uint32_t)(now - d->fault_status_at) < 500000u)
+    if (cs_link_unacked(&d->app.link) != 0 && (uint32_t)(now - d->fault_status_at) < 500000u)
         return false;
     int kind = d->fault_kind;
-    d->fault_kind = 0;
+    d->fault_kind = FAULT_NONE;
     d->fault_phase = 0;
-    if (kind == 1) {
+    cs_fw_motion_take_limit(mo, 0);
+    if (kind == FAULT_RESET) {
         d->res->resets++;
-        boot(d, now, 0);
-    } else if (kind == 2) {
+        cs_fw_app_reboot(&d->app, next_boot_id(d->app.boot));
+        d->res->boot_id = d->app.boot;
+    } else if (kind == FAULT_HANG) {
         d->hung = true;
     } else {
         return true;
@@ -554,6 +200,54 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
+static void arm_faults(sim_dev_t *d)
+{
+    const cs_sim_device_cfg_t *cfg = d->cfg;
+    d->fault_kind = cfg->reset_after   ? FAULT_RESET
+                    : cfg->hang_after  ? FAULT_HANG
+                    : cfg->close_after ? FAULT_CLOSE
+                                       : FAULT_NONE;
+    d->fault_at = cfg->reset_after  ? cfg->reset_after
+                  : cfg->hang_after ? cfg->hang_after
+                                    : cfg->close_after;
+    if (d->fault_kind != FAULT_NONE)
+        cs_fw_motion_take_limit(&d->app.mo, (uint32_t)d->fault_at);
+}
+
+/* Reads what the line has (waiting up to wait_ms); -1 when the line is gone. */
+static int read_line(sim_dev_t *d, int wait_ms)
+{
+    ssize_t n = cs_serial_read(&d->ser, d->rx, sizeof d->rx, wait_ms);
+    if (n < 0) {
+        if (errno == EIO || errno == EBADF)
+            return -1;
+        sleep_ms(5);
+        n = 0;
+    }
+    d->rx_len = (size_t)n;
+    d->rx_off = 0;
+    if (n > 0 && d->cfg->corrupt_in > 0)
+        corrupt_in(d);
+    return 0;
+}
+
+/* One pass of the device: the line read, the application run over it, time advanced. */
+static cs_err_t serve_pass(sim_dev_t *d, double *last_rx_s)
+{
+    cs_fw_motion_t *mo = &d->app.mo;
+    bool busy = !cs_fw_motion_done(mo) && !mo->hold.hold;
+    if (read_line(d, busy ? 1 : 5) != 0)
+        return CS_ERR_IO;
+    if (d->rx_len > 0)
+        *last_rx_s = cs_serial_now_s();
+    do /* the application reads CS_FW_RX_CHUNK bytes a poll */
+        cs_fw_app_poll(&d->app);
+    while (d->rx_off < d->rx_len);
+    advance(d, cs_serial_now_s());
+    cs_fw_app_poll(&d->app); /* STATUS, ERROR and acknowledgements after the motion moved */
+    return CS_OK;
+}
+
 cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile sig_atomic_t *stop,
                              cs_sim_device_result_t *res)
 {
@@ -565,98 +259,31 @@ cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile si
     cs_serial_set_lossy(&d->ser, true);
     cs_serial_set_line_rate(&d->ser, cfg->line_rate);
     cs_serial_set_faults(&d->ser, &cfg->faults);
+    port_posix_uart_hooks(uart_read, uart_write, d);
     double start = cs_serial_now_s();
-    d->nonce = (uint32_t)getpid() ^ (uint32_t)(start * 1e6);
-    d->boot = d->nonce ^ 0xA5A5A5A5u;
-    uint32_t now = cs_serial_now_us();
-    boot(d, now, cfg->boot_id);
-    if (cfg->reset_after) {
-        d->fault_kind = 1;
-        d->fault_at = cfg->reset_after;
-    } else if (cfg->hang_after) {
-        d->fault_kind = 2;
-        d->fault_at = cfg->hang_after;
-    } else if (cfg->close_after) {
-        d->fault_kind = 3;
-        d->fault_at = cfg->close_after;
-    }
-    d->state = CS_PROTO_STATE_IDLE;
-    d->status_due = true;
-    d->last_rx_s = start;
-    uint32_t status_period = cfg->status_ms ? cfg->status_ms : 50;
+    uint32_t seed = (uint32_t)getpid() ^ (uint32_t)(start * 1e6);
+    cs_fw_app_reboot(&d->app, cfg->boot_id != 0 ? cfg->boot_id : seed ^ 0xA5A5A5A5u);
+    res->boot_id = d->app.boot;
+    arm_faults(d);
+    double last_rx_s = start;
     cs_err_t rc = CS_OK;
-    uint8_t buf[4096];
     while (stop == NULL || !*stop) {
-        double wall = cs_serial_now_s();
-        now = cs_serial_now_us();
         if (d->hung) {
             sleep_ms(10);
             continue;
         }
-        bool busy = !everything_done(d) && !d->held;
-        ssize_t n = cs_serial_read(&d->ser, buf, sizeof buf, busy ? 1 : 5);
-        if (n < 0) {
-            if (errno == EIO || errno == EBADF) { /* the line is gone */
-                rc = CS_ERR_IO;
-                break;
-            }
-            sleep_ms(5);
-            n = 0;
-        }
-        if (n > 0)
-            d->last_rx_s = wall;
-        now = cs_serial_now_us();
-        for (ssize_t k = 0; k < n; k++) {
-            uint8_t b = buf[k];
-            if (cfg->corrupt_in > 0) {
-                /* the same xorshift as the write side: corrupt what arrives too */
-                uint64_t x = d->ser.rng;
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                d->ser.rng = x;
-                if ((double)(x >> 11) * (1.0 / 9007199254740992.0) < cfg->corrupt_in) {
-                    b ^= (uint8_t)(1u + (uint8_t)((x >> 3) % 255u));
-                    d->ser.corrupted++;
-                }
-            }
-            cs_link_event_t ev;
-            cs_err_t fe = cs_link_feed(&d->link, b, now, free_slots(d), &ev);
-            if (fe != CS_OK)
-                continue;
-            if (ev.what & CS_LINK_EV_DELIVER)
-                on_deliver(d, &ev);
-            if (ev.what & CS_LINK_EV_RESET) /* the host restarted: join the new one */
-                cs_link_restart(&d->link, new_nonce(d), now);
-            if (ev.what & CS_LINK_EV_OPEN)
-                send_hello(d);
-        }
-        advance(d, cs_serial_now_s());
-        now = cs_serial_now_us();
-        while (d->nerr > 0 && cs_link_can_send(&d->link, CS_PROTO_ERROR)) {
-            cs_proto_msg_t em = {.type = CS_PROTO_ERROR};
-            em.u.error = d->errs[0];
-            if (cs_link_send_msg(&d->link, &em, NULL) != CS_OK)
-                break;
-            memmove(d->errs, d->errs + 1, (d->nerr - 1) * sizeof d->errs[0]);
-            d->nerr--;
-            res->errors_sent++;
-        }
-        uint32_t period = (d->state == CS_PROTO_STATE_RUNNING || d->state == CS_PROTO_STATE_HELD)
-                              ? status_period
-                              : 250u;
-        if (cs_link_state(&d->link) == CS_LINK_OPEN &&
-            (d->status_due || (uint32_t)(now - d->status_at) >= period * 1000u))
-            send_status(d, now);
-        if (run_fault(d, now))
+        rc = serve_pass(d, &last_rx_s);
+        if (rc != CS_OK)
             break;
-        flush_link(d, now);
-        if (cfg->idle_exit_s > 0 && d->exec_item > 0 && everything_done(d) &&
-            wall - d->last_rx_s > cfg->idle_exit_s)
+        if (run_fault(d, cs_serial_now_us()))
+            break;
+        if (cfg->idle_exit_s > 0 && d->app.mo.stats.executed > 0 && cs_fw_motion_done(&d->app.mo) &&
+            cs_serial_now_s() - last_rx_s > cfg->idle_exit_s)
             break;
     }
-    res->link = d->link.stats;
-    res->frames = d->link.dec.stats;
+    port_posix_uart_hooks(NULL, NULL, NULL);
+    res->link = d->app.link.stats;
+    res->frames = d->app.link.dec.stats;
     res->bytes_in = d->ser.bytes_in;
     res->bytes_out = d->ser.bytes_out;
     res->wall_s = cs_serial_now_s() - start;
@@ -666,12 +293,16 @@ cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile si
 
 /* --- the motion side, shared with the Modbus device ---------------------------------------- */
 
+static uint32_t clock_us(void)
+{
+    return cs_serial_now_us();
+}
+
 cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
                             cs_sim_device_result_t *res)
 {
     *out = NULL;
     memset(res, 0, sizeof *res);
-    res->seg_hash = CS_SIM_DEVICE_HASH0;
     if (cfg == NULL || cfg->m == NULL || cfg->queue_size < 1 ||
         cfg->queue_size > CS_SIM_DEVICE_QUEUE_MAX)
         return CS_ERR_ARG;
@@ -681,52 +312,55 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     d->cfg = cfg;
     d->m = cfg->m;
     d->res = res;
-    cs_err_t e = cs_stepper_init(&d->st, d->m);
-    if (e == CS_OK)
-        e = cs_planner_init(&d->pl, d->m);
-    if (e == CS_OK)
-        e = cs_segment_init(&d->gen, d->m);
-    if (e != CS_OK) {
-        free(d);
-        return CS_ERR_ARG;
-    }
     for (unsigned i = 0; i < d->m->n_axes; i++)
         if (d->m->axis[i].invert_dir)
             d->inv = (uint8_t)(d->inv | (1u << i));
     port_posix_reset(d->m->tick_hz, d->inv);
     port_posix_record(true);
-    port_stepper_attach(&d->st);
-    d->exec_seq = 0xFFFFu;
-    d->item_seq[0] = 0xFFFFu;
-    d->state = CS_PROTO_STATE_IDLE;
+    /* the application on the POSIX port, its link on the wall clock in microseconds with the
+     * timing of the simulated line (cs_stream_link_timing) */
+    cs_fw_app_cfg_t ac;
+    cs_fw_app_cfg_default(&ac, d->m);
+    ac.motion.queue_size = cfg->queue_size;
+    ac.motion.tol = cfg->tol > 0 ? cfg->tol : d->m->tolerance;
+    ac.motion.method = (uint8_t)cfg->method;
+    ac.clock = clock_us;
+    ac.clock_hz = 1000000u;
+    cs_stream_link_timing(&ac.link, cfg->line_rate);
+    ac.link.keepalive = 0;
+    ac.link.max_retries = 20;
+    ac.status_ms = cfg->status_ms ? cfg->status_ms : 50;
+    cs_err_t e = cs_fw_app_init_cfg(&d->app, d->m, cfg->boot_id ? cfg->boot_id : 1u, &ac);
+    if (e != CS_OK) {
+        port_stepper_attach(NULL);
+        free(d);
+        return CS_ERR_ARG;
+    }
+    res->seg_hash = d->app.mo.log.hash;
     *out = d;
     return CS_OK;
 }
 
+cs_fw_motion_t *cs_sim_motion_fw(sim_dev_t *d)
+{
+    return &d->app.mo;
+}
+
 cs_err_t cs_sim_motion_queue(sim_dev_t *d, const cs_proto_msg_t *m, uint16_t seq)
 {
-    if (m->type != CS_PROTO_SEGMENT && m->type != CS_PROTO_CURVE)
-        return CS_ERR_UNSUPPORTED;
-    if (d->qcount >= d->cfg->queue_size)
-        return CS_ERR_FULL;
-    d->q[(d->qhead + d->qcount) % CS_SIM_DEVICE_QUEUE_MAX] = (qitem_t){*m, seq};
-    d->qcount++;
-    d->aborted = false;
-    return CS_OK;
+    return cs_fw_motion_queue(&d->app.mo, m, seq);
 }
 
 void cs_sim_motion_hold(sim_dev_t *d, bool on)
 {
-    if (on && !d->held)
-        d->res->holds++;
-    d->held = on;
-    d->status_due = true;
+    cs_fw_motion_hold(&d->app.mo, on);
+    sync_res(d);
 }
 
 void cs_sim_motion_abort(sim_dev_t *d)
 {
-    do_abort(d);
-    d->status_due = true;
+    cs_fw_motion_abort(&d->app.mo);
+    sync_res(d);
 }
 
 void cs_sim_motion_advance(sim_dev_t *d, double wall_s)
@@ -736,44 +370,61 @@ void cs_sim_motion_advance(sim_dev_t *d, double wall_s)
 
 uint16_t cs_sim_motion_free_slots(const sim_dev_t *d)
 {
-    return free_slots(d);
+    return cs_fw_motion_free(&d->app.mo);
 }
 
 void cs_sim_motion_status(const sim_dev_t *d, cs_proto_status_t *st)
 {
-    st->state = d->state;
-    st->boot_id = d->boot;
-    st->queue_fill = (uint16_t)d->qcount;
-    st->last_seq = d->exec_seq;
-    st->axes = d->m->n_axes;
-    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
-        st->pos[i] = i < d->m->n_axes ? cs_stepper_position(&d->st, i) : 0;
+    cs_fw_motion_status(&d->app.mo, st);
+    st->boot_id = d->app.boot;
 }
 
 bool cs_sim_motion_pop_error(sim_dev_t *d, cs_proto_error_t *e)
 {
-    if (d->nerr == 0)
-        return false;
-    *e = d->errs[0];
-    memmove(d->errs, d->errs + 1, (d->nerr - 1) * sizeof d->errs[0]);
-    d->nerr--;
-    d->res->errors_sent++;
-    return true;
+    bool got = cs_fw_motion_pop_error(&d->app.mo, e);
+    sync_res(d);
+    return got;
 }
 
 bool cs_sim_motion_done(const sim_dev_t *d)
 {
-    return everything_done(d);
+    return cs_fw_motion_done(&d->app.mo);
 }
 
 bool cs_sim_motion_started(const sim_dev_t *d)
 {
-    return d->exec_item > 0;
+    return d->app.mo.stats.executed > 0;
 }
 
 bool cs_sim_motion_busy(const sim_dev_t *d)
 {
-    return !everything_done(d) && !d->held;
+    return !cs_fw_motion_done(&d->app.mo) && !d->app.mo.hold.hold;
+}
+
+/* Copies the port's recorded edges into res->ex (keep_edges). */
+static cs_err_t keep_edges(sim_dev_t *d)
+{
+    cs_sim_device_result_t *res = d->res;
+    cs_err_t rc = CS_OK;
+    size_t ne;
+    const port_posix_edge_t *edges = port_posix_edges(&ne);
+    if (!port_posix_record_ok()) {
+        rc = CS_ERR_FULL;
+    } else if (ne > 0) {
+        res->ex.edges = malloc(ne * sizeof *edges);
+        if (res->ex.edges == NULL)
+            rc = CS_ERR_FULL;
+        else
+            memcpy(res->ex.edges, edges, ne * sizeof *edges);
+    }
+    if (res->ex.edges != NULL || ne == 0)
+        res->ex.n = ne;
+    res->ex.end_tick = port_posix_now();
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        res->ex.pos[i] = port_posix_position(i);
+        res->ex.exec_pos[i] = cs_stepper_position(&d->app.mo.st, i);
+    }
+    return rc;
 }
 
 cs_err_t cs_sim_motion_close(sim_dev_t *d)
@@ -782,30 +433,15 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     cs_err_t rc = CS_OK;
     /* what the executor still holds is executed (a stop request finishes the ring) */
     port_posix_run(UINT64_MAX);
-    note_completed(d);
+    cs_fw_motion_poll(&d->app.mo);
+    sync_res(d);
     res->ticks = port_posix_now();
     for (unsigned i = 0; i < CS_AXES; i++)
         res->pos[i] = port_posix_position(i);
-    if (d->cfg->keep_edges) {
-        size_t ne;
-        const port_posix_edge_t *edges = port_posix_edges(&ne);
-        if (!port_posix_record_ok()) {
-            rc = CS_ERR_FULL;
-        } else if (ne > 0) {
-            res->ex.edges = malloc(ne * sizeof *edges);
-            if (res->ex.edges == NULL)
-                rc = CS_ERR_FULL;
-            else
-                memcpy(res->ex.edges, edges, ne * sizeof *edges);
-        }
-        if (res->ex.edges != NULL || ne == 0)
-            res->ex.n = ne;
-        res->ex.end_tick = port_posix_now();
-        for (unsigned i = 0; i < CS_AXES; i++) {
-            res->ex.pos[i] = port_posix_position(i);
-            res->ex.exec_pos[i] = cs_stepper_position(&d->st, i);
-        }
-    }
+    res->log_segs = d->app.mo.log;
+    res->log_edges = port_posix_edge_log();
+    if (d->cfg->keep_edges)
+        rc = keep_edges(d);
     port_posix_reset(d->m->tick_hz, d->inv); /* frees the port's copy of the edges */
     port_stepper_attach(NULL);
     free(d);
@@ -1136,8 +772,12 @@ int cs_sim_device_report(const cs_machine_t *mp, const cs_sim_device_cfg_t *cfg,
     bool check = o->check;
     printf("executor ran dry %u times mid-job (%.3f s of wall time)\n", (unsigned)res.exec_gaps,
            res.gap_wall_s);
-    printf("executed step segments' hash (FNV-1a 64, in order): %016llx\n",
+    printf("executed step segments' hash (FNV-1a 32, in order): %08llx\n",
            (unsigned long long)res.seg_hash);
+    /* the execution log in the words of the Cortex-M3 image's report (main_m3.c) */
+    printf("log: %u segments hash %u, %u step edges hash %u at executor tick %u\n",
+           (unsigned)res.log_segs.n, (unsigned)res.log_segs.hash, (unsigned)res.log_edges.n,
+           (unsigned)res.log_edges.hash, (unsigned)res.log_edges.clock);
     printf("job time: %.4f s simulated, %zu steps\n", (double)res.ticks / m.tick_hz, res.ex.n);
     printf("final position:");
     for (unsigned i = 0; i < m.n_axes; i++)

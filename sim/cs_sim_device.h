@@ -1,10 +1,10 @@
 /* cs_sim_device: the simulator as the device on the far end of a serial line (a pty or a tty).
- * Runs what the firmware runs -- the cs_link receiver/sender, a motion queue whose free slots are
- * the flow-control credits, the core planner and segment generator for CURVE messages (traced
- * with cs_trace on the device), the cs_stepper executor on the POSIX port -- with the simulated
- * time paced against the wall clock (see docs/streaming.md, "The device's pacing"), answers
- * HELLO/STATUS/HOLD/RESUME/ABORT, injects faults for tests, and records every STEP edge for the
- * check report. Host only (POSIX); one device per process (the POSIX port is process-wide). */
+ * The device is the firmware's own application (firmware/app: cs_fw_app over cs_fw_motion) on the
+ * POSIX port (firmware/ports/posix), unchanged; this module adds what a simulator is for: the
+ * simulated time paced against the wall clock (see docs/streaming.md, "The device's pacing"),
+ * faults injected on the line and scheduled resets/hangs/closes, every STEP edge recorded for the
+ * check report, the command line. Host only (POSIX); one device per process (the POSIX port is
+ * process-wide). */
 #ifndef CS_SIM_DEVICE_H
 #define CS_SIM_DEVICE_H
 
@@ -13,13 +13,16 @@
 #include <stdint.h>
 
 #include "cs_jobopts.h"
+#include "cs_exlog.h"
+#include "cs_fw_motion.h"
 #include "cs_link.h"
 #include "cs_machine.h"
 #include "cs_serial.h"
 #include "cs_sim.h"
 
-/* Largest motion queue (slot-using messages waiting for the executor). */
-#define CS_SIM_DEVICE_QUEUE_MAX 256
+/* Largest motion queue (slot-using messages waiting for the executor): the application's
+ * compile-time queue (the host build sets CS_FW_QUEUE=256). */
+#define CS_SIM_DEVICE_QUEUE_MAX CS_FW_QUEUE
 
 typedef struct {
     const cs_machine_t *m;
@@ -45,7 +48,7 @@ typedef struct {
 typedef struct {
     uint64_t executed;       /* slot-using messages executed (SEGMENT and CURVE) */
     uint64_t segments;       /* step segments run by the executor */
-    uint64_t seg_hash;       /* FNV-1a 64 over every executed SEGMENT message, in order */
+    uint64_t seg_hash;       /* FNV-1a 32 over every segment handed to the executor (cs_exlog) */
     uint64_t curves;         /* CURVE messages executed */
     uint64_t out_of_order;   /* deliveries whose sequence was not the previous + 1 (must be 0) */
     uint32_t resets;         /* simulated reboots */
@@ -57,10 +60,12 @@ typedef struct {
     cs_link_stats_t link;    /* the device's link counters (duplicates, out of order, ...) */
     cs_frame_stats_t frames; /* frames decoded, CRC errors, malformed */
     uint64_t bytes_in, bytes_out;
-    uint64_t ticks;       /* simulated time at the end (executor ticks) */
-    double wall_s;        /* wall time served */
-    int64_t pos[CS_AXES]; /* final position from the STEP/DIR lines, steps */
-    cs_sim_exec_t ex;     /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
+    uint64_t ticks;             /* simulated time at the end (executor ticks) */
+    double wall_s;              /* wall time served */
+    int64_t pos[CS_AXES];       /* final position from the STEP/DIR lines, steps */
+    cs_sim_exec_t ex;           /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
+    cs_exlog_segs_t log_segs;   /* the execution log, as a board keeps it (cs_exlog) */
+    cs_exlog_edges_t log_edges; /* the STEP edges on the executor's clock (cs_exlog) */
 } cs_sim_device_result_t;
 
 /* Defaults: queue 32, real time, no faults, subdivision at the machine's tolerance. */
@@ -71,10 +76,6 @@ void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m);
  * CS_ERR_FULL when out of memory. Not reentrant (uses the process-wide POSIX port). */
 cs_err_t cs_sim_device_serve(int fd, const cs_sim_device_cfg_t *cfg, volatile sig_atomic_t *stop,
                              cs_sim_device_result_t *res);
-/* FNV-1a 64 of one segment (ticks, then each of the CS_AXES steps, little-endian), chained from
- * h (start with CS_SIM_DEVICE_HASH0): what the tests compare with the host's own sum. */
-#define CS_SIM_DEVICE_HASH0 0xcbf29ce484222325ull
-uint64_t cs_sim_device_hash(uint64_t h, const cs_segment_t *s);
 
 /* The device's motion side, shared by the serial device above and the Modbus device
  * (cs_sim_modbus): the motion queue, the planner and tracer for CURVE, the executor on the POSIX
@@ -86,6 +87,8 @@ typedef struct cs_sim_motion cs_sim_motion_t;
  * filled as it runs. CS_ERR_ARG for a bad cfg, CS_ERR_FULL out of memory. */
 cs_err_t cs_sim_motion_open(cs_sim_motion_t **d, const cs_sim_device_cfg_t *cfg,
                             cs_sim_device_result_t *res);
+/* The firmware's motion side it runs (for a front end of the firmware's own, cs_fw_modbus). */
+cs_fw_motion_t *cs_sim_motion_fw(cs_sim_motion_t *d);
 /* Queues a SEGMENT or CURVE with its sequence: CS_ERR_FULL when no slot is free,
  * CS_ERR_UNSUPPORTED for another type. */
 cs_err_t cs_sim_motion_queue(cs_sim_motion_t *d, const cs_proto_msg_t *m, uint16_t seq);

@@ -23,6 +23,7 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_jobplan.h"
+#include "cs_fw_modbus.h"
 #include "cs_machine_ini.h"
 #include "cs_modbus.h"
 #include "cs_motion.h"
@@ -51,12 +52,10 @@ typedef struct {
 
 typedef struct {
     cs_sim_motion_t *mo;
+    cs_fw_modbus_t fm; /* the device's Modbus front end (firmware/app) */
     const cs_machine_t *m;
-    uint16_t queue_size;
     cs_modbus_map_t map;
     uint8_t unit;
-    uint32_t boot;
-    uint16_t error, error_seq;
     mb_faults_t f;
     uint64_t rng;
     uint64_t writes; /* mailbox writes seen by submit */
@@ -77,8 +76,9 @@ static double rnd(mbdev_t *d)
     return (double)(x >> 11) * (1.0 / 9007199254740992.0);
 }
 
-/* --- the register map's hooks -------------------------------------------------------------- */
+/* --- the register map's hooks: the firmware's Modbus front end, with faults in front ------- */
 
+/* A mailbox write: the injected refusals first, then the device's own (cs_fw_modbus). */
 static cs_err_t app_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
 {
     mbdev_t *d = ctx;
@@ -91,65 +91,27 @@ static cs_err_t app_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
         d->busy++;
         return CS_ERR_FULL; /* -> exception 06, SERVER DEVICE BUSY */
     }
-    return cs_sim_motion_queue(d->mo, m, seq);
+    return cs_fw_modbus_submit(&d->fm, m, seq);
 }
 
+/* The rest goes to the device's front end as it is (the map has one ctx for its hooks). */
 static void app_command(void *ctx, uint16_t cmd)
 {
     mbdev_t *d = ctx;
-    switch (cmd) {
-    case CS_MODBUS_CMD_HOLD:
-        cs_sim_motion_hold(d->mo, true);
-        break;
-    case CS_MODBUS_CMD_RESUME:
-        cs_sim_motion_hold(d->mo, false);
-        break;
-    case CS_MODBUS_CMD_ABORT:
-        cs_sim_motion_abort(d->mo);
-        break;
-    case CS_MODBUS_CMD_RESET:
-        cs_sim_motion_abort(d->mo);
-        d->error = 0;
-        d->error_seq = 0;
-        break;
-    default:
-        break;
-    }
+    cs_fw_modbus_command(&d->fm, cmd);
 }
 
 static void app_status(void *ctx, cs_modbus_status_t *st)
 {
     mbdev_t *d = ctx;
-    cs_proto_status_t ps;
-    cs_sim_motion_status(d->mo, &ps);
-    st->caps = CS_PROTO_CAP_ALL;
-    st->axes = d->m->n_axes;
-    st->queue_size = d->queue_size;
-    st->tick_hz = d->m->tick_hz;
-    st->boot_id = d->boot;
-    /* an execution error stops the job: FAULT until the host aborts or resets */
-    st->state =
-        d->error != 0 && ps.state != CS_PROTO_STATE_RUNNING ? CS_PROTO_STATE_FAULT : ps.state;
-    st->free_slots = cs_sim_motion_free_slots(d->mo);
-    st->last_exec = ps.last_seq;
-    st->error = d->error;
-    st->error_seq = d->error_seq;
-    for (unsigned i = 0; i < CS_AXES; i++)
-        st->pos[i] = i < CS_PROTO_AXES_MAX ? ps.pos[i] : 0;
+    cs_fw_modbus_status(&d->fm, st);
 }
 
-/* Runs the motion and collects its errors (the first one stays until RESET). */
+/* Runs the motion paced to the wall clock and latches its errors (cs_fw_modbus). */
 static void step_motion(mbdev_t *d)
 {
     cs_sim_motion_advance(d->mo, cs_serial_now_s());
-    cs_proto_error_t e;
-    while (cs_sim_motion_pop_error(d->mo, &e)) {
-        if (d->error == 0) {
-            d->error = e.code;
-            d->error_seq = e.seq;
-            cs_sim_motion_abort(d->mo);
-        }
-    }
+    cs_fw_modbus_collect(&d->fm);
 }
 
 /* What to do with an answer: 0 send now, 1 drop, 2 delay. */
@@ -668,20 +630,21 @@ int cs_sim_modbus_main(int argc, char **argv)
         return INTERNAL;
     }
     d->m = &m;
-    d->queue_size = cfg.queue_size;
     d->unit = (uint8_t)unit;
     d->f = f;
     d->rng = f.seed ? f.seed : 0x9E3779B97F4A7C15ull;
     double start = cs_serial_now_s();
-    d->boot = (uint32_t)getpid() * 2654435761u ^ (uint32_t)(start * 1e6);
-    if (d->boot == 0)
-        d->boot = 1;
     d->last_rx_s = start;
     cs_sim_device_result_t res;
     cs_err_t e = cs_sim_motion_open(&d->mo, &cfg, &res);
-    cs_modbus_app_t app = {app_submit, app_command, app_status, d};
-    if (e == CS_OK)
+    if (e == CS_OK) {
+        cs_modbus_app_t app;
+        cs_fw_modbus_init(&d->fm, cs_sim_motion_fw(d->mo),
+                          (uint32_t)getpid() * 2654435761u ^ (uint32_t)(start * 1e6), &app);
+        /* the injected refusals in front of the device's; one ctx for the three hooks */
+        app = (cs_modbus_app_t){app_submit, app_command, app_status, d};
         e = cs_modbus_map_init(&d->map, &app, 0);
+    }
     if (e != CS_OK) {
         fprintf(stderr, "curvestep-sim: device failed: %s\n", cs_err_text(e));
         if (d->mo)
@@ -717,7 +680,7 @@ int cs_sim_modbus_main(int argc, char **argv)
            "%u holds, %u aborts, error %u (%s)\n",
            res.wall_s, (unsigned long long)res.executed, (unsigned long long)res.segments,
            (unsigned long long)res.curves, (unsigned)res.holds, (unsigned)res.aborts,
-           (unsigned)d->error, d->error ? cs_err_text((cs_err_t)d->error) : "none");
+           (unsigned)d->fm.error, d->fm.error ? cs_err_text((cs_err_t)d->fm.error) : "none");
     printf("modbus %s unit %u: %llu requests (%llu for other units, not answered); %u mailbox "
            "writes accepted, %u repeats answered without executing, %u refused; %u exceptions\n",
            tcp ? "tcp" : "rtu", (unsigned)d->unit, (unsigned long long)d->requests,

@@ -79,7 +79,7 @@ landed() {
     hostpids=()
 }
 rc_of() { cat "$T/$1.rc" 2>/dev/null; }
-hash_of() { sed -n "s/^executed step segments' hash (FNV-1a 64, in order): //p" "$T/$1.sim"; }
+hash_of() { sed -n "s/^executed step segments' hash (FNV-1a 32, in order): //p" "$T/$1.sim"; }
 executed_of() { sed -n 's/^device: served [0-9.]* s; \([0-9]*\) messages executed.*/\1/p' "$T/$1.sim"; }
 # the step trace without its time column (see docs/modbus.md: the time of an edge moves by one
 # executor tick each time the executor runs dry and restarts, which depends on the link's pace)

@@ -9,7 +9,13 @@
 #     position, steps) and summed per axis here with awk (pulses per axis, messages);
 #   curves mode (the device traces and plans): the simulator's device `curvestep-sim --pty` fed
 #     the same stream (final position, steps in total);
+#   one device application: the simulator's device runs the image's application (firmware/app)
+#     on the POSIX port; fed the same segments it logs the same executed segments and the same
+#     STEP edges, tick for tick on the executor's clock (cs_exlog: count and FNV-1a hash of each);
 #   Ctrl-C: hold then abort reach the image, and it executed exactly what the host says;
+#   feed hold (the core's cs_hold, run by the application): paused mid-job through
+#     `curvestep serve`, held, resumed; the image executed every segment once (its log of the
+#     segments as planned equals case 1's), counted one hold, and ended where the replay ends;
 #   a machine file whose tick rate is not the image's is refused at the HELLO.
 # Every process is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
 set -u
@@ -28,6 +34,7 @@ QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none 
     -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=500)
 # the shared harness: T, pids (killed on exit), ok / ko / expect (tests/cli/lib/common.sh)
 . "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/daemon.sh"
 # value NAME FILE SED-EXPR: the last match of a report line (for messages).
 value() { sed -n "$2" "$1" | tail -n1; }
 
@@ -76,6 +83,18 @@ expect "image built" [ -f "$ELF" ]
 ) &
 REFPID=$!
 pids+=("$REFPID")
+# The segments-mode twin: the simulator's device fed the plan the image gets in case 1.
+(
+    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
+    spid=$!
+    spty=
+    end=$((SECONDS + 10))
+    while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/simseg.out" 2>/dev/null); sleep 0.05; done
+    timeout -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --port "$spty" "$JOB" >"$T/simseg.stream" 2>&1
+    wait "$spid"
+) &
+SEGPID=$!
+pids+=("$SEGPID")
 
 # 1. segments mode: the host plans, the image executes; everything equals the plan's replay.
 "$CS" plan --machine "$INI" --feed $FEED "$JOB" -o "$T/job.seg" 2>/dev/null
@@ -102,6 +121,14 @@ expect "segments: STEP pulses per axis = the plan's" grep -q "^fw: step pulses: 
 expect "segments: steps in total = replay" grep -q "^fw: steps total $ref_steps " "$T/seg.fw"
 expect "segments: no UART byte lost" grep -q " 0 UART overruns$" "$T/seg.fw"
 [ $fail -eq 0 ] || { echo "--- image report:"; tail -n 6 "$T/seg.fw"; tail -n 3 "$T/seg.out"; }
+# 1b. the same application in the simulator: the same executed segments and step edges
+wait "$SEGPID"
+simlog=$(sed -n 's/^log: //p' "$T/simseg.out" | tail -n1)
+fwlog=$(sed -n 's/^fw: log: //p' "$T/seg.fw" | tail -n1)
+expect "one application: simulator logged $nseg segments" grep -q "^log: $nseg segments hash " "$T/simseg.out"
+expect "one application: simulator = image, segments and step edges tick for tick" \
+    [ -n "$simlog" ] && [ "$simlog" = "$fwlog" ]
+echo "note: simulator log: ${simlog:-none}; image log: ${fwlog:-none}"
 
 # 2. curves mode: the image traces and plans each cubic itself; the simulator's device, fed the
 # same stream (run in the background during case 1), is the reference (same core, same machine).
@@ -138,6 +165,38 @@ expect "ctrl-c: exit 8" [ $rc -eq 8 ]
 expect "ctrl-c: image held and aborted" grep -q "^fw: executed [0-9]* messages, .* 1 holds, 1 aborts$" "$T/int.fw"
 expect "ctrl-c: host and image agree on what ran" grep -q "^fw: executed ${k:-x} messages" "$T/int.fw"
 expect "ctrl-c: stopped mid-job" [ "${k:-0}" -gt 0 ] && [ "${k:-0}" -lt "$nseg" ]
+
+# 3b. feed hold and resume through the daemon: every segment once, the position exact.
+S=$T/sock/cs.sock
+N=$nseg
+mkdir -p "$T/sock"
+start_fw hold
+dmn_start --port "$PTY" --machine "$INI"
+C submit --feed $FEED "$JOB" >"$T/hsub.out" 2>&1
+expect "hold: submitted" grep -q "^OK job 1 queued: .*: $nseg segments$" "$T/hsub.out"
+expect "hold: a quarter ran" wait_until 40 dmn_quarter
+C pause >"$T/hp.out"
+expect "hold: device held" grep -q "^OK paused (device held)" "$T/hp.out"
+expect "hold: progress stands still" wait_until 20 dmn_still
+C resume >/dev/null
+expect "hold: job ended" wait_until 60 dmn_finished
+C status >"$T/hst.out" 2>&1
+expect "hold: every segment executed" grep -q "^job 1 done: .*: $nseg/$nseg segments executed" "$T/hst.out"
+kill -TERM "$DPID"
+wait "$DPID"
+wait_fw
+holdlog=$(sed -n 's/^fw: log: \([0-9]* segments hash [0-9]*\),.*/\1/p' "$T/hold.fw" | tail -n1)
+expect "hold: image exit status 0" [ $QRC -eq 0 ]
+expect "hold: one hold, no abort" grep -q "^fw: executed $nseg messages, $nseg step segments, .* 1 holds, 0 aborts$" "$T/hold.fw"
+expect "hold: the same segments as without the hold, each once" \
+    [ -n "$holdlog" ] && [ "$holdlog" = "$(echo "$fwlog" | sed 's/,.*//')" ]
+# the ramps re-timed segments on the image: its executor's clock ran longer than case 1's
+tick1=$(echo "$fwlog" | sed -n 's/.* at executor tick \([0-9]*\)$/\1/p')
+tickh=$(sed -n 's/^fw: log: .* at executor tick \([0-9]*\)$/\1/p' "$T/hold.fw" | tail -n1)
+expect "hold: the image ramped (executor clock ${tickh:-?} > ${tick1:-?} ticks)" \
+    [ "${tickh:-0}" -gt "${tick1:-0}" ]
+expect "hold: executor position = replay" grep -q "^fw: position (executor): $ref_pos$" "$T/hold.fw"
+expect "hold: STEP/DIR pins position = replay" grep -q "^fw: position (STEP/DIR pins): $ref_pos$" "$T/hold.fw"
 
 # 4. a machine file at another tick rate: the image's HELLO is refused (exit 4), nothing moves.
 sed 's/^tick_hz = .*/tick_hz = 1000000/' "$INI" >"$T/fast.ini"

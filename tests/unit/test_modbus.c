@@ -28,6 +28,7 @@
 #include "cs_serial.h"
 #include "cs_sim_device.h"
 #include "cs_stream.h"
+#include "fw_test.h"
 
 /* --- a fake application behind the map ------------------------------------------------------ */
 
@@ -35,7 +36,7 @@
 
 typedef struct {
     unsigned submitted;
-    uint64_t hash; /* FNV-1a chain of the SEGMENTs queued, as cs_sim_device_hash */
+    uint64_t hash; /* FNV-1a chain of the SEGMENTs queued, as the device logs them (fw_test_hash) */
     uint16_t last_seq;
     unsigned pending; /* queued, not yet "executed" (the test drains by hand) */
     bool instant;     /* executed as soon as queued */
@@ -53,7 +54,7 @@ static cs_err_t fake_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
     f->last = *m;
     f->last_seq = seq;
     if (m->type == CS_PROTO_SEGMENT)
-        f->hash = cs_sim_device_hash(f->hash, &m->u.segment);
+        f->hash = fw_test_hash(f->hash, &m->u.segment);
     if (!f->instant)
         f->pending++;
     return CS_OK;
@@ -86,7 +87,7 @@ static void fake_status(void *ctx, cs_modbus_status_t *st)
 static void fake_map(cs_modbus_map_t *mp, fake_t *f)
 {
     memset(f, 0, sizeof *f);
-    f->hash = CS_SIM_DEVICE_HASH0;
+    f->hash = FW_TEST_HASH0;
     cs_modbus_app_t app = {fake_submit, fake_command, fake_status, f};
     assert_int_equal(cs_modbus_map_init(mp, &app, 0), CS_OK);
 }
@@ -535,7 +536,7 @@ static pid_t start_server(int *slave_fd, char *path, size_t cap, int *result_fd,
         cs_modbus_map_t mp;
         fake_t f;
         memset(&f, 0, sizeof f);
-        f.hash = CS_SIM_DEVICE_HASH0;
+        f.hash = FW_TEST_HASH0;
         f.instant = true;
         cs_modbus_app_t app = {fake_submit, fake_command, fake_status, &f};
         cs_modbus_map_init(&mp, &app, 0);
@@ -642,7 +643,7 @@ static void test_libmodbus_client(void **state)
     uint64_t hash;
     stop_server(pid, slave, res, &submitted, &hash);
     assert_int_equal(submitted, 1);
-    assert_int_equal(hash, cs_sim_device_hash(CS_SIM_DEVICE_HASH0, &s.u.segment));
+    assert_int_equal(hash, fw_test_hash(FW_TEST_HASH0, &s.u.segment));
 }
 
 /* --- the host's link end to end, answers lost ------------------------------------------------ */
@@ -656,7 +657,7 @@ static void test_stream_lost_answers(void **state)
     const size_t n = 400;
     cs_stream_job_t job;
     cs_stream_job_init(&job, CS_STREAM_SEGMENTS);
-    uint64_t want = CS_SIM_DEVICE_HASH0;
+    uint64_t want = FW_TEST_HASH0;
     uint32_t x = 777;
     for (size_t k = 0; k < n; k++) {
         x = x * 1103515245u + 12345u;
@@ -664,7 +665,7 @@ static void test_stream_lost_answers(void **state)
         sg.steps[0] = (int32_t)((x >> 8) % 41) - 20;
         sg.steps[1] = (int32_t)((x >> 16) % 41) - 20;
         assert_int_equal(cs_stream_job_add_segments(&job, &sg, 1), CS_OK);
-        want = cs_sim_device_hash(want, &sg);
+        want = fw_test_hash(want, &sg);
     }
     cs_mb_client_t c;
     char why[200];

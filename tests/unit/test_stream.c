@@ -31,6 +31,7 @@
 #include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_sim.h"
+#include "fw_test.h"
 #include "cs_sim_device.h"
 #include "cs_stream.h"
 
@@ -167,9 +168,9 @@ static cs_stream_result_t run_host(cs_serial_t *ser, const cs_stream_job_t *job,
 
 static uint64_t hash_of(const cs_segment_t *s, size_t n)
 {
-    uint64_t h = CS_SIM_DEVICE_HASH0;
+    uint64_t h = FW_TEST_HASH0;
     for (size_t k = 0; k < n; k++)
-        h = cs_sim_device_hash(h, &s[k]);
+        h = fw_test_hash(h, &s[k]);
     return h;
 }
 

@@ -98,6 +98,22 @@ static void report(void)
     semihost_fmt_uint(b, sizeof b, &n, port_m3_rx_overruns());
     semihost_fmt_str(b, sizeof b, &n, " UART overruns\n");
     semihost_write0(b);
+    /* the execution log (cs_exlog), printed as the simulator prints it (sim/cs_sim_device.c) */
+    cs_exlog_edges_t ed;
+    port_m3_edges(&ed);
+    n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: log: ");
+    semihost_fmt_uint(b, sizeof b, &n, r.log.n);
+    semihost_fmt_str(b, sizeof b, &n, " segments hash ");
+    semihost_fmt_uint(b, sizeof b, &n, r.log.hash);
+    semihost_fmt_str(b, sizeof b, &n, ", ");
+    semihost_fmt_uint(b, sizeof b, &n, ed.n);
+    semihost_fmt_str(b, sizeof b, &n, " step edges hash ");
+    semihost_fmt_uint(b, sizeof b, &n, ed.hash);
+    semihost_fmt_str(b, sizeof b, &n, " at executor tick ");
+    semihost_fmt_uint(b, sizeof b, &n, ed.clock);
+    semihost_fmt_str(b, sizeof b, &n, "\n");
+    semihost_write0(b);
 }
 
 void port_m3_on_fault(cs_err_t code)
@@ -133,14 +149,14 @@ int main(void)
     uint32_t hz_ms = port_tick_hz() / 1000u;
     for (;;) {
         cs_fw_app_poll(&app);
-        if (cs_fw_app_idle(&app) && app.stats.executed != reported) {
-            reported = app.stats.executed;
+        if (cs_fw_app_idle(&app) && app.mo.stats.executed != reported) {
+            reported = app.mo.stats.executed;
             report();
         }
         if (exit_idle_ms != 0 && reported != 0 && cs_fw_app_idle(&app) &&
             port_ticks_now() - cs_fw_app_last_rx(&app) >= exit_idle_ms * hz_ms) {
             report();
-            semihost_exit(app.stats.errors != 0 ? 1u : 0u);
+            semihost_exit(app.mo.stats.errors != 0 ? 1u : 0u);
             exit_idle_ms = 0; /* no debugger took the exit: go on serving */
         }
         /* nothing to do until an interrupt: sleep while no motion runs, spin while it does.

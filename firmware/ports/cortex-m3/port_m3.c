@@ -40,6 +40,7 @@ static uint8_t dir_lines; /* the DIR pins as last written (step interrupt only) 
 static volatile cs_err_t fault_code;
 static volatile uint32_t step_irqs; /* step interrupts that ran the executor */
 static volatile uint32_t irq_count; /* interrupts taken: port_m3_spin waits for a change */
+static cs_exlog_edges_t edge_log;   /* STEP edges on the executor's clock (cs_exlog) */
 
 static volatile uint8_t rxb[PORT_M3_RX_RING];
 static volatile uint16_t rx_head, rx_tail; /* head: written by the ISR, tail: by the main loop */
@@ -122,6 +123,7 @@ static void clock_init(void)
 void port_init(void)
 {
     clock_init();
+    cs_exlog_edges_init(&edge_log);
     SYSCTL_RCGC1 |= SYSCTL_RCGC1_TIMER0 | SYSCTL_RCGC1_UART0;
     SYSCTL_RCGC2 |= SYSCTL_RCGC2_GPIOA | SYSCTL_RCGC2_GPIOD | SYSCTL_RCGC2_GPIOG;
     for (volatile uint32_t k = 0; k < 16u; k++) /* a few cycles before the clocks are up */
@@ -242,12 +244,20 @@ void Timer0A_Handler(void)
     step_irqs++;
     cs_stepper_out_t o;
     cs_stepper_tick(step_st, &o);
+    cs_exlog_tick(&edge_log, &o);
     port_step_pulse(o.step_mask);
     port_dir_set(o.dir_mask);
     if (o.next_ticks != 0)
         port_timer_arm(o.next_ticks);
     else
         port_timer_stop();
+}
+
+void port_m3_edges(cs_exlog_edges_t *l)
+{
+    uint32_t s = port_irq_save();
+    *l = edge_log;
+    port_irq_restore(s);
 }
 
 void port_m3_pins(uint32_t p[4], int32_t pos[4])

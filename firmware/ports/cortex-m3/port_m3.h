@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "cs_exlog.h"
 #include "port.h"
 
 #define PORT_M3_SYSCLK_HZ 50000000u /* PLL: 200 MHz / 4 (8 MHz crystal on the EVB) */
@@ -26,6 +27,9 @@ uint32_t port_m3_cycles(void);
 /* Per axis: STEP pulses issued and the position they made with the DIR level at each pulse
  * (DIR high = +1). ISR-safe snapshot. */
 void port_m3_pins(uint32_t pulses[4], int32_t pos[4]);
+/* The STEP edges the step interrupt produced, logged on the executor's clock (cs_exlog: the
+ * simulator logs the same through firmware/ports/posix). ISR-safe snapshot. */
+void port_m3_edges(cs_exlog_edges_t *l);
 /* Sleeps (WFI) until the next interrupt unless a received byte waits or transmit bytes are
  * queued. Main loop only. */
 void port_m3_sleep(void);

@@ -19,16 +19,31 @@ struct posix_state {
     cs_err_t fault;
     uint32_t irq_depth;
     int fd_in, fd_out;
+    size_t (*rd)(void *, uint8_t *, size_t);
+    size_t (*wr)(void *, const uint8_t *, size_t);
+    void *io_ctx;
+    cs_exlog_edges_t elog;
 };
-static struct posix_state g = {
-    .hz = 100000, .record = true, .record_ok = true, .fd_in = -1, .fd_out = -1};
+static struct posix_state g = {.hz = 100000,
+                               .record = true,
+                               .record_ok = true,
+                               .fd_in = -1,
+                               .fd_out = -1,
+                               .elog = {0, CS_EXLOG_HASH0, 0, 0}};
 
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
 {
     free(g.edges);
     cs_stepper_t *st = g.st;
     int in = g.fd_in, out = g.fd_out;
+    size_t (*rd)(void *, uint8_t *, size_t) = g.rd;
+    size_t (*wr)(void *, const uint8_t *, size_t) = g.wr;
+    void *ctx = g.io_ctx;
     g = (struct posix_state){0};
+    g.rd = rd;
+    g.wr = wr;
+    g.io_ctx = ctx;
+    cs_exlog_edges_init(&g.elog);
     g.hz = tick_hz;
     g.invert = invert_mask;
     g.dir_lines = invert_mask; /* positive direction at rest */
@@ -118,6 +133,8 @@ void port_dir_set(uint8_t mask)
 
 size_t port_uart_read(uint8_t *buf, size_t max)
 {
+    if (g.rd != NULL)
+        return g.rd(g.io_ctx, buf, max);
     if (g.fd_in < 0)
         return 0;
     ssize_t r = read(g.fd_in, buf, max);
@@ -126,6 +143,8 @@ size_t port_uart_read(uint8_t *buf, size_t max)
 
 size_t port_uart_write(const uint8_t *buf, size_t len)
 {
+    if (g.wr != NULL)
+        return g.wr(g.io_ctx, buf, len);
     if (g.fd_out < 0)
         return 0;
     ssize_t r = write(g.fd_out, buf, len);
@@ -143,6 +162,7 @@ static void step_isr(void)
 {
     cs_stepper_out_t o;
     cs_stepper_tick(g.st, &o);
+    cs_exlog_tick(&g.elog, &o);
     port_step_pulse(o.step_mask);
     port_dir_set(o.dir_mask);
     if (o.next_ticks != 0)
@@ -172,6 +192,12 @@ bool port_posix_run(uint64_t until)
         g.armed = false;
         step_isr();
     }
+}
+
+void port_posix_idle_until(uint64_t until)
+{
+    if (!g.armed && (g.st == NULL || cs_stepper_idle(g.st)) && until > g.now)
+        g.now = until;
 }
 
 bool port_posix_step(void)
@@ -219,4 +245,17 @@ void port_posix_uart(int fd_in, int fd_out)
 {
     g.fd_in = fd_in;
     g.fd_out = fd_out;
+}
+
+void port_posix_uart_hooks(size_t (*rd)(void *ctx, uint8_t *buf, size_t max),
+                           size_t (*wr)(void *ctx, const uint8_t *buf, size_t len), void *ctx)
+{
+    g.rd = rd;
+    g.wr = wr;
+    g.io_ctx = ctx;
+}
+
+cs_exlog_edges_t port_posix_edge_log(void)
+{
+    return g.elog;
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cs_exlog.h"
 #include "port.h"
 
 /* One recorded step: rising STEP edge at tick t on axis, dir = +1 or -1 (DIR line level after
@@ -29,6 +30,9 @@ uint64_t port_posix_now(void);
  * in the past runs nothing and leaves the time as it is). Returns false when a fault was raised
  * or no stepper is attached. */
 bool port_posix_run(uint64_t until);
+/* Lets simulated time pass to `until` with the step timer stopped (a device at rest, e.g. held):
+ * nothing happens when the timer is armed or work is queued, or when `until` is not ahead. */
+void port_posix_idle_until(uint64_t until);
 /* Runs exactly one step interrupt (starting the timer if work is queued): advances time to its
  * deadline. false when the stepper is idle with the timer stopped, or after a fault. */
 bool port_posix_step(void);
@@ -43,5 +47,12 @@ int64_t port_posix_position(unsigned axis);
 cs_err_t port_posix_fault(void);
 /* The UART: file descriptors (non-blocking reads); -1 disables. */
 void port_posix_uart(int fd_in, int fd_out);
+/* The UART through functions instead (the simulator's line with its faults): port_uart_read and
+ * port_uart_write call rd / wr with ctx; NULL rd and wr go back to the file descriptors. */
+void port_posix_uart_hooks(size_t (*rd)(void *ctx, uint8_t *buf, size_t max),
+                           size_t (*wr)(void *ctx, const uint8_t *buf, size_t len), void *ctx);
+/* The STEP edges logged by the step interrupt on the executor's clock since reset (cs_exlog, as
+ * the Cortex-M3 port logs them). */
+cs_exlog_edges_t port_posix_edge_log(void);
 
 #endif

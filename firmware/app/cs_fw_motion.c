@@ -1,0 +1,454 @@
+/* cs_fw_motion: the device's motion side over port.h and the core. See cs_fw_motion.h; the
+ * protocol is docs/protocol.md. */
+#include "cs_fw_motion.h"
+
+#include <stddef.h>
+
+#include "port.h"
+
+#define SEQ_MASK ((uint32_t)CS_FW_SEQMAP - 1u)
+#define TAG_MASK ((uint8_t)(CS_STEPPER_RING - 1))
+/* next_segment's work budget a pass (blocks cut, points traced, items taken) */
+#define NEXT_GUARD 64u
+
+void cs_fw_motion_error(cs_fw_motion_t *a, cs_err_t code, uint16_t seq)
+{
+    a->stats.errors++;
+    if (a->nerr < CS_FW_ERRQ) {
+        a->errs[a->nerr].code = (uint8_t)code;
+        a->errs[a->nerr].seq = seq;
+        a->nerr++;
+    }
+}
+
+int32_t cs_fw_motion_position(const cs_fw_motion_t *a, unsigned axis)
+{
+    /* a 32-bit read is not atomic on the AVR: mask the step interrupt */
+    uint32_t s = port_irq_save();
+    int32_t p = cs_stepper_position(&a->st, axis);
+    port_irq_restore(s);
+    return p;
+}
+
+bool cs_fw_motion_drained(const cs_fw_motion_t *a)
+{
+#if CS_FW_CURVES
+    if (a->tracing || a->gen_busy || cs_planner_count(&a->pl) != 0)
+        return false;
+#endif
+    return !a->has_pend && cs_stepper_idle(&a->st);
+}
+
+bool cs_fw_motion_done(const cs_fw_motion_t *a)
+{
+    return a->qcount == 0 && cs_fw_motion_drained(a);
+}
+
+static bool item_after(uint32_t x, uint32_t y)
+{
+    return (int32_t)(x - y) > 0;
+}
+
+static void mark_executed(cs_fw_motion_t *a, uint32_t item)
+{
+    if (item_after(item, a->exec_item)) {
+        a->stats.executed += item - a->exec_item;
+        a->exec_item = item;
+        a->exec_seq = a->item_seq[item & SEQ_MASK];
+    }
+}
+
+/* Segments the executor has finished: pushed - (queued in the ring) - (the running one). */
+static void note_completed(cs_fw_motion_t *a)
+{
+    uint32_t s = port_irq_save();
+    uint8_t inring = (uint8_t)(a->st.tail - a->st.head);
+    uint8_t running = a->st.running ? 1u : 0u;
+    port_irq_restore(s);
+    uint8_t done = (uint8_t)(a->pushed - inring - running);
+    while (a->completed != done) {
+        mark_executed(a, a->tag[a->completed & TAG_MASK]);
+        a->completed++;
+    }
+    if (cs_fw_motion_drained(a))
+        mark_executed(a, a->popped); /* items that made no segment (zero moves, errors) */
+}
+
+static void pop_item(cs_fw_motion_t *a, cs_fw_item_t *out)
+{
+    *out = a->q[a->qhead];
+    a->qhead = (uint16_t)((a->qhead + 1u) % CS_FW_QUEUE);
+    a->qcount--;
+    a->popped++;
+    a->item_seq[a->popped & SEQ_MASK] = out->seq;
+}
+
+static bool may_take_item(const cs_fw_motion_t *a)
+{
+    return a->qcount > 0 && (a->take_max == 0 || item_after(a->take_max, a->popped));
+}
+
+#if CS_FW_CURVES
+static cs_pos_t steps_to_pos(int32_t steps, int32_t spm)
+{
+    /* mm Q16 = steps * 2^32 / spm(Q16), rounded to nearest */
+    int64_t num = (int64_t)steps * ((int64_t)1 << 32);
+    int64_t q = num >= 0 ? (num + spm / 2) / spm : -((-num + spm / 2) / spm);
+    return (cs_pos_t)q;
+}
+
+/* SEGMENT messages moved the machine behind the planner's back: start it from there. */
+static void refresh_planner(cs_fw_motion_t *a)
+{
+    if (!a->pl_stale || cs_planner_count(&a->pl) != 0)
+        return;
+    cs_pos_t p[CS_AXES] = {0};
+    for (unsigned i = 0; i < a->m->n_axes; i++)
+        p[i] = steps_to_pos(a->steps_pos[i], a->m->axis[i].steps_per_mm);
+    (void)cs_planner_set_position(&a->pl, p);
+    a->pl_stale = false;
+}
+
+static void start_curve(cs_fw_motion_t *a, const cs_fw_item_t *it)
+{
+    refresh_planner(a);
+    cs_bezier_t c;
+    cs_err_t e = cs_bezier_init(&c, 3, it->u.curve.p);
+    if (e == CS_OK)
+        e = cs_trace_begin(&a->tr, &c, a->cfg.tol, (cs_trace_method_t)a->cfg.method);
+    if (e != CS_OK) {
+        cs_fw_motion_error(a, e, it->seq);
+        return;
+    }
+    a->tracing = true;
+    a->tr_feed = it->u.curve.feed;
+    a->tr_item = a->popped;
+    const cs_vec3_t *p0 = &it->u.curve.p[0];
+    a->rapid_pending = p0->x != a->pl.pos[0] || p0->y != a->pl.pos[1] || p0->z != a->pl.pos[2];
+    a->rapid_to = *p0;
+    a->stats.curves++;
+}
+
+/* The next segment of the planned blocks: 1 with *s, *done set; 0 when the block ended (go on);
+ * -1 on an error (the planner is reset). */
+static int cut_block(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
+{
+    cs_err_t e = cs_segment_next(&a->gen, &a->pl, s);
+    if (e == CS_ERR_EMPTY) {
+        a->gen_busy = false;
+        return 0;
+    }
+    if (e != CS_OK) {
+        cs_fw_motion_error(a, e, a->item_seq[a->gen.line & SEQ_MASK]);
+        a->gen_busy = false;
+        (void)cs_planner_init(&a->pl, a->m);
+        a->pl_stale = true;
+        return -1;
+    }
+    a->gen_busy = !cs_segment_block_end(&a->gen);
+    /* the block's "line" is its item: the item before it is done when this ends */
+    *done = a->gen.line - 1u;
+    return 1;
+}
+
+/* One traced point (or the travel to the curve's start) into the planner. */
+static void trace_step(cs_fw_motion_t *a)
+{
+    cs_vec3_t pt;
+    cs_err_t e;
+    if (a->rapid_pending) {
+        pt = a->rapid_to;
+        e = cs_planner_line3(&a->pl, &pt, 0, a->tr_item);
+        a->rapid_pending = false;
+    } else {
+        e = cs_trace_next(&a->tr, &pt);
+        if (e == CS_END) {
+            a->tracing = false;
+            return;
+        }
+        if (e == CS_OK)
+            e = cs_planner_line3(&a->pl, &pt, a->tr_feed, a->tr_item);
+    }
+    if (e != CS_OK) {
+        cs_fw_motion_error(a, e, a->item_seq[a->tr_item & SEQ_MASK]);
+        a->tracing = false;
+    }
+}
+#endif
+
+/* Next step segment for the executor: true with *s and *done (the item executed once it has
+ * run) set, false when nothing is ready now (a->more: the work budget of this pass ran out
+ * first). Bounded work. */
+static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
+{
+    for (unsigned guard = 0; guard < NEXT_GUARD; guard++) {
+#if CS_FW_CURVES
+        bool feeding = a->tracing || (may_take_item(a) && a->q[a->qhead].type == CS_PROTO_CURVE);
+        /* Cut when the look-ahead is full or nothing more can be added now (the planner always
+         * plans its last block to end at rest, so cutting early is safe). */
+        if (a->gen_busy ||
+            (cs_planner_count(&a->pl) > 0 && (cs_planner_full(&a->pl) || !feeding))) {
+            int r = cut_block(a, s, done);
+            if (r < 0)
+                return false;
+            if (r > 0)
+                return true;
+            continue;
+        }
+        if (a->tracing) {
+            trace_step(a);
+            continue;
+        }
+#endif
+        if (!may_take_item(a))
+            return false;
+        cs_fw_item_t it;
+        pop_item(a, &it);
+#if CS_FW_CURVES
+        if (it.type == CS_PROTO_CURVE) {
+            start_curve(a, &it);
+            continue;
+        }
+        a->pl_stale = true;
+#endif
+        *s = it.u.seg;
+        *done = a->popped;
+        return true;
+    }
+    a->more = true;
+    return false;
+}
+
+/* Hands one segment to the executor, starting the step timer when it was idle (the step
+ * interrupt stops it when the ring runs dry: idle <=> stopped, checked with interrupts masked).
+ * The log gets the segment as planned (orig: before a hold re-timed it), so that a job logs the
+ * same segments whether it was held or not. */
+static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segment_t *orig,
+                         uint32_t done)
+{
+    uint32_t irq = port_irq_save();
+    bool was_idle = cs_stepper_idle(&a->st);
+    cs_err_t e = cs_stepper_push(&a->st, s);
+    if (e == CS_OK) {
+        a->tag[a->pushed & TAG_MASK] = done;
+        a->pushed++;
+        if (was_idle)
+            port_timer_arm(1);
+    }
+    port_irq_restore(irq);
+    if (e != CS_OK) { /* cs_proto checked the invariant already */
+        cs_fw_motion_error(a, e, a->item_seq[done & SEQ_MASK]);
+        return;
+    }
+    a->stats.segments++;
+    cs_exlog_segment(&a->log, orig);
+    for (unsigned i = 0; i < CS_AXES; i++)
+        a->steps_pos[i] += s->steps[i];
+}
+
+/* Keeps the executor's ring full; a hold re-times what it hands over and, at rest, keeps the
+ * next segment back (cs_hold). */
+static void feed(cs_fw_motion_t *a)
+{
+    a->more = false;
+    while (cs_stepper_free(&a->st) > 0) {
+        if (!a->has_pend) {
+            if (!next_segment(a, &a->pend, &a->pend_done))
+                break;
+            a->has_pend = true;
+        }
+        cs_segment_t orig = a->pend;
+        if (!cs_hold_admit(&a->hold, &a->pend))
+            break;
+        a->has_pend = false;
+        push_segment(a, &a->pend, &orig, a->pend_done);
+    }
+}
+
+static void update_state(cs_fw_motion_t *a)
+{
+    uint8_t st = a->hold.hold            ? CS_PROTO_STATE_HELD
+                 : !cs_fw_motion_done(a) ? CS_PROTO_STATE_RUNNING
+                 : a->aborted            ? CS_PROTO_STATE_ABORTED
+                                         : CS_PROTO_STATE_IDLE;
+    if (st != a->state) {
+        a->state = st;
+        a->news = true;
+    }
+}
+
+/* --- the API ------------------------------------------------------------------------------- */
+
+void cs_fw_motion_zero(void *p, size_t n)
+{
+    uint8_t *b = p;
+    for (size_t i = 0; i < n; i++)
+        b[i] = 0;
+}
+
+void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m)
+{
+    c->queue_size = CS_FW_QUEUE;
+    c->tol = m->tolerance;
+#if CS_FW_CURVES
+    c->method = (uint8_t)CS_FW_TRACE;
+#else
+    c->method = 0;
+#endif
+}
+
+cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_fw_motion_cfg_t *c)
+{
+    if (mo == NULL || m == NULL || c == NULL || c->queue_size < 1 || c->queue_size > CS_FW_QUEUE ||
+        c->tol <= 0)
+        return CS_ERR_ARG;
+    cs_fw_motion_zero(mo, sizeof *mo);
+    mo->m = m;
+    mo->cfg = *c;
+    cs_err_t e = cs_stepper_init(&mo->st, m);
+    if (e == CS_OK)
+        e = cs_hold_init(&mo->hold, m);
+#if CS_FW_CURVES
+    if (e == CS_OK)
+        e = cs_planner_init(&mo->pl, m);
+    if (e == CS_OK)
+        e = cs_segment_init(&mo->gen, m);
+#endif
+    if (e != CS_OK)
+        return CS_ERR_ARG;
+    cs_exlog_segs_init(&mo->log);
+    /* nothing executed yet: the last executed sequence is the one before the receiver's first
+     * (a host reads STATUS.last_seq against its own first sequence) */
+    mo->exec_seq = 0xFFFFu;
+    mo->item_seq[0] = 0xFFFFu;
+    mo->state = CS_PROTO_STATE_IDLE;
+    mo->news = true;
+    port_stepper_attach(&mo->st);
+    return CS_OK;
+}
+
+cs_err_t cs_fw_motion_queue(cs_fw_motion_t *a, const cs_proto_msg_t *msg, uint16_t seq)
+{
+    bool curve = false;
+#if CS_FW_CURVES
+    curve = msg->type == CS_PROTO_CURVE;
+#endif
+    if (msg->type != CS_PROTO_SEGMENT && !curve)
+        return CS_ERR_UNSUPPORTED;
+    if (a->qcount >= a->cfg.queue_size)
+        return CS_ERR_FULL;
+    cs_fw_item_t *it = &a->q[(a->qhead + a->qcount) % CS_FW_QUEUE];
+    it->type = msg->type;
+    it->seq = seq;
+#if CS_FW_CURVES
+    if (curve)
+        it->u.curve = msg->u.curve;
+    else
+#endif
+        it->u.seg = msg->u.segment;
+    a->qcount++;
+    a->aborted = false;
+    return CS_OK;
+}
+
+void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
+{
+    if (on && !a->hold.hold)
+        a->stats.holds++;
+    cs_hold_set(&a->hold, on);
+    a->news = true;
+}
+
+void cs_fw_motion_abort(cs_fw_motion_t *a)
+{
+    a->qcount = 0;
+    a->qhead = 0;
+    a->has_pend = false;
+#if CS_FW_CURVES
+    a->tracing = false;
+    a->rapid_pending = false;
+    /* the executor's ring finishes (at most CS_STEPPER_RING segments), the rest is dropped */
+    if (a->gen_busy || cs_planner_count(&a->pl) > 0) {
+        (void)cs_planner_init(&a->pl, a->m);
+        (void)cs_segment_init(&a->gen, a->m);
+        a->gen_busy = false;
+    }
+    a->pl_stale = true;
+#endif
+    cs_hold_reset(&a->hold);
+    a->aborted = true;
+    a->stats.aborts++;
+    a->news = true;
+}
+
+void cs_fw_motion_poll(cs_fw_motion_t *a)
+{
+    feed(a);
+    note_completed(a);
+    update_state(a);
+}
+
+void cs_fw_motion_reboot(cs_fw_motion_t *a)
+{
+    a->qcount = 0;
+    a->qhead = 0;
+    a->exec_seq = 0xFFFFu;
+    a->item_seq[a->popped & SEQ_MASK] = 0xFFFFu;
+    cs_hold_reset(&a->hold);
+    a->aborted = false;
+    a->nerr = 0;
+    a->news = true;
+}
+
+void cs_fw_motion_take_limit(cs_fw_motion_t *a, uint32_t n)
+{
+    a->take_max = n;
+}
+
+uint16_t cs_fw_motion_free(const cs_fw_motion_t *a)
+{
+    return (uint16_t)(a->cfg.queue_size - a->qcount);
+}
+
+bool cs_fw_motion_news(cs_fw_motion_t *a)
+{
+    bool n = a->news;
+    a->news = false;
+    return n;
+}
+
+void cs_fw_motion_status(const cs_fw_motion_t *a, cs_proto_status_t *st)
+{
+    st->state = a->state;
+    st->queue_fill = a->qcount;
+    st->last_seq = a->exec_seq;
+    st->axes = a->m->n_axes;
+    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
+        st->pos[i] = i < a->m->n_axes ? cs_fw_motion_position(a, i) : 0;
+}
+
+bool cs_fw_motion_peek_error(const cs_fw_motion_t *a, cs_proto_error_t *e)
+{
+    if (a->nerr == 0)
+        return false;
+    *e = a->errs[0];
+    return true;
+}
+
+void cs_fw_motion_drop_error(cs_fw_motion_t *a)
+{
+    if (a->nerr == 0)
+        return;
+    for (uint8_t i = 1; i < a->nerr; i++)
+        a->errs[i - 1] = a->errs[i];
+    a->nerr--;
+    a->stats.errors_sent++;
+}
+
+bool cs_fw_motion_pop_error(cs_fw_motion_t *a, cs_proto_error_t *e)
+{
+    if (!cs_fw_motion_peek_error(a, e))
+        return false;
+    cs_fw_motion_drop_error(a);
+    return true;
+}

@@ -1,0 +1,168 @@
+/* cs_fw_motion: the device's motion side, the same on every board and in the simulator. Owns the
+ * motion queue (SEGMENT and CURVE messages with their link sequence; its free slots are a link's
+ * credits), the on-board tracer and planner for CURVE messages, the step executor fed from them,
+ * feed hold along the path (cs_hold) and abort, the device state, the sequence of the last
+ * executed message, the errors to report and the execution log (cs_exlog). It knows no link:
+ * the front ends (cs_fw_app: framed serial; the simulator's Modbus server) hand it messages and
+ * read its status. Touches hardware only through firmware/ports/port.h (step timer, interrupt
+ * masking); freestanding C99 like the core: no heap, no float, no libc. Build-time sizes: see
+ * cs_fw_app.h (CS_FW_QUEUE, CS_FW_CURVES, CS_FW_ERRQ, CS_FW_TRACE). */
+#ifndef CS_FW_MOTION_H
+#define CS_FW_MOTION_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cs_err.h"
+#include "cs_exlog.h"
+#include "cs_hold.h"
+#include "cs_machine.h"
+#include "cs_proto.h"
+#include "cs_segment.h"
+#include "cs_stepper.h"
+
+#ifndef CS_FW_QUEUE
+#define CS_FW_QUEUE 32
+#endif
+#ifndef CS_FW_CURVES
+#define CS_FW_CURVES 1
+#endif
+#ifndef CS_FW_ERRQ
+#define CS_FW_ERRQ 4
+#endif
+
+#if CS_FW_CURVES
+#include "cs_planner.h"
+#include "cs_trace.h"
+#ifndef CS_FW_TRACE
+#define CS_FW_TRACE CS_TRACE_SUBDIV
+#endif
+/* Items taken from the queue and not yet executed: the executor's ring, the planner's blocks
+ * (one curve may be a single block), the curve being traced, the segment held back by a hold;
+ * a power of two above that. */
+#define CS_FW_SEQMAP 64
+CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + CS_PLANNER_RING + 3, fw_seqmap_room);
+#else
+#define CS_FW_SEQMAP 32
+CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + 3, fw_seqmap_room);
+#endif
+CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_two);
+CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
+CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
+
+/* One motion-queue slot: a SEGMENT or (with curves) a CURVE, and its link sequence. */
+typedef struct {
+    uint8_t type; /* CS_PROTO_SEGMENT or CS_PROTO_CURVE */
+    uint16_t seq;
+    union {
+        cs_segment_t seg;
+#if CS_FW_CURVES
+        cs_proto_curve_t curve;
+#endif
+    } u;
+} cs_fw_item_t;
+
+/* Counters for the report (cs_fw_app_report) and the figures. */
+typedef struct {
+    uint32_t executed; /* queue items (SEGMENT, CURVE) fully executed since boot */
+    uint32_t segments; /* step segments pushed to the executor */
+    uint32_t curves;   /* CURVE messages traced */
+    uint32_t holds, aborts;
+    uint32_t errors;      /* errors raised (the first CS_FW_ERRQ waiting ones are reported) */
+    uint32_t rx_bytes;    /* UART bytes received (the serial front end's) */
+    uint32_t errors_sent; /* ERROR messages a front end took (cs_fw_motion_pop_error) */
+} cs_fw_stats_t;
+
+/* Run-time choices (a board takes cs_fw_motion_cfg_default). */
+typedef struct {
+    uint16_t queue_size; /* slots offered, 1..CS_FW_QUEUE */
+    cs_pos_t tol;        /* chord tolerance for CURVE messages, > 0 */
+    uint8_t method;      /* cs_trace_method_t for CURVE messages */
+} cs_fw_motion_cfg_t;
+
+typedef struct {
+    const cs_machine_t *m;
+    cs_fw_motion_cfg_t cfg;
+    /* motion queue: slots free = link credits */
+    cs_fw_item_t q[CS_FW_QUEUE];
+    uint16_t qhead, qcount;
+    /* executor and which item each queued segment finishes */
+    cs_stepper_t st;
+    uint32_t tag[CS_STEPPER_RING]; /* item executed once segment k has run */
+    uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
+    cs_hold_t hold;
+    cs_segment_t pend; /* produced, held back by a hold at rest */
+    uint32_t pend_done;
+    bool has_pend;
+    /* items: numbered from 1 in the order they leave the queue */
+    uint32_t popped;    /* items taken from the queue */
+    uint32_t take_max;  /* take no item past this number (0: no limit) */
+    uint32_t exec_item; /* items executed */
+    uint16_t item_seq[CS_FW_SEQMAP];
+    uint16_t exec_seq;          /* sequence of the last item executed */
+    int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
+#if CS_FW_CURVES
+    cs_planner_t pl;
+    cs_segment_gen_t gen;
+    cs_trace_t tr;
+    bool gen_busy, tracing, rapid_pending, pl_stale;
+    cs_vec3_t rapid_to;
+    int32_t tr_feed;
+    uint32_t tr_item;
+#endif
+    uint8_t state; /* cs_proto_state_t */
+    bool aborted;
+    bool news; /* state or hold changed since cs_fw_motion_news */
+    bool more; /* the last poll stopped with work left */
+    cs_proto_error_t errs[CS_FW_ERRQ];
+    uint8_t nerr;
+    cs_exlog_segs_t log; /* every segment handed to the executor */
+    cs_fw_stats_t stats;
+} cs_fw_motion_t;
+
+/* Zeroes n bytes at p without memset (freestanding: no libc; the application's structs are
+ * zeroed before they are set up). */
+void cs_fw_motion_zero(void *p, size_t n);
+/* Defaults: CS_FW_QUEUE slots, the machine's tolerance, CS_FW_TRACE (or subdivision). */
+void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m);
+/* Empty queue, executor at 0, attached to the port's step timer (port_stepper_attach); the last
+ * executed sequence reads 0xFFFF. CS_ERR_ARG for a bad machine or cfg. Not ISR-safe. */
+cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_fw_motion_cfg_t *c);
+/* Queues a SEGMENT or CURVE with its sequence: CS_ERR_FULL when no slot is free,
+ * CS_ERR_UNSUPPORTED for another type (or CURVE without curves). Main loop. */
+cs_err_t cs_fw_motion_queue(cs_fw_motion_t *mo, const cs_proto_msg_t *msg, uint16_t seq);
+/* HOLD (on: decelerate along the path to rest, cs_hold) or RESUME (off: from rest). */
+void cs_fw_motion_hold(cs_fw_motion_t *mo, bool on);
+/* ABORT: the queue and everything not yet in the executor's ring are dropped (the ring, at most
+ * CS_STEPPER_RING segments, finishes), the hold is released. */
+void cs_fw_motion_abort(cs_fw_motion_t *mo);
+/* Keeps the executor's ring full (tracing curves as needed), notes what completed, updates the
+ * state. Never blocks; bounded work. Main loop. */
+void cs_fw_motion_poll(cs_fw_motion_t *mo);
+/* A new boot of the link (a reset that keeps the machine where it is): the queue, the errors and
+ * the sequences are forgotten; the executor, its position and what it holds are kept. */
+void cs_fw_motion_reboot(cs_fw_motion_t *mo);
+/* Takes no queue item numbered past n (items count from 1 since init; 0: no limit). */
+void cs_fw_motion_take_limit(cs_fw_motion_t *mo, uint32_t n);
+/* Free queue slots (the link's credits). */
+uint16_t cs_fw_motion_free(const cs_fw_motion_t *mo);
+/* Everything taken from the queue has been executed / that and the queue is empty too. */
+bool cs_fw_motion_drained(const cs_fw_motion_t *mo);
+bool cs_fw_motion_done(const cs_fw_motion_t *mo);
+/* True (once) when the state changed or a hold/resume/abort came since the last call. */
+bool cs_fw_motion_news(cs_fw_motion_t *mo);
+/* State, queue fill, last executed sequence, axes and position (boot_id left as it is). Masks
+ * the step interrupt while it reads the executor. Main loop. */
+void cs_fw_motion_status(const cs_fw_motion_t *mo, cs_proto_status_t *st);
+/* Executor position of axis, steps (interrupt masked while read). Main loop. */
+int32_t cs_fw_motion_position(const cs_fw_motion_t *mo, unsigned axis);
+/* Raises an error about the message with sequence seq (reported in an ERROR; the first
+ * CS_FW_ERRQ waiting are kept, the rest only counted). */
+void cs_fw_motion_error(cs_fw_motion_t *mo, cs_err_t code, uint16_t seq);
+/* The oldest error not yet reported: true and *e (counted in stats.errors_sent), else false. */
+bool cs_fw_motion_peek_error(const cs_fw_motion_t *mo, cs_proto_error_t *e);
+void cs_fw_motion_drop_error(cs_fw_motion_t *mo);
+bool cs_fw_motion_pop_error(cs_fw_motion_t *mo, cs_proto_error_t *e);
+
+#endif

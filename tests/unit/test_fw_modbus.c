@@ -1,0 +1,128 @@
+/* Tests of the device's Modbus front end (firmware/app/cs_fw_modbus.c) over the motion side on
+ * the POSIX port: the identity and status registers' source (queue size, axes, tick rate, boot
+ * id, free slots, last executed, position: compared with what was queued), a mailbox write that
+ * finds no slot (CS_ERR_FULL: exception DEVICE_BUSY), HOLD/RESUME/ABORT through the command
+ * hook, and the execution error latch (FAULT until RESET, the motion aborted). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "cs_fw_app.h"
+#include "cs_fw_modbus.h"
+#include "fw_test.h"
+#include "port_posix.h"
+
+static cs_machine_t machine;
+static cs_fw_motion_t mo;
+static cs_fw_modbus_t fm;
+static cs_modbus_app_t app;
+
+static int setup(void **state)
+{
+    (void)state;
+    if (fw_test_motion(&machine, &mo, 4) != 0)
+        return -1;
+    cs_fw_modbus_init(&fm, &mo, 0x1234u, &app);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    port_stepper_attach(NULL);
+    return 0;
+}
+
+static cs_proto_msg_t seg(int32_t x)
+{
+    cs_proto_msg_t m = {.type = CS_PROTO_SEGMENT};
+    m.u.segment.ticks = 500;
+    m.u.segment.steps[0] = x;
+    return m;
+}
+
+static void run_all(void)
+{
+    for (int k = 0; k < 1000; k++) {
+        cs_fw_modbus_poll(&fm);
+        if (cs_stepper_idle(&mo.st))
+            break;
+        port_posix_run(UINT64_MAX);
+    }
+    cs_fw_modbus_poll(&fm);
+}
+
+static void test_status_and_queue(void **state)
+{
+    (void)state;
+    cs_modbus_status_t st;
+    app.status(app.ctx, &st);
+    assert_int_equal(st.queue_size, 4);
+    assert_int_equal(st.free_slots, 4);
+    assert_int_equal(st.axes, 3);
+    assert_int_equal(st.tick_hz, 100000);
+    assert_int_equal(st.boot_id, 0x1234u);
+    assert_int_equal(st.caps, CS_PROTO_CAP_ALL);
+    assert_int_equal(st.state, CS_PROTO_STATE_IDLE);
+    for (uint16_t k = 0; k < 4; k++) {
+        cs_proto_msg_t m = seg(10 + k);
+        assert_int_equal(app.submit(app.ctx, &m, k), CS_OK);
+    }
+    cs_proto_msg_t m = seg(1);
+    assert_int_equal(app.submit(app.ctx, &m, 4), CS_ERR_FULL);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.free_slots, 0);
+    run_all();
+    app.status(app.ctx, &st);
+    assert_int_equal(st.last_exec, 3);
+    assert_int_equal(st.pos[0], 10 + 11 + 12 + 13);
+    assert_int_equal(st.free_slots, 4);
+    m.type = CS_PROTO_HOLD;
+    assert_int_equal(app.submit(app.ctx, &m, 5), CS_ERR_UNSUPPORTED);
+}
+
+static void test_commands_and_error_latch(void **state)
+{
+    (void)state;
+    cs_modbus_status_t st;
+    cs_proto_msg_t m = seg(50);
+    assert_int_equal(app.submit(app.ctx, &m, 0), CS_OK);
+    app.command(app.ctx, CS_MODBUS_CMD_HOLD);
+    cs_fw_modbus_poll(&fm);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.state, CS_PROTO_STATE_HELD);
+    app.command(app.ctx, CS_MODBUS_CMD_RESUME);
+    run_all();
+    app.status(app.ctx, &st);
+    assert_int_equal(st.state, CS_PROTO_STATE_IDLE);
+    assert_int_equal(st.pos[0], 50);
+    /* an execution error: latched, the queue aborted, FAULT until RESET */
+    assert_int_equal(app.submit(app.ctx, &m, 1), CS_OK);
+    assert_int_equal(app.submit(app.ctx, &m, 2), CS_OK);
+    cs_fw_motion_error(&mo, CS_ERR_RANGE, 1);
+    cs_fw_motion_error(&mo, CS_ERR_FRAME, 2);
+    cs_fw_modbus_collect(&fm); /* before the motion took them: both are dropped */
+    run_all();
+    app.status(app.ctx, &st);
+    assert_int_equal(st.state, CS_PROTO_STATE_FAULT);
+    assert_int_equal(st.error, CS_ERR_RANGE); /* the first one stays */
+    assert_int_equal(st.error_seq, 1);
+    assert_int_equal(st.pos[0], 50); /* the abort dropped what was queued */
+    assert_int_equal(st.free_slots, 4);
+    app.command(app.ctx, CS_MODBUS_CMD_RESET);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.error, 0);
+    assert_int_equal(st.state, CS_PROTO_STATE_ABORTED);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_status_and_queue, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_commands_and_error_latch, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,197 @@
+/* Tests of the device's motion side (firmware/app/cs_fw_motion.c) running on the POSIX port, as
+ * in the simulator: queued SEGMENT messages execute in order, once each, with the last executed
+ * sequence and the position as their sums say (computed here from the messages); the queue's
+ * credits and its full case; feed hold mid-job stops at rest with work left and the position of
+ * the executed segments, resume finishes with the same segment log as a run without a hold;
+ * abort drops what is queued; the take limit; refused message types. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "cs_fw_app.h"
+#include "cs_fw_motion.h"
+#include "fw_test.h"
+#include "port_posix.h"
+
+#define NSEG 120
+
+static cs_machine_t machine;
+static cs_fw_motion_t mo;
+
+/* segment k of the test job: 5 ms, x at 160..200 mm/s, y back and forth */
+static cs_proto_msg_t job_msg(unsigned k)
+{
+    cs_proto_msg_t m = {.type = CS_PROTO_SEGMENT};
+    m.u.segment.ticks = 500;
+    m.u.segment.steps[0] = 64 + (int32_t)(k % 17);
+    m.u.segment.steps[1] = (k / 10) % 2 ? -20 : 20;
+    return m;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    return fw_test_motion(&machine, &mo, NSEG);
+}
+
+static void queue_job(unsigned n)
+{
+    for (unsigned k = 0; k < n; k++) {
+        cs_proto_msg_t m = job_msg(k);
+        assert_int_equal(cs_fw_motion_queue(&mo, &m, (uint16_t)k), CS_OK);
+    }
+}
+
+/* The main loop and the step interrupt, alternately, until the time `until` or until nothing
+ * moves any more. */
+static void run_until(uint64_t until)
+{
+    for (int k = 0; k < 100000; k++) {
+        cs_fw_motion_poll(&mo);
+        if (cs_stepper_idle(&mo.st) || port_posix_now() >= until)
+            break;
+        port_posix_run(port_posix_now() + 100 < until ? port_posix_now() + 100 : until);
+    }
+    cs_fw_motion_poll(&mo);
+}
+
+static void sum_steps(unsigned n, int64_t out[2])
+{
+    out[0] = out[1] = 0;
+    for (unsigned k = 0; k < n; k++) {
+        cs_proto_msg_t m = job_msg(k);
+        out[0] += m.u.segment.steps[0];
+        out[1] += m.u.segment.steps[1];
+    }
+}
+
+static void test_segments_in_order(void **state)
+{
+    (void)state;
+    assert_int_equal(cs_fw_motion_free(&mo), NSEG);
+    queue_job(NSEG);
+    assert_int_equal(cs_fw_motion_free(&mo), 0);
+    cs_proto_msg_t extra = job_msg(0);
+    assert_int_equal(cs_fw_motion_queue(&mo, &extra, 999), CS_ERR_FULL);
+    run_until(UINT64_MAX);
+    assert_true(cs_fw_motion_done(&mo));
+    int64_t want[2];
+    sum_steps(NSEG, want);
+    assert_int_equal(mo.stats.executed, NSEG);
+    assert_int_equal(mo.log.n, NSEG);
+    cs_proto_status_t st;
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.last_seq, NSEG - 1);
+    assert_int_equal(st.state, CS_PROTO_STATE_IDLE);
+    assert_int_equal(st.pos[0], want[0]);
+    assert_int_equal(st.pos[1], want[1]);
+    assert_int_equal(port_posix_position(0), want[0]);
+    assert_int_equal(port_posix_position(1), want[1]);
+    assert_int_equal(port_posix_now(), 500u * NSEG + 1u); /* never ran dry: one kick tick */
+}
+
+static void test_hold_resume(void **state)
+{
+    (void)state;
+    queue_job(NSEG);
+    run_until(500u * 30); /* mid-job, at full speed */
+    cs_fw_motion_hold(&mo, true);
+    run_until(UINT64_MAX);
+    cs_proto_status_t st;
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.state, CS_PROTO_STATE_HELD);
+    assert_true(cs_hold_stopped(&mo.hold));
+    assert_true(cs_stepper_idle(&mo.st));
+    assert_false(cs_fw_motion_done(&mo));
+    uint32_t ran = mo.stats.executed;
+    assert_true(ran > 30 && ran < NSEG);
+    int64_t want[2];
+    sum_steps(ran, want); /* stopped at a segment end: the executed segments exactly */
+    assert_int_equal(st.pos[0], want[0]);
+    assert_int_equal(st.pos[1], want[1]);
+    assert_int_equal(st.last_seq, ran - 1);
+    /* held at rest: time passes, nothing moves */
+    run_until(port_posix_now() + 100000);
+    assert_int_equal(mo.stats.executed, ran);
+    cs_fw_motion_hold(&mo, false);
+    run_until(UINT64_MAX);
+    assert_true(cs_fw_motion_done(&mo));
+    sum_steps(NSEG, want);
+    assert_int_equal(mo.stats.executed, NSEG);
+    assert_int_equal(port_posix_position(0), want[0]);
+    assert_int_equal(port_posix_position(1), want[1]);
+    assert_int_equal(mo.stats.holds, 1);
+    /* the same segments as a run without a hold: each once, in order */
+    cs_exlog_segs_t held = mo.log;
+    assert_int_equal(setup(NULL), 0);
+    queue_job(NSEG);
+    run_until(UINT64_MAX);
+    assert_int_equal(held.n, mo.log.n);
+    assert_int_equal(held.hash, mo.log.hash);
+}
+
+static void test_abort_and_limit(void **state)
+{
+    (void)state;
+    cs_fw_motion_take_limit(&mo, 10);
+    queue_job(40);
+    run_until(UINT64_MAX);
+    assert_int_equal(mo.stats.executed, 10); /* stopped taking after item 10 */
+    assert_true(cs_fw_motion_drained(&mo));
+    assert_false(cs_fw_motion_done(&mo));
+    cs_fw_motion_take_limit(&mo, 0);
+    run_until(500u * 5 + port_posix_now());
+    cs_fw_motion_abort(&mo);
+    run_until(UINT64_MAX);
+    cs_proto_status_t st;
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.state, CS_PROTO_STATE_ABORTED);
+    assert_true(cs_fw_motion_done(&mo));
+    uint32_t ran = mo.stats.executed;
+    assert_true(ran > 10 && ran < 40);
+    int64_t want[2];
+    sum_steps(ran, want);
+    assert_int_equal(port_posix_position(0), want[0]);
+    assert_int_equal(cs_fw_motion_free(&mo), NSEG);
+}
+
+static void test_refused_types(void **state)
+{
+    (void)state;
+    cs_proto_msg_t m = {.type = CS_PROTO_STATUS};
+    assert_int_equal(cs_fw_motion_queue(&mo, &m, 1), CS_ERR_UNSUPPORTED);
+    cs_fw_motion_error(&mo, CS_ERR_RANGE, 7);
+    cs_proto_error_t e;
+    assert_true(cs_fw_motion_pop_error(&mo, &e));
+    assert_int_equal(e.code, CS_ERR_RANGE);
+    assert_int_equal(e.seq, 7);
+    assert_false(cs_fw_motion_pop_error(&mo, &e));
+    assert_int_equal(mo.stats.errors_sent, 1);
+    cs_fw_motion_cfg_t c;
+    cs_fw_motion_cfg_default(&c, &machine);
+    c.queue_size = CS_FW_QUEUE + 1;
+    cs_fw_motion_t other;
+    assert_int_equal(cs_fw_motion_init(&other, &machine, &c), CS_ERR_ARG);
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    port_stepper_attach(NULL);
+    port_posix_reset(machine.tick_hz, 0);
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_segments_in_order, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_hold_resume, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_abort_and_limit, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_refused_types, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
