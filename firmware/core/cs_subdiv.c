@@ -12,7 +12,7 @@
 
 CS_STATIC_ASSERT(CS_SUBDIV_MAX_DEPTH >= 1 && CS_SUBDIV_MAX_DEPTH <= 60, subdiv_depth_sane);
 CS_STATIC_ASSERT(sizeof(cs_subdiv_hcurve_t) == 32 * CS_BEZIER_MAX_POINTS, hcurve_size);
-/* thr <= 2 * CS_SUBDIV_TOL_MAX keeps thr^2 < 2^62 (see dist_ok). */
+/* thr <= 2 * CS_SUBDIV_TOL_MAX keeps thr^2 < 2^62 (see cs_subdiv_dist_ok). */
 CS_STATIC_ASSERT(CS_SUBDIV_TOL_MAX <= ((int32_t)1 << 29), tol_max_fits_thr_squared);
 
 static cs_err_t check_curve(const cs_bezier_t *c)
@@ -134,7 +134,7 @@ static uint64_t sq_mag(int64_t v)
 
 /* dist(P, segment AB) <= thr, exactly. Coordinates are projected control points (|.| <= 2^28
  * plus rounding), so differences are < 2^30 and cross-product components < 2^60. */
-static bool dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr)
+bool cs_subdiv_dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr)
 {
     int64_t dx = (int64_t)b->x - a->x, dy = (int64_t)b->y - a->y, dz = (int64_t)b->z - a->z;
     int64_t vx = (int64_t)p->x - a->x, vy = (int64_t)p->y - a->y, vz = (int64_t)p->z - a->z;
@@ -176,7 +176,7 @@ static cs_err_t is_flat(const cs_subdiv_hcurve_t *h, unsigned n, bool rational, 
     }
     *flat = true;
     for (unsigned i = 1; i < n && *flat; i++)
-        *flat = dist_ok(&p[i], &p[0], &p[n], thr);
+        *flat = cs_subdiv_dist_ok(&p[i], &p[0], &p[n], thr);
     return CS_OK;
 }
 

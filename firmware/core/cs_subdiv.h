@@ -62,6 +62,9 @@ cs_err_t cs_subdiv_next(cs_subdiv_t *s, cs_vec3_t *pt);
  * and rounding budget the tracers use (false for invalid input). */
 bool cs_subdiv_is_flat(const cs_bezier_t *c, cs_pos_t tol);
 
+/* True when the distance from p to the segment ab is <= thr, decided exactly (coordinates with
+ * differences below 2^30, thr <= 2^30). Pure. */
+bool cs_subdiv_dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr);
 /* Homogeneous form of c (no checks: c must be valid). */
 void cs_subdiv_to_homogeneous(const cs_bezier_t *c, cs_subdiv_hcurve_t *h);
 /* Split h (degree n) at t in [0, CS_PARAM_ONE] into left [0, t] and right [t, 1] (either may

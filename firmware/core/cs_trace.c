@@ -6,6 +6,8 @@
 
 CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_subdiv);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_SUBDIV_TOL_MAX, trace_tol_max_within_subdiv);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_PREDICT_TOL_MIN, trace_tol_min_covers_predict);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_PREDICT_TOL_MAX, trace_tol_max_within_predict);
 
 cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
                         cs_trace_method_t method)
@@ -13,12 +15,16 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
     tr->done = true;
     tr->count = 0;
     tr->method = (uint8_t)method;
-    if (method != CS_TRACE_FD && method != CS_TRACE_AFD && method != CS_TRACE_SUBDIV)
+    if (method != CS_TRACE_FD && method != CS_TRACE_AFD && method != CS_TRACE_SUBDIV &&
+        method != CS_TRACE_PREDICT)
         return CS_ERR_ARG;
     if (tol < CS_TRACE_TOL_MIN || tol > CS_TRACE_TOL_MAX)
         return CS_ERR_TOLERANCE;
     cs_err_t e;
-    if (method == CS_TRACE_SUBDIV) {
+    if (method == CS_TRACE_PREDICT && cs_predict_accepts(c)) {
+        tr->impl = CS_TRACE_IMPL_PREDICT;
+        e = cs_predict_begin(&tr->u.pr, c, tol);
+    } else if (method == CS_TRACE_SUBDIV || method == CS_TRACE_PREDICT) {
         tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
         e = cs_subdiv_begin(&tr->u.sd, c, tol, true);
     } else if (method == CS_TRACE_FD) {
@@ -55,6 +61,9 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
         break;
     case CS_TRACE_IMPL_AFD:
         e = cs_afd_next(&tr->u.afd, pt);
+        break;
+    case CS_TRACE_IMPL_PREDICT:
+        e = cs_predict_next(&tr->u.pr, pt);
         break;
     default:
         e = cs_subdiv_next(&tr->u.sd, pt);

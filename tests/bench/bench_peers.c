@@ -23,10 +23,11 @@
 
 #define MAX_VERTS (1u << 21)
 #define N_TOLS    3
-#define N_ENG     6
-#define N_CS      4 /* engines 0..3 are curvestep's */
-#define ENG_CAIRO 4
-#define ENG_AGG   5
+#define N_ENG     7
+#define N_CS      5 /* engines 0..4 are curvestep's */
+#define ENG_PRED  4 /* the default tracer (CS_TRACE_DEFAULT) */
+#define ENG_CAIRO 5
+#define ENG_AGG   6
 #define N_RUNS    5
 /* cairo keeps paths in 24.8 fixed point device units: 1/256 mm with an identity matrix, coarser
  * than the 0.001 mm tolerance. Coordinates are therefore handed to cairo multiplied by
@@ -42,7 +43,10 @@ static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static const char *eng_name[N_ENG] = {
     "curvestep FD (uniform, Wang)", "curvestep AFD",
     "curvestep subdiv dyadic",      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
+    "curvestep predict (CS_TRACE_PREDICT, default)",
     "cairo copy_path_flat",         "AGG curve4_div"};
+static const cs_trace_method_t eng_method[N_CS] = {CS_TRACE_FD, CS_TRACE_AFD, CS_TRACE_SUBDIV,
+                                                   CS_TRACE_SUBDIV, CS_TRACE_PREDICT};
 static cs_vec3_t verts[MAX_VERTS];
 static bench_rng_t rng = {BENCH_RNG_SEED};
 static pt2_t poly[MAX_VERTS + 1];
@@ -169,8 +173,7 @@ static size_t flatten(const cs_bezier_t *c, double tol, int e, bool out)
             while (n < MAX_VERTS && (r = cs_subdiv_next(&sd, &verts[n])) == CS_OK)
                 n++;
         } else {
-            cs_trace_method_t m = e == 0 ? CS_TRACE_FD : e == 1 ? CS_TRACE_AFD : CS_TRACE_SUBDIV;
-            if (cs_trace_begin(&tr, c, t, m) != CS_OK)
+            if (cs_trace_begin(&tr, c, t, eng_method[e]) != CS_OK)
                 return SIZE_MAX;
             while (n < MAX_VERTS && (r = cs_trace_next(&tr, &verts[n])) == CS_OK)
                 n++;
@@ -386,8 +389,14 @@ static double fd_floor_pps(void)
 typedef struct {
     size_t chords;
     double worst, cps, pps;
+    double worst_curve; /* largest chords / greedy of one curve with greedy >= GREEDY_MIN */
     int errors;
 } result_t;
+
+/* Per-curve ratios are judged on curves of at least this many greedy chords (below it one
+ * chord more is already a ratio of 1.1 or more). */
+#define GREEDY_MIN 20
+static size_t *greedy_of; /* greedy chord count of each curve of the set being run */
 
 int main(int argc, char **argv)
 {
@@ -401,6 +410,7 @@ int main(int argc, char **argv)
     size_t skipped = bench_svg_curves(&sets[1], NULL, 0, planar_cubic);
     teapot_set(&sets[2]);
     static result_t res[3][N_TOLS][N_ENG];
+    static size_t greedy[3][N_TOLS];
     if (csv)
         fprintf(csv, "set,engine,tol_mm,curves,chords,max_dev_mm,curves_per_s,points_per_s,"
                      "errors\n");
@@ -435,11 +445,19 @@ int main(int argc, char **argv)
         if (s->n == 0)
             continue;
         printf("### %s (%zu curves)\n\n", s->name, s->n);
-        printf(
-            "| engine | tol (mm) | chords/curve | vs cairo | vs AGG | max dev / tol | curves/s | "
-            "points/s | errors |\n|---|---|---|---|---|---|---|---|---|\n");
+        printf("| engine | tol (mm) | chords/curve | vs cairo | vs AGG | vs greedy (worst curve) "
+               "| max dev / tol | curves/s | points/s | errors |\n"
+               "|---|---|---|---|---|---|---|---|---|---|\n");
+        greedy_of = realloc(greedy_of, s->n * sizeof *greedy_of);
+        if (!greedy_of)
+            abort();
         for (int ti = 0; ti < N_TOLS; ti++) {
             double tol = tols_mm[ti];
+            greedy[si][ti] = 0;
+            for (size_t k = 0; k < s->n; k++) {
+                greedy_of[k] = cs_ref_greedy_count(&s->c[k], tol);
+                greedy[si][ti] += greedy_of[k];
+            }
             for (int e = 0; e < N_ENG; e++) {
                 result_t *r = &res[si][ti][e];
                 memset(r, 0, sizeof *r);
@@ -450,6 +468,9 @@ int main(int argc, char **argv)
                         continue;
                     }
                     r->chords += n;
+                    if (greedy_of[k] >= GREEDY_MIN)
+                        r->worst_curve =
+                            fmax(r->worst_curve, (double)n / (double)greedy_of[k]);
                     double dev = judge(&s->c[k], poly, n + 1, tol);
                     r->worst = fmax(r->worst, dev);
                     /* Cross-check of the judge against the project's reference on the
@@ -466,10 +487,11 @@ int main(int argc, char **argv)
             }
             for (int e = 0; e < N_ENG; e++) {
                 result_t *r = &res[si][ti][e];
-                printf("| %s | %g | %.1f | %.3f | %.3f | %.4f | %.3g | %.3g | %d |\n", eng_name[e],
-                       tol, (double)r->chords / (double)s->n,
+                printf("| %s | %g | %.1f | %.3f | %.3f | %.3f (%.3f) | %.4f | %.3g | %.3g | %d |\n",
+                       eng_name[e], tol, (double)r->chords / (double)s->n,
                        (double)r->chords / (double)res[si][ti][ENG_CAIRO].chords,
-                       (double)r->chords / (double)res[si][ti][ENG_AGG].chords, r->worst / tol,
+                       (double)r->chords / (double)res[si][ti][ENG_AGG].chords,
+                       (double)r->chords / (double)greedy[si][ti], r->worst_curve, r->worst / tol,
                        r->cps, r->pps, r->errors);
                 if (csv)
                     fprintf(csv, "%s,%s,%g,%zu,%zu,%.6g,%.4g,%.4g,%d\n", s->name, eng_name[e], tol,

@@ -1,0 +1,296 @@
+/* cs_predict: predicted-step tracer (see cs_predict.h; derivation and error bound in
+ * docs/fixed-point.md, "Predicted-step tracer"). */
+#include "cs_predict.h"
+
+#include "cs_subdiv.h"
+
+#define F        CS_PREDICT_FRAC
+#define UNIT_LIM ((int64_t)1 << 26) /* sub-curve vectors scaled below this: cross < 2^53 */
+#define THR_LIM  ((int64_t)1 << 20) /* threshold in units below this: (3072 T)^2 < 2^64 */
+#define F16_ONE  ((uint32_t)1 << 16)
+#define F16_CAP  (16u * F16_ONE) /* at most 4x growth of the step per test */
+/* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
+ * then within about 2.5 % of the largest that passes). */
+#define F16_ACCEPT ((F16_ONE * 105u) / 100u)
+
+/* Piecewise-linear majorant of m(a, b) = max_{t in [0,1]} |3t(1-t)((1-t) a + t b)|, in 1/1024,
+ * for p = max(|a|, |b|), q = min(|a|, |b|): m is convex and positively homogeneous in (a, b)
+ * (a maximum of linear functions), so on each segment between the sampled ratios
+ * q/p = 0, 1/2, 1 (same and opposite signs) it lies below the chord through the samples
+ * m(1,0) = 4/9, m(1,+-1/2) = 1/sqrt(3), 0.35210, m(1,1) = 3/4, m(1,-1) = sqrt(3)/6, each rounded
+ * up to 1/1024. Worst overestimate 1.3 %. */
+#define MAJ_SCALE 1024
+static uint64_t majorant(int64_t c1, int64_t c2)
+{
+    uint64_t a1 = c1 < 0 ? (uint64_t)0 - (uint64_t)c1 : (uint64_t)c1;
+    uint64_t a2 = c2 < 0 ? (uint64_t)0 - (uint64_t)c2 : (uint64_t)c2;
+    uint64_t p = a1 > a2 ? a1 : a2, q = a1 > a2 ? a2 : a1;
+    bool same = (c1 >= 0) == (c2 >= 0) || c1 == 0 || c2 == 0;
+    if (2 * q <= p)
+        return same ? 456 * p + 272 * q : 456 * p - 190 * q;
+    return same ? 416 * p + 352 * q : 426 * p - 130 * q;
+}
+
+static uint64_t uabs64(int64_t v)
+{
+    return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+}
+
+bool cs_predict_accepts(const cs_bezier_t *c)
+{
+    if (c->rational || c->degree < 1 || c->degree > 3)
+        return false;
+    for (unsigned i = 1; i <= c->degree; i++)
+        if (c->p[i].z != c->p[0].z)
+            return false;
+    return true;
+}
+
+cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    p->done = true;
+    if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
+        return CS_ERR_TOLERANCE;
+    if (!cs_predict_accepts(c))
+        return CS_ERR_UNSUPPORTED;
+    for (unsigned i = 0; i <= c->degree; i++)
+        if (!cs_fixed_vec_ok(&c->p[i]))
+            return CS_ERR_RANGE;
+    for (unsigned k = 0; k < 2; k++) {
+        /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
+        int64_t q[4] = {0, 0, 0, 0};
+        for (unsigned i = 0; i <= c->degree; i++)
+            q[i] = k == 0 ? c->p[i].x : c->p[i].y;
+        int64_t a1, a2 = 0, a3 = 0;
+        if (c->degree == 1) {
+            a1 = q[1] - q[0];
+        } else if (c->degree == 2) {
+            a1 = 2 * (q[1] - q[0]);
+            a2 = q[0] - 2 * q[1] + q[2];
+        } else {
+            a1 = 3 * (q[1] - q[0]);
+            a2 = 3 * (q[0] - 2 * q[1] + q[2]);
+            a3 = q[3] - q[0] + 3 * (q[1] - q[2]);
+        }
+        p->a[0][k] = q[0] * ((int64_t)1 << F);
+        p->a[1][k] = a1 * ((int64_t)1 << F);
+        p->a[2][k] = a2 * ((int64_t)1 << F);
+        p->a[3][k] = a3 * ((int64_t)1 << F);
+    }
+    p->t = 0;
+    p->h = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->thr = tol - CS_PREDICT_SLACK_LSB;
+    p->z = c->p[0].z;
+    p->end = c->p[c->degree];
+    p->done = false;
+    return CS_OK;
+}
+
+/* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
+ * rounded once: <= 1 unit in d1, 1/2 in d2). */
+static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
+{
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t a3x3 = 3 * p->a[3][k];
+        d[1][k] = p->a[2][k] + cs_fixed_mul64_q30(a3x3, t);
+        d[0][k] = p->a[1][k] + cs_fixed_mul64_q30(2 * p->a[2][k] + cs_fixed_mul64_q30(a3x3, t), t);
+    }
+}
+
+/* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
+ * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
+ * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
+ * piece, computed directly; each product rounded once, docs/fixed-point.md). */
+static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+{
+    for (unsigned k = 0; k < 2; k++) {
+        /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
+         * by |d2| up to 2^44 units): <= 1/2 unit per product. */
+        int64_t c1 = cs_fixed_mul64_q30(d[0][k], h);
+        int64_t c2 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(d[1][k], h), h);
+        int64_t c3 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(cs_fixed_mul64_q30(p->a[3][k], h), h), h);
+        v[0][k] = c1;
+        v[1][k] = 2 * c1 + c2;
+        v[2][k] = 3 * (c1 + c2 + c3);
+    }
+}
+
+/* Room left by a test, (bound allowed) / (bound found), in Q16, capped at F16_CAP. */
+static uint32_t room_q16(uint64_t allowed, uint64_t found)
+{
+    while (allowed >= ((uint64_t)1 << 46)) {
+        allowed >>= 1;
+        found >>= 1;
+    }
+    if (found == 0 || (allowed << 16) / found >= F16_CAP)
+        return F16_CAP;
+    return (uint32_t)((allowed << 16) / found);
+}
+
+/* |(x, y)| within 0.3 % (for the predictor only): max + 3/8 min (within 7 %), then one Newton
+ * step on dd (error e -> e^2 / 2). */
+static uint64_t approx_len(int64_t x, int64_t y, uint64_t dd)
+{
+    uint64_t ax = uabs64(x), ay = uabs64(y);
+    uint64_t l = ax > ay ? ax + 3 * ay / 8 : ay + 3 * ax / 8;
+    return l == 0 ? 0 : (l + dd / l) / 2;
+}
+
+/* Convex-hull test for short chords and pieces whose inner points project outside the chord:
+ * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
+ * dist(V_i, D) <= 4 T in the 3x-scaled units. */
+static bool hull_flat(int64_t v[3][2], int64_t T)
+{
+    cs_vec3_t o = {0, 0, 0}, d = {(cs_pos_t)v[2][0], (cs_pos_t)v[2][1], 0};
+    cs_vec3_t q1 = {(cs_pos_t)v[0][0], (cs_pos_t)v[0][1], 0};
+    cs_vec3_t q2 = {(cs_pos_t)v[1][0], (cs_pos_t)v[1][1], 0};
+    return cs_subdiv_dist_ok(&q1, &o, &d, (uint32_t)(4 * T)) &&
+           cs_subdiv_dist_ok(&q2, &o, &d, (uint32_t)(4 * T));
+}
+
+/* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
+ * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
+static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
+{
+    int64_t v[3][2];
+    sub_curve(p, d, h, v);
+    uint64_t m = 0;
+    for (unsigned i = 0; i < 3; i++)
+        for (unsigned k = 0; k < 2; k++)
+            m |= uabs64(v[i][k]);
+    unsigned s = 0;
+    while ((m >> s) >= (uint64_t)UNIT_LIM)
+        s++;
+    int64_t thr_f = (int64_t)p->thr << F;
+    while ((thr_f >> s) >= THR_LIM)
+        s++;
+    int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
+    if (T <= 0) {
+        *room = F16_ONE / 4;
+        return false;
+    }
+    for (unsigned i = 0; i < 3 && s > 0; i++)
+        for (unsigned k = 0; k < 2; k++)
+            v[i][k] = cs_fixed_round_shift64(v[i][k], s);
+    int64_t dd = v[2][0] * v[2][0] + v[2][1] * v[2][1];
+    int64_t dot1 = v[0][0] * v[2][0] + v[0][1] * v[2][1];
+    int64_t dot2 = v[1][0] * v[2][0] + v[1][1] * v[2][1];
+    if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
+        bool ok = hull_flat(v, T);
+        *room = ok ? F16_ONE : F16_ONE / 4;
+        return ok;
+    }
+    int64_t c1 = v[2][0] * v[0][1] - v[2][1] * v[0][0];
+    int64_t c2 = v[2][0] * v[1][1] - v[2][1] * v[1][0];
+    uint64_t found = majorant(c1, c2);
+    /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, decided exactly on squares (128 bits):
+     * found^2 <= (3072 T)^2 dd. */
+    uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
+    bool ok = cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
+    *room = room_q16(k * approx_len(v[2][0], v[2][1], (uint64_t)dd), found);
+    return ok;
+}
+
+/* sqrt(x) in Q16 for x in Q16 (0 < x <= F16_CAP), within 0.2 %: x = m 4^e with m in [1/2, 2),
+ * sqrt(m) ~ the mean of the arithmetic and harmonic means of 1 and m ((1+m)/4 + m/(1+m)),
+ * one 32-bit division (the predictor needs no more). */
+static uint32_t sqrt_q16(uint32_t x)
+{
+    int e = 0;
+    while (x >= 2 * F16_ONE) {
+        x >>= 2;
+        e++;
+    }
+    while (x < F16_ONE / 2) {
+        x <<= 2;
+        e--;
+    }
+    uint32_t y = (x + F16_ONE) / 4 + F16_ONE - (uint32_t)(0xFFFFFFFFu / (x + F16_ONE));
+    return e >= 0 ? y << e : y >> -e;
+}
+
+/* Step predicted from a tested one: deviation ~ h^2, so h * sqrt(room), 1.6 % short. */
+static int64_t predict(cs_param_t h, uint32_t room)
+{
+    uint64_t r = room == 0 ? 0 : sqrt_q16(room); /* sqrt(room) * 2^16 */
+    uint64_t nh = ((uint64_t)h * r) >> 16;
+    return (int64_t)(nh - nh / 64);
+}
+
+static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
+{
+    int64_t r[2];
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t acc = p->a[2][k] + cs_fixed_mul64_q30(p->a[3][k], t);
+        acc = p->a[1][k] + cs_fixed_mul64_q30(acc, t);
+        r[k] = cs_fixed_round_shift64(p->a[0][k] + cs_fixed_mul64_q30(acc, t), F);
+    }
+    /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
+    pt->x = (cs_pos_t)r[0];
+    pt->y = (cs_pos_t)r[1];
+    pt->z = p->z;
+}
+
+/* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
+ * between the largest passing and the smallest failing step. 0 when none passes. */
+static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
+{
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h < rem ? p->h : rem;
+    int64_t d[2][2];
+    derivs(p, p->t, d);
+    for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
+        uint32_t room;
+        if (test_step(p, d, (cs_param_t)h, &room)) {
+            lo = h;
+            *lo_room = room;
+            if (h == rem || room <= F16_ACCEPT)
+                break;
+        } else {
+            hi = h;
+        }
+        int64_t nh = predict((cs_param_t)h, room);
+        if (nh > rem)
+            nh = rem;
+        if (nh <= lo || nh >= hi)
+            nh = lo + (hi - lo) / 2;
+        if (nh == h || hi - lo <= 1)
+            break;
+        h = nh;
+    }
+    for (unsigned k = 0; lo == 0 && k < CS_PARAM_FRAC_BITS + 1; k++) {
+        h = hi / 2; /* the predictor gave up: halve until a step passes */
+        if (h == 0)
+            break;
+        uint32_t room;
+        if (test_step(p, d, (cs_param_t)h, &room)) {
+            lo = h;
+            *lo_room = room;
+        }
+        hi = h;
+    }
+    return (cs_param_t)lo;
+}
+
+cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+{
+    if (p->done)
+        return CS_END;
+    cs_param_t rem = CS_PARAM_ONE - p->t;
+    uint32_t room = F16_ONE;
+    cs_param_t h = find_step(p, rem, &room);
+    if (h == 0) {
+        p->done = true;
+        return CS_ERR_DEPTH;
+    }
+    p->t += h;
+    if (p->t == CS_PARAM_ONE) {
+        *pt = p->end;
+        p->done = true;
+        return CS_OK;
+    }
+    /* Next chord: about as long in t as this one, corrected by the room this one left. */
+    int64_t nh = predict(h, room);
+    p->h = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    eval_at(p, p->t, pt);
+    return CS_OK;
+}
