@@ -12,7 +12,7 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv]\n"
+    fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv|predict]\n"
           "                      [--feed MM/S] [--lenient] [-o OUT] FILE\n"
           "Plans the job FILE (G-code .nc .gcode .ngc .g .tap .cnc, HP-GL .plt .hpgl .hgl .hpg,\n"
           "SVG document or bare SVG path data; other names and '-' by content) on the machine\n"
@@ -28,7 +28,7 @@ static void usage(FILE *f)
           "                      G-code M3/M4 (pen down) and M5 (pen up) move Z, rapid, to\n"
           "                      its down_z / up_z\n"
           "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
-          "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
+          "  --method M          tracer: fd, afd, subdiv or predict (default predict)\n"
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
           "                      any F; default: the machine's default_feed)\n"
           "  --lenient           G-code: unsupported words are warnings (ignored), not errors\n"
@@ -43,7 +43,7 @@ int cs_cmd_plan(int argc, char **argv)
     const char *out_file = NULL, *job = NULL;
     cs_jobplan_opts_t jo;
     cs_jobplan_opts_init(&jo);
-    int method = CS_TRACE_SUBDIV;
+    int method = CS_TRACE_DEFAULT;
     bool lenient = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -67,8 +67,10 @@ int cs_cmd_plan(int argc, char **argv)
                 method = CS_TRACE_AFD;
             else if (strcmp(m, "subdiv") == 0)
                 method = CS_TRACE_SUBDIV;
+            else if (strcmp(m, "predict") == 0)
+                method = CS_TRACE_PREDICT;
             else {
-                fprintf(stderr, "curvestep plan: --method wants fd, afd or subdiv\n");
+                fprintf(stderr, "curvestep plan: --method wants fd, afd, subdiv or predict\n");
                 return CS_EXIT_USAGE;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
