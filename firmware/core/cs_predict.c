@@ -5,8 +5,8 @@
 #include "cs_subdiv.h"
 
 #define F        CS_PREDICT_FRAC
-#define UNIT_LIM ((int64_t)1 << 26) /* sub-curve vectors scaled below this: cross < 2^53 */
-#define THR_LIM  ((int64_t)1 << 20) /* threshold in units below this: (3072 T)^2 < 2^64 */
+#define UNIT_BITS 26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
+#define THR_BITS  20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
 #define F16_ONE  ((uint32_t)1 << 16)
 #define F16_CAP  (16u * F16_ONE) /* at most 4x growth of the step per test */
 /* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
@@ -34,6 +34,19 @@ static uint64_t majorant(int64_t c1, int64_t c2)
 static uint64_t uabs64(int64_t v)
 {
     return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+}
+
+/* Smallest k with v >> k < 2^bits, from the bit length of v (found by halving: 6 steps). */
+static unsigned shift_below(uint64_t v, unsigned bits)
+{
+    unsigned n = 0;
+    for (unsigned step = 32; step != 0; step >>= 1)
+        if ((v >> step) != 0) {
+            v >>= step;
+            n += step;
+        }
+    n += (unsigned)v; /* bit length: v is now 0 or 1 */
+    return n > bits ? n - bits : 0;
 }
 
 bool cs_predict_accepts(const cs_bezier_t *c)
@@ -80,6 +93,7 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     p->t = 0;
     p->h = CS_PARAM_ONE; /* first try the whole curve as one chord */
     p->thr = tol - CS_PREDICT_SLACK_LSB;
+    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
     p->z = c->p[0].z;
     p->end = c->p[c->degree];
     p->done = false;
@@ -115,24 +129,33 @@ static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int6
     }
 }
 
-/* Room left by a test, (bound allowed) / (bound found), in Q16, capped at F16_CAP. */
+/* Room left by a test, (bound allowed) / (bound found), in Q16, capped at F16_CAP. Both are
+ * shifted right together until found < 2^16 (16 significant bits are plenty for a prediction),
+ * so the quotient is one 32-bit division (no 64-bit division routine on 32-bit chips). */
 static uint32_t room_q16(uint64_t allowed, uint64_t found)
 {
-    while (allowed >= ((uint64_t)1 << 46)) {
-        allowed >>= 1;
-        found >>= 1;
-    }
-    if (found == 0 || (allowed << 16) / found >= F16_CAP)
+    unsigned k = shift_below(found, 16);
+    allowed >>= k;
+    found >>= k;
+    if (found == 0 || allowed >= 16 * found)
         return F16_CAP;
-    return (uint32_t)((allowed << 16) / found);
+    /* allowed < 2^20: allowed * 2^12 < 2^32 */
+    return ((uint32_t)allowed << 12) / (uint32_t)found << 4;
 }
 
-/* |(x, y)| within 0.3 % (for the predictor only): max + 3/8 min (within 7 %), then one Newton
- * step on dd (error e -> e^2 / 2). */
-static uint64_t approx_len(int64_t x, int64_t y, uint64_t dd)
+/* |(x, y)| within 0.3 % (for the predictor only), in units of 2^sh: the components are cut to
+ * 15 bits, then max + 3/8 min (within 7 %) and one Newton step (error e -> e^2 / 2), all in 32
+ * bits. */
+static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
 {
     uint64_t ax = uabs64(x), ay = uabs64(y);
-    uint64_t l = ax > ay ? ax + 3 * ay / 8 : ay + 3 * ax / 8;
+    unsigned k = 11; /* components < 2^26: >> 11 leaves < 2^15; keep more bits if they are small */
+    while (k > 0 && ((ax | ay) >> (k - 1)) < ((uint64_t)1 << 15))
+        k--;
+    uint32_t bx = (uint32_t)(ax >> k), by = (uint32_t)(ay >> k);
+    uint32_t dd = bx * bx + by * by; /* < 2^31 */
+    uint32_t l = bx > by ? bx + 3 * by / 8 : by + 3 * bx / 8;
+    *sh = k;
     return l == 0 ? 0 : (l + dd / l) / 2;
 }
 
@@ -158,11 +181,9 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
             m |= uabs64(v[i][k]);
-    unsigned s = 0;
-    while ((m >> s) >= (uint64_t)UNIT_LIM)
-        s++;
     int64_t thr_f = (int64_t)p->thr << F;
-    while ((thr_f >> s) >= THR_LIM)
+    unsigned s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
+    while ((m >> s) >= ((uint64_t)1 << UNIT_BITS))
         s++;
     int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
     if (T <= 0) {
@@ -187,7 +208,9 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
      * found^2 <= (3072 T)^2 dd. */
     uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
     bool ok = cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
-    *room = room_q16(k * approx_len(v[2][0], v[2][1], (uint64_t)dd), found);
+    unsigned sh;
+    uint32_t len = approx_len(v[2][0], v[2][1], &sh);
+    *room = room_q16(k * len, found >> sh); /* both scaled by 2^-sh */
     return ok;
 }
 

@@ -28,12 +28,13 @@
 #define CS_PREDICT_MAX_TESTS 12
 
 /* Tracer state: the curve in power basis (x, y: LSB * 2^CS_PREDICT_FRAC), the parameter
- * reached, and the last accepted step. 88 bytes; no stack. */
+ * reached, and the last accepted step. 96 bytes; no stack. */
 typedef struct {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
     cs_param_t t;    /* parameter of the last vertex returned */
     cs_param_t h;    /* the step predicted for the next chord */
     cs_pos_t thr;    /* tol - slack, LSB */
+    uint8_t thr_shift; /* least shift of thr * 2^F below 2^20 (the test's unit) */
     cs_pos_t z;      /* the plane's z (every control point has it) */
     cs_vec3_t end;   /* P_n, returned exactly as the last vertex */
     bool done;
