@@ -7,6 +7,7 @@
 #define F        CS_PREDICT_FRAC
 #define UNIT_BITS 26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
 #define THR_BITS  20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
+#define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
 #define F16_ONE  ((uint32_t)1 << 16)
 #define F16_CAP  (16u * F16_ONE) /* at most 4x growth of the step per test */
 /* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
@@ -49,9 +50,21 @@ static unsigned shift_below(uint64_t v, unsigned bits)
     return n > bits ? n - bits : 0;
 }
 
+#define CONIC_W_MIN (CS_WEIGHT_ONE / 16) /* keeps the division by the weight's errors small */
+
+static bool conic_ok(const cs_bezier_t *c)
+{
+    if (c->degree != 2)
+        return false;
+    for (unsigned i = 0; i <= 2; i++)
+        if (c->w[i] < CONIC_W_MIN || c->w[i] > CS_WEIGHT_ONE)
+            return false;
+    return (int64_t)c->w[1] * c->w[1] <= (int64_t)c->w[0] * c->w[2];
+}
+
 bool cs_predict_accepts(const cs_bezier_t *c)
 {
-    if (c->rational || c->degree < 1 || c->degree > 3)
+    if (c->degree < 1 || c->degree > 3 || (c->rational && !conic_ok(c)))
         return false;
     for (unsigned i = 1; i <= c->degree; i++)
         if (c->p[i].z != c->p[0].z)
@@ -90,8 +103,15 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
         p->a[2][k] = a2 * ((int64_t)1 << F);
         p->a[3][k] = a3 * ((int64_t)1 << F);
     }
+    p->conic = c->rational;
+    for (unsigned i = 0; i <= 2 && p->conic; i++) {
+        int64_t w = c->w[i]; /* exact products: |w x| < 2^58 */
+        p->h[i][0] = w * c->p[i].x;
+        p->h[i][1] = w * c->p[i].y;
+        p->h[i][2] = w;
+    }
     p->t = 0;
-    p->h = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
     p->thr = tol - CS_PREDICT_SLACK_LSB;
     p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
     p->z = c->p[0].z;
@@ -240,8 +260,90 @@ static int64_t predict(cs_param_t h, uint32_t room)
     return (int64_t)(nh - nh / 64);
 }
 
+/* --- conic arcs ------------------------------------------------------------------------- */
+/* a + (b - a) u, u in Q30 (|b - a| < 2^60: one rounding of 1/2 unit). */
+static int64_t lerp(int64_t a, int64_t b, cs_param_t u)
+{
+    return a + cs_fixed_mul64_q30(b - a, u);
+}
+
+/* Homogeneous blossom b(u, v) of the conic (x, y, w), by two levels of lerps. */
+static void blossom(const cs_predict_t *p, cs_param_t u, cs_param_t v, int64_t out[3])
+{
+    for (unsigned k = 0; k < 3; k++)
+        out[k] = lerp(lerp(p->h[0][k], p->h[1][k], u), lerp(p->h[1][k], p->h[2][k], u), v);
+}
+
+/* Cartesian x, y of a homogeneous point, in LSB * 2^frac (rounded; w >= 2^26 here). */
+static void project(const int64_t hp[3], unsigned frac, int64_t q[2])
+{
+    for (unsigned k = 0; k < 2; k++)
+        if (cs_fixed_muldiv64(hp[k], (int64_t)1 << frac, hp[2], &q[k]) != CS_OK)
+            q[k] = 0; /* cannot happen: |x / w| <= 2^28 LSB for weights >= 1/16 */
+}
+
+/* Flatness test of the conic piece [t, t + h] with control points Q0, Q1, Q2 and weights W0,
+ * W1, W2: its farthest point from the chord is the shoulder, at omega/(1 + omega) of Q1's
+ * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
+ * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
+ * rounded up to 1/256. */
+static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
+{
+    int64_t b0[3], b1[3], b2[3], q0[2], q1[2], q2[2], v[2], d[2];
+    cs_param_t t1 = p->t + h;
+    blossom(p, p->t, p->t, b0);
+    blossom(p, p->t, t1, b1);
+    blossom(p, t1, t1, b2);
+    project(b0, F, q0);
+    project(b1, F, q1);
+    project(b2, F, q2);
+    uint64_t m = 0;
+    for (unsigned k = 0; k < 2; k++) {
+        v[k] = q1[k] - q0[k];
+        d[k] = q2[k] - q0[k];
+        m |= uabs64(v[k]) | uabs64(d[k]);
+    }
+    unsigned s = p->thr_shift;
+    while ((m >> s) >= ((uint64_t)1 << CONIC_UNIT_BITS))
+        s++;
+    int64_t T = (((int64_t)p->thr << F) >> s) - 2;
+    if (T <= 0) {
+        *room = F16_ONE / 4;
+        return false;
+    }
+    for (unsigned k = 0; k < 2 && s > 0; k++) {
+        v[k] = cs_fixed_round_shift64(v[k], s);
+        d[k] = cs_fixed_round_shift64(d[k], s);
+    }
+    /* phi = W1 / (W1 + sqrt(W0 W2)) rounded up to 1/256 (sqrt rounded down). */
+    uint64_t sq = cs_fixed_isqrt64((uint64_t)b0[2] * (uint64_t)b2[2]);
+    uint64_t w1 = (uint64_t)b1[2], phi = ((w1 << 8) + w1 + sq - 1) / (w1 + sq);
+    uint64_t lim = (uint64_t)T << 8, lim2 = lim * lim; /* T < 2^20: lim^2 < 2^56 */
+    int64_t dd = d[0] * d[0] + d[1] * d[1], dot = v[0] * d[0] + v[1] * d[1];
+    if (dot <= 0 || dot >= dd) { /* nearest chord point is an end: distance to it */
+        int64_t ex = dot <= 0 ? v[0] : v[0] - d[0], ey = dot <= 0 ? v[1] : v[1] - d[1];
+        bool ok = cs_fixed_cmp_prod_u64((uint64_t)(ex * ex + ey * ey), phi * phi, lim2, 1) <= 0;
+        *room = ok ? F16_ONE : F16_ONE / 4;
+        return ok;
+    }
+    uint64_t found = uabs64(d[0] * v[1] - d[1] * v[0]) * phi; /* < 2^49 * 2^9 */
+    unsigned sh;
+    uint32_t len = approx_len(d[0], d[1], &sh);
+    *room = room_q16(lim * len, found >> sh);
+    return cs_fixed_cmp_prod_u64(found, found, lim2, (uint64_t)dd) <= 0;
+}
+
 static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
 {
+    if (p->conic) {
+        int64_t b[3], q[2];
+        blossom(p, t, t, b);
+        project(b, 0, q);
+        pt->x = (cs_pos_t)q[0];
+        pt->y = (cs_pos_t)q[1];
+        pt->z = p->z;
+        return;
+    }
     int64_t r[2];
     for (unsigned k = 0; k < 2; k++) {
         int64_t acc = p->a[2][k] + cs_fixed_mul64_q30(p->a[3][k], t);
@@ -258,12 +360,13 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
  * between the largest passing and the smallest failing step. 0 when none passes. */
 static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
 {
-    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h < rem ? p->h : rem;
-    int64_t d[2][2];
-    derivs(p, p->t, d);
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
+    int64_t d[2][2] = {{0, 0}, {0, 0}};
+    if (!p->conic)
+        derivs(p, p->t, d);
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (test_step(p, d, (cs_param_t)h, &room)) {
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room) : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
             if (h == rem || room <= F16_ACCEPT)
@@ -285,7 +388,7 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (test_step(p, d, (cs_param_t)h, &room)) {
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room) : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
         }
@@ -313,7 +416,7 @@ cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
     }
     /* Next chord: about as long in t as this one, corrected by the room this one left. */
     int64_t nh = predict(h, room);
-    p->h = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
     eval_at(p, p->t, pt);
     return CS_OK;
 }

@@ -1,5 +1,6 @@
 /* cs_predict: the predicted-step tracer for planar polynomial curves of degree 1..3 (lines,
- * quadratics, cubics: what SVG, G5 and G5.1 give). Each chord's parameter step is predicted from
+ * quadratics, cubics: what SVG, G5 and G5.1 give) and planar conic arcs (rational quadratics
+ * with w1^2 <= w0 w2: the circles and ellipses of cs_arc, SVG 'A', G2/G3). Each chord's parameter step is predicted from
  * the last one and from how much room the last flatness test left (deviation ~ h^2), then
  * VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are computed
  * directly from the power-basis Taylor expansion at t (no chain of de Casteljau splits). The test
@@ -28,11 +29,13 @@
 #define CS_PREDICT_MAX_TESTS 12
 
 /* Tracer state: the curve in power basis (x, y: LSB * 2^CS_PREDICT_FRAC), the parameter
- * reached, and the last accepted step. 96 bytes; no stack. */
+ * reached, and the last accepted step. 176 bytes; no stack. */
 typedef struct {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
+    int64_t h[3][3]; /* conic: homogeneous points w_i x_i, w_i y_i (LSB * 2^30), w_i (Q30) */
+    bool conic;
     cs_param_t t;    /* parameter of the last vertex returned */
-    cs_param_t h;    /* the step predicted for the next chord */
+    cs_param_t h_next; /* the step predicted for the next chord */
     cs_pos_t thr;    /* tol - slack, LSB */
     uint8_t thr_shift; /* least shift of thr * 2^F below 2^20 (the test's unit) */
     cs_pos_t z;      /* the plane's z (every control point has it) */
@@ -40,7 +43,9 @@ typedef struct {
     bool done;
 } cs_predict_t;
 
-/* True when cs_predict takes c: polynomial, degree 1..3, every control point at the same z. */
+/* True when cs_predict takes c: every control point at the same z, and polynomial of degree
+ * 1..3, or rational of degree 2 with every weight >= 1/16 and w1^2 <= w0 w2 (an ellipse or
+ * parabola arc: the conic's shoulder is then its farthest point from the chord). */
 bool cs_predict_accepts(const cs_bezier_t *c);
 /* Start tracing c with chord tolerance tol (LSB). CS_ERR_TOLERANCE outside
  * CS_PREDICT_TOL_MIN..MAX, CS_ERR_UNSUPPORTED when !cs_predict_accepts(c), CS_ERR_RANGE for a

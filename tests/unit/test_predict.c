@@ -5,8 +5,7 @@
  * near the greedy optimum (cs_ref_greedy_count). Corpora: 200 random cubics and 100 random
  * quadratics (xorshift, fixed seed, 200 mm box), the hard cases (cusp, loop, collinear fold,
  * near-equal end points, coincident points, inflection, 2 m curves, worst-case coordinates) and
- * the arcs of cs_arc traced through cs_trace (rational: the tracer hands them to the reach
- * tracer, whose promise holds). Also: what cs_predict refuses and cs_trace's fallback. */
+ * the circular and elliptical arcs of cs_arc (rational quadratics: the conic path). Also: what cs_predict refuses and cs_trace's fallback. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -195,35 +194,42 @@ static void test_small_tol(void **state)
     }
 }
 
-/* Circles and ellipses from cs_arc, traced by cs_trace with CS_TRACE_PREDICT (rational: the
- * reach tracer), and the same arcs' cubic approximations by cs_predict directly. */
+/* Circles and ellipses from cs_arc (rational quadratic pieces: the conic path), at every
+ * tolerance: the promise, and chords within 1.05x greedy over the set; the same arcs' cubic
+ * approximations (kappa = 0.5523) by the polynomial path. */
 static void test_arcs(void **state)
 {
     (void)state;
-    static const double radii[] = {0.5, 5, 50, 500};
-    for (size_t ri = 0; ri < sizeof radii / sizeof radii[0]; ri++) {
-        double r = radii[ri];
-        cs_vec3_t C = {MM(10), MM(-20), 0}, U = {MM(r), 0, 0}, V = {0, MM(r * 0.6), 0};
-        cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
-        unsigned n = 0;
-        assert_int_equal(cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, 0, CS_PARAM_ONE, true, seg, &n),
-                         CS_OK);
-        for (unsigned s = 0; s < n; s++) {
-            static cs_trace_t tr;
-            size_t nv = 0;
-            cs_err_t e = cs_trace_begin(&tr, &seg[s], MM(0.01), CS_TRACE_PREDICT);
-            assert_int_equal(e, CS_OK);
-            while (nv < MAX_VERTS && (e = cs_trace_next(&tr, &verts[nv])) == CS_OK)
-                nv++;
-            assert_int_equal(e, CS_END);
-            assert_true(cs_ref_max_deviation(&seg[s], verts, nv) <= 0.01);
+    static const double radii[] = {0.3, 2, 5, 50, 500, 2000};
+    static const double aspect[] = {1.0, 0.6, 0.1};
+    for (int ti = 0; ti < N_TOLS; ti++) {
+        size_t chords = 0, greedy = 0;
+        for (size_t ri = 0; ri < sizeof radii / sizeof radii[0]; ri++)
+            for (size_t ai = 0; ai < sizeof aspect / sizeof aspect[0]; ai++) {
+                double r = radii[ri], q = aspect[ai];
+                cs_vec3_t C = {MM(10), MM(-20), MM(1)}, U = {MM(r * 0.8), MM(r * 0.6), 0},
+                          V = {MM(-r * 0.6 * q), MM(r * 0.8 * q), 0};
+                cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
+                unsigned n = 0;
+                /* from 0 to 300 degrees, counter-clockwise: 4 pieces */
+                assert_int_equal(cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, CS_PARAM_ONE / 2,
+                                              -(cs_param_t)(0.8660254 * CS_PARAM_ONE), true, seg,
+                                              &n),
+                                 CS_OK);
+                for (unsigned k = 0; k < n; k++) {
+                    assert_true(cs_predict_accepts(&seg[k]));
+                    chords += check(&seg[k], MM(tols_mm[ti]), "arc piece");
+                    greedy += cs_ref_greedy_count(&seg[k], tols_mm[ti]);
+                }
+                const double kap = 0.5522847498;
+                double p[4][2] = {{r, 0}, {r, kap * r * q}, {kap * r, r * q}, {0, r * q}};
+                cs_bezier_t c = make(3, (const double(*)[2])p, 0);
+                check(&c, MM(tols_mm[ti]), "cubic quarter ellipse");
+            }
+        if ((double)chords > 1.05 * (double)greedy) {
+            print_error("arcs tol %g: %zu chords, greedy %zu\n", tols_mm[ti], chords, greedy);
+            fail();
         }
-        /* The quarter ellipse by its usual cubic (kappa = 0.5523): a polynomial arc. */
-        const double k = 0.5522847498;
-        double p[4][2] = {{r, 0}, {r, k * r * 0.6}, {k * r, r * 0.6}, {0, r * 0.6}};
-        cs_bezier_t c = make(3, (const double(*)[2])p, 0);
-        for (int ti = 0; ti < N_TOLS; ti++)
-            check(&c, MM(tols_mm[ti]), "cubic quarter ellipse");
     }
 }
 
@@ -240,8 +246,16 @@ static void test_refuse(void **state)
     assert_false(cs_predict_accepts(&d));
     assert_int_equal(cs_predict_begin(&p, &d, MM(0.01)), CS_ERR_UNSUPPORTED);
     cs_bezier_t r = c;
-    r.rational = true;
+    r.rational = true; /* a rational cubic */
     assert_false(cs_predict_accepts(&r));
+    static const double hyp[3][2] = {{0, 0}, {10, 10}, {20, 0}};
+    cs_bezier_t h = make(2, hyp, 0);
+    h.rational = true;
+    h.w[0] = h.w[2] = CS_WEIGHT_ONE / 2; /* w1^2 > w0 w2: a hyperbola arc */
+    assert_false(cs_predict_accepts(&h));
+    h.w[0] = CS_WEIGHT_ONE / 32; /* a weight below 1/16 */
+    h.w[1] = CS_WEIGHT_ONE / 64;
+    assert_false(cs_predict_accepts(&h));
     cs_bezier_t big = c;
     big.p[1].x = CS_POS_LIMIT + 1;
     assert_int_equal(cs_predict_begin(&p, &big, MM(0.01)), CS_ERR_RANGE);
