@@ -16,6 +16,7 @@
 
 #include "agg_flat.h"
 #include "bench_curves.h"
+#include "cs_arc.h"
 #include "cs_patchfile.h"
 #include "cs_ref.h"
 #include "cs_svgdoc.h"
@@ -398,6 +399,187 @@ typedef struct {
 #define GREEDY_MIN 20
 static size_t *greedy_of; /* greedy chord count of each curve of the set being run */
 
+/* --- arcs: circular and elliptical arcs, greedy over the whole arc ------------------------- */
+#define N_ARCS_R  6
+#define N_ARCS_Q  2
+#define N_ARCS_SW 5
+#define N_ARCS    (N_ARCS_R * N_ARCS_Q * N_ARCS_SW)
+typedef struct {
+    double r, q, sweep; /* radius (mm), minor/major axis ratio, sweep (rad) */
+    cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
+    unsigned n;
+} arc_t;
+static arc_t arcs[N_ARCS];
+
+/* The corpus: radii 0.5 .. 1000 mm, circles and 1:2 ellipses, sweeps 30 .. 360 degrees, each
+ * built by cs_arc_build (centre at the origin, axes x and y) as the parsers build SVG 'A' and
+ * G2/G3. */
+static void arcs_set(void)
+{
+    static const double rs[N_ARCS_R] = {0.5, 2, 10, 50, 200, 1000}, qs[N_ARCS_Q] = {1, 0.5};
+    static const double sws[N_ARCS_SW] = {30, 90, 180, 300, 360};
+    size_t k = 0;
+    for (int i = 0; i < N_ARCS_R; i++)
+        for (int j = 0; j < N_ARCS_Q; j++)
+            for (int w = 0; w < N_ARCS_SW; w++, k++) {
+                arc_t *a = &arcs[k];
+                a->r = rs[i];
+                a->q = qs[j];
+                a->sweep = sws[w] * M_PI / 180;
+                cs_vec3_t C = {0, 0, 0}, U = {mm(a->r), 0, 0}, V = {0, mm(a->r * a->q), 0};
+                cs_param_t c1 = (cs_param_t)lround(cos(a->sweep) * CS_PARAM_ONE);
+                cs_param_t s1 = (cs_param_t)lround(sin(a->sweep) * CS_PARAM_ONE);
+                if (sws[w] == 360) {
+                    c1 = CS_PARAM_ONE;
+                    s1 = 0;
+                }
+                if (cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, c1, s1, true, a->seg, &a->n) !=
+                    CS_OK)
+                    abort();
+            }
+}
+
+static pt2_t arc_pt(const arc_t *a, double phi)
+{
+    return (pt2_t){a->r * cos(phi), a->r * a->q * sin(phi)};
+}
+
+/* Largest distance of the arc [f0, f1] from its chord: the arc is convex, so the distance is
+ * unimodal in phi; golden-section search, 60 steps. */
+static double arc_chord_dev(const arc_t *a, double f0, double f1)
+{
+    pt2_t A = arc_pt(a, f0), B = arc_pt(a, f1);
+    const double g = 0.6180339887498949;
+    double lo = f0, hi = f1, x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double d1 = seg_dist(arc_pt(a, x1), A, B), d2 = seg_dist(arc_pt(a, x2), A, B);
+    for (int i = 0; i < 60; i++) {
+        if (d1 > d2) {
+            hi = x2, x2 = x1, d2 = d1, x1 = hi - g * (hi - lo), d1 = seg_dist(arc_pt(a, x1), A, B);
+        } else {
+            lo = x1, x1 = x2, d1 = d2, x2 = lo + g * (hi - lo), d2 = seg_dist(arc_pt(a, x2), A, B);
+        }
+    }
+    return fmax(d1, d2);
+}
+
+/* Greedy chord count over the whole arc (no vertex forced at the pieces' joins): from each
+ * vertex the largest phi whose chord stays within tol, bisection on phi (50 steps). */
+static size_t arc_greedy(const arc_t *a, double tol)
+{
+    size_t n = 0;
+    double f = 0;
+    while (f < a->sweep) {
+        double lo = f, hi = a->sweep;
+        if (arc_chord_dev(a, f, hi) > tol) {
+            for (int i = 0; i < 50; i++) {
+                double mid = 0.5 * (lo + hi);
+                if (arc_chord_dev(a, f, mid) <= tol)
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            hi = lo;
+        }
+        f = hi;
+        n++;
+    }
+    return n;
+}
+
+/* Chords of one arc by engine e (curvestep: every piece traced, the joins are vertices; cairo:
+ * cairo_arc on the scaled ellipse); *dev = worst cs_ref_max_deviation of curvestep's pieces. */
+static size_t arc_flatten(const arc_t *a, double tol, int e, double *dev)
+{
+    size_t total = 0;
+    if (e == ENG_CAIRO) {
+        const double k = CAIRO_SCALE;
+        cairo_new_path(cr);
+        cairo_set_tolerance(cr, tol * k);
+        cairo_save(cr);
+        cairo_scale(cr, k, k * a->q);
+        cairo_arc(cr, 0, 0, a->r, 0, a->sweep);
+        cairo_restore(cr);
+        cairo_path_t *path = cairo_copy_path_flat(cr);
+        for (int i = 0; i < path->num_data; i += path->data[i].header.length)
+            if (path->data[i].header.type == CAIRO_PATH_LINE_TO)
+                total++;
+        cairo_path_destroy(path);
+        return total;
+    }
+    for (unsigned k = 0; k < a->n; k++) {
+        static cs_trace_t tr;
+        size_t n = 0;
+        if (cs_trace_begin(&tr, &a->seg[k], mm(tol), eng_method[e]) != CS_OK)
+            return SIZE_MAX;
+        cs_err_t r;
+        while (n < MAX_VERTS && (r = cs_trace_next(&tr, &verts[n])) == CS_OK)
+            n++;
+        if (r != CS_END)
+            return SIZE_MAX;
+        if (dev)
+            *dev = fmax(*dev, cs_ref_max_deviation(&a->seg[k], verts, n));
+        total += n;
+    }
+    return total;
+}
+
+static void arcs_report(FILE *csv)
+{
+    static const int engs[] = {3, ENG_PRED, ENG_CAIRO};
+    arcs_set();
+    printf("### Arcs: circles and ellipses traced as drawn elements (%d arcs)\n\n", N_ARCS);
+    printf("Radii 0.5, 2, 10, 50, 200, 1000 mm; circles and 1:2 ellipses; sweeps 30, 90, 180, "
+           "300, 360 degrees; each built by `cs_arc_build` as the parsers build SVG `A` and "
+           "G2/G3 (pieces of at most 90 degrees, rational quadratics; a join between pieces is "
+           "a vertex). Greedy = over the **whole arc** (bisection on the angle, chord deviation by "
+           "golden-section search, double). Max dev / tol: `cs_ref_max_deviation` per piece "
+           "(curvestep only). cairo: `cairo_arc` on the scaled ellipse (not judged). "
+           "Throughput: median of %d runs.\n\n",
+           N_RUNS);
+    printf("| engine | tol (mm) | chords/arc | greedy/arc (whole arc) | vs greedy | vs cairo | "
+           "max dev / tol | arcs/s | points/s |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (int ti = 0; ti < N_TOLS; ti++) {
+        double tol = tols_mm[ti];
+        size_t greedy = 0, cairo_n = 0;
+        for (int k = 0; k < N_ARCS; k++) {
+            greedy += arc_greedy(&arcs[k], tol);
+            cairo_n += arc_flatten(&arcs[k], tol, ENG_CAIRO, NULL);
+        }
+        for (size_t ei = 0; ei < sizeof engs / sizeof engs[0]; ei++) {
+            int e = engs[ei];
+            size_t chords = 0;
+            double dev = 0, aps[N_RUNS], pps[N_RUNS];
+            for (int k = 0; k < N_ARCS; k++)
+                chords += arc_flatten(&arcs[k], tol, e, e == ENG_CAIRO ? NULL : &dev);
+            for (int r = 0; r < N_RUNS; r++) {
+                size_t na = 0, np = 0;
+                double t0 = bench_now(), t1;
+                do {
+                    for (int k = 0; k < N_ARCS; k++)
+                        np += arc_flatten(&arcs[k], tol, e, NULL);
+                    na += N_ARCS;
+                    t1 = bench_now();
+                } while (t1 - t0 < 0.03);
+                aps[r] = (double)na / (t1 - t0);
+                pps[r] = (double)np / (t1 - t0);
+            }
+            qsort(aps, N_RUNS, sizeof aps[0], cmp_d);
+            qsort(pps, N_RUNS, sizeof pps[0], cmp_d);
+            char devs[32] = "-";
+            if (e != ENG_CAIRO)
+                snprintf(devs, sizeof devs, "%.4f", dev / tol);
+            printf("| %s | %g | %.1f | %.1f | %.3f | %.3f | %s | %.3g | %.3g |\n", eng_name[e], tol,
+                   (double)chords / N_ARCS, (double)greedy / N_ARCS,
+                   (double)chords / (double)greedy, (double)chords / (double)cairo_n, devs,
+                   aps[N_RUNS / 2], pps[N_RUNS / 2]);
+            if (csv)
+                fprintf(csv, "arcs,%s,%g,%d,%zu,%.6g,%.4g,%.4g,0\n", eng_name[e], tol, N_ARCS,
+                        chords, dev, aps[N_RUNS / 2], pps[N_RUNS / 2]);
+        }
+    }
+    printf("\n");
+}
+
 int main(int argc, char **argv)
 {
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
@@ -563,6 +745,8 @@ int main(int argc, char **argv)
     printf("- cairo keeps within its tolerance (its test bounds the control points, a "
            "conservative bound on the curve, which is why it stays near 0.75 of tol and emits "
            "more chords than needed).\n\n");
+
+    arcs_report(csv);
 
     /* FD rate against the floor: random cubics at 0.001 mm, uniform FD only. */
     bench_set_t rnd = sets[0];
