@@ -274,12 +274,15 @@ static void blossom(const cs_predict_t *p, cs_param_t u, cs_param_t v, int64_t o
         out[k] = lerp(lerp(p->h[0][k], p->h[1][k], u), lerp(p->h[1][k], p->h[2][k], u), v);
 }
 
-/* Cartesian x, y of a homogeneous point, in LSB * 2^frac (rounded; w >= 2^26 here). */
+/* Cartesian x, y of a homogeneous point, in LSB * 2^frac (frac <= 12), truncated: the quotient
+ * and the remainder's fraction by two int64 divisions (|x| < 2^59, 2^26 <= w <= 2^30 for
+ * weights >= 1/16, so remainder * 2^frac < 2^42), error < 2^-frac LSB. */
 static void project(const int64_t hp[3], unsigned frac, int64_t q[2])
 {
-    for (unsigned k = 0; k < 2; k++)
-        if (cs_fixed_muldiv64(hp[k], (int64_t)1 << frac, hp[2], &q[k]) != CS_OK)
-            q[k] = 0; /* cannot happen: |x / w| <= 2^28 LSB for weights >= 1/16 */
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t whole = hp[k] / hp[2], rem = hp[k] % hp[2];
+        q[k] = whole * ((int64_t)1 << frac) + rem * ((int64_t)1 << frac) / hp[2];
+    }
 }
 
 /* Flatness test of the conic piece [t, t + h] with control points Q0, Q1, Q2 and weights W0,
@@ -338,7 +341,8 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
     if (p->conic) {
         int64_t b[3], q[2];
         blossom(p, t, t, b);
-        project(b, 0, q);
+        for (unsigned k = 0; k < 2; k++) /* rounded to the nearest LSB */
+            q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
         pt->x = (cs_pos_t)q[0];
         pt->y = (cs_pos_t)q[1];
         pt->z = p->z;
