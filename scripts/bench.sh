@@ -190,6 +190,7 @@ cpu=$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -n1)
     echo "- Compiler: $(${CC:-cc} --version | head -n1), -O2."
     echo "- Date: $(date -u +%Y-%m-%d)."
     echo "- CSV files: build/bench/*.csv."
+    [ -z "${BENCH_NOTE:-}" ] || echo "- Note: $BENCH_NOTE"
     echo
     for b in "$@"; do
         name=$(basename "$b")
