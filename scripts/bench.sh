@@ -110,11 +110,11 @@ fw_section() {
     curve_core fd_rat "-DCURVE_CORE_FD" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c
     local fd_rat=$CORE_BYTES
-    echo "**Every tracer** (cs_trace: FD, AFD and flatness subdivision, rational included):"
+    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision and the predicted step, rational included):"
     echo
     curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
-        firmware/core/cs_trace.c
+        firmware/core/cs_predict.c firmware/core/cs_trace.c
     local trace=$CORE_BYTES
     echo "**The default tracer alone** (cs_predict: planar polynomial curves of degree <= 3, what"
     echo "curves mode gets from SVG and G5; cs_subdiv contributes its distance test only):"
