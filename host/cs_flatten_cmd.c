@@ -36,8 +36,8 @@ static const struct {
 static void flatten_usage(FILE *f)
 {
     fprintf(f,
-            "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv|predict] [--stats] [--svg OUT.svg]"
-            "\n                         [--lenient] FILE\n"
+            "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv|predict] [--stats]\n"
+            "                         [--svg OUT.svg] [--lenient] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -142,7 +142,8 @@ int cs_cmd_flatten(int argc, char **argv)
             while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
                 k++;
             if (k == sizeof methods / sizeof methods[0]) {
-                fprintf(stderr, "curvestep flatten: --method '%s': expected fd, afd, subdiv or predict\n",
+                fprintf(stderr,
+                        "curvestep flatten: --method '%s': expected fd, afd, subdiv or predict\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }

@@ -4,12 +4,12 @@
 
 #include "cs_subdiv.h"
 
-#define F        CS_PREDICT_FRAC
-#define UNIT_BITS 26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
-#define THR_BITS  20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
+#define F               CS_PREDICT_FRAC
+#define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
+#define THR_BITS        20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
 #define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
-#define F16_ONE  ((uint32_t)1 << 16)
-#define F16_CAP  (16u * F16_ONE) /* at most 4x growth of the step per test */
+#define F16_ONE         ((uint32_t)1 << 16)
+#define F16_CAP         (16u * F16_ONE) /* at most 4x growth of the step per test */
 /* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
  * then within about 2.5 % of the largest that passes). */
 #define F16_ACCEPT ((F16_ONE * 105u) / 100u)
@@ -142,7 +142,8 @@ static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int6
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
         int64_t c1 = cs_fixed_mul64_q30(d[0][k], h);
         int64_t c2 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(d[1][k], h), h);
-        int64_t c3 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(cs_fixed_mul64_q30(p->a[3][k], h), h), h);
+        int64_t c3 =
+            cs_fixed_mul64_q30(cs_fixed_mul64_q30(cs_fixed_mul64_q30(p->a[3][k], h), h), h);
         v[0][k] = c1;
         v[1][k] = 2 * c1 + c2;
         v[2][k] = 3 * (c1 + c2 + c3);
@@ -370,7 +371,8 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         derivs(p, p->t, d);
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room) : test_step(p, d, (cs_param_t)h, &room)) {
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+                     : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
             if (h == rem || room <= F16_ACCEPT)
@@ -392,7 +394,8 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room) : test_step(p, d, (cs_param_t)h, &room)) {
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+                     : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
         }

@@ -1,14 +1,14 @@
 /* cs_predict: the predicted-step tracer for planar polynomial curves of degree 1..3 (lines,
  * quadratics, cubics: what SVG, G5 and G5.1 give) and planar conic arcs (rational quadratics
- * with w1^2 <= w0 w2: the circles and ellipses of cs_arc, SVG 'A', G2/G3). Each chord's parameter step is predicted from
- * the last one and from how much room the last flatness test left (deviation ~ h^2), then
- * VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are computed
- * directly from the power-basis Taylor expansion at t (no chain of de Casteljau splits). The test
- * bounds the exact deviation of the sub-curve from its chord by a piecewise-linear majorant of
- * max_t |B1(t) d1 + B2(t) d2| (d1, d2 the signed distances of the inner control points), within
- * 1.3 % of the exact maximum, so chords come within a few per cent of the greedy optimum.
- * Owns the power-basis state, the test and the step predictor; derivation and error bound in
- * docs/fixed-point.md, "Predicted-step tracer". */
+ * with w1^2 <= w0 w2: the circles and ellipses of cs_arc, SVG 'A', G2/G3). Each chord's parameter
+ * step is predicted from the last one and from how much room the last flatness test left (deviation
+ * ~ h^2), then VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are
+ * computed directly from the power-basis Taylor expansion at t (no chain of de Casteljau splits).
+ * The test bounds the exact deviation of the sub-curve from its chord by a piecewise-linear
+ * majorant of max_t |B1(t) d1 + B2(t) d2| (d1, d2 the signed distances of the inner control
+ * points), within 1.3 % of the exact maximum, so chords come within a few per cent of the greedy
+ * optimum. Owns the power-basis state, the test and the step predictor; derivation and error bound
+ * in docs/fixed-point.md, "Predicted-step tracer". */
 #ifndef CS_PREDICT_H
 #define CS_PREDICT_H
 
@@ -34,12 +34,12 @@ typedef struct {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
     int64_t h[3][3]; /* conic: homogeneous points w_i x_i, w_i y_i (LSB * 2^30), w_i (Q30) */
     bool conic;
-    cs_param_t t;    /* parameter of the last vertex returned */
+    cs_param_t t;      /* parameter of the last vertex returned */
     cs_param_t h_next; /* the step predicted for the next chord */
-    cs_pos_t thr;    /* tol - slack, LSB */
+    cs_pos_t thr;      /* tol - slack, LSB */
     uint8_t thr_shift; /* least shift of thr * 2^F below 2^20 (the test's unit) */
-    cs_pos_t z;      /* the plane's z (every control point has it) */
-    cs_vec3_t end;   /* P_n, returned exactly as the last vertex */
+    cs_pos_t z;        /* the plane's z (every control point has it) */
+    cs_vec3_t end;     /* P_n, returned exactly as the last vertex */
     bool done;
 } cs_predict_t;
 

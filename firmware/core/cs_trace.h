@@ -12,14 +12,15 @@
 #include "cs_subdiv.h"
 
 typedef enum {
-    CS_TRACE_FD = 0,     /* uniform forward differences, step count from Wang's bound */
-    CS_TRACE_AFD = 1,    /* adaptive forward differences (step doubling/halving) */
-    CS_TRACE_SUBDIV = 2, /* flatness subdivision: farthest flat chord by de Casteljau splits */
+    CS_TRACE_FD = 0,      /* uniform forward differences, step count from Wang's bound */
+    CS_TRACE_AFD = 1,     /* adaptive forward differences (step doubling/halving) */
+    CS_TRACE_SUBDIV = 2,  /* flatness subdivision: farthest flat chord by de Casteljau splits */
     CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict) */
 } cs_trace_method_t;
 
 /* The method every caller uses unless told otherwise (flatten, plan, stream, the daemon, the
- * firmware's curves mode): near-greedy chord counts at a few tests per chord (docs/benchmarks.md). */
+ * firmware's curves mode): near-greedy chord counts at a few tests per chord (docs/benchmarks.md).
+ */
 #define CS_TRACE_DEFAULT CS_TRACE_PREDICT
 
 /* The state struct (cs_trace_t) is defined below by the tracing modules; its size is fixed at

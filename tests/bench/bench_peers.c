@@ -41,11 +41,13 @@ typedef struct {
 } pt2_t;
 
 static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
-static const char *eng_name[N_ENG] = {
-    "curvestep FD (uniform, Wang)", "curvestep AFD",
-    "curvestep subdiv dyadic",      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
-    "curvestep predict (CS_TRACE_PREDICT, default)",
-    "cairo copy_path_flat",         "AGG curve4_div"};
+static const char *eng_name[N_ENG] = {"curvestep FD (uniform, Wang)",
+                                      "curvestep AFD",
+                                      "curvestep subdiv dyadic",
+                                      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
+                                      "curvestep predict (CS_TRACE_PREDICT, default)",
+                                      "cairo copy_path_flat",
+                                      "AGG curve4_div"};
 static const cs_trace_method_t eng_method[N_CS] = {CS_TRACE_FD, CS_TRACE_AFD, CS_TRACE_SUBDIV,
                                                    CS_TRACE_SUBDIV, CS_TRACE_PREDICT};
 static cs_vec3_t verts[MAX_VERTS];
@@ -433,8 +435,7 @@ static void arcs_set(void)
                     c1 = CS_PARAM_ONE;
                     s1 = 0;
                 }
-                if (cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, c1, s1, true, a->seg, &a->n) !=
-                    CS_OK)
+                if (cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, c1, s1, true, a->seg, &a->n) != CS_OK)
                     abort();
             }
 }
@@ -699,8 +700,7 @@ int main(int argc, char **argv)
                     }
                     r->chords += n;
                     if (greedy_of[k] >= GREEDY_MIN)
-                        r->worst_curve =
-                            fmax(r->worst_curve, (double)n / (double)greedy_of[k]);
+                        r->worst_curve = fmax(r->worst_curve, (double)n / (double)greedy_of[k]);
                     double dev = judge(&s->c[k], poly, n + 1, tol);
                     r->worst = fmax(r->worst, dev);
                     /* Cross-check of the judge against the project's reference on the

@@ -5,7 +5,8 @@
  * near the greedy optimum (cs_ref_greedy_count). Corpora: 200 random cubics and 100 random
  * quadratics (xorshift, fixed seed, 200 mm box), the hard cases (cusp, loop, collinear fold,
  * near-equal end points, coincident points, inflection, 2 m curves, worst-case coordinates) and
- * the circular and elliptical arcs of cs_arc (rational quadratics: the conic path). Also: what cs_predict refuses and cs_trace's fallback. */
+ * the circular and elliptical arcs of cs_arc (rational quadratics: the conic path). Also: what
+ * cs_predict refuses and cs_trace's fallback. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -111,8 +112,8 @@ static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
         verr = fold_vertex_error(c, n);
     double tol_mm = tol * LSB;
     if (!(dev <= tol_mm) || !(verr <= LSB)) {
-        print_error("%s: tol %g mm: deviation %.9g mm, vertex error %.3g LSB (%zu chords)\n",
-                    what, tol_mm, dev, verr / LSB, n);
+        print_error("%s: tol %g mm: deviation %.9g mm, vertex error %.3g LSB (%zu chords)\n", what,
+                    tol_mm, dev, verr / LSB, n);
         fail();
     }
     return n;
@@ -276,7 +277,7 @@ static void test_refuse(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_random), cmocka_unit_test(test_hard),
+        cmocka_unit_test(test_random),    cmocka_unit_test(test_hard),
         cmocka_unit_test(test_small_tol), cmocka_unit_test(test_arcs),
         cmocka_unit_test(test_refuse),
     };
