@@ -225,7 +225,7 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
     int32_t feed_q = cs_motion_speed(feed);
     if (e == CS_OK)
         e = cs_jobplan_plan(&jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
-                            CS_TRACE_SUBDIV, feed_q);
+                            CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
         e = cs_jobplan_linkable(&jp, file);
     if (e == CS_OK)

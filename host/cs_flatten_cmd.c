@@ -28,17 +28,18 @@ static const struct {
     {"fd", CS_TRACE_FD},
     {"afd", CS_TRACE_AFD},
     {"subdiv", CS_TRACE_SUBDIV},
+    {"predict", CS_TRACE_PREDICT},
 };
 
-/* The default: flatness subdivision, the method whose chords are proven within the tolerance
- * with the fewest assumptions (cs_trace.h names no preferred method). */
-#define FLATTEN_DEFAULT_METHOD 2
+/* The default: CS_TRACE_DEFAULT (the predicted-step tracer: near-greedy chords, proven within
+ * the tolerance, several times faster than subdiv; docs/benchmarks.md). */
+#define FLATTEN_DEFAULT_METHOD 3
 
 static void flatten_usage(FILE *f)
 {
     fprintf(f,
-            "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
-            "\n                         [--font FILE.jhf] [input and layout options] FILE\n"
+            "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv|predict] [--stats]\n"
+            "                         [--svg OUT.svg] [--font FILE.jhf] [input and layout options] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -61,7 +62,8 @@ static void flatten_usage(FILE *f)
             "Options:\n"
             "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
             "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
-            "                  differences) or subdiv (flatness subdivision; the default)\n"
+            "                  differences), subdiv (flatness subdivision) or predict\n"
+            "                  (predicted step verified by one flatness test; the default)\n"
             "  --stats         print a summary on stderr: elements, chords, and the largest\n"
             "                  deviation of a chord from its exact curve, measured in double on\n"
             "                  the host\n"
@@ -175,7 +177,8 @@ int cs_cmd_flatten(int argc, char **argv)
             while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
                 k++;
             if (k == sizeof methods / sizeof methods[0]) {
-                fprintf(stderr, "curvestep flatten: --method '%s': expected fd, afd or subdiv\n",
+                fprintf(stderr,
+                        "curvestep flatten: --method '%s': expected fd, afd, subdiv or predict\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }

@@ -12,7 +12,7 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv]\n"
+    fputs("usage: curvestep plan [--machine FILE.ini] [--tol MM] [--method fd|afd|subdiv|predict]\n"
           "                      [--feed MM/S] [input and layout options] [-o OUT] FILE\n"
           "Plans the job FILE (G-code .nc .gcode .ngc .g .tap .cnc, HP-GL .plt .hpgl .hgl .hpg,\n"
           "SVG document or bare SVG path data; other names and '-' by content) on the machine\n"
@@ -31,7 +31,7 @@ static void usage(FILE *f)
           "                      M5 / M3); [pen] mode = servo writes \"pen US\" lines, each\n"
           "                      followed by the settle wait (docs/plotting.md)\n"
           "  --tol MM            chord tolerance (default: the machine's tolerance)\n"
-          "  --method M          tracer: fd, afd or subdiv (default subdiv)\n"
+          "  --method M          tracer: fd, afd, subdiv or predict (default predict)\n"
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
           "                      any F; default: the machine's default_feed)\n"
           "  --font FILE.jhf     Hershey stroke font for SVG <text> and HP-GL LB (default:\n"
@@ -49,7 +49,7 @@ int cs_cmd_plan(int argc, char **argv)
     const char *out_file = NULL, *job = NULL;
     cs_jobplan_opts_t jo;
     cs_jobplan_opts_init(&jo);
-    int method = CS_TRACE_SUBDIV;
+    int method = CS_TRACE_DEFAULT;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int r = cs_jobplan_option("plan", argc, argv, &i, &jo);
@@ -70,8 +70,10 @@ int cs_cmd_plan(int argc, char **argv)
                 method = CS_TRACE_AFD;
             else if (strcmp(m, "subdiv") == 0)
                 method = CS_TRACE_SUBDIV;
+            else if (strcmp(m, "predict") == 0)
+                method = CS_TRACE_PREDICT;
             else {
-                fprintf(stderr, "curvestep plan: --method wants fd, afd or subdiv\n");
+                fprintf(stderr, "curvestep plan: --method wants fd, afd, subdiv or predict\n");
                 return CS_EXIT_USAGE;
             }
         } else if (a[0] == '-' && a[1] != '\0') {

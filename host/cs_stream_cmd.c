@@ -219,7 +219,7 @@ int cs_cmd_stream(int argc, char **argv)
         return rc;
     }
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
-    e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_SUBDIV, feed_q);
+    e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
         e = cs_jobplan_linkable(&jp, job_file);
     cs_stream_job_t job;

@@ -112,16 +112,23 @@ fw_section() {
     curve_core fd_rat "-DCURVE_CORE_FD" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c
     local fd_rat=$CORE_BYTES
-    echo "**Every tracer** (cs_trace: FD, AFD and flatness subdivision, rational included):"
+    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision and the predicted step, rational included):"
     echo
     curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
-        firmware/core/cs_trace.c
+        firmware/core/cs_predict.c firmware/core/cs_trace.c
     local trace=$CORE_BYTES
+    echo "**The default tracer alone** (cs_predict: planar polynomial curves of degree <= 3, what"
+    echo "curves mode gets from SVG and G5; cs_subdiv contributes its distance test only):"
+    echo
+    curve_core predict "-DCURVE_CORE_PREDICT" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
+        firmware/core/cs_subdiv.c firmware/core/cs_predict.c
+    local predict=$CORE_BYTES
     local verdict="met"
     [ "$fd_poly" -lt 3072 ] || verdict="NOT met"
     echo "Against the goal (3 KB = 3072 bytes): the polynomial FD curve core takes **$fd_poly bytes**:"
-    echo "goal $verdict. With rational curves it takes $fd_rat bytes, with every tracer $trace bytes"
+    echo "goal $verdict. The default tracer's curve core takes $predict bytes. With rational curves"
+    echo "FD takes $fd_rat bytes, with every tracer $trace bytes"
     echo "(over the goal: those are what curves mode links, not the G5 equivalent)."
     echo
     local bench=build/fw/cortex-m3/fdbench.elf
@@ -153,6 +160,7 @@ fw_section() {
                 else if (w == "trace_fd_chord") w = "cs_trace, FD: one chord (begin included)"
                 else if (w == "trace_afd_chord") w = "cs_trace, AFD: one chord (begin included)"
                 else if (w == "trace_subdiv_chord") w = "cs_trace, subdivision: one chord (begin included)"
+                else if (w == "trace_predict_chord") w = "**cs_trace, predicted step (the default): one chord (begin included)**"
                 else if (w == "planner_chord") w = "**cs_planner_line3 + cs_segment_next: one chord planned and cut**"
                 printf "| %s | %d | %d | %.0f |\n", w, n, i, i / n }
             $2 == "planner_segments" {seg = $4}
@@ -184,6 +192,7 @@ cpu=$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -n1)
     echo "- Compiler: $(${CC:-cc} --version | head -n1), -O2."
     echo "- Date: $(date -u +%Y-%m-%d)."
     echo "- CSV files: build/bench/*.csv."
+    [ -z "${BENCH_NOTE:-}" ] || echo "- Note: $BENCH_NOTE"
     echo
     for b in "$@"; do
         name=$(basename "$b")

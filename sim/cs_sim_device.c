@@ -53,7 +53,7 @@ void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
     cfg->m = m;
     cfg->queue_size = 32;
     cfg->speed = 1.0;
-    cfg->method = CS_TRACE_SUBDIV;
+    cfg->method = CS_TRACE_DEFAULT;
     cfg->status_ms = 50;
 }
 

@@ -22,7 +22,7 @@
  *                     caps say so), no tracer or planner in RAM or flash.
  *   CS_FW_ERRQ        ERROR messages waiting for room in the link window, default 4 (4 B each).
  *   CS_FW_RX_CHUNK    UART bytes read per poll, on the stack, default 32.
- *   CS_FW_TRACE       tracer for CURVE messages (cs_trace_method_t), default CS_TRACE_SUBDIV.
+ *   CS_FW_TRACE       tracer for CURVE messages (cs_trace_method_t), default CS_TRACE_DEFAULT.
  *   CS_FW_RTO_MS      link retransmission timeout, ms, default 50 (>= a full window at the line
  *                     rate plus a round trip: docs/protocol.md 3.6); CS_FW_NAK_MS, default 2.
  *   CS_FW_XY_RATE, CS_FW_XY_ACCEL  x/y limits of cs_fw_machine_default (500 mm/s, 5000 mm/s^2).

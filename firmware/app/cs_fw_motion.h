@@ -36,7 +36,7 @@
 #include "cs_planner.h"
 #include "cs_trace.h"
 #ifndef CS_FW_TRACE
-#define CS_FW_TRACE CS_TRACE_SUBDIV
+#define CS_FW_TRACE CS_TRACE_DEFAULT
 #endif
 /* Items taken from the queue and not yet executed: the executor's ring, the planner's blocks
  * (one curve may be a single block), the curve being traced, the segment held back by a hold;

@@ -12,7 +12,7 @@
 
 CS_STATIC_ASSERT(CS_SUBDIV_MAX_DEPTH >= 1 && CS_SUBDIV_MAX_DEPTH <= 60, subdiv_depth_sane);
 CS_STATIC_ASSERT(sizeof(cs_subdiv_hcurve_t) == 32 * CS_BEZIER_MAX_POINTS, hcurve_size);
-/* thr <= 2 * CS_SUBDIV_TOL_MAX keeps thr^2 < 2^62 (see dist_ok). */
+/* thr <= 2 * CS_SUBDIV_TOL_MAX keeps thr^2 < 2^62 (see cs_subdiv_dist_ok). */
 CS_STATIC_ASSERT(CS_SUBDIV_TOL_MAX <= ((int32_t)1 << 29), tol_max_fits_thr_squared);
 
 static cs_err_t check_curve(const cs_bezier_t *c)
@@ -134,7 +134,7 @@ static uint64_t sq_mag(int64_t v)
 
 /* dist(P, segment AB) <= thr, exactly. Coordinates are projected control points (|.| <= 2^28
  * plus rounding), so differences are < 2^30 and cross-product components < 2^60. */
-static bool dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr)
+bool cs_subdiv_dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr)
 {
     int64_t dx = (int64_t)b->x - a->x, dy = (int64_t)b->y - a->y, dz = (int64_t)b->z - a->z;
     int64_t vx = (int64_t)p->x - a->x, vy = (int64_t)p->y - a->y, vz = (int64_t)p->z - a->z;
@@ -176,7 +176,7 @@ static cs_err_t is_flat(const cs_subdiv_hcurve_t *h, unsigned n, bool rational, 
     }
     *flat = true;
     for (unsigned i = 1; i < n && *flat; i++)
-        *flat = dist_ok(&p[i], &p[0], &p[n], thr);
+        *flat = cs_subdiv_dist_ok(&p[i], &p[0], &p[n], thr);
     return CS_OK;
 }
 
@@ -191,7 +191,7 @@ static uint32_t threshold(cs_pos_t tol, unsigned n, bool rational)
     return base + base / m;
 }
 
-cs_err_t cs_subdiv_begin(cs_subdiv_t *s, const cs_bezier_t *c, cs_pos_t tol, bool reach)
+cs_err_t cs_subdiv_reach_begin(cs_subdiv_reach_t *s, const cs_bezier_t *c, cs_pos_t tol)
 {
     s->done = true;
     if (tol < CS_SUBDIV_TOL_MIN || tol > CS_SUBDIV_TOL_MAX)
@@ -201,7 +201,7 @@ cs_err_t cs_subdiv_begin(cs_subdiv_t *s, const cs_bezier_t *c, cs_pos_t tol, boo
         return e;
     s->degree = c->degree;
     s->rational = c->rational;
-    s->reach = reach;
+    s->reach = true;
     s->sp = 0;
     s->cur_depth = 0;
     s->thr = threshold(tol, c->degree, c->rational);
@@ -212,7 +212,14 @@ cs_err_t cs_subdiv_begin(cs_subdiv_t *s, const cs_bezier_t *c, cs_pos_t tol, boo
     return CS_OK;
 }
 
-static cs_err_t finish(cs_subdiv_t *s, cs_err_t e)
+cs_err_t cs_subdiv_begin(cs_subdiv_t *s, const cs_bezier_t *c, cs_pos_t tol, bool reach)
+{
+    cs_err_t e = cs_subdiv_reach_begin(&s->b, c, tol);
+    s->b.reach = reach;
+    return e;
+}
+
+static cs_err_t finish(cs_subdiv_reach_t *s, cs_err_t e)
 {
     s->done = true;
     return e;
@@ -220,45 +227,47 @@ static cs_err_t finish(cs_subdiv_t *s, cs_err_t e)
 
 static cs_err_t dyadic_next(cs_subdiv_t *s, cs_vec3_t *pt)
 {
-    unsigned n = s->degree;
+    unsigned n = s->b.degree;
     for (;;) {
         bool flat;
-        cs_err_t e = is_flat(&s->cur, n, s->rational, s->thr, &flat);
+        cs_err_t e = is_flat(&s->b.cur, n, s->b.rational, s->b.thr, &flat);
         if (e != CS_OK)
-            return finish(s, e);
+            return finish(&s->b, e);
         if (flat)
             break;
-        if (s->cur_depth >= CS_SUBDIV_MAX_DEPTH)
-            return finish(s, CS_ERR_DEPTH);
+        if (s->b.cur_depth >= CS_SUBDIV_MAX_DEPTH)
+            return finish(&s->b, CS_ERR_DEPTH);
         /* Push the right half, continue with the left one (depth-first, in curve order). */
-        cs_subdiv_split(&s->cur, n, T_HALF, &s->cur, &s->stack[s->sp]);
-        s->cur_depth++;
-        s->depth[s->sp] = s->cur_depth;
-        s->sp++;
+        cs_subdiv_split(&s->b.cur, n, T_HALF, &s->b.cur, &s->stack[s->b.sp]);
+        s->b.cur_depth++;
+        s->depth[s->b.sp] = s->b.cur_depth;
+        s->b.sp++;
     }
-    if (s->sp == 0) {
-        *pt = s->end;
-        s->done = true;
+    if (s->b.sp == 0) {
+        *pt = s->b.end;
+        s->b.done = true;
         return CS_OK;
     }
-    cs_err_t e = cs_subdiv_project(&s->cur.p[n], s->rational, pt);
+    cs_err_t e = cs_subdiv_project(&s->b.cur.p[n], s->b.rational, pt);
     if (e != CS_OK)
-        return finish(s, e);
-    s->sp--;
-    s->cur = s->stack[s->sp];
-    s->cur_depth = s->depth[s->sp];
+        return finish(&s->b, e);
+    s->b.sp--;
+    s->b.cur = s->stack[s->b.sp];
+    s->b.cur_depth = s->depth[s->b.sp];
     return CS_OK;
 }
 
-static cs_err_t reach_test(const cs_subdiv_t *s, cs_param_t t, bool *flat)
+static cs_err_t reach_test(const cs_subdiv_reach_t *s, cs_param_t t, bool *flat)
 {
     cs_subdiv_hcurve_t left;
     cs_subdiv_split(&s->cur, s->degree, t, &left, NULL);
     return is_flat(&left, s->degree, s->rational, s->thr, flat);
 }
 
-static cs_err_t reach_next(cs_subdiv_t *s, cs_vec3_t *pt)
+cs_err_t cs_subdiv_reach_next(cs_subdiv_reach_t *s, cs_vec3_t *pt)
 {
+    if (s->done)
+        return CS_END;
     bool flat;
     cs_err_t e = is_flat(&s->cur, s->degree, s->rational, s->thr, &flat);
     if (e != CS_OK)
@@ -319,9 +328,9 @@ static cs_err_t reach_next(cs_subdiv_t *s, cs_vec3_t *pt)
 
 cs_err_t cs_subdiv_next(cs_subdiv_t *s, cs_vec3_t *pt)
 {
-    if (s->done)
+    if (s->b.done)
         return CS_END;
-    return s->reach ? reach_next(s, pt) : dyadic_next(s, pt);
+    return s->b.reach ? cs_subdiv_reach_next(&s->b, pt) : dyadic_next(s, pt);
 }
 
 bool cs_subdiv_is_flat(const cs_bezier_t *c, cs_pos_t tol)

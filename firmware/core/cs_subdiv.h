@@ -35,6 +35,8 @@ typedef struct {
     cs_subdiv_hpt_t p[CS_BEZIER_MAX_POINTS];
 } cs_subdiv_hcurve_t;
 
+/* The state both tracers share; alone, the reach tracer's whole state (312 bytes, no stack), so
+ * cs_trace and firmware images that only reach never carry the dyadic stack. */
 typedef struct {
     uint8_t degree;
     bool rational;
@@ -46,6 +48,11 @@ typedef struct {
     cs_param_t reach_prev; /* reach: the previous chord's share of the remaining curve */
     cs_vec3_t end;         /* P_n, returned exactly as the last vertex */
     cs_subdiv_hcurve_t cur;
+} cs_subdiv_reach_t;
+
+/* Either tracer: the shared state plus the dyadic tracer's explicit stack. */
+typedef struct {
+    cs_subdiv_reach_t b;
     cs_subdiv_hcurve_t stack[CS_SUBDIV_MAX_DEPTH];
     uint8_t depth[CS_SUBDIV_MAX_DEPTH];
 } cs_subdiv_t;
@@ -57,11 +64,18 @@ cs_err_t cs_subdiv_begin(cs_subdiv_t *s, const cs_bezier_t *c, cs_pos_t tol, boo
 /* Next vertex (see cs_trace_next): CS_OK, CS_END, or CS_ERR_DEPTH when a piece cannot be made
  * flat within CS_SUBDIV_MAX_DEPTH levels (nothing out of tolerance is ever returned). */
 cs_err_t cs_subdiv_next(cs_subdiv_t *s, cs_vec3_t *pt);
+/* The reach tracer alone, on its stack-free state: as cs_subdiv_begin(.., true) and
+ * cs_subdiv_next. ISR-safe begin; next does bounded work (about 15 splits). */
+cs_err_t cs_subdiv_reach_begin(cs_subdiv_reach_t *s, const cs_bezier_t *c, cs_pos_t tol);
+cs_err_t cs_subdiv_reach_next(cs_subdiv_reach_t *s, cs_vec3_t *pt);
 
 /* True when the chord P0-Pn of c is proven within tol (LSB) of the curve, with the same test
  * and rounding budget the tracers use (false for invalid input). */
 bool cs_subdiv_is_flat(const cs_bezier_t *c, cs_pos_t tol);
 
+/* True when the distance from p to the segment ab is <= thr, decided exactly (coordinates with
+ * differences below 2^30, thr <= 2^30). Pure. */
+bool cs_subdiv_dist_ok(const cs_vec3_t *p, const cs_vec3_t *a, const cs_vec3_t *b, uint32_t thr);
 /* Homogeneous form of c (no checks: c must be valid). */
 void cs_subdiv_to_homogeneous(const cs_bezier_t *c, cs_subdiv_hcurve_t *h);
 /* Split h (degree n) at t in [0, CS_PARAM_ONE] into left [0, t] and right [t, 1] (either may

@@ -1,11 +1,14 @@
-/* cs_trace: one front for the three tracers (see cs_trace.h). It checks the tolerance, picks the
+/* cs_trace: one front for the tracers (see cs_trace.h). It checks the tolerance, picks the
  * engine (AFD does not difference rational curves, and FD hands back those that would need too
- * many steps for its 128-bit format: both then go to homogeneous subdivision, see
- * docs/fixed-point.md) and caps the vertex count so no caller can be made to loop forever. */
+ * many steps for its 128-bit format: both then go to the homogeneous reach subdivision, see
+ * docs/fixed-point.md; cs_predict takes planar polynomial curves up to degree 3, the reach tracer
+ * the rest) and caps the vertex count so no caller can be made to loop forever. */
 #include "cs_trace.h"
 
 CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_subdiv);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_SUBDIV_TOL_MAX, trace_tol_max_within_subdiv);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_PREDICT_TOL_MIN, trace_tol_min_covers_predict);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_PREDICT_TOL_MAX, trace_tol_max_within_predict);
 
 cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
                         cs_trace_method_t method)
@@ -13,24 +16,28 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
     tr->done = true;
     tr->count = 0;
     tr->method = (uint8_t)method;
-    if (method != CS_TRACE_FD && method != CS_TRACE_AFD && method != CS_TRACE_SUBDIV)
+    if (method != CS_TRACE_FD && method != CS_TRACE_AFD && method != CS_TRACE_SUBDIV &&
+        method != CS_TRACE_PREDICT)
         return CS_ERR_ARG;
     if (tol < CS_TRACE_TOL_MIN || tol > CS_TRACE_TOL_MAX)
         return CS_ERR_TOLERANCE;
     cs_err_t e;
-    if (method == CS_TRACE_SUBDIV) {
+    if (method == CS_TRACE_PREDICT && cs_predict_accepts(c)) {
+        tr->impl = CS_TRACE_IMPL_PREDICT;
+        e = cs_predict_begin(&tr->u.pr, c, tol);
+    } else if (method == CS_TRACE_SUBDIV || method == CS_TRACE_PREDICT) {
         tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
-        e = cs_subdiv_begin(&tr->u.sd, c, tol, true);
+        e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
     } else if (method == CS_TRACE_FD) {
         tr->impl = CS_TRACE_IMPL_FD;
         e = cs_fd_begin(&tr->u.fd, c, tol);
         if (e == CS_ERR_UNSUPPORTED) { /* rational curve needing more than 2^(60/n) steps */
-            tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
-            e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
+            tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
+            e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
         }
     } else if (c->rational) {
-        tr->impl = CS_TRACE_IMPL_SUBDIV_DYADIC;
-        e = cs_subdiv_begin(&tr->u.sd, c, tol, false);
+        tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
+        e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
     } else {
         tr->impl = CS_TRACE_IMPL_AFD;
         e = cs_afd_begin(&tr->u.afd, c, tol);
@@ -56,8 +63,11 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
     case CS_TRACE_IMPL_AFD:
         e = cs_afd_next(&tr->u.afd, pt);
         break;
+    case CS_TRACE_IMPL_PREDICT:
+        e = cs_predict_next(&tr->u.pr, pt);
+        break;
     default:
-        e = cs_subdiv_next(&tr->u.sd, pt);
+        e = cs_subdiv_reach_next(&tr->u.reach, pt);
         break;
     }
     if (e == CS_OK)

@@ -8,13 +8,20 @@
 #include "cs_afd.h"
 #include "cs_bezier.h"
 #include "cs_fd.h"
+#include "cs_predict.h"
 #include "cs_subdiv.h"
 
 typedef enum {
-    CS_TRACE_FD = 0,     /* uniform forward differences, step count from Wang's bound */
-    CS_TRACE_AFD = 1,    /* adaptive forward differences (step doubling/halving) */
-    CS_TRACE_SUBDIV = 2, /* flatness subdivision: farthest flat chord by de Casteljau splits */
+    CS_TRACE_FD = 0,      /* uniform forward differences, step count from Wang's bound */
+    CS_TRACE_AFD = 1,     /* adaptive forward differences (step doubling/halving) */
+    CS_TRACE_SUBDIV = 2,  /* flatness subdivision: farthest flat chord by de Casteljau splits */
+    CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict) */
 } cs_trace_method_t;
+
+/* The method every caller uses unless told otherwise (flatten, plan, stream, the daemon, the
+ * firmware's curves mode): near-greedy chord counts at a few tests per chord (docs/benchmarks.md).
+ */
+#define CS_TRACE_DEFAULT CS_TRACE_PREDICT
 
 /* The state struct (cs_trace_t) is defined below by the tracing modules; its size is fixed at
  * compile time. Every vertex it yields lies on the curve to within 1 LSB, and every chord between
@@ -29,16 +36,19 @@ typedef enum {
 #define CS_TRACE_MAX_VERTICES ((uint32_t)1 << 26)
 
 /* Which engine a cs_trace_t runs: rational curves asked for AFD, or for FD when they would need
- * more than 2^(60/n) uniform steps, are traced by dyadic homogeneous subdivision (see
- * docs/fixed-point.md); CS_TRACE_SUBDIV runs the reach tracer. */
+ * more than 2^(60/n) uniform steps, are traced by the homogeneous reach subdivision (see
+ * docs/fixed-point.md; until issue 18 the dyadic one, whose 6 KB stack cs_trace_t no longer
+ * carries); CS_TRACE_SUBDIV runs the reach tracer, and so does CS_TRACE_PREDICT for
+ * the curves cs_predict does not take (rational, degree > 3, not in a plane z = const). */
 typedef enum {
     CS_TRACE_IMPL_FD = 0,
     CS_TRACE_IMPL_AFD = 1,
-    CS_TRACE_IMPL_SUBDIV_DYADIC = 2,
+    CS_TRACE_IMPL_SUBDIV_DYADIC = 2, /* not run by cs_trace any more (cs_subdiv_t directly) */
     CS_TRACE_IMPL_SUBDIV_REACH = 3,
+    CS_TRACE_IMPL_PREDICT = 4,
 } cs_trace_impl_t;
 
-/* The tracing state: caller-owned, fixed size (one of the three method states). */
+/* The tracing state: caller-owned, fixed size (one of the engine states; no dyadic stack). */
 typedef struct {
     uint8_t method; /* cs_trace_method_t asked for */
     uint8_t impl;   /* cs_trace_impl_t running */
@@ -47,7 +57,8 @@ typedef struct {
     union {
         cs_fd_t fd;
         cs_afd_t afd;
-        cs_subdiv_t sd;
+        cs_subdiv_reach_t reach;
+        cs_predict_t pr;
     } u;
 } cs_trace_t;
 

@@ -19,11 +19,12 @@
 
 #define MAX_VERTS 400000
 #define N_TOLS    3
-#define N_METH    4
+#define N_METH    5
 
 static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static const char *meth_name[N_METH] = {"FD (uniform, Wang)", "AFD", "subdiv dyadic",
-                                        "subdiv reach (CS_TRACE_SUBDIV)"};
+                                        "subdiv reach (CS_TRACE_SUBDIV)",
+                                        "predict (CS_TRACE_PREDICT, default)"};
 static cs_vec3_t verts[MAX_VERTS];
 static bench_rng_t rng = {BENCH_RNG_SEED};
 
@@ -78,7 +79,10 @@ static size_t run(const cs_bezier_t *c, cs_pos_t tol, int m)
         while (n < MAX_VERTS && (e = cs_subdiv_next(&sd, &verts[n])) == CS_OK)
             n++;
     } else {
-        cs_trace_method_t tm = m == 0 ? CS_TRACE_FD : m == 1 ? CS_TRACE_AFD : CS_TRACE_SUBDIV;
+        cs_trace_method_t tm = m == 0   ? CS_TRACE_FD
+                               : m == 1 ? CS_TRACE_AFD
+                               : m == 3 ? CS_TRACE_SUBDIV
+                                        : CS_TRACE_PREDICT;
         if (cs_trace_begin(&tr, c, tol, tm) != CS_OK)
             return 0;
         while (n < MAX_VERTS && (e = cs_trace_next(&tr, &verts[n])) == CS_OK)

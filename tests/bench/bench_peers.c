@@ -17,6 +17,7 @@
 #include "bench_args.h"
 #include "agg_flat.h"
 #include "bench_curves.h"
+#include "cs_arc.h"
 #include "cs_patchfile.h"
 #include "cs_ref.h"
 #include "cs_svgdoc.h"
@@ -24,10 +25,11 @@
 
 #define MAX_VERTS (1u << 21)
 #define N_TOLS    3
-#define N_ENG     6
-#define N_CS      4 /* engines 0..3 are curvestep's */
-#define ENG_CAIRO 4
-#define ENG_AGG   5
+#define N_ENG     7
+#define N_CS      5 /* engines 0..4 are curvestep's */
+#define ENG_PRED  4 /* the default tracer (CS_TRACE_DEFAULT) */
+#define ENG_CAIRO 5
+#define ENG_AGG   6
 #define N_RUNS    5
 /* cairo keeps paths in 24.8 fixed point device units: 1/256 mm with an identity matrix, coarser
  * than the 0.001 mm tolerance. Coordinates are therefore handed to cairo multiplied by
@@ -40,10 +42,15 @@ typedef struct {
 } pt2_t;
 
 static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
-static const char *eng_name[N_ENG] = {
-    "curvestep FD (uniform, Wang)", "curvestep AFD",
-    "curvestep subdiv dyadic",      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
-    "cairo copy_path_flat",         "AGG curve4_div"};
+static const char *eng_name[N_ENG] = {"curvestep FD (uniform, Wang)",
+                                      "curvestep AFD",
+                                      "curvestep subdiv dyadic",
+                                      "curvestep subdiv reach (CS_TRACE_SUBDIV)",
+                                      "curvestep predict (CS_TRACE_PREDICT, default)",
+                                      "cairo copy_path_flat",
+                                      "AGG curve4_div"};
+static const cs_trace_method_t eng_method[N_CS] = {CS_TRACE_FD, CS_TRACE_AFD, CS_TRACE_SUBDIV,
+                                                   CS_TRACE_SUBDIV, CS_TRACE_PREDICT};
 static cs_vec3_t verts[MAX_VERTS];
 static bench_rng_t rng = {BENCH_RNG_SEED};
 static pt2_t poly[MAX_VERTS + 1];
@@ -170,8 +177,7 @@ static size_t flatten(const cs_bezier_t *c, double tol, int e, bool out)
             while (n < MAX_VERTS && (r = cs_subdiv_next(&sd, &verts[n])) == CS_OK)
                 n++;
         } else {
-            cs_trace_method_t m = e == 0 ? CS_TRACE_FD : e == 1 ? CS_TRACE_AFD : CS_TRACE_SUBDIV;
-            if (cs_trace_begin(&tr, c, t, m) != CS_OK)
+            if (cs_trace_begin(&tr, c, t, eng_method[e]) != CS_OK)
                 return SIZE_MAX;
             while (n < MAX_VERTS && (r = cs_trace_next(&tr, &verts[n])) == CS_OK)
                 n++;
@@ -387,8 +393,242 @@ static double fd_floor_pps(void)
 typedef struct {
     size_t chords;
     double worst, cps, pps;
+    double worst_curve; /* largest chords / greedy of one curve with greedy >= GREEDY_MIN */
     int errors;
 } result_t;
+
+/* Per-curve ratios are judged on curves of at least this many greedy chords (below it one
+ * chord more is already a ratio of 1.1 or more). */
+#define GREEDY_MIN 20
+static size_t *greedy_of; /* greedy chord count of each curve of the set being run */
+
+/* --- arcs: circular and elliptical arcs, greedy over the whole arc ------------------------- */
+#define N_ARCS_R  6
+#define N_ARCS_Q  2
+#define N_ARCS_SW 5
+#define N_ARCS    (N_ARCS_R * N_ARCS_Q * N_ARCS_SW)
+typedef struct {
+    double r, q, sweep; /* radius (mm), minor/major axis ratio, sweep (rad) */
+    cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
+    unsigned n;
+} arc_t;
+static arc_t arcs[N_ARCS];
+
+/* The corpus: radii 0.5 .. 1000 mm, circles and 1:2 ellipses, sweeps 30 .. 360 degrees, each
+ * built by cs_arc_build (centre at the origin, axes x and y) as the parsers build SVG 'A' and
+ * G2/G3. */
+static void arcs_set(void)
+{
+    static const double rs[N_ARCS_R] = {0.5, 2, 10, 50, 200, 1000}, qs[N_ARCS_Q] = {1, 0.5};
+    static const double sws[N_ARCS_SW] = {30, 90, 180, 300, 360};
+    size_t k = 0;
+    for (int i = 0; i < N_ARCS_R; i++)
+        for (int j = 0; j < N_ARCS_Q; j++)
+            for (int w = 0; w < N_ARCS_SW; w++, k++) {
+                arc_t *a = &arcs[k];
+                a->r = rs[i];
+                a->q = qs[j];
+                a->sweep = sws[w] * M_PI / 180;
+                cs_vec3_t C = {0, 0, 0}, U = {mm(a->r), 0, 0}, V = {0, mm(a->r * a->q), 0};
+                cs_param_t c1 = (cs_param_t)lround(cos(a->sweep) * CS_PARAM_ONE);
+                cs_param_t s1 = (cs_param_t)lround(sin(a->sweep) * CS_PARAM_ONE);
+                if (sws[w] == 360) {
+                    c1 = CS_PARAM_ONE;
+                    s1 = 0;
+                }
+                if (cs_arc_build(&C, &U, &V, CS_PARAM_ONE, 0, c1, s1, true, a->seg, &a->n) != CS_OK)
+                    abort();
+            }
+}
+
+static pt2_t arc_pt(const arc_t *a, double phi)
+{
+    return (pt2_t){a->r * cos(phi), a->r * a->q * sin(phi)};
+}
+
+/* Largest distance of the arc [f0, f1] from its chord: the arc is convex, so the distance is
+ * unimodal in phi; golden-section search, 60 steps. */
+static double arc_chord_dev(const arc_t *a, double f0, double f1)
+{
+    pt2_t A = arc_pt(a, f0), B = arc_pt(a, f1);
+    const double g = 0.6180339887498949;
+    double lo = f0, hi = f1, x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double d1 = seg_dist(arc_pt(a, x1), A, B), d2 = seg_dist(arc_pt(a, x2), A, B);
+    for (int i = 0; i < 60; i++) {
+        if (d1 > d2) {
+            hi = x2, x2 = x1, d2 = d1, x1 = hi - g * (hi - lo), d1 = seg_dist(arc_pt(a, x1), A, B);
+        } else {
+            lo = x1, x1 = x2, d1 = d2, x2 = lo + g * (hi - lo), d2 = seg_dist(arc_pt(a, x2), A, B);
+        }
+    }
+    return fmax(d1, d2);
+}
+
+/* Greedy chord count over the whole arc (no vertex forced at the pieces' joins): from each
+ * vertex the largest phi whose chord stays within tol, bisection on phi (50 steps). */
+static size_t arc_greedy(const arc_t *a, double tol)
+{
+    size_t n = 0;
+    double f = 0;
+    while (f < a->sweep) {
+        double lo = f, hi = a->sweep;
+        if (arc_chord_dev(a, f, hi) > tol) {
+            for (int i = 0; i < 50; i++) {
+                double mid = 0.5 * (lo + hi);
+                if (arc_chord_dev(a, f, mid) <= tol)
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            hi = lo;
+        }
+        f = hi;
+        n++;
+    }
+    return n;
+}
+
+/* Chords of one arc by engine e (curvestep: every piece traced, the joins are vertices; cairo:
+ * cairo_arc on the scaled ellipse); *dev = worst cs_ref_max_deviation of curvestep's pieces. */
+static size_t arc_flatten(const arc_t *a, double tol, int e, double *dev)
+{
+    size_t total = 0;
+    if (e == ENG_CAIRO) {
+        const double k = CAIRO_SCALE;
+        cairo_new_path(cr);
+        cairo_set_tolerance(cr, tol * k);
+        cairo_save(cr);
+        cairo_scale(cr, k, k * a->q);
+        cairo_arc(cr, 0, 0, a->r, 0, a->sweep);
+        cairo_restore(cr);
+        cairo_path_t *path = cairo_copy_path_flat(cr);
+        for (int i = 0; i < path->num_data; i += path->data[i].header.length)
+            if (path->data[i].header.type == CAIRO_PATH_LINE_TO)
+                total++;
+        cairo_path_destroy(path);
+        return total;
+    }
+    for (unsigned k = 0; k < a->n; k++) {
+        static cs_trace_t tr;
+        size_t n = 0;
+        if (cs_trace_begin(&tr, &a->seg[k], mm(tol), eng_method[e]) != CS_OK)
+            return SIZE_MAX;
+        cs_err_t r;
+        while (n < MAX_VERTS && (r = cs_trace_next(&tr, &verts[n])) == CS_OK)
+            n++;
+        if (r != CS_END)
+            return SIZE_MAX;
+        if (dev)
+            *dev = fmax(*dev, cs_ref_max_deviation(&a->seg[k], verts, n));
+        total += n;
+    }
+    return total;
+}
+
+/* The default tracer's worst figures on the arcs (for the issue 18 goals table). */
+static double arcs_worst_greedy, arcs_worst_dev, arcs_worst_cps = INFINITY,
+                                                 arcs_worst_pps = INFINITY;
+
+static void arcs_report(FILE *csv);
+
+/* The goals of issue 18 for the default tracer (ENG_PRED), worst over the sets and tolerances
+ * above and the arcs. */
+static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
+                    const bench_set_t *sets)
+{
+    double dev = arcs_worst_dev, gr = 0, cps = INFINITY, pps = INFINITY;
+    int errors = 0;
+    for (int si = 0; si < 3; si++)
+        for (int ti = 0; ti < N_TOLS; ti++) {
+            if (sets[si].n == 0)
+                continue;
+            result_t *r = &res[si][ti][ENG_PRED], *c = &res[si][ti][ENG_CAIRO];
+            errors += r->errors;
+            dev = fmax(dev, r->worst / tols_mm[ti]);
+            gr = fmax(gr, (double)r->chords / (double)greedy[si][ti]);
+            cps = fmin(cps, r->cps / c->cps);
+            pps = fmin(pps, r->pps / c->pps);
+        }
+    printf("### Goals (issue 18) for the default tracer, %s\n\n", eng_name[ENG_PRED]);
+    printf("Worst case over the three sets and three tolerances above, and the arcs.\n\n");
+    printf("| goal | measured | verdict |\n|---|---|---|\n");
+    printf("| max dev / tol <= 1, no error | %.4f, %d errors | %s |\n", dev, errors,
+           dev <= 1 && errors == 0 ? "met" : "MISSED");
+    printf("| chords <= 1.05x greedy (per set of curves) | %.3f | %s |\n", gr,
+           gr <= 1.05 ? "met" : "MISSED");
+    printf("| chords <= 1.10x whole-element greedy, arcs | %.3f | %s |\n", arcs_worst_greedy,
+           arcs_worst_greedy <= 1.10 ? "met" : "MISSED");
+    printf("| curves/s >= 2x cairo's | %.2fx (arcs %.2fx) | %s |\n", cps, arcs_worst_cps,
+           cps >= 2 && arcs_worst_cps >= 2 ? "met" : "MISSED");
+    printf("| points/s >= cairo's | %.2fx (arcs %.2fx) | %s |\n\n", pps, arcs_worst_pps,
+           pps >= 1 && arcs_worst_pps >= 1 ? "met" : "MISSED");
+}
+
+static void arcs_report(FILE *csv)
+{
+    static const int engs[] = {ENG_CAIRO, 3, ENG_PRED}; /* cairo first: the others' reference */
+    arcs_set();
+    printf("### Arcs: circles and ellipses traced as drawn elements (%d arcs)\n\n", N_ARCS);
+    printf("Radii 0.5, 2, 10, 50, 200, 1000 mm; circles and 1:2 ellipses; sweeps 30, 90, 180, "
+           "300, 360 degrees; each built by `cs_arc_build` as the parsers build SVG `A` and "
+           "G2/G3 (pieces of at most 90 degrees, rational quadratics; a join between pieces is "
+           "a vertex). Greedy = over the **whole arc** (bisection on the angle, chord deviation by "
+           "golden-section search, double). Max dev / tol: `cs_ref_max_deviation` per piece "
+           "(curvestep only). cairo: `cairo_arc` on the scaled ellipse (not judged). "
+           "Throughput: median of %d runs.\n\n",
+           N_RUNS);
+    printf("| engine | tol (mm) | chords/arc | greedy/arc (whole arc) | vs greedy | vs cairo | "
+           "max dev / tol | arcs/s | points/s |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (int ti = 0; ti < N_TOLS; ti++) {
+        double tol = tols_mm[ti], cairo_aps = 0, cairo_pps = 0;
+        size_t greedy = 0, cairo_n = 0;
+        for (int k = 0; k < N_ARCS; k++) {
+            greedy += arc_greedy(&arcs[k], tol);
+            cairo_n += arc_flatten(&arcs[k], tol, ENG_CAIRO, NULL);
+        }
+        for (size_t ei = 0; ei < sizeof engs / sizeof engs[0]; ei++) {
+            int e = engs[ei];
+            size_t chords = 0;
+            double dev = 0, aps[N_RUNS], pps[N_RUNS];
+            for (int k = 0; k < N_ARCS; k++)
+                chords += arc_flatten(&arcs[k], tol, e, e == ENG_CAIRO ? NULL : &dev);
+            for (int r = 0; r < N_RUNS; r++) {
+                size_t na = 0, np = 0;
+                double t0 = bench_now(), t1;
+                do {
+                    for (int k = 0; k < N_ARCS; k++)
+                        np += arc_flatten(&arcs[k], tol, e, NULL);
+                    na += N_ARCS;
+                    t1 = bench_now();
+                } while (t1 - t0 < 0.03);
+                aps[r] = (double)na / (t1 - t0);
+                pps[r] = (double)np / (t1 - t0);
+            }
+            qsort(aps, N_RUNS, sizeof aps[0], cmp_d);
+            qsort(pps, N_RUNS, sizeof pps[0], cmp_d);
+            if (e == ENG_CAIRO) {
+                cairo_aps = aps[N_RUNS / 2];
+                cairo_pps = pps[N_RUNS / 2];
+            } else if (e == ENG_PRED) {
+                arcs_worst_greedy = fmax(arcs_worst_greedy, (double)chords / (double)greedy);
+                arcs_worst_dev = fmax(arcs_worst_dev, dev / tol);
+                arcs_worst_cps = fmin(arcs_worst_cps, aps[N_RUNS / 2] / cairo_aps);
+                arcs_worst_pps = fmin(arcs_worst_pps, pps[N_RUNS / 2] / cairo_pps);
+            }
+            char devs[32] = "-";
+            if (e != ENG_CAIRO)
+                snprintf(devs, sizeof devs, "%.4f", dev / tol);
+            printf("| %s | %g | %.1f | %.1f | %.3f | %.3f | %s | %.3g | %.3g |\n", eng_name[e], tol,
+                   (double)chords / N_ARCS, (double)greedy / N_ARCS,
+                   (double)chords / (double)greedy, (double)chords / (double)cairo_n, devs,
+                   aps[N_RUNS / 2], pps[N_RUNS / 2]);
+            if (csv)
+                fprintf(csv, "arcs,%s,%g,%d,%zu,%.6g,%.4g,%.4g,0\n", eng_name[e], tol, N_ARCS,
+                        chords, dev, aps[N_RUNS / 2], pps[N_RUNS / 2]);
+        }
+    }
+    printf("\n");
+}
 
 int main(int argc, char **argv)
 {
@@ -408,6 +648,7 @@ int main(int argc, char **argv)
     size_t skipped = bench_svg_curves(&sets[1], NULL, 0, planar_cubic);
     teapot_set(&sets[2]);
     static result_t res[3][N_TOLS][N_ENG];
+    static size_t greedy[3][N_TOLS];
     if (csv)
         fprintf(csv, "set,engine,tol_mm,curves,chords,max_dev_mm,curves_per_s,points_per_s,"
                      "errors\n");
@@ -442,11 +683,19 @@ int main(int argc, char **argv)
         if (s->n == 0)
             continue;
         printf("### %s (%zu curves)\n\n", s->name, s->n);
-        printf(
-            "| engine | tol (mm) | chords/curve | vs cairo | vs AGG | max dev / tol | curves/s | "
-            "points/s | errors |\n|---|---|---|---|---|---|---|---|---|\n");
+        printf("| engine | tol (mm) | chords/curve | vs cairo | vs AGG | vs greedy (worst curve) "
+               "| max dev / tol | curves/s | points/s | errors |\n"
+               "|---|---|---|---|---|---|---|---|---|---|\n");
+        greedy_of = realloc(greedy_of, s->n * sizeof *greedy_of);
+        if (!greedy_of)
+            abort();
         for (int ti = 0; ti < N_TOLS; ti++) {
             double tol = tols_mm[ti];
+            greedy[si][ti] = 0;
+            for (size_t k = 0; k < s->n; k++) {
+                greedy_of[k] = cs_ref_greedy_count(&s->c[k], tol);
+                greedy[si][ti] += greedy_of[k];
+            }
             for (int e = 0; e < N_ENG; e++) {
                 result_t *r = &res[si][ti][e];
                 memset(r, 0, sizeof *r);
@@ -457,6 +706,8 @@ int main(int argc, char **argv)
                         continue;
                     }
                     r->chords += n;
+                    if (greedy_of[k] >= GREEDY_MIN)
+                        r->worst_curve = fmax(r->worst_curve, (double)n / (double)greedy_of[k]);
                     double dev = judge(&s->c[k], poly, n + 1, tol);
                     r->worst = fmax(r->worst, dev);
                     /* Cross-check of the judge against the project's reference on the
@@ -473,10 +724,11 @@ int main(int argc, char **argv)
             }
             for (int e = 0; e < N_ENG; e++) {
                 result_t *r = &res[si][ti][e];
-                printf("| %s | %g | %.1f | %.3f | %.3f | %.4f | %.3g | %.3g | %d |\n", eng_name[e],
-                       tol, (double)r->chords / (double)s->n,
+                printf("| %s | %g | %.1f | %.3f | %.3f | %.3f (%.3f) | %.4f | %.3g | %.3g | %d |\n",
+                       eng_name[e], tol, (double)r->chords / (double)s->n,
                        (double)r->chords / (double)res[si][ti][ENG_CAIRO].chords,
-                       (double)r->chords / (double)res[si][ti][ENG_AGG].chords, r->worst / tol,
+                       (double)r->chords / (double)res[si][ti][ENG_AGG].chords,
+                       (double)r->chords / (double)greedy[si][ti], r->worst_curve, r->worst / tol,
                        r->cps, r->pps, r->errors);
                 if (csv)
                     fprintf(csv, "%s,%s,%g,%zu,%zu,%.6g,%.4g,%.4g,%d\n", s->name, eng_name[e], tol,
@@ -548,6 +800,9 @@ int main(int argc, char **argv)
     printf("- cairo keeps within its tolerance (its test bounds the control points, a "
            "conservative bound on the curve, which is why it stays near 0.75 of tol and emits "
            "more chords than needed).\n\n");
+
+    arcs_report(csv);
+    goals18(res, greedy, sets);
 
     /* FD rate against the floor: random cubics at 0.001 mm, uniform FD only. */
     bench_set_t rnd = sets[0];

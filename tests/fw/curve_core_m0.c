@@ -2,12 +2,15 @@
  * flash on a Cortex-M0+ once linked with --gc-sections (scripts/bench.sh, "The curve core").
  * CURVE_CORE_FD: a cubic Bezier traced by uniform forward differences (cs_bezier_init,
  * cs_fd_begin, cs_fd_next), the equivalent of Marlin's G5; CURVE_CORE_TRACE: any Bezier by any of
- * the three tracers (cs_trace). Not run: the volatile sink keeps every call. */
+ * the tracers (cs_trace); CURVE_CORE_PREDICT: a planar cubic by the default tracer alone
+ * (cs_predict_begin, cs_predict_next). Not run: the volatile sink keeps every call. */
 #include <stddef.h>
 #include <stdint.h>
 
 #if defined(CURVE_CORE_TRACE)
 #include "cs_trace.h"
+#elif defined(CURVE_CORE_PREDICT)
+#include "cs_predict.h"
 #else
 #include "cs_fd.h"
 #endif
@@ -66,6 +69,12 @@ int main(void)
     if (cs_trace_begin(&tr, &c, 655, (cs_trace_method_t)method) != CS_OK)
         return 1;
     while (cs_trace_next(&tr, &v) == CS_OK)
+        sink = v.x + v.y + v.z;
+#elif defined(CURVE_CORE_PREDICT)
+    static cs_predict_t pr;
+    if (cs_predict_begin(&pr, &c, 655) != CS_OK)
+        return 1;
+    while (cs_predict_next(&pr, &v) == CS_OK)
         sink = v.x + v.y + v.z;
 #else
     static cs_fd_t f;

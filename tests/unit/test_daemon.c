@@ -96,7 +96,7 @@ static void test_protocol(void **state)
     assert_int_equal(cs_jobopts_prepare(&in, "test", &m, false, 0.01, &path, &diag, NULL), CS_OK);
     cs_motion_t mo;
     assert_int_equal(cs_motion_init(&mo, &m), CS_OK);
-    assert_int_equal(cs_motion_plan_path(&mo, &path, m.tolerance, CS_TRACE_SUBDIV, 0, &diag),
+    assert_int_equal(cs_motion_plan_path(&mo, &path, m.tolerance, CS_TRACE_DEFAULT, 0, &diag),
                      CS_OK);
     char want[PATH_MAX + 400];
     snprintf(want, sizeof want, "OK job 1 queued: %s: %zu segments\n", abs, mo.segs.n);
@@ -174,7 +174,7 @@ static size_t plan_count(const char *ini, const char *file, bool pen_z)
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
     assert_int_equal(cs_jobplan_read(&jp, file, pen_z ? &pen : NULL, false), CS_OK);
-    assert_int_equal(cs_jobplan_plan(&jp, file, &m, NULL, m.tolerance, CS_TRACE_SUBDIV, 0), CS_OK);
+    assert_int_equal(cs_jobplan_plan(&jp, file, &m, NULL, m.tolerance, CS_TRACE_DEFAULT, 0), CS_OK);
     size_t n = jp.mo.segs.n;
     cs_jobplan_free(&jp);
     return n;

@@ -173,6 +173,7 @@ int main(void)
     bench_trace(&c, CS_TRACE_FD, "trace_fd_chord");
     bench_trace(&c, CS_TRACE_AFD, "trace_afd_chord");
     bench_trace(&c, CS_TRACE_SUBDIV, "trace_subdiv_chord");
+    bench_trace(&c, CS_TRACE_PREDICT, "trace_predict_chord");
     bench_planner(&c);
     semihost_exit(failed ? 1u : 0u);
     for (;;)

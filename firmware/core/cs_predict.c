@@ -1,0 +1,429 @@
+/* cs_predict: predicted-step tracer (see cs_predict.h; derivation and error bound in
+ * docs/fixed-point.md, "Predicted-step tracer"). */
+#include "cs_predict.h"
+
+#include "cs_subdiv.h"
+
+#define F               CS_PREDICT_FRAC
+#define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
+#define THR_BITS        20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
+#define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
+#define F16_ONE         ((uint32_t)1 << 16)
+#define F16_CAP         (16u * F16_ONE) /* at most 4x growth of the step per test */
+/* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
+ * then within about 2.5 % of the largest that passes). */
+#define F16_ACCEPT ((F16_ONE * 105u) / 100u)
+
+/* Piecewise-linear majorant of m(a, b) = max_{t in [0,1]} |3t(1-t)((1-t) a + t b)|, in 1/1024,
+ * for p = max(|a|, |b|), q = min(|a|, |b|): m is convex and positively homogeneous in (a, b)
+ * (a maximum of linear functions), so on each segment between the sampled ratios
+ * q/p = 0, 1/2, 1 (same and opposite signs) it lies below the chord through the samples
+ * m(1,0) = 4/9, m(1,+-1/2) = 1/sqrt(3), 0.35210, m(1,1) = 3/4, m(1,-1) = sqrt(3)/6, each rounded
+ * up to 1/1024. Worst overestimate 1.3 %. */
+#define MAJ_SCALE 1024
+static uint64_t majorant(int64_t c1, int64_t c2)
+{
+    uint64_t a1 = c1 < 0 ? (uint64_t)0 - (uint64_t)c1 : (uint64_t)c1;
+    uint64_t a2 = c2 < 0 ? (uint64_t)0 - (uint64_t)c2 : (uint64_t)c2;
+    uint64_t p = a1 > a2 ? a1 : a2, q = a1 > a2 ? a2 : a1;
+    bool same = (c1 >= 0) == (c2 >= 0) || c1 == 0 || c2 == 0;
+    if (2 * q <= p)
+        return same ? 456 * p + 272 * q : 456 * p - 190 * q;
+    return same ? 416 * p + 352 * q : 426 * p - 130 * q;
+}
+
+static uint64_t uabs64(int64_t v)
+{
+    return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+}
+
+/* Smallest k with v >> k < 2^bits, from the bit length of v (found by halving: 6 steps). */
+static unsigned shift_below(uint64_t v, unsigned bits)
+{
+    unsigned n = 0;
+    for (unsigned step = 32; step != 0; step >>= 1)
+        if ((v >> step) != 0) {
+            v >>= step;
+            n += step;
+        }
+    n += (unsigned)v; /* bit length: v is now 0 or 1 */
+    return n > bits ? n - bits : 0;
+}
+
+#define CONIC_W_MIN (CS_WEIGHT_ONE / 16) /* keeps the division by the weight's errors small */
+
+static bool conic_ok(const cs_bezier_t *c)
+{
+    if (c->degree != 2)
+        return false;
+    for (unsigned i = 0; i <= 2; i++)
+        if (c->w[i] < CONIC_W_MIN || c->w[i] > CS_WEIGHT_ONE)
+            return false;
+    return (int64_t)c->w[1] * c->w[1] <= (int64_t)c->w[0] * c->w[2];
+}
+
+bool cs_predict_accepts(const cs_bezier_t *c)
+{
+    if (c->degree < 1 || c->degree > 3 || (c->rational && !conic_ok(c)))
+        return false;
+    for (unsigned i = 1; i <= c->degree; i++)
+        if (c->p[i].z != c->p[0].z)
+            return false;
+    return true;
+}
+
+cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    p->done = true;
+    if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
+        return CS_ERR_TOLERANCE;
+    if (!cs_predict_accepts(c))
+        return CS_ERR_UNSUPPORTED;
+    for (unsigned i = 0; i <= c->degree; i++)
+        if (!cs_fixed_vec_ok(&c->p[i]))
+            return CS_ERR_RANGE;
+    for (unsigned k = 0; k < 2; k++) {
+        /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
+        int64_t q[4] = {0, 0, 0, 0};
+        for (unsigned i = 0; i <= c->degree; i++)
+            q[i] = k == 0 ? c->p[i].x : c->p[i].y;
+        int64_t a1, a2 = 0, a3 = 0;
+        if (c->degree == 1) {
+            a1 = q[1] - q[0];
+        } else if (c->degree == 2) {
+            a1 = 2 * (q[1] - q[0]);
+            a2 = q[0] - 2 * q[1] + q[2];
+        } else {
+            a1 = 3 * (q[1] - q[0]);
+            a2 = 3 * (q[0] - 2 * q[1] + q[2]);
+            a3 = q[3] - q[0] + 3 * (q[1] - q[2]);
+        }
+        p->a[0][k] = q[0] * ((int64_t)1 << F);
+        p->a[1][k] = a1 * ((int64_t)1 << F);
+        p->a[2][k] = a2 * ((int64_t)1 << F);
+        p->a[3][k] = a3 * ((int64_t)1 << F);
+    }
+    p->conic = c->rational;
+    for (unsigned i = 0; i <= 2 && p->conic; i++) {
+        int64_t w = c->w[i]; /* exact products: |w x| < 2^58 */
+        p->h[i][0] = w * c->p[i].x;
+        p->h[i][1] = w * c->p[i].y;
+        p->h[i][2] = w;
+    }
+    p->t = 0;
+    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->thr = tol - CS_PREDICT_SLACK_LSB;
+    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
+    p->z = c->p[0].z;
+    p->end = c->p[c->degree];
+    p->done = false;
+    return CS_OK;
+}
+
+/* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
+ * rounded once: <= 1 unit in d1, 1/2 in d2). */
+static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
+{
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t a3x3 = 3 * p->a[3][k];
+        d[1][k] = p->a[2][k] + cs_fixed_mul64_q30(a3x3, t);
+        d[0][k] = p->a[1][k] + cs_fixed_mul64_q30(2 * p->a[2][k] + cs_fixed_mul64_q30(a3x3, t), t);
+    }
+}
+
+/* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
+ * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
+ * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
+ * piece, computed directly; each product rounded once, docs/fixed-point.md). */
+static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+{
+    for (unsigned k = 0; k < 2; k++) {
+        /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
+         * by |d2| up to 2^44 units): <= 1/2 unit per product. */
+        int64_t c1 = cs_fixed_mul64_q30(d[0][k], h);
+        int64_t c2 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(d[1][k], h), h);
+        int64_t c3 =
+            cs_fixed_mul64_q30(cs_fixed_mul64_q30(cs_fixed_mul64_q30(p->a[3][k], h), h), h);
+        v[0][k] = c1;
+        v[1][k] = 2 * c1 + c2;
+        v[2][k] = 3 * (c1 + c2 + c3);
+    }
+}
+
+/* Room left by a test, (bound allowed) / (bound found), in Q16, capped at F16_CAP. Both are
+ * shifted right together until found < 2^16 (16 significant bits are plenty for a prediction),
+ * so the quotient is one 32-bit division (no 64-bit division routine on 32-bit chips). */
+static uint32_t room_q16(uint64_t allowed, uint64_t found)
+{
+    unsigned k = shift_below(found, 16);
+    allowed >>= k;
+    found >>= k;
+    if (found == 0 || allowed >= 16 * found)
+        return F16_CAP;
+    /* allowed < 2^20: allowed * 2^12 < 2^32 */
+    return ((uint32_t)allowed << 12) / (uint32_t)found << 4;
+}
+
+/* |(x, y)| within 0.3 % (for the predictor only), in units of 2^sh: the components are cut to
+ * 15 bits, then max + 3/8 min (within 7 %) and one Newton step (error e -> e^2 / 2), all in 32
+ * bits. */
+static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
+{
+    uint64_t ax = uabs64(x), ay = uabs64(y);
+    unsigned k = 11; /* components < 2^26: >> 11 leaves < 2^15; keep more bits if they are small */
+    while (k > 0 && ((ax | ay) >> (k - 1)) < ((uint64_t)1 << 15))
+        k--;
+    uint32_t bx = (uint32_t)(ax >> k), by = (uint32_t)(ay >> k);
+    uint32_t dd = bx * bx + by * by; /* < 2^31 */
+    uint32_t l = bx > by ? bx + 3 * by / 8 : by + 3 * bx / 8;
+    *sh = k;
+    return l == 0 ? 0 : (l + dd / l) / 2;
+}
+
+/* Convex-hull test for short chords and pieces whose inner points project outside the chord:
+ * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
+ * dist(V_i, D) <= 4 T in the 3x-scaled units. */
+static bool hull_flat(int64_t v[3][2], int64_t T)
+{
+    cs_vec3_t o = {0, 0, 0}, d = {(cs_pos_t)v[2][0], (cs_pos_t)v[2][1], 0};
+    cs_vec3_t q1 = {(cs_pos_t)v[0][0], (cs_pos_t)v[0][1], 0};
+    cs_vec3_t q2 = {(cs_pos_t)v[1][0], (cs_pos_t)v[1][1], 0};
+    return cs_subdiv_dist_ok(&q1, &o, &d, (uint32_t)(4 * T)) &&
+           cs_subdiv_dist_ok(&q2, &o, &d, (uint32_t)(4 * T));
+}
+
+/* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
+ * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
+static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
+{
+    int64_t v[3][2];
+    sub_curve(p, d, h, v);
+    uint64_t m = 0;
+    for (unsigned i = 0; i < 3; i++)
+        for (unsigned k = 0; k < 2; k++)
+            m |= uabs64(v[i][k]);
+    int64_t thr_f = (int64_t)p->thr << F;
+    unsigned s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
+    while ((m >> s) >= ((uint64_t)1 << UNIT_BITS))
+        s++;
+    int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
+    if (T <= 0) {
+        *room = F16_ONE / 4;
+        return false;
+    }
+    for (unsigned i = 0; i < 3 && s > 0; i++)
+        for (unsigned k = 0; k < 2; k++)
+            v[i][k] = cs_fixed_round_shift64(v[i][k], s);
+    int64_t dd = v[2][0] * v[2][0] + v[2][1] * v[2][1];
+    int64_t dot1 = v[0][0] * v[2][0] + v[0][1] * v[2][1];
+    int64_t dot2 = v[1][0] * v[2][0] + v[1][1] * v[2][1];
+    if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
+        bool ok = hull_flat(v, T);
+        *room = ok ? F16_ONE : F16_ONE / 4;
+        return ok;
+    }
+    int64_t c1 = v[2][0] * v[0][1] - v[2][1] * v[0][0];
+    int64_t c2 = v[2][0] * v[1][1] - v[2][1] * v[1][0];
+    uint64_t found = majorant(c1, c2);
+    /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, decided exactly on squares (128 bits):
+     * found^2 <= (3072 T)^2 dd. */
+    uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
+    bool ok = cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
+    unsigned sh;
+    uint32_t len = approx_len(v[2][0], v[2][1], &sh);
+    *room = room_q16(k * len, found >> sh); /* both scaled by 2^-sh */
+    return ok;
+}
+
+/* sqrt(x) in Q16 for x in Q16 (0 < x <= F16_CAP), within 0.2 %: x = m 4^e with m in [1/2, 2),
+ * sqrt(m) ~ the mean of the arithmetic and harmonic means of 1 and m ((1+m)/4 + m/(1+m)),
+ * one 32-bit division (the predictor needs no more). */
+static uint32_t sqrt_q16(uint32_t x)
+{
+    int e = 0;
+    while (x >= 2 * F16_ONE) {
+        x >>= 2;
+        e++;
+    }
+    while (x < F16_ONE / 2) {
+        x <<= 2;
+        e--;
+    }
+    uint32_t y = (x + F16_ONE) / 4 + F16_ONE - (uint32_t)(0xFFFFFFFFu / (x + F16_ONE));
+    return e >= 0 ? y << e : y >> -e;
+}
+
+/* Step predicted from a tested one: deviation ~ h^2, so h * sqrt(room), 1.6 % short. */
+static int64_t predict(cs_param_t h, uint32_t room)
+{
+    uint64_t r = room == 0 ? 0 : sqrt_q16(room); /* sqrt(room) * 2^16 */
+    uint64_t nh = ((uint64_t)h * r) >> 16;
+    return (int64_t)(nh - nh / 64);
+}
+
+/* --- conic arcs ------------------------------------------------------------------------- */
+/* a + (b - a) u, u in Q30 (|b - a| < 2^60: one rounding of 1/2 unit). */
+static int64_t lerp(int64_t a, int64_t b, cs_param_t u)
+{
+    return a + cs_fixed_mul64_q30(b - a, u);
+}
+
+/* Homogeneous blossom b(u, v) of the conic (x, y, w), by two levels of lerps. */
+static void blossom(const cs_predict_t *p, cs_param_t u, cs_param_t v, int64_t out[3])
+{
+    for (unsigned k = 0; k < 3; k++)
+        out[k] = lerp(lerp(p->h[0][k], p->h[1][k], u), lerp(p->h[1][k], p->h[2][k], u), v);
+}
+
+/* Cartesian x, y of a homogeneous point, in LSB * 2^frac (frac <= 12), truncated: the quotient
+ * and the remainder's fraction by two int64 divisions (|x| < 2^59, 2^26 <= w <= 2^30 for
+ * weights >= 1/16, so remainder * 2^frac < 2^42), error < 2^-frac LSB. */
+static void project(const int64_t hp[3], unsigned frac, int64_t q[2])
+{
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t whole = hp[k] / hp[2], rem = hp[k] % hp[2];
+        q[k] = whole * ((int64_t)1 << frac) + rem * ((int64_t)1 << frac) / hp[2];
+    }
+}
+
+/* Flatness test of the conic piece [t, t + h] with control points Q0, Q1, Q2 and weights W0,
+ * W1, W2: its farthest point from the chord is the shoulder, at omega/(1 + omega) of Q1's
+ * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
+ * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
+ * rounded up to 1/256. */
+static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
+{
+    int64_t b0[3], b1[3], b2[3], q0[2], q1[2], q2[2], v[2], d[2];
+    cs_param_t t1 = p->t + h;
+    blossom(p, p->t, p->t, b0);
+    blossom(p, p->t, t1, b1);
+    blossom(p, t1, t1, b2);
+    project(b0, F, q0);
+    project(b1, F, q1);
+    project(b2, F, q2);
+    uint64_t m = 0;
+    for (unsigned k = 0; k < 2; k++) {
+        v[k] = q1[k] - q0[k];
+        d[k] = q2[k] - q0[k];
+        m |= uabs64(v[k]) | uabs64(d[k]);
+    }
+    unsigned s = p->thr_shift;
+    while ((m >> s) >= ((uint64_t)1 << CONIC_UNIT_BITS))
+        s++;
+    int64_t T = (((int64_t)p->thr << F) >> s) - 2;
+    if (T <= 0) {
+        *room = F16_ONE / 4;
+        return false;
+    }
+    for (unsigned k = 0; k < 2 && s > 0; k++) {
+        v[k] = cs_fixed_round_shift64(v[k], s);
+        d[k] = cs_fixed_round_shift64(d[k], s);
+    }
+    /* phi = W1 / (W1 + sqrt(W0 W2)) rounded up to 1/256 (sqrt rounded down). */
+    uint64_t sq = cs_fixed_isqrt64((uint64_t)b0[2] * (uint64_t)b2[2]);
+    uint64_t w1 = (uint64_t)b1[2], phi = ((w1 << 8) + w1 + sq - 1) / (w1 + sq);
+    uint64_t lim = (uint64_t)T << 8, lim2 = lim * lim; /* T < 2^20: lim^2 < 2^56 */
+    int64_t dd = d[0] * d[0] + d[1] * d[1], dot = v[0] * d[0] + v[1] * d[1];
+    if (dot <= 0 || dot >= dd) { /* nearest chord point is an end: distance to it */
+        int64_t ex = dot <= 0 ? v[0] : v[0] - d[0], ey = dot <= 0 ? v[1] : v[1] - d[1];
+        bool ok = cs_fixed_cmp_prod_u64((uint64_t)(ex * ex + ey * ey), phi * phi, lim2, 1) <= 0;
+        *room = ok ? F16_ONE : F16_ONE / 4;
+        return ok;
+    }
+    uint64_t found = uabs64(d[0] * v[1] - d[1] * v[0]) * phi; /* < 2^49 * 2^9 */
+    unsigned sh;
+    uint32_t len = approx_len(d[0], d[1], &sh);
+    *room = room_q16(lim * len, found >> sh);
+    return cs_fixed_cmp_prod_u64(found, found, lim2, (uint64_t)dd) <= 0;
+}
+
+static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
+{
+    if (p->conic) {
+        int64_t b[3], q[2];
+        blossom(p, t, t, b);
+        for (unsigned k = 0; k < 2; k++) /* rounded to the nearest LSB */
+            q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
+        pt->x = (cs_pos_t)q[0];
+        pt->y = (cs_pos_t)q[1];
+        pt->z = p->z;
+        return;
+    }
+    int64_t r[2];
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t acc = p->a[2][k] + cs_fixed_mul64_q30(p->a[3][k], t);
+        acc = p->a[1][k] + cs_fixed_mul64_q30(acc, t);
+        r[k] = cs_fixed_round_shift64(p->a[0][k] + cs_fixed_mul64_q30(acc, t), F);
+    }
+    /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
+    pt->x = (cs_pos_t)r[0];
+    pt->y = (cs_pos_t)r[1];
+    pt->z = p->z;
+}
+
+/* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
+ * between the largest passing and the smallest failing step. 0 when none passes. */
+static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
+{
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
+    int64_t d[2][2] = {{0, 0}, {0, 0}};
+    if (!p->conic)
+        derivs(p, p->t, d);
+    for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
+        uint32_t room;
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+                     : test_step(p, d, (cs_param_t)h, &room)) {
+            lo = h;
+            *lo_room = room;
+            if (h == rem || room <= F16_ACCEPT)
+                break;
+        } else {
+            hi = h;
+        }
+        int64_t nh = predict((cs_param_t)h, room);
+        if (nh > rem)
+            nh = rem;
+        if (nh <= lo || nh >= hi)
+            nh = lo + (hi - lo) / 2;
+        if (nh == h || hi - lo <= 1)
+            break;
+        h = nh;
+    }
+    for (unsigned k = 0; lo == 0 && k < CS_PARAM_FRAC_BITS + 1; k++) {
+        h = hi / 2; /* the predictor gave up: halve until a step passes */
+        if (h == 0)
+            break;
+        uint32_t room;
+        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+                     : test_step(p, d, (cs_param_t)h, &room)) {
+            lo = h;
+            *lo_room = room;
+        }
+        hi = h;
+    }
+    return (cs_param_t)lo;
+}
+
+cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+{
+    if (p->done)
+        return CS_END;
+    cs_param_t rem = CS_PARAM_ONE - p->t;
+    uint32_t room = F16_ONE;
+    cs_param_t h = find_step(p, rem, &room);
+    if (h == 0) {
+        p->done = true;
+        return CS_ERR_DEPTH;
+    }
+    p->t += h;
+    if (p->t == CS_PARAM_ONE) {
+        *pt = p->end;
+        p->done = true;
+        return CS_OK;
+    }
+    /* Next chord: about as long in t as this one, corrected by the room this one left. */
+    int64_t nh = predict(h, room);
+    p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    eval_at(p, p->t, pt);
+    return CS_OK;
+}
