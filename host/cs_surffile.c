@@ -1,7 +1,6 @@
 /* cs_surffile: Newell or native surface files -> core patches (see cs_surffile.h). */
 #include "cs_surffile.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -9,130 +8,22 @@
 #include <string.h>
 
 #include "cs_coons.h"
-#include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_lex.h"
 #include "cs_patchfile.h"
 #include "cs_revolve.h"
 
 #define NATIVE_MAGIC "curvestep-surfaces"
 
-typedef struct {
-    const char *p, *end;
-    unsigned line, col;
-    const char *name;
-    cs_path_diag_t *diag;
-    double scale;
-    /* the token just read */
-    char tok[64];
-    unsigned tline, tcol;
-} lex_t;
-
-static cs_path_loc_t here(const lex_t *lx)
-{
-    cs_path_loc_t l = {lx->name, lx->tline, lx->tcol};
-    return l;
-}
-
-/* Next token into lx->tok; false at end of text. */
-static bool next_tok(lex_t *lx)
-{
-    for (;;) {
-        while (lx->p < lx->end && isspace((unsigned char)*lx->p)) {
-            if (*lx->p == '\n') {
-                lx->line++;
-                lx->col = 1;
-            } else {
-                lx->col++;
-            }
-            lx->p++;
-        }
-        if (lx->p < lx->end && *lx->p == '#') {
-            while (lx->p < lx->end && *lx->p != '\n')
-                lx->p++;
-            continue;
-        }
-        break;
-    }
-    if (lx->p >= lx->end) {
-        lx->tline = lx->line;
-        lx->tcol = lx->col;
-        return false;
-    }
-    lx->tline = lx->line;
-    lx->tcol = lx->col;
-    size_t k = 0;
-    while (lx->p < lx->end && !isspace((unsigned char)*lx->p) && *lx->p != '#') {
-        if (k < sizeof lx->tok - 1)
-            lx->tok[k++] = *lx->p;
-        lx->p++;
-        lx->col++;
-    }
-    lx->tok[k] = '\0';
-    return true;
-}
-
-static cs_err_t number(lex_t *lx, const char *what, double *out)
-{
-    if (!next_tok(lx))
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx), "end of file: %s expected", what);
-    char *e = NULL;
-    errno = 0;
-    double v = strtod(lx->tok, &e);
-    if (e == lx->tok || *e != '\0' || !isfinite(v))
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx), "'%s': %s expected", lx->tok,
-                                what);
-    *out = v;
-    return CS_OK;
-}
-
-static cs_err_t integer(lex_t *lx, const char *what, int lo, int hi, int *out)
-{
-    double v;
-    cs_err_t e = number(lx, what, &v);
-    if (e != CS_OK)
-        return e;
-    if (v != floor(v) || v < lo || v > hi)
-        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, here(lx), "%s must be an integer %d..%d",
-                                what, lo, hi);
-    *out = (int)v;
-    return CS_OK;
-}
-
-/* Three numbers; a point (scaled, range-checked) into *p, the raw scaled values into d[]. */
-static cs_err_t vec(lex_t *lx, const char *what, cs_vec3_t *p, double d[3])
-{
-    double v[3];
-    unsigned line = 0, col = 0;
-    for (int k = 0; k < 3; k++) {
-        cs_err_t e = number(lx, what, &v[k]);
-        if (e != CS_OK)
-            return e;
-        if (k == 0) {
-            line = lx->tline;
-            col = lx->tcol;
-        }
-        v[k] *= lx->scale;
-    }
-    if (d)
-        for (int k = 0; k < 3; k++)
-            d[k] = v[k];
-    if (p && cs_conv_mm_to_vec(v[0], v[1], v[2], p) != CS_OK) {
-        cs_path_loc_t l = {lx->name, line, col};
-        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, l, "%s (%g, %g, %g) mm is outside +/-%d mm",
-                                what, v[0], v[1], v[2], CS_POS_LIMIT_MM);
-    }
-    return CS_OK;
-}
-
-static cs_err_t curve(lex_t *lx, cs_bezier_t *c)
+static cs_err_t curve(cs_lex_t *lx, cs_bezier_t *c)
 {
     int n;
-    cs_err_t e = integer(lx, "curve degree", 1, 3, &n);
+    cs_err_t e = cs_lex_integer(lx, "curve degree", 1, 3, &n);
     if (e != CS_OK)
         return e;
     cs_vec3_t pts[4];
     for (int i = 0; i <= n; i++) {
-        e = vec(lx, "curve point", &pts[i], NULL);
+        e = cs_lex_vec(lx, "curve point", &pts[i], NULL);
         if (e != CS_OK)
             return e;
     }
@@ -163,29 +54,29 @@ static cs_err_t push_quad(cs_surffile_t *sf, const cs_patch_t *p, unsigned line)
 }
 
 /* One statement after its keyword (in lx->tok). */
-static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
+static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
 {
     char kw[64];
     snprintf(kw, sizeof kw, "%s", lx->tok);
-    cs_path_loc_t at = here(lx);
+    cs_path_loc_t at = cs_lex_here(lx);
     cs_err_t e = CS_OK;
     cs_patch_t p;
     if (strcmp(kw, "bezier") == 0) {
         int du, dv;
         cs_vec3_t pts[16];
-        e = integer(lx, "degree in u", 1, 3, &du);
+        e = cs_lex_integer(lx, "degree in u", 1, 3, &du);
         if (e == CS_OK)
-            e = integer(lx, "degree in v", 1, 3, &dv);
+            e = cs_lex_integer(lx, "degree in v", 1, 3, &dv);
         for (int k = 0; e == CS_OK && k < (du + 1) * (dv + 1); k++)
-            e = vec(lx, "control point", &pts[k], NULL);
+            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         if (e == CS_OK && (e = cs_patch_init(&p, (unsigned)du, (unsigned)dv, pts)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "tri") == 0) {
         int n;
         cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
-        e = integer(lx, "degree", 1, 3, &n);
+        e = cs_lex_integer(lx, "degree", 1, 3, &n);
         for (int k = 0; e == CS_OK && k < (n + 1) * (n + 2) / 2; k++)
-            e = vec(lx, "control point", &pts[k], NULL);
+            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         cs_surf_item_t it;
         memset(&it, 0, sizeof it);
         if (e == CS_OK && (e = cs_tripatch_init(&it.trip, (unsigned)n, pts)) == CS_OK) {
@@ -197,7 +88,7 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
         bool herm = kw[0] == 'h';
         cs_vec3_t v[16];
         for (int k = 0; e == CS_OK && k < 16; k++)
-            e = vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
+            e = cs_lex_vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
         if (e == CS_OK) {
             if (herm) {
                 cs_patch_hermite_t h;
@@ -240,19 +131,19 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
         cs_vec3_t d;
         e = curve(lx, &c);
         if (e == CS_OK)
-            e = vec(lx, "direction", &d, NULL);
+            e = cs_lex_vec(lx, "direction", &d, NULL);
         if (e == CS_OK && (e = cs_coons_extrude(&c, &d, &p)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "revolve") == 0) {
         double o[3], ax[3], rf[3], sweep;
         cs_bezier_t c;
-        e = vec(lx, "axis origin", NULL, o);
+        e = cs_lex_vec(lx, "axis origin", NULL, o);
         if (e == CS_OK)
-            e = vec(lx, "axis direction", NULL, ax);
+            e = cs_lex_vec(lx, "axis direction", NULL, ax);
         if (e == CS_OK)
-            e = vec(lx, "reference direction", NULL, rf);
+            e = cs_lex_vec(lx, "reference direction", NULL, rf);
         if (e == CS_OK)
-            e = number(lx, "sweep in degrees", &sweep);
+            e = cs_lex_number(lx, "sweep in degrees", &sweep);
         if (e == CS_OK)
             e = curve(lx, &c);
         if (e == CS_OK) {
@@ -273,27 +164,17 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
             /* varady-scheme BLEND PARAM N C x N */
             static const char *const blends[] = {"mu", "lambda-kappa"};
             static const char *const params[] = {"side", "radial", "centre"};
-            int got = -1;
-            if (next_tok(lx))
-                for (int k = 0; k < 2; k++)
-                    if (strcmp(lx->tok, blends[k]) == 0)
-                        got = k;
-            if (got < 0)
-                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
-                                        "'%s': blend mu or lambda-kappa expected", lx->tok);
+            int got = 0;
+            e = cs_lex_choice(lx, "blend mu or lambda-kappa", blends, 2, &got);
+            if (e != CS_OK)
+                return e;
             blend = (cs_varady_blend_t)got;
-            got = -1;
-            if (next_tok(lx))
-                for (int k = 0; k < 3; k++)
-                    if (strcmp(lx->tok, params[k]) == 0)
-                        got = k;
-            if (got < 0)
-                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
-                                        "'%s': parametrisation side, radial or centre expected",
-                                        lx->tok);
+            e = cs_lex_choice(lx, "parametrisation side, radial or centre", params, 3, &got);
+            if (e != CS_OK)
+                return e;
             param = (cs_varady_param_t)got;
         }
-        e = integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
+        e = cs_lex_integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
         for (int k = 0; e == CS_OK && k < n; k++)
             e = curve(lx, &c[k]);
         cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
@@ -329,8 +210,9 @@ void cs_surffile_free(cs_surffile_t *sf)
 
 static bool is_native(const char *text, size_t len)
 {
-    lex_t lx = {text, text + len, 1, 1, "", NULL, 1, "", 0, 0};
-    return next_tok(&lx) && strcmp(lx.tok, NATIVE_MAGIC) == 0;
+    cs_lex_t lx;
+    cs_lex_init(&lx, text, len, "", NULL, 1);
+    return cs_lex_next(&lx) && strcmp(lx.tok, NATIVE_MAGIC) == 0;
 }
 
 cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, double scale,
@@ -355,14 +237,15 @@ cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, doubl
         return e;
     }
     sf->native = true;
-    lex_t lx = {text, text + len, 1, 1, sf->file, diag, scale, "", 0, 0};
-    next_tok(&lx); /* the magic */
+    cs_lex_t lx;
+    cs_lex_init(&lx, text, len, sf->file, diag, scale);
+    cs_lex_next(&lx); /* the magic */
     int version;
-    cs_err_t e = integer(&lx, "format version", 1, 1, &version);
-    while (e == CS_OK && next_tok(&lx))
+    cs_err_t e = cs_lex_integer(&lx, "format version", 1, 1, &version);
+    while (e == CS_OK && cs_lex_next(&lx))
         e = statement(&lx, sf, rev_tol_mm);
     if (e == CS_OK && sf->n == 0)
-        e = cs_path_diag_set(diag, CS_ERR_EMPTY, here(&lx), "no surfaces in the file");
+        e = cs_path_diag_set(diag, CS_ERR_EMPTY, cs_lex_here(&lx), "no surfaces in the file");
     return e;
 }
 
