@@ -361,6 +361,16 @@ static bool edge_c2(const cs_patch_t *a, const cs_patch_t *b, double tol, double
     return true;
 }
 
+/* True when a's edge u = 1 is a single point (a collapsed edge, as at the teapot's lid: every
+ * patch meeting there would "share" it). */
+static bool edge_is_point(const cs_patch_t *a)
+{
+    for (int j = 1; j <= a->deg_v; j++)
+        if (memcmp(&a->p[a->deg_u][j], &a->p[a->deg_u][0], sizeof a->p[0][0]) != 0)
+            return false;
+    return true;
+}
+
 /* The continuity of the first shared edge of patches a and b (either orientation), or false. */
 static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_opts_t *o,
                         int *ea, int *eb, const char **cls)
@@ -378,7 +388,7 @@ static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_
                 if (rev)
                     flip_v(&pb);
                 cs_patch_cont_t c;
-                if (pa.deg_v != pb.deg_v ||
+                if (pa.deg_v != pb.deg_v || edge_is_point(&pa) ||
                     cs_patch_continuity(&pa, &pb, tol, sin_tol, &c) != CS_OK ||
                     c == CS_PATCH_CONT_NONE)
                     continue;
