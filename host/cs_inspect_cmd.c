@@ -518,7 +518,7 @@ static bool is_surfaces(const char *file, const char *buf, size_t len)
 
 static int input_status(cs_err_t e)
 {
-    return (e == CS_ERR_FULL || e == CS_ERR_IO) ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    return (e == CS_ERR_FULL || e == CS_ERR_OVERFLOW) ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
 }
 
 static int inspect_file(const inspect_opts_t *o, const char *file, bool patches)

@@ -53,6 +53,26 @@ static cs_err_t push_quad(cs_surffile_t *sf, const cs_patch_t *p, unsigned line)
     return push(sf, &it);
 }
 
+static const char *const keywords[] = {
+    "bezier",         "tri",  "hermite", "power",   "coons-bilinear", "coons-bicubic",
+    "varady",         "varady-scheme",   "ruled",   "extrude",        "revolve",
+};
+
+const char *cs_surffile_keyword(size_t i)
+{
+    return i < sizeof keywords / sizeof keywords[0] ? keywords[i] : NULL;
+}
+
+void cs_surffile_keyword_list(char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; cs_surffile_keyword(i) && n + 1 < cap; i++) {
+        int w = snprintf(buf + n, cap - n, "%s%s", i ? ", " : "", cs_surffile_keyword(i));
+        n = w < 0 ? cap : n + (size_t)w;
+    }
+}
+
 /* One statement after its keyword (in lx->tok). */
 static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
 {
@@ -190,11 +210,9 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
         }
         free(it);
     } else {
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at,
-                                "unknown surface '%s' (bezier, tri, hermite, power, "
-                                "coons-bilinear, coons-bicubic, ruled, extrude, revolve, "
-                                "varady, varady-scheme)",
-                                kw);
+        char list[256];
+        cs_surffile_keyword_list(list, sizeof list);
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at, "unknown surface '%s' (%s)", kw, list);
     }
     if (e != CS_OK && lx->diag->code != e)
         return cs_path_diag_set(lx->diag, e, at, "%s: %s", kw, cs_err_text(e));

@@ -58,5 +58,10 @@ cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, doubl
                            double rev_tol_mm, cs_surffile_t *sf, cs_path_diag_t *diag);
 /* Frees everything (fine on an empty or failed one). */
 void cs_surffile_free(cs_surffile_t *sf);
+/* The keywords the native format accepts, in the order docs/surfaces.md lists them: keyword i,
+ * or NULL past the last (the one table the parser, toolpath --help and the docs test share). */
+const char *cs_surffile_keyword(size_t i);
+/* All keywords joined by ", " into buf (cut to cap - 1 characters, always terminated). */
+void cs_surffile_keyword_list(char *buf, size_t cap);
 
 #endif

@@ -46,6 +46,8 @@ static const tp_view_t views[] = {
 
 static void tp_usage(FILE *f)
 {
+    char kw[256];
+    cs_surffile_keyword_list(kw, sizeof kw);
     fprintf(
         f,
         "Usage: curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM]\n"
@@ -54,11 +56,13 @@ static void tp_usage(FILE *f)
         "                          [--safe-z Z] [--scale S] [--view V] [--svg OUT.svg]\n"
         "       (either form also takes --gcode OUT.nc)\n"
         "\n"
-        "Reads surface patches and prints a path over them. FILE is either in Newell's\n"
-        "format (a patch count; one line of 16 one-based vertex indices per patch; a vertex\n"
-        "count; one \"x,y,z\" line per vertex: the Utah teapot's format) or in curvestep's\n"
-        "native surface format (first word \"curvestep-surfaces 1\", then bezier, tri,\n"
-        "hermite, power, coons-bilinear, coons-bicubic, ruled, extrude and revolve items;\n"
+        "Reads surface patches and prints a path over them. FILE is in Newell's format (a\n"
+        "patch count; one line of 16 one-based vertex indices per patch; a vertex count; one\n"
+        "\"x,y,z\" line per vertex: the Utah teapot's format), in the .bpt format (a patch\n"
+        "count; per patch a line \"degu degv\" and its (degu+1)(degv+1) points \"x y z\"), or\n"
+        "in curvestep's native surface format (first word \"curvestep-surfaces 1\", then\n"
+        "items, each starting with one of the keywords\n"
+        "  %s;\n"
         "see docs/surfaces.md). Surfaces of revolution are approximated within --tol / 4.\n"
         "\n"
         "Wireframe (without --ball): the iso-parametric lines of each patch, N + 1 in each\n"
@@ -105,7 +109,7 @@ static void tp_usage(FILE *f)
         "\n"
         "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
         "coordinates outside +/-%d mm after scaling); 2 usage error; 3 internal error.\n",
-        TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
+        kw, TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
 }
 
 static bool parse_double(const char *s, double *out)

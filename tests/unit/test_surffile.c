@@ -208,6 +208,61 @@ static void test_errors(void **state)
     expect("bezier 1 1\n", CS_ERR_PARSE, 1, 1, "not a finite number");
 }
 
+/* The keyword table (cs_surffile_keyword) is what the parser accepts and what docs/surfaces.md
+ * lists in its "Native surface format" block, both ways (toolpath --help prints the table; the
+ * CLI test test_inspect.sh compares it with the docs too). */
+static void test_keywords(void **state)
+{
+    (void)state;
+    size_t n = 0;
+    for (; cs_surffile_keyword(n); n++) {
+        char text[128];
+        snprintf(text, sizeof text, "curvestep-surfaces 1\n%s x\n", cs_surffile_keyword(n));
+        cs_surffile_t sf;
+        cs_path_diag_t d;
+        assert_int_not_equal(cs_surffile_parse(text, strlen(text), "k", 1, 0.01, &sf, &d), CS_OK);
+        if (strstr(d.reason, "unknown surface"))
+            fprintf(stderr, "'%s' is in the table but the parser refuses it\n",
+                    cs_surffile_keyword(n));
+        assert_null(strstr(d.reason, "unknown surface"));
+        cs_surffile_free(&sf);
+    }
+    FILE *f = fopen("docs/surfaces.md", "r");
+    assert_non_null(f);
+    char line[256];
+    bool in_section = false, in_block = false;
+    size_t seen = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, "## ", 3) == 0)
+            in_section = strncmp(line, "## Native surface format", 24) == 0;
+        if (!in_section)
+            continue;
+        if (strncmp(line, "```", 3) == 0) {
+            if (in_block)
+                break;
+            in_block = true;
+            continue;
+        }
+        if (!in_block || line[0] == ' ' || line[0] == '#' ||
+            strncmp(line, "curvestep-surfaces", 18) == 0)
+            continue;
+        char word[64];
+        assert_int_equal(sscanf(line, "%63s", word), 1);
+        size_t k = 0;
+        while (cs_surffile_keyword(k) && strcmp(cs_surffile_keyword(k), word) != 0)
+            k++;
+        if (!cs_surffile_keyword(k))
+            fprintf(stderr, "docs/surfaces.md lists '%s', the parser's table does not\n", word);
+        assert_non_null(cs_surffile_keyword(k));
+        assert_int_equal(k, seen); /* same order */
+        seen++;
+    }
+    fclose(f);
+    if (seen != n)
+        fprintf(stderr, "docs/surfaces.md lists %zu keywords, the table %zu\n", seen, n);
+    assert_int_equal(seen, n);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -215,6 +270,7 @@ int main(void)
         cmocka_unit_test(test_varady),
         cmocka_unit_test(test_newell_fallback),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_keywords),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
