@@ -83,10 +83,10 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
     cs_patch_t p;
     if (strcmp(kw, "bezier") == 0) {
         int du, dv;
-        cs_vec3_t pts[16];
-        e = cs_lex_integer(lx, "degree in u", 1, 3, &du);
+        cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
+        e = cs_lex_integer(lx, "degree in u", 1, CS_PATCH_MAX_DEGREE, &du);
         if (e == CS_OK)
-            e = cs_lex_integer(lx, "degree in v", 1, 3, &dv);
+            e = cs_lex_integer(lx, "degree in v", 1, CS_PATCH_MAX_DEGREE, &dv);
         for (int k = 0; e == CS_OK && k < (du + 1) * (dv + 1); k++)
             e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         if (e == CS_OK && (e = cs_patch_init(&p, (unsigned)du, (unsigned)dv, pts)) == CS_OK)
@@ -94,7 +94,7 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
     } else if (strcmp(kw, "tri") == 0) {
         int n;
         cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
-        e = cs_lex_integer(lx, "degree", 1, 3, &n);
+        e = cs_lex_integer(lx, "degree", 1, CS_TRIPATCH_MAX_DEGREE, &n);
         for (int k = 0; e == CS_OK && k < (n + 1) * (n + 2) / 2; k++)
             e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         cs_surf_item_t it;

@@ -271,7 +271,10 @@ static cs_err_t wire_patch(tp_out_t *o, const cs_patch_t *p, unsigned lines, cs_
     for (int dir = 0; dir < 2; dir++) {
         cs_bezier_t c;
         cs_err_t e;
-        if (is_pow2(lines) && lines <= (1u << CS_PATCH_RASTER_MAX_SHIFT)) {
+        /* Exact forward differences while N^m fits (cs_patch_raster_t), de Casteljau per
+         * line beyond (higher degrees, more lines). */
+        unsigned m = dir == CS_PATCH_ISO_U ? p->deg_v : p->deg_u;
+        if (is_pow2(lines) && lines <= (1u << cs_patch_raster_max_shift(m))) {
             unsigned shift = 0;
             while ((1u << shift) < lines)
                 shift++;

@@ -226,7 +226,7 @@ static void test_bpt(void **state)
     assert_int_equal(p.p[1][2].z, 3 * 65536);
     assert_int_equal(p.p[0][1].y, 2 * 65536);
     cs_patchfile_free(&bp);
-    expect("1\n3 4\n", CS_ERR_DEGREE, 2, 3, "degree 4 outside 1..3 (.bpt format)");
+    expect("1\n3 8\n", CS_ERR_DEGREE, 2, 3, "degree 8 outside 1..7 (.bpt format)");
     expect("1\n1 2 3\n", CS_ERR_PARSE, 2, 6, "16 vertex indices (Newell's format; a .bpt file");
     expect("2\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n1 1 1\n", CS_ERR_PARSE, 7, 6,
            "expected 'degu degv' (.bpt format), found 3");
