@@ -87,6 +87,24 @@ grep -v '^patch ' "$T/out" | sed 's/newell_teapot.txt/X/' >"$T/newell"
 check ".bpt teapot = Newell teapot (edges, summary)" cmp -s "$T/bpt" "$T/newell"
 check "teapot: 32 patches" grep -q ': 32 patches, ' "$T/out"
 
+# --- degrees above 3 (issue 19): a 7 x 4 tensor patch and a quintic triangle, wireframe past the
+# raster's bound (64 lines > 2^3 for the degree-7 direction) and ball-end finishing
+{
+    echo "curvestep-surfaces 1"
+    echo "bezier 7 4"; for i in 0 1 2 3 4 5 6 7; do for j in 0 1 2 3 4; do echo "$((i * 5)) $((j * 5)) $(((i * j) % 5))"; done; done
+    echo "tri 5"; for i in 0 1 2 3 4 5; do for j in $(seq 0 $((5 - i))); do echo "$((50 + i * 4)) $((j * 4)) $((i * j % 3))"; done; done
+} >"$T/high.txt"
+run "toolpath degree 7 x 4 and 5" 0 toolpath --patches "$T/high.txt" --lines 64 --tol 0.01 --stats
+dev=$(sed -n 's/.*max deviation \([0-9.e-]*\) mm.*/\1/p' "$T/err")
+check "high degrees: chords within 0.01 mm ($dev)" awk -v d="$dev" 'BEGIN { exit !(d != "" && d <= 0.01) }'
+run "finishing degree 7 x 4 and 5" 0 toolpath --patches "$T/high.txt" --ball 2 --scallop 0.05
+run "inspect high degrees" 0 inspect "$T/high.txt"
+check "inspect: tensor degree 7 x 4" grep -q 'tensor degree 7 x 4' "$T/out"
+check "inspect: triangle degree 5" grep -q 'triangle degree 5' "$T/out"
+printf 'curvestep-surfaces 1\nbezier 8 1\n' >"$T/deg8.txt"
+run "degree 8 refused" 1 toolpath --patches "$T/deg8.txt"
+expect_err "degree 8: located" 'deg8.txt:2:8: degree in u must be an integer 1\.\.7'
+
 # --- the surface keywords: toolpath --help, docs/surfaces.md and the parser's own list agree
 run "toolpath help" 0 toolpath --help
 help_kw=$(grep -A1 'each starting with one of the keywords' "$T/out" | tail -1 | sed 's/^ *//; s/;$//')
