@@ -111,13 +111,18 @@ static void test_bezier(void **state)
 /* ---- hermite: H(t) = (2t^3-3t^2+1) P0 + (t^3-2t^2+t) T0 + (-2t^3+3t^2) P1 + (t^3-t^2) T1 */
 static const v3 HP[3] = {{0, 0, 0}, {30, 10, 0}, {50, 0, 2}};
 static const v3 HT[3] = {{20, 20, 0}, {20, 0, 1}, {10, -20, 0}};
-static v3 ref_hermite(size_t i, double t)
+static v3 hermite_at(v3 p0, v3 t0, v3 p1, v3 t1, double t)
 {
     double t2 = t * t, t3 = t2 * t;
-    v3 r = add(zero(), HP[i], 2 * t3 - 3 * t2 + 1);
-    r = add(r, HT[i], t3 - 2 * t2 + t);
-    r = add(r, HP[i + 1], -2 * t3 + 3 * t2);
-    return add(r, HT[i + 1], t3 - t2);
+    v3 r = add(zero(), p0, 2 * t3 - 3 * t2 + 1);
+    r = add(r, t0, t3 - 2 * t2 + t);
+    r = add(r, p1, -2 * t3 + 3 * t2);
+    return add(r, t1, t3 - t2);
+}
+
+static v3 ref_hermite(size_t i, double t)
+{
+    return hermite_at(HP[i], HT[i], HP[i + 1], HT[i + 1], t);
 }
 
 static void test_hermite(void **state)
@@ -270,11 +275,7 @@ static void solve_natural(void)
 
 static v3 ref_natural(size_t i, double t)
 {
-    double t2 = t * t, t3 = t2 * t;
-    v3 r = add(zero(), NAT_P[i], 2 * t3 - 3 * t2 + 1);
-    r = add(r, NAT_D[i], t3 - 2 * t2 + t);
-    r = add(r, NAT_P[i + 1], -2 * t3 + 3 * t2);
-    return add(r, NAT_D[i + 1], t3 - t2);
+    return hermite_at(NAT_P[i], NAT_D[i], NAT_P[i + 1], NAT_D[i + 1], t);
 }
 
 static void test_natural(void **state)
