@@ -53,6 +53,37 @@ static cs_err_t push_quad(cs_surffile_t *sf, const cs_patch_t *p, unsigned line)
     return push(sf, &it);
 }
 
+/* coons-bicubic C C C C [derivatives C C C C] [twists V V V V] (after the keyword): boundaries
+ * p1 p2 q1 q2, cross-boundary derivative curves p1v p2v q1u q2u, twists at the corners (u, v) =
+ * (0,0) (1,0) (0,1) (1,1) (seed 000; cs_coons_bicubic_twist). */
+static cs_err_t coons_bicubic(cs_lex_t *lx, cs_patch_t *p)
+{
+    cs_bezier_t c[8];
+    const cs_bezier_t *der[4] = {NULL, NULL, NULL, NULL};
+    cs_vec3_t tw[2][2];
+    bool twists = false;
+    cs_err_t e = CS_OK;
+    for (int k = 0; e == CS_OK && k < 4; k++)
+        e = curve(lx, &c[k]);
+    if (e == CS_OK && cs_lex_peek_is(lx, "derivatives")) {
+        cs_lex_next(lx);
+        for (int k = 0; e == CS_OK && k < 4; k++) {
+            e = curve(lx, &c[4 + k]); /* mm per unit parameter, within the point range */
+            der[k] = &c[4 + k];
+        }
+    }
+    if (e == CS_OK && cs_lex_peek_is(lx, "twists")) {
+        cs_lex_next(lx);
+        twists = true;
+        for (int k = 0; e == CS_OK && k < 4; k++)
+            e = cs_lex_vec(lx, "twist vector", &tw[k % 2][k / 2], NULL);
+    }
+    if (e != CS_OK)
+        return e;
+    return cs_coons_bicubic_twist(&c[0], &c[1], &c[2], &c[3], der[0], der[1], der[2], der[3],
+                                  twists ? (const cs_vec3_t(*)[2])tw : NULL, p);
+}
+
 static const char *const keywords[] = {
     "bezier",         "tri",  "hermite", "power",   "coons-bilinear", "coons-bicubic",
     "varady",         "varady-scheme",   "ruled",   "extrude",        "revolve",
@@ -129,17 +160,16 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
             if (e == CS_OK)
                 return push_quad(sf, &p, at.line);
         }
-    } else if (strcmp(kw, "coons-bilinear") == 0 || strcmp(kw, "coons-bicubic") == 0) {
+    } else if (strcmp(kw, "coons-bilinear") == 0) {
         cs_bezier_t c[4];
         for (int k = 0; e == CS_OK && k < 4; k++)
             e = curve(lx, &c[k]);
-        if (e == CS_OK) {
-            e = strcmp(kw, "coons-bilinear") == 0
-                    ? cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], &p)
-                    : cs_coons_bicubic(&c[0], &c[1], &c[2], &c[3], NULL, NULL, NULL, NULL, &p);
-            if (e == CS_OK)
-                return push_quad(sf, &p, at.line);
-        }
+        if (e == CS_OK && (e = cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], &p)) == CS_OK)
+            return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "coons-bicubic") == 0) {
+        e = coons_bicubic(lx, &p);
+        if (e == CS_OK)
+            return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "ruled") == 0) {
         cs_bezier_t c[2];
         for (int k = 0; e == CS_OK && k < 2; k++)

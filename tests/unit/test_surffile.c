@@ -208,6 +208,46 @@ static void test_errors(void **state)
     expect("bezier 1 1\n", CS_ERR_PARSE, 1, 1, "not a finite number");
 }
 
+/* coons-bicubic with its optional derivative curves and twists gives bit for bit what
+ * cs_coons_bicubic_twist gives for the same data (the formula itself: test_coons). */
+static void test_coons_derivatives_twists(void **state)
+{
+    (void)state;
+    const char *text = "curvestep-surfaces 1\ncoons-bicubic\n"
+                       " 3 0 0 0 10 0 5 20 0 5 30 0 0\n 3 0 30 0 10 30 -5 20 30 -5 30 30 0\n"
+                       " 3 0 0 0 0 10 2 0 20 2 0 30 0\n 3 30 0 0 30 10 2 30 20 2 30 30 0\n"
+                       " derivatives 1 0 30 6 0 30 6  1 0 30 6 0 30 6  1 30 0 6 30 0 -6\n"
+                       "   2 30 0 6 30 0 0 30 0 -6\n"
+                       " twists 0 0 5  0 0 -5  0 0 5  0 0 -4\n"
+                       "coons-bicubic\n"
+                       " 3 0 0 0 10 0 5 20 0 5 30 0 0\n 3 0 30 0 10 30 -5 20 30 -5 30 30 0\n"
+                       " 3 0 0 0 0 10 2 0 20 2 0 30 0\n 3 30 0 0 30 10 2 30 20 2 30 30 0\n"
+                       " twists 0 0 5  0 0 -5  0 0 5  0 0 -4\n";
+    cs_surffile_t sf;
+    cs_path_diag_t d;
+    assert_int_equal(cs_surffile_parse(text, strlen(text), "c", 1, 0.01, &sf, &d), CS_OK);
+    assert_int_equal(sf.n, 2);
+    cs_vec3_t a[4] = {mm(0, 0, 0), mm(10, 0, 5), mm(20, 0, 5), mm(30, 0, 0)};
+    cs_vec3_t b[4] = {mm(0, 30, 0), mm(10, 30, -5), mm(20, 30, -5), mm(30, 30, 0)};
+    cs_vec3_t c[4] = {mm(0, 0, 0), mm(0, 10, 2), mm(0, 20, 2), mm(0, 30, 0)};
+    cs_vec3_t e[4] = {mm(30, 0, 0), mm(30, 10, 2), mm(30, 20, 2), mm(30, 30, 0)};
+    cs_vec3_t d0[2] = {mm(0, 30, 6), mm(0, 30, 6)}, d2[2] = {mm(30, 0, 6), mm(30, 0, -6)};
+    cs_vec3_t d3[3] = {mm(30, 0, 6), mm(30, 0, 0), mm(30, 0, -6)};
+    cs_bezier_t p1 = bz(3, a), p2 = bz(3, b), q1 = bz(3, c), q2 = bz(3, e);
+    cs_bezier_t p1v = bz(1, d0), p2v = bz(1, d0), q1u = bz(1, d2), q2u = bz(2, d3);
+    cs_vec3_t tw[2][2] = {{mm(0, 0, 5), mm(0, 0, 5)}, {mm(0, 0, -5), mm(0, 0, -4)}};
+    cs_patch_t want;
+    assert_int_equal(cs_coons_bicubic_twist(&p1, &p2, &q1, &q2, &p1v, &p2v, &q1u, &q2u,
+                                            (const cs_vec3_t(*)[2])tw, &want),
+                     CS_OK);
+    assert_memory_equal(&sf.items[0].quad, &want, sizeof want);
+    assert_int_equal(cs_coons_bicubic_twist(&p1, &p2, &q1, &q2, NULL, NULL, NULL, NULL,
+                                            (const cs_vec3_t(*)[2])tw, &want),
+                     CS_OK);
+    assert_memory_equal(&sf.items[1].quad, &want, sizeof want);
+    cs_surffile_free(&sf);
+}
+
 /* The keyword table (cs_surffile_keyword) is what the parser accepts and what docs/surfaces.md
  * lists in its "Native surface format" block, both ways (toolpath --help prints the table; the
  * CLI test test_inspect.sh compares it with the docs too). */
@@ -271,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_newell_fallback),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_keywords),
+        cmocka_unit_test(test_coons_derivatives_twists),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
