@@ -9,6 +9,7 @@
 
 #include "cs_coons.h"
 #include "cs_err_text.h"
+#include "cs_gcoons.h"
 #include "cs_lex.h"
 #include "cs_patchfile.h"
 #include "cs_revolve.h"
@@ -84,9 +85,29 @@ static cs_err_t coons_bicubic(cs_lex_t *lx, cs_patch_t *p)
                                   twists ? (const cs_vec3_t(*)[2])tw : NULL, p);
 }
 
+/* A blend of coons-blend: linear | hermite | bernstein b0 b1 b2 b3 (cs_gcoons). */
+static cs_err_t blend(cs_lex_t *lx, cs_gcoons_blend_t *f)
+{
+    static const char *const kinds[] = {"linear", "hermite", "bernstein"};
+    int k = 0;
+    cs_err_t e = cs_lex_choice(lx, "blend linear, hermite or bernstein", kinds, 3, &k);
+    if (e != CS_OK)
+        return e;
+    if (k < 2) {
+        *f = k == 0 ? cs_gcoons_linear() : cs_gcoons_hermite();
+        return CS_OK;
+    }
+    for (int i = 0; e == CS_OK && i < 4; i++)
+        e = cs_lex_number(lx, "Bernstein coefficient of the blend", &f->b[i]);
+    if (e == CS_OK && (f->b[0] != 1 || f->b[3] != 0))
+        e = cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
+                             "a blend starts at 1 and ends at 0 (b0 = 1, b3 = 0; seed 002)");
+    return e;
+}
+
 static const char *const keywords[] = {
-    "bezier",         "tri",  "hermite", "power",   "coons-bilinear", "coons-bicubic",
-    "varady",         "varady-scheme",   "ruled",   "extrude",        "revolve",
+    "bezier", "tri",           "hermite", "power",   "coons-bilinear", "coons-bicubic",
+    "coons-blend", "varady", "varady-scheme", "ruled", "extrude",        "revolve",
 };
 
 const char *cs_surffile_keyword(size_t i)
@@ -169,6 +190,16 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
     } else if (strcmp(kw, "coons-bicubic") == 0) {
         e = coons_bicubic(lx, &p);
         if (e == CS_OK)
+            return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "coons-blend") == 0) {
+        cs_gcoons_blend_t f, g;
+        cs_bezier_t c[4];
+        e = blend(lx, &f);
+        if (e == CS_OK)
+            e = blend(lx, &g);
+        for (int k = 0; e == CS_OK && k < 4; k++)
+            e = curve(lx, &c[k]);
+        if (e == CS_OK && (e = cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, &p)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "ruled") == 0) {
         cs_bezier_t c[2];

@@ -8,7 +8,11 @@
  *   hermite  V x 16                 P00 P10 P01 P11 Pu.. Pv.. Puv.. (index: u corner, v corner)
  *   power  V x 16                   a[i][j] (coefficient of u^i v^j), i-major
  *   coons-bilinear C C C C          boundaries p1 (v=0), p2 (v=1), q1 (u=0), q2 (u=1)
- *   coons-bicubic C C C C           same, default cross-boundary derivatives, zero twists
+ *   coons-bicubic C C C C [derivatives C C C C] [twists V V V V]
+ *                                   same with Hermite blends; derivative curves and twists
+ *                                   default to the corner tangents and zero
+ *   coons-blend F G C C C C         generalised Coons (seed 002), blends linear | hermite |
+ *                                   bernstein 1 b1 b2 0 (cs_gcoons)
  *   ruled C C                       (1 - v) C1(u) + v C2(u)
  *   extrude C V                     C(u) + v V
  *   revolve O A R SWEEP C           profile C (x = radius, y = height) about the axis through O
