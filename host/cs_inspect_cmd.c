@@ -45,7 +45,8 @@ static void inspect_usage(FILE *f)
             "first and second derivatives (mm per unit t, per unit t^2) and of the curvature\n"
             "vectors (1/mm). A surfaces file (first token 'curvestep-surfaces', or any file\n"
             "with --patches: Newell's format or .bpt) gives one line per patch and, for each\n"
-            "edge two tensor patches share, its continuity (C0, G1, C1, C2). A summary line\n"
+            "edge two tensor patches share, its continuity (C0, G1, C1, C2: cs_patch_continuity\n"
+            "within --tol). A summary line\n"
             "ends the report.\n"
             "\n"
             "Options:\n"
@@ -335,32 +336,6 @@ static void orient(cs_patch_t *p, int e, bool at_end)
         flip_u(p);
 }
 
-/* C2 across a's u = 1 and b's u = 0 (oriented, C1 already): the second cross-boundary
- * derivative control vectors n (n - 1) (P_n - 2 P_(n-1) + P_(n-2)) agree within tol + rel |.|.
- * Linear patches have none (zero). */
-static bool edge_c2(const cs_patch_t *a, const cs_patch_t *b, double tol, double rel)
-{
-    int n = a->deg_u, m = b->deg_u;
-    for (int j = 0; j <= a->deg_v; j++) {
-        double u[3] = {0, 0, 0}, v[3] = {0, 0, 0}, d[3], p0[3], p1[3], p2[3];
-        if (n >= 2) {
-            pt_mm(&a->p[n][j], p0), pt_mm(&a->p[n - 1][j], p1), pt_mm(&a->p[n - 2][j], p2);
-            for (int k = 0; k < 3; k++)
-                u[k] = n * (n - 1.0) * (p0[k] - 2 * p1[k] + p2[k]);
-        }
-        if (m >= 2) {
-            pt_mm(&b->p[0][j], p0), pt_mm(&b->p[1][j], p1), pt_mm(&b->p[2][j], p2);
-            for (int k = 0; k < 3; k++)
-                v[k] = m * (m - 1.0) * (p0[k] - 2 * p1[k] + p2[k]);
-        }
-        for (int k = 0; k < 3; k++)
-            d[k] = u[k] - v[k];
-        if (norm3(d) > tol + rel * fmax(norm3(u), norm3(v)))
-            return false;
-    }
-    return true;
-}
-
 /* True when a's edge u = 1 is a single point (a collapsed edge, as at the teapot's lid: every
  * patch meeting there would "share" it). */
 static bool edge_is_point(const cs_patch_t *a)
@@ -392,9 +367,8 @@ static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_
                     cs_patch_continuity(&pa, &pb, tol, sin_tol, &c) != CS_OK ||
                     c == CS_PATCH_CONT_NONE)
                     continue;
-                static const char *const names[4] = {"none", "C0", "G1", "C1"};
-                *cls = c == CS_PATCH_CONT_C1 && edge_c2(&pa, &pb, o->tol_mm, o->rel) ? "C2"
-                                                                                    : names[c];
+                static const char *const names[5] = {"none", "C0", "G1", "C1", "C2"};
+                *cls = names[c];
                 return true;
             }
     return false;

@@ -684,6 +684,32 @@ static cs_vec3_t cross_ctrl(const cs_patch_t *p, unsigned j, bool far, bool *ok)
     return r;
 }
 
+/* Second cross-boundary derivative control vector of column j, n (n - 1) (P_n - 2 P_(n-1) +
+ * P_(n-2)) at a's far edge (far) or n (n - 1) (P_0 - 2 P_1 + P_2) at b's near edge, axis a:
+ * exact (|.| < 42 * 4 * 2^28 < 2^36). */
+static int64_t second_ctrl(const cs_patch_t *p, unsigned j, bool far, unsigned a)
+{
+    unsigned n = p->deg_u;
+    if (n < 2)
+        return 0;
+    const cs_vec3_t *e = far ? &p->p[n][j] : &p->p[0][j];
+    const cs_vec3_t *m = far ? &p->p[n - 1][j] : &p->p[1][j];
+    const cs_vec3_t *f = far ? &p->p[n - 2][j] : &p->p[2][j];
+    return (int64_t)n * (n - 1) * ((int64_t)coord(e, a) - 2 * (int64_t)coord(m, a) + coord(f, a));
+}
+
+/* The second cross-boundary derivatives of a (u = 1) and b (u = 0) agree within tol. */
+static bool second_agree(const cs_patch_t *a, const cs_patch_t *b, int64_t tol)
+{
+    for (unsigned j = 0; j <= a->deg_v; j++)
+        for (unsigned x = 0; x < 3; x++) {
+            int64_t d = second_ctrl(a, j, true, x) - second_ctrl(b, j, false, x);
+            if (d > tol || d < -tol)
+                return false;
+        }
+    return true;
+}
+
 cs_err_t cs_patch_continuity(const cs_patch_t *a, const cs_patch_t *b, cs_pos_t tol,
                              cs_param_t sin_tol, cs_patch_cont_t *out)
 {
@@ -709,7 +735,7 @@ cs_err_t cs_patch_continuity(const cs_patch_t *a, const cs_patch_t *b, cs_pos_t 
             c1 = false;
     }
     if (ok && c1) {
-        *out = CS_PATCH_CONT_C1;
+        *out = second_agree(a, b, tol) ? CS_PATCH_CONT_C2 : CS_PATCH_CONT_C1;
         return CS_OK;
     }
     /* G1: Pu_a(1, v), Pu_b(0, v) and the edge tangent Pv coplanar, the two Pu on the same side

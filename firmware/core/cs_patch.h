@@ -72,6 +72,7 @@ typedef enum {
     CS_PATCH_CONT_C0 = 1,   /* same edge curve */
     CS_PATCH_CONT_G1 = 2,   /* same tangent plane all along the edge */
     CS_PATCH_CONT_C1 = 3,   /* same cross-boundary derivative dP/du all along the edge */
+    CS_PATCH_CONT_C2 = 4,   /* C1 and the same second cross-boundary derivative d2P/du2 */
 } cs_patch_cont_t;
 
 /* Patch from (deg_u + 1) * (deg_v + 1) points, pts[i * (deg_v + 1) + j] = p[i][j].
@@ -140,7 +141,9 @@ cs_err_t cs_patch_hermite_split9(const cs_patch_hermite_t *h, const cs_param_t u
 cs_err_t cs_patch_transpose(const cs_patch_t *p, cs_patch_t *out);
 /* Continuity along a's edge u = 1 against b's edge u = 0 (same deg_v, else CS_ERR_DEGREE):
  * C0 when the edge control points agree within tol LSB (each coordinate); C1 when also the
- * cross-boundary derivative control vectors deg_u (p[n][j] - p[n-1][j]) agree within tol; G1
+ * cross-boundary derivative control vectors deg_u (p[n][j] - p[n-1][j]) agree within tol; C2
+ * when, beyond C1, the second ones deg_u (deg_u - 1) (p[n][j] - 2 p[n-1][j] + p[n-2][j]) (zero
+ * for deg_u = 1) agree within tol too (exact integers); G1
  * when instead det(Pu_a, Pu_b, Pv) / (|Pu_a| |Pu_b| |Pv|) <= sin_tol (Q30) with Pu_a . Pu_b > 0
  * relative to the edge (same side) at 3 deg_v + 1 points along the edge: the determinant is a
  * polynomial of degree <= 3 deg_v - 1 in v, so that many zeros mean it vanishes everywhere.

@@ -685,9 +685,19 @@ static void test_continuity(void **state)
         cs_patch_cont_t c;
         const cs_param_t sin_tol = (cs_param_t)(1e-4 * Q30);
         /* Halves at u = 1/2: same derivative scale both sides, C1 within rounding (each point
-         * rounded by 0.5 LSB: a cross derivative 3 (p3 - p2) by up to 3 LSB). */
+         * rounded by 0.5 LSB: a cross derivative 3 (p3 - p2) by up to 3 LSB), and C2 within
+         * the second derivative's rounding, 6 (0.5 + 2 * 0.5 + 0.5) = 12 LSB. */
         assert_int_equal(cs_patch_split_u(&p, CS_PARAM_ONE / 2, &lo, &hi), CS_OK);
         assert_int_equal(cs_patch_continuity(&lo, &hi, 3, sin_tol, &c), CS_OK);
+        assert_true(c == CS_PATCH_CONT_C1 || c == CS_PATCH_CONT_C2);
+        assert_int_equal(cs_patch_continuity(&lo, &hi, 12, sin_tol, &c), CS_OK);
+        assert_int_equal(c, CS_PATCH_CONT_C2);
+        /* Move hi's third row: the first cross derivative (rows 0, 1) stays, the second
+         * 6 (p0 - 2 p1 + p2) changes by 6 x 100 LSB: C1, not C2. */
+        cs_patch_t third = hi;
+        for (int j = 0; j < 4; j++)
+            third.p[2][j].z += 100;
+        assert_int_equal(cs_patch_continuity(&lo, &third, 12, sin_tol, &c), CS_OK);
         assert_int_equal(c, CS_PATCH_CONT_C1);
         /* At u = 1/4 the cross derivatives differ in length (1/4 vs 3/4 of Pu): G1 only. */
         assert_int_equal(cs_patch_split_u(&p, CS_PARAM_ONE / 4, &lo, &hi), CS_OK);
