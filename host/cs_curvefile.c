@@ -273,6 +273,22 @@ static cs_err_t st_natural(cf_t *c)
     return e;
 }
 
+cs_err_t cs_curvefile_arc(const cs_vec3_t v[3], double a0_deg, double a1_deg,
+                          cs_bezier_t out[CS_ARC_MAX_SEGMENTS], unsigned *n)
+{
+    double sweep = fabs(a1_deg - a0_deg);
+    if (!(sweep > 0 && sweep <= 360))
+        return CS_ERR_RANGE;
+    cs_param_t cs[4];
+    for (int i = 0; i < 2; i++) {
+        double r = (i ? a1_deg : a0_deg) * M_PI / 180;
+        if (cs_conv_to_param(cos(r), &cs[2 * i]) != CS_OK ||
+            cs_conv_to_param(sin(r), &cs[2 * i + 1]) != CS_OK)
+            return CS_ERR_RANGE;
+    }
+    return cs_arc_build(&v[0], &v[1], &v[2], cs[0], cs[1], cs[2], cs[3], a1_deg > a0_deg, out, n);
+}
+
 /* arc C U V A0 A1: the ellipse arc C + U cos(a) + V sin(a) for a from A0 to A1 degrees. */
 static cs_err_t st_arc(cf_t *c)
 {
@@ -290,16 +306,9 @@ static cs_err_t st_arc(cf_t *c)
     if (!(sweep > 0 && sweep <= 360))
         return cs_path_diag_set(c->lx.diag, CS_ERR_RANGE, cs_lex_here(&c->lx),
                                 "the sweep %g degrees must be in (0, 360]", a[1] - a[0]);
-    cs_param_t cs[4];
-    for (int i = 0; i < 2; i++) {
-        double r = a[i] * M_PI / 180;
-        if (cs_conv_to_param(cos(r), &cs[2 * i]) != CS_OK ||
-            cs_conv_to_param(sin(r), &cs[2 * i + 1]) != CS_OK)
-            return CS_ERR_RANGE;
-    }
     cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
     unsigned n = 0;
-    e = cs_arc_build(&v[0], &v[1], &v[2], cs[0], cs[1], cs[2], cs[3], a[1] > a[0], seg, &n);
+    e = cs_curvefile_arc(v, a[0], a[1], seg, &n);
     for (unsigned i = 0; e == CS_OK && i < n; i++)
         e = emit(c, &seg[i], i == 0);
     return e;

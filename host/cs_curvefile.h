@@ -22,6 +22,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "cs_arc.h"
 #include "cs_path.h"
 
 /* First token of every curves file. */
@@ -30,6 +31,12 @@
  * CS_SPLINE_MAX_POINTS, is lower). */
 #define CS_CURVEFILE_MAX_POINTS 65536
 
+/* The `arc` statement's curve: C + U cos(a) + V sin(a) (v[0..2] = C, U, V) for a from a0 to a1
+ * degrees (counter-clockwise from U towards V when a1 > a0), 0 < |a1 - a0| <= 360, as the exact
+ * rational quadratics of cs_arc_build (cos and sin in double, then Q1.30). CS_ERR_RANGE for a
+ * sweep outside that range, plus cs_arc_build's errors. */
+cs_err_t cs_curvefile_arc(const cs_vec3_t v[3], double a0_deg, double a1_deg,
+                          cs_bezier_t out[CS_ARC_MAX_SEGMENTS], unsigned *n);
 /* True when the first token of text[0..len) is CS_CURVEFILE_MAGIC. */
 bool cs_curvefile_is(const char *text, size_t len);
 /* Parses text[0..len) (name for diagnostics) and appends every curve's Bézier segments to

@@ -374,7 +374,8 @@ static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_
     return false;
 }
 
-/* Box of a surface item's control points (which contains the surface: convex hull). */
+/* Box of a surface item's control points (which contains the surface: convex hull); a
+ * sphere's own box. */
 static void item_box(const cs_surf_item_t *it, double b[6])
 {
     for (int k = 0; k < 3; k++) {
@@ -383,6 +384,13 @@ static void item_box(const cs_surf_item_t *it, double b[6])
     }
     const cs_vec3_t *pts[CS_VARADY_MAX_SIDES * CS_BEZIER_MAX_POINTS];
     size_t n = 0;
+    if (it->sphere) {
+        for (int k = 0; k < 3; k++) {
+            b[k] = it->sph.c[k] - it->sph.r;
+            b[k + 3] = it->sph.c[k] + it->sph.r;
+        }
+        return;
+    }
     if (it->tri) {
         for (unsigned i = 0; i < (it->trip.degree + 1u) * (it->trip.degree + 2u) / 2; i++)
             pts[n++] = &it->trip.p[i];
@@ -409,7 +417,9 @@ static void print_item(const inspect_opts_t *o, const cs_surffile_t *sf, size_t 
 {
     const cs_surf_item_t *it = &sf->items[i];
     char kind[48];
-    if (it->tri)
+    if (it->sphere)
+        snprintf(kind, sizeof kind, "sphere radius %g", it->sph.r);
+    else if (it->tri)
         snprintf(kind, sizeof kind, "triangle degree %u", it->trip.degree);
     else if (it->varady)
         snprintf(kind, sizeof kind, "%zu-sided", it->nside.n);
@@ -450,7 +460,7 @@ static int inspect_surfaces(const inspect_opts_t *o, const cs_surffile_t *sf)
             const cs_surf_item_t *a = &sf->items[i], *b = &sf->items[j];
             int ea, eb;
             const char *cls;
-            if (a->tri || a->varady || b->tri || b->varady ||
+            if (a->tri || a->varady || a->sphere || b->tri || b->varady || b->sphere ||
                 !shared_edge(&a->quad, &b->quad, o, &ea, &eb, &cls))
                 continue;
             for (int k = 0; k < NPCLASSES; k++)

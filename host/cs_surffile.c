@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cs_coons.h"
+#include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_gcoons.h"
 #include "cs_lex.h"
@@ -108,6 +109,7 @@ static cs_err_t blend(cs_lex_t *lx, cs_gcoons_blend_t *f)
 static const char *const keywords[] = {
     "bezier", "tri",           "hermite", "power",   "coons-bilinear", "coons-bicubic",
     "coons-blend", "varady", "varady-scheme", "ruled", "extrude",        "revolve",
+    "sphere",
 };
 
 const char *cs_surffile_keyword(size_t i)
@@ -201,6 +203,28 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
             e = curve(lx, &c[k]);
         if (e == CS_OK && (e = cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, &p)) == CS_OK)
             return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "sphere") == 0) {
+        cs_surf_item_t it;
+        memset(&it, 0, sizeof it);
+        e = cs_lex_vec(lx, "centre", NULL, it.sph.c);
+        if (e == CS_OK)
+            e = cs_lex_number(lx, "radius", &it.sph.r);
+        if (e != CS_OK)
+            return e;
+        it.sph.r *= lx->scale;
+        cs_vec3_t lo, hi;
+        if (!(it.sph.r > 0) ||
+            cs_conv_mm_to_vec(it.sph.c[0] - it.sph.r, it.sph.c[1] - it.sph.r,
+                              it.sph.c[2] - it.sph.r, &lo) != CS_OK ||
+            cs_conv_mm_to_vec(it.sph.c[0] + it.sph.r, it.sph.c[1] + it.sph.r,
+                              it.sph.c[2] + it.sph.r, &hi) != CS_OK)
+            return cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
+                                    "radius %g mm: must be > 0 and keep the sphere inside "
+                                    "+/-%d mm",
+                                    it.sph.r, CS_POS_LIMIT_MM);
+        it.sphere = true;
+        it.line = at.line;
+        return push(sf, &it);
     } else if (strcmp(kw, "ruled") == 0) {
         cs_bezier_t c[2];
         for (int k = 0; e == CS_OK && k < 2; k++)

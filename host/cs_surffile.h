@@ -20,6 +20,7 @@
  *   varady N C x N                  n-sided transfinite patch (seed 002) bounded by a loop
  *   varady-scheme B P N C x N       same with blend B (mu, lambda-kappa) and parametrisation
  *                                   P (side, radial, centre); varady = "varady-scheme mu side"
+ *   sphere C R                      the exact sphere of centre C, radius R (seed 000)
  * where C = "N P0 .. PN" (a Bézier curve of degree N = 1..3), P and V = three numbers, '#'
  * starts a comment; numbers are free-form across lines. Every item becomes core patches
  * (cs_patch_t or cs_tripatch_t) with the line of its keyword. Bad input: file:line:col. */
@@ -31,12 +32,15 @@
 
 #include "cs_patch.h"
 #include "cs_path.h"
+#include "cs_sphere.h"
 #include "cs_tripatch.h"
 #include "cs_varady.h"
 
 typedef struct {
     bool tri;    /* triangular: trip is set */
     bool varady; /* n-sided: nside is set (else quad) */
+    bool sphere; /* the exact sphere: sph is set (else quad) */
+    cs_sphere_t sph;
     cs_patch_t quad;
     cs_tripatch_t trip;
     cs_varady_t nside;

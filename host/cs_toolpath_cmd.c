@@ -358,6 +358,27 @@ static cs_err_t wire_varady(tp_out_t *o, const cs_varady_t *v, unsigned lines, c
     return e;
 }
 
+/* The exact sphere (cs_sphere): N meridians (longitudes 360 k / N, each a half circle from
+ * pole to pole) and the N - 1 parallels at latitudes -90 + 180 k / N, every piece an exact
+ * rational arc, traced within tol. */
+static cs_err_t wire_sphere(tp_out_t *o, const cs_sphere_t *s, unsigned lines, cs_pos_t tol)
+{
+    cs_bezier_t arc[CS_ARC_MAX_SEGMENTS];
+    unsigned n = 0;
+    cs_err_t e = CS_OK;
+    for (unsigned k = 0; e == CS_OK && k < 2 * lines; k++) {
+        bool meridian = k < lines;
+        e = meridian ? cs_sphere_meridian(s, 0, 360.0 * k / lines, -90, 90, arc, &n)
+            : k == lines ? CS_END
+                         : cs_sphere_parallel(s, 0, -90 + 180.0 * (k - lines) / lines, arc, &n);
+        for (unsigned i = 0; e == CS_OK && i < n; i++)
+            e = emit_curve(o, &arc[i], tol, i == 0);
+        if (e == CS_END)
+            e = CS_OK;
+    }
+    return e;
+}
+
 /* --- finishing with a ball-end tool -------------------------------------------------------- */
 
 typedef struct {
@@ -393,6 +414,51 @@ static bool ball_emit(void *ctx, size_t pass, double u, double v, const cs_vec3_
     return out_vertex_g(b->o, c, false, false); /* the plunge too is a feed move */
 }
 
+/* Traces c within tol and hands every vertex after the first to ball_emit (a feed move). */
+static cs_err_t ball_trace(tp_ball_ctx_t *ctx, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_trace_t tr;
+    cs_vec3_t pt;
+    cs_err_t e = cs_trace_begin(&tr, c, tol, CS_TRACE_SUBDIV);
+    while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK)
+        if (!ball_emit(ctx, 0, 0, 0, &pt, false))
+            return CS_ERR_FULL;
+    return e == CS_END ? CS_OK : e;
+}
+
+/* The upper hemisphere of an exact sphere (below the equator a 3-axis tool cannot reach): the
+ * tool centre runs on the offset sphere r + R, from the pole down a meridian (longitude 0) to
+ * each parallel in turn and once around it, the parallels spaced equally in latitude by at most
+ * cs_sphere_step(r, R, H), so the scallop (closed form, cs_sphere_scallop) stays below H. */
+static cs_err_t finish_sphere(tp_ball_ctx_t *ctx, const cs_sphere_t *s, const tp_ball_t *bp,
+                              cs_pos_t tol, cs_finish_stats_t *st)
+{
+    double step = cs_sphere_step(s->r, bp->r_mm, bp->h_mm);
+    unsigned n = (unsigned)ceil((M_PI / 2) / step - 1e-9);
+    double dlat = 90.0 / n, rho = s->r + bp->r_mm;
+    cs_vec3_t pole;
+    if (n == 0 || n > 100000 ||
+        cs_conv_mm_to_vec(s->c[0], s->c[1], s->c[2] + rho, &pole) != CS_OK)
+        return CS_ERR_RANGE;
+    if (!ball_emit(ctx, 0, 0, 0, &pole, true))
+        return CS_ERR_FULL;
+    cs_bezier_t arc[CS_ARC_MAX_SEGMENTS];
+    unsigned na = 0;
+    cs_err_t e = CS_OK;
+    for (unsigned k = 1; e == CS_OK && k <= n; k++) {
+        e = cs_sphere_meridian(s, bp->r_mm, 0, 90 - dlat * (k - 1), 90 - dlat * k, arc, &na);
+        for (unsigned i = 0; e == CS_OK && i < na; i++)
+            e = ball_trace(ctx, &arc[i], tol);
+        if (e == CS_OK)
+            e = cs_sphere_parallel(s, bp->r_mm, 90 - dlat * k, arc, &na);
+        for (unsigned i = 0; e == CS_OK && i < na; i++)
+            e = ball_trace(ctx, &arc[i], tol);
+    }
+    st->passes += n;
+    st->max_scallop = fmax(st->max_scallop, cs_sphere_scallop(s->r, bp->r_mm, dlat * M_PI / 180));
+    return e;
+}
+
 /* Every patch in turn: approach from the safe height, the zig-zag passes, retract. */
 static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const tp_ball_t *bp,
                       cs_finish_stats_t *st, double *fit_out)
@@ -406,7 +472,9 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
         if (it->tri)
             for (unsigned k = 0; k < (it->trip.degree + 1u) * (it->trip.degree + 2u) / 2; k++)
                 top = fmax(top, cs_conv_pos_to_mm(it->trip.p[k].z));
-        for (int a = 0; !it->tri && !it->varady && a <= it->quad.deg_u; a++)
+        if (it->sphere)
+            top = fmax(top, it->sph.c[2] + it->sph.r);
+        for (int a = 0; !it->tri && !it->varady && !it->sphere && a <= it->quad.deg_u; a++)
             for (int b = 0; b <= it->quad.deg_v; b++)
                 top = fmax(top, cs_conv_pos_to_mm(it->quad.p[a][b].z));
     }
@@ -429,7 +497,11 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
         size_t ncell = 1;
         const cs_patch_t *list = &it->quad;
         cs_err_t e = CS_OK;
-        if (it->tri) {
+        if (it->sphere) {
+            ncell = 0;
+            ctx.patch_start = true;
+            e = finish_sphere(&ctx, &it->sph, bp, tol, st);
+        } else if (it->tri) {
             e = cs_finish_tri_patch(&it->trip, &tq);
             list = &tq;
         } else if (it->varady) {
@@ -722,6 +794,7 @@ int cs_cmd_toolpath(int argc, char **argv)
     for (size_t i = 0; i < sf.n && status == CS_EXIT_OK && !ball; i++) {
         e = sf.items[i].tri      ? wire_tri(&o, &sf.items[i].trip, lines, tol)
             : sf.items[i].varady ? wire_varady(&o, &sf.items[i].nside, lines, tol)
+            : sf.items[i].sphere ? wire_sphere(&o, &sf.items[i].sph, lines, tol)
                                  : wire_patch(&o, &sf.items[i].quad, lines, tol);
         if (e != CS_OK) {
             cs_path_loc_t l = {sf.file, sf.items[i].line, 1};

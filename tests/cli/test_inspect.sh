@@ -105,6 +105,16 @@ printf 'curvestep-surfaces 1\nbezier 8 1\n' >"$T/deg8.txt"
 run "degree 8 refused" 1 toolpath --patches "$T/deg8.txt"
 expect_err "degree 8: located" 'deg8.txt:2:8: degree in u must be an integer 1\.\.7'
 
+# --- the exact sphere (seed 000): every wireframe vertex on the sphere, every tool centre on the
+# offset sphere r + R (vertices lie on the exact arcs: within their 2 LSB plus the 6 printed
+# decimals), the closed-form scallop below H
+printf 'curvestep-surfaces 1\nsphere 10 20 5  25\n' >"$T/sphere.txt"
+run "sphere wireframe" 0 toolpath --patches "$T/sphere.txt" --lines 8 --view 1,0,0,-10,0,1,0,-20,0,0,1,0 --stats
+check "sphere wireframe: vertices within 25 mm of the centre (top view)" awk 'NF == 2 { d = sqrt($1 * $1 + $2 * $2); if (d > 25 + 4e-5) bad++; n++ } END { exit !(n > 100 && !bad) }' "$T/out"
+run "sphere finishing" 0 toolpath --patches "$T/sphere.txt" --ball 3 --scallop 0.02 --stats
+check "sphere finishing: tool centres on the offset sphere r + R = 28" awk 'NF == 3 && NR > 1 { d = sqrt(($1 - 10) ^ 2 + ($2 - 20) ^ 2 + ($3 - 5) ^ 2); if ($3 < 38 && (d > 28 + 4e-5 || d < 28 - 4e-5)) bad++; n++ } END { exit !(n > 1000 && !bad) }' "$T/out"
+check "sphere finishing: scallop below 0.02" grep -qE 'scallop 0\.02 mm: [0-9]+ passes, measured scallop 0\.01[0-9]+ mm' "$T/err"
+
 # --- the surface keywords: toolpath --help, docs/surfaces.md and the parser's own list agree
 run "toolpath help" 0 toolpath --help
 help_kw=$(grep -A1 'each starting with one of the keywords' "$T/out" | tail -1 | sed 's/^ *//; s/;$//')

@@ -190,7 +190,7 @@ static void test_errors(void **state)
     (void)state;
     expect("curvestep-surfaces 2\n", CS_ERR_RANGE, 1, 20, "format version");
     expect("curvestep-surfaces 1\n# nothing\n", CS_ERR_EMPTY, 3, 1, "no surfaces");
-    expect("curvestep-surfaces 1\nsphere 3\n", CS_ERR_PARSE, 2, 1, "unknown surface 'sphere'");
+    expect("curvestep-surfaces 1\ntorus 3\n", CS_ERR_PARSE, 2, 1, "unknown surface 'torus'");
     expect("curvestep-surfaces 1\nbezier 8 1\n", CS_ERR_RANGE, 2, 8, "degree in u");
     expect("curvestep-surfaces 1\nbezier 1 1 0 0 0  1 0 0  0 1 x\n", CS_ERR_PARSE, 2, 30,
            "'x': control point expected");
