@@ -265,6 +265,7 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
         cs_bezier_t c[CS_VARADY_MAX_SIDES];
         cs_varady_blend_t blend = CS_VARADY_MU;
         cs_varady_param_t param = CS_VARADY_SIDE;
+        cs_varady_domain_t domain = CS_VARADY_DOMAIN_ARC;
         if (strcmp(kw, "varady-scheme") == 0) {
             /* varady-scheme BLEND PARAM N C x N */
             static const char *const blends[] = {"mu", "lambda-kappa"};
@@ -278,6 +279,15 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
             if (e != CS_OK)
                 return e;
             param = (cs_varady_param_t)got;
+            if (cs_lex_peek_is(lx, "domain")) {
+                static const char *const doms[] = {"arc", "chords", "angles", "least-squares"};
+                cs_lex_next(lx);
+                e = cs_lex_choice(lx, "domain arc, chords, angles or least-squares", doms, 4,
+                                  &got);
+                if (e != CS_OK)
+                    return e;
+                domain = (cs_varady_domain_t)got;
+            }
         }
         e = cs_lex_integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
         for (int k = 0; e == CS_OK && k < n; k++)
@@ -286,7 +296,8 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
         if (e == CS_OK && !it)
             return CS_ERR_FULL;
         if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
-            (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK) {
+            (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK &&
+            (e = cs_varady_set_domain(&it->nside, domain)) == CS_OK) {
             it->varady = true;
             it->line = at.line;
             e = push(sf, it);

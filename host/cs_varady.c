@@ -36,46 +36,23 @@ static double norm3(const double a[3])
     return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
 
-cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
+/* Seed 002, solution 1: vertices on a circle, angles proportional to arc length; the
+ * circle's circumference is the boundary's length, so domain units are about mm. */
+static void place_arc(cs_varady_t *v, double total)
 {
-    if (!v || !sides || n < 3 || n > CS_VARADY_MAX_SIDES)
-        return CS_ERR_ARG;
-    memset(v, 0, sizeof *v);
-    v->n = n;
-    double total = 0;
-    for (size_t i = 0; i < n; i++) {
-        const cs_bezier_t *c = &sides[i], *nx = &sides[(i + 1) % n];
-        if (c->rational)
-            return CS_ERR_UNSUPPORTED;
-        if (c->degree < 1 || c->degree > 3)
-            return CS_ERR_DEGREE;
-        const cs_vec3_t *e = &c->p[c->degree];
-        if (e->x != nx->p[0].x || e->y != nx->p[0].y || e->z != nx->p[0].z)
-            return CS_ERR_DEGENERATE;
-        v->side[i] = *c;
-        /* Arc length by 64-chord polyline (enough for the domain's proportions). */
-        double prev[3], q[3];
-        curve_d(c, 0, prev, NULL);
-        for (int k = 1; k <= 64; k++) {
-            curve_d(c, k / 64.0, q, NULL);
-            double d[3] = {q[0] - prev[0], q[1] - prev[1], q[2] - prev[2]};
-            v->len[i] += norm3(d);
-            memcpy(prev, q, sizeof q);
-        }
-        if (!(v->len[i] > 0))
-            return CS_ERR_DEGENERATE;
-        total += v->len[i];
-    }
-    /* Seed 002, solution 1: vertices on a circle, angles proportional to arc length; the
-     * circle's circumference is the boundary's length, so domain units are about mm. */
     double rho = total / (2 * PI), acc = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < v->n; i++) {
         double beta = 2 * PI * acc / total;
         v->vert[i][0] = rho * cos(beta);
         v->vert[i][1] = rho * sin(beta);
         acc += v->len[i];
     }
-    /* Local frames of the domain sides (for the radial and central-line parametrisations). */
+}
+
+/* Local frames of the domain sides (for the radial and central-line parametrisations). */
+static void frames(cs_varady_t *v)
+{
+    size_t n = v->n;
     double cx = 0, cy = 0;
     for (size_t i = 0; i < n; i++) {
         cx += v->vert[i][0] / (double)n;
@@ -112,6 +89,41 @@ cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
             v->rc[i][1] = ka * v->w1[i][1];
         }
     }
+}
+
+cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
+{
+    if (!v || !sides || n < 3 || n > CS_VARADY_MAX_SIDES)
+        return CS_ERR_ARG;
+    memset(v, 0, sizeof *v);
+    v->n = n;
+    double total = 0;
+    for (size_t i = 0; i < n; i++) {
+        const cs_bezier_t *c = &sides[i], *nx = &sides[(i + 1) % n];
+        if (c->rational)
+            return CS_ERR_UNSUPPORTED;
+        if (c->degree < 1 || c->degree > 3)
+            return CS_ERR_DEGREE;
+        const cs_vec3_t *e = &c->p[c->degree];
+        if (e->x != nx->p[0].x || e->y != nx->p[0].y || e->z != nx->p[0].z)
+            return CS_ERR_DEGENERATE;
+        v->side[i] = *c;
+        /* Arc length by 64-chord polyline (enough for the domain's proportions). */
+        double prev[3], q[3];
+        curve_d(c, 0, prev, NULL);
+        for (int k = 1; k <= 64; k++) {
+            curve_d(c, k / 64.0, q, NULL);
+            double d[3] = {q[0] - prev[0], q[1] - prev[1], q[2] - prev[2]};
+            v->len[i] += norm3(d);
+            memcpy(prev, q, sizeof q);
+        }
+        if (!(v->len[i] > 0))
+            return CS_ERR_DEGENERATE;
+        total += v->len[i];
+    }
+    v->domain = CS_VARADY_DOMAIN_ARC;
+    place_arc(v, total);
+    frames(v);
     /* Cross-boundary tangents: away from each corner along the neighbouring side. */
     for (size_t i = 0; i < n; i++) {
         double a[3], b[3];
@@ -125,6 +137,215 @@ cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
             v->t1[i][k] = b[k] / lb;
         }
     }
+    return CS_OK;
+}
+
+double cs_varady_corner_angle(const cs_varady_t *v, size_t i)
+{
+    double a[3], b[3];
+    curve_d(&v->side[(i + v->n - 1) % v->n], 1, NULL, a);
+    curve_d(&v->side[i], 0, NULL, b);
+    double c = -(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (norm3(a) * norm3(b));
+    return acos(fmax(-1, fmin(1, c)));
+}
+
+/* Solution 2: R with sum 2 asin(L_i / 2R) = 2 pi (decreasing in R; asin x <= pi x / 2 bounds R
+ * by sum L / 4), then the vertices at the accumulated central angles. */
+static cs_err_t place_chords(cs_varady_t *v, double total, double out[][2])
+{
+    double lmax = 0;
+    for (size_t i = 0; i < v->n; i++)
+        lmax = fmax(lmax, v->len[i]);
+    double lo = lmax / 2, hi = total / 4, f = 0;
+    for (size_t i = 0; i < v->n; i++)
+        f += 2 * asin(fmin(1, v->len[i] / (2 * lo)));
+    if (!(hi >= lo) || f < 2 * PI)
+        return CS_ERR_DEGENERATE; /* the centre would lie outside the polygon */
+    for (int it = 0; it < 200 && hi - lo > 1e-14 * hi; it++) {
+        double mid = (lo + hi) / 2;
+        f = 0;
+        for (size_t i = 0; i < v->n; i++)
+            f += 2 * asin(v->len[i] / (2 * mid));
+        *(f > 2 * PI ? &lo : &hi) = mid;
+    }
+    double r = (lo + hi) / 2, acc = 0;
+    for (size_t i = 0; i < v->n; i++) {
+        out[i][0] = r * cos(acc);
+        out[i][1] = r * sin(acc);
+        acc += 2 * asin(v->len[i] / (2 * r));
+    }
+    return CS_OK;
+}
+
+/* A polygon from its side lengths l and interior angles alpha (alpha[i] at vertex i, the start
+ * of side i): p_0 = 0, side 0 along +x, turning left by pi - alpha at each vertex. Writes the
+ * n + 1 points p_0 .. p_n (p_n = p_0 when it closes). */
+static void turtle(size_t n, const double l[], const double alpha[], double p[][2])
+{
+    double th = 0;
+    p[0][0] = p[0][1] = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0)
+            th += PI - alpha[i];
+        p[i + 1][0] = p[i][0] + l[i] * cos(th);
+        p[i + 1][1] = p[i][1] + l[i] * sin(th);
+    }
+}
+
+/* Targets of solutions 3 and least squares: l_i = L_i, alpha_i = c_angle phi_i. */
+static void targets(const cs_varady_t *v, double l[], double alpha[])
+{
+    double sum = 0;
+    for (size_t i = 0; i < v->n; i++)
+        sum += cs_varady_corner_angle(v, i);
+    for (size_t i = 0; i < v->n; i++) {
+        l[i] = v->len[i];
+        alpha[i] = (double)(v->n - 2) * PI / sum * cs_varady_corner_angle(v, i);
+    }
+}
+
+/* Solution 3: the targets' polygon, its gap e = p_0 - p_n spread as p_i += (i / n) e. */
+static void place_angles(const cs_varady_t *v, double out[][2])
+{
+    double l[CS_VARADY_MAX_SIDES], alpha[CS_VARADY_MAX_SIDES], p[CS_VARADY_MAX_SIDES + 1][2];
+    targets(v, l, alpha);
+    turtle(v->n, l, alpha, p);
+    double e[2] = {p[0][0] - p[v->n][0], p[0][1] - p[v->n][1]};
+    for (size_t i = 0; i < v->n; i++) {
+        out[i][0] = p[i][0] + (double)i / (double)v->n * e[0];
+        out[i][1] = p[i][1] + (double)i / (double)v->n * e[1];
+    }
+}
+
+static double det3(const double m[3][3])
+{
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* a y = r for a 3 x 3 a, by Cramer's rule; false when singular. */
+static bool solve3(const double a[3][3], const double r[3], double y[3])
+{
+    double det = det3(a);
+    if (!(fabs(det) > 0))
+        return false;
+    for (int c = 0; c < 3; c++) {
+        double m[3][3];
+        memcpy(m, a, sizeof m);
+        for (int k = 0; k < 3; k++)
+            m[k][c] = r[k];
+        y[c] = det3((const double(*)[3])m) / det;
+    }
+    return true;
+}
+
+/* Constraints of a closed polygon with sides x[0..n-1] and angles x[n..2n-1]: closure (x, y)
+ * and sum alpha = (n - 2) pi. */
+static void closing(size_t n, const double x[], double g[3])
+{
+    double p[CS_VARADY_MAX_SIDES + 1][2];
+    turtle(n, x, x + n, p);
+    g[0] = p[n][0];
+    g[1] = p[n][1];
+    g[2] = -(double)(n - 2) * PI;
+    for (size_t i = 0; i < n; i++)
+        g[2] += x[n + i];
+}
+
+/* Least squares: x = (l, alpha) nearest the targets x0 on {g = 0}, by Gauss-Newton steps
+ * dx = (x0 - x) - J^T (J J^T)^-1 (g + J (x0 - x)) with J by central differences. */
+static cs_err_t place_lsq(const cs_varady_t *v, double out[][2])
+{
+    size_t n = v->n, m = 2 * n;
+    double x0[2 * CS_VARADY_MAX_SIDES], x[2 * CS_VARADY_MAX_SIDES];
+    targets(v, x0, x0 + n);
+    memcpy(x, x0, sizeof x);
+    double g[3] = {1, 1, 1};
+    for (int it = 0; it < 100 && fabs(g[0]) + fabs(g[1]) + fabs(g[2]) > 1e-12 * v->len[0]; it++) {
+        double jac[3][2 * CS_VARADY_MAX_SIDES], r[3], a[3][3] = {{0}}, y[3];
+        closing(n, x, g);
+        for (size_t k = 0; k < m; k++) {
+            double h = 1e-7 * (k < n ? x0[k] : 1), xp[2 * CS_VARADY_MAX_SIDES], gp[3], gm[3];
+            memcpy(xp, x, sizeof xp);
+            xp[k] = x[k] + h;
+            closing(n, xp, gp);
+            xp[k] = x[k] - h;
+            closing(n, xp, gm);
+            for (int c = 0; c < 3; c++)
+                jac[c][k] = (gp[c] - gm[c]) / (2 * h);
+        }
+        for (int c = 0; c < 3; c++) {
+            r[c] = g[c];
+            for (size_t k = 0; k < m; k++)
+                r[c] += jac[c][k] * (x0[k] - x[k]);
+            for (int d = 0; d < 3; d++)
+                for (size_t k = 0; k < m; k++)
+                    a[c][d] += jac[c][k] * jac[d][k];
+        }
+        if (!solve3(a, r, y))
+            return CS_ERR_DEGENERATE;
+        for (size_t k = 0; k < m; k++)
+            x[k] = x0[k] - (jac[0][k] * y[0] + jac[1][k] * y[1] + jac[2][k] * y[2]);
+        closing(n, x, g);
+    }
+    if (fabs(g[0]) + fabs(g[1]) + fabs(g[2]) > 1e-9 * v->len[0])
+        return CS_ERR_DEGENERATE;
+    double p[CS_VARADY_MAX_SIDES + 1][2];
+    turtle(n, x, x + n, p);
+    for (size_t i = 0; i < n; i++) {
+        if (!(x[n + i] > 0 && x[n + i] < PI) || !(x[i] > 0))
+            return CS_ERR_DEGENERATE;
+        out[i][0] = p[i][0];
+        out[i][1] = p[i][1];
+    }
+    return CS_OK;
+}
+
+/* True when out[0..n-1] is a convex counter-clockwise polygon (every turn strictly left). */
+static bool convex_ccw(size_t n, const double p[][2])
+{
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p[i], *b = p[(i + 1) % n], *c = p[(i + 2) % n];
+        if ((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) <= 0)
+            return false;
+    }
+    return true;
+}
+
+cs_err_t cs_varady_set_domain(cs_varady_t *v, cs_varady_domain_t domain)
+{
+    if (!v || v->n < 3)
+        return CS_ERR_ARG;
+    double total = 0, p[CS_VARADY_MAX_SIDES][2];
+    for (size_t i = 0; i < v->n; i++)
+        total += v->len[i];
+    cs_err_t e = CS_OK;
+    cs_varady_t w = *v;
+    switch (domain) {
+    case CS_VARADY_DOMAIN_ARC:
+        place_arc(&w, total);
+        memcpy(p, w.vert, sizeof p);
+        break;
+    case CS_VARADY_DOMAIN_CHORDS:
+        e = place_chords(v, total, p);
+        break;
+    case CS_VARADY_DOMAIN_ANGLES:
+        place_angles(v, p);
+        break;
+    case CS_VARADY_DOMAIN_LSQ:
+        e = place_lsq(v, p);
+        break;
+    default:
+        return CS_ERR_ARG;
+    }
+    if (e == CS_OK && !convex_ccw(v->n, p))
+        e = CS_ERR_DEGENERATE;
+    if (e != CS_OK)
+        return e;
+    memcpy(v->vert, p, sizeof p);
+    v->domain = domain;
+    frames(v);
     return CS_OK;
 }
 

@@ -38,8 +38,23 @@ typedef enum {
                          * centre; (s_i, d_i) = r^-1(point) */
 } cs_varady_param_t;
 
+/* The domain polygon (seed 002, "Choix du domaine"): p_i starts side i, counter-clockwise;
+ * L_i the boundary curves' arc lengths, phi_i the 3D angle between the two boundaries at corner
+ * i, c_angle = (n - 2) pi / sum phi_j. */
+typedef enum {
+    CS_VARADY_DOMAIN_ARC = 0, /* solution 1: on a circle of circumference sum L, at angles
+                               * 2 pi (L_1 + .. + L_(i-1)) / sum L */
+    CS_VARADY_DOMAIN_CHORDS,  /* solution 2: on a circle, |p_i p_(i+1)| = L_i */
+    CS_VARADY_DOMAIN_ANGLES,  /* solution 3: sides L_i, interior angles alpha_i = c_angle phi_i,
+                               * the closing gap e = p_(n+1) -> p_1 spread as (i / n) e */
+    CS_VARADY_DOMAIN_LSQ,     /* the least-squares domain: sides l_i and angles alpha_i
+                               * minimising sum (l_i - L_i)^2 + sum (alpha_i - c_angle phi_i)^2
+                               * over closed polygons (Gauss-Newton on the constraints) */
+} cs_varady_domain_t;
+
 typedef struct {
     size_t n;
+    cs_varady_domain_t domain;
     cs_varady_blend_t blend;
     cs_varady_param_t param;
     cs_bezier_t side[CS_VARADY_MAX_SIDES]; /* P_i(s), s in [0, 1], P_i(1) = P_{i+1}(0) */
@@ -63,6 +78,15 @@ typedef struct {
  * corner the unit tangent of the neighbouring side leading away from it, blended linearly
  * along the side (1 mm per domain mm). */
 cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n);
+/* Places the domain polygon by one of seed 002's constructions (cs_varady_init uses
+ * CS_VARADY_DOMAIN_ARC). CS_ERR_ARG for an unknown value; CS_ERR_DEGENERATE when the
+ * construction has no convex counter-clockwise solution (solution 2: a side longer than the
+ * others allow on one circle; 3 and least squares: an angle outside (0, pi), or no closing).
+ * On error the previous domain stays. */
+cs_err_t cs_varady_set_domain(cs_varady_t *v, cs_varady_domain_t domain);
+/* The 3D angle phi_i (radians) between the boundaries meeting at corner i (the start of side
+ * i): between -P_(i-1)'(1) and P_i'(0). */
+double cs_varady_corner_angle(const cs_varady_t *v, size_t i);
 /* Chooses the blending and the parametrisation (cs_varady_init sets CS_VARADY_MU,
  * CS_VARADY_SIDE). CS_ERR_ARG for unknown values. */
 cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param);

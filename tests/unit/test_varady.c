@@ -828,6 +828,128 @@ static void test_cells(void **state)
     assert_int_equal(cs_varady_patches(&v, 0.005, out, NULL, 4, &count, NULL), CS_ERR_FULL);
 }
 
+/* An uneven pentagon (corners at 0, 50, 150, 200, 290 degrees, alternating heights), so
+ * the domain constructions of seed 002 differ. */
+static void uneven(cs_bezier_t *sides)
+{
+    static const double ang[5] = {0, 50, 150, 200, 290};
+    const double pi = 3.14159265358979323846;
+    cs_vec3_t c[5];
+    for (int i = 0; i < 5; i++)
+        c[i] = mm(20 * cos(ang[i] * pi / 180), 20 * sin(ang[i] * pi / 180), i % 2 ? 3 : -2);
+    for (int i = 0; i < 5; i++) {
+        cs_vec3_t p0 = c[i], p3 = c[(i + 1) % 5];
+        cs_vec3_t pts[4] = {p0, cs_fixed_vec((2 * p0.x + p3.x) / 3, (2 * p0.y + p3.y) / 3, p0.z + 65536),
+                            cs_fixed_vec((p0.x + 2 * p3.x) / 3, (p0.y + 2 * p3.y) / 3, p3.z - 65536),
+                            p3};
+        assert_int_equal(cs_bezier_init(&sides[i], 3, pts), CS_OK);
+    }
+}
+
+/* Side lengths l and interior angles alpha (at vertex i, the start of side i) of a polygon. */
+static void shape(size_t n, const double p[][2], double l[], double alpha[])
+{
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p[(i + n - 1) % n], *b = p[i], *c = p[(i + 1) % n];
+        l[i] = hypot(c[0] - b[0], c[1] - b[1]);
+        double u[2] = {a[0] - b[0], a[1] - b[1]}, w[2] = {c[0] - b[0], c[1] - b[1]};
+        alpha[i] = acos((u[0] * w[0] + u[1] * w[1]) / (hypot(u[0], u[1]) * hypot(w[0], w[1])));
+    }
+}
+
+/* Seed 002's phi_i from the control points: the angle between -(P3 - P2) of side i - 1 and
+ * (P1 - P0) of side i (cubic end tangents). */
+static double phi(const cs_bezier_t *sides, size_t n, size_t i)
+{
+    const cs_bezier_t *a = &sides[(i + n - 1) % n], *b = &sides[i];
+    double u[3] = {-(double)(a->p[3].x - a->p[2].x), -(double)(a->p[3].y - a->p[2].y),
+                   -(double)(a->p[3].z - a->p[2].z)};
+    double w[3] = {(double)(b->p[1].x - b->p[0].x), (double)(b->p[1].y - b->p[0].y),
+                   (double)(b->p[1].z - b->p[0].z)};
+    double d = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+    return acos(d / (sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) *
+                     sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])));
+}
+
+static void test_domains(void **state)
+{
+    (void)state;
+    const double pi = 3.14159265358979323846;
+    const size_t n = 5;
+    cs_bezier_t sides[5];
+    uneven(sides);
+    cs_varady_t v;
+    assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+    double p[5][2], l[5], al[5], ca = 0, L[5], target[5];
+    for (size_t i = 0; i < n; i++) {
+        ca += phi(sides, n, i);
+        assert_true(fabs(cs_varady_corner_angle(&v, i) - phi(sides, n, i)) < 1e-12);
+        L[i] = v.len[i];
+    }
+    ca = (double)(n - 2) * pi / ca;
+    for (size_t i = 0; i < n; i++)
+        target[i] = ca * phi(sides, n, i);
+    /* Solution 2: every vertex on one circle, chord i = L_i. */
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_CHORDS), CS_OK);
+    for (size_t i = 0; i < n; i++)
+        cs_varady_vertex(&v, i, p[i]);
+    shape(n, (const double(*)[2])p, l, al);
+    double r0 = hypot(p[0][0], p[0][1]);
+    for (size_t i = 0; i < n; i++) {
+        assert_true(fabs(l[i] - L[i]) < 1e-9 * L[i]);
+        assert_true(fabs(hypot(p[i][0], p[i][1]) - r0) < 1e-9 * r0); /* centred on 0 */
+    }
+    /* Solution 3, transcribed: turtle along L_i turning by pi - c_angle phi_i, the gap e
+     * spread as (i / n) e. */
+    double q[6][2] = {{0, 0}}, th = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0)
+            th += pi - target[i];
+        q[i + 1][0] = q[i][0] + L[i] * cos(th);
+        q[i + 1][1] = q[i][1] + L[i] * sin(th);
+    }
+    double e[2] = {q[0][0] - q[n][0], q[0][1] - q[n][1]};
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_ANGLES), CS_OK);
+    double l3[5], a3[5], f3 = 0;
+    for (size_t i = 0; i < n; i++) {
+        cs_varady_vertex(&v, i, p[i]);
+        assert_true(fabs(p[i][0] - (q[i][0] + (double)i / n * e[0])) < 1e-9);
+        assert_true(fabs(p[i][1] - (q[i][1] + (double)i / n * e[1])) < 1e-9);
+    }
+    shape(n, (const double(*)[2])p, l3, a3);
+    for (size_t i = 0; i < n; i++)
+        f3 += (l3[i] - L[i]) * (l3[i] - L[i]) + (a3[i] - target[i]) * (a3[i] - target[i]);
+    /* Least squares: closed (the polygon's own angles sum to (n - 2) pi), and no worse than
+     * solution 3's polygon, which is one of the closed polygons it minimises over. */
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_LSQ), CS_OK);
+    for (size_t i = 0; i < n; i++)
+        cs_varady_vertex(&v, i, p[i]);
+    shape(n, (const double(*)[2])p, l, al);
+    double fl = 0, sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        fl += (l[i] - L[i]) * (l[i] - L[i]) + (al[i] - target[i]) * (al[i] - target[i]);
+        sum += al[i];
+    }
+    assert_true(fabs(sum - 3 * pi) < 1e-9);
+    assert_true(fl <= f3 + 1e-12);
+    if (getenv("CS_TEST_VERBOSE"))
+        printf("domain objective: solution 3 %.6g, least squares %.6g\n", f3, fl);
+    /* Every domain interpolates the boundary at the vertices. */
+    static const cs_varady_domain_t doms[4] = {CS_VARADY_DOMAIN_ARC, CS_VARADY_DOMAIN_CHORDS,
+                                                CS_VARADY_DOMAIN_ANGLES, CS_VARADY_DOMAIN_LSQ};
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(cs_varady_set_domain(&v, doms[k]), CS_OK);
+        for (size_t i = 0; i < n; i++) {
+            double a[2], out[3];
+            cs_varady_vertex(&v, i, a);
+            cs_varady_eval(&v, a[0], a[1], out);
+            cs_ref_vec_t c = cs_ref_from_pos(&sides[i].p[0]);
+            assert_true(fabs(out[0] - c.x) + fabs(out[1] - c.y) + fabs(out[2] - c.z) < 1e-9);
+        }
+    }
+    assert_int_equal(cs_varady_set_domain(&v, (cs_varady_domain_t)9), CS_ERR_ARG);
+}
+
 int main(void)
 {
     if (getenv("CS_SURF_PICTURES"))
@@ -845,6 +967,7 @@ int main(void)
         cmocka_unit_test(test_schemes_curves),
         cmocka_unit_test(test_params_roundtrip),
         cmocka_unit_test(test_cells),
+        cmocka_unit_test(test_domains),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
