@@ -106,6 +106,82 @@ static cs_err_t blend(cs_lex_t *lx, cs_gcoons_blend_t *f)
     return e;
 }
 
+/* varady-scheme's words after the keyword: B P [domain D] (cs_varady). */
+static cs_err_t varady_scheme(cs_lex_t *lx, cs_varady_blend_t *blend, cs_varady_param_t *param,
+                              cs_varady_domain_t *domain)
+{
+    static const char *const blends[] = {"mu", "lambda-kappa"};
+    static const char *const params[] = {"side", "radial", "centre"};
+    static const char *const doms[] = {"arc", "chords", "angles", "least-squares"};
+    int got = 0;
+    cs_err_t e = cs_lex_choice(lx, "blend mu or lambda-kappa", blends, 2, &got);
+    *blend = (cs_varady_blend_t)got;
+    if (e == CS_OK)
+        e = cs_lex_choice(lx, "parametrisation side, radial or centre", params, 3, &got);
+    *param = (cs_varady_param_t)got;
+    if (e == CS_OK && cs_lex_peek_is(lx, "domain")) {
+        cs_lex_next(lx);
+        e = cs_lex_choice(lx, "domain arc, chords, angles or least-squares", doms, 4, &got);
+        *domain = (cs_varady_domain_t)got;
+    }
+    return e;
+}
+
+/* The optional "tangents C x n" and "twists V x n" of a varady statement, taken as written
+ * (mm per domain unit, not scaled: the domain scales with the boundary). */
+static cs_err_t varady_extras(cs_lex_t *lx, cs_varady_t *v)
+{
+    double scale = lx->scale;
+    cs_err_t e = CS_OK;
+    lx->scale = 1;
+    if (cs_lex_peek_is(lx, "tangents")) {
+        cs_bezier_t tan[CS_VARADY_MAX_SIDES];
+        cs_lex_next(lx);
+        for (size_t k = 0; e == CS_OK && k < v->n; k++)
+            e = curve(lx, &tan[k]);
+        if (e == CS_OK)
+            e = cs_varady_set_tangents(v, tan);
+    }
+    if (e == CS_OK && cs_lex_peek_is(lx, "twists")) {
+        double tw[CS_VARADY_MAX_SIDES][3];
+        cs_lex_next(lx);
+        for (size_t k = 0; e == CS_OK && k < v->n; k++)
+            e = cs_lex_vec(lx, "twist", NULL, tw[k]);
+        if (e == CS_OK)
+            cs_varady_set_twists(v, (const double(*)[3])tw);
+    }
+    lx->scale = scale;
+    return e;
+}
+
+/* varady N C x N [tangents ..] [twists ..], or varady-scheme B P [domain D] N C x N [..]. */
+static cs_err_t varady(cs_lex_t *lx, bool scheme, unsigned line, cs_surffile_t *sf)
+{
+    int n;
+    cs_bezier_t c[CS_VARADY_MAX_SIDES];
+    cs_varady_blend_t blend = CS_VARADY_MU;
+    cs_varady_param_t param = CS_VARADY_SIDE;
+    cs_varady_domain_t domain = CS_VARADY_DOMAIN_ARC;
+    cs_err_t e = scheme ? varady_scheme(lx, &blend, &param, &domain) : CS_OK;
+    if (e == CS_OK)
+        e = cs_lex_integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
+    for (int k = 0; e == CS_OK && k < n; k++)
+        e = curve(lx, &c[k]);
+    cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
+    if (e == CS_OK && !it)
+        return CS_ERR_FULL;
+    if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
+        (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK &&
+        (e = cs_varady_set_domain(&it->nside, domain)) == CS_OK &&
+        (e = varady_extras(lx, &it->nside)) == CS_OK) {
+        it->varady = true;
+        it->line = line;
+        e = push(sf, it);
+    }
+    free(it);
+    return e;
+}
+
 static const char *const keywords[] = {
     "bezier", "tri",           "hermite", "power",   "coons-bilinear", "coons-bicubic",
     "coons-blend", "varady", "varady-scheme", "ruled", "extrude",        "revolve",
@@ -261,50 +337,9 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
                 return e;
         }
     } else if (strcmp(kw, "varady") == 0 || strcmp(kw, "varady-scheme") == 0) {
-        int n;
-        cs_bezier_t c[CS_VARADY_MAX_SIDES];
-        cs_varady_blend_t blend = CS_VARADY_MU;
-        cs_varady_param_t param = CS_VARADY_SIDE;
-        cs_varady_domain_t domain = CS_VARADY_DOMAIN_ARC;
-        if (strcmp(kw, "varady-scheme") == 0) {
-            /* varady-scheme BLEND PARAM N C x N */
-            static const char *const blends[] = {"mu", "lambda-kappa"};
-            static const char *const params[] = {"side", "radial", "centre"};
-            int got = 0;
-            e = cs_lex_choice(lx, "blend mu or lambda-kappa", blends, 2, &got);
-            if (e != CS_OK)
-                return e;
-            blend = (cs_varady_blend_t)got;
-            e = cs_lex_choice(lx, "parametrisation side, radial or centre", params, 3, &got);
-            if (e != CS_OK)
-                return e;
-            param = (cs_varady_param_t)got;
-            if (cs_lex_peek_is(lx, "domain")) {
-                static const char *const doms[] = {"arc", "chords", "angles", "least-squares"};
-                cs_lex_next(lx);
-                e = cs_lex_choice(lx, "domain arc, chords, angles or least-squares", doms, 4,
-                                  &got);
-                if (e != CS_OK)
-                    return e;
-                domain = (cs_varady_domain_t)got;
-            }
-        }
-        e = cs_lex_integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
-        for (int k = 0; e == CS_OK && k < n; k++)
-            e = curve(lx, &c[k]);
-        cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
-        if (e == CS_OK && !it)
-            return CS_ERR_FULL;
-        if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
-            (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK &&
-            (e = cs_varady_set_domain(&it->nside, domain)) == CS_OK) {
-            it->varady = true;
-            it->line = at.line;
-            e = push(sf, it);
-            free(it);
+        e = varady(lx, strcmp(kw, "varady-scheme") == 0, at.line, sf);
+        if (e == CS_OK || e == CS_ERR_FULL)
             return e;
-        }
-        free(it);
     } else {
         char list[256];
         cs_surffile_keyword_list(list, sizeof list);

@@ -498,13 +498,48 @@ static void nearest_corner(const cs_varady_t *v, double x, double y, double out[
     curve_d(&v->side[best], 0, out, NULL);
 }
 
-/* Ribbon R_i(s, d) = P_i(s) + d T_i(s), T_i linear between t0 and t1. */
+cs_err_t cs_varady_set_tangents(cs_varady_t *v, const cs_bezier_t *tan)
+{
+    if (!v)
+        return CS_ERR_ARG;
+    for (size_t i = 0; tan && i < v->n; i++) {
+        if (tan[i].rational)
+            return CS_ERR_UNSUPPORTED;
+        if (tan[i].degree < 1 || tan[i].degree > 3)
+            return CS_ERR_DEGREE;
+    }
+    v->user_tan = tan != NULL;
+    for (size_t i = 0; tan && i < v->n; i++)
+        v->tan[i] = tan[i];
+    return CS_OK;
+}
+
+void cs_varady_set_twists(cs_varady_t *v, const double (*twist)[3])
+{
+    for (size_t i = 0; i < v->n; i++)
+        for (int k = 0; k < 3; k++)
+            v->twist[i][k] = twist ? twist[i][k] : 0;
+}
+
+/* Cross-boundary tangent T_i(s): the user's curve, or t0 -> t1 linearly. */
+static void tangent(const cs_varady_t *v, size_t i, double s, double out[3])
+{
+    if (v->user_tan) {
+        curve_d(&v->tan[i], s, out, NULL);
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = (1 - s) * v->t0[i][k] + s * v->t1[i][k];
+}
+
+/* Ribbon R_i(s, d) = P_i(s) + d T_i(s). */
 static void ribbon(const cs_varady_t *v, size_t i, double s, double d, double out[3])
 {
-    double p[3];
+    double p[3], t[3];
     curve_d(&v->side[i], s, p, NULL);
+    tangent(v, i, s, t);
     for (int k = 0; k < 3; k++)
-        out[k] = p[k] + d * ((1 - s) * v->t0[i][k] + s * v->t1[i][k]);
+        out[k] = p[k] + d * t[k];
 }
 
 void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
@@ -549,12 +584,16 @@ void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
                 out[k] += lambda[i] * r[k];
         }
         if (kappa[i] != 0) {
-            /* Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0), zero twist (seed 000's choice). */
+            /* Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0) + d_{i-1} d_i W_i (W_i zero by
+             * default, seed 000's choice). */
             size_t im = (i + n - 1) % n;
-            double p[3];
+            double p[3], ta[3], tb[3];
             curve_d(&v->side[i], 0, p, NULL);
+            tangent(v, im, 1, ta);
+            tangent(v, i, 0, tb);
             for (int k = 0; k < 3; k++)
-                out[k] -= kappa[i] * (p[k] + d[im] * v->t1[im][k] + d[i] * v->t0[i][k]);
+                out[k] -= kappa[i] * (p[k] + d[im] * ta[k] + d[i] * tb[k] +
+                                      d[im] * d[i] * v->twist[i][k]);
         }
     }
 }

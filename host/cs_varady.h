@@ -11,6 +11,7 @@
 #ifndef CS_VARADY_H
 #define CS_VARADY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "cs_bezier.h"
@@ -69,6 +70,9 @@ typedef struct {
     double w12u[CS_VARADY_MAX_SIDES];  /* central line: u of w12 (its v is (w1v + w2v) / 2) */
     double rc[CS_VARADY_MAX_SIDES][2]; /* radial: where the lines of sides i - 1, i + 1 meet */
     int rpar[CS_VARADY_MAX_SIDES];     /* radial: those lines are parallel (rays along w1) */
+    bool user_tan;                     /* tan[] replaces the linear t0 -> t1 blend */
+    cs_bezier_t tan[CS_VARADY_MAX_SIDES]; /* T_i(s), mm per domain unit (cs_varady_set_tangents) */
+    double twist[CS_VARADY_MAX_SIDES][3]; /* W_i at corner i (start of side i), zero by default */
 } cs_varady_t;
 
 /* n (3..CS_VARADY_MAX_SIDES) polynomial boundary curves of degree 1..3 forming a loop (the end
@@ -87,6 +91,18 @@ cs_err_t cs_varady_set_domain(cs_varady_t *v, cs_varady_domain_t domain);
 /* The 3D angle phi_i (radians) between the boundaries meeting at corner i (the start of side
  * i): between -P_(i-1)'(1) and P_i'(0). */
 double cs_varady_corner_angle(const cs_varady_t *v, size_t i);
+/* The cross-boundary tangents given by the user (seed 002: "contrainte tangentielle T_i(s_i)"):
+ * tan[i] is T_i(s), s in [0, 1], in mm per domain unit (degree 1..3, any direction pointing
+ * into the patch), replacing the default unit tangents blended linearly along the side; NULL
+ * goes back to the defaults. Ribbons R_i(s, d) = P_i(s) + d T_i(s); the corner patches use
+ * T_(i-1)(1) and T_i(0). CS_ERR_DEGREE / CS_ERR_UNSUPPORTED (rational). */
+cs_err_t cs_varady_set_tangents(cs_varady_t *v, const cs_bezier_t *tan);
+/* The twists W_i (mm per domain unit squared) at the corners (corner i starts side i; NULL:
+ * zero, the default): the corner patches become Q_i = P_i(0) + d_(i-1) T_(i-1)(1) + d_i T_i(0)
+ * + d_(i-1) d_i W_i (seed 002's corner cross derivatives W_i(0)), which is 0 on sides i - 1 and
+ * i, so the boundaries are still interpolated. Only the lambda / kappa blending has corner
+ * patches; mu ignores them. */
+void cs_varady_set_twists(cs_varady_t *v, const double (*twist)[3]);
 /* Chooses the blending and the parametrisation (cs_varady_init sets CS_VARADY_MU,
  * CS_VARADY_SIDE). CS_ERR_ARG for unknown values. */
 cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param);

@@ -248,6 +248,29 @@ static void test_coons_derivatives_twists(void **state)
     cs_surffile_free(&sf);
 }
 
+/* varady-scheme with a domain, user tangents and twists: the item carries them as given. */
+static void test_varady_extras(void **state)
+{
+    (void)state;
+    const char *text = "curvestep-surfaces 1\nvarady-scheme lambda-kappa side domain angles 3\n"
+                       " 1 0 0 0 30 0 0\n 1 30 0 0 15 25 4\n 1 15 25 4 0 0 0\n"
+                       " tangents 1 0 1 0 0 1 0.5  1 -1 0 0 -1 -1 0  1 1 -1 0 1 0 0\n"
+                       " twists 0 0 0.1  0 0 -0.2  0.05 0 0\n";
+    cs_surffile_t sf;
+    cs_path_diag_t d;
+    cs_err_t e = cs_surffile_parse(text, strlen(text), "v", 2.0, 0.01, &sf, &d);
+    if (e != CS_OK)
+        cs_path_diag_print(stderr, &d);
+    assert_int_equal(e, CS_OK);
+    const cs_varady_t *v = &sf.items[0].nside;
+    assert_int_equal(v->domain, CS_VARADY_DOMAIN_ANGLES);
+    assert_int_equal(v->blend, CS_VARADY_LAMBDA_KAPPA);
+    assert_true(v->user_tan);
+    assert_int_equal(v->tan[0].p[1].z, 32768); /* 0.5, not scaled */
+    assert_true(v->twist[1][2] == -0.2 && v->twist[2][0] == 0.05);
+    cs_surffile_free(&sf);
+}
+
 /* The keyword table (cs_surffile_keyword) is what the parser accepts and what docs/surfaces.md
  * lists in its "Native surface format" block, both ways (toolpath --help prints the table; the
  * CLI test test_inspect.sh compares it with the docs too). */
@@ -311,6 +334,7 @@ int main(void)
         cmocka_unit_test(test_newell_fallback),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_keywords),
+        cmocka_unit_test(test_varady_extras),
         cmocka_unit_test(test_coons_derivatives_twists),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

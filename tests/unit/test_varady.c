@@ -262,6 +262,10 @@ static void test_blends_unity(void **state)
 
 /* The seed's lambda / kappa surface with the side-based parametrisation, written out here from
  * the domain vertices and the boundary curves alone. */
+/* User tangent curves (NULL: the defaults) and corner twists (NULL: zero) of the reference. */
+static const cs_bezier_t *ref_tan;
+static const double (*ref_twist)[3];
+
 static void lk_reference(const cs_varady_t *v, const cs_bezier_t *sides, size_t n, double x,
                          double y, double out[3])
 {
@@ -296,9 +300,24 @@ static void lk_reference(const cs_varady_t *v, const cs_bezier_t *sides, size_t 
         double s = d[im] / (d[im] + d[ip]);
         cs_ref_vec_t p = cs_ref_eval(&sides[i], s), c = cs_ref_from_pos(&sides[i].p[0]);
         double pp[3] = {p.x, p.y, p.z}, cc[3] = {c.x, c.y, c.z};
+        /* T_i(s), T_(i-1)(1), T_i(0): the user's curves or the linear default */
+        double ts[3], ta[3], tb[3];
         for (int k = 0; k < 3; k++) {
-            double r = pp[k] + d[i] * ((1 - s) * t0[i][k] + s * t1[i][k]);
-            double qc = cc[k] + d[im] * t1[im][k] + d[i] * t0[i][k];
+            ts[k] = (1 - s) * t0[i][k] + s * t1[i][k];
+            ta[k] = t1[im][k];
+            tb[k] = t0[i][k];
+        }
+        if (ref_tan) {
+            cs_ref_vec_t a = cs_ref_eval(&ref_tan[i], s), b = cs_ref_eval(&ref_tan[im], 1);
+            cs_ref_vec_t c = cs_ref_eval(&ref_tan[i], 0);
+            ts[0] = a.x, ts[1] = a.y, ts[2] = a.z;
+            ta[0] = b.x, ta[1] = b.y, ta[2] = b.z;
+            tb[0] = c.x, tb[1] = c.y, tb[2] = c.z;
+        }
+        for (int k = 0; k < 3; k++) {
+            double r = pp[k] + d[i] * ts[k];
+            double qc = cc[k] + d[im] * ta[k] + d[i] * tb[k] +
+                        (ref_twist ? d[im] * d[i] * ref_twist[i][k] : 0);
             out[k] += lambda * r - kappa * qc;
         }
     }
@@ -333,6 +352,59 @@ static void test_lk_reference(void **state)
         }
     }
     report("lambda/kappa surface vs the seed's formula written out", worst);
+    assert_true(worst < 1e-9);
+    /* User-given cross-boundary tangent curves and non-zero twists (seed 002's T_i(s_i) and
+     * W_i): the same formula with them, and the boundary still interpolated. */
+    worst = 0;
+    for (size_t n = 3; n <= 7; n++) {
+        cs_bezier_t sides[CS_VARADY_MAX_SIDES], tan[CS_VARADY_MAX_SIDES];
+        double tw[CS_VARADY_MAX_SIDES][3];
+        loop(n, 4, sides);
+        cs_varady_t v;
+        assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+        assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_SIDE), CS_OK);
+        for (size_t i = 0; i < n; i++) {
+            cs_vec3_t q[3] = {mm(0.2 * (double)i, 0.5, 1), mm(-0.3, 0.4, 0.8 + 0.1 * (double)i),
+                              mm(0.1, -0.2, 1.2)};
+            assert_int_equal(cs_bezier_init(&tan[i], 2, q), CS_OK);
+            tw[i][0] = 0.01 * (double)i, tw[i][1] = -0.02, tw[i][2] = 0.03;
+        }
+        assert_int_equal(cs_varady_set_tangents(&v, tan), CS_OK);
+        cs_varady_set_twists(&v, (const double(*)[3])tw);
+        ref_tan = tan;
+        ref_twist = (const double(*)[3])tw;
+        for (int k = 0; k < 200; k++) {
+            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0, q[3], r[3];
+            for (size_t i = 0; i < n; i++)
+                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
+            for (size_t i = 0; i < n; i++) {
+                double p[2];
+                cs_varady_vertex(&v, i, p);
+                x += w[i] / sw * p[0];
+                y += w[i] / sw * p[1];
+            }
+            cs_varady_eval(&v, x, y, q);
+            lk_reference(&v, sides, n, x, y, r);
+            worst =
+                fmax(worst, fmax(fabs(q[0] - r[0]), fmax(fabs(q[1] - r[1]), fabs(q[2] - r[2]))));
+        }
+        for (size_t i = 0; i < n; i++) { /* midpoint of domain side i: P_i(1/2) by symmetry */
+            double a[2], b[2], q[3];
+            cs_varady_vertex(&v, i, a);
+            cs_varady_vertex(&v, (i + 1) % n, b);
+            cs_varady_eval(&v, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, q);
+            double s = 0, dd = 0, ss[CS_VARADY_MAX_SIDES], ds[CS_VARADY_MAX_SIDES];
+            cs_varady_params(&v, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, ss, ds);
+            s = ss[i];
+            dd = ds[i];
+            cs_ref_vec_t pc = cs_ref_eval(&sides[i], s);
+            assert_true(fabs(dd) < 1e-9);
+            assert_true(fabs(q[0] - pc.x) + fabs(q[1] - pc.y) + fabs(q[2] - pc.z) < 1e-9);
+        }
+        ref_tan = NULL;
+        ref_twist = NULL;
+    }
+    report("lambda/kappa with user tangents and twists vs the seed's formula", worst);
     assert_true(worst < 1e-9);
 }
 
