@@ -111,13 +111,14 @@ static cs_err_t varady_scheme(cs_lex_t *lx, cs_varady_blend_t *blend, cs_varady_
                               cs_varady_domain_t *domain)
 {
     static const char *const blends[] = {"mu", "lambda-kappa"};
-    static const char *const params[] = {"side", "radial", "centre"};
+    static const char *const params[] = {"side", "radial", "centre", "biquadratic"};
     static const char *const doms[] = {"arc", "chords", "angles", "least-squares"};
     int got = 0;
     cs_err_t e = cs_lex_choice(lx, "blend mu or lambda-kappa", blends, 2, &got);
     *blend = (cs_varady_blend_t)got;
     if (e == CS_OK)
-        e = cs_lex_choice(lx, "parametrisation side, radial or centre", params, 3, &got);
+        e = cs_lex_choice(lx, "parametrisation side, radial, centre or biquadratic", params, 4,
+                          &got);
     *param = (cs_varady_param_t)got;
     if (e == CS_OK && cs_lex_peek_is(lx, "domain")) {
         cs_lex_next(lx);

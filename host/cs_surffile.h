@@ -18,8 +18,11 @@
  *   revolve O A R SWEEP C           profile C (x = radius, y = height) about the axis through O
  *                                   along A, from the direction R, SWEEP degrees
  *   varady N C x N                  n-sided transfinite patch (seed 002) bounded by a loop
- *   varady-scheme B P N C x N       same with blend B (mu, lambda-kappa) and parametrisation
- *                                   P (side, radial, centre); varady = "varady-scheme mu side"
+ *   varady-scheme B P [domain D] N C x N [tangents C x N] [twists V x N]
+ *                                   same with blend B (mu, lambda-kappa), parametrisation
+ *                                   P (side, radial, centre, biquadratic), domain D (arc,
+ *                                   chords, angles, least-squares); varady = "varady-scheme mu
+ *                                   side" (it takes the tangents and twists too)
  *   sphere C R                      the exact sphere of centre C, radius R (seed 000)
  * where C = "N P0 .. PN" (a Bézier curve of degree N = 1..3), P and V = three numbers, '#'
  * starts a comment; numbers are free-form across lines. Every item becomes core patches

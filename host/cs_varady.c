@@ -367,7 +367,8 @@ static double side_dist(const cs_varady_t *v, size_t i, double x, double y)
 cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param)
 {
     if (!v || (blend != CS_VARADY_MU && blend != CS_VARADY_LAMBDA_KAPPA) ||
-        (param != CS_VARADY_SIDE && param != CS_VARADY_RADIAL && param != CS_VARADY_CENTRE))
+        (param != CS_VARADY_SIDE && param != CS_VARADY_RADIAL && param != CS_VARADY_CENTRE &&
+         param != CS_VARADY_BIQUADRATIC))
         return CS_ERR_ARG;
     v->blend = blend;
     v->param = param;
@@ -405,6 +406,78 @@ static double centre_s(const cs_varady_t *v, size_t i, double u0, double v0)
     return f0 == 0 ? 0 : f1 == 0 ? 1 : 0.5 * (lo + hi);
 }
 
+/* The centroid of the domain's vertices. */
+static void centroid(const cs_varady_t *v, double ce[2])
+{
+    ce[0] = ce[1] = 0;
+    for (size_t k = 0; k < v->n; k++)
+        for (int x = 0; x < 2; x++)
+            ce[x] += v->vert[k][x] / (double)v->n;
+}
+
+/* The biquadratic net of side i (cs_varady.h, CS_VARADY_BIQUADRATIC): C[a][b], a along s. */
+static void biq_net(const cs_varady_t *v, size_t i, double c[3][3][2])
+{
+    size_t n = v->n;
+    const double *pm = v->vert[(i + n - 1) % n], *p0 = v->vert[i], *p1 = v->vert[(i + 1) % n],
+                 *p2 = v->vert[(i + 2) % n];
+    double ce[2];
+    centroid(v, ce);
+    for (int x = 0; x < 2; x++) {
+        c[0][0][x] = p0[x];
+        c[1][0][x] = (p0[x] + p1[x]) / 2;
+        c[2][0][x] = p1[x];
+        c[0][2][x] = pm[x];
+        c[1][2][x] = n == 3 ? pm[x] : ce[x]; /* a triangle: the row t = 2 is its apex */
+        c[2][2][x] = p2[x];
+        for (int a = 0; a < 3; a++)
+            c[a][1][x] = (c[a][0][x] + c[a][2][x]) / 2;
+    }
+}
+
+/* The map at (s, t) and its partial derivatives (Bernstein B2 and their derivatives). */
+static void biq_map(const double c[3][3][2], double s, double t, double out[2], double ds[2],
+                    double dt[2])
+{
+    double bs[3] = {(1 - s) * (1 - s), 2 * s * (1 - s), s * s};
+    double bt[3] = {(1 - t) * (1 - t), 2 * t * (1 - t), t * t};
+    double es[3] = {-2 * (1 - s), 2 - 4 * s, 2 * s}, et[3] = {-2 * (1 - t), 2 - 4 * t, 2 * t};
+    for (int x = 0; x < 2; x++) {
+        out[x] = ds[x] = dt[x] = 0;
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                out[x] += bs[a] * bt[b] * c[a][b][x];
+                ds[x] += es[a] * bt[b] * c[a][b][x];
+                dt[x] += bs[a] * et[b] * c[a][b][x];
+            }
+    }
+}
+
+/* (s, t) with map(s, t) = (x, y) by Newton-Raphson from (s, t) (at most 50 steps, to 1e-13 of
+ * the side's length); the last iterate when the Jacobian is singular. */
+static void biq_invert(const cs_varady_t *v, size_t i, double x, double y, double *s, double *t)
+{
+    double c[3][3][2];
+    biq_net(v, i, c);
+    for (int it = 0; it < 50; it++) {
+        double m[2], ds[2], dt[2];
+        biq_map((const double(*)[3][2])c, *s, *t, m, ds, dt);
+        double fx = m[0] - x, fy = m[1] - y, det = ds[0] * dt[1] - ds[1] * dt[0];
+        if (fabs(fx) + fabs(fy) < 1e-13 * v->len_d[i] || !(fabs(det) > 0))
+            break;
+        *s -= (dt[1] * fx - dt[0] * fy) / det;
+        *t -= (-ds[1] * fx + ds[0] * fy) / det;
+    }
+}
+
+/* Distance from the vertices' centroid to side i's line (the biquadratic d scale). */
+static double centre_height(const cs_varady_t *v, size_t i)
+{
+    double ce[2];
+    centroid(v, ce);
+    return side_dist(v, i, ce[0], ce[1]);
+}
+
 void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], double d[])
 {
     size_t n = v->n;
@@ -416,10 +489,15 @@ void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], doub
         double l = v->len_d[i], eu[2] = {(b[0] - a[0]) / l, (b[1] - a[1]) / l};
         double u0 = (x - a[0]) * eu[0] + (y - a[1]) * eu[1];
         double v0 = -(x - a[0]) * eu[1] + (y - a[1]) * eu[0];
-        if (v->param == CS_VARADY_SIDE) {
+        if (v->param == CS_VARADY_SIDE || v->param == CS_VARADY_BIQUADRATIC) {
             double dp = dist[(i + n - 1) % n], dn = dist[(i + 1) % n];
             s[i] = dp + dn != 0 ? dp / (dp + dn) : 0.5;
             d[i] = dist[i];
+            if (v->param == CS_VARADY_BIQUADRATIC) {
+                double h = centre_height(v, i), t = d[i] / h;
+                biq_invert(v, i, x, y, &s[i], &t);
+                d[i] = t * h;
+            }
         } else if (v->param == CS_VARADY_RADIAL) {
             /* e: where the ray from the centre rc (or along w1) through (u0, v0) meets v = 0. */
             double eu0, len;

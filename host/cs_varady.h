@@ -37,6 +37,13 @@ typedef enum {
                          * + 2 w12 (1 - s) s + w2 s^2] d, w1 and w2 the unit directions of the
                          * neighbouring sides, w12 chosen so that r(1/2, d_c) is the domain
                          * centre; (s_i, d_i) = r^-1(point) */
+    CS_VARADY_BIQUADRATIC, /* seed 002's biquadratic mapping: (x, y) = sum C_ab B2_a(s) B2_b(t)
+                            * with rows t = 0: p_i, (p_i + p_(i+1)) / 2, p_(i+1); t = 2:
+                            * p_(i-1), c, p_(i+2) (c the vertices' centroid; for n = 3 the
+                            * apex p_(i-1) = p_(i+2) itself); t = 1: the
+                            * midpoints of those columns, so lines s = const are straight and
+                            * the map is linear on side i; (s, t) by Newton-Raphson from the
+                            * side-based values, d_i = t h_i (h_i: distance from c to side i) */
 } cs_varady_param_t;
 
 /* The domain polygon (seed 002, "Choix du domaine"): p_i starts side i, counter-clockwise;

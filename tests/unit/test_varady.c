@@ -1022,6 +1022,95 @@ static void test_domains(void **state)
     assert_int_equal(cs_varady_set_domain(&v, (cs_varady_domain_t)9), CS_ERR_ARG);
 }
 
+/* Seed 002's biquadratic mapping, transcribed: the net of side i (rows t = 0: p_i, midpoint,
+ * p_(i+1); t = 2: p_(i-1), centroid (a triangle: its apex), p_(i+2); t = 1: the columns'
+ * midpoints), evaluated by
+ * Bernstein sums. cs_varady_params' (s_i, d_i / h_i) must map back to the point (the Newton
+ * inversion), s = const lines are straight, and the surface still interpolates the boundary. */
+static void biq_forward(const double vert[][2], size_t n, size_t i, double s, double t,
+                        double out[2])
+{
+    double c[3][3][2], ce[2] = {0, 0};
+    for (size_t k = 0; k < n; k++)
+        ce[0] += vert[k][0] / (double)n, ce[1] += vert[k][1] / (double)n;
+    const double *rows[2][3] = {{vert[i], NULL, vert[(i + 1) % n]},
+                                {vert[(i + n - 1) % n], n == 3 ? vert[(i + 2) % n] : ce,
+                                 vert[(i + 2) % n]}};
+    for (int x = 0; x < 2; x++) {
+        c[0][0][x] = rows[0][0][x], c[2][0][x] = rows[0][2][x];
+        c[1][0][x] = (rows[0][0][x] + rows[0][2][x]) / 2;
+        for (int a = 0; a < 3; a++) {
+            c[a][2][x] = rows[1][a][x];
+            c[a][1][x] = (c[a][0][x] + c[a][2][x]) / 2;
+        }
+    }
+    double bs[3] = {(1 - s) * (1 - s), 2 * s * (1 - s), s * s};
+    double bt[3] = {(1 - t) * (1 - t), 2 * t * (1 - t), t * t};
+    out[0] = out[1] = 0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            for (int x = 0; x < 2; x++)
+                out[x] += bs[a] * bt[b] * c[a][b][x];
+}
+
+static void test_biquadratic(void **state)
+{
+    (void)state;
+    srand(5);
+    double worst = 0;
+    for (size_t n = 3; n <= 7; n++) {
+        cs_bezier_t sides[CS_VARADY_MAX_SIDES];
+        loop(n, 4, sides);
+        cs_varady_t v;
+        assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+        assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_BIQUADRATIC),
+                         CS_OK);
+        double vert[CS_VARADY_MAX_SIDES][2], ce[2] = {0, 0};
+        for (size_t i = 0; i < n; i++) {
+            cs_varady_vertex(&v, i, vert[i]);
+            ce[0] += vert[i][0] / (double)n, ce[1] += vert[i][1] / (double)n;
+        }
+        for (int k = 0; k < 200; k++) {
+            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0;
+            for (size_t i = 0; i < n; i++)
+                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
+            for (size_t i = 0; i < n; i++)
+                x += w[i] / sw * vert[i][0], y += w[i] / sw * vert[i][1];
+            double s[CS_VARADY_MAX_SIDES], d[CS_VARADY_MAX_SIDES];
+            cs_varady_params(&v, x, y, s, d);
+            for (size_t i = 0; i < n; i++) {
+                double h = dist_line(vert[i], vert[(i + 1) % n], ce[0], ce[1]), m[2];
+                biq_forward((const double(*)[2])vert, n, i, s[i], d[i] / h, m);
+                worst = fmax(worst, hypot(m[0] - x, m[1] - y));
+            }
+        }
+        if (getenv("CS_TEST_VERBOSE"))
+            printf("n %zu: worst %g\n", n, worst);
+        /* s = const: the straight segment from C(s, 0) to C(s, 1) keeps its s. */
+        double a[2], b[2], s[CS_VARADY_MAX_SIDES], d[CS_VARADY_MAX_SIDES];
+        biq_forward((const double(*)[2])vert, n, 0, 0.3, 0, a);
+        biq_forward((const double(*)[2])vert, n, 0, 0.3, 1, b);
+        for (int k = 1; k < 8; k++) {
+            double t = k / 8.0 * 0.6;
+            cs_varady_params(&v, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), s, d);
+            assert_true(fabs(s[0] - 0.3) < 1e-9);
+        }
+        /* The boundary: on side i, s is the linear fraction and S the boundary curve. */
+        for (size_t i = 0; i < n; i++)
+            for (int k = 1; k < 8; k++) {
+                double t = k / 8.0, x = vert[i][0] + t * (vert[(i + 1) % n][0] - vert[i][0]);
+                double y = vert[i][1] + t * (vert[(i + 1) % n][1] - vert[i][1]), q[3];
+                cs_varady_params(&v, x, y, s, d);
+                assert_true(fabs(s[i] - t) < 1e-9 && fabs(d[i]) < 1e-9);
+                cs_varady_eval(&v, x, y, q);
+                cs_ref_vec_t r = cs_ref_eval(&sides[i], t);
+                assert_true(fabs(q[0] - r.x) + fabs(q[1] - r.y) + fabs(q[2] - r.z) < 1e-9);
+            }
+    }
+    report("biquadratic mapping: Newton inversion maps back within", worst);
+    assert_true(worst < 1e-9);
+}
+
 int main(void)
 {
     if (getenv("CS_SURF_PICTURES"))
@@ -1040,6 +1129,7 @@ int main(void)
         cmocka_unit_test(test_params_roundtrip),
         cmocka_unit_test(test_cells),
         cmocka_unit_test(test_domains),
+        cmocka_unit_test(test_biquadratic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
