@@ -12,6 +12,7 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_input.h"
+#include "cs_lensub.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -26,7 +27,12 @@ static const struct {
     {"fd", CS_TRACE_FD},
     {"afd", CS_TRACE_AFD},
     {"subdiv", CS_TRACE_SUBDIV},
+    {"length", CS_TRACE_SUBDIV}, /* not a cs_trace method: cs_lensub (FLATTEN_METHOD_LENGTH) */
 };
+
+/* Seed 003's length-based subdivision: chords at most --seg-len long (cs_lensub). */
+#define FLATTEN_METHOD_LENGTH 3
+#define FLATTEN_DEFAULT_SEG_LEN_MM 1.0
 
 /* The default: flatness subdivision, the method whose chords are proven within the tolerance
  * with the fewest assumptions (cs_trace.h names no preferred method). */
@@ -37,6 +43,8 @@ static void flatten_usage(FILE *f)
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv] [--stats] [--svg OUT.svg]"
             "\n                         [--lenient] FILE\n"
+            "       curvestep flatten --method length [--seg-len MM] [--eval decasteljau|horner]\n"
+            "                         [--stats] [--svg OUT.svg] [--lenient] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -58,7 +66,14 @@ static void flatten_usage(FILE *f)
             "Options:\n"
             "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
             "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
-            "                  differences) or subdiv (flatness subdivision; the default)\n"
+            "                  differences) or subdiv (flatness subdivision; the default); or\n"
+            "                  length, seed 003's length-based subdivision: chords at most\n"
+            "                  --seg-len long, with no promise on the deviation (--tol is not\n"
+            "                  used; --stats measures the deviation)\n"
+            "  --seg-len MM    longest chord of --method length (default %g)\n"
+            "  --eval E        how --method length evaluates points: decasteljau (the default)\n"
+            "                  or horner (power basis, Horner's rule; rational curves keep de\n"
+            "                  Casteljau)\n"
             "  --stats         print a summary on stderr: elements, chords, and the largest\n"
             "                  deviation of a chord from its exact curve, measured in double on\n"
             "                  the host\n"
@@ -71,7 +86,7 @@ static void flatten_usage(FILE *f)
             "coordinates outside the range); 2 usage error; 3 internal error (arithmetic overflow\n"
             "or depth limit while tracing, out of memory, write error).\n",
             CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
-            CS_POS_LIMIT_MM);
+            CS_POS_LIMIT_MM, FLATTEN_DEFAULT_SEG_LEN_MM);
 }
 
 /* Exit status for a code met while reading input. */
@@ -108,6 +123,8 @@ int cs_cmd_flatten(int argc, char **argv)
         {"svg", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},
         {"lenient", no_argument, NULL, 'l'},
+        {"seg-len", required_argument, NULL, 'L'},
+        {"eval", required_argument, NULL, 'E'},
         {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
@@ -115,6 +132,8 @@ int cs_cmd_flatten(int argc, char **argv)
     bool stats = false;
     const char *svg_out = NULL;
     bool lenient = false;
+    double seg_len_mm = FLATTEN_DEFAULT_SEG_LEN_MM;
+    bool horner = false, eval_given = false;
     int c;
     optind = 1;
     opterr = 0;
@@ -142,7 +161,8 @@ int cs_cmd_flatten(int argc, char **argv)
             while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
                 k++;
             if (k == sizeof methods / sizeof methods[0]) {
-                fprintf(stderr, "curvestep flatten: --method '%s': expected fd, afd or subdiv\n",
+                fprintf(stderr,
+                        "curvestep flatten: --method '%s': expected fd, afd, subdiv or length\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }
@@ -157,6 +177,28 @@ int cs_cmd_flatten(int argc, char **argv)
             break;
         case 'l':
             lenient = true;
+            break;
+        case 'L': {
+            char *end = NULL;
+            cs_pos_t t = 0;
+            seg_len_mm = strtod(optarg, &end);
+            if (!end || end == optarg || *end != '\0' ||
+                cs_conv_tol_to_pos(seg_len_mm, &t) != CS_OK) {
+                fprintf(stderr, "curvestep flatten: --seg-len '%s': expected a length in mm, "
+                                "from 1 LSB (0.0000153) to 4096\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        }
+        case 'E':
+            eval_given = true;
+            horner = strcmp(optarg, "horner") == 0;
+            if (!horner && strcmp(optarg, "decasteljau") != 0) {
+                fprintf(stderr, "curvestep flatten: --eval '%s': expected decasteljau or horner\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
             break;
         case 'h':
             flatten_usage(stdout);
@@ -177,8 +219,15 @@ int cs_cmd_flatten(int argc, char **argv)
         fprintf(stderr, "Try 'curvestep flatten --help'.\n");
         return CS_EXIT_USAGE;
     }
+    if (eval_given && method != FLATTEN_METHOD_LENGTH) {
+        fprintf(stderr, "curvestep flatten: --eval applies to --method length (the other "
+                        "tracers step their own differences)\n");
+        return CS_EXIT_USAGE;
+    }
     const char *file = argv[optind];
     const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    cs_pos_t seg_len;
+    cs_conv_tol_to_pos(seg_len_mm, &seg_len); /* validated above */
     cs_pos_t tol;
     cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
 
@@ -203,6 +252,8 @@ int cs_cmd_flatten(int argc, char **argv)
     double maxdev = 0.0;
     size_t maxdev_elem = 0;
     cs_trace_t tr;
+    cs_lensub_t ls;
+    bool by_length = method == FLATTEN_METHOD_LENGTH;
     for (size_t i = 0; i < path.n && status == CS_EXIT_OK; i++) {
         const cs_path_elem_t *el = &path.elems[i];
         const cs_bezier_t *cv = &el->curve;
@@ -228,7 +279,8 @@ int cs_cmd_flatten(int argc, char **argv)
             fprintf(stderr, "curvestep flatten: out of memory\n");
             break;
         }
-        e = cs_trace_begin(&tr, cv, tol, methods[method].method);
+        e = by_length ? cs_lensub_begin(&ls, cv, seg_len, horner && !cv->rational)
+                      : cs_trace_begin(&tr, cv, tol, methods[method].method);
         if (e == CS_ERR_TOLERANCE) {
             fprintf(stderr, "curvestep flatten: --tol %g: %s (method %s)\n", tol_mm, cs_err_text(e),
                     methods[method].name);
@@ -236,7 +288,8 @@ int cs_cmd_flatten(int argc, char **argv)
             break;
         }
         cs_vec3_t pt;
-        while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK) {
+        while (e == CS_OK &&
+               (e = by_length ? cs_lensub_next(&ls, &pt) : cs_trace_next(&tr, &pt)) == CS_OK) {
             printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
             nchords++;
             if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
@@ -268,7 +321,12 @@ int cs_cmd_flatten(int argc, char **argv)
     if (stats && status == CS_EXIT_OK) {
         fprintf(stderr, "flatten: %s: %zu elements in %u subpaths, %zu chords (%zu vertices)\n",
                 shown, path.n, path.nsubpaths, nchords, poly.n);
-        fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name, tol_mm);
+        if (method == FLATTEN_METHOD_LENGTH)
+            fprintf(stderr, "flatten: method length (%s), chords at most %.6g mm\n",
+                    horner ? "horner" : "decasteljau", seg_len_mm);
+        else
+            fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name,
+                    tol_mm);
         if (path.n > 0) {
             const cs_path_loc_t *l = &path.elems[maxdev_elem].loc;
             if (isinf(maxdev)) {

@@ -30,6 +30,18 @@ run "unknown keyword" 1 plan "$T/bad2.curves"
 expect_err "unknown keyword: located, lists the keywords" \
     "bad2.curves:2:1: unknown curve 'spiral' \(line, bezier, hermite, bspline, nurbs, catmull-rom, beta, natural, arc\)"
 
+# --- seed 003's length-based subdivision and Horner evaluation (flatten --method length --eval):
+# every chord at most --seg-len (measured on the printed vertices), the same drawing either way
+for ev in decasteljau horner; do
+    run "flatten length $ev" 0 flatten --method length --seg-len 0.5 --eval "$ev" --stats "$EVERY"
+    check "length $ev: chords <= 0.5 mm" awk 'NF == 2 { if (have && sqrt(($1 - x) ^ 2 + ($2 - y) ^ 2) > 0.5 + 2e-6) bad++; x = $1; y = $2; have = 1; n++ } NF == 0 { have = 0 } END { exit !(n > 500 && !bad) }' "$T/out"
+    check "length $ev: stats name the method" grep -q "method length ($ev), chords at most 0.5 mm" "$T/err"
+    wc -l <"$T/out" >"$T/n_$ev"
+done
+check "length: Horner and de Casteljau within 1 % of each other" awk -v a="$(cat "$T/n_decasteljau")" -v b="$(cat "$T/n_horner")" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= a / 100) }'
+run "--eval needs --method length" 2 flatten --eval horner "$EVERY"
+run "--eval bad" 2 flatten --method length --eval naive "$EVERY"
+
 # --- inspect: classes known from theory
 cat >"$T/classes.curves" <<'CURVES'
 curvestep-curves 1
