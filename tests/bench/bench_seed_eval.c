@@ -60,6 +60,17 @@ static void naive_eval(const cs_horner_t *h, cs_param_t t, cs_vec3_t *out)
     *out = cs_fixed_vec(r[0], r[1], r[2]);
 }
 
+/* Point at t by evaluator m (0 naive, 1 Horner, 2 de Casteljau). */
+static void eval_m(int m, const cs_horner_t *h, const cs_bezier_t *c, cs_param_t t, cs_vec3_t *p)
+{
+    if (m == 0)
+        naive_eval(h, t, p);
+    else if (m == 1)
+        cs_horner_eval(h, t, p);
+    else
+        cs_bezier_eval(c, t, p);
+}
+
 static long double exact(const cs_bezier_t *c, long double t, int axis)
 {
     long double s = 0, b = 1;
@@ -82,12 +93,7 @@ static void eval_cost(const bench_set_t *s, int m, double *ns, double *worst)
         for (int k = 0; k <= NPOINTS; k++) {
             cs_param_t t = (cs_param_t)(((int64_t)k * CS_PARAM_ONE) / NPOINTS);
             cs_vec3_t p;
-            if (m == 0)
-                naive_eval(&h, t, &p);
-            else if (m == 1)
-                cs_horner_eval(&h, t, &p);
-            else
-                cs_bezier_eval(&s->c[i], t, &p);
+            eval_m(m, &h, &s->c[i], t, &p);
             sink = p.x;
         }
     }
@@ -98,12 +104,7 @@ static void eval_cost(const bench_set_t *s, int m, double *ns, double *worst)
         for (int k = 0; k <= 64; k++) {
             cs_param_t t = (cs_param_t)(((int64_t)k * CS_PARAM_ONE) / 64);
             cs_vec3_t p;
-            if (m == 0)
-                naive_eval(&h, t, &p);
-            else if (m == 1)
-                cs_horner_eval(&h, t, &p);
-            else
-                cs_bezier_eval(&s->c[i], t, &p);
+            eval_m(m, &h, &s->c[i], t, &p);
             long double tt = (long double)t / CS_PARAM_ONE;
             *worst = fmax(*worst, (double)fmaxl(fabsl(exact(&s->c[i], tt, 0) - p.x),
                                                 fabsl(exact(&s->c[i], tt, 1) - p.y)));

@@ -111,6 +111,21 @@ static void hblend(double t, double h[4])
         h[k] = H[k][0] * m[0] + H[k][1] * m[1] + H[k][2] * m[2] + H[k][3] * m[3];
 }
 
+/* Seed 000: S = S1 + S2 - S3, S1 = (P1, P2, P1v, P2v) H(v), S2 = (Q1, Q2, Q1u, Q2u) H(u),
+ * S3 = H(u)^T A H(v), with hu, hv the Hermite blends and c1, c2 the curves at u, v. */
+static cs_ref_vec_t seed_coons(const double hu[4], const double hv[4], const cs_ref_vec_t c1[4],
+                               const cs_ref_vec_t c2[4], const cs_ref_vec_t A[4][4])
+{
+    cs_ref_vec_t want = {0, 0, 0};
+    for (int k = 0; k < 4; k++) {
+        want = lin(1, want, hv[k], c1[k]);
+        want = lin(1, want, hu[k], c2[k]);
+        for (int l = 0; l < 4; l++)
+            want = lin(1, want, -hu[k] * hv[l], A[k][l]);
+    }
+    return want;
+}
+
 typedef struct {
     cs_bezier_t p1, p2, q1, q2;
 } boundary_t;
@@ -204,13 +219,7 @@ static void test_bicubic(void **state)
                 cs_ref_vec_t c2[4] = {cs_ref_eval(&b.q1, v), cs_ref_eval(&b.q2, v),
                                       with ? cs_ref_eval(dp[2], v) : d2,
                                       with ? cs_ref_eval(dp[3], v) : d3};
-                cs_ref_vec_t want = {0, 0, 0};
-                for (int k = 0; k < 4; k++) {
-                    want = lin(1, want, hv[k], c1[k]);
-                    want = lin(1, want, hu[k], c2[k]);
-                    for (int l = 0; l < 4; l++)
-                        want = lin(1, want, -hu[k] * hv[l], A[k][l]);
-                }
+                cs_ref_vec_t want = seed_coons(hu, hv, c1, c2, (const cs_ref_vec_t(*)[4])A);
                 double d = maxc(want, patch_eval(&p, u, v));
                 worst = fmax(worst, d);
                 assert_true(d <= 0.5 * LSB + 1e-9);
@@ -287,13 +296,7 @@ static void test_bicubic_twist(void **state)
                 cs_ref_vec_t c2[4] = {cs_ref_eval(&b.q1, v), cs_ref_eval(&b.q2, v),
                                       with ? cs_ref_eval(dp[2], v) : d2,
                                       with ? cs_ref_eval(dp[3], v) : d3};
-                cs_ref_vec_t want = {0, 0, 0};
-                for (int k = 0; k < 4; k++) {
-                    want = lin(1, want, hv[k], c1[k]);
-                    want = lin(1, want, hu[k], c2[k]);
-                    for (int l = 0; l < 4; l++)
-                        want = lin(1, want, -hu[k] * hv[l], A[k][l]);
-                }
+                cs_ref_vec_t want = seed_coons(hu, hv, c1, c2, (const cs_ref_vec_t(*)[4])A);
                 double d = maxc(want, patch_eval(&p, u, v));
                 worst = fmax(worst, d);
                 assert_true(d <= 0.5 * LSB + 1e-9);

@@ -323,6 +323,21 @@ static void lk_reference(const cs_varady_t *v, const cs_bezier_t *sides, size_t 
     }
 }
 
+/* A random point inside the domain polygon: a convex combination of its vertices. */
+static void rnd_inside(const cs_varady_t *v, double *x, double *y)
+{
+    double w[CS_VARADY_MAX_SIDES], sw = 0;
+    *x = *y = 0;
+    for (size_t i = 0; i < v->n; i++)
+        sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
+    for (size_t i = 0; i < v->n; i++) {
+        double p[2];
+        cs_varady_vertex(v, i, p);
+        *x += w[i] / sw * p[0];
+        *y += w[i] / sw * p[1];
+    }
+}
+
 static void test_lk_reference(void **state)
 {
     (void)state;
@@ -336,15 +351,8 @@ static void test_lk_reference(void **state)
         assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_SIDE), CS_OK);
         for (int k = 0; k < 300; k++) {
             /* random points in the polygon: convex combinations of the vertices */
-            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0, q[3], r[3];
-            for (size_t i = 0; i < n; i++)
-                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
-            for (size_t i = 0; i < n; i++) {
-                double p[2];
-                cs_varady_vertex(&v, i, p);
-                x += w[i] / sw * p[0];
-                y += w[i] / sw * p[1];
-            }
+            double x, y, q[3], r[3];
+            rnd_inside(&v, &x, &y);
             cs_varady_eval(&v, x, y, q);
             lk_reference(&v, sides, n, x, y, r);
             worst =
@@ -374,15 +382,8 @@ static void test_lk_reference(void **state)
         ref_tan = tan;
         ref_twist = (const double(*)[3])tw;
         for (int k = 0; k < 200; k++) {
-            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0, q[3], r[3];
-            for (size_t i = 0; i < n; i++)
-                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
-            for (size_t i = 0; i < n; i++) {
-                double p[2];
-                cs_varady_vertex(&v, i, p);
-                x += w[i] / sw * p[0];
-                y += w[i] / sw * p[1];
-            }
+            double x, y, q[3], r[3];
+            rnd_inside(&v, &x, &y);
             cs_varady_eval(&v, x, y, q);
             lk_reference(&v, sides, n, x, y, r);
             worst =
