@@ -227,9 +227,9 @@ int main(int argc, char **argv)
                 fprintf(csv, "%s,length %g,%.5f,%zu,%zu\n", sets[k]->name, tols[j], len, nl, ns);
         }
     printf("\nThe length criterion cannot see curvature: its chord length must suit the most "
-           "curved place of every curve, so it needs several times the chords of flatness "
-           "subdivision for the same deviation, as seed 003 says of evaluation at fixed "
-           "intervals.\n");
+           "curved place of every curve, so it spends far more chords than flatness subdivision "
+           "for the same deviation (the table), the weakness seed 003 names for evaluation at "
+           "fixed intervals.\n");
     if (csv)
         fclose(csv);
     free(cubic.c);
