@@ -183,6 +183,31 @@ static cs_err_t varady(cs_lex_t *lx, bool scheme, unsigned line, cs_surffile_t *
     return e;
 }
 
+/* sphere C R (after the keyword): the exact sphere (cs_sphere), inside the coordinate range. */
+static cs_err_t sphere(cs_lex_t *lx, unsigned line, cs_surffile_t *sf)
+{
+    cs_surf_item_t it;
+    memset(&it, 0, sizeof it);
+    cs_err_t e = cs_lex_vec(lx, "centre", NULL, it.sph.c);
+    if (e == CS_OK)
+        e = cs_lex_number(lx, "radius", &it.sph.r);
+    if (e != CS_OK)
+        return e;
+    it.sph.r *= lx->scale;
+    cs_vec3_t lo, hi;
+    if (!(it.sph.r > 0) ||
+        cs_conv_mm_to_vec(it.sph.c[0] - it.sph.r, it.sph.c[1] - it.sph.r, it.sph.c[2] - it.sph.r,
+                          &lo) != CS_OK ||
+        cs_conv_mm_to_vec(it.sph.c[0] + it.sph.r, it.sph.c[1] + it.sph.r, it.sph.c[2] + it.sph.r,
+                          &hi) != CS_OK)
+        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
+                                "radius %g mm: must be > 0 and keep the sphere inside +/-%d mm",
+                                it.sph.r, CS_POS_LIMIT_MM);
+    it.sphere = true;
+    it.line = line;
+    return push(sf, &it);
+}
+
 static const char *const keywords[] = {
     "bezier", "tri",           "hermite", "power",   "coons-bilinear", "coons-bicubic",
     "coons-blend", "varady", "varady-scheme", "ruled", "extrude",        "revolve",
@@ -281,27 +306,7 @@ static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
         if (e == CS_OK && (e = cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, &p)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "sphere") == 0) {
-        cs_surf_item_t it;
-        memset(&it, 0, sizeof it);
-        e = cs_lex_vec(lx, "centre", NULL, it.sph.c);
-        if (e == CS_OK)
-            e = cs_lex_number(lx, "radius", &it.sph.r);
-        if (e != CS_OK)
-            return e;
-        it.sph.r *= lx->scale;
-        cs_vec3_t lo, hi;
-        if (!(it.sph.r > 0) ||
-            cs_conv_mm_to_vec(it.sph.c[0] - it.sph.r, it.sph.c[1] - it.sph.r,
-                              it.sph.c[2] - it.sph.r, &lo) != CS_OK ||
-            cs_conv_mm_to_vec(it.sph.c[0] + it.sph.r, it.sph.c[1] + it.sph.r,
-                              it.sph.c[2] + it.sph.r, &hi) != CS_OK)
-            return cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
-                                    "radius %g mm: must be > 0 and keep the sphere inside "
-                                    "+/-%d mm",
-                                    it.sph.r, CS_POS_LIMIT_MM);
-        it.sphere = true;
-        it.line = at.line;
-        return push(sf, &it);
+        return sphere(lx, at.line, sf);
     } else if (strcmp(kw, "ruled") == 0) {
         cs_bezier_t c[2];
         for (int k = 0; e == CS_OK && k < 2; k++)
