@@ -77,7 +77,7 @@ for par in side radial centre; do
 done
 sed "s/^varady 5/varady-scheme lambda-kappa sideways 5/" tests/data/surfaces/pentagon.txt >"$T/lk.txt"
 run "varady-scheme bad parametrisation" 1 toolpath --patches "$T/lk.txt"
-expect_err "varady-scheme bad parametrisation" "lk.txt:3:28: 'sideways': parametrisation side, radial or centre expected"
+expect_err "varady-scheme bad parametrisation" "lk.txt:3:28: 'sideways': parametrisation side, radial, centre or biquadratic expected"
 # Finishing the n-sided patch: bicubic cells fitted within tol / 2 = 0.005 mm, each a block from
 # and back to the safe height.
 run "varady with --ball" 0 toolpath --patches tests/data/surfaces/pentagon.txt --ball 2 --scallop 0.2 --safe-z 20 --stats
