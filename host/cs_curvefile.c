@@ -243,6 +243,60 @@ static cs_err_t st_nurbs(cf_t *c)
     return spline_stmt(c, true);
 }
 
+/* The clamped cubic spline through p[0..n-1] with end tangents t0, t1 (mm per unit of the
+ * parameter: 1 per segment, or the chord length with chord), in double: C2 at every inner point,
+ * h_i D_(i-1) + 2 (h_(i-1) + h_i) D_i + h_(i-1) D_(i+1) = 3 (h_i (P_i - P_(i-1)) / h_(i-1) +
+ * h_(i-1) (P_(i+1) - P_i) / h_i), D_0 = t0, D_(n-1) = t1 (Thomas algorithm), then each segment
+ * the Bézier (P_i, P_i + h_i D_i / 3, P_(i+1) - h_i D_(i+1) / 3, P_(i+1)). */
+static cs_err_t clamped(cf_t *c, const cs_vec3_t *p, int n, bool chord, const double t0[3],
+                        const double t1[3])
+{
+    double h[CS_SPLINE_MAX_POINTS], d[CS_SPLINE_MAX_POINTS][3], q[CS_SPLINE_MAX_POINTS][3];
+    double diag[CS_SPLINE_MAX_POINTS], up[CS_SPLINE_MAX_POINTS];
+    for (int i = 0; i < n; i++) {
+        q[i][0] = cs_conv_pos_to_mm(p[i].x);
+        q[i][1] = cs_conv_pos_to_mm(p[i].y);
+        q[i][2] = cs_conv_pos_to_mm(p[i].z);
+    }
+    for (int i = 0; i + 1 < n; i++) {
+        h[i] = chord ? sqrt(pow(q[i + 1][0] - q[i][0], 2) + pow(q[i + 1][1] - q[i][1], 2) +
+                            pow(q[i + 1][2] - q[i][2], 2))
+                     : 1;
+        if (!(h[i] > 0))
+            return CS_ERR_DEGENERATE;
+    }
+    diag[0] = 1, up[0] = 0;
+    for (int k = 0; k < 3; k++)
+        d[0][k] = t0[k], d[n - 1][k] = t1[k];
+    for (int i = 1; i + 1 < n; i++) { /* forward elimination of row i against row i - 1 */
+        double lo = h[i], di = 2 * (h[i - 1] + h[i]), m = lo / diag[i - 1];
+        diag[i] = di - m * up[i - 1];
+        up[i] = h[i - 1];
+        for (int k = 0; k < 3; k++)
+            d[i][k] = 3 * (h[i] * (q[i][k] - q[i - 1][k]) / h[i - 1] +
+                           h[i - 1] * (q[i + 1][k] - q[i][k]) / h[i]) -
+                      m * d[i - 1][k];
+    }
+    for (int i = n - 2; i >= 1; i--) /* back substitution; D_(n-1) is given */
+        for (int k = 0; k < 3; k++)
+            d[i][k] = (d[i][k] - up[i] * d[i + 1][k]) / diag[i];
+    cs_err_t e = CS_OK;
+    for (int i = 0; e == CS_OK && i + 1 < n; i++) {
+        cs_vec3_t b[4] = {p[i], {0, 0, 0}, {0, 0, 0}, p[i + 1]};
+        if (cs_conv_mm_to_vec(q[i][0] + h[i] * d[i][0] / 3, q[i][1] + h[i] * d[i][1] / 3,
+                              q[i][2] + h[i] * d[i][2] / 3, &b[1]) != CS_OK ||
+            cs_conv_mm_to_vec(q[i + 1][0] - h[i] * d[i + 1][0] / 3,
+                              q[i + 1][1] - h[i] * d[i + 1][1] / 3,
+                              q[i + 1][2] - h[i] * d[i + 1][2] / 3, &b[2]) != CS_OK)
+            return CS_ERR_RANGE;
+        cs_bezier_t seg;
+        if ((e = cs_bezier_init(&seg, 3, b)) == CS_OK)
+            e = emit(c, &seg, i == 0);
+    }
+    return e;
+}
+
+/* natural N P.. [chord] [clamped T0 T1]: cs_spline's natural ends, or clamped end tangents. */
 static cs_err_t st_natural(cf_t *c)
 {
     int n;
@@ -253,17 +307,22 @@ static cs_err_t st_natural(cf_t *c)
         return cs_path_diag_set(c->lx.diag, CS_ERR_FULL, cs_lex_here(&c->lx),
                                 "a natural spline has at most %d points", CS_SPLINE_MAX_POINTS);
     cs_vec3_t p[CS_SPLINE_MAX_POINTS];
-    cs_spline_t *s = malloc(sizeof *s);
-    if (!s)
-        return CS_ERR_FULL;
     e = points(c, n, p, NULL, NULL);
-    cs_spline_param_t param = CS_SPLINE_UNIFORM;
-    if (e == CS_OK && cs_lex_peek_is(&c->lx, "chord")) {
+    bool chord = e == CS_OK && cs_lex_peek_is(&c->lx, "chord");
+    if (chord)
         cs_lex_next(&c->lx);
-        param = CS_SPLINE_CHORD;
+    if (e == CS_OK && cs_lex_peek_is(&c->lx, "clamped")) {
+        double t[2][3];
+        cs_lex_next(&c->lx);
+        for (int k = 0; e == CS_OK && k < 2; k++)
+            e = cs_lex_vec(&c->lx, k ? "end tangent" : "start tangent", NULL, t[k]);
+        return e == CS_OK ? clamped(c, p, n, chord, t[0], t[1]) : e;
     }
+    cs_spline_t *s = e == CS_OK ? malloc(sizeof *s) : NULL;
+    if (e == CS_OK && !s)
+        return CS_ERR_FULL;
     if (e == CS_OK)
-        e = cs_spline_solve(s, p, (size_t)n, param);
+        e = cs_spline_solve(s, p, (size_t)n, chord ? CS_SPLINE_CHORD : CS_SPLINE_UNIFORM);
     for (size_t i = 0; e == CS_OK && i < cs_spline_segments(s); i++) {
         cs_bezier_t b;
         if ((e = cs_spline_segment(s, i, &b)) == CS_OK)

@@ -11,8 +11,10 @@
  *   nurbs N P1 w1 .. PN wN knots K k1 .. k(N+K)    weights > 0 (cs_nurbs)
  *   catmull-rom N P1 .. PN             through P2 .. P(N-1), N >= 4 (cs_basis)
  *   beta B1 B2 N P1 .. PN              beta-spline, bias B1, tension B2, N >= 4 (cs_basis)
- *   natural N P1 .. PN [chord]         natural cubic spline through the points, zero second
- *                                      derivative at both ends; uniform or chord parameter
+ *   natural N P1 .. PN [chord] [clamped T0 T1]
+ *                                      cubic spline through the points, C2; ends natural (zero
+ *                                      second derivative) or clamped to the tangents T0, T1;
+ *                                      uniform or chord parameter
  *   arc C U V A0 A1                    C + U cos(a) + V sin(a), a from A0 to A1 degrees
  * P, T, C, U, V = three numbers in mm; '#' starts a comment; numbers are free-form across lines.
  * A statement whose start is not the previous end starts a new subpath (a pen lift). */

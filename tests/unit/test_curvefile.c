@@ -288,6 +288,72 @@ static void test_natural(void **state)
     cs_path_free(&p);
 }
 
+/* ---- natural ... clamped T0 T1: the clamped spline's defining conditions, checked on the
+ * segments from their control points in double (not by re-solving): it passes through the
+ * points, starts and ends with the given tangents, and is C1 and C2 at every inner point, with
+ * derivatives per unit of the global parameter (segment i spans h_i: 1, or the chord length). */
+static void check_clamped(const char *text, const v3 *P, int n, v3 t0, v3 t1, bool chord)
+{
+    cs_path_t p;
+    parse_ok(text, &p);
+    assert_int_equal(p.n, (size_t)n - 1);
+    double h[8], tol1 = 4 * CS_REF_LSB_MM, tol2 = 16 * CS_REF_LSB_MM;
+    for (int i = 0; i + 1 < n; i++)
+        h[i] = chord ? sqrt(pow(P[i + 1].x - P[i].x, 2) + pow(P[i + 1].y - P[i].y, 2) +
+                            pow(P[i + 1].z - P[i].z, 2))
+                     : 1;
+    for (int i = 0; i + 1 < n; i++) {
+        const cs_bezier_t *b = &p.elems[i].curve;
+        cs_ref_vec_t q[4];
+        for (int k = 0; k < 4; k++)
+            q[k] = cs_ref_from_pos(&b->p[k]);
+        cs_ref_vec_t want0 = {P[i].x, P[i].y, P[i].z}, want1 = {P[i + 1].x, P[i + 1].y, P[i + 1].z};
+        assert_true(cs_ref_dist(q[0], want0) <= CS_REF_LSB_MM && cs_ref_dist(q[3], want1) <= CS_REF_LSB_MM);
+        if (i == 0) {
+            cs_ref_vec_t d = {3 * (q[1].x - q[0].x) / h[0], 3 * (q[1].y - q[0].y) / h[0],
+                              3 * (q[1].z - q[0].z) / h[0]};
+            cs_ref_vec_t w = {t0.x, t0.y, t0.z};
+            assert_true(cs_ref_dist(d, w) <= tol1 / h[0]);
+        }
+        if (i + 2 == n) {
+            cs_ref_vec_t d = {3 * (q[3].x - q[2].x) / h[i], 3 * (q[3].y - q[2].y) / h[i],
+                              3 * (q[3].z - q[2].z) / h[i]};
+            cs_ref_vec_t w = {t1.x, t1.y, t1.z};
+            assert_true(cs_ref_dist(d, w) <= tol1 / h[i]);
+            continue;
+        }
+        const cs_bezier_t *nb = &p.elems[i + 1].curve;
+        cs_ref_vec_t r[3];
+        for (int k = 0; k < 3; k++)
+            r[k] = cs_ref_from_pos(&nb->p[k]);
+        double hi = h[i], hn = h[i + 1];
+        cs_ref_vec_t d1a = {3 * (q[3].x - q[2].x) / hi, 3 * (q[3].y - q[2].y) / hi, 3 * (q[3].z - q[2].z) / hi};
+        cs_ref_vec_t d1b = {3 * (r[1].x - r[0].x) / hn, 3 * (r[1].y - r[0].y) / hn, 3 * (r[1].z - r[0].z) / hn};
+        assert_true(cs_ref_dist(d1a, d1b) <= tol1 * (1 / hi + 1 / hn));
+        cs_ref_vec_t d2a = {6 * (q[3].x - 2 * q[2].x + q[1].x) / (hi * hi),
+                            6 * (q[3].y - 2 * q[2].y + q[1].y) / (hi * hi),
+                            6 * (q[3].z - 2 * q[2].z + q[1].z) / (hi * hi)};
+        cs_ref_vec_t d2b = {6 * (r[0].x - 2 * r[1].x + r[2].x) / (hn * hn),
+                            6 * (r[0].y - 2 * r[1].y + r[2].y) / (hn * hn),
+                            6 * (r[0].z - 2 * r[1].z + r[2].z) / (hn * hn)};
+        assert_true(cs_ref_dist(d2a, d2b) <= tol2 * (1 / (hi * hi) + 1 / (hn * hn)));
+    }
+    cs_path_free(&p);
+}
+
+static void test_natural_clamped(void **state)
+{
+    (void)state;
+    static const v3 P[5] = {{0, 0, 0}, {10, 20, 0}, {25, 5, 2}, {30, 25, 0}, {50, 10, 0}};
+    v3 t0 = {10, 0, 0}, t1 = {0, -15, 5}, u0 = {1, 0, 0}, u1 = {0, -1, 0};
+    check_clamped("curvestep-curves 1\nnatural 5  0 0 0  10 20 0  25 5 2  30 25 0  50 10 0\n"
+                  "  clamped 10 0 0  0 -15 5\n",
+                  P, 5, t0, t1, false);
+    check_clamped("curvestep-curves 1\nnatural 5  0 0 0  10 20 0  25 5 2  30 25 0  50 10 0\n"
+                  "  chord clamped 1 0 0  0 -1 0\n",
+                  P, 5, u0, u1, true);
+}
+
 /* ---- arc C U V a0 a1: every point is C + U cos(a) + V sin(a) for some a in [a0, a1] (U, V
  * orthogonal here, so cos(a) = (X - C).U / |U|^2, sin(a) = (X - C).V / |V|^2), and the ends are
  * at a0 and a1. */
@@ -397,7 +463,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bezier),  cmocka_unit_test(test_hermite),
         cmocka_unit_test(test_cubic_bases), cmocka_unit_test(test_nurbs),
-        cmocka_unit_test(test_natural), cmocka_unit_test(test_arc),
+        cmocka_unit_test(test_natural), cmocka_unit_test(test_natural_clamped),
+        cmocka_unit_test(test_arc),
         cmocka_unit_test(test_line_and_subpaths), cmocka_unit_test(test_errors),
         cmocka_unit_test(test_input),
     };
