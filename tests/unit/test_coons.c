@@ -141,6 +141,31 @@ static boundary_t rnd_boundary(int32_t lim)
     return b;
 }
 
+/* Seed 000's bicubic Coons point at (u, v) from the boundaries, the derivative curves dp (when
+ * with) or their defaults, and S3's matrix A (twists in its lower right block): the default
+ * derivative curves are the Hermite cubics between the crossing curves' corner tangents with the
+ * twists as end slopes (zero twists: Bézier (a, a, b, b)). */
+static cs_ref_vec_t coons_ref(const boundary_t *b, const cs_bezier_t *const dp[4], bool with,
+                              const cs_ref_vec_t A[4][4], double u, double v)
+{
+    double hu[4], hv[4];
+    hblend(u, hu);
+    hblend(v, hv);
+    cs_ref_vec_t d0 = lin(1, lin(hu[0], A[0][2], hu[1], A[1][2]), 1,
+                          lin(hu[2], A[2][2], hu[3], A[3][2]));
+    cs_ref_vec_t d1 = lin(1, lin(hu[0], A[0][3], hu[1], A[1][3]), 1,
+                          lin(hu[2], A[2][3], hu[3], A[3][3]));
+    cs_ref_vec_t d2 = lin(1, lin(hv[0], A[2][0], hv[1], A[2][1]), 1,
+                          lin(hv[2], A[2][2], hv[3], A[2][3]));
+    cs_ref_vec_t d3 = lin(1, lin(hv[0], A[3][0], hv[1], A[3][1]), 1,
+                          lin(hv[2], A[3][2], hv[3], A[3][3]));
+    cs_ref_vec_t c1[4] = {cs_ref_eval(&b->p1, u), cs_ref_eval(&b->p2, u),
+                          with ? cs_ref_eval(dp[0], u) : d0, with ? cs_ref_eval(dp[1], u) : d1};
+    cs_ref_vec_t c2[4] = {cs_ref_eval(&b->q1, v), cs_ref_eval(&b->q2, v),
+                          with ? cs_ref_eval(dp[2], v) : d2, with ? cs_ref_eval(dp[3], v) : d3};
+    return seed_coons(hu, hv, c1, c2, A);
+}
+
 static void test_bilinear(void **state)
 {
     (void)state;
@@ -205,21 +230,8 @@ static void test_bicubic(void **state)
         };
         for (int s = 0; s <= 8; s++)
             for (int r = 0; r <= 8; r++) {
-                double u = s / 8.0, v = r / 8.0, hu[4], hv[4];
-                hblend(u, hu);
-                hblend(v, hv);
-                /* Default derivative curves: Bézier (a, a, b, b), i.e. h0 a + h1 b. */
-                cs_ref_vec_t d0 = lin(hu[0], A[0][2], hu[1], A[1][2]);
-                cs_ref_vec_t d1 = lin(hu[0], A[0][3], hu[1], A[1][3]);
-                cs_ref_vec_t d2 = lin(hv[0], A[2][0], hv[1], A[2][1]);
-                cs_ref_vec_t d3 = lin(hv[0], A[3][0], hv[1], A[3][1]);
-                cs_ref_vec_t c1[4] = {cs_ref_eval(&b.p1, u), cs_ref_eval(&b.p2, u),
-                                      with ? cs_ref_eval(dp[0], u) : d0,
-                                      with ? cs_ref_eval(dp[1], u) : d1};
-                cs_ref_vec_t c2[4] = {cs_ref_eval(&b.q1, v), cs_ref_eval(&b.q2, v),
-                                      with ? cs_ref_eval(dp[2], v) : d2,
-                                      with ? cs_ref_eval(dp[3], v) : d3};
-                cs_ref_vec_t want = seed_coons(hu, hv, c1, c2, (const cs_ref_vec_t(*)[4])A);
+                double u = s / 8.0, v = r / 8.0;
+                cs_ref_vec_t want = coons_ref(&b, dp, with, (const cs_ref_vec_t(*)[4])A, u, v);
                 double d = maxc(want, patch_eval(&p, u, v));
                 worst = fmax(worst, d);
                 assert_true(d <= 0.5 * LSB + 1e-9);
@@ -278,25 +290,8 @@ static void test_bicubic_twist(void **state)
         };
         for (int s = 0; s <= 8; s++)
             for (int r = 0; r <= 8; r++) {
-                double u = s / 8.0, v = r / 8.0, hu[4], hv[4];
-                hblend(u, hu);
-                hblend(v, hv);
-                /* Default derivative curves: Hermite (a, b, slope0, slope1). */
-                cs_ref_vec_t d0 = lin(1, lin(hu[0], A[0][2], hu[1], A[1][2]), 1,
-                                      lin(hu[2], T[0][0], hu[3], T[1][0]));
-                cs_ref_vec_t d1 = lin(1, lin(hu[0], A[0][3], hu[1], A[1][3]), 1,
-                                      lin(hu[2], T[0][1], hu[3], T[1][1]));
-                cs_ref_vec_t d2 = lin(1, lin(hv[0], A[2][0], hv[1], A[2][1]), 1,
-                                      lin(hv[2], T[0][0], hv[3], T[0][1]));
-                cs_ref_vec_t d3 = lin(1, lin(hv[0], A[3][0], hv[1], A[3][1]), 1,
-                                      lin(hv[2], T[1][0], hv[3], T[1][1]));
-                cs_ref_vec_t c1[4] = {cs_ref_eval(&b.p1, u), cs_ref_eval(&b.p2, u),
-                                      with ? cs_ref_eval(dp[0], u) : d0,
-                                      with ? cs_ref_eval(dp[1], u) : d1};
-                cs_ref_vec_t c2[4] = {cs_ref_eval(&b.q1, v), cs_ref_eval(&b.q2, v),
-                                      with ? cs_ref_eval(dp[2], v) : d2,
-                                      with ? cs_ref_eval(dp[3], v) : d3};
-                cs_ref_vec_t want = seed_coons(hu, hv, c1, c2, (const cs_ref_vec_t(*)[4])A);
+                double u = s / 8.0, v = r / 8.0;
+                cs_ref_vec_t want = coons_ref(&b, dp, with, (const cs_ref_vec_t(*)[4])A, u, v);
                 double d = maxc(want, patch_eval(&p, u, v));
                 worst = fmax(worst, d);
                 assert_true(d <= 0.5 * LSB + 1e-9);
