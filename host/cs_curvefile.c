@@ -407,8 +407,7 @@ static cs_err_t statement(cf_t *c)
     c->kind = statements[k].kind;
     cs_err_t e = statements[k].fn(c);
     if (e != CS_OK && c->lx.diag->code != e)
-        return cs_path_diag_set(c->lx.diag, e, c->at, "%s: %s", statements[k].name,
-                                cs_err_text(e));
+        return cs_path_diag_set(c->lx.diag, e, c->at, "%s: %s", statements[k].name, cs_err_text(e));
     return e;
 }
 

@@ -31,7 +31,7 @@ static const struct {
 };
 
 /* Seed 003's length-based subdivision: chords at most --seg-len long (cs_lensub). */
-#define FLATTEN_METHOD_LENGTH 3
+#define FLATTEN_METHOD_LENGTH      3
 #define FLATTEN_DEFAULT_SEG_LEN_MM 1.0
 
 /* The default: flatness subdivision, the method whose chords are proven within the tolerance
@@ -184,8 +184,9 @@ int cs_cmd_flatten(int argc, char **argv)
             seg_len_mm = strtod(optarg, &end);
             if (!end || end == optarg || *end != '\0' ||
                 cs_conv_tol_to_pos(seg_len_mm, &t) != CS_OK) {
-                fprintf(stderr, "curvestep flatten: --seg-len '%s': expected a length in mm, "
-                                "from 1 LSB (0.0000153) to 4096\n",
+                fprintf(stderr,
+                        "curvestep flatten: --seg-len '%s': expected a length in mm, "
+                        "from 1 LSB (0.0000153) to 4096\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }

@@ -38,10 +38,10 @@ static cs_input_format_t by_extension(const char *filename)
         const char *ext;
         cs_input_format_t f;
     } exts[] = {
-        {"svg", CS_INPUT_SVG},  {"txt", CS_INPUT_SVG},     {"d", CS_INPUT_SVG},
-        {"nc", CS_INPUT_GCODE}, {"gcode", CS_INPUT_GCODE}, {"ngc", CS_INPUT_GCODE},
-        {"g", CS_INPUT_GCODE},  {"tap", CS_INPUT_GCODE},   {"cnc", CS_INPUT_GCODE},
-        {"plt", CS_INPUT_HPGL}, {"hpgl", CS_INPUT_HPGL},   {"hgl", CS_INPUT_HPGL},
+        {"svg", CS_INPUT_SVG},  {"txt", CS_INPUT_SVG},       {"d", CS_INPUT_SVG},
+        {"nc", CS_INPUT_GCODE}, {"gcode", CS_INPUT_GCODE},   {"ngc", CS_INPUT_GCODE},
+        {"g", CS_INPUT_GCODE},  {"tap", CS_INPUT_GCODE},     {"cnc", CS_INPUT_GCODE},
+        {"plt", CS_INPUT_HPGL}, {"hpgl", CS_INPUT_HPGL},     {"hgl", CS_INPUT_HPGL},
         {"hpg", CS_INPUT_HPGL}, {"curves", CS_INPUT_CURVES},
     };
     if (!filename || strcmp(filename, "-") == 0)

@@ -192,9 +192,8 @@ static void print_elem(const inspect_opts_t *o, size_t i, const cs_path_elem_t *
 {
     const cs_bezier_t *c = &el->curve;
     cs_pos_t len = 0;
-    double lmm = cs_arclen_length(c, INSPECT_LENGTH_TOL_LSB, &len) == CS_OK
-                     ? cs_conv_pos_to_mm(len)
-                     : NAN;
+    double lmm =
+        cs_arclen_length(c, INSPECT_LENGTH_TOL_LSB, &len) == CS_OK ? cs_conv_pos_to_mm(len) : NAN;
     cs_vec3_t lo, hi;
     double b[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
     if (cs_bezier_bbox(c, &lo, &hi) == CS_OK) {
@@ -347,8 +346,8 @@ static bool edge_is_point(const cs_patch_t *a)
 }
 
 /* The continuity of the first shared edge of patches a and b (either orientation), or false. */
-static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_opts_t *o,
-                        int *ea, int *eb, const char **cls)
+static bool shared_edge(const cs_patch_t *a, const cs_patch_t *b, const inspect_opts_t *o, int *ea,
+                        int *eb, const char **cls)
 {
     cs_pos_t tol;
     cs_param_t sin_tol;
@@ -428,8 +427,8 @@ static void print_item(const inspect_opts_t *o, const cs_surffile_t *sf, size_t 
     double b[6];
     item_box(it, b);
     if (o->json) {
-        printf("%s\n    {\"index\": %zu, \"kind\": \"%s\", \"line\": %u, \"bbox_mm\": [", i ? "," : "",
-               i + 1, kind, it->line);
+        printf("%s\n    {\"index\": %zu, \"kind\": \"%s\", \"line\": %u, \"bbox_mm\": [",
+               i ? "," : "", i + 1, kind, it->line);
         for (int k = 0; k < 6; k++) {
             printf(k ? ", " : "");
             num(true, b[k]);
@@ -554,9 +553,9 @@ static bool positive(const char *s, double lo, double hi, double *out)
 int cs_cmd_inspect(int argc, char **argv)
 {
     static const struct option longopts[] = {
-        {"json", no_argument, NULL, 'j'},          {"tol", required_argument, NULL, 't'},
-        {"rel", required_argument, NULL, 'r'},     {"patches", no_argument, NULL, 'p'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+        {"json", no_argument, NULL, 'j'},      {"tol", required_argument, NULL, 't'},
+        {"rel", required_argument, NULL, 'r'}, {"patches", no_argument, NULL, 'p'},
+        {"help", no_argument, NULL, 'h'},      {NULL, 0, NULL, 0},
     };
     inspect_opts_t o = {false, INSPECT_DEFAULT_TOL_MM, INSPECT_DEFAULT_REL};
     bool patches = false;
@@ -579,8 +578,8 @@ int cs_cmd_inspect(int argc, char **argv)
         } else if (c == ':' || c == '?')
             bad = c == ':' ? "option needs a value" : "unknown option";
         if (bad) {
-            fprintf(stderr, "curvestep inspect: %s ('%s')\nTry 'curvestep inspect --help'.\n",
-                    bad, argv[optind - 1]);
+            fprintf(stderr, "curvestep inspect: %s ('%s')\nTry 'curvestep inspect --help'.\n", bad,
+                    argv[optind - 1]);
             return CS_EXIT_USAGE;
         }
     }

@@ -9,8 +9,8 @@
 
 #include "cs_conv.h"
 
-void cs_lex_init(cs_lex_t *lx, const char *text, size_t len, const char *name,
-                 cs_path_diag_t *diag, double scale)
+void cs_lex_init(cs_lex_t *lx, const char *text, size_t len, const char *name, cs_path_diag_t *diag,
+                 double scale)
 {
     memset(lx, 0, sizeof *lx);
     lx->p = text;
@@ -72,8 +72,8 @@ bool cs_lex_peek_is(const cs_lex_t *lx, const char *word)
 cs_err_t cs_lex_number(cs_lex_t *lx, const char *what, double *out)
 {
     if (!cs_lex_next(lx))
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, cs_lex_here(lx),
-                                "end of file: %s expected", what);
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, cs_lex_here(lx), "end of file: %s expected",
+                                what);
     char *e = NULL;
     errno = 0;
     double v = strtod(lx->tok, &e);

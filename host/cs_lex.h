@@ -24,8 +24,8 @@ typedef struct {
 } cs_lex_t;
 
 /* Reader over text[0..len) named name, diagnostics into *diag, coordinates times scale. */
-void cs_lex_init(cs_lex_t *lx, const char *text, size_t len, const char *name,
-                 cs_path_diag_t *diag, double scale);
+void cs_lex_init(cs_lex_t *lx, const char *text, size_t len, const char *name, cs_path_diag_t *diag,
+                 double scale);
 /* Next token into lx->tok; false at the end of the text (tline/tcol then point there). */
 bool cs_lex_next(cs_lex_t *lx);
 /* Location of the token just read. */

@@ -164,8 +164,7 @@ static cs_err_t alloc_verts(cs_patchfile_t *pf, size_t n)
 }
 
 /* One "x y z" line into vertex v. */
-static cs_err_t read_vertex(lexer_t *lx, cs_patchfile_t *pf, size_t v, const char *what,
-                            size_t of)
+static cs_err_t read_vertex(lexer_t *lx, cs_patchfile_t *pf, size_t v, const char *what, size_t of)
 {
     fields_t f;
     cs_err_t e;
@@ -202,20 +201,20 @@ static cs_err_t parse_bpt(lexer_t *lx, cs_patchfile_t *pf)
         for (unsigned k = 0; k < 2 && f.n == 2; k++)
             if (!f.integer[k] || f.v[k] < 1 || f.v[k] > CS_PATCH_MAX_DEGREE)
                 return cs_path_diag_set(lx->diag, CS_ERR_DEGREE, loc(lx, f.lineno, f.col[k]),
-                                        "patch %zu: degree %g outside 1..%d (.bpt format)",
-                                        i + 1, f.v[k], CS_PATCH_MAX_DEGREE);
+                                        "patch %zu: degree %g outside 1..%d (.bpt format)", i + 1,
+                                        f.v[k], CS_PATCH_MAX_DEGREE);
         if (f.n != 2)
             return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, f.lineno, f.endcol),
                                     "patch %zu: expected 'degu degv' (.bpt format), found %zu "
-                                    "numbers", i + 1, f.n);
+                                    "numbers",
+                                    i + 1, f.n);
         pf->deg[i][0] = (uint8_t)f.v[0];
         pf->deg[i][1] = (uint8_t)f.v[1];
         pf->line[i] = f.lineno;
         size_t npts = (size_t)(pf->deg[i][0] + 1) * (size_t)(pf->deg[i][1] + 1);
         for (size_t k = 0; k < npts; k++, nv++) {
             pf->idx[i][k] = nv;
-            if ((e = read_vertex(lx, pf, nv, "control points", nv + npts - k)) !=
-                CS_OK)
+            if ((e = read_vertex(lx, pf, nv, "control points", nv + npts - k)) != CS_OK)
                 return e;
         }
     }
@@ -316,8 +315,7 @@ cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_p
     fields_t f;
     if (e == CS_OK && next_line(&lx, &f, &e) && e == CS_OK)
         e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.col[0]),
-                             "unexpected data after the last %s",
-                             pf->bpt ? "patch" : "vertex");
+                             "unexpected data after the last %s", pf->bpt ? "patch" : "vertex");
     if (e == CS_OK)
         return CS_OK;
     /* Keep only the name, which the diagnostic points to (freed by cs_patchfile_free). */

@@ -23,9 +23,9 @@
 #define CS_PATCHFILE_MAX_POINTS (CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS)
 
 typedef struct {
-    char *file;      /* the name diagnostics use (owned) */
-    bool bpt;        /* read as .bpt (else Newell's format) */
-    size_t npatches; /* patches read */
+    char *file;                             /* the name diagnostics use (owned) */
+    bool bpt;                               /* read as .bpt (else Newell's format) */
+    size_t npatches;                        /* patches read */
     size_t (*idx)[CS_PATCHFILE_MAX_POINTS]; /* 0-based vertex index of each control point */
     uint8_t (*deg)[2];   /* degrees in u and v of each patch (3, 3 in Newell's format) */
     unsigned *line;      /* source line of each patch */

@@ -209,9 +209,9 @@ static cs_err_t sphere(cs_lex_t *lx, unsigned line, cs_surffile_t *sf)
 }
 
 static const char *const keywords[] = {
-    "bezier", "tri",           "hermite", "power",   "coons-bilinear", "coons-bicubic",
-    "coons-blend", "varady", "varady-scheme", "ruled", "extrude",        "revolve",
-    "sphere",
+    "bezier",        "tri",         "hermite", "power",         "coons-bilinear",
+    "coons-bicubic", "coons-blend", "varady",  "varady-scheme", "ruled",
+    "extrude",       "revolve",     "sphere",
 };
 
 const char *cs_surffile_keyword(size_t i)

@@ -368,7 +368,7 @@ static cs_err_t wire_sphere(tp_out_t *o, const cs_sphere_t *s, unsigned lines, c
     cs_err_t e = CS_OK;
     for (unsigned k = 0; e == CS_OK && k < 2 * lines; k++) {
         bool meridian = k < lines;
-        e = meridian ? cs_sphere_meridian(s, 0, 360.0 * k / lines, -90, 90, arc, &n)
+        e = meridian     ? cs_sphere_meridian(s, 0, 360.0 * k / lines, -90, 90, arc, &n)
             : k == lines ? CS_END
                          : cs_sphere_parallel(s, 0, -90 + 180.0 * (k - lines) / lines, arc, &n);
         for (unsigned i = 0; e == CS_OK && i < n; i++)
@@ -437,8 +437,7 @@ static cs_err_t finish_sphere(tp_ball_ctx_t *ctx, const cs_sphere_t *s, const tp
     unsigned n = (unsigned)ceil((M_PI / 2) / step - 1e-9);
     double dlat = 90.0 / n, rho = s->r + bp->r_mm;
     cs_vec3_t pole;
-    if (n == 0 || n > 100000 ||
-        cs_conv_mm_to_vec(s->c[0], s->c[1], s->c[2] + rho, &pole) != CS_OK)
+    if (n == 0 || n > 100000 || cs_conv_mm_to_vec(s->c[0], s->c[1], s->c[2] + rho, &pole) != CS_OK)
         return CS_ERR_RANGE;
     if (!ball_emit(ctx, 0, 0, 0, &pole, true))
         return CS_ERR_FULL;

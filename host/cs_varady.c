@@ -670,8 +670,8 @@ void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
             tangent(v, im, 1, ta);
             tangent(v, i, 0, tb);
             for (int k = 0; k < 3; k++)
-                out[k] -= kappa[i] * (p[k] + d[im] * ta[k] + d[i] * tb[k] +
-                                      d[im] * d[i] * v->twist[i][k]);
+                out[k] -= kappa[i] *
+                          (p[k] + d[im] * ta[k] + d[i] * tb[k] + d[im] * d[i] * v->twist[i][k]);
         }
     }
 }

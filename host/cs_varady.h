@@ -71,13 +71,13 @@ typedef struct {
     double t0[CS_VARADY_MAX_SIDES][3];     /* cross-boundary tangent of side i at s = 0 */
     double t1[CS_VARADY_MAX_SIDES][3];     /* ... at s = 1 (unit vectors into the patch) */
     /* Per side i, in its local frame (origin p_i, u along side i, v into the domain): */
-    double len_d[CS_VARADY_MAX_SIDES]; /* domain side length |p_{i+1} - p_i| */
-    double w1[CS_VARADY_MAX_SIDES][2]; /* unit direction p_i -> p_{i-1} */
-    double w2[CS_VARADY_MAX_SIDES][2]; /* unit direction p_{i+1} -> p_{i+2} */
-    double w12u[CS_VARADY_MAX_SIDES];  /* central line: u of w12 (its v is (w1v + w2v) / 2) */
-    double rc[CS_VARADY_MAX_SIDES][2]; /* radial: where the lines of sides i - 1, i + 1 meet */
-    int rpar[CS_VARADY_MAX_SIDES];     /* radial: those lines are parallel (rays along w1) */
-    bool user_tan;                     /* tan[] replaces the linear t0 -> t1 blend */
+    double len_d[CS_VARADY_MAX_SIDES];    /* domain side length |p_{i+1} - p_i| */
+    double w1[CS_VARADY_MAX_SIDES][2];    /* unit direction p_i -> p_{i-1} */
+    double w2[CS_VARADY_MAX_SIDES][2];    /* unit direction p_{i+1} -> p_{i+2} */
+    double w12u[CS_VARADY_MAX_SIDES];     /* central line: u of w12 (its v is (w1v + w2v) / 2) */
+    double rc[CS_VARADY_MAX_SIDES][2];    /* radial: where the lines of sides i - 1, i + 1 meet */
+    int rpar[CS_VARADY_MAX_SIDES];        /* radial: those lines are parallel (rays along w1) */
+    bool user_tan;                        /* tan[] replaces the linear t0 -> t1 blend */
     cs_bezier_t tan[CS_VARADY_MAX_SIDES]; /* T_i(s), mm per domain unit (cs_varady_set_tangents) */
     double twist[CS_VARADY_MAX_SIDES][3]; /* W_i at corner i (start of side i), zero by default */
 } cs_varady_t;

@@ -149,11 +149,11 @@ cs_err_t cs_coons_bicubic(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs
     return cs_coons_bicubic_twist(p1, p2, q1, q2, p1v, p2v, q1u, q2u, NULL, out);
 }
 
-cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2,
-                                const cs_bezier_t *q1, const cs_bezier_t *q2,
-                                const cs_bezier_t *p1v, const cs_bezier_t *p2v,
-                                const cs_bezier_t *q1u, const cs_bezier_t *q2u,
-                                const cs_vec3_t twist[2][2], cs_patch_t *out)
+cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs_bezier_t *q1,
+                                const cs_bezier_t *q2, const cs_bezier_t *p1v,
+                                const cs_bezier_t *p2v, const cs_bezier_t *q1u,
+                                const cs_bezier_t *q2u, const cs_vec3_t twist[2][2],
+                                cs_patch_t *out)
 {
     cs_err_t e = check_boundary(p1, p2, q1, q2);
     if (e != CS_OK)
@@ -208,8 +208,8 @@ cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2,
              end_tangent(q2, true, a)},
             {end_tangent(p1, false, a), end_tangent(p2, false, a),
              twist ? coord(&twist[0][0], a) : 0, twist ? coord(&twist[0][1], a) : 0},
-            {end_tangent(p1, true, a), end_tangent(p2, true, a),
-             twist ? coord(&twist[1][0], a) : 0, twist ? coord(&twist[1][1], a) : 0},
+            {end_tangent(p1, true, a), end_tangent(p2, true, a), twist ? coord(&twist[1][0], a) : 0,
+             twist ? coord(&twist[1][1], a) : 0},
         };
         for (unsigned i = 0; i < 4; i++) {
             for (unsigned j = 0; j < 4; j++) {

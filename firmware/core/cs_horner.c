@@ -5,8 +5,14 @@ CS_STATIC_ASSERT(CS_BEZIER_MAX_DEGREE <= 7, binomials_up_to_7);
 CS_STATIC_ASSERT(40 + CS_HORNER_GUARD + 3 <= 62, horner_sums_below_2_62);
 
 static const int64_t binom[8][8] = {
-    {1},          {1, 1},           {1, 2, 1},           {1, 3, 3, 1},
-    {1, 4, 6, 4, 1}, {1, 5, 10, 10, 5, 1}, {1, 6, 15, 20, 15, 6, 1}, {1, 7, 21, 35, 35, 21, 7, 1},
+    {1},
+    {1, 1},
+    {1, 2, 1},
+    {1, 3, 3, 1},
+    {1, 4, 6, 4, 1},
+    {1, 5, 10, 10, 5, 1},
+    {1, 6, 15, 20, 15, 6, 1},
+    {1, 7, 21, 35, 35, 21, 7, 1},
 };
 
 static int32_t coord(const cs_vec3_t *p, unsigned a)

@@ -357,8 +357,14 @@ cs_err_t cs_patch_iso(const cs_patch_t *p, cs_patch_iso_t dir, cs_param_t t, cs_
 /* --- raster by forward differences ------------------------------------------------------- */
 
 static const int64_t binom[NPTS][NPTS] = {
-    {1},          {1, 1},           {1, 2, 1},           {1, 3, 3, 1},
-    {1, 4, 6, 4, 1}, {1, 5, 10, 10, 5, 1}, {1, 6, 15, 20, 15, 6, 1}, {1, 7, 21, 35, 35, 21, 7, 1},
+    {1},
+    {1, 1},
+    {1, 2, 1},
+    {1, 3, 3, 1},
+    {1, 4, 6, 4, 1},
+    {1, 5, 10, 10, 5, 1},
+    {1, 6, 15, 20, 15, 6, 1},
+    {1, 7, 21, 35, 35, 21, 7, 1},
 };
 
 unsigned cs_patch_raster_max_shift(unsigned m)
@@ -433,9 +439,9 @@ cs_err_t cs_patch_raster_next(cs_patch_raster_t *r, cs_bezier_t *out, cs_param_t
     for (unsigned i = 0; i <= r->degree; i++) {
         for (unsigned a = 0; a < 3; a++) {
             int32_t v;
-            if (cs_fixed_narrow(cs_fixed_round_shift64(r->f[i][a][0], (unsigned)r->order *
-                                                                          r->shift),
-                                &v) != CS_OK)
+            if (cs_fixed_narrow(
+                    cs_fixed_round_shift64(r->f[i][a][0], (unsigned)r->order * r->shift), &v) !=
+                CS_OK)
                 return CS_ERR_OVERFLOW;
             set_coord(&c.p[i], a, v);
         }

@@ -62,7 +62,7 @@ typedef struct {
     uint8_t degree; /* of each iso-curve */
     uint8_t order;  /* m: degree of the control points in the fixed parameter */
     uint8_t shift;
-    uint16_t k;                                               /* next curve, 0..N; N + 1: done */
+    uint16_t k;                                             /* next curve, 0..N; N + 1: done */
     int64_t f[CS_PATCH_MAX_POINTS][3][CS_PATCH_MAX_POINTS]; /* N^m * value, then differences */
 } cs_patch_raster_t;
 

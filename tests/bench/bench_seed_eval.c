@@ -189,7 +189,7 @@ int main(int argc, char **argv)
     random_set(&seven, 7);
     const bench_set_t *sets[2] = {&cubic, &seven};
     static const char *const names[3] = {"naive power form", "Horner (cs_horner)",
-                                          "de Casteljau (cs_bezier_eval)"};
+                                         "de Casteljau (cs_bezier_eval)"};
     printf("## Seed 003's evaluations and length-based subdivision (bench_seed_eval)\n\n");
     printf("Cost per point and worst error against a long double Bernstein sum, %d curves per "
            "set, %d points each (`flatten --eval`, `--method length`):\n\n",

@@ -151,14 +151,14 @@ static cs_ref_vec_t coons_ref(const boundary_t *b, const cs_bezier_t *const dp[4
     double hu[4], hv[4];
     hblend(u, hu);
     hblend(v, hv);
-    cs_ref_vec_t d0 = lin(1, lin(hu[0], A[0][2], hu[1], A[1][2]), 1,
-                          lin(hu[2], A[2][2], hu[3], A[3][2]));
-    cs_ref_vec_t d1 = lin(1, lin(hu[0], A[0][3], hu[1], A[1][3]), 1,
-                          lin(hu[2], A[2][3], hu[3], A[3][3]));
-    cs_ref_vec_t d2 = lin(1, lin(hv[0], A[2][0], hv[1], A[2][1]), 1,
-                          lin(hv[2], A[2][2], hv[3], A[2][3]));
-    cs_ref_vec_t d3 = lin(1, lin(hv[0], A[3][0], hv[1], A[3][1]), 1,
-                          lin(hv[2], A[3][2], hv[3], A[3][3]));
+    cs_ref_vec_t d0 =
+        lin(1, lin(hu[0], A[0][2], hu[1], A[1][2]), 1, lin(hu[2], A[2][2], hu[3], A[3][2]));
+    cs_ref_vec_t d1 =
+        lin(1, lin(hu[0], A[0][3], hu[1], A[1][3]), 1, lin(hu[2], A[2][3], hu[3], A[3][3]));
+    cs_ref_vec_t d2 =
+        lin(1, lin(hv[0], A[2][0], hv[1], A[2][1]), 1, lin(hv[2], A[2][2], hv[3], A[2][3]));
+    cs_ref_vec_t d3 =
+        lin(1, lin(hv[0], A[3][0], hv[1], A[3][1]), 1, lin(hv[2], A[3][2], hv[3], A[3][3]));
     cs_ref_vec_t c1[4] = {cs_ref_eval(&b->p1, u), cs_ref_eval(&b->p2, u),
                           with ? cs_ref_eval(dp[0], u) : d0, with ? cs_ref_eval(dp[1], u) : d1};
     cs_ref_vec_t c2[4] = {cs_ref_eval(&b->q1, v), cs_ref_eval(&b->q2, v),
@@ -302,8 +302,10 @@ static void test_bicubic_twist(void **state)
                  * second difference, signed by the direction of each step. */
                 int a0 = 3 * i, a1 = i ? 2 : 1, b0 = 3 * j, b1 = j ? 2 : 1;
                 double sg = (i ? -1 : 1) * (j ? -1 : 1);
-                cs_ref_vec_t q00 = cs_ref_from_pos(&p.p[a0][b0]), q10 = cs_ref_from_pos(&p.p[a1][b0]);
-                cs_ref_vec_t q01 = cs_ref_from_pos(&p.p[a0][b1]), q11 = cs_ref_from_pos(&p.p[a1][b1]);
+                cs_ref_vec_t q00 = cs_ref_from_pos(&p.p[a0][b0]),
+                             q10 = cs_ref_from_pos(&p.p[a1][b0]);
+                cs_ref_vec_t q01 = cs_ref_from_pos(&p.p[a0][b1]),
+                             q11 = cs_ref_from_pos(&p.p[a1][b1]);
                 cs_ref_vec_t got = {9 * sg * (q11.x - q10.x - q01.x + q00.x),
                                     9 * sg * (q11.y - q10.y - q01.y + q00.y),
                                     9 * sg * (q11.z - q10.z - q01.z + q00.z)};

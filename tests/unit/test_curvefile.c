@@ -24,7 +24,7 @@
 /* Control points are written on the 2^-16 mm grid, so only the conversions' own roundings
  * (<= 1 LSB per Bézier point, cs_basis.h / cs_nurbs.h / cs_spline.h) separate core and
  * reference; 4 LSB leaves room for the sum of a few. */
-#define TOL_MM (4 * CS_REF_LSB_MM)
+#define TOL_MM   (4 * CS_REF_LSB_MM)
 #define NSAMPLES 17
 
 typedef struct {
@@ -79,7 +79,8 @@ static void check_all(const cs_path_t *p, size_t nseg, v3 (*want)(size_t, double
 }
 
 /* ---- bezier: B(t) = sum C(n,i) t^i (1-t)^(n-i) P_i */
-static const v3 BZ[6] = {{0, 0, 0}, {5, 10, 1}, {10, -10, 2}, {15, 10, 3}, {20, -10, 4}, {25, 0, 5}};
+static const v3 BZ[6] = {{0, 0, 0},   {5, 10, 1},   {10, -10, 2},
+                         {15, 10, 3}, {20, -10, 4}, {25, 0, 5}};
 static v3 ref_bezier(size_t seg, double t)
 {
     (void)seg;
@@ -308,7 +309,8 @@ static void check_clamped(const char *text, const v3 *P, int n, v3 t0, v3 t1, bo
         for (int k = 0; k < 4; k++)
             q[k] = cs_ref_from_pos(&b->p[k]);
         cs_ref_vec_t want0 = {P[i].x, P[i].y, P[i].z}, want1 = {P[i + 1].x, P[i + 1].y, P[i + 1].z};
-        assert_true(cs_ref_dist(q[0], want0) <= CS_REF_LSB_MM && cs_ref_dist(q[3], want1) <= CS_REF_LSB_MM);
+        assert_true(cs_ref_dist(q[0], want0) <= CS_REF_LSB_MM &&
+                    cs_ref_dist(q[3], want1) <= CS_REF_LSB_MM);
         if (i == 0) {
             cs_ref_vec_t d = {3 * (q[1].x - q[0].x) / h[0], 3 * (q[1].y - q[0].y) / h[0],
                               3 * (q[1].z - q[0].z) / h[0]};
@@ -327,8 +329,10 @@ static void check_clamped(const char *text, const v3 *P, int n, v3 t0, v3 t1, bo
         for (int k = 0; k < 3; k++)
             r[k] = cs_ref_from_pos(&nb->p[k]);
         double hi = h[i], hn = h[i + 1];
-        cs_ref_vec_t d1a = {3 * (q[3].x - q[2].x) / hi, 3 * (q[3].y - q[2].y) / hi, 3 * (q[3].z - q[2].z) / hi};
-        cs_ref_vec_t d1b = {3 * (r[1].x - r[0].x) / hn, 3 * (r[1].y - r[0].y) / hn, 3 * (r[1].z - r[0].z) / hn};
+        cs_ref_vec_t d1a = {3 * (q[3].x - q[2].x) / hi, 3 * (q[3].y - q[2].y) / hi,
+                            3 * (q[3].z - q[2].z) / hi};
+        cs_ref_vec_t d1b = {3 * (r[1].x - r[0].x) / hn, 3 * (r[1].y - r[0].y) / hn,
+                            3 * (r[1].z - r[0].z) / hn};
         assert_true(cs_ref_dist(d1a, d1b) <= tol1 * (1 / hi + 1 / hn));
         cs_ref_vec_t d2a = {6 * (q[3].x - 2 * q[2].x + q[1].x) / (hi * hi),
                             6 * (q[3].y - 2 * q[2].y + q[1].y) / (hi * hi),
@@ -428,16 +432,15 @@ static void test_errors(void **state)
     expect_error("curvestep-curves 1\nline 0 0 0 5000 0 0\n", CS_ERR_RANGE, 2, 12, "outside");
     expect_error("curvestep-curves 1\nbspline 3 0 0 0 1 1 0 2 0 0\n", CS_ERR_DEGENERATE, 2, 1,
                  "bspline");
-    expect_error("curvestep-curves 1\nnurbs 2 0 0 0 1 1 1 0 0 knots 2 0 0 1 1\n", CS_ERR_WEIGHT,
-                 2, 23, "weight 0 must be > 0");
+    expect_error("curvestep-curves 1\nnurbs 2 0 0 0 1 1 1 0 0 knots 2 0 0 1 1\n", CS_ERR_WEIGHT, 2,
+                 23, "weight 0 must be > 0");
     expect_error("curvestep-curves 1\nnurbs 2 0 0 0 1 1 1 0 1 2 0 0 1 1\n", CS_ERR_PARSE, 2, 25,
                  "'knots' expected");
     expect_error("curvestep-curves 1\nbspline 4 0 0 0 1 1 0 2 0 0 3 1 0\nknots 4 0 0 0 0 2 1 1 1\n",
                  CS_ERR_KNOTS, 3, 19, "below");
     expect_error("curvestep-curves 1\nbeta 0 1 4 0 0 0 1 1 0 2 0 0 3 1 0\n", CS_ERR_RANGE, 2, 6,
                  "bias");
-    expect_error("curvestep-curves 1\narc 0 0 0 1 0 0 0 1 0 10 10\n", CS_ERR_RANGE, 2, 26,
-                 "sweep");
+    expect_error("curvestep-curves 1\narc 0 0 0 1 0 0 0 1 0 10 10\n", CS_ERR_RANGE, 2, 26, "sweep");
 }
 
 /* cs_input reads curves files by extension and, under any other name, by their header. */
@@ -461,12 +464,11 @@ static void test_input(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_bezier),  cmocka_unit_test(test_hermite),
+        cmocka_unit_test(test_bezier),      cmocka_unit_test(test_hermite),
         cmocka_unit_test(test_cubic_bases), cmocka_unit_test(test_nurbs),
-        cmocka_unit_test(test_natural), cmocka_unit_test(test_natural_clamped),
-        cmocka_unit_test(test_arc),
-        cmocka_unit_test(test_line_and_subpaths), cmocka_unit_test(test_errors),
-        cmocka_unit_test(test_input),
+        cmocka_unit_test(test_natural),     cmocka_unit_test(test_natural_clamped),
+        cmocka_unit_test(test_arc),         cmocka_unit_test(test_line_and_subpaths),
+        cmocka_unit_test(test_errors),      cmocka_unit_test(test_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -56,7 +56,8 @@ static cs_ref_vec_t patch_at(const cs_patch_t *p, double u, double v)
     cs_ref_vec_t r = {0, 0, 0};
     for (int i = 0; i < 4; i++)
         for (int j = 0; j < 4; j++) {
-            double b = bin[i] * pow(u, i) * pow(1 - u, 3 - i) * bin[j] * pow(v, j) * pow(1 - v, 3 - j);
+            double b =
+                bin[i] * pow(u, i) * pow(1 - u, 3 - i) * bin[j] * pow(v, j) * pow(1 - v, 3 - j);
             cs_ref_vec_t q = cs_ref_from_pos(&p->p[i][j]);
             r.x += b * q.x;
             r.y += b * q.y;

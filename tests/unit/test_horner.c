@@ -53,13 +53,15 @@ static void test_horner_eval(void **state)
         cs_bezier_t c = rnd_curve(n, CS_POS_LIMIT);
         cs_horner_t h;
         assert_int_equal(cs_horner_init(&h, &c), CS_OK);
-        cs_param_t t = it % 13 == 0 ? 0 : it % 17 == 0 ? CS_PARAM_ONE
-                                    : (cs_param_t)(ref_xorshift32_next(&rng) >> 2);
+        cs_param_t t = it % 13 == 0   ? 0
+                       : it % 17 == 0 ? CS_PARAM_ONE
+                                      : (cs_param_t)(ref_xorshift32_next(&rng) >> 2);
         cs_vec3_t p;
         assert_int_equal(cs_horner_eval(&h, t, &p), CS_OK);
         long double tt = (long double)t / CS_PARAM_ONE;
-        double d = (double)fmaxl(fabsl(bern_ref(&c, tt, 0) - p.x),
-                                 fmaxl(fabsl(bern_ref(&c, tt, 1) - p.y), fabsl(bern_ref(&c, tt, 2) - p.z)));
+        double d = (double)fmaxl(
+            fabsl(bern_ref(&c, tt, 0) - p.x),
+            fmaxl(fabsl(bern_ref(&c, tt, 1) - p.y), fabsl(bern_ref(&c, tt, 2) - p.z)));
         worst = fmax(worst, d);
         assert_true(d <= 0.5 + n * ldexp(1, -17) + 1e-9);
     }
@@ -126,7 +128,8 @@ static void test_lensub(void **state)
                     assert_true(k < rn);
                     assert_memory_equal(&p, &rpts[k], sizeof p);
                 }
-                double dl = sqrt(pow(p.x - prev.x, 2) + pow(p.y - prev.y, 2) + pow(p.z - prev.z, 2));
+                double dl =
+                    sqrt(pow(p.x - prev.x, 2) + pow(p.y - prev.y, 2) + pow(p.z - prev.z, 2));
                 assert_true(dl <= len);
                 prev = p;
                 k++;

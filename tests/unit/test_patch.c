@@ -378,7 +378,8 @@ static void test_iso_and_raster(void **state)
         cs_patch_t p;
         /* Cubics and below first, then degrees 4..7 (their raster stops at a smaller shift,
          * cs_patch_raster_max_shift: one more is refused). */
-        unsigned du = it < 60 ? 1 + it % 3 : 1 + it % 7, dv = it < 60 ? 1 + (it / 3) % 3 : 4 + it % 4;
+        unsigned du = it < 60 ? 1 + it % 3 : 1 + it % 7,
+                 dv = it < 60 ? 1 + (it / 3) % 3 : 4 + it % 4;
         rnd_patch(&p, du, dv, CS_POS_LIMIT);
         for (int dir = 0; dir < 2; dir++) {
             unsigned m = dir == 0 ? p.deg_v : p.deg_u, top = cs_patch_raster_max_shift(m);

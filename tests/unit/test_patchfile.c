@@ -232,8 +232,7 @@ static void test_bpt(void **state)
            "expected 'degu degv' (.bpt format), found 3");
     expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n", CS_ERR_PARSE, 6, 1, "end of file after 3 of 4");
     expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1\n", CS_ERR_PARSE, 6, 4, "expected x,y,z");
-    expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n9\n", CS_ERR_PARSE, 7, 1,
-           "after the last patch");
+    expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n9\n", CS_ERR_PARSE, 7, 1, "after the last patch");
 }
 
 int main(void)

@@ -18,7 +18,7 @@
 #include "cs_sphere.h"
 #include "cs_surffile.h"
 
-#define LSB CS_REF_LSB_MM
+#define LSB       CS_REF_LSB_MM
 #define ON_SPHERE (2 * LSB + 1e-9) /* cs_arc_build: every point within 2 LSB of the ellipse */
 
 static const cs_sphere_t S = {{10, -20, 5}, 25};
@@ -61,7 +61,8 @@ static void test_parallels_meridians(void **state)
                 assert_true(fabs(dist_c(p) - rho) <= ON_SPHERE);
                 /* in the meridian plane: (p - c) . (-sin lon, cos lon, 0) = 0 */
                 double lr = lon * M_PI / 180;
-                assert_true(fabs(-(p.x - S.c[0]) * sin(lr) + (p.y - S.c[1]) * cos(lr)) <= ON_SPHERE);
+                assert_true(fabs(-(p.x - S.c[0]) * sin(lr) + (p.y - S.c[1]) * cos(lr)) <=
+                            ON_SPHERE);
             }
         cs_ref_vec_t e0 = cs_ref_eval(&a[0], 0), e1 = cs_ref_eval(&a[n - 1], 1);
         assert_true(fabs(e0.z - S.c[2] - rho * sin(lat0 * M_PI / 180)) <= ON_SPHERE);

@@ -912,9 +912,9 @@ static void uneven(cs_bezier_t *sides)
         c[i] = mm(20 * cos(ang[i] * pi / 180), 20 * sin(ang[i] * pi / 180), i % 2 ? 3 : -2);
     for (int i = 0; i < 5; i++) {
         cs_vec3_t p0 = c[i], p3 = c[(i + 1) % 5];
-        cs_vec3_t pts[4] = {p0, cs_fixed_vec((2 * p0.x + p3.x) / 3, (2 * p0.y + p3.y) / 3, p0.z + 65536),
-                            cs_fixed_vec((p0.x + 2 * p3.x) / 3, (p0.y + 2 * p3.y) / 3, p3.z - 65536),
-                            p3};
+        cs_vec3_t pts[4] = {
+            p0, cs_fixed_vec((2 * p0.x + p3.x) / 3, (2 * p0.y + p3.y) / 3, p0.z + 65536),
+            cs_fixed_vec((p0.x + 2 * p3.x) / 3, (p0.y + 2 * p3.y) / 3, p3.z - 65536), p3};
         assert_int_equal(cs_bezier_init(&sides[i], 3, pts), CS_OK);
     }
 }
@@ -1009,7 +1009,7 @@ static void test_domains(void **state)
         printf("domain objective: solution 3 %.6g, least squares %.6g\n", f3, fl);
     /* Every domain interpolates the boundary at the vertices. */
     static const cs_varady_domain_t doms[4] = {CS_VARADY_DOMAIN_ARC, CS_VARADY_DOMAIN_CHORDS,
-                                                CS_VARADY_DOMAIN_ANGLES, CS_VARADY_DOMAIN_LSQ};
+                                               CS_VARADY_DOMAIN_ANGLES, CS_VARADY_DOMAIN_LSQ};
     for (int k = 0; k < 4; k++) {
         assert_int_equal(cs_varady_set_domain(&v, doms[k]), CS_OK);
         for (size_t i = 0; i < n; i++) {
@@ -1034,9 +1034,9 @@ static void biq_forward(const double vert[][2], size_t n, size_t i, double s, do
     double c[3][3][2], ce[2] = {0, 0};
     for (size_t k = 0; k < n; k++)
         ce[0] += vert[k][0] / (double)n, ce[1] += vert[k][1] / (double)n;
-    const double *rows[2][3] = {{vert[i], NULL, vert[(i + 1) % n]},
-                                {vert[(i + n - 1) % n], n == 3 ? vert[(i + 2) % n] : ce,
-                                 vert[(i + 2) % n]}};
+    const double *rows[2][3] = {
+        {vert[i], NULL, vert[(i + 1) % n]},
+        {vert[(i + n - 1) % n], n == 3 ? vert[(i + 2) % n] : ce, vert[(i + 2) % n]}};
     for (int x = 0; x < 2; x++) {
         c[0][0][x] = rows[0][0][x], c[2][0][x] = rows[0][2][x];
         c[1][0][x] = (rows[0][0][x] + rows[0][2][x]) / 2;
