@@ -33,6 +33,9 @@ int cs_cmd_toolpath(int argc, char **argv);
  * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] [JOBOPTS] FILE */
 int cs_cmd_stream(int argc, char **argv);
 
+/* curvestep inspect [--json] [--tol MM] [--rel R] [--patches] FILE */
+int cs_cmd_inspect(int argc, char **argv);
+
 /* curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH] */
 int cs_cmd_serve(int argc, char **argv);
 /* curvestep submit [--socket PATH] [--mode M] [--tol MM] [--feed MM/S] [JOBOPTS] FILE */

@@ -20,12 +20,20 @@
 #define TARGET       0.9  /* planned scallop, fraction of H */
 #define SHRINK       0.85 /* step reduction while the measured scallop is too high */
 
+/* C(n, k) for n <= CS_PATCH_MAX_DEGREE (exact in int64). */
+static int64_t binomial(unsigned n, unsigned k)
+{
+    int64_t c = 1;
+    for (unsigned i = 1; i <= k; i++)
+        c = c * (int64_t)(n - k + i) / (int64_t)i;
+    return c;
+}
+
 static double bern(int n, int k, double t)
 {
-    static const double b[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
     if (k < 0 || k > n)
         return 0;
-    return b[n][k] * pow(t, k) * pow(1 - t, n - k);
+    return (double)binomial((unsigned)n, (unsigned)k) * pow(t, k) * pow(1 - t, n - k);
 }
 
 /* d-th derivative of B_k^n at t (d = 0..2). */
@@ -154,11 +162,10 @@ double cs_finish_scallop(const cs_patch_t *p, double r_mm, double v1, double v2,
 
 cs_err_t cs_finish_tri_patch(const cs_tripatch_t *t, cs_patch_t *out)
 {
-    static const int64_t binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-    if (!t || !out || t->degree < 1 || t->degree > 3)
+    if (!t || !out || t->degree < 1 || t->degree > CS_TRIPATCH_MAX_DEGREE)
         return CS_ERR_DEGREE;
     unsigned n = t->degree;
-    cs_vec3_t pts[16];
+    cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
     for (unsigned i = 0; i <= n; i++) {
         unsigned m = n - i;
         for (unsigned l = 0; l <= n; l++) {
@@ -168,13 +175,13 @@ cs_err_t cs_finish_tri_patch(const cs_tripatch_t *t, cs_patch_t *out)
             for (unsigned j = 0; j <= m; j++) {
                 if (l < j || l - j > n - m)
                     continue;
-                int64_t w = binom[m][j] * binom[n - m][l - j];
+                int64_t w = binomial(m, j) * binomial(n - m, l - j);
                 const cs_vec3_t *b = &t->p[cs_tripatch_index(n, i, j)];
                 acc[0] += w * b->x;
                 acc[1] += w * b->y;
                 acc[2] += w * b->z;
             }
-            int64_t den = binom[n][l], r[3];
+            int64_t den = binomial(n, l), r[3];
             for (int k = 0; k < 3; k++) /* round half away from zero */
                 r[k] = acc[k] >= 0 ? (2 * acc[k] + den) / (2 * den)
                                    : -((-2 * acc[k] + den) / (2 * den));

@@ -14,6 +14,7 @@
 #include "cs_input.h"
 #include "cs_jobopts.h"
 #include "cs_machine_ini.h"
+#include "cs_lensub.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -29,7 +30,12 @@ static const struct {
     {"afd", CS_TRACE_AFD},
     {"subdiv", CS_TRACE_SUBDIV},
     {"predict", CS_TRACE_PREDICT},
+    {"length", CS_TRACE_SUBDIV}, /* not a cs_trace method: cs_lensub (FLATTEN_METHOD_LENGTH) */
 };
+
+/* Seed 003's length-based subdivision: chords at most --seg-len long (cs_lensub). */
+#define FLATTEN_METHOD_LENGTH      4
+#define FLATTEN_DEFAULT_SEG_LEN_MM 1.0
 
 /* The default: CS_TRACE_DEFAULT (the predicted-step tracer: near-greedy chords, proven within
  * the tolerance, several times faster than subdiv; docs/benchmarks.md). */
@@ -40,6 +46,8 @@ static void flatten_usage(FILE *f)
     fprintf(f,
             "Usage: curvestep flatten [--tol MM] [--method fd|afd|subdiv|predict] [--stats]\n"
             "                         [--svg OUT.svg] [--font FILE.jhf] [input and layout options] FILE\n"
+            "       curvestep flatten --method length [--seg-len MM] [--eval decasteljau|horner]\n"
+            "                         [--stats] [--svg OUT.svg] [input and layout options] FILE\n"
             "\n"
             "Flattens the curves of FILE into chords that stay within a tolerance of the exact\n"
             "curves, and prints the polyline: one vertex \"x y\" per line in millimetres (6\n"
@@ -47,7 +55,8 @@ static void flatten_usage(FILE *f)
             "\n"
             "FILE is G-code (.nc .gcode .ngc .g .tap .cnc: G0 G1 G2 G3 G5 G5.1 G5.2 G6.2,\n"
             "LinuxCNC parameters, expressions and O-words; see docs/inputs.md), HP-GL\n"
-            "(.plt .hpgl .hgl .hpg), or, for .svg .txt .d and by default,\n"
+            "(.plt .hpgl .hgl .hpg), a curves file (.curves, or first word \"curvestep-curves\":\n"
+            "every basis, docs/inputs.md), or, for .svg .txt .d and by default,\n"
             "an SVG document (<path>, <rect>, <circle>, <ellipse>, <line>, <polyline>,\n"
             "<polygon>, with every transform; width/height/viewBox map it to millimetres;\n"
             "fills are drawn as outlines; <text> is drawn in a stroke font; <use> is not drawn:\n"
@@ -63,7 +72,14 @@ static void flatten_usage(FILE *f)
             "  --tol MM        chord tolerance in mm (default %g; from %.7f to %d)\n"
             "  --method M      fd (uniform forward differences), afd (adaptive forward\n"
             "                  differences), subdiv (flatness subdivision) or predict\n"
-            "                  (predicted step verified by one flatness test; the default)\n"
+            "                  (predicted step verified by one flatness test; the default),\n"
+            "                  or length, seed 003's length-based subdivision: chords at most\n"
+            "                  --seg-len long, with no promise on the deviation (--tol is not\n"
+            "                  used; --stats measures the deviation)\n"
+            "  --seg-len MM    longest chord of --method length (default %g)\n"
+            "  --eval E        how --method length evaluates points: decasteljau (the default)\n"
+            "                  or horner (power basis, Horner's rule; rational curves keep de\n"
+            "                  Casteljau)\n"
             "  --stats         print a summary on stderr: elements, chords, and the largest\n"
             "                  deviation of a chord from its exact curve, measured in double on\n"
             "                  the host\n"
@@ -72,7 +88,7 @@ static void flatten_usage(FILE *f)
             "                  share/fonts/futural.jhf; a file that is not a font is an error)\n"
             "  -h, --help      show this help\n",
             CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
-            CS_POS_LIMIT_MM);
+            CS_POS_LIMIT_MM, FLATTEN_DEFAULT_SEG_LEN_MM);
     cs_jobopts_help(f);
     fprintf(f,
             "--fit uses the built-in machine's travel (or --page); merge and sort are off\n"
@@ -138,6 +154,8 @@ int cs_cmd_flatten(int argc, char **argv)
         {"svg", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},
         {"font", required_argument, NULL, 'f'},
+        {"seg-len", required_argument, NULL, 'L'},
+        {"eval", required_argument, NULL, 'E'},
         {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
@@ -150,6 +168,8 @@ int cs_cmd_flatten(int argc, char **argv)
     int r = take_jobopts(&argc, argv, &in);
     if (r != 0)
         return r;
+    double seg_len_mm = FLATTEN_DEFAULT_SEG_LEN_MM;
+    bool horner = false, eval_given = false;
     int c;
     optind = 1;
     opterr = 0;
@@ -178,7 +198,7 @@ int cs_cmd_flatten(int argc, char **argv)
                 k++;
             if (k == sizeof methods / sizeof methods[0]) {
                 fprintf(stderr,
-                        "curvestep flatten: --method '%s': expected fd, afd, subdiv or predict\n",
+                        "curvestep flatten: --method '%s': expected fd, afd, subdiv, predict or length\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }
@@ -193,6 +213,29 @@ int cs_cmd_flatten(int argc, char **argv)
             break;
         case 'f':
             font = optarg;
+            break;
+        case 'L': {
+            char *end = NULL;
+            cs_pos_t t = 0;
+            seg_len_mm = strtod(optarg, &end);
+            if (!end || end == optarg || *end != '\0' ||
+                cs_conv_tol_to_pos(seg_len_mm, &t) != CS_OK) {
+                fprintf(stderr,
+                        "curvestep flatten: --seg-len '%s': expected a length in mm, "
+                        "from 1 LSB (0.0000153) to 4096\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
+            break;
+        }
+        case 'E':
+            eval_given = true;
+            horner = strcmp(optarg, "horner") == 0;
+            if (!horner && strcmp(optarg, "decasteljau") != 0) {
+                fprintf(stderr, "curvestep flatten: --eval '%s': expected decasteljau or horner\n",
+                        optarg);
+                return CS_EXIT_USAGE;
+            }
             break;
         case 'h':
             flatten_usage(stdout);
@@ -213,8 +256,15 @@ int cs_cmd_flatten(int argc, char **argv)
         fprintf(stderr, "Try 'curvestep flatten --help'.\n");
         return CS_EXIT_USAGE;
     }
+    if (eval_given && method != FLATTEN_METHOD_LENGTH) {
+        fprintf(stderr, "curvestep flatten: --eval applies to --method length (the other "
+                        "tracers step their own differences)\n");
+        return CS_EXIT_USAGE;
+    }
     const char *file = argv[optind];
     const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
+    cs_pos_t seg_len;
+    cs_conv_tol_to_pos(seg_len_mm, &seg_len); /* validated above */
     cs_pos_t tol;
     cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
 
@@ -244,6 +294,8 @@ int cs_cmd_flatten(int argc, char **argv)
     double maxdev = 0.0;
     size_t maxdev_elem = 0;
     cs_trace_t tr;
+    cs_lensub_t ls;
+    bool by_length = method == FLATTEN_METHOD_LENGTH;
     for (size_t i = 0; i < path.n && status == CS_EXIT_OK; i++) {
         const cs_path_elem_t *el = &path.elems[i];
         const cs_bezier_t *cv = &el->curve;
@@ -269,7 +321,8 @@ int cs_cmd_flatten(int argc, char **argv)
             fprintf(stderr, "curvestep flatten: out of memory\n");
             break;
         }
-        e = cs_trace_begin(&tr, cv, tol, methods[method].method);
+        e = by_length ? cs_lensub_begin(&ls, cv, seg_len, horner && !cv->rational)
+                      : cs_trace_begin(&tr, cv, tol, methods[method].method);
         if (e == CS_ERR_TOLERANCE) {
             fprintf(stderr, "curvestep flatten: --tol %g: %s (method %s)\n", tol_mm, cs_err_text(e),
                     methods[method].name);
@@ -277,7 +330,8 @@ int cs_cmd_flatten(int argc, char **argv)
             break;
         }
         cs_vec3_t pt;
-        while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK) {
+        while (e == CS_OK &&
+               (e = by_length ? cs_lensub_next(&ls, &pt) : cs_trace_next(&tr, &pt)) == CS_OK) {
             printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
             nchords++;
             if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
@@ -309,7 +363,12 @@ int cs_cmd_flatten(int argc, char **argv)
     if (stats && status == CS_EXIT_OK) {
         fprintf(stderr, "flatten: %s: %zu elements in %u subpaths, %zu chords (%zu vertices)\n",
                 shown, path.n, path.nsubpaths, nchords, poly.n);
-        fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name, tol_mm);
+        if (method == FLATTEN_METHOD_LENGTH)
+            fprintf(stderr, "flatten: method length (%s), chords at most %.6g mm\n",
+                    horner ? "horner" : "decasteljau", seg_len_mm);
+        else
+            fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name,
+                    tol_mm);
         if (path.n > 0) {
             const cs_path_loc_t *l = &path.elems[maxdev_elem].loc;
             if (isinf(maxdev)) {

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "cs_curvefile.h"
 #include "cs_gcode.h"
 #include "cs_hpgl.h"
 #include "cs_svgdoc.h"
@@ -24,6 +25,8 @@ const char *cs_input_format_name(cs_input_format_t f)
         return "gcode";
     case CS_INPUT_HPGL:
         return "hpgl";
+    case CS_INPUT_CURVES:
+        return "curves";
     default:
         return "auto";
     }
@@ -35,11 +38,11 @@ static cs_input_format_t by_extension(const char *filename)
         const char *ext;
         cs_input_format_t f;
     } exts[] = {
-        {"svg", CS_INPUT_SVG},  {"txt", CS_INPUT_SVG},     {"d", CS_INPUT_SVG},
-        {"nc", CS_INPUT_GCODE}, {"gcode", CS_INPUT_GCODE}, {"ngc", CS_INPUT_GCODE},
-        {"g", CS_INPUT_GCODE},  {"tap", CS_INPUT_GCODE},   {"cnc", CS_INPUT_GCODE},
-        {"plt", CS_INPUT_HPGL}, {"hpgl", CS_INPUT_HPGL},   {"hgl", CS_INPUT_HPGL},
-        {"hpg", CS_INPUT_HPGL},
+        {"svg", CS_INPUT_SVG},  {"txt", CS_INPUT_SVG},       {"d", CS_INPUT_SVG},
+        {"nc", CS_INPUT_GCODE}, {"gcode", CS_INPUT_GCODE},   {"ngc", CS_INPUT_GCODE},
+        {"g", CS_INPUT_GCODE},  {"tap", CS_INPUT_GCODE},     {"cnc", CS_INPUT_GCODE},
+        {"plt", CS_INPUT_HPGL}, {"hpgl", CS_INPUT_HPGL},     {"hgl", CS_INPUT_HPGL},
+        {"hpg", CS_INPUT_HPGL}, {"curves", CS_INPUT_CURVES},
     };
     if (!filename || strcmp(filename, "-") == 0)
         return CS_INPUT_AUTO;
@@ -73,6 +76,8 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
     cs_input_format_t f = by_extension(filename);
     if (f != CS_INPUT_AUTO)
         return f;
+    if (cs_curvefile_is(buf, len))
+        return CS_INPUT_CURVES;
     size_t i = 0;
     if (len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
         (unsigned char)buf[2] == 0xBF)
@@ -195,6 +200,8 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
         go.warn_ctx = o->warn_ctx;
         return cs_gcode_read(name, buf, len, &go, path, diag, NULL);
     }
+    case CS_INPUT_CURVES:
+        return cs_curvefile_parse(name, buf, len, path, diag);
     case CS_INPUT_HPGL:
     default:
         return parse_drawing(f, name, buf, len, o, path, diag);

@@ -1,7 +1,7 @@
 /* cs_input: the one input loader every command that takes FILE uses. Reads the whole file (or
  * standard input) first, picks the reader by extension or, for other names and stdin, by
  * content, and runs it: SVG documents and bare SVG path data (cs_svgdoc), G-code (cs_gcode),
- * HP-GL (cs_hpgl). A job is parsed whole before anything is sent. */
+ * HP-GL (cs_hpgl), curves files (cs_curvefile). A job is parsed whole before anything is sent. */
 #ifndef CS_INPUT_H
 #define CS_INPUT_H
 
@@ -15,6 +15,7 @@ typedef enum {
     CS_INPUT_SVG = 1,  /* SVG document or bare SVG path data */
     CS_INPUT_GCODE = 2,
     CS_INPUT_HPGL = 3,
+    CS_INPUT_CURVES = 4, /* curvestep's curves file (cs_curvefile) */
 } cs_input_format_t;
 
 /* G-code dialect (--dialect): whose modal defaults, words and error behaviour apply
@@ -55,10 +56,11 @@ void cs_input_opts_init(cs_input_opts_t *o);
 
 /* The reader for filename (may be NULL or "-") holding buf[0..len): by extension (.svg; .txt
  * and .d = bare path data -> SVG; .nc .gcode .ngc .g .tap .cnc -> G-code; .plt .hpgl .hgl .hpg
- * -> HP-GL; any case), else by content (see docs/inputs.md). Never CS_INPUT_AUTO. */
+ * -> HP-GL; .curves -> curves file; any case), else by content (a first token
+ * "curvestep-curves" is a curves file; the rest: docs/inputs.md). Never CS_INPUT_AUTO. */
 cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t len);
 
-/* Short name of a format ("svg", "gcode", "hpgl", "auto"). */
+/* Short name of a format ("svg", "gcode", "hpgl", "curves", "auto"). */
 const char *cs_input_format_name(cs_input_format_t f);
 
 /* Parses buf[0..len) named name (for diagnostics) as format f (CS_INPUT_AUTO: detected from

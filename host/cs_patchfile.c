@@ -23,6 +23,7 @@ typedef struct {
 } lexer_t;
 
 #define MAX_FIELDS 17 /* one more than any line needs, to report "too many" */
+CS_STATIC_ASSERT(CS_PATCHFILE_MAX_POINTS >= 16, newell_patch_fits);
 
 typedef struct {
     size_t n;
@@ -136,51 +137,122 @@ void cs_patchfile_free(cs_patchfile_t *pf)
 {
     free(pf->file);
     free(pf->idx);
+    free(pf->deg);
     free(pf->line);
     free(pf->vert);
     free(pf->vert_line);
     memset(pf, 0, sizeof *pf);
 }
 
-cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_patchfile_t *pf,
-                            cs_path_diag_t *diag)
+/* Room for n patches' indices, degrees and lines. */
+static cs_err_t alloc_patches(cs_patchfile_t *pf, size_t n)
 {
-    memset(pf, 0, sizeof *pf);
-    pf->file = strdup(name ? name : "-");
-    if (!pf->file)
-        return CS_ERR_FULL;
-    lexer_t lx = {pf->file, text, text + len, text, 0, diag};
-    cs_err_t e = read_count(&lx, "patch", &pf->npatches);
+    pf->npatches = n;
+    pf->idx = calloc(n, sizeof *pf->idx);
+    pf->deg = calloc(n, sizeof *pf->deg);
+    pf->line = calloc(n, sizeof *pf->line);
+    return pf->idx && pf->deg && pf->line ? CS_OK : CS_ERR_FULL;
+}
+
+/* Room for n vertices. */
+static cs_err_t alloc_verts(cs_patchfile_t *pf, size_t n)
+{
+    pf->nverts = n;
+    pf->vert = calloc(n, sizeof *pf->vert);
+    pf->vert_line = calloc(n, sizeof *pf->vert_line);
+    return pf->vert && pf->vert_line ? CS_OK : CS_ERR_FULL;
+}
+
+/* One "x y z" line into vertex v. */
+static cs_err_t read_vertex(lexer_t *lx, cs_patchfile_t *pf, size_t v, const char *what, size_t of)
+{
+    fields_t f;
+    cs_err_t e;
+    if (!next_line(lx, &f, &e))
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno + 1, 1),
+                                "end of file after %zu of %zu %s", v, of, what);
     if (e != CS_OK)
-        goto fail;
-    pf->idx = calloc(pf->npatches, sizeof *pf->idx);
-    pf->line = calloc(pf->npatches, sizeof *pf->line);
-    unsigned(*icol)[16] = calloc(pf->npatches, sizeof *icol);
-    if (!pf->idx || !pf->line || !icol) {
-        free(icol);
-        e = CS_ERR_FULL;
-        goto fail;
+        return e;
+    if (f.n != 3)
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, f.lineno, f.endcol),
+                                "vertex %zu: expected x,y,z (3 numbers), found %s%zu", v + 1,
+                                f.n > MAX_FIELDS ? "more than " : "",
+                                f.n > MAX_FIELDS ? (size_t)MAX_FIELDS : f.n);
+    for (unsigned a = 0; a < 3; a++)
+        pf->vert[v][a] = f.v[a];
+    pf->vert_line[v] = f.lineno;
+    return CS_OK;
+}
+
+/* .bpt: per patch "degu degv" then its points, each stored as a vertex of its own. */
+static cs_err_t parse_bpt(lexer_t *lx, cs_patchfile_t *pf)
+{
+    size_t np = pf->npatches, nv = 0;
+    if (alloc_verts(pf, np * CS_PATCHFILE_MAX_POINTS) != CS_OK)
+        return CS_ERR_FULL;
+    for (size_t i = 0; i < np; i++) {
+        fields_t f;
+        cs_err_t e;
+        if (!next_line(lx, &f, &e))
+            return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno + 1, 1),
+                                    "end of file after %zu of %zu patches", i, np);
+        if (e != CS_OK)
+            return e;
+        for (unsigned k = 0; k < 2 && f.n == 2; k++)
+            if (!f.integer[k] || f.v[k] < 1 || f.v[k] > CS_PATCH_MAX_DEGREE)
+                return cs_path_diag_set(lx->diag, CS_ERR_DEGREE, loc(lx, f.lineno, f.col[k]),
+                                        "patch %zu: degree %g outside 1..%d (.bpt format)", i + 1,
+                                        f.v[k], CS_PATCH_MAX_DEGREE);
+        if (f.n != 2)
+            return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, f.lineno, f.endcol),
+                                    "patch %zu: expected 'degu degv' (.bpt format), found %zu "
+                                    "numbers",
+                                    i + 1, f.n);
+        pf->deg[i][0] = (uint8_t)f.v[0];
+        pf->deg[i][1] = (uint8_t)f.v[1];
+        pf->line[i] = f.lineno;
+        size_t npts = (size_t)(pf->deg[i][0] + 1) * (size_t)(pf->deg[i][1] + 1);
+        for (size_t k = 0; k < npts; k++, nv++) {
+            pf->idx[i][k] = nv;
+            if ((e = read_vertex(lx, pf, nv, "control points", nv + npts - k)) != CS_OK)
+                return e;
+        }
     }
+    pf->nverts = nv;
+    return CS_OK;
+}
+
+/* Newell's format after the patch count: index lines, vertex count, vertices. */
+static cs_err_t parse_newell(lexer_t *lx, cs_patchfile_t *pf)
+{
+    cs_path_diag_t *diag = lx->diag;
+    cs_err_t e = CS_OK;
+    unsigned(*icol)[16] = calloc(pf->npatches, sizeof *icol);
+    if (!icol)
+        return CS_ERR_FULL;
     for (size_t i = 0; i < pf->npatches; i++) {
         fields_t f;
-        if (!next_line(&lx, &f, &e)) {
-            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, lx.lineno + 1, 1),
+        if (!next_line(lx, &f, &e)) {
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(lx, lx->lineno + 1, 1),
                                  "end of file after %zu of %zu patches", i, pf->npatches);
             break;
         }
         if (e != CS_OK)
             break;
         if (f.n != 16) {
-            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.endcol),
-                                 "patch %zu: expected 16 vertex indices, found %s%zu", i + 1,
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(lx, f.lineno, f.endcol),
+                                 "patch %zu: expected 16 vertex indices (Newell's format%s), "
+                                 "found %s%zu",
+                                 i + 1, i == 0 ? "; a .bpt file has 'degu degv' here" : "",
                                  f.n > 16 ? "more than " : "", f.n > 16 ? (size_t)16 : f.n);
             break;
         }
         pf->line[i] = f.lineno;
+        pf->deg[i][0] = pf->deg[i][1] = 3;
         for (unsigned k = 0; k < 16; k++) {
             if (!f.integer[k] || f.v[k] < 1) {
                 e = cs_path_diag_set(diag, f.integer[k] ? CS_ERR_RANGE : CS_ERR_PARSE,
-                                     loc(&lx, f.lineno, f.col[k]),
+                                     loc(lx, f.lineno, f.col[k]),
                                      "vertex index must be an integer >= 1 (indices are "
                                      "one-based)");
                 break;
@@ -191,64 +263,66 @@ cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_p
         if (e != CS_OK)
             break;
     }
+    size_t nverts = 0;
     if (e == CS_OK)
-        e = read_count(&lx, "vertex", &pf->nverts);
-    if (e == CS_OK) {
-        /* Every index must name a vertex (checked now that the count is known). */
-        for (size_t i = 0; i < pf->npatches && e == CS_OK; i++)
-            for (unsigned k = 0; k < 16 && e == CS_OK; k++)
-                if (pf->idx[i][k] >= pf->nverts)
-                    e = cs_path_diag_set(diag, CS_ERR_RANGE, loc(&lx, pf->line[i], icol[i][k]),
-                                         "vertex index %zu outside 1..%zu", pf->idx[i][k] + 1,
-                                         pf->nverts);
-    }
+        e = read_count(lx, "vertex", &nverts);
+    /* Every index must name a vertex (checked now that the count is known). */
+    for (size_t i = 0; i < pf->npatches && e == CS_OK; i++)
+        for (unsigned k = 0; k < 16 && e == CS_OK; k++)
+            if (pf->idx[i][k] >= nverts)
+                e = cs_path_diag_set(diag, CS_ERR_RANGE, loc(lx, pf->line[i], icol[i][k]),
+                                     "vertex index %zu outside 1..%zu", pf->idx[i][k] + 1, nverts);
     free(icol);
+    if (e == CS_OK)
+        e = alloc_verts(pf, nverts);
+    for (size_t i = 0; e == CS_OK && i < nverts; i++)
+        e = read_vertex(lx, pf, i, "vertices", nverts);
+    return e;
+}
+
+/* Which format: the line after the patch count holds 2 degrees (.bpt) or, in Newell's format,
+ * 16 indices (parse_newell refuses any other count, naming both formats). */
+static cs_err_t which_format(const lexer_t *lx, bool *bpt)
+{
+    lexer_t peek = *lx;
+    fields_t f;
+    cs_err_t e;
+    if (!next_line(&peek, &f, &e))
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, loc(lx, lx->lineno + 1, 1),
+                                "end of file: the first patch was expected");
     if (e != CS_OK)
-        goto fail;
-    pf->vert = calloc(pf->nverts, sizeof *pf->vert);
-    pf->vert_line = calloc(pf->nverts, sizeof *pf->vert_line);
-    if (!pf->vert || !pf->vert_line) {
-        e = CS_ERR_FULL;
-        goto fail;
-    }
-    for (size_t i = 0; i < pf->nverts; i++) {
-        fields_t f;
-        if (!next_line(&lx, &f, &e)) {
-            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, lx.lineno + 1, 1),
-                                 "end of file after %zu of %zu vertices", i, pf->nverts);
-            goto fail;
-        }
-        if (e != CS_OK)
-            goto fail;
-        if (f.n != 3) {
-            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.endcol),
-                                 "vertex %zu: expected x,y,z (3 numbers), found %s%zu", i + 1,
-                                 f.n > MAX_FIELDS ? "more than " : "",
-                                 f.n > MAX_FIELDS ? (size_t)MAX_FIELDS : f.n);
-            goto fail;
-        }
-        for (unsigned a = 0; a < 3; a++)
-            pf->vert[i][a] = f.v[a];
-        pf->vert_line[i] = f.lineno;
-    }
-    {
-        fields_t f;
-        if (next_line(&lx, &f, &e)) {
-            if (e == CS_OK)
-                e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.col[0]),
-                                     "unexpected data after the last of %zu vertices", pf->nverts);
-            goto fail;
-        }
-    }
+        return e;
+    *bpt = f.n == 2;
     return CS_OK;
-fail:
+}
+
+cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_patchfile_t *pf,
+                            cs_path_diag_t *diag)
+{
+    memset(pf, 0, sizeof *pf);
+    pf->file = strdup(name ? name : "-");
+    if (!pf->file)
+        return CS_ERR_FULL;
+    lexer_t lx = {pf->file, text, text + len, text, 0, diag};
+    size_t np = 0;
+    cs_err_t e = read_count(&lx, "patch", &np);
+    if (e == CS_OK)
+        e = which_format(&lx, &pf->bpt);
+    if (e == CS_OK)
+        e = alloc_patches(pf, np);
+    if (e == CS_OK)
+        e = pf->bpt ? parse_bpt(&lx, pf) : parse_newell(&lx, pf);
+    fields_t f;
+    if (e == CS_OK && next_line(&lx, &f, &e) && e == CS_OK)
+        e = cs_path_diag_set(diag, CS_ERR_PARSE, loc(&lx, f.lineno, f.col[0]),
+                             "unexpected data after the last %s", pf->bpt ? "patch" : "vertex");
+    if (e == CS_OK)
+        return CS_OK;
     /* Keep only the name, which the diagnostic points to (freed by cs_patchfile_free). */
-    {
-        char *file = pf->file;
-        pf->file = NULL;
-        cs_patchfile_free(pf);
-        pf->file = file;
-    }
+    char *file = pf->file;
+    pf->file = NULL;
+    cs_patchfile_free(pf);
+    pf->file = file;
     return e;
 }
 
@@ -305,8 +379,9 @@ cs_err_t cs_patchfile_patch(const cs_patchfile_t *pf, size_t i, double scale, cs
 {
     if (i >= pf->npatches || !isfinite(scale))
         return CS_ERR_ARG;
-    cs_vec3_t pts[16];
-    for (unsigned k = 0; k < 16; k++) {
+    cs_vec3_t pts[CS_PATCHFILE_MAX_POINTS];
+    unsigned du = pf->deg[i][0], dv = pf->deg[i][1];
+    for (unsigned k = 0; k < (du + 1) * (dv + 1); k++) {
         size_t v = pf->idx[i][k];
         const double *q = pf->vert[v];
         if (cs_conv_mm_to_vec(q[0] * scale, q[1] * scale, q[2] * scale, &pts[k]) != CS_OK) {
@@ -316,7 +391,7 @@ cs_err_t cs_patchfile_patch(const cs_patchfile_t *pf, size_t i, double scale, cs
                                     v + 1, i + 1, scale, CS_POS_LIMIT_MM);
         }
     }
-    return cs_patch_init(out, 3, 3, pts);
+    return cs_patch_init(out, du, dv, pts);
 }
 
 cs_err_t cs_patchfile_write(FILE *f, const cs_patch_t *patches, size_t n)

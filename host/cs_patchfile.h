@@ -1,21 +1,33 @@
-/* cs_patchfile: reads bicubic Bézier patch sets in Newell's indexed text format (the Utah
- * teapot's): a patch count; one line of 16 one-based vertex indices per patch (k = 4 i + j:
- * i runs along u, j along v); a vertex count; one "x,y,z" line per vertex. Commas and blanks
- * both separate numbers; blank lines are skipped. Owns the parsed file and its conversion to
- * the core's cs_patch_t (with a scale, range-checked); bad input is "file:line:col: reason". */
+/* cs_patchfile: reads Bézier patch sets in two text formats, told apart by the line after the
+ * patch count:
+ *  - Newell's indexed format (the Utah teapot's): a patch count; one line of 16 one-based vertex
+ *    indices per patch (k = 4 i + j: i runs along u, j along v); a vertex count; one "x,y,z"
+ *    line per vertex (bicubic patches);
+ *  - the .bpt format: a patch count; per patch a line "degu degv" (each 1..CS_PATCH_MAX_DEGREE)
+ *    then (degu + 1)(degv + 1) lines "x y z", point k = i (degv + 1) + j (i along u).
+ * Commas and blanks both separate numbers; blank lines are skipped. Owns the parsed file and
+ * its conversion to the core's cs_patch_t (with a scale, range-checked); bad input is
+ * "file:line:col: reason", and a file of neither shape says what each format expected. */
 #ifndef CS_PATCHFILE_H
 #define CS_PATCHFILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "cs_patch.h"
 #include "cs_path.h"
 
+/* Most control points of one patch (either format). */
+#define CS_PATCHFILE_MAX_POINTS (CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS)
+
 typedef struct {
-    char *file;          /* the name diagnostics use (owned) */
-    size_t npatches;     /* patches read */
-    size_t (*idx)[16];   /* 0-based vertex index of each control point */
+    char *file;                             /* the name diagnostics use (owned) */
+    bool bpt;                               /* read as .bpt (else Newell's format) */
+    size_t npatches;                        /* patches read */
+    size_t (*idx)[CS_PATCHFILE_MAX_POINTS]; /* 0-based vertex index of each control point */
+    uint8_t (*deg)[2];   /* degrees in u and v of each patch (3, 3 in Newell's format) */
     unsigned *line;      /* source line of each patch */
     size_t nverts;       /* vertices read */
     double (*vert)[3];   /* x, y, z as written */
@@ -30,7 +42,7 @@ cs_err_t cs_patchfile_read(const char *filename, cs_patchfile_t *pf, cs_path_dia
 /* Same, from a string already in memory (name used in diagnostics). */
 cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_patchfile_t *pf,
                             cs_path_diag_t *diag);
-/* Patch i as a bicubic cs_patch_t with every coordinate multiplied by scale (mm per file
+/* Patch i as a cs_patch_t of its degrees with every coordinate multiplied by scale (mm per file
  * unit). CS_ERR_RANGE with *diag (at the offending vertex's line) when a coordinate leaves
  * +/-CS_POS_LIMIT_MM; CS_ERR_ARG for i out of range. */
 cs_err_t cs_patchfile_patch(const cs_patchfile_t *pf, size_t i, double scale, cs_patch_t *out,

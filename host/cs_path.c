@@ -411,3 +411,11 @@ double cs_path_deviation_mm(const cs_bezier_t *c, const cs_vec3_t *v, size_t n)
     free(tv);
     return worst;
 }
+
+const char *cs_path_kind_name(cs_path_kind_t k)
+{
+    static const char *const names[] = {"line",  "quad",        "cubic",   "arc",
+                                        "other", "bezier",      "hermite", "bspline",
+                                        "nurbs", "catmull-rom", "beta",    "natural"};
+    return (unsigned)k < sizeof names / sizeof names[0] ? names[k] : "?";
+}

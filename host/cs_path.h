@@ -19,7 +19,19 @@ typedef enum {
     CS_PATH_CUBIC = 2, /* cubic Bézier (SVG C/S) */
     CS_PATH_ARC = 3,   /* one piece (<= 90 degrees) of a circular/elliptical arc, rational */
     CS_PATH_OTHER = 4, /* any other curve converted to Bézier form */
+    /* The curves file's bases (cs_curvefile), each converted to Bézier segments: */
+    CS_PATH_BEZIER = 5,      /* a Bézier of any degree 1..7 */
+    CS_PATH_HERMITE = 6,     /* cubic Hermite (points and tangents) */
+    CS_PATH_BSPLINE = 7,     /* uniform cubic or non-uniform B-spline */
+    CS_PATH_NURBS = 8,       /* rational B-spline */
+    CS_PATH_CATMULL_ROM = 9, /* Catmull-Rom spline */
+    CS_PATH_BETA = 10,       /* Barsky beta-spline */
+    CS_PATH_NATURAL = 11,    /* natural cubic spline */
 } cs_path_kind_t;
+
+/* The kind's name as the curves file spells it ("line", "quad", "cubic", "arc", "other",
+ * "bezier", "hermite", ...); "?" for a value outside the enum. */
+const char *cs_path_kind_name(cs_path_kind_t k);
 
 /* A place in an input file: 1-based line and column (columns count characters, a tab is 1).
  * file points to a name owned by the cs_path_t (or a static string); never NULL. */

@@ -1,7 +1,6 @@
 /* cs_surffile: Newell or native surface files -> core patches (see cs_surffile.h). */
 #include "cs_surffile.h"
 
-#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,128 +10,22 @@
 #include "cs_coons.h"
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_gcoons.h"
+#include "cs_lex.h"
 #include "cs_patchfile.h"
 #include "cs_revolve.h"
 
 #define NATIVE_MAGIC "curvestep-surfaces"
 
-typedef struct {
-    const char *p, *end;
-    unsigned line, col;
-    const char *name;
-    cs_path_diag_t *diag;
-    double scale;
-    /* the token just read */
-    char tok[64];
-    unsigned tline, tcol;
-} lex_t;
-
-static cs_path_loc_t here(const lex_t *lx)
-{
-    cs_path_loc_t l = {lx->name, lx->tline, lx->tcol};
-    return l;
-}
-
-/* Next token into lx->tok; false at end of text. */
-static bool next_tok(lex_t *lx)
-{
-    for (;;) {
-        while (lx->p < lx->end && isspace((unsigned char)*lx->p)) {
-            if (*lx->p == '\n') {
-                lx->line++;
-                lx->col = 1;
-            } else {
-                lx->col++;
-            }
-            lx->p++;
-        }
-        if (lx->p < lx->end && *lx->p == '#') {
-            while (lx->p < lx->end && *lx->p != '\n')
-                lx->p++;
-            continue;
-        }
-        break;
-    }
-    if (lx->p >= lx->end) {
-        lx->tline = lx->line;
-        lx->tcol = lx->col;
-        return false;
-    }
-    lx->tline = lx->line;
-    lx->tcol = lx->col;
-    size_t k = 0;
-    while (lx->p < lx->end && !isspace((unsigned char)*lx->p) && *lx->p != '#') {
-        if (k < sizeof lx->tok - 1)
-            lx->tok[k++] = *lx->p;
-        lx->p++;
-        lx->col++;
-    }
-    lx->tok[k] = '\0';
-    return true;
-}
-
-static cs_err_t number(lex_t *lx, const char *what, double *out)
-{
-    if (!next_tok(lx))
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx), "end of file: %s expected", what);
-    char *e = NULL;
-    errno = 0;
-    double v = strtod(lx->tok, &e);
-    if (e == lx->tok || *e != '\0' || !isfinite(v))
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx), "'%s': %s expected", lx->tok,
-                                what);
-    *out = v;
-    return CS_OK;
-}
-
-static cs_err_t integer(lex_t *lx, const char *what, int lo, int hi, int *out)
-{
-    double v;
-    cs_err_t e = number(lx, what, &v);
-    if (e != CS_OK)
-        return e;
-    if (v != floor(v) || v < lo || v > hi)
-        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, here(lx), "%s must be an integer %d..%d",
-                                what, lo, hi);
-    *out = (int)v;
-    return CS_OK;
-}
-
-/* Three numbers; a point (scaled, range-checked) into *p, the raw scaled values into d[]. */
-static cs_err_t vec(lex_t *lx, const char *what, cs_vec3_t *p, double d[3])
-{
-    double v[3];
-    unsigned line = 0, col = 0;
-    for (int k = 0; k < 3; k++) {
-        cs_err_t e = number(lx, what, &v[k]);
-        if (e != CS_OK)
-            return e;
-        if (k == 0) {
-            line = lx->tline;
-            col = lx->tcol;
-        }
-        v[k] *= lx->scale;
-    }
-    if (d)
-        for (int k = 0; k < 3; k++)
-            d[k] = v[k];
-    if (p && cs_conv_mm_to_vec(v[0], v[1], v[2], p) != CS_OK) {
-        cs_path_loc_t l = {lx->name, line, col};
-        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, l, "%s (%g, %g, %g) mm is outside +/-%d mm",
-                                what, v[0], v[1], v[2], CS_POS_LIMIT_MM);
-    }
-    return CS_OK;
-}
-
-static cs_err_t curve(lex_t *lx, cs_bezier_t *c)
+static cs_err_t curve(cs_lex_t *lx, cs_bezier_t *c)
 {
     int n;
-    cs_err_t e = integer(lx, "curve degree", 1, 3, &n);
+    cs_err_t e = cs_lex_integer(lx, "curve degree", 1, 3, &n);
     if (e != CS_OK)
         return e;
     cs_vec3_t pts[4];
     for (int i = 0; i <= n; i++) {
-        e = vec(lx, "curve point", &pts[i], NULL);
+        e = cs_lex_vec(lx, "curve point", &pts[i], NULL);
         if (e != CS_OK)
             return e;
     }
@@ -162,30 +55,204 @@ static cs_err_t push_quad(cs_surffile_t *sf, const cs_patch_t *p, unsigned line)
     return push(sf, &it);
 }
 
+/* coons-bicubic C C C C [derivatives C C C C] [twists V V V V] (after the keyword): boundaries
+ * p1 p2 q1 q2, cross-boundary derivative curves p1v p2v q1u q2u, twists at the corners (u, v) =
+ * (0,0) (1,0) (0,1) (1,1) (seed 000; cs_coons_bicubic_twist). */
+static cs_err_t coons_bicubic(cs_lex_t *lx, cs_patch_t *p)
+{
+    cs_bezier_t c[8];
+    const cs_bezier_t *der[4] = {NULL, NULL, NULL, NULL};
+    cs_vec3_t tw[2][2];
+    bool twists = false;
+    cs_err_t e = CS_OK;
+    for (int k = 0; e == CS_OK && k < 4; k++)
+        e = curve(lx, &c[k]);
+    if (e == CS_OK && cs_lex_peek_is(lx, "derivatives")) {
+        cs_lex_next(lx);
+        for (int k = 0; e == CS_OK && k < 4; k++) {
+            e = curve(lx, &c[4 + k]); /* mm per unit parameter, within the point range */
+            der[k] = &c[4 + k];
+        }
+    }
+    if (e == CS_OK && cs_lex_peek_is(lx, "twists")) {
+        cs_lex_next(lx);
+        twists = true;
+        for (int k = 0; e == CS_OK && k < 4; k++)
+            e = cs_lex_vec(lx, "twist vector", &tw[k % 2][k / 2], NULL);
+    }
+    if (e != CS_OK)
+        return e;
+    return cs_coons_bicubic_twist(&c[0], &c[1], &c[2], &c[3], der[0], der[1], der[2], der[3],
+                                  twists ? (const cs_vec3_t(*)[2])tw : NULL, p);
+}
+
+/* A blend of coons-blend: linear | hermite | bernstein b0 b1 b2 b3 (cs_gcoons). */
+static cs_err_t blend(cs_lex_t *lx, cs_gcoons_blend_t *f)
+{
+    static const char *const kinds[] = {"linear", "hermite", "bernstein"};
+    int k = 0;
+    cs_err_t e = cs_lex_choice(lx, "blend linear, hermite or bernstein", kinds, 3, &k);
+    if (e != CS_OK)
+        return e;
+    if (k < 2) {
+        *f = k == 0 ? cs_gcoons_linear() : cs_gcoons_hermite();
+        return CS_OK;
+    }
+    for (int i = 0; e == CS_OK && i < 4; i++)
+        e = cs_lex_number(lx, "Bernstein coefficient of the blend", &f->b[i]);
+    if (e == CS_OK && (f->b[0] != 1 || f->b[3] != 0))
+        e = cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
+                             "a blend starts at 1 and ends at 0 (b0 = 1, b3 = 0; seed 002)");
+    return e;
+}
+
+/* varady-scheme's words after the keyword: B P [domain D] (cs_varady). */
+static cs_err_t varady_scheme(cs_lex_t *lx, cs_varady_blend_t *blend, cs_varady_param_t *param,
+                              cs_varady_domain_t *domain)
+{
+    static const char *const blends[] = {"mu", "lambda-kappa"};
+    static const char *const params[] = {"side", "radial", "centre", "biquadratic"};
+    static const char *const doms[] = {"arc", "chords", "angles", "least-squares"};
+    int got = 0;
+    cs_err_t e = cs_lex_choice(lx, "blend mu or lambda-kappa", blends, 2, &got);
+    *blend = (cs_varady_blend_t)got;
+    if (e == CS_OK)
+        e = cs_lex_choice(lx, "parametrisation side, radial, centre or biquadratic", params, 4,
+                          &got);
+    *param = (cs_varady_param_t)got;
+    if (e == CS_OK && cs_lex_peek_is(lx, "domain")) {
+        cs_lex_next(lx);
+        e = cs_lex_choice(lx, "domain arc, chords, angles or least-squares", doms, 4, &got);
+        *domain = (cs_varady_domain_t)got;
+    }
+    return e;
+}
+
+/* The optional "tangents C x n" and "twists V x n" of a varady statement, taken as written
+ * (mm per domain unit, not scaled: the domain scales with the boundary). */
+static cs_err_t varady_extras(cs_lex_t *lx, cs_varady_t *v)
+{
+    double scale = lx->scale;
+    cs_err_t e = CS_OK;
+    lx->scale = 1;
+    if (cs_lex_peek_is(lx, "tangents")) {
+        cs_bezier_t tan[CS_VARADY_MAX_SIDES];
+        cs_lex_next(lx);
+        for (size_t k = 0; e == CS_OK && k < v->n; k++)
+            e = curve(lx, &tan[k]);
+        if (e == CS_OK)
+            e = cs_varady_set_tangents(v, tan);
+    }
+    if (e == CS_OK && cs_lex_peek_is(lx, "twists")) {
+        double tw[CS_VARADY_MAX_SIDES][3];
+        cs_lex_next(lx);
+        for (size_t k = 0; e == CS_OK && k < v->n; k++)
+            e = cs_lex_vec(lx, "twist", NULL, tw[k]);
+        if (e == CS_OK)
+            cs_varady_set_twists(v, (const double(*)[3])tw);
+    }
+    lx->scale = scale;
+    return e;
+}
+
+/* varady N C x N [tangents ..] [twists ..], or varady-scheme B P [domain D] N C x N [..]. */
+static cs_err_t varady(cs_lex_t *lx, bool scheme, unsigned line, cs_surffile_t *sf)
+{
+    int n;
+    cs_bezier_t c[CS_VARADY_MAX_SIDES];
+    cs_varady_blend_t blend = CS_VARADY_MU;
+    cs_varady_param_t param = CS_VARADY_SIDE;
+    cs_varady_domain_t domain = CS_VARADY_DOMAIN_ARC;
+    cs_err_t e = scheme ? varady_scheme(lx, &blend, &param, &domain) : CS_OK;
+    if (e == CS_OK)
+        e = cs_lex_integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
+    for (int k = 0; e == CS_OK && k < n; k++)
+        e = curve(lx, &c[k]);
+    cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
+    if (e == CS_OK && !it)
+        return CS_ERR_FULL;
+    if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
+        (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK &&
+        (e = cs_varady_set_domain(&it->nside, domain)) == CS_OK &&
+        (e = varady_extras(lx, &it->nside)) == CS_OK) {
+        it->varady = true;
+        it->line = line;
+        e = push(sf, it);
+    }
+    free(it);
+    return e;
+}
+
+/* sphere C R (after the keyword): the exact sphere (cs_sphere), inside the coordinate range. */
+static cs_err_t sphere(cs_lex_t *lx, unsigned line, cs_surffile_t *sf)
+{
+    cs_surf_item_t it;
+    memset(&it, 0, sizeof it);
+    cs_err_t e = cs_lex_vec(lx, "centre", NULL, it.sph.c);
+    if (e == CS_OK)
+        e = cs_lex_number(lx, "radius", &it.sph.r);
+    if (e != CS_OK)
+        return e;
+    it.sph.r *= lx->scale;
+    cs_vec3_t lo, hi;
+    if (!(it.sph.r > 0) ||
+        cs_conv_mm_to_vec(it.sph.c[0] - it.sph.r, it.sph.c[1] - it.sph.r, it.sph.c[2] - it.sph.r,
+                          &lo) != CS_OK ||
+        cs_conv_mm_to_vec(it.sph.c[0] + it.sph.r, it.sph.c[1] + it.sph.r, it.sph.c[2] + it.sph.r,
+                          &hi) != CS_OK)
+        return cs_path_diag_set(lx->diag, CS_ERR_RANGE, cs_lex_here(lx),
+                                "radius %g mm: must be > 0 and keep the sphere inside +/-%d mm",
+                                it.sph.r, CS_POS_LIMIT_MM);
+    it.sphere = true;
+    it.line = line;
+    return push(sf, &it);
+}
+
+static const char *const keywords[] = {
+    "bezier",        "tri",         "hermite", "power",         "coons-bilinear",
+    "coons-bicubic", "coons-blend", "varady",  "varady-scheme", "ruled",
+    "extrude",       "revolve",     "sphere",
+};
+
+const char *cs_surffile_keyword(size_t i)
+{
+    return i < sizeof keywords / sizeof keywords[0] ? keywords[i] : NULL;
+}
+
+void cs_surffile_keyword_list(char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; cs_surffile_keyword(i) && n + 1 < cap; i++) {
+        int w = snprintf(buf + n, cap - n, "%s%s", i ? ", " : "", cs_surffile_keyword(i));
+        n = w < 0 ? cap : n + (size_t)w;
+    }
+}
+
 /* One statement after its keyword (in lx->tok). */
-static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
+static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
 {
     char kw[64];
     snprintf(kw, sizeof kw, "%s", lx->tok);
-    cs_path_loc_t at = here(lx);
+    cs_path_loc_t at = cs_lex_here(lx);
     cs_err_t e = CS_OK;
     cs_patch_t p;
     if (strcmp(kw, "bezier") == 0) {
         int du, dv;
-        cs_vec3_t pts[16];
-        e = integer(lx, "degree in u", 1, 3, &du);
+        cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
+        e = cs_lex_integer(lx, "degree in u", 1, CS_PATCH_MAX_DEGREE, &du);
         if (e == CS_OK)
-            e = integer(lx, "degree in v", 1, 3, &dv);
+            e = cs_lex_integer(lx, "degree in v", 1, CS_PATCH_MAX_DEGREE, &dv);
         for (int k = 0; e == CS_OK && k < (du + 1) * (dv + 1); k++)
-            e = vec(lx, "control point", &pts[k], NULL);
+            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         if (e == CS_OK && (e = cs_patch_init(&p, (unsigned)du, (unsigned)dv, pts)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "tri") == 0) {
         int n;
         cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
-        e = integer(lx, "degree", 1, 3, &n);
+        e = cs_lex_integer(lx, "degree", 1, CS_TRIPATCH_MAX_DEGREE, &n);
         for (int k = 0; e == CS_OK && k < (n + 1) * (n + 2) / 2; k++)
-            e = vec(lx, "control point", &pts[k], NULL);
+            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
         cs_surf_item_t it;
         memset(&it, 0, sizeof it);
         if (e == CS_OK && (e = cs_tripatch_init(&it.trip, (unsigned)n, pts)) == CS_OK) {
@@ -197,7 +264,7 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
         bool herm = kw[0] == 'h';
         cs_vec3_t v[16];
         for (int k = 0; e == CS_OK && k < 16; k++)
-            e = vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
+            e = cs_lex_vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
         if (e == CS_OK) {
             if (herm) {
                 cs_patch_hermite_t h;
@@ -218,17 +285,28 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
             if (e == CS_OK)
                 return push_quad(sf, &p, at.line);
         }
-    } else if (strcmp(kw, "coons-bilinear") == 0 || strcmp(kw, "coons-bicubic") == 0) {
+    } else if (strcmp(kw, "coons-bilinear") == 0) {
         cs_bezier_t c[4];
         for (int k = 0; e == CS_OK && k < 4; k++)
             e = curve(lx, &c[k]);
-        if (e == CS_OK) {
-            e = strcmp(kw, "coons-bilinear") == 0
-                    ? cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], &p)
-                    : cs_coons_bicubic(&c[0], &c[1], &c[2], &c[3], NULL, NULL, NULL, NULL, &p);
-            if (e == CS_OK)
-                return push_quad(sf, &p, at.line);
-        }
+        if (e == CS_OK && (e = cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], &p)) == CS_OK)
+            return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "coons-bicubic") == 0) {
+        e = coons_bicubic(lx, &p);
+        if (e == CS_OK)
+            return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "coons-blend") == 0) {
+        cs_gcoons_blend_t f, g;
+        cs_bezier_t c[4];
+        e = blend(lx, &f);
+        if (e == CS_OK)
+            e = blend(lx, &g);
+        for (int k = 0; e == CS_OK && k < 4; k++)
+            e = curve(lx, &c[k]);
+        if (e == CS_OK && (e = cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, &p)) == CS_OK)
+            return push_quad(sf, &p, at.line);
+    } else if (strcmp(kw, "sphere") == 0) {
+        return sphere(lx, at.line, sf);
     } else if (strcmp(kw, "ruled") == 0) {
         cs_bezier_t c[2];
         for (int k = 0; e == CS_OK && k < 2; k++)
@@ -240,19 +318,19 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
         cs_vec3_t d;
         e = curve(lx, &c);
         if (e == CS_OK)
-            e = vec(lx, "direction", &d, NULL);
+            e = cs_lex_vec(lx, "direction", &d, NULL);
         if (e == CS_OK && (e = cs_coons_extrude(&c, &d, &p)) == CS_OK)
             return push_quad(sf, &p, at.line);
     } else if (strcmp(kw, "revolve") == 0) {
         double o[3], ax[3], rf[3], sweep;
         cs_bezier_t c;
-        e = vec(lx, "axis origin", NULL, o);
+        e = cs_lex_vec(lx, "axis origin", NULL, o);
         if (e == CS_OK)
-            e = vec(lx, "axis direction", NULL, ax);
+            e = cs_lex_vec(lx, "axis direction", NULL, ax);
         if (e == CS_OK)
-            e = vec(lx, "reference direction", NULL, rf);
+            e = cs_lex_vec(lx, "reference direction", NULL, rf);
         if (e == CS_OK)
-            e = number(lx, "sweep in degrees", &sweep);
+            e = cs_lex_number(lx, "sweep in degrees", &sweep);
         if (e == CS_OK)
             e = curve(lx, &c);
         if (e == CS_OK) {
@@ -265,55 +343,13 @@ static cs_err_t statement(lex_t *lx, cs_surffile_t *sf, double rev_tol)
                 return e;
         }
     } else if (strcmp(kw, "varady") == 0 || strcmp(kw, "varady-scheme") == 0) {
-        int n;
-        cs_bezier_t c[CS_VARADY_MAX_SIDES];
-        cs_varady_blend_t blend = CS_VARADY_MU;
-        cs_varady_param_t param = CS_VARADY_SIDE;
-        if (strcmp(kw, "varady-scheme") == 0) {
-            /* varady-scheme BLEND PARAM N C x N */
-            static const char *const blends[] = {"mu", "lambda-kappa"};
-            static const char *const params[] = {"side", "radial", "centre"};
-            int got = -1;
-            if (next_tok(lx))
-                for (int k = 0; k < 2; k++)
-                    if (strcmp(lx->tok, blends[k]) == 0)
-                        got = k;
-            if (got < 0)
-                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
-                                        "'%s': blend mu or lambda-kappa expected", lx->tok);
-            blend = (cs_varady_blend_t)got;
-            got = -1;
-            if (next_tok(lx))
-                for (int k = 0; k < 3; k++)
-                    if (strcmp(lx->tok, params[k]) == 0)
-                        got = k;
-            if (got < 0)
-                return cs_path_diag_set(lx->diag, CS_ERR_PARSE, here(lx),
-                                        "'%s': parametrisation side, radial or centre expected",
-                                        lx->tok);
-            param = (cs_varady_param_t)got;
-        }
-        e = integer(lx, "number of sides", 3, CS_VARADY_MAX_SIDES, &n);
-        for (int k = 0; e == CS_OK && k < n; k++)
-            e = curve(lx, &c[k]);
-        cs_surf_item_t *it = e == CS_OK ? calloc(1, sizeof *it) : NULL;
-        if (e == CS_OK && !it)
-            return CS_ERR_FULL;
-        if (e == CS_OK && (e = cs_varady_init(&it->nside, c, (size_t)n)) == CS_OK &&
-            (e = cs_varady_set_scheme(&it->nside, blend, param)) == CS_OK) {
-            it->varady = true;
-            it->line = at.line;
-            e = push(sf, it);
-            free(it);
+        e = varady(lx, strcmp(kw, "varady-scheme") == 0, at.line, sf);
+        if (e == CS_OK || e == CS_ERR_FULL)
             return e;
-        }
-        free(it);
     } else {
-        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at,
-                                "unknown surface '%s' (bezier, tri, hermite, power, "
-                                "coons-bilinear, coons-bicubic, ruled, extrude, revolve, "
-                                "varady, varady-scheme)",
-                                kw);
+        char list[256];
+        cs_surffile_keyword_list(list, sizeof list);
+        return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at, "unknown surface '%s' (%s)", kw, list);
     }
     if (e != CS_OK && lx->diag->code != e)
         return cs_path_diag_set(lx->diag, e, at, "%s: %s", kw, cs_err_text(e));
@@ -329,8 +365,9 @@ void cs_surffile_free(cs_surffile_t *sf)
 
 static bool is_native(const char *text, size_t len)
 {
-    lex_t lx = {text, text + len, 1, 1, "", NULL, 1, "", 0, 0};
-    return next_tok(&lx) && strcmp(lx.tok, NATIVE_MAGIC) == 0;
+    cs_lex_t lx;
+    cs_lex_init(&lx, text, len, "", NULL, 1);
+    return cs_lex_next(&lx) && strcmp(lx.tok, NATIVE_MAGIC) == 0;
 }
 
 cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, double scale,
@@ -355,14 +392,15 @@ cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, doubl
         return e;
     }
     sf->native = true;
-    lex_t lx = {text, text + len, 1, 1, sf->file, diag, scale, "", 0, 0};
-    next_tok(&lx); /* the magic */
+    cs_lex_t lx;
+    cs_lex_init(&lx, text, len, sf->file, diag, scale);
+    cs_lex_next(&lx); /* the magic */
     int version;
-    cs_err_t e = integer(&lx, "format version", 1, 1, &version);
-    while (e == CS_OK && next_tok(&lx))
+    cs_err_t e = cs_lex_integer(&lx, "format version", 1, 1, &version);
+    while (e == CS_OK && cs_lex_next(&lx))
         e = statement(&lx, sf, rev_tol_mm);
     if (e == CS_OK && sf->n == 0)
-        e = cs_path_diag_set(diag, CS_ERR_EMPTY, here(&lx), "no surfaces in the file");
+        e = cs_path_diag_set(diag, CS_ERR_EMPTY, cs_lex_here(&lx), "no surfaces in the file");
     return e;
 }
 

@@ -8,14 +8,22 @@
  *   hermite  V x 16                 P00 P10 P01 P11 Pu.. Pv.. Puv.. (index: u corner, v corner)
  *   power  V x 16                   a[i][j] (coefficient of u^i v^j), i-major
  *   coons-bilinear C C C C          boundaries p1 (v=0), p2 (v=1), q1 (u=0), q2 (u=1)
- *   coons-bicubic C C C C           same, default cross-boundary derivatives, zero twists
+ *   coons-bicubic C C C C [derivatives C C C C] [twists V V V V]
+ *                                   same with Hermite blends; derivative curves and twists
+ *                                   default to the corner tangents and zero
+ *   coons-blend F G C C C C         generalised Coons (seed 002), blends linear | hermite |
+ *                                   bernstein 1 b1 b2 0 (cs_gcoons)
  *   ruled C C                       (1 - v) C1(u) + v C2(u)
  *   extrude C V                     C(u) + v V
  *   revolve O A R SWEEP C           profile C (x = radius, y = height) about the axis through O
  *                                   along A, from the direction R, SWEEP degrees
  *   varady N C x N                  n-sided transfinite patch (seed 002) bounded by a loop
- *   varady-scheme B P N C x N       same with blend B (mu, lambda-kappa) and parametrisation
- *                                   P (side, radial, centre); varady = "varady-scheme mu side"
+ *   varady-scheme B P [domain D] N C x N [tangents C x N] [twists V x N]
+ *                                   same with blend B (mu, lambda-kappa), parametrisation
+ *                                   P (side, radial, centre, biquadratic), domain D (arc,
+ *                                   chords, angles, least-squares); varady = "varady-scheme mu
+ *                                   side" (it takes the tangents and twists too)
+ *   sphere C R                      the exact sphere of centre C, radius R (seed 000)
  * where C = "N P0 .. PN" (a Bézier curve of degree N = 1..3), P and V = three numbers, '#'
  * starts a comment; numbers are free-form across lines. Every item becomes core patches
  * (cs_patch_t or cs_tripatch_t) with the line of its keyword. Bad input: file:line:col. */
@@ -27,12 +35,15 @@
 
 #include "cs_patch.h"
 #include "cs_path.h"
+#include "cs_sphere.h"
 #include "cs_tripatch.h"
 #include "cs_varady.h"
 
 typedef struct {
     bool tri;    /* triangular: trip is set */
     bool varady; /* n-sided: nside is set (else quad) */
+    bool sphere; /* the exact sphere: sph is set (else quad) */
+    cs_sphere_t sph;
     cs_patch_t quad;
     cs_tripatch_t trip;
     cs_varady_t nside;
@@ -58,5 +69,10 @@ cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, doubl
                            double rev_tol_mm, cs_surffile_t *sf, cs_path_diag_t *diag);
 /* Frees everything (fine on an empty or failed one). */
 void cs_surffile_free(cs_surffile_t *sf);
+/* The keywords the native format accepts, in the order docs/surfaces.md lists them: keyword i,
+ * or NULL past the last (the one table the parser, toolpath --help and the docs test share). */
+const char *cs_surffile_keyword(size_t i);
+/* All keywords joined by ", " into buf (cut to cap - 1 characters, always terminated). */
+void cs_surffile_keyword_list(char *buf, size_t cap);
 
 #endif

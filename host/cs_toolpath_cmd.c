@@ -46,6 +46,8 @@ static const tp_view_t views[] = {
 
 static void tp_usage(FILE *f)
 {
+    char kw[256];
+    cs_surffile_keyword_list(kw, sizeof kw);
     fprintf(
         f,
         "Usage: curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM]\n"
@@ -54,11 +56,13 @@ static void tp_usage(FILE *f)
         "                          [--safe-z Z] [--scale S] [--view V] [--svg OUT.svg]\n"
         "       (either form also takes --gcode OUT.nc)\n"
         "\n"
-        "Reads surface patches and prints a path over them. FILE is either in Newell's\n"
-        "format (a patch count; one line of 16 one-based vertex indices per patch; a vertex\n"
-        "count; one \"x,y,z\" line per vertex: the Utah teapot's format) or in curvestep's\n"
-        "native surface format (first word \"curvestep-surfaces 1\", then bezier, tri,\n"
-        "hermite, power, coons-bilinear, coons-bicubic, ruled, extrude and revolve items;\n"
+        "Reads surface patches and prints a path over them. FILE is in Newell's format (a\n"
+        "patch count; one line of 16 one-based vertex indices per patch; a vertex count; one\n"
+        "\"x,y,z\" line per vertex: the Utah teapot's format), in the .bpt format (a patch\n"
+        "count; per patch a line \"degu degv\" and its (degu+1)(degv+1) points \"x y z\"), or\n"
+        "in curvestep's native surface format (first word \"curvestep-surfaces 1\", then\n"
+        "items, each starting with one of the keywords\n"
+        "  %s;\n"
         "see docs/surfaces.md). Surfaces of revolution are approximated within --tol / 4.\n"
         "\n"
         "Wireframe (without --ball): the iso-parametric lines of each patch, N + 1 in each\n"
@@ -105,7 +109,7 @@ static void tp_usage(FILE *f)
         "\n"
         "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
         "coordinates outside +/-%d mm after scaling); 2 usage error; 3 internal error.\n",
-        TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
+        kw, TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
 }
 
 static bool parse_double(const char *s, double *out)
@@ -267,7 +271,10 @@ static cs_err_t wire_patch(tp_out_t *o, const cs_patch_t *p, unsigned lines, cs_
     for (int dir = 0; dir < 2; dir++) {
         cs_bezier_t c;
         cs_err_t e;
-        if (is_pow2(lines) && lines <= (1u << CS_PATCH_RASTER_MAX_SHIFT)) {
+        /* Exact forward differences while N^m fits (cs_patch_raster_t), de Casteljau per
+         * line beyond (higher degrees, more lines). */
+        unsigned m = dir == CS_PATCH_ISO_U ? p->deg_v : p->deg_u;
+        if (is_pow2(lines) && lines <= (1u << cs_patch_raster_max_shift(m))) {
             unsigned shift = 0;
             while ((1u << shift) < lines)
                 shift++;
@@ -351,6 +358,27 @@ static cs_err_t wire_varady(tp_out_t *o, const cs_varady_t *v, unsigned lines, c
     return e;
 }
 
+/* The exact sphere (cs_sphere): N meridians (longitudes 360 k / N, each a half circle from
+ * pole to pole) and the N - 1 parallels at latitudes -90 + 180 k / N, every piece an exact
+ * rational arc, traced within tol. */
+static cs_err_t wire_sphere(tp_out_t *o, const cs_sphere_t *s, unsigned lines, cs_pos_t tol)
+{
+    cs_bezier_t arc[CS_ARC_MAX_SEGMENTS];
+    unsigned n = 0;
+    cs_err_t e = CS_OK;
+    for (unsigned k = 0; e == CS_OK && k < 2 * lines; k++) {
+        bool meridian = k < lines;
+        e = meridian     ? cs_sphere_meridian(s, 0, 360.0 * k / lines, -90, 90, arc, &n)
+            : k == lines ? CS_END
+                         : cs_sphere_parallel(s, 0, -90 + 180.0 * (k - lines) / lines, arc, &n);
+        for (unsigned i = 0; e == CS_OK && i < n; i++)
+            e = emit_curve(o, &arc[i], tol, i == 0);
+        if (e == CS_END)
+            e = CS_OK;
+    }
+    return e;
+}
+
 /* --- finishing with a ball-end tool -------------------------------------------------------- */
 
 typedef struct {
@@ -386,6 +414,50 @@ static bool ball_emit(void *ctx, size_t pass, double u, double v, const cs_vec3_
     return out_vertex_g(b->o, c, false, false); /* the plunge too is a feed move */
 }
 
+/* Traces c within tol and hands every vertex after the first to ball_emit (a feed move). */
+static cs_err_t ball_trace(tp_ball_ctx_t *ctx, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_trace_t tr;
+    cs_vec3_t pt;
+    cs_err_t e = cs_trace_begin(&tr, c, tol, CS_TRACE_SUBDIV);
+    while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK)
+        if (!ball_emit(ctx, 0, 0, 0, &pt, false))
+            return CS_ERR_FULL;
+    return e == CS_END ? CS_OK : e;
+}
+
+/* The upper hemisphere of an exact sphere (below the equator a 3-axis tool cannot reach): the
+ * tool centre runs on the offset sphere r + R, from the pole down a meridian (longitude 0) to
+ * each parallel in turn and once around it, the parallels spaced equally in latitude by at most
+ * cs_sphere_step(r, R, H), so the scallop (closed form, cs_sphere_scallop) stays below H. */
+static cs_err_t finish_sphere(tp_ball_ctx_t *ctx, const cs_sphere_t *s, const tp_ball_t *bp,
+                              cs_pos_t tol, cs_finish_stats_t *st)
+{
+    double step = cs_sphere_step(s->r, bp->r_mm, bp->h_mm);
+    unsigned n = (unsigned)ceil((M_PI / 2) / step - 1e-9);
+    double dlat = 90.0 / n, rho = s->r + bp->r_mm;
+    cs_vec3_t pole;
+    if (n == 0 || n > 100000 || cs_conv_mm_to_vec(s->c[0], s->c[1], s->c[2] + rho, &pole) != CS_OK)
+        return CS_ERR_RANGE;
+    if (!ball_emit(ctx, 0, 0, 0, &pole, true))
+        return CS_ERR_FULL;
+    cs_bezier_t arc[CS_ARC_MAX_SEGMENTS];
+    unsigned na = 0;
+    cs_err_t e = CS_OK;
+    for (unsigned k = 1; e == CS_OK && k <= n; k++) {
+        e = cs_sphere_meridian(s, bp->r_mm, 0, 90 - dlat * (k - 1), 90 - dlat * k, arc, &na);
+        for (unsigned i = 0; e == CS_OK && i < na; i++)
+            e = ball_trace(ctx, &arc[i], tol);
+        if (e == CS_OK)
+            e = cs_sphere_parallel(s, bp->r_mm, 90 - dlat * k, arc, &na);
+        for (unsigned i = 0; e == CS_OK && i < na; i++)
+            e = ball_trace(ctx, &arc[i], tol);
+    }
+    st->passes += n;
+    st->max_scallop = fmax(st->max_scallop, cs_sphere_scallop(s->r, bp->r_mm, dlat * M_PI / 180));
+    return e;
+}
+
 /* Every patch in turn: approach from the safe height, the zig-zag passes, retract. */
 static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const tp_ball_t *bp,
                       cs_finish_stats_t *st, double *fit_out)
@@ -399,7 +471,9 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
         if (it->tri)
             for (unsigned k = 0; k < (it->trip.degree + 1u) * (it->trip.degree + 2u) / 2; k++)
                 top = fmax(top, cs_conv_pos_to_mm(it->trip.p[k].z));
-        for (int a = 0; !it->tri && !it->varady && a <= it->quad.deg_u; a++)
+        if (it->sphere)
+            top = fmax(top, it->sph.c[2] + it->sph.r);
+        for (int a = 0; !it->tri && !it->varady && !it->sphere && a <= it->quad.deg_u; a++)
             for (int b = 0; b <= it->quad.deg_v; b++)
                 top = fmax(top, cs_conv_pos_to_mm(it->quad.p[a][b].z));
     }
@@ -422,7 +496,11 @@ static int finish_all(tp_out_t *o, const cs_surffile_t *sf, cs_pos_t tol, const 
         size_t ncell = 1;
         const cs_patch_t *list = &it->quad;
         cs_err_t e = CS_OK;
-        if (it->tri) {
+        if (it->sphere) {
+            ncell = 0;
+            ctx.patch_start = true;
+            e = finish_sphere(&ctx, &it->sph, bp, tol, st);
+        } else if (it->tri) {
             e = cs_finish_tri_patch(&it->trip, &tq);
             list = &tq;
         } else if (it->varady) {
@@ -715,6 +793,7 @@ int cs_cmd_toolpath(int argc, char **argv)
     for (size_t i = 0; i < sf.n && status == CS_EXIT_OK && !ball; i++) {
         e = sf.items[i].tri      ? wire_tri(&o, &sf.items[i].trip, lines, tol)
             : sf.items[i].varady ? wire_varady(&o, &sf.items[i].nside, lines, tol)
+            : sf.items[i].sphere ? wire_sphere(&o, &sf.items[i].sph, lines, tol)
                                  : wire_patch(&o, &sf.items[i].quad, lines, tol);
         if (e != CS_OK) {
             cs_path_loc_t l = {sf.file, sf.items[i].line, 1};

@@ -36,46 +36,23 @@ static double norm3(const double a[3])
     return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
 
-cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
+/* Seed 002, solution 1: vertices on a circle, angles proportional to arc length; the
+ * circle's circumference is the boundary's length, so domain units are about mm. */
+static void place_arc(cs_varady_t *v, double total)
 {
-    if (!v || !sides || n < 3 || n > CS_VARADY_MAX_SIDES)
-        return CS_ERR_ARG;
-    memset(v, 0, sizeof *v);
-    v->n = n;
-    double total = 0;
-    for (size_t i = 0; i < n; i++) {
-        const cs_bezier_t *c = &sides[i], *nx = &sides[(i + 1) % n];
-        if (c->rational)
-            return CS_ERR_UNSUPPORTED;
-        if (c->degree < 1 || c->degree > 3)
-            return CS_ERR_DEGREE;
-        const cs_vec3_t *e = &c->p[c->degree];
-        if (e->x != nx->p[0].x || e->y != nx->p[0].y || e->z != nx->p[0].z)
-            return CS_ERR_DEGENERATE;
-        v->side[i] = *c;
-        /* Arc length by 64-chord polyline (enough for the domain's proportions). */
-        double prev[3], q[3];
-        curve_d(c, 0, prev, NULL);
-        for (int k = 1; k <= 64; k++) {
-            curve_d(c, k / 64.0, q, NULL);
-            double d[3] = {q[0] - prev[0], q[1] - prev[1], q[2] - prev[2]};
-            v->len[i] += norm3(d);
-            memcpy(prev, q, sizeof q);
-        }
-        if (!(v->len[i] > 0))
-            return CS_ERR_DEGENERATE;
-        total += v->len[i];
-    }
-    /* Seed 002, solution 1: vertices on a circle, angles proportional to arc length; the
-     * circle's circumference is the boundary's length, so domain units are about mm. */
     double rho = total / (2 * PI), acc = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < v->n; i++) {
         double beta = 2 * PI * acc / total;
         v->vert[i][0] = rho * cos(beta);
         v->vert[i][1] = rho * sin(beta);
         acc += v->len[i];
     }
-    /* Local frames of the domain sides (for the radial and central-line parametrisations). */
+}
+
+/* Local frames of the domain sides (for the radial and central-line parametrisations). */
+static void frames(cs_varady_t *v)
+{
+    size_t n = v->n;
     double cx = 0, cy = 0;
     for (size_t i = 0; i < n; i++) {
         cx += v->vert[i][0] / (double)n;
@@ -112,6 +89,41 @@ cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
             v->rc[i][1] = ka * v->w1[i][1];
         }
     }
+}
+
+cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
+{
+    if (!v || !sides || n < 3 || n > CS_VARADY_MAX_SIDES)
+        return CS_ERR_ARG;
+    memset(v, 0, sizeof *v);
+    v->n = n;
+    double total = 0;
+    for (size_t i = 0; i < n; i++) {
+        const cs_bezier_t *c = &sides[i], *nx = &sides[(i + 1) % n];
+        if (c->rational)
+            return CS_ERR_UNSUPPORTED;
+        if (c->degree < 1 || c->degree > 3)
+            return CS_ERR_DEGREE;
+        const cs_vec3_t *e = &c->p[c->degree];
+        if (e->x != nx->p[0].x || e->y != nx->p[0].y || e->z != nx->p[0].z)
+            return CS_ERR_DEGENERATE;
+        v->side[i] = *c;
+        /* Arc length by 64-chord polyline (enough for the domain's proportions). */
+        double prev[3], q[3];
+        curve_d(c, 0, prev, NULL);
+        for (int k = 1; k <= 64; k++) {
+            curve_d(c, k / 64.0, q, NULL);
+            double d[3] = {q[0] - prev[0], q[1] - prev[1], q[2] - prev[2]};
+            v->len[i] += norm3(d);
+            memcpy(prev, q, sizeof q);
+        }
+        if (!(v->len[i] > 0))
+            return CS_ERR_DEGENERATE;
+        total += v->len[i];
+    }
+    v->domain = CS_VARADY_DOMAIN_ARC;
+    place_arc(v, total);
+    frames(v);
     /* Cross-boundary tangents: away from each corner along the neighbouring side. */
     for (size_t i = 0; i < n; i++) {
         double a[3], b[3];
@@ -125,6 +137,215 @@ cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n)
             v->t1[i][k] = b[k] / lb;
         }
     }
+    return CS_OK;
+}
+
+double cs_varady_corner_angle(const cs_varady_t *v, size_t i)
+{
+    double a[3], b[3];
+    curve_d(&v->side[(i + v->n - 1) % v->n], 1, NULL, a);
+    curve_d(&v->side[i], 0, NULL, b);
+    double c = -(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (norm3(a) * norm3(b));
+    return acos(fmax(-1, fmin(1, c)));
+}
+
+/* Solution 2: R with sum 2 asin(L_i / 2R) = 2 pi (decreasing in R; asin x <= pi x / 2 bounds R
+ * by sum L / 4), then the vertices at the accumulated central angles. */
+static cs_err_t place_chords(cs_varady_t *v, double total, double out[][2])
+{
+    double lmax = 0;
+    for (size_t i = 0; i < v->n; i++)
+        lmax = fmax(lmax, v->len[i]);
+    double lo = lmax / 2, hi = total / 4, f = 0;
+    for (size_t i = 0; i < v->n; i++)
+        f += 2 * asin(fmin(1, v->len[i] / (2 * lo)));
+    if (!(hi >= lo) || f < 2 * PI)
+        return CS_ERR_DEGENERATE; /* the centre would lie outside the polygon */
+    for (int it = 0; it < 200 && hi - lo > 1e-14 * hi; it++) {
+        double mid = (lo + hi) / 2;
+        f = 0;
+        for (size_t i = 0; i < v->n; i++)
+            f += 2 * asin(v->len[i] / (2 * mid));
+        *(f > 2 * PI ? &lo : &hi) = mid;
+    }
+    double r = (lo + hi) / 2, acc = 0;
+    for (size_t i = 0; i < v->n; i++) {
+        out[i][0] = r * cos(acc);
+        out[i][1] = r * sin(acc);
+        acc += 2 * asin(v->len[i] / (2 * r));
+    }
+    return CS_OK;
+}
+
+/* A polygon from its side lengths l and interior angles alpha (alpha[i] at vertex i, the start
+ * of side i): p_0 = 0, side 0 along +x, turning left by pi - alpha at each vertex. Writes the
+ * n + 1 points p_0 .. p_n (p_n = p_0 when it closes). */
+static void turtle(size_t n, const double l[], const double alpha[], double p[][2])
+{
+    double th = 0;
+    p[0][0] = p[0][1] = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0)
+            th += PI - alpha[i];
+        p[i + 1][0] = p[i][0] + l[i] * cos(th);
+        p[i + 1][1] = p[i][1] + l[i] * sin(th);
+    }
+}
+
+/* Targets of solutions 3 and least squares: l_i = L_i, alpha_i = c_angle phi_i. */
+static void targets(const cs_varady_t *v, double l[], double alpha[])
+{
+    double sum = 0;
+    for (size_t i = 0; i < v->n; i++)
+        sum += cs_varady_corner_angle(v, i);
+    for (size_t i = 0; i < v->n; i++) {
+        l[i] = v->len[i];
+        alpha[i] = (double)(v->n - 2) * PI / sum * cs_varady_corner_angle(v, i);
+    }
+}
+
+/* Solution 3: the targets' polygon, its gap e = p_0 - p_n spread as p_i += (i / n) e. */
+static void place_angles(const cs_varady_t *v, double out[][2])
+{
+    double l[CS_VARADY_MAX_SIDES], alpha[CS_VARADY_MAX_SIDES], p[CS_VARADY_MAX_SIDES + 1][2];
+    targets(v, l, alpha);
+    turtle(v->n, l, alpha, p);
+    double e[2] = {p[0][0] - p[v->n][0], p[0][1] - p[v->n][1]};
+    for (size_t i = 0; i < v->n; i++) {
+        out[i][0] = p[i][0] + (double)i / (double)v->n * e[0];
+        out[i][1] = p[i][1] + (double)i / (double)v->n * e[1];
+    }
+}
+
+static double det3(const double m[3][3])
+{
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* a y = r for a 3 x 3 a, by Cramer's rule; false when singular. */
+static bool solve3(const double a[3][3], const double r[3], double y[3])
+{
+    double det = det3(a);
+    if (!(fabs(det) > 0))
+        return false;
+    for (int c = 0; c < 3; c++) {
+        double m[3][3];
+        memcpy(m, a, sizeof m);
+        for (int k = 0; k < 3; k++)
+            m[k][c] = r[k];
+        y[c] = det3((const double(*)[3])m) / det;
+    }
+    return true;
+}
+
+/* Constraints of a closed polygon with sides x[0..n-1] and angles x[n..2n-1]: closure (x, y)
+ * and sum alpha = (n - 2) pi. */
+static void closing(size_t n, const double x[], double g[3])
+{
+    double p[CS_VARADY_MAX_SIDES + 1][2];
+    turtle(n, x, x + n, p);
+    g[0] = p[n][0];
+    g[1] = p[n][1];
+    g[2] = -(double)(n - 2) * PI;
+    for (size_t i = 0; i < n; i++)
+        g[2] += x[n + i];
+}
+
+/* Least squares: x = (l, alpha) nearest the targets x0 on {g = 0}, by Gauss-Newton steps
+ * dx = (x0 - x) - J^T (J J^T)^-1 (g + J (x0 - x)) with J by central differences. */
+static cs_err_t place_lsq(const cs_varady_t *v, double out[][2])
+{
+    size_t n = v->n, m = 2 * n;
+    double x0[2 * CS_VARADY_MAX_SIDES], x[2 * CS_VARADY_MAX_SIDES];
+    targets(v, x0, x0 + n);
+    memcpy(x, x0, sizeof x);
+    double g[3] = {1, 1, 1};
+    for (int it = 0; it < 100 && fabs(g[0]) + fabs(g[1]) + fabs(g[2]) > 1e-12 * v->len[0]; it++) {
+        double jac[3][2 * CS_VARADY_MAX_SIDES], r[3], a[3][3] = {{0}}, y[3];
+        closing(n, x, g);
+        for (size_t k = 0; k < m; k++) {
+            double h = 1e-7 * (k < n ? x0[k] : 1), xp[2 * CS_VARADY_MAX_SIDES], gp[3], gm[3];
+            memcpy(xp, x, sizeof xp);
+            xp[k] = x[k] + h;
+            closing(n, xp, gp);
+            xp[k] = x[k] - h;
+            closing(n, xp, gm);
+            for (int c = 0; c < 3; c++)
+                jac[c][k] = (gp[c] - gm[c]) / (2 * h);
+        }
+        for (int c = 0; c < 3; c++) {
+            r[c] = g[c];
+            for (size_t k = 0; k < m; k++)
+                r[c] += jac[c][k] * (x0[k] - x[k]);
+            for (int d = 0; d < 3; d++)
+                for (size_t k = 0; k < m; k++)
+                    a[c][d] += jac[c][k] * jac[d][k];
+        }
+        if (!solve3(a, r, y))
+            return CS_ERR_DEGENERATE;
+        for (size_t k = 0; k < m; k++)
+            x[k] = x0[k] - (jac[0][k] * y[0] + jac[1][k] * y[1] + jac[2][k] * y[2]);
+        closing(n, x, g);
+    }
+    if (fabs(g[0]) + fabs(g[1]) + fabs(g[2]) > 1e-9 * v->len[0])
+        return CS_ERR_DEGENERATE;
+    double p[CS_VARADY_MAX_SIDES + 1][2];
+    turtle(n, x, x + n, p);
+    for (size_t i = 0; i < n; i++) {
+        if (!(x[n + i] > 0 && x[n + i] < PI) || !(x[i] > 0))
+            return CS_ERR_DEGENERATE;
+        out[i][0] = p[i][0];
+        out[i][1] = p[i][1];
+    }
+    return CS_OK;
+}
+
+/* True when out[0..n-1] is a convex counter-clockwise polygon (every turn strictly left). */
+static bool convex_ccw(size_t n, const double p[][2])
+{
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p[i], *b = p[(i + 1) % n], *c = p[(i + 2) % n];
+        if ((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) <= 0)
+            return false;
+    }
+    return true;
+}
+
+cs_err_t cs_varady_set_domain(cs_varady_t *v, cs_varady_domain_t domain)
+{
+    if (!v || v->n < 3)
+        return CS_ERR_ARG;
+    double total = 0, p[CS_VARADY_MAX_SIDES][2];
+    for (size_t i = 0; i < v->n; i++)
+        total += v->len[i];
+    cs_err_t e = CS_OK;
+    cs_varady_t w = *v;
+    switch (domain) {
+    case CS_VARADY_DOMAIN_ARC:
+        place_arc(&w, total);
+        memcpy(p, w.vert, sizeof p);
+        break;
+    case CS_VARADY_DOMAIN_CHORDS:
+        e = place_chords(v, total, p);
+        break;
+    case CS_VARADY_DOMAIN_ANGLES:
+        place_angles(v, p);
+        break;
+    case CS_VARADY_DOMAIN_LSQ:
+        e = place_lsq(v, p);
+        break;
+    default:
+        return CS_ERR_ARG;
+    }
+    if (e == CS_OK && !convex_ccw(v->n, p))
+        e = CS_ERR_DEGENERATE;
+    if (e != CS_OK)
+        return e;
+    memcpy(v->vert, p, sizeof p);
+    v->domain = domain;
+    frames(v);
     return CS_OK;
 }
 
@@ -146,7 +367,8 @@ static double side_dist(const cs_varady_t *v, size_t i, double x, double y)
 cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param)
 {
     if (!v || (blend != CS_VARADY_MU && blend != CS_VARADY_LAMBDA_KAPPA) ||
-        (param != CS_VARADY_SIDE && param != CS_VARADY_RADIAL && param != CS_VARADY_CENTRE))
+        (param != CS_VARADY_SIDE && param != CS_VARADY_RADIAL && param != CS_VARADY_CENTRE &&
+         param != CS_VARADY_BIQUADRATIC))
         return CS_ERR_ARG;
     v->blend = blend;
     v->param = param;
@@ -184,6 +406,78 @@ static double centre_s(const cs_varady_t *v, size_t i, double u0, double v0)
     return f0 == 0 ? 0 : f1 == 0 ? 1 : 0.5 * (lo + hi);
 }
 
+/* The centroid of the domain's vertices. */
+static void centroid(const cs_varady_t *v, double ce[2])
+{
+    ce[0] = ce[1] = 0;
+    for (size_t k = 0; k < v->n; k++)
+        for (int x = 0; x < 2; x++)
+            ce[x] += v->vert[k][x] / (double)v->n;
+}
+
+/* The biquadratic net of side i (cs_varady.h, CS_VARADY_BIQUADRATIC): C[a][b], a along s. */
+static void biq_net(const cs_varady_t *v, size_t i, double c[3][3][2])
+{
+    size_t n = v->n;
+    const double *pm = v->vert[(i + n - 1) % n], *p0 = v->vert[i], *p1 = v->vert[(i + 1) % n],
+                 *p2 = v->vert[(i + 2) % n];
+    double ce[2];
+    centroid(v, ce);
+    for (int x = 0; x < 2; x++) {
+        c[0][0][x] = p0[x];
+        c[1][0][x] = (p0[x] + p1[x]) / 2;
+        c[2][0][x] = p1[x];
+        c[0][2][x] = pm[x];
+        c[1][2][x] = n == 3 ? pm[x] : ce[x]; /* a triangle: the row t = 2 is its apex */
+        c[2][2][x] = p2[x];
+        for (int a = 0; a < 3; a++)
+            c[a][1][x] = (c[a][0][x] + c[a][2][x]) / 2;
+    }
+}
+
+/* The map at (s, t) and its partial derivatives (Bernstein B2 and their derivatives). */
+static void biq_map(const double c[3][3][2], double s, double t, double out[2], double ds[2],
+                    double dt[2])
+{
+    double bs[3] = {(1 - s) * (1 - s), 2 * s * (1 - s), s * s};
+    double bt[3] = {(1 - t) * (1 - t), 2 * t * (1 - t), t * t};
+    double es[3] = {-2 * (1 - s), 2 - 4 * s, 2 * s}, et[3] = {-2 * (1 - t), 2 - 4 * t, 2 * t};
+    for (int x = 0; x < 2; x++) {
+        out[x] = ds[x] = dt[x] = 0;
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                out[x] += bs[a] * bt[b] * c[a][b][x];
+                ds[x] += es[a] * bt[b] * c[a][b][x];
+                dt[x] += bs[a] * et[b] * c[a][b][x];
+            }
+    }
+}
+
+/* (s, t) with map(s, t) = (x, y) by Newton-Raphson from (s, t) (at most 50 steps, to 1e-13 of
+ * the side's length); the last iterate when the Jacobian is singular. */
+static void biq_invert(const cs_varady_t *v, size_t i, double x, double y, double *s, double *t)
+{
+    double c[3][3][2];
+    biq_net(v, i, c);
+    for (int it = 0; it < 50; it++) {
+        double m[2], ds[2], dt[2];
+        biq_map((const double(*)[3][2])c, *s, *t, m, ds, dt);
+        double fx = m[0] - x, fy = m[1] - y, det = ds[0] * dt[1] - ds[1] * dt[0];
+        if (fabs(fx) + fabs(fy) < 1e-13 * v->len_d[i] || !(fabs(det) > 0))
+            break;
+        *s -= (dt[1] * fx - dt[0] * fy) / det;
+        *t -= (-ds[1] * fx + ds[0] * fy) / det;
+    }
+}
+
+/* Distance from the vertices' centroid to side i's line (the biquadratic d scale). */
+static double centre_height(const cs_varady_t *v, size_t i)
+{
+    double ce[2];
+    centroid(v, ce);
+    return side_dist(v, i, ce[0], ce[1]);
+}
+
 void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], double d[])
 {
     size_t n = v->n;
@@ -195,10 +489,15 @@ void cs_varady_params(const cs_varady_t *v, double x, double y, double s[], doub
         double l = v->len_d[i], eu[2] = {(b[0] - a[0]) / l, (b[1] - a[1]) / l};
         double u0 = (x - a[0]) * eu[0] + (y - a[1]) * eu[1];
         double v0 = -(x - a[0]) * eu[1] + (y - a[1]) * eu[0];
-        if (v->param == CS_VARADY_SIDE) {
+        if (v->param == CS_VARADY_SIDE || v->param == CS_VARADY_BIQUADRATIC) {
             double dp = dist[(i + n - 1) % n], dn = dist[(i + 1) % n];
             s[i] = dp + dn != 0 ? dp / (dp + dn) : 0.5;
             d[i] = dist[i];
+            if (v->param == CS_VARADY_BIQUADRATIC) {
+                double h = centre_height(v, i), t = d[i] / h;
+                biq_invert(v, i, x, y, &s[i], &t);
+                d[i] = t * h;
+            }
         } else if (v->param == CS_VARADY_RADIAL) {
             /* e: where the ray from the centre rc (or along w1) through (u0, v0) meets v = 0. */
             double eu0, len;
@@ -277,13 +576,48 @@ static void nearest_corner(const cs_varady_t *v, double x, double y, double out[
     curve_d(&v->side[best], 0, out, NULL);
 }
 
-/* Ribbon R_i(s, d) = P_i(s) + d T_i(s), T_i linear between t0 and t1. */
+cs_err_t cs_varady_set_tangents(cs_varady_t *v, const cs_bezier_t *tan)
+{
+    if (!v)
+        return CS_ERR_ARG;
+    for (size_t i = 0; tan && i < v->n; i++) {
+        if (tan[i].rational)
+            return CS_ERR_UNSUPPORTED;
+        if (tan[i].degree < 1 || tan[i].degree > 3)
+            return CS_ERR_DEGREE;
+    }
+    v->user_tan = tan != NULL;
+    for (size_t i = 0; tan && i < v->n; i++)
+        v->tan[i] = tan[i];
+    return CS_OK;
+}
+
+void cs_varady_set_twists(cs_varady_t *v, const double (*twist)[3])
+{
+    for (size_t i = 0; i < v->n; i++)
+        for (int k = 0; k < 3; k++)
+            v->twist[i][k] = twist ? twist[i][k] : 0;
+}
+
+/* Cross-boundary tangent T_i(s): the user's curve, or t0 -> t1 linearly. */
+static void tangent(const cs_varady_t *v, size_t i, double s, double out[3])
+{
+    if (v->user_tan) {
+        curve_d(&v->tan[i], s, out, NULL);
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = (1 - s) * v->t0[i][k] + s * v->t1[i][k];
+}
+
+/* Ribbon R_i(s, d) = P_i(s) + d T_i(s). */
 static void ribbon(const cs_varady_t *v, size_t i, double s, double d, double out[3])
 {
-    double p[3];
+    double p[3], t[3];
     curve_d(&v->side[i], s, p, NULL);
+    tangent(v, i, s, t);
     for (int k = 0; k < 3; k++)
-        out[k] = p[k] + d * ((1 - s) * v->t0[i][k] + s * v->t1[i][k]);
+        out[k] = p[k] + d * t[k];
 }
 
 void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
@@ -328,12 +662,16 @@ void cs_varady_eval(const cs_varady_t *v, double x, double y, double out[3])
                 out[k] += lambda[i] * r[k];
         }
         if (kappa[i] != 0) {
-            /* Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0), zero twist (seed 000's choice). */
+            /* Q_i = P_i(0) + d_{i-1} T_{i-1}(1) + d_i T_i(0) + d_{i-1} d_i W_i (W_i zero by
+             * default, seed 000's choice). */
             size_t im = (i + n - 1) % n;
-            double p[3];
+            double p[3], ta[3], tb[3];
             curve_d(&v->side[i], 0, p, NULL);
+            tangent(v, im, 1, ta);
+            tangent(v, i, 0, tb);
             for (int k = 0; k < 3; k++)
-                out[k] -= kappa[i] * (p[k] + d[im] * v->t1[im][k] + d[i] * v->t0[i][k]);
+                out[k] -= kappa[i] *
+                          (p[k] + d[im] * ta[k] + d[i] * tb[k] + d[im] * d[i] * v->twist[i][k]);
         }
     }
 }

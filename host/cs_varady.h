@@ -11,6 +11,7 @@
 #ifndef CS_VARADY_H
 #define CS_VARADY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "cs_bezier.h"
@@ -36,10 +37,32 @@ typedef enum {
                          * + 2 w12 (1 - s) s + w2 s^2] d, w1 and w2 the unit directions of the
                          * neighbouring sides, w12 chosen so that r(1/2, d_c) is the domain
                          * centre; (s_i, d_i) = r^-1(point) */
+    CS_VARADY_BIQUADRATIC, /* seed 002's biquadratic mapping: (x, y) = sum C_ab B2_a(s) B2_b(t)
+                            * with rows t = 0: p_i, (p_i + p_(i+1)) / 2, p_(i+1); t = 2:
+                            * p_(i-1), c, p_(i+2) (c the vertices' centroid; for n = 3 the
+                            * apex p_(i-1) = p_(i+2) itself); t = 1: the
+                            * midpoints of those columns, so lines s = const are straight and
+                            * the map is linear on side i; (s, t) by Newton-Raphson from the
+                            * side-based values, d_i = t h_i (h_i: distance from c to side i) */
 } cs_varady_param_t;
+
+/* The domain polygon (seed 002, "Choix du domaine"): p_i starts side i, counter-clockwise;
+ * L_i the boundary curves' arc lengths, phi_i the 3D angle between the two boundaries at corner
+ * i, c_angle = (n - 2) pi / sum phi_j. */
+typedef enum {
+    CS_VARADY_DOMAIN_ARC = 0, /* solution 1: on a circle of circumference sum L, at angles
+                               * 2 pi (L_1 + .. + L_(i-1)) / sum L */
+    CS_VARADY_DOMAIN_CHORDS,  /* solution 2: on a circle, |p_i p_(i+1)| = L_i */
+    CS_VARADY_DOMAIN_ANGLES,  /* solution 3: sides L_i, interior angles alpha_i = c_angle phi_i,
+                               * the closing gap e = p_(n+1) -> p_1 spread as (i / n) e */
+    CS_VARADY_DOMAIN_LSQ,     /* the least-squares domain: sides l_i and angles alpha_i
+                               * minimising sum (l_i - L_i)^2 + sum (alpha_i - c_angle phi_i)^2
+                               * over closed polygons (Gauss-Newton on the constraints) */
+} cs_varady_domain_t;
 
 typedef struct {
     size_t n;
+    cs_varady_domain_t domain;
     cs_varady_blend_t blend;
     cs_varady_param_t param;
     cs_bezier_t side[CS_VARADY_MAX_SIDES]; /* P_i(s), s in [0, 1], P_i(1) = P_{i+1}(0) */
@@ -48,12 +71,15 @@ typedef struct {
     double t0[CS_VARADY_MAX_SIDES][3];     /* cross-boundary tangent of side i at s = 0 */
     double t1[CS_VARADY_MAX_SIDES][3];     /* ... at s = 1 (unit vectors into the patch) */
     /* Per side i, in its local frame (origin p_i, u along side i, v into the domain): */
-    double len_d[CS_VARADY_MAX_SIDES]; /* domain side length |p_{i+1} - p_i| */
-    double w1[CS_VARADY_MAX_SIDES][2]; /* unit direction p_i -> p_{i-1} */
-    double w2[CS_VARADY_MAX_SIDES][2]; /* unit direction p_{i+1} -> p_{i+2} */
-    double w12u[CS_VARADY_MAX_SIDES];  /* central line: u of w12 (its v is (w1v + w2v) / 2) */
-    double rc[CS_VARADY_MAX_SIDES][2]; /* radial: where the lines of sides i - 1, i + 1 meet */
-    int rpar[CS_VARADY_MAX_SIDES];     /* radial: those lines are parallel (rays along w1) */
+    double len_d[CS_VARADY_MAX_SIDES];    /* domain side length |p_{i+1} - p_i| */
+    double w1[CS_VARADY_MAX_SIDES][2];    /* unit direction p_i -> p_{i-1} */
+    double w2[CS_VARADY_MAX_SIDES][2];    /* unit direction p_{i+1} -> p_{i+2} */
+    double w12u[CS_VARADY_MAX_SIDES];     /* central line: u of w12 (its v is (w1v + w2v) / 2) */
+    double rc[CS_VARADY_MAX_SIDES][2];    /* radial: where the lines of sides i - 1, i + 1 meet */
+    int rpar[CS_VARADY_MAX_SIDES];        /* radial: those lines are parallel (rays along w1) */
+    bool user_tan;                        /* tan[] replaces the linear t0 -> t1 blend */
+    cs_bezier_t tan[CS_VARADY_MAX_SIDES]; /* T_i(s), mm per domain unit (cs_varady_set_tangents) */
+    double twist[CS_VARADY_MAX_SIDES][3]; /* W_i at corner i (start of side i), zero by default */
 } cs_varady_t;
 
 /* n (3..CS_VARADY_MAX_SIDES) polynomial boundary curves of degree 1..3 forming a loop (the end
@@ -63,6 +89,27 @@ typedef struct {
  * corner the unit tangent of the neighbouring side leading away from it, blended linearly
  * along the side (1 mm per domain mm). */
 cs_err_t cs_varady_init(cs_varady_t *v, const cs_bezier_t *sides, size_t n);
+/* Places the domain polygon by one of seed 002's constructions (cs_varady_init uses
+ * CS_VARADY_DOMAIN_ARC). CS_ERR_ARG for an unknown value; CS_ERR_DEGENERATE when the
+ * construction has no convex counter-clockwise solution (solution 2: a side longer than the
+ * others allow on one circle; 3 and least squares: an angle outside (0, pi), or no closing).
+ * On error the previous domain stays. */
+cs_err_t cs_varady_set_domain(cs_varady_t *v, cs_varady_domain_t domain);
+/* The 3D angle phi_i (radians) between the boundaries meeting at corner i (the start of side
+ * i): between -P_(i-1)'(1) and P_i'(0). */
+double cs_varady_corner_angle(const cs_varady_t *v, size_t i);
+/* The cross-boundary tangents given by the user (seed 002: "contrainte tangentielle T_i(s_i)"):
+ * tan[i] is T_i(s), s in [0, 1], in mm per domain unit (degree 1..3, any direction pointing
+ * into the patch), replacing the default unit tangents blended linearly along the side; NULL
+ * goes back to the defaults. Ribbons R_i(s, d) = P_i(s) + d T_i(s); the corner patches use
+ * T_(i-1)(1) and T_i(0). CS_ERR_DEGREE / CS_ERR_UNSUPPORTED (rational). */
+cs_err_t cs_varady_set_tangents(cs_varady_t *v, const cs_bezier_t *tan);
+/* The twists W_i (mm per domain unit squared) at the corners (corner i starts side i; NULL:
+ * zero, the default): the corner patches become Q_i = P_i(0) + d_(i-1) T_(i-1)(1) + d_i T_i(0)
+ * + d_(i-1) d_i W_i (seed 002's corner cross derivatives W_i(0)), which is 0 on sides i - 1 and
+ * i, so the boundaries are still interpolated. Only the lambda / kappa blending has corner
+ * patches; mu ignores them. */
+void cs_varady_set_twists(cs_varady_t *v, const double (*twist)[3]);
 /* Chooses the blending and the parametrisation (cs_varady_init sets CS_VARADY_MU,
  * CS_VARADY_SIDE). CS_ERR_ARG for unknown values. */
 cs_err_t cs_varady_set_scheme(cs_varady_t *v, cs_varady_blend_t blend, cs_varady_param_t param);

@@ -15,6 +15,7 @@ static const struct {
 } commands[] = {
     {"flatten", cs_cmd_flatten, "print a job's chords (SVG, G-code, HP-GL), within a tolerance"},
     {"plan", cs_cmd_plan, "plan a job into step segments (ticks dx dy dz) for a machine"},
+    {"inspect", cs_cmd_inspect, "describe a job or surfaces file: elements, lengths, continuity"},
     {"toolpath", cs_cmd_toolpath, "surface patches: projected wireframe or ball-end finishing"},
     {"stream", cs_cmd_stream, "stream a job to a device on a serial port (segments or curves)"},
     {"serve", cs_cmd_serve, "the daemon: keep a device open, stream queued jobs one by one"},

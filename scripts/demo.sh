@@ -6,7 +6,8 @@
 # cubic curves the device interpolates itself, over a line paced at 115200 baud; part 3 keeps the
 # first demo's flattening picture; part 4 makes the Utah teapot's iso wireframe and ball-end
 # finishing path (`curvestep toolpath --gcode`), plans them and runs them through the simulator,
-# which checks and draws them. Exits non-zero when any check fails. Every background process
+# which checks and draws them; part 5 draws one curves file holding every basis of the core
+# (flatten, plan, simulator). Exits non-zero when any check fails. Every background process
 # is bounded by `timeout` and killed on exit.
 set -u
 . "$(dirname "$0")/args.sh"
@@ -134,6 +135,27 @@ surface() {
 surface teapot-wireframe top --view iso --lines 4
 echo
 surface teapot-finish iso --ball 2 --scallop 0.5
+
+# demo 5: every basis of the core in one picture, from one curves file (docs/inputs.md): flattened
+# (chords within 0.01 mm, measured), then planned and run by the simulator against the file.
+CURVES=tests/data/curves/every-basis.curves
+echo
+echo "demo 5: every basis in one curves file ($CURVES)"
+"$CS" flatten --stats --tol 0.01 --svg "$OUT/every-basis.svg" "$CURVES" >/dev/null \
+    2>"$OUT/every-basis.log"
+rc=$?
+dev=$(sed -n 's/.*max deviation \([0-9.]*\) mm.*/\1/p' "$OUT/every-basis.log")
+"$CS" plan -o "$OUT/every-basis.seg" "$CURVES" 2>>"$OUT/every-basis.log" &&
+    timeout -k 5 120 "$SIM" --replay "$OUT/every-basis.seg" --reference "$CURVES" --check \
+        --png "$OUT/every-basis.png" >"$OUT/every-basis.report" 2>&1
+simrc=$?
+grep -E '^(deviation|check)' "$OUT/every-basis.report" | sed 's/^/  /'
+if [ $rc -ne 0 ] || [ $simrc -ne 0 ] || ! awk -v d="${dev:-1}" 'BEGIN { exit !(d <= 0.01) }'; then
+    echo "  every-basis: FAILED (flatten exit $rc, deviation '${dev:-?}', simulator exit $simrc)"
+    failures=$((failures + 1))
+else
+    echo "  max chord deviation $dev mm; pictures: $OUT/every-basis.svg, $OUT/every-basis.png"
+fi
 
 echo
 if [ "$failures" -ne 0 ]; then

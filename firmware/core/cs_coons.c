@@ -8,6 +8,8 @@
  * exactly in int64 (|inputs| < 2^31, weights < 2^7) and divided by 9 once. */
 #include "cs_coons.h"
 
+#include <stddef.h>
+
 typedef int64_t e3_t[4][3]; /* 3 x the control points of a curve elevated to degree 3 */
 
 static int32_t coord(const cs_vec3_t *p, unsigned a)
@@ -144,22 +146,39 @@ cs_err_t cs_coons_bicubic(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs
                           const cs_bezier_t *q2, const cs_bezier_t *p1v, const cs_bezier_t *p2v,
                           const cs_bezier_t *q1u, const cs_bezier_t *q2u, cs_patch_t *out)
 {
+    return cs_coons_bicubic_twist(p1, p2, q1, q2, p1v, p2v, q1u, q2u, NULL, out);
+}
+
+cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs_bezier_t *q1,
+                                const cs_bezier_t *q2, const cs_bezier_t *p1v,
+                                const cs_bezier_t *p2v, const cs_bezier_t *q1u,
+                                const cs_bezier_t *q2u, const cs_vec3_t twist[2][2],
+                                cs_patch_t *out)
+{
     cs_err_t e = check_boundary(p1, p2, q1, q2);
     if (e != CS_OK)
         return e;
     const cs_bezier_t *der[4] = {p1v, p2v, q1u, q2u};
-    /* Defaults: the cubic (a, a, b, b) between the corner tangents of the crossing curves
-     * (p1v from q1'(0) to q2'(0), ...): compatible with the corners and the zero twists. */
+    /* Defaults: the Hermite cubic between the corner tangents of the crossing curves (p1v from
+     * q1'(0) to q2'(0), ...) with the twists as its end slopes, 3 x Bézier (3a, 3a + s0,
+     * 3b - s1, 3b): compatible with the corners and the twists (zero twists: (a, a, b, b)).
+     * End slopes: p1v (tw00, tw10), p2v (tw01, tw11), q1u (tw00, tw01), q2u (tw10, tw11). */
     const cs_bezier_t *from[4] = {q1, q1, p1, p1}, *to[4] = {q2, q2, p2, p2};
     const bool at_end[4] = {false, true, false, true};
+    static const unsigned slope[4][2][2] = {
+        {{0, 0}, {1, 0}}, {{0, 1}, {1, 1}}, {{0, 0}, {0, 1}}, {{1, 0}, {1, 1}}};
     e3_t g[4];
     for (unsigned k = 0; k < 4; k++) {
         if (!der[k]) {
             for (unsigned a = 0; a < 3; a++) {
                 int64_t ta = end_tangent(from[k], at_end[k], a),
                         tb = end_tangent(to[k], at_end[k], a);
-                g[k][0][a] = g[k][1][a] = 3 * ta;
-                g[k][2][a] = g[k][3][a] = 3 * tb;
+                int64_t s0 = twist ? coord(&twist[slope[k][0][0]][slope[k][0][1]], a) : 0;
+                int64_t s1 = twist ? coord(&twist[slope[k][1][0]][slope[k][1][1]], a) : 0;
+                g[k][0][a] = 3 * ta;
+                g[k][1][a] = 3 * ta + s0;
+                g[k][2][a] = 3 * tb - s1;
+                g[k][3][a] = 3 * tb;
             }
             continue;
         }
@@ -180,15 +199,17 @@ cs_err_t cs_coons_bicubic(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs
     int64_t net9[4][4][3];
     for (unsigned a = 0; a < 3; a++) {
         /* S3's B matrix (seed 000): corners, u-tangents of p1 / p2, v-tangents of q1 / q2,
-         * zero twists. Rows (A(0,.), A(1,.), A^u(0,.), A^u(1,.)), columns (v = 0, v = 1,
-         * d/dv at 0, d/dv at 1). */
+         * the twists A^uv (zero unless given). Rows (A(0,.), A(1,.), A^u(0,.), A^u(1,.)),
+         * columns (v = 0, v = 1, d/dv at 0, d/dv at 1). */
         int64_t bm[4][4] = {
             {coord(&p1->p[0], a), coord(&p2->p[0], a), end_tangent(q1, false, a),
              end_tangent(q1, true, a)},
             {coord(&p1->p[p1->degree], a), coord(&p2->p[p2->degree], a), end_tangent(q2, false, a),
              end_tangent(q2, true, a)},
-            {end_tangent(p1, false, a), end_tangent(p2, false, a), 0, 0},
-            {end_tangent(p1, true, a), end_tangent(p2, true, a), 0, 0},
+            {end_tangent(p1, false, a), end_tangent(p2, false, a),
+             twist ? coord(&twist[0][0], a) : 0, twist ? coord(&twist[0][1], a) : 0},
+            {end_tangent(p1, true, a), end_tangent(p2, true, a), twist ? coord(&twist[1][0], a) : 0,
+             twist ? coord(&twist[1][1], a) : 0},
         };
         for (unsigned i = 0; i < 4; i++) {
             for (unsigned j = 0; j < 4; j++) {

@@ -1,8 +1,8 @@
 /* cs_coons: Coons patches from four boundary curves (seed 000, "Patches de Coons"), built exactly
  * as bicubic cs_patch_t when the boundaries (and cross-boundary derivative curves) are Bézier
  * curves of degree <= 3: bilinear S = S1 + S2 - S3 (linear blends) and bicubic (Hermite blends,
- * the seed's matrix H, twist vectors of S3 zero as the seed's default). Also the swept surfaces
- * that are exact tensor products: ruled surfaces between two curves and extrusions. */
+ * the seed's matrix H, twist vectors of S3 zero as the seed's default, or given). Also the swept
+ * surfaces that are exact tensor products: ruled surfaces between two curves and extrusions. */
 #ifndef CS_COONS_H
 #define CS_COONS_H
 
@@ -30,6 +30,17 @@ cs_err_t cs_coons_bilinear(const cs_bezier_t *p1, const cs_bezier_t *p2, const c
 cs_err_t cs_coons_bicubic(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs_bezier_t *q1,
                           const cs_bezier_t *q2, const cs_bezier_t *p1v, const cs_bezier_t *p2v,
                           const cs_bezier_t *q1u, const cs_bezier_t *q2u, cs_patch_t *out);
+/* Bicubic Coons with the twist vectors of S3 given (seed 000: A^uv_ab = d2S/dudv at corner
+ * (u = a, v = b), twist[a][b], mm per unit u per unit v, any int32 components) instead of zero;
+ * NULL twist is cs_coons_bicubic. A NULL derivative curve then defaults to the Hermite cubic
+ * between the crossing curves' corner tangents whose end slopes are the twists (p1v: twist[0][0],
+ * twist[1][0]; p2v: [0][1], [1][1]; q1u: [0][0], [0][1]; q2u: [1][0], [1][1]), so S interpolates
+ * the boundaries and has those twists at the corners. Errors as cs_coons_bicubic. Pure. */
+cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs_bezier_t *q1,
+                                const cs_bezier_t *q2, const cs_bezier_t *p1v,
+                                const cs_bezier_t *p2v, const cs_bezier_t *q1u,
+                                const cs_bezier_t *q2u, const cs_vec3_t twist[2][2],
+                                cs_patch_t *out);
 /* Ruled surface S(u, v) = (1 - v) p(u) + v q(u) (seed 000, "Surface réglée"): a patch of degree
  * max(deg p, deg q) x 1; the lower-degree curve is elevated (exact to 0.5 LSB). Polynomial
  * curves of degree 1..3 only. Pure. */

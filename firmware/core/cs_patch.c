@@ -1,28 +1,33 @@
 /* cs_patch: tensor-product Bézier patches (seed 003 "Surfaces bicubiques": Q(s, t) =
- * S M G M^T T^T; seed 004: Hermite bicubic, B-matrix, 9-way split, normal Pu x Pv).
+ * S M G M^T T^T; seed 004: Hermite bicubic, B-matrix, 9-way split, normal Pu x Pv), of any
+ * degree up to 7 x 7.
  *
  * Precision. Evaluation runs de Casteljau in v on each row, then in u, on int64 values carrying
- * GUARD = 28 guard bits (|coordinate| <= 2^28 LSB, so values < 2^56, differences < 2^57). Each
+ * GUARD = 26 guard bits (|coordinate| <= 2^28 LSB, so values < 2^54, differences < 2^55). Each
  * lerp adds at most 1/2 guard unit and convex combinations do not grow earlier errors: after
- * 6 levels a point is within 3 * 2^-28 LSB before the final rounding. A derivative multiplies
- * a difference of two such values by the degree (Pu, Pv: <= 3 * 2 * 3 * 2^-28; Puv: 9 * 4 *
- * 3 * 2^-28 < 2^-20 LSB). The largest intermediate, Puv = 9 * (second difference), stays below
- * 9 * 4 * 2^56 < 2^62, inside cs_fixed_mul64_q30's domain.
+ * du + dv <= 14 levels a point is within 7 * 2^-26 < 2^-23 LSB before the final rounding. A
+ * derivative multiplies a difference of two such values by the degree (Pu, Pv: <= 7 * 2 * 7 *
+ * 2^-26 < 2^-19 LSB; Puv: 49 * 4 * 7 * 2^-26 < 2^-15 LSB). The largest intermediate, Puv =
+ * du dv (second difference), stays below 2 * 7 * 7 * 2^(GUARD + 29) < 2^62, inside
+ * cs_fixed_mul64_q30's domain: GUARD + 29 + log2(2 * 7^2) <= 62 gives GUARD <= 26 (it was 28
+ * while patches were at most bicubic: 28 + 29 + log2(2 * 9) < 62).
  *
  * The Hermite path (9-way split) evaluates the exact Bézier form of the Hermite patch scaled by
  * 9 (integer control points 9 b = 9 P + 3 Pu + 3 Pv + Puv) with HGUARD = 22 guard bits
  * (|9 b| <= 16 * 2^28 = 2^32 -> values < 2^54) and divides by 9 * 2^22 once at the end.
  *
- * No recursion; stack is a few 4 x 4 x 3 int64 arrays (<= 1.5 KiB in cs_patch_hermite_split9). */
+ * No recursion; stack is a few 8 x 8 x 3 int64 arrays (<= 2 KiB in cs_patch_continuity). */
 #include "cs_patch.h"
 
-#define GUARD  28
+#define GUARD  26
 #define HGUARD 22
 #define NPTS   CS_PATCH_MAX_POINTS
 
-CS_STATIC_ASSERT(CS_PATCH_MAX_DEGREE == 3, bicubic_at_most);
-CS_STATIC_ASSERT(GUARD + 28 + 6 <= 62, twist_below_2_62);
-CS_STATIC_ASSERT(3 * CS_PATCH_RASTER_MAX_SHIFT + 28 + 1 <= 59, raster_values_below_2_59);
+CS_STATIC_ASSERT(CS_PATCH_MAX_DEGREE <= 7, binomials_up_to_7);
+CS_STATIC_ASSERT(2 * CS_PATCH_MAX_DEGREE * CS_PATCH_MAX_DEGREE < (1 << (62 - GUARD - 29)),
+                 twist_below_2_62);
+/* Raster: m (shift + 1) + 29 <= 63 at m = 3 and the largest shift (see cs_patch_raster_t). */
+CS_STATIC_ASSERT(3 * (CS_PATCH_RASTER_MAX_SHIFT + 1) + 29 <= 63, cubic_raster_full_shift);
 
 typedef int64_t wnet_t[NPTS][NPTS][3];
 
@@ -351,7 +356,41 @@ cs_err_t cs_patch_iso(const cs_patch_t *p, cs_patch_iso_t dir, cs_param_t t, cs_
 
 /* --- raster by forward differences ------------------------------------------------------- */
 
-static const int64_t binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+static const int64_t binom[NPTS][NPTS] = {
+    {1},
+    {1, 1},
+    {1, 2, 1},
+    {1, 3, 3, 1},
+    {1, 4, 6, 4, 1},
+    {1, 5, 10, 10, 5, 1},
+    {1, 6, 15, 20, 15, 6, 1},
+    {1, 7, 21, 35, 35, 21, 7, 1},
+};
+
+unsigned cs_patch_raster_max_shift(unsigned m)
+{
+    if (m == 0)
+        return CS_PATCH_RASTER_MAX_SHIFT;
+    unsigned s = (34u - m) / m; /* m (s + 1) + 29 <= 63 */
+    return s < CS_PATCH_RASTER_MAX_SHIFT ? s : CS_PATCH_RASTER_MAX_SHIFT;
+}
+
+/* F(k) = N^m c(k / N) = sum_j C(m, j) k^j (N - k)^(m - j) c_j for one coordinate of the curve
+ * c of degree m: an integer polynomial in k. For k <= m <= N each term is below
+ * C(m, j) N^m 2^28; for N < m (shift < 3), below C(m, j) m^m 2^28 < 2^(3 m + 28 + m). */
+static int64_t raster_value(const cs_bezier_t *c, unsigned a, int64_t big_n, int64_t k)
+{
+    int64_t s = 0;
+    for (unsigned j = 0; j <= c->degree; j++) {
+        int64_t b = binom[c->degree][j];
+        for (unsigned q = 0; q < j; q++)
+            b *= k;
+        for (unsigned q = j; q < c->degree; q++)
+            b *= big_n - k;
+        s += b * coord(&c->p[j], a);
+    }
+    return s;
+}
 
 cs_err_t cs_patch_raster_begin(cs_patch_raster_t *r, const cs_patch_t *p, cs_patch_iso_t dir,
                                unsigned shift)
@@ -359,40 +398,29 @@ cs_err_t cs_patch_raster_begin(cs_patch_raster_t *r, const cs_patch_t *p, cs_pat
     cs_err_t e = check_patch(p);
     if (e != CS_OK)
         return e;
-    if (!r || shift > CS_PATCH_RASTER_MAX_SHIFT || (dir != CS_PATCH_ISO_U && dir != CS_PATCH_ISO_V))
+    if (!r || (dir != CS_PATCH_ISO_U && dir != CS_PATCH_ISO_V))
         return CS_ERR_ARG;
     cs_patch_iso_t other = dir == CS_PATCH_ISO_U ? CS_PATCH_ISO_V : CS_PATCH_ISO_U;
     unsigned n = dir == CS_PATCH_ISO_U ? p->deg_u : p->deg_v;
+    unsigned m = dir == CS_PATCH_ISO_U ? p->deg_v : p->deg_u;
+    if (shift > cs_patch_raster_max_shift(m))
+        return CS_ERR_ARG;
     int64_t big_n = (int64_t)1 << shift;
     r->degree = (uint8_t)n;
+    r->order = (uint8_t)m;
     r->shift = (uint8_t)shift;
     r->k = 0;
     for (unsigned i = 0; i <= n; i++) {
         cs_bezier_t c;
         net_line(p, other, i, &c);
-        unsigned m = c.degree;
         for (unsigned a = 0; a < 3; a++) {
-            /* F(k) = N^3 c(k / N) = N^(3-m) sum_j C(m, j) k^j (N - k)^(m-j) c_j: an integer
-             * polynomial of degree m in k, so its forward differences are exact integers. */
-            int64_t f[4];
-            for (int64_t k = 0; k < 4; k++) {
-                int64_t s = 0;
-                for (unsigned j = 0; j <= m; j++) {
-                    int64_t b = binom[m][j];
-                    for (unsigned q = 0; q < j; q++)
-                        b *= k;
-                    for (unsigned q = j; q < m; q++)
-                        b *= big_n - k;
-                    s += b * coord(&c.p[j], a);
-                }
-                for (unsigned q = m; q < 3; q++)
-                    s *= big_n;
-                f[k] = s;
-            }
-            r->f[i][a][0] = f[0];
-            r->f[i][a][1] = f[1] - f[0];
-            r->f[i][a][2] = f[2] - 2 * f[1] + f[0];
-            r->f[i][a][3] = f[3] - 3 * f[2] + 3 * f[1] - f[0];
+            /* F(0..m), then its forward differences in place: f[d] = Delta^d F(0). */
+            int64_t *f = r->f[i][a];
+            for (unsigned k = 0; k <= m; k++)
+                f[k] = raster_value(&c, a, big_n, (int64_t)k);
+            for (unsigned d = 1; d <= m; d++)
+                for (unsigned k = m; k >= d; k--)
+                    f[k] -= f[k - 1];
         }
     }
     return CS_OK;
@@ -400,8 +428,8 @@ cs_err_t cs_patch_raster_begin(cs_patch_raster_t *r, const cs_patch_t *p, cs_pat
 
 cs_err_t cs_patch_raster_next(cs_patch_raster_t *r, cs_bezier_t *out, cs_param_t *t)
 {
-    if (!r || !out || r->shift > CS_PATCH_RASTER_MAX_SHIFT || r->degree < 1 ||
-        r->degree > CS_PATCH_MAX_DEGREE)
+    if (!r || !out || r->degree < 1 || r->degree > CS_PATCH_MAX_DEGREE ||
+        r->order > CS_PATCH_MAX_DEGREE || r->shift > cs_patch_raster_max_shift(r->order))
         return CS_ERR_ARG;
     uint32_t big_n = (uint32_t)1 << r->shift;
     if (r->k > big_n)
@@ -411,7 +439,9 @@ cs_err_t cs_patch_raster_next(cs_patch_raster_t *r, cs_bezier_t *out, cs_param_t
     for (unsigned i = 0; i <= r->degree; i++) {
         for (unsigned a = 0; a < 3; a++) {
             int32_t v;
-            if (cs_fixed_narrow(cs_fixed_round_shift64(r->f[i][a][0], 3u * r->shift), &v) != CS_OK)
+            if (cs_fixed_narrow(
+                    cs_fixed_round_shift64(r->f[i][a][0], (unsigned)r->order * r->shift), &v) !=
+                CS_OK)
                 return CS_ERR_OVERFLOW;
             set_coord(&c.p[i], a, v);
         }
@@ -419,16 +449,11 @@ cs_err_t cs_patch_raster_next(cs_patch_raster_t *r, cs_bezier_t *out, cs_param_t
     }
     if (t)
         *t = (cs_param_t)((int64_t)r->k << (CS_PARAM_FRAC_BITS - r->shift));
-    if (r->k < big_n) {
-        for (unsigned i = 0; i <= r->degree; i++) {
-            for (unsigned a = 0; a < 3; a++) {
-                int64_t *f = r->f[i][a];
-                f[0] += f[1];
-                f[1] += f[2];
-                f[2] += f[3];
-            }
-        }
-    }
+    if (r->k < big_n)
+        for (unsigned i = 0; i <= r->degree; i++)
+            for (unsigned a = 0; a < 3; a++)
+                for (unsigned d = 0; d < r->order; d++)
+                    r->f[i][a][d] += r->f[i][a][d + 1];
     r->k++;
     *out = c;
     return CS_OK;
@@ -665,6 +690,32 @@ static cs_vec3_t cross_ctrl(const cs_patch_t *p, unsigned j, bool far, bool *ok)
     return r;
 }
 
+/* Second cross-boundary derivative control vector of column j, n (n - 1) (P_n - 2 P_(n-1) +
+ * P_(n-2)) at a's far edge (far) or n (n - 1) (P_0 - 2 P_1 + P_2) at b's near edge, axis a:
+ * exact (|.| < 42 * 4 * 2^28 < 2^36). */
+static int64_t second_ctrl(const cs_patch_t *p, unsigned j, bool far, unsigned a)
+{
+    unsigned n = p->deg_u;
+    if (n < 2)
+        return 0;
+    const cs_vec3_t *e = far ? &p->p[n][j] : &p->p[0][j];
+    const cs_vec3_t *m = far ? &p->p[n - 1][j] : &p->p[1][j];
+    const cs_vec3_t *f = far ? &p->p[n - 2][j] : &p->p[2][j];
+    return (int64_t)n * (n - 1) * ((int64_t)coord(e, a) - 2 * (int64_t)coord(m, a) + coord(f, a));
+}
+
+/* The second cross-boundary derivatives of a (u = 1) and b (u = 0) agree within tol. */
+static bool second_agree(const cs_patch_t *a, const cs_patch_t *b, int64_t tol)
+{
+    for (unsigned j = 0; j <= a->deg_v; j++)
+        for (unsigned x = 0; x < 3; x++) {
+            int64_t d = second_ctrl(a, j, true, x) - second_ctrl(b, j, false, x);
+            if (d > tol || d < -tol)
+                return false;
+        }
+    return true;
+}
+
 cs_err_t cs_patch_continuity(const cs_patch_t *a, const cs_patch_t *b, cs_pos_t tol,
                              cs_param_t sin_tol, cs_patch_cont_t *out)
 {
@@ -690,7 +741,7 @@ cs_err_t cs_patch_continuity(const cs_patch_t *a, const cs_patch_t *b, cs_pos_t 
             c1 = false;
     }
     if (ok && c1) {
-        *out = CS_PATCH_CONT_C1;
+        *out = second_agree(a, b, tol) ? CS_PATCH_CONT_C2 : CS_PATCH_CONT_C1;
         return CS_OK;
     }
     /* G1: Pu_a(1, v), Pu_b(0, v) and the edge tangent Pv coplanar, the two Pu on the same side

@@ -1,4 +1,4 @@
-/* cs_patch: tensor-product Bézier patches of degree up to 3 x 3 (bicubic above all), the one
+/* cs_patch: tensor-product Bézier patches of degree up to 7 x 7 (bicubic above all), the one
  * surface representation of the core (seed 003 "Surfaces bicubiques", seed 004 Hermite).
  * Owns evaluation with Pu, Pv, Puv and the unit normal (limit normal on collapsed edges), de
  * Casteljau splits, iso-curves as cs_bezier_t (stepped by exact forward differences for a
@@ -14,13 +14,15 @@
 #include "cs_err.h"
 #include "cs_fixed.h"
 
-#define CS_PATCH_MAX_DEGREE 3
+/* Any degree the curves have (seed 000's patches are not limited to bicubics); the Hermite and
+ * algebraic forms and the 9-way split stay bicubic (seed 004). */
+#define CS_PATCH_MAX_DEGREE CS_BEZIER_MAX_DEGREE
 #define CS_PATCH_MAX_POINTS (CS_PATCH_MAX_DEGREE + 1)
 
 /* P(u, v) = sum_i sum_j B_i^du(u) B_j^dv(v) p[i][j], u, v in [0, 1]: i runs along u, j along v
  * (Newell's 16 indices k = 4 i + j). Every control point inside CS_POS_LIMIT. */
 typedef struct {
-    uint8_t deg_u, deg_v; /* 1..3 each */
+    uint8_t deg_u, deg_v; /* 1..CS_PATCH_MAX_DEGREE each */
     cs_vec3_t p[CS_PATCH_MAX_POINTS][CS_PATCH_MAX_POINTS];
 } cs_patch_t;
 
@@ -50,15 +52,18 @@ typedef enum {
 } cs_patch_iso_t;
 
 /* Raster of N + 1 iso-curves at the parameters k / N, N = 2^shift: each control point of the
- * iso-curve is a polynomial of degree <= 3 in the fixed parameter, stepped by exact integer
- * forward differences (values scaled by N^3), so each step is 3 int64 additions per coordinate
- * per control point and every curve is the exact iso-curve rounded once (<= 0.5 LSB). */
+ * iso-curve is a polynomial of degree m <= 7 (the patch's degree in the fixed parameter) in it,
+ * stepped by exact integer forward differences (values scaled by N^m), so each step is m int64
+ * additions per coordinate per control point and every curve is the exact iso-curve rounded
+ * once (<= 0.5 LSB). Exactness needs |N^m c| 2^m < 2^63 with |c| < 2^28 LSB: m (shift + 1) + 29
+ * <= 63, so shift <= cs_patch_raster_max_shift(m) (10 up to cubics, 7, 5, 4, 3 for m = 4..7). */
 #define CS_PATCH_RASTER_MAX_SHIFT 10
 typedef struct {
     uint8_t degree; /* of each iso-curve */
+    uint8_t order;  /* m: degree of the control points in the fixed parameter */
     uint8_t shift;
-    uint16_t k;                           /* next curve, 0..N; N + 1 means finished */
-    int64_t f[CS_PATCH_MAX_POINTS][3][4]; /* [point][axis]: N^3 * value, then its differences */
+    uint16_t k;                                             /* next curve, 0..N; N + 1: done */
+    int64_t f[CS_PATCH_MAX_POINTS][3][CS_PATCH_MAX_POINTS]; /* N^m * value, then differences */
 } cs_patch_raster_t;
 
 /* Continuity along the shared edge a(1, v) = b(0, v), the highest that holds. */
@@ -67,6 +72,7 @@ typedef enum {
     CS_PATCH_CONT_C0 = 1,   /* same edge curve */
     CS_PATCH_CONT_G1 = 2,   /* same tangent plane all along the edge */
     CS_PATCH_CONT_C1 = 3,   /* same cross-boundary derivative dP/du all along the edge */
+    CS_PATCH_CONT_C2 = 4,   /* C1 and the same second cross-boundary derivative d2P/du2 */
 } cs_patch_cont_t;
 
 /* Patch from (deg_u + 1) * (deg_v + 1) points, pts[i * (deg_v + 1) + j] = p[i][j].
@@ -98,8 +104,12 @@ cs_err_t cs_patch_split_v(const cs_patch_t *p, cs_param_t v, cs_patch_t *lo, cs_
  * (degree deg_u), ISO_V gives v -> P(t, v); control points rounded once (<= 0.5 + 2^-25 LSB). */
 cs_err_t cs_patch_iso(const cs_patch_t *p, cs_patch_iso_t dir, cs_param_t t, cs_bezier_t *out);
 
+/* Largest raster shift for iso-curves whose control points have degree m in the fixed
+ * parameter (see cs_patch_raster_t): min(CS_PATCH_RASTER_MAX_SHIFT, (34 - m) / m). Pure. */
+unsigned cs_patch_raster_max_shift(unsigned m);
 /* Start a raster of 2^shift + 1 iso-curves of family dir at t = k / 2^shift, k = 0..2^shift
- * (shift 0..CS_PATCH_RASTER_MAX_SHIFT, else CS_ERR_ARG). Bounded work, ISR-safe. */
+ * (shift 0..cs_patch_raster_max_shift(the other degree), else CS_ERR_ARG). Bounded work,
+ * ISR-safe. */
 cs_err_t cs_patch_raster_begin(cs_patch_raster_t *r, const cs_patch_t *p, cs_patch_iso_t dir,
                                unsigned shift);
 /* Next iso-curve (*t its fixed parameter, may be NULL); CS_END after the last (k = 2^shift, the
@@ -131,7 +141,9 @@ cs_err_t cs_patch_hermite_split9(const cs_patch_hermite_t *h, const cs_param_t u
 cs_err_t cs_patch_transpose(const cs_patch_t *p, cs_patch_t *out);
 /* Continuity along a's edge u = 1 against b's edge u = 0 (same deg_v, else CS_ERR_DEGREE):
  * C0 when the edge control points agree within tol LSB (each coordinate); C1 when also the
- * cross-boundary derivative control vectors deg_u (p[n][j] - p[n-1][j]) agree within tol; G1
+ * cross-boundary derivative control vectors deg_u (p[n][j] - p[n-1][j]) agree within tol; C2
+ * when, beyond C1, the second ones deg_u (deg_u - 1) (p[n][j] - 2 p[n-1][j] + p[n-2][j]) (zero
+ * for deg_u = 1) agree within tol too (exact integers); G1
  * when instead det(Pu_a, Pu_b, Pv) / (|Pu_a| |Pu_b| |Pv|) <= sin_tol (Q30) with Pu_a . Pu_b > 0
  * relative to the edge (same side) at 3 deg_v + 1 points along the edge: the determinant is a
  * polynomial of degree <= 3 deg_v - 1 in v, so that many zeros mean it vanishes everywhere.

@@ -1,13 +1,15 @@
 /* cs_tripatch: barycentric de Casteljau (seed 000): level r + 1 point (i, j, k) is
- * u b(i+1, j, k) + v b(i, j+1, k) + w b(i, j, k+1). Values carry GUARD = 28 bits (|.| < 2^56);
- * each of the three products is rounded by cs_fixed_mul64_q30 (1/2 guard unit each), and the
- * weights sum to exactly 2^30, so n <= 3 levels add at most 4.5 guard units: 2^-25 LSB.
+ * u b(i+1, j, k) + v b(i, j+1, k) + w b(i, j, k+1). Values carry GUARD = 28 bits (|.| < 2^56,
+ * convex combinations never leave the control points' range; the three products are formed
+ * separately, each < 2^56); each of the three products is rounded by cs_fixed_mul64_q30 (1/2
+ * guard unit each), and the weights sum to exactly 2^30, so n <= 7 levels add at most 10.5
+ * guard units: < 2^-24 LSB (it was 4.5 units, 2^-25 LSB, while n <= 3).
  * The blossom runs the same levels with a different barycentric point per level. */
 #include "cs_tripatch.h"
 
 #define GUARD 28
 
-CS_STATIC_ASSERT(CS_TRIPATCH_MAX_POINTS == 10, cubic_has_10_points);
+CS_STATIC_ASSERT(CS_TRIPATCH_MAX_POINTS == 36, degree_7_has_36_points);
 
 unsigned cs_tripatch_index(unsigned n, unsigned i, unsigned j)
 {

@@ -1,4 +1,4 @@
-/* cs_tripatch: triangular Bézier patches of degree 1..3 (seed 000, "Carreaux triangulaires de
+/* cs_tripatch: triangular Bézier patches of degree 1..7 (seed 000, "Carreaux triangulaires de
  * Bézier"): p(u, v) = sum over i + j + k = n of n! / (i! j! k!) u^i v^j w^k S_ijk with
  * barycentric (u, v, w), w = 1 - u - v. Owns evaluation by barycentric de Casteljau and the
  * image of a straight domain segment (edges and iso-lines) as a cs_bezier_t, by blossoming. */
@@ -11,8 +11,8 @@
 #include "cs_err.h"
 #include "cs_fixed.h"
 
-#define CS_TRIPATCH_MAX_DEGREE 3
-#define CS_TRIPATCH_MAX_POINTS 10 /* (n + 1)(n + 2) / 2 for n = 3 */
+#define CS_TRIPATCH_MAX_DEGREE CS_BEZIER_MAX_DEGREE /* its lines are cs_bezier_t of degree n */
+#define CS_TRIPATCH_MAX_POINTS ((CS_TRIPATCH_MAX_DEGREE + 1) * (CS_TRIPATCH_MAX_DEGREE + 2) / 2)
 
 /* Control point S_ijk (k = n - i - j) is p[cs_tripatch_index(n, i, j)]: rows of constant i,
  * i = 0..n, each holding j = 0..n - i. Points inside CS_POS_LIMIT. */

@@ -77,7 +77,7 @@ for par in side radial centre; do
 done
 sed "s/^varady 5/varady-scheme lambda-kappa sideways 5/" tests/data/surfaces/pentagon.txt >"$T/lk.txt"
 run "varady-scheme bad parametrisation" 1 toolpath --patches "$T/lk.txt"
-expect_err "varady-scheme bad parametrisation" "lk.txt:3:28: 'sideways': parametrisation side, radial or centre expected"
+expect_err "varady-scheme bad parametrisation" "lk.txt:3:28: 'sideways': parametrisation side, radial, centre or biquadratic expected"
 # Finishing the n-sided patch: bicubic cells fitted within tol / 2 = 0.005 mm, each a block from
 # and back to the safe height.
 run "varady with --ball" 0 toolpath --patches tests/data/surfaces/pentagon.txt --ball 2 --scallop 0.2 --safe-z 20 --stats
@@ -111,7 +111,7 @@ expect_err "native bad number" "nat_bad.txt:2:38: 'oops': control point expected
 # Bad input: file:line:col, exit 1.
 printf '1\n1,2,3\n' >"$T/bad1.txt"
 run "short patch line" 1 toolpath --patches "$T/bad1.txt"
-expect_err "short patch line" "bad1.txt:2:6: patch 1: expected 16 vertex indices, found 3"
+expect_err "short patch line" "bad1.txt:2:6: patch 1: expected 16 vertex indices \(Newell's format; a .bpt file has 'degu degv' here\), found 3"
 sed 's/^16$/15/' "$T/flat.txt" >"$T/bad2.txt"
 run "index beyond the vertices" 1 toolpath --patches "$T/bad2.txt"
 expect_err "index beyond the vertices" "bad2.txt:2:37: vertex index 16 outside 1..15"

@@ -111,6 +111,21 @@ static void hblend(double t, double h[4])
         h[k] = H[k][0] * m[0] + H[k][1] * m[1] + H[k][2] * m[2] + H[k][3] * m[3];
 }
 
+/* Seed 000: S = S1 + S2 - S3, S1 = (P1, P2, P1v, P2v) H(v), S2 = (Q1, Q2, Q1u, Q2u) H(u),
+ * S3 = H(u)^T A H(v), with hu, hv the Hermite blends and c1, c2 the curves at u, v. */
+static cs_ref_vec_t seed_coons(const double hu[4], const double hv[4], const cs_ref_vec_t c1[4],
+                               const cs_ref_vec_t c2[4], const cs_ref_vec_t A[4][4])
+{
+    cs_ref_vec_t want = {0, 0, 0};
+    for (int k = 0; k < 4; k++) {
+        want = lin(1, want, hv[k], c1[k]);
+        want = lin(1, want, hu[k], c2[k]);
+        for (int l = 0; l < 4; l++)
+            want = lin(1, want, -hu[k] * hv[l], A[k][l]);
+    }
+    return want;
+}
+
 typedef struct {
     cs_bezier_t p1, p2, q1, q2;
 } boundary_t;
@@ -124,6 +139,31 @@ static boundary_t rnd_boundary(int32_t lim)
     b.q1 = curve(1 + (unsigned)(xorshift() % 3), A, D, lim);
     b.q2 = curve(1 + (unsigned)(xorshift() % 3), B, C, lim);
     return b;
+}
+
+/* Seed 000's bicubic Coons point at (u, v) from the boundaries, the derivative curves dp (when
+ * with) or their defaults, and S3's matrix A (twists in its lower right block): the default
+ * derivative curves are the Hermite cubics between the crossing curves' corner tangents with the
+ * twists as end slopes (zero twists: Bézier (a, a, b, b)). */
+static cs_ref_vec_t coons_ref(const boundary_t *b, const cs_bezier_t *const dp[4], bool with,
+                              const cs_ref_vec_t A[4][4], double u, double v)
+{
+    double hu[4], hv[4];
+    hblend(u, hu);
+    hblend(v, hv);
+    cs_ref_vec_t d0 =
+        lin(1, lin(hu[0], A[0][2], hu[1], A[1][2]), 1, lin(hu[2], A[2][2], hu[3], A[3][2]));
+    cs_ref_vec_t d1 =
+        lin(1, lin(hu[0], A[0][3], hu[1], A[1][3]), 1, lin(hu[2], A[2][3], hu[3], A[3][3]));
+    cs_ref_vec_t d2 =
+        lin(1, lin(hv[0], A[2][0], hv[1], A[2][1]), 1, lin(hv[2], A[2][2], hv[3], A[2][3]));
+    cs_ref_vec_t d3 =
+        lin(1, lin(hv[0], A[3][0], hv[1], A[3][1]), 1, lin(hv[2], A[3][2], hv[3], A[3][3]));
+    cs_ref_vec_t c1[4] = {cs_ref_eval(&b->p1, u), cs_ref_eval(&b->p2, u),
+                          with ? cs_ref_eval(dp[0], u) : d0, with ? cs_ref_eval(dp[1], u) : d1};
+    cs_ref_vec_t c2[4] = {cs_ref_eval(&b->q1, v), cs_ref_eval(&b->q2, v),
+                          with ? cs_ref_eval(dp[2], v) : d2, with ? cs_ref_eval(dp[3], v) : d3};
+    return seed_coons(hu, hv, c1, c2, A);
 }
 
 static void test_bilinear(void **state)
@@ -190,27 +230,8 @@ static void test_bicubic(void **state)
         };
         for (int s = 0; s <= 8; s++)
             for (int r = 0; r <= 8; r++) {
-                double u = s / 8.0, v = r / 8.0, hu[4], hv[4];
-                hblend(u, hu);
-                hblend(v, hv);
-                /* Default derivative curves: Bézier (a, a, b, b), i.e. h0 a + h1 b. */
-                cs_ref_vec_t d0 = lin(hu[0], A[0][2], hu[1], A[1][2]);
-                cs_ref_vec_t d1 = lin(hu[0], A[0][3], hu[1], A[1][3]);
-                cs_ref_vec_t d2 = lin(hv[0], A[2][0], hv[1], A[2][1]);
-                cs_ref_vec_t d3 = lin(hv[0], A[3][0], hv[1], A[3][1]);
-                cs_ref_vec_t c1[4] = {cs_ref_eval(&b.p1, u), cs_ref_eval(&b.p2, u),
-                                      with ? cs_ref_eval(dp[0], u) : d0,
-                                      with ? cs_ref_eval(dp[1], u) : d1};
-                cs_ref_vec_t c2[4] = {cs_ref_eval(&b.q1, v), cs_ref_eval(&b.q2, v),
-                                      with ? cs_ref_eval(dp[2], v) : d2,
-                                      with ? cs_ref_eval(dp[3], v) : d3};
-                cs_ref_vec_t want = {0, 0, 0};
-                for (int k = 0; k < 4; k++) {
-                    want = lin(1, want, hv[k], c1[k]);
-                    want = lin(1, want, hu[k], c2[k]);
-                    for (int l = 0; l < 4; l++)
-                        want = lin(1, want, -hu[k] * hv[l], A[k][l]);
-                }
+                double u = s / 8.0, v = r / 8.0;
+                cs_ref_vec_t want = coons_ref(&b, dp, with, (const cs_ref_vec_t(*)[4])A, u, v);
                 double d = maxc(want, patch_eval(&p, u, v));
                 worst = fmax(worst, d);
                 assert_true(d <= 0.5 * LSB + 1e-9);
@@ -229,6 +250,72 @@ static void test_bicubic(void **state)
     cs_patch_t p;
     assert_int_equal(cs_coons_bicubic(&b.p1, &b.p2, &b.q1, &b.q2, NULL, NULL, NULL, NULL, &p),
                      CS_ERR_UNSUPPORTED);
+}
+
+/* Bicubic Coons with the twists given (cs_coons_bicubic_twist) against seed 000's formula
+ * transcribed here: S = S1 + S2 - S3, S3 = H(u)^T A H(v) with the twists in A's lower right
+ * block; default derivative curves are then the Hermite cubics between the crossing curves'
+ * corner tangents with the twists as end slopes. With the defaults, the patch's corner twists
+ * (9 (p11 - p10 - p01 + p00) at (0, 0), ...) are the given ones. */
+static void test_bicubic_twist(void **state)
+{
+    (void)state;
+    double worst = 0, worst_tw = 0;
+    for (int it = 0; it < 300; it++) {
+        boundary_t b = rnd_boundary(CS_POS_LIMIT / 4);
+        cs_vec3_t tw[2][2];
+        cs_ref_vec_t T[2][2];
+        for (int i = 0; i < 2; i++)
+            for (int j = 0; j < 2; j++) {
+                tw[i][j] = rnd_vec(CS_POS_LIMIT / 8);
+                T[i][j] = cs_ref_from_pos(&tw[i][j]);
+            }
+        cs_bezier_t dv[4];
+        const cs_bezier_t *dp[4] = {NULL, NULL, NULL, NULL};
+        bool with = it % 3 == 1;
+        for (int k = 0; k < 4 && with; k++) {
+            dv[k] = curve(1 + (unsigned)(xorshift() % 3), rnd_vec(CS_POS_LIMIT / 8),
+                          rnd_vec(CS_POS_LIMIT / 8), CS_POS_LIMIT / 8);
+            dp[k] = &dv[k];
+        }
+        cs_patch_t p;
+        assert_int_equal(cs_coons_bicubic_twist(&b.p1, &b.p2, &b.q1, &b.q2, dp[0], dp[1], dp[2],
+                                                dp[3], (const cs_vec3_t(*)[2])tw, &p),
+                         CS_OK);
+        cs_ref_vec_t A[4][4] = {
+            {cs_ref_eval(&b.p1, 0), cs_ref_eval(&b.p2, 0), deriv(&b.q1, 0), deriv(&b.q1, 1)},
+            {cs_ref_eval(&b.p1, 1), cs_ref_eval(&b.p2, 1), deriv(&b.q2, 0), deriv(&b.q2, 1)},
+            {deriv(&b.p1, 0), deriv(&b.p2, 0), T[0][0], T[0][1]},
+            {deriv(&b.p1, 1), deriv(&b.p2, 1), T[1][0], T[1][1]},
+        };
+        for (int s = 0; s <= 8; s++)
+            for (int r = 0; r <= 8; r++) {
+                double u = s / 8.0, v = r / 8.0;
+                cs_ref_vec_t want = coons_ref(&b, dp, with, (const cs_ref_vec_t(*)[4])A, u, v);
+                double d = maxc(want, patch_eval(&p, u, v));
+                worst = fmax(worst, d);
+                assert_true(d <= 0.5 * LSB + 1e-9);
+            }
+        for (int i = 0; i < 2 && !with; i++)
+            for (int j = 0; j < 2; j++) {
+                /* d2S/dudv at corner (i, j) of a bicubic net: 9 times the corner cell's
+                 * second difference, signed by the direction of each step. */
+                int a0 = 3 * i, a1 = i ? 2 : 1, b0 = 3 * j, b1 = j ? 2 : 1;
+                double sg = (i ? -1 : 1) * (j ? -1 : 1);
+                cs_ref_vec_t q00 = cs_ref_from_pos(&p.p[a0][b0]),
+                             q10 = cs_ref_from_pos(&p.p[a1][b0]);
+                cs_ref_vec_t q01 = cs_ref_from_pos(&p.p[a0][b1]),
+                             q11 = cs_ref_from_pos(&p.p[a1][b1]);
+                cs_ref_vec_t got = {9 * sg * (q11.x - q10.x - q01.x + q00.x),
+                                    9 * sg * (q11.y - q10.y - q01.y + q00.y),
+                                    9 * sg * (q11.z - q10.z - q01.z + q00.z)};
+                double d = maxc(got, T[i][j]);
+                worst_tw = fmax(worst_tw, d);
+                assert_true(d <= 18 * LSB + 1e-9); /* four points rounded by 0.5 LSB, times 9 */
+            }
+    }
+    report("bicubic Coons with twists", worst);
+    report("bicubic Coons: corner twists", worst_tw);
 }
 
 static void test_ruled_extrude(void **state)
@@ -340,6 +427,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bilinear),
         cmocka_unit_test(test_bicubic),
+        cmocka_unit_test(test_bicubic_twist),
         cmocka_unit_test(test_ruled_extrude),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

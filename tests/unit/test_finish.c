@@ -378,7 +378,7 @@ static void tensor_ref(const cs_patch_t *p, double a, double b, double o[3])
 static void test_tri_convert(void **state)
 {
     (void)state;
-    for (unsigned n = 1; n <= 3; n++) {
+    for (unsigned n = 1; n <= CS_TRIPATCH_MAX_DEGREE; n++) { /* every degree up to 7 */
         cs_tripatch_t t;
         make_tri(&t, n);
         cs_patch_t q;

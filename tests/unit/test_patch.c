@@ -54,8 +54,12 @@ typedef struct {
 
 static double binom(int n, int k)
 {
-    static const double b[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-    return (k < 0 || k > n) ? 0 : b[n][k];
+    if (k < 0 || k > n)
+        return 0;
+    double c = 1;
+    for (int i = 1; i <= k; i++)
+        c = c * (n - k + i) / i;
+    return c;
 }
 /* Bernstein B_k^n(t) and its derivative. */
 static double bern(int n, int k, double t)
@@ -119,7 +123,7 @@ static dv3 ref_normal(const cs_patch_t *p, double u, double v)
 
 static void rnd_patch(cs_patch_t *p, unsigned du, unsigned dv, int32_t lim)
 {
-    cs_vec3_t pts[16];
+    cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
     for (unsigned k = 0; k < (du + 1) * (dv + 1); k++)
         pts[k] = rnd_vec(lim);
     assert_int_equal(cs_patch_init(p, du, dv, pts), CS_OK);
@@ -174,7 +178,9 @@ static int teapot_load(cs_patch_t patches[32])
 static void test_eval_derivs(void **state)
 {
     (void)state;
-    static const unsigned degs[][2] = {{3, 3}, {1, 1}, {1, 3}, {2, 3}, {3, 2}, {2, 1}};
+    /* Up to the cap, 7 x 7 (issue 19: patches were capped at 3 x 3). */
+    static const unsigned degs[][2] = {{3, 3}, {1, 1}, {1, 3}, {2, 3}, {3, 2}, {2, 1},
+                                       {4, 3}, {5, 2}, {7, 7}, {6, 1}, {7, 4}};
     double worst[4] = {0, 0, 0, 0};
     for (size_t d = 0; d < sizeof degs / sizeof degs[0]; d++) {
         for (int it = 0; it < 200; it++) {
@@ -216,9 +222,12 @@ static void test_eval_derivs(void **state)
 static void test_args(void **state)
 {
     (void)state;
-    cs_vec3_t pts[16] = {{0, 0, 0}};
+    cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS] = {{0, 0, 0}};
     cs_patch_t p;
-    assert_int_equal(cs_patch_init(&p, 4, 3, pts), CS_ERR_DEGREE);
+    assert_int_equal(cs_patch_init(&p, 8, 3, pts), CS_ERR_DEGREE);
+    assert_int_equal(cs_patch_init(&p, 3, 8, pts), CS_ERR_DEGREE);
+    assert_int_equal(cs_patch_init(&p, 4, 3, pts), CS_OK);
+    assert_int_equal(cs_patch_init(&p, 7, 7, pts), CS_OK);
     assert_int_equal(cs_patch_init(&p, 0, 3, pts), CS_ERR_DEGREE);
     pts[5].x = CS_POS_LIMIT + 1;
     assert_int_equal(cs_patch_init(&p, 3, 3, pts), CS_ERR_RANGE);
@@ -361,12 +370,24 @@ static void test_iso_and_raster(void **state)
 {
     (void)state;
     double worst = 0;
-    for (int it = 0; it < 60; it++) {
+    /* The largest shifts the bound m (shift + 1) + 29 <= 63 allows (cs_patch.h). */
+    static const unsigned want[8] = {10, 10, 10, 10, 7, 5, 4, 3};
+    for (unsigned m = 0; m <= 7; m++)
+        assert_int_equal(cs_patch_raster_max_shift(m), want[m]);
+    for (int it = 0; it < 120; it++) {
         cs_patch_t p;
-        rnd_patch(&p, 1 + it % 3, 1 + (it / 3) % 3, CS_POS_LIMIT);
+        /* Cubics and below first, then degrees 4..7 (their raster stops at a smaller shift,
+         * cs_patch_raster_max_shift: one more is refused). */
+        unsigned du = it < 60 ? 1 + it % 3 : 1 + it % 7,
+                 dv = it < 60 ? 1 + (it / 3) % 3 : 4 + it % 4;
+        rnd_patch(&p, du, dv, CS_POS_LIMIT);
         for (int dir = 0; dir < 2; dir++) {
-            unsigned shift = (unsigned)(it % (CS_PATCH_RASTER_MAX_SHIFT + 1));
+            unsigned m = dir == 0 ? p.deg_v : p.deg_u, top = cs_patch_raster_max_shift(m);
+            unsigned shift = (unsigned)it % (top + 1);
             cs_patch_raster_t r;
+            if (top < CS_PATCH_RASTER_MAX_SHIFT)
+                assert_int_equal(cs_patch_raster_begin(&r, &p, (cs_patch_iso_t)dir, top + 1),
+                                 CS_ERR_ARG);
             assert_int_equal(cs_patch_raster_begin(&r, &p, (cs_patch_iso_t)dir, shift), CS_OK);
             uint32_t n = 1u << shift, k = 0;
             cs_bezier_t c, iso;
@@ -665,9 +686,19 @@ static void test_continuity(void **state)
         cs_patch_cont_t c;
         const cs_param_t sin_tol = (cs_param_t)(1e-4 * Q30);
         /* Halves at u = 1/2: same derivative scale both sides, C1 within rounding (each point
-         * rounded by 0.5 LSB: a cross derivative 3 (p3 - p2) by up to 3 LSB). */
+         * rounded by 0.5 LSB: a cross derivative 3 (p3 - p2) by up to 3 LSB), and C2 within
+         * the second derivative's rounding, 6 (0.5 + 2 * 0.5 + 0.5) = 12 LSB. */
         assert_int_equal(cs_patch_split_u(&p, CS_PARAM_ONE / 2, &lo, &hi), CS_OK);
         assert_int_equal(cs_patch_continuity(&lo, &hi, 3, sin_tol, &c), CS_OK);
+        assert_true(c == CS_PATCH_CONT_C1 || c == CS_PATCH_CONT_C2);
+        assert_int_equal(cs_patch_continuity(&lo, &hi, 12, sin_tol, &c), CS_OK);
+        assert_int_equal(c, CS_PATCH_CONT_C2);
+        /* Move hi's third row: the first cross derivative (rows 0, 1) stays, the second
+         * 6 (p0 - 2 p1 + p2) changes by 6 x 100 LSB: C1, not C2. */
+        cs_patch_t third = hi;
+        for (int j = 0; j < 4; j++)
+            third.p[2][j].z += 100;
+        assert_int_equal(cs_patch_continuity(&lo, &third, 12, sin_tol, &c), CS_OK);
         assert_int_equal(c, CS_PATCH_CONT_C1);
         /* At u = 1/4 the cross derivatives differ in length (1/4 vs 3/4 of Pu): G1 only. */
         assert_int_equal(cs_patch_split_u(&p, CS_PARAM_ONE / 4, &lo, &hi), CS_OK);

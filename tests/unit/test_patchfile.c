@@ -192,12 +192,56 @@ static void test_write_roundtrip(void **state)
     free(buf);
 }
 
+/* The .bpt format (issue 15 item 8): the teapot written as .bpt (tests/data/teapot/teapot.bpt,
+ * the same numbers as Newell's file, converted by a script) gives bit for bit the patches of
+ * Newell's file; patches of other degrees; errors name the format tried and what it expects. */
+static void test_bpt(void **state)
+{
+    (void)state;
+    cs_patchfile_t nw, bp;
+    cs_path_diag_t d;
+    assert_int_equal(cs_patchfile_read(TEAPOT, &nw, &d), CS_OK);
+    assert_int_equal(cs_patchfile_read("tests/data/teapot/teapot.bpt", &bp, &d), CS_OK);
+    assert_false(nw.bpt);
+    assert_true(bp.bpt);
+    assert_int_equal(bp.npatches, 32);
+    for (size_t i = 0; i < 32; i++) {
+        cs_patch_t a, b;
+        assert_int_equal(cs_patchfile_patch(&nw, i, 10.0, &a, &d), CS_OK);
+        assert_int_equal(cs_patchfile_patch(&bp, i, 10.0, &b, &d), CS_OK);
+        assert_memory_equal(&a, &b, sizeof a);
+        assert_int_equal(bp.line[i], 2 + 17 * i);
+    }
+    cs_patchfile_free(&nw);
+    cs_patchfile_free(&bp);
+    /* A 1 x 2 patch: point k = i (degv + 1) + j, i along u. */
+    const char *small = "1\n1 2\n0 0 0\n0 1 0\n0 2 1\n1 0 0\n1 1 0\n1 2 1.5\n";
+    assert_int_equal(cs_patchfile_parse(small, strlen(small), "s.bpt", &bp, &d), CS_OK);
+    cs_patch_t p;
+    assert_int_equal(cs_patchfile_patch(&bp, 0, 2.0, &p, &d), CS_OK);
+    assert_int_equal(p.deg_u, 1);
+    assert_int_equal(p.deg_v, 2);
+    assert_int_equal(p.p[1][2].x, 2 * 65536);
+    assert_int_equal(p.p[1][2].y, 4 * 65536);
+    assert_int_equal(p.p[1][2].z, 3 * 65536);
+    assert_int_equal(p.p[0][1].y, 2 * 65536);
+    cs_patchfile_free(&bp);
+    expect("1\n3 8\n", CS_ERR_DEGREE, 2, 3, "degree 8 outside 1..7 (.bpt format)");
+    expect("1\n1 2 3\n", CS_ERR_PARSE, 2, 6, "16 vertex indices (Newell's format; a .bpt file");
+    expect("2\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n1 1 1\n", CS_ERR_PARSE, 7, 6,
+           "expected 'degu degv' (.bpt format), found 3");
+    expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n", CS_ERR_PARSE, 6, 1, "end of file after 3 of 4");
+    expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1\n", CS_ERR_PARSE, 6, 4, "expected x,y,z");
+    expect("1\n1 1\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n9\n", CS_ERR_PARSE, 7, 1, "after the last patch");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_teapot),
         cmocka_unit_test(test_small_and_errors),
         cmocka_unit_test(test_write_roundtrip),
+        cmocka_unit_test(test_bpt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -190,8 +190,8 @@ static void test_errors(void **state)
     (void)state;
     expect("curvestep-surfaces 2\n", CS_ERR_RANGE, 1, 20, "format version");
     expect("curvestep-surfaces 1\n# nothing\n", CS_ERR_EMPTY, 3, 1, "no surfaces");
-    expect("curvestep-surfaces 1\nsphere 3\n", CS_ERR_PARSE, 2, 1, "unknown surface 'sphere'");
-    expect("curvestep-surfaces 1\nbezier 4 1\n", CS_ERR_RANGE, 2, 8, "degree in u");
+    expect("curvestep-surfaces 1\ntorus 3\n", CS_ERR_PARSE, 2, 1, "unknown surface 'torus'");
+    expect("curvestep-surfaces 1\nbezier 8 1\n", CS_ERR_RANGE, 2, 8, "degree in u");
     expect("curvestep-surfaces 1\nbezier 1 1 0 0 0  1 0 0  0 1 x\n", CS_ERR_PARSE, 2, 30,
            "'x': control point expected");
     expect("curvestep-surfaces 1\nbezier 1 1 0 0 0  1 0 0  0 1 0\n", CS_ERR_PARSE, 3, 1,
@@ -208,6 +208,124 @@ static void test_errors(void **state)
     expect("bezier 1 1\n", CS_ERR_PARSE, 1, 1, "not a finite number");
 }
 
+/* coons-bicubic with its optional derivative curves and twists gives bit for bit what
+ * cs_coons_bicubic_twist gives for the same data (the formula itself: test_coons). */
+static void test_coons_derivatives_twists(void **state)
+{
+    (void)state;
+    const char *text = "curvestep-surfaces 1\ncoons-bicubic\n"
+                       " 3 0 0 0 10 0 5 20 0 5 30 0 0\n 3 0 30 0 10 30 -5 20 30 -5 30 30 0\n"
+                       " 3 0 0 0 0 10 2 0 20 2 0 30 0\n 3 30 0 0 30 10 2 30 20 2 30 30 0\n"
+                       " derivatives 1 0 30 6 0 30 6  1 0 30 6 0 30 6  1 30 0 6 30 0 -6\n"
+                       "   2 30 0 6 30 0 0 30 0 -6\n"
+                       " twists 0 0 5  0 0 -5  0 0 5  0 0 -4\n"
+                       "coons-bicubic\n"
+                       " 3 0 0 0 10 0 5 20 0 5 30 0 0\n 3 0 30 0 10 30 -5 20 30 -5 30 30 0\n"
+                       " 3 0 0 0 0 10 2 0 20 2 0 30 0\n 3 30 0 0 30 10 2 30 20 2 30 30 0\n"
+                       " twists 0 0 5  0 0 -5  0 0 5  0 0 -4\n";
+    cs_surffile_t sf;
+    cs_path_diag_t d;
+    assert_int_equal(cs_surffile_parse(text, strlen(text), "c", 1, 0.01, &sf, &d), CS_OK);
+    assert_int_equal(sf.n, 2);
+    cs_vec3_t a[4] = {mm(0, 0, 0), mm(10, 0, 5), mm(20, 0, 5), mm(30, 0, 0)};
+    cs_vec3_t b[4] = {mm(0, 30, 0), mm(10, 30, -5), mm(20, 30, -5), mm(30, 30, 0)};
+    cs_vec3_t c[4] = {mm(0, 0, 0), mm(0, 10, 2), mm(0, 20, 2), mm(0, 30, 0)};
+    cs_vec3_t e[4] = {mm(30, 0, 0), mm(30, 10, 2), mm(30, 20, 2), mm(30, 30, 0)};
+    cs_vec3_t d0[2] = {mm(0, 30, 6), mm(0, 30, 6)}, d2[2] = {mm(30, 0, 6), mm(30, 0, -6)};
+    cs_vec3_t d3[3] = {mm(30, 0, 6), mm(30, 0, 0), mm(30, 0, -6)};
+    cs_bezier_t p1 = bz(3, a), p2 = bz(3, b), q1 = bz(3, c), q2 = bz(3, e);
+    cs_bezier_t p1v = bz(1, d0), p2v = bz(1, d0), q1u = bz(1, d2), q2u = bz(2, d3);
+    cs_vec3_t tw[2][2] = {{mm(0, 0, 5), mm(0, 0, 5)}, {mm(0, 0, -5), mm(0, 0, -4)}};
+    cs_patch_t want;
+    assert_int_equal(cs_coons_bicubic_twist(&p1, &p2, &q1, &q2, &p1v, &p2v, &q1u, &q2u,
+                                            (const cs_vec3_t(*)[2])tw, &want),
+                     CS_OK);
+    assert_memory_equal(&sf.items[0].quad, &want, sizeof want);
+    assert_int_equal(cs_coons_bicubic_twist(&p1, &p2, &q1, &q2, NULL, NULL, NULL, NULL,
+                                            (const cs_vec3_t(*)[2])tw, &want),
+                     CS_OK);
+    assert_memory_equal(&sf.items[1].quad, &want, sizeof want);
+    cs_surffile_free(&sf);
+}
+
+/* varady-scheme with a domain, user tangents and twists: the item carries them as given. */
+static void test_varady_extras(void **state)
+{
+    (void)state;
+    const char *text = "curvestep-surfaces 1\nvarady-scheme lambda-kappa side domain angles 3\n"
+                       " 1 0 0 0 30 0 0\n 1 30 0 0 15 25 4\n 1 15 25 4 0 0 0\n"
+                       " tangents 1 0 1 0 0 1 0.5  1 -1 0 0 -1 -1 0  1 1 -1 0 1 0 0\n"
+                       " twists 0 0 0.1  0 0 -0.2  0.05 0 0\n";
+    cs_surffile_t sf;
+    cs_path_diag_t d;
+    cs_err_t e = cs_surffile_parse(text, strlen(text), "v", 2.0, 0.01, &sf, &d);
+    if (e != CS_OK)
+        cs_path_diag_print(stderr, &d);
+    assert_int_equal(e, CS_OK);
+    const cs_varady_t *v = &sf.items[0].nside;
+    assert_int_equal(v->domain, CS_VARADY_DOMAIN_ANGLES);
+    assert_int_equal(v->blend, CS_VARADY_LAMBDA_KAPPA);
+    assert_true(v->user_tan);
+    assert_int_equal(v->tan[0].p[1].z, 32768); /* 0.5, not scaled */
+    assert_true(v->twist[1][2] == -0.2 && v->twist[2][0] == 0.05);
+    cs_surffile_free(&sf);
+}
+
+/* The keyword table (cs_surffile_keyword) is what the parser accepts and what docs/surfaces.md
+ * lists in its "Native surface format" block, both ways (toolpath --help prints the table; the
+ * CLI test test_inspect.sh compares it with the docs too). */
+static void test_keywords(void **state)
+{
+    (void)state;
+    size_t n = 0;
+    for (; cs_surffile_keyword(n); n++) {
+        char text[128];
+        snprintf(text, sizeof text, "curvestep-surfaces 1\n%s x\n", cs_surffile_keyword(n));
+        cs_surffile_t sf;
+        cs_path_diag_t d;
+        assert_int_not_equal(cs_surffile_parse(text, strlen(text), "k", 1, 0.01, &sf, &d), CS_OK);
+        if (strstr(d.reason, "unknown surface"))
+            fprintf(stderr, "'%s' is in the table but the parser refuses it\n",
+                    cs_surffile_keyword(n));
+        assert_null(strstr(d.reason, "unknown surface"));
+        cs_surffile_free(&sf);
+    }
+    FILE *f = fopen("docs/surfaces.md", "r");
+    assert_non_null(f);
+    char line[256];
+    bool in_section = false, in_block = false;
+    size_t seen = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, "## ", 3) == 0)
+            in_section = strncmp(line, "## Native surface format", 24) == 0;
+        if (!in_section)
+            continue;
+        if (strncmp(line, "```", 3) == 0) {
+            if (in_block)
+                break;
+            in_block = true;
+            continue;
+        }
+        if (!in_block || line[0] == ' ' || line[0] == '#' ||
+            strncmp(line, "curvestep-surfaces", 18) == 0)
+            continue;
+        char word[64];
+        assert_int_equal(sscanf(line, "%63s", word), 1);
+        size_t k = 0;
+        while (cs_surffile_keyword(k) && strcmp(cs_surffile_keyword(k), word) != 0)
+            k++;
+        if (!cs_surffile_keyword(k))
+            fprintf(stderr, "docs/surfaces.md lists '%s', the parser's table does not\n", word);
+        assert_non_null(cs_surffile_keyword(k));
+        assert_int_equal(k, seen); /* same order */
+        seen++;
+    }
+    fclose(f);
+    if (seen != n)
+        fprintf(stderr, "docs/surfaces.md lists %zu keywords, the table %zu\n", seen, n);
+    assert_int_equal(seen, n);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -215,6 +333,9 @@ int main(void)
         cmocka_unit_test(test_varady),
         cmocka_unit_test(test_newell_fallback),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_keywords),
+        cmocka_unit_test(test_varady_extras),
+        cmocka_unit_test(test_coons_derivatives_twists),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,7 +94,7 @@ static void test_eval(void **state)
     double worst = 0;
     for (int it = 0; it < 3000; it++) {
         cs_tripatch_t t;
-        rnd_patch(&t, 1 + it % 3);
+        rnd_patch(&t, 1 + it % 7); /* every degree up to the cap, 7 */
         cs_param_t u = rnd_unit(), v = rnd_unit();
         if ((int64_t)u + v > CS_PARAM_ONE) {
             u = CS_PARAM_ONE - u;
@@ -121,8 +121,9 @@ static void test_eval(void **state)
     assert_memory_equal(&p, &t.p[cs_tripatch_index(3, 0, 0)], sizeof p);
     assert_int_equal(cs_tripatch_eval(&t, CS_PARAM_ONE / 2 + 1, CS_PARAM_ONE / 2, &p), CS_ERR_ARG);
     assert_int_equal(cs_tripatch_eval(&t, -1, 0, &p), CS_ERR_ARG);
-    cs_vec3_t pts[10] = {{0, 0, 0}};
-    assert_int_equal(cs_tripatch_init(&t, 4, pts), CS_ERR_DEGREE);
+    cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS] = {{0, 0, 0}};
+    assert_int_equal(cs_tripatch_init(&t, 8, pts), CS_ERR_DEGREE);
+    assert_int_equal(cs_tripatch_init(&t, 7, pts), CS_OK);
     pts[9].z = CS_POS_LIMIT + 1;
     assert_int_equal(cs_tripatch_init(&t, 3, pts), CS_ERR_RANGE);
 }
@@ -133,7 +134,7 @@ static void test_lines(void **state)
     double worst = 0;
     for (int it = 0; it < 500; it++) {
         cs_tripatch_t t;
-        unsigned n = 1 + (unsigned)(it % 3);
+        unsigned n = 1 + (unsigned)(it % 7);
         rnd_patch(&t, n);
         /* Iso-line u = u0 from (u0, 0) to (u0, 1 - u0), and a random chord of the domain. */
         cs_param_t u0 = rnd_unit();

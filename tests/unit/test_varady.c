@@ -262,6 +262,10 @@ static void test_blends_unity(void **state)
 
 /* The seed's lambda / kappa surface with the side-based parametrisation, written out here from
  * the domain vertices and the boundary curves alone. */
+/* User tangent curves (NULL: the defaults) and corner twists (NULL: zero) of the reference. */
+static const cs_bezier_t *ref_tan;
+static const double (*ref_twist)[3];
+
 static void lk_reference(const cs_varady_t *v, const cs_bezier_t *sides, size_t n, double x,
                          double y, double out[3])
 {
@@ -296,11 +300,41 @@ static void lk_reference(const cs_varady_t *v, const cs_bezier_t *sides, size_t 
         double s = d[im] / (d[im] + d[ip]);
         cs_ref_vec_t p = cs_ref_eval(&sides[i], s), c = cs_ref_from_pos(&sides[i].p[0]);
         double pp[3] = {p.x, p.y, p.z}, cc[3] = {c.x, c.y, c.z};
+        /* T_i(s), T_(i-1)(1), T_i(0): the user's curves or the linear default */
+        double ts[3], ta[3], tb[3];
         for (int k = 0; k < 3; k++) {
-            double r = pp[k] + d[i] * ((1 - s) * t0[i][k] + s * t1[i][k]);
-            double qc = cc[k] + d[im] * t1[im][k] + d[i] * t0[i][k];
+            ts[k] = (1 - s) * t0[i][k] + s * t1[i][k];
+            ta[k] = t1[im][k];
+            tb[k] = t0[i][k];
+        }
+        if (ref_tan) {
+            cs_ref_vec_t a = cs_ref_eval(&ref_tan[i], s), b = cs_ref_eval(&ref_tan[im], 1);
+            cs_ref_vec_t c = cs_ref_eval(&ref_tan[i], 0);
+            ts[0] = a.x, ts[1] = a.y, ts[2] = a.z;
+            ta[0] = b.x, ta[1] = b.y, ta[2] = b.z;
+            tb[0] = c.x, tb[1] = c.y, tb[2] = c.z;
+        }
+        for (int k = 0; k < 3; k++) {
+            double r = pp[k] + d[i] * ts[k];
+            double qc = cc[k] + d[im] * ta[k] + d[i] * tb[k] +
+                        (ref_twist ? d[im] * d[i] * ref_twist[i][k] : 0);
             out[k] += lambda * r - kappa * qc;
         }
+    }
+}
+
+/* A random point inside the domain polygon: a convex combination of its vertices. */
+static void rnd_inside(const cs_varady_t *v, double *x, double *y)
+{
+    double w[CS_VARADY_MAX_SIDES], sw = 0;
+    *x = *y = 0;
+    for (size_t i = 0; i < v->n; i++)
+        sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
+    for (size_t i = 0; i < v->n; i++) {
+        double p[2];
+        cs_varady_vertex(v, i, p);
+        *x += w[i] / sw * p[0];
+        *y += w[i] / sw * p[1];
     }
 }
 
@@ -317,15 +351,8 @@ static void test_lk_reference(void **state)
         assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_SIDE), CS_OK);
         for (int k = 0; k < 300; k++) {
             /* random points in the polygon: convex combinations of the vertices */
-            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0, q[3], r[3];
-            for (size_t i = 0; i < n; i++)
-                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
-            for (size_t i = 0; i < n; i++) {
-                double p[2];
-                cs_varady_vertex(&v, i, p);
-                x += w[i] / sw * p[0];
-                y += w[i] / sw * p[1];
-            }
+            double x, y, q[3], r[3];
+            rnd_inside(&v, &x, &y);
             cs_varady_eval(&v, x, y, q);
             lk_reference(&v, sides, n, x, y, r);
             worst =
@@ -333,6 +360,52 @@ static void test_lk_reference(void **state)
         }
     }
     report("lambda/kappa surface vs the seed's formula written out", worst);
+    assert_true(worst < 1e-9);
+    /* User-given cross-boundary tangent curves and non-zero twists (seed 002's T_i(s_i) and
+     * W_i): the same formula with them, and the boundary still interpolated. */
+    worst = 0;
+    for (size_t n = 3; n <= 7; n++) {
+        cs_bezier_t sides[CS_VARADY_MAX_SIDES], tan[CS_VARADY_MAX_SIDES];
+        double tw[CS_VARADY_MAX_SIDES][3];
+        loop(n, 4, sides);
+        cs_varady_t v;
+        assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+        assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_SIDE), CS_OK);
+        for (size_t i = 0; i < n; i++) {
+            cs_vec3_t q[3] = {mm(0.2 * (double)i, 0.5, 1), mm(-0.3, 0.4, 0.8 + 0.1 * (double)i),
+                              mm(0.1, -0.2, 1.2)};
+            assert_int_equal(cs_bezier_init(&tan[i], 2, q), CS_OK);
+            tw[i][0] = 0.01 * (double)i, tw[i][1] = -0.02, tw[i][2] = 0.03;
+        }
+        assert_int_equal(cs_varady_set_tangents(&v, tan), CS_OK);
+        cs_varady_set_twists(&v, (const double(*)[3])tw);
+        ref_tan = tan;
+        ref_twist = (const double(*)[3])tw;
+        for (int k = 0; k < 200; k++) {
+            double x, y, q[3], r[3];
+            rnd_inside(&v, &x, &y);
+            cs_varady_eval(&v, x, y, q);
+            lk_reference(&v, sides, n, x, y, r);
+            worst =
+                fmax(worst, fmax(fabs(q[0] - r[0]), fmax(fabs(q[1] - r[1]), fabs(q[2] - r[2]))));
+        }
+        for (size_t i = 0; i < n; i++) { /* midpoint of domain side i: P_i(1/2) by symmetry */
+            double a[2], b[2], q[3];
+            cs_varady_vertex(&v, i, a);
+            cs_varady_vertex(&v, (i + 1) % n, b);
+            cs_varady_eval(&v, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, q);
+            double s = 0, dd = 0, ss[CS_VARADY_MAX_SIDES], ds[CS_VARADY_MAX_SIDES];
+            cs_varady_params(&v, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, ss, ds);
+            s = ss[i];
+            dd = ds[i];
+            cs_ref_vec_t pc = cs_ref_eval(&sides[i], s);
+            assert_true(fabs(dd) < 1e-9);
+            assert_true(fabs(q[0] - pc.x) + fabs(q[1] - pc.y) + fabs(q[2] - pc.z) < 1e-9);
+        }
+        ref_tan = NULL;
+        ref_twist = NULL;
+    }
+    report("lambda/kappa with user tangents and twists vs the seed's formula", worst);
     assert_true(worst < 1e-9);
 }
 
@@ -828,6 +901,217 @@ static void test_cells(void **state)
     assert_int_equal(cs_varady_patches(&v, 0.005, out, NULL, 4, &count, NULL), CS_ERR_FULL);
 }
 
+/* An uneven pentagon (corners at 0, 50, 150, 200, 290 degrees, alternating heights), so
+ * the domain constructions of seed 002 differ. */
+static void uneven(cs_bezier_t *sides)
+{
+    static const double ang[5] = {0, 50, 150, 200, 290};
+    const double pi = 3.14159265358979323846;
+    cs_vec3_t c[5];
+    for (int i = 0; i < 5; i++)
+        c[i] = mm(20 * cos(ang[i] * pi / 180), 20 * sin(ang[i] * pi / 180), i % 2 ? 3 : -2);
+    for (int i = 0; i < 5; i++) {
+        cs_vec3_t p0 = c[i], p3 = c[(i + 1) % 5];
+        cs_vec3_t pts[4] = {
+            p0, cs_fixed_vec((2 * p0.x + p3.x) / 3, (2 * p0.y + p3.y) / 3, p0.z + 65536),
+            cs_fixed_vec((p0.x + 2 * p3.x) / 3, (p0.y + 2 * p3.y) / 3, p3.z - 65536), p3};
+        assert_int_equal(cs_bezier_init(&sides[i], 3, pts), CS_OK);
+    }
+}
+
+/* Side lengths l and interior angles alpha (at vertex i, the start of side i) of a polygon. */
+static void shape(size_t n, const double p[][2], double l[], double alpha[])
+{
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p[(i + n - 1) % n], *b = p[i], *c = p[(i + 1) % n];
+        l[i] = hypot(c[0] - b[0], c[1] - b[1]);
+        double u[2] = {a[0] - b[0], a[1] - b[1]}, w[2] = {c[0] - b[0], c[1] - b[1]};
+        alpha[i] = acos((u[0] * w[0] + u[1] * w[1]) / (hypot(u[0], u[1]) * hypot(w[0], w[1])));
+    }
+}
+
+/* Seed 002's phi_i from the control points: the angle between -(P3 - P2) of side i - 1 and
+ * (P1 - P0) of side i (cubic end tangents). */
+static double phi(const cs_bezier_t *sides, size_t n, size_t i)
+{
+    const cs_bezier_t *a = &sides[(i + n - 1) % n], *b = &sides[i];
+    double u[3] = {-(double)(a->p[3].x - a->p[2].x), -(double)(a->p[3].y - a->p[2].y),
+                   -(double)(a->p[3].z - a->p[2].z)};
+    double w[3] = {(double)(b->p[1].x - b->p[0].x), (double)(b->p[1].y - b->p[0].y),
+                   (double)(b->p[1].z - b->p[0].z)};
+    double d = u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+    return acos(d / (sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) *
+                     sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])));
+}
+
+static void test_domains(void **state)
+{
+    (void)state;
+    const double pi = 3.14159265358979323846;
+    const size_t n = 5;
+    cs_bezier_t sides[5];
+    uneven(sides);
+    cs_varady_t v;
+    assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+    double p[5][2], l[5], al[5], ca = 0, L[5], target[5];
+    for (size_t i = 0; i < n; i++) {
+        ca += phi(sides, n, i);
+        assert_true(fabs(cs_varady_corner_angle(&v, i) - phi(sides, n, i)) < 1e-12);
+        L[i] = v.len[i];
+    }
+    ca = (double)(n - 2) * pi / ca;
+    for (size_t i = 0; i < n; i++)
+        target[i] = ca * phi(sides, n, i);
+    /* Solution 2: every vertex on one circle, chord i = L_i. */
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_CHORDS), CS_OK);
+    for (size_t i = 0; i < n; i++)
+        cs_varady_vertex(&v, i, p[i]);
+    shape(n, (const double(*)[2])p, l, al);
+    double r0 = hypot(p[0][0], p[0][1]);
+    for (size_t i = 0; i < n; i++) {
+        assert_true(fabs(l[i] - L[i]) < 1e-9 * L[i]);
+        assert_true(fabs(hypot(p[i][0], p[i][1]) - r0) < 1e-9 * r0); /* centred on 0 */
+    }
+    /* Solution 3, transcribed: turtle along L_i turning by pi - c_angle phi_i, the gap e
+     * spread as (i / n) e. */
+    double q[6][2] = {{0, 0}}, th = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0)
+            th += pi - target[i];
+        q[i + 1][0] = q[i][0] + L[i] * cos(th);
+        q[i + 1][1] = q[i][1] + L[i] * sin(th);
+    }
+    double e[2] = {q[0][0] - q[n][0], q[0][1] - q[n][1]};
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_ANGLES), CS_OK);
+    double l3[5], a3[5], f3 = 0;
+    for (size_t i = 0; i < n; i++) {
+        cs_varady_vertex(&v, i, p[i]);
+        assert_true(fabs(p[i][0] - (q[i][0] + (double)i / n * e[0])) < 1e-9);
+        assert_true(fabs(p[i][1] - (q[i][1] + (double)i / n * e[1])) < 1e-9);
+    }
+    shape(n, (const double(*)[2])p, l3, a3);
+    for (size_t i = 0; i < n; i++)
+        f3 += (l3[i] - L[i]) * (l3[i] - L[i]) + (a3[i] - target[i]) * (a3[i] - target[i]);
+    /* Least squares: closed (the polygon's own angles sum to (n - 2) pi), and no worse than
+     * solution 3's polygon, which is one of the closed polygons it minimises over. */
+    assert_int_equal(cs_varady_set_domain(&v, CS_VARADY_DOMAIN_LSQ), CS_OK);
+    for (size_t i = 0; i < n; i++)
+        cs_varady_vertex(&v, i, p[i]);
+    shape(n, (const double(*)[2])p, l, al);
+    double fl = 0, sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        fl += (l[i] - L[i]) * (l[i] - L[i]) + (al[i] - target[i]) * (al[i] - target[i]);
+        sum += al[i];
+    }
+    assert_true(fabs(sum - 3 * pi) < 1e-9);
+    assert_true(fl <= f3 + 1e-12);
+    if (getenv("CS_TEST_VERBOSE"))
+        printf("domain objective: solution 3 %.6g, least squares %.6g\n", f3, fl);
+    /* Every domain interpolates the boundary at the vertices. */
+    static const cs_varady_domain_t doms[4] = {CS_VARADY_DOMAIN_ARC, CS_VARADY_DOMAIN_CHORDS,
+                                               CS_VARADY_DOMAIN_ANGLES, CS_VARADY_DOMAIN_LSQ};
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(cs_varady_set_domain(&v, doms[k]), CS_OK);
+        for (size_t i = 0; i < n; i++) {
+            double a[2], out[3];
+            cs_varady_vertex(&v, i, a);
+            cs_varady_eval(&v, a[0], a[1], out);
+            cs_ref_vec_t c = cs_ref_from_pos(&sides[i].p[0]);
+            assert_true(fabs(out[0] - c.x) + fabs(out[1] - c.y) + fabs(out[2] - c.z) < 1e-9);
+        }
+    }
+    assert_int_equal(cs_varady_set_domain(&v, (cs_varady_domain_t)9), CS_ERR_ARG);
+}
+
+/* Seed 002's biquadratic mapping, transcribed: the net of side i (rows t = 0: p_i, midpoint,
+ * p_(i+1); t = 2: p_(i-1), centroid (a triangle: its apex), p_(i+2); t = 1: the columns'
+ * midpoints), evaluated by
+ * Bernstein sums. cs_varady_params' (s_i, d_i / h_i) must map back to the point (the Newton
+ * inversion), s = const lines are straight, and the surface still interpolates the boundary. */
+static void biq_forward(const double vert[][2], size_t n, size_t i, double s, double t,
+                        double out[2])
+{
+    double c[3][3][2], ce[2] = {0, 0};
+    for (size_t k = 0; k < n; k++)
+        ce[0] += vert[k][0] / (double)n, ce[1] += vert[k][1] / (double)n;
+    const double *rows[2][3] = {
+        {vert[i], NULL, vert[(i + 1) % n]},
+        {vert[(i + n - 1) % n], n == 3 ? vert[(i + 2) % n] : ce, vert[(i + 2) % n]}};
+    for (int x = 0; x < 2; x++) {
+        c[0][0][x] = rows[0][0][x], c[2][0][x] = rows[0][2][x];
+        c[1][0][x] = (rows[0][0][x] + rows[0][2][x]) / 2;
+        for (int a = 0; a < 3; a++) {
+            c[a][2][x] = rows[1][a][x];
+            c[a][1][x] = (c[a][0][x] + c[a][2][x]) / 2;
+        }
+    }
+    double bs[3] = {(1 - s) * (1 - s), 2 * s * (1 - s), s * s};
+    double bt[3] = {(1 - t) * (1 - t), 2 * t * (1 - t), t * t};
+    out[0] = out[1] = 0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            for (int x = 0; x < 2; x++)
+                out[x] += bs[a] * bt[b] * c[a][b][x];
+}
+
+static void test_biquadratic(void **state)
+{
+    (void)state;
+    srand(5);
+    double worst = 0;
+    for (size_t n = 3; n <= 7; n++) {
+        cs_bezier_t sides[CS_VARADY_MAX_SIDES];
+        loop(n, 4, sides);
+        cs_varady_t v;
+        assert_int_equal(cs_varady_init(&v, sides, n), CS_OK);
+        assert_int_equal(cs_varady_set_scheme(&v, CS_VARADY_LAMBDA_KAPPA, CS_VARADY_BIQUADRATIC),
+                         CS_OK);
+        double vert[CS_VARADY_MAX_SIDES][2], ce[2] = {0, 0};
+        for (size_t i = 0; i < n; i++) {
+            cs_varady_vertex(&v, i, vert[i]);
+            ce[0] += vert[i][0] / (double)n, ce[1] += vert[i][1] / (double)n;
+        }
+        for (int k = 0; k < 200; k++) {
+            double w[CS_VARADY_MAX_SIDES], sw = 0, x = 0, y = 0;
+            for (size_t i = 0; i < n; i++)
+                sw += (w[i] = 0.05 + (double)rand() / RAND_MAX);
+            for (size_t i = 0; i < n; i++)
+                x += w[i] / sw * vert[i][0], y += w[i] / sw * vert[i][1];
+            double s[CS_VARADY_MAX_SIDES], d[CS_VARADY_MAX_SIDES];
+            cs_varady_params(&v, x, y, s, d);
+            for (size_t i = 0; i < n; i++) {
+                double h = dist_line(vert[i], vert[(i + 1) % n], ce[0], ce[1]), m[2];
+                biq_forward((const double(*)[2])vert, n, i, s[i], d[i] / h, m);
+                worst = fmax(worst, hypot(m[0] - x, m[1] - y));
+            }
+        }
+        if (getenv("CS_TEST_VERBOSE"))
+            printf("n %zu: worst %g\n", n, worst);
+        /* s = const: the straight segment from C(s, 0) to C(s, 1) keeps its s. */
+        double a[2], b[2], s[CS_VARADY_MAX_SIDES], d[CS_VARADY_MAX_SIDES];
+        biq_forward((const double(*)[2])vert, n, 0, 0.3, 0, a);
+        biq_forward((const double(*)[2])vert, n, 0, 0.3, 1, b);
+        for (int k = 1; k < 8; k++) {
+            double t = k / 8.0 * 0.6;
+            cs_varady_params(&v, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), s, d);
+            assert_true(fabs(s[0] - 0.3) < 1e-9);
+        }
+        /* The boundary: on side i, s is the linear fraction and S the boundary curve. */
+        for (size_t i = 0; i < n; i++)
+            for (int k = 1; k < 8; k++) {
+                double t = k / 8.0, x = vert[i][0] + t * (vert[(i + 1) % n][0] - vert[i][0]);
+                double y = vert[i][1] + t * (vert[(i + 1) % n][1] - vert[i][1]), q[3];
+                cs_varady_params(&v, x, y, s, d);
+                assert_true(fabs(s[i] - t) < 1e-9 && fabs(d[i]) < 1e-9);
+                cs_varady_eval(&v, x, y, q);
+                cs_ref_vec_t r = cs_ref_eval(&sides[i], t);
+                assert_true(fabs(q[0] - r.x) + fabs(q[1] - r.y) + fabs(q[2] - r.z) < 1e-9);
+            }
+    }
+    report("biquadratic mapping: Newton inversion maps back within", worst);
+    assert_true(worst < 1e-9);
+}
+
 int main(void)
 {
     if (getenv("CS_SURF_PICTURES"))
@@ -845,6 +1129,8 @@ int main(void)
         cmocka_unit_test(test_schemes_curves),
         cmocka_unit_test(test_params_roundtrip),
         cmocka_unit_test(test_cells),
+        cmocka_unit_test(test_domains),
+        cmocka_unit_test(test_biquadratic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
