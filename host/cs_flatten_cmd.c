@@ -12,6 +12,8 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_input.h"
+#include "cs_motion.h"
+#include "cs_readall.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -63,6 +65,7 @@ static void flatten_usage(FILE *f)
             "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
             "  --lenient       G-code: a word curvestep does not carry out is a warning (and is\n"
             "                  ignored) instead of an error\n"
+            "  --max-input-mb N  refuse a FILE larger than N MiB (default 64; docs/inputs.md)\n"
             "  -h, --help      show this help\n"
             "\n"
             "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
@@ -106,6 +109,7 @@ int cs_cmd_flatten(int argc, char **argv)
         {"svg", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},
         {"lenient", no_argument, NULL, 'l'},
+        {"max-input-mb", required_argument, NULL, 'M'},
         {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
@@ -113,6 +117,7 @@ int cs_cmd_flatten(int argc, char **argv)
     bool stats = false;
     const char *svg_out = NULL;
     bool lenient = false;
+    size_t max_bytes = 0;
     int c;
     optind = 1;
     opterr = 0;
@@ -156,6 +161,15 @@ int cs_cmd_flatten(int argc, char **argv)
         case 'l':
             lenient = true;
             break;
+        case 'M':
+            if (!cs_readall_parse_mb(optarg, &max_bytes)) {
+                fprintf(stderr,
+                        "curvestep flatten: --max-input-mb '%s': expected a whole number of MiB, "
+                        "1 to %u\n",
+                        optarg, CS_READALL_MAX_MB);
+                return CS_EXIT_USAGE;
+            }
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -186,6 +200,7 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
     iopts.lenient = lenient;
+    iopts.max_bytes = max_bytes;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &diag);
@@ -235,14 +250,25 @@ int cs_cmd_flatten(int argc, char **argv)
         }
         cs_vec3_t pt;
         while (e == CS_OK && (e = cs_trace_next(&tr, &pt)) == CS_OK) {
+            if (++nchords > CS_MOTION_MAX_SEGS) { /* bounded memory: the plan's own limit */
+                e = CS_ERR_RANGE;
+                break;
+            }
             printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
-            nchords++;
             if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
                     CS_OK ||
                 !vbuf_push(&vb, pt)) {
                 e = CS_ERR_FULL;
                 break;
             }
+        }
+        if (e == CS_ERR_RANGE) {
+            cs_path_diag_set(&diag, e, el->loc,
+                             "more than %zu chords: too large to flatten (docs/inputs.md, Limits)",
+                             CS_MOTION_MAX_SEGS);
+            cs_path_diag_print(stderr, &diag);
+            status = CS_EXIT_INPUT;
+            break;
         }
         if (e != CS_END) {
             cs_path_diag_set(&diag, e, el->loc, "cannot trace this curve: %s", cs_err_text(e));

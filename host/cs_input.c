@@ -7,6 +7,7 @@
 
 #include "cs_gcode.h"
 #include "cs_hpgl.h"
+#include "cs_readall.h"
 #include "cs_svgdoc.h"
 
 void cs_input_opts_init(cs_input_opts_t *o)
@@ -123,8 +124,8 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
     return CS_INPUT_SVG;
 }
 
-cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
-                        cs_path_t *path, cs_path_diag_t *diag)
+static cs_err_t parse_format(const char *name, const char *buf, size_t len,
+                             const cs_input_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
 {
     cs_input_opts_t dflt;
     if (!o) {
@@ -163,12 +164,21 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
     }
 }
 
+cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
+                        cs_path_t *path, cs_path_diag_t *diag)
+{
+    cs_err_t e = parse_format(name, buf, len, o, path, diag);
+    if (cs_path_over_limit(path, diag)) /* whatever the reader said about the refused element */
+        return CS_ERR_RANGE;
+    return e;
+}
+
 cs_err_t cs_input_load(const char *filename, const cs_input_opts_t *o, cs_path_t *path,
                        cs_path_diag_t *diag)
 {
     char *buf = NULL;
     size_t len = 0;
-    cs_err_t e = cs_svgdoc_load(filename, &buf, &len, diag);
+    cs_err_t e = cs_readall(filename, o ? o->max_bytes : 0, o && o->regular_only, &buf, &len, diag);
     if (e != CS_OK)
         return e;
     bool is_stdin = strcmp(filename, "-") == 0;

@@ -44,6 +44,7 @@ typedef struct {
     cs_units_t units;      /* --units (G-code) */
     const char *font_file; /* --font: stroke font for SVG <text> and HP-GL LB; NULL: default */
     size_t max_bytes;      /* input size limit in bytes; 0: the default (docs/inputs.md) */
+    bool regular_only;     /* refuse FIFOs, devices, directories (the daemon; cs_readall) */
     cs_input_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_input_opts_t;

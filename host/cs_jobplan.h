@@ -17,6 +17,8 @@ typedef struct {
     const char *machine_file; /* --machine FILE.ini; NULL: the built-in machine */
     double tol_mm;            /* --tol MM; 0: the machine's tolerance */
     double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
+    size_t max_input_bytes;   /* --max-input-mb N; 0: CS_READALL_DEFAULT_MAX (64 MiB) */
+    size_t max_segs;          /* --max-segments N; 0: CS_MOTION_MAX_SEGS */
 } cs_jobplan_opts_t;
 
 /* One job: read, then planned. */
@@ -26,11 +28,15 @@ typedef struct {
     cs_path_diag_t diag; /* after an error: "file:line:col: reason" (cs_path_diag_print) */
     bool have_mo;        /* mo was initialised (and must be freed) */
     bool read_ok;        /* the file was read: a later error is the planner's */
+    size_t max_bytes;    /* input size limit (cs_readall; 0: its default) */
+    size_t max_segs;     /* segment limit (cs_motion_t.max_segs; 0: its default) */
+    bool regular_only;   /* refuse FIFOs, devices, directories (the daemon) */
 } cs_jobplan_t;
 
 /* No machine file, no --tol, no --feed. */
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
-/* argv[*i] is --machine FILE, --tol MM or --feed MM/S with its value: stores it, moves *i onto
+/* argv[*i] is --machine FILE, --tol MM, --feed MM/S, --max-input-mb N or --max-segments N with
+ * its value: stores it, moves *i onto
  * the value and returns 1; any other word: 0; a bad value: -1, after "curvestep CMD: --tol
  * wants ..." on stderr (a usage error). */
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);
@@ -43,8 +49,10 @@ bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol);
 int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t *m,
                        cs_machine_pen_t *pen, cs_pos_t *tol);
 
-/* Empty job: no path, no segments, diag cleared. */
+/* Empty job: no path, no segments, diag cleared, default limits. */
 void cs_jobplan_init(cs_jobplan_t *jp);
+/* The limits of o (--max-input-mb, --max-segments) for the next read and plan of jp. */
+void cs_jobplan_limits(cs_jobplan_t *jp, const cs_jobplan_opts_t *o);
 /* Reads file (cs_input_load: SVG, G-code, HP-GL) into jp->path. pen (NULL: none) with mode = z
  * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z; lenient: unsupported
  * G-code words are warnings. CS_OK, or an error with jp->diag filled. */

@@ -4,6 +4,7 @@
  * per line, "ticks dx dy dz". */
 #include <stdio.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 
 #include "cs_cmd.h"
@@ -32,6 +33,8 @@ static void usage(FILE *f)
           "  --feed MM/S         feed for moves the job gives none (SVG, HP-GL, G-code before\n"
           "                      any F; default: the machine's default_feed)\n"
           "  --lenient           G-code: unsupported words are warnings (ignored), not errors\n"
+          "  --max-input-mb N    refuse a job file larger than N MiB (default 64)\n"
+          "  --max-segments N    refuse a job of more than N step segments (default 8388608)\n"
           "  -o OUT              write segments to OUT\n"
           "Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
           "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
@@ -94,6 +97,7 @@ int cs_cmd_plan(int argc, char **argv)
         return rc;
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    cs_jobplan_limits(&jp, &jo);
     cs_err_t e = cs_jobplan_read(&jp, job, &pen, lenient);
     if (e == CS_OK)
         e = cs_jobplan_plan(&jp, job, &m, NULL, tol, method, cs_motion_speed(jo.feed_mm_s));
@@ -102,13 +106,17 @@ int cs_cmd_plan(int argc, char **argv)
         rc = cs_jobplan_exit(&jp, e);
     } else {
         FILE *f = out_file ? fopen(out_file, "w") : stdout;
+        const char *name = out_file ? out_file : "<stdout>";
         if (f == NULL) {
-            perror(out_file);
+            fprintf(stderr, "curvestep plan: %s: cannot open: %s\n", name, strerror(errno));
             rc = CS_EXIT_INTERNAL;
         } else {
-            if (cs_motion_write(f, &m, jp.mo.segs.v, jp.mo.segs.n) != 0 ||
-                (out_file && fclose(f) != 0) || (!out_file && fflush(f) != 0)) {
-                fprintf(stderr, "curvestep plan: write error\n");
+            int w = cs_motion_write(f, &m, jp.mo.segs.v, jp.mo.segs.n);
+            int err = errno;
+            if (out_file ? fclose(f) != 0 : fflush(f) != 0)
+                w = -1, err = errno;
+            if (w != 0) {
+                fprintf(stderr, "curvestep plan: %s: write error: %s\n", name, strerror(err));
                 rc = CS_EXIT_INTERNAL;
             }
         }

@@ -3,6 +3,7 @@
  * the right character, the raw start tag is re-scanned from expat's byte index, the attribute's
  * value decoded here with a map from each decoded byte to its offset in the file. */
 #include "cs_svgdoc.h"
+#include "cs_readall.h"
 
 #include <errno.h>
 #include <expat.h>
@@ -28,45 +29,7 @@
 
 cs_err_t cs_svgdoc_load(const char *filename, char **buf, size_t *len, cs_path_diag_t *diag)
 {
-    bool is_stdin = strcmp(filename, "-") == 0;
-    cs_path_loc_t loc = {is_stdin ? "<stdin>" : filename, 0, 0};
-    FILE *f = is_stdin ? stdin : fopen(filename, "rb");
-    if (!f)
-        return cs_path_diag_set(diag, CS_ERR_IO, loc, "cannot open: %s", strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *b = malloc(cap);
-    cs_err_t e = CS_OK;
-    while (b) {
-        if (n + 1 >= cap) {
-            char *nb = cap < ((size_t)-1) / 2 ? realloc(b, cap * 2) : NULL;
-            if (!nb) {
-                free(b);
-                b = NULL;
-                break;
-            }
-            b = nb;
-            cap *= 2;
-        }
-        size_t got = fread(b + n, 1, cap - 1 - n, f);
-        n += got;
-        if (got == 0) {
-            if (ferror(f))
-                e = cs_path_diag_set(diag, CS_ERR_IO, loc, "read error: %s", strerror(errno));
-            break;
-        }
-    }
-    if (!is_stdin)
-        fclose(f);
-    if (!b)
-        return cs_path_diag_set(diag, CS_ERR_FULL, loc, "out of memory");
-    if (e != CS_OK) {
-        free(b);
-        return e;
-    }
-    b[n] = '\0';
-    *buf = b;
-    *len = n;
-    return CS_OK;
+    return cs_readall(filename, 0, false, buf, len, diag);
 }
 
 /* --- positions ------------------------------------------------------------------------------ */
@@ -489,7 +452,7 @@ static void warn_once(doc_t *d, const char *key, size_t raw, const char *fmt, ..
     if (d->o->warn)
         d->o->warn(d->o->warn_ctx, &w);
     else
-        fprintf(stderr, "%s:%u:%u: warning: %s\n", w.loc.file, w.loc.line, w.loc.col, w.reason);
+        cs_path_warn_print(stderr, &w);
 }
 
 static const char *att_get(const char **atts, const char *name)
