@@ -74,10 +74,7 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
     cs_input_format_t f = by_extension(filename);
     if (f != CS_INPUT_AUTO)
         return f;
-    size_t i = 0;
-    if (len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
-        (unsigned char)buf[2] == 0xBF)
-        i = 3;
+    size_t i = cs_readall_bom(buf, len);
     while (i < len && (buf[i] == ' ' || buf[i] == '\t' || buf[i] == '\r' || buf[i] == '\n'))
         i++;
     if (i == len)
@@ -167,9 +164,19 @@ static cs_err_t parse_format(const char *name, const char *buf, size_t len,
 cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
                         cs_path_t *path, cs_path_diag_t *diag)
 {
+    size_t before = path->n;
     cs_err_t e = parse_format(name, buf, len, o, path, diag);
     if (cs_path_over_limit(path, diag)) /* whatever the reader said about the refused element */
         return CS_ERR_RANGE;
+    if (e == CS_OK && path->n == before) { /* empty, BOM only, comments only: never silence */
+        cs_path_loc_t loc = {name ? name : "-", 1, 1};
+        return cs_path_diag_set(diag, CS_ERR_EMPTY, loc,
+                                "no drawable geometry (the %s input is empty or holds nothing "
+                                "curvestep draws)",
+                                cs_input_format_name(o && o->format != CS_INPUT_AUTO
+                                                         ? o->format
+                                                         : cs_input_detect(name, buf, len)));
+    }
     return e;
 }
 

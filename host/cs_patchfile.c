@@ -150,7 +150,13 @@ cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_p
     pf->file = strdup(name ? name : "-");
     if (!pf->file)
         return CS_ERR_FULL;
-    lexer_t lx = {pf->file, text, text + len, text, 0, diag};
+    if (cs_readall_blank(text, len)) {
+        cs_path_loc_t l = {pf->file, 1, 1};
+        return cs_path_diag_set(diag, CS_ERR_EMPTY, l,
+                                "no drawable geometry (the patch file is empty)");
+    }
+    size_t bom = cs_readall_bom(text, len); /* as the other readers: a leading BOM is skipped */
+    lexer_t lx = {pf->file, text + bom, text + len, text + bom, 0, diag};
     cs_err_t e = read_count(&lx, "patch", &pf->npatches);
     if (e != CS_OK)
         goto fail;

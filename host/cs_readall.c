@@ -116,3 +116,19 @@ bool cs_readall_parse_mb(const char *s, size_t *bytes)
     *bytes = (size_t)v << 20;
     return true;
 }
+
+size_t cs_readall_bom(const char *buf, size_t len)
+{
+    return len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
+                   (unsigned char)buf[2] == 0xBF
+               ? 3
+               : 0;
+}
+
+bool cs_readall_blank(const char *buf, size_t len)
+{
+    for (size_t i = cs_readall_bom(buf, len); i < len; i++)
+        if (buf[i] != ' ' && buf[i] != '\t' && buf[i] != '\r' && buf[i] != '\n')
+            return false;
+    return true;
+}

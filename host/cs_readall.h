@@ -28,6 +28,11 @@
 cs_err_t cs_readall(const char *filename, size_t max_bytes, bool regular_only, char **buf,
                     size_t *len, cs_path_diag_t *diag);
 
+/* Bytes of the UTF-8 byte order mark at buf[0..len): 3 or 0. */
+size_t cs_readall_bom(const char *buf, size_t len);
+/* True when buf[0..len) holds nothing but a byte order mark and white space. */
+bool cs_readall_blank(const char *buf, size_t len);
+
 /* Parses the value of --max-input-mb (a whole number of MiB, 1..CS_READALL_MAX_MB) into *bytes.
  * False when it is not one. */
 bool cs_readall_parse_mb(const char *s, size_t *bytes);
