@@ -43,9 +43,21 @@ expect "its directory is 0700" [ "$(stat -c %a "$T/rt/curvestep")" = 700 ]
 C() { timeout -k 5 30 "$CS" "$@" --socket "$S"; }
 XDG_RUNTIME_DIR=$T/rt timeout -k 5 30 "$CS" status >"$T/st0.out" 2>&1; rc=$?
 expect "clients find the default socket" [ $rc -eq 0 ]
+kill -TERM $DPID
+wait_until 30 gone $DPID
+expect "default socket removed on stop" [ ! -e "$S" ]
+
+# The rest with --socket in a private directory (as the old daemon could be run).
+mkdir "$T/priv"
+S=$T/priv/d.sock
+timeout -k 5 120 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve2.err" &
+DPID=$!
+pids+=($DPID)
+wait_until 20 [ -S "$S" ]
+expect "second daemon up" [ -S "$S" ]
 
 # 4. sixteen silent clients (the old limit) and more: status still answers.
-python3 "$LIB/holdconn.py" "$S" 20 60 >"$T/hold.out" 2>&1 &
+python3 "$LIB/holdconn.py" "$S" 20 40 >"$T/hold.out" 2>&1 &
 HPID=$!
 pids+=($HPID)
 wait_until 20 grep -qs holding "$T/hold.out"
@@ -60,20 +72,6 @@ kill $HPID 2>/dev/null
 python3 "$LIB/holdconn.py" "$S" 1 60 --wait-eof >"$T/idle.out" 2>&1; rc=$?
 expect "idle client closed by the daemon" [ $rc -eq 0 ]
 expect "idle client told why" grep -q "idle" "$T/idle.out"
-
-# 6. a FIFO, a character device and a directory are refused at submit; the daemon answers on.
-mkfifo "$T/job.fifo"
-C submit "$T/job.fifo" >"$T/fifo.out" 2>&1; rc=$?
-expect "FIFO: refused (exit 1)" [ $rc -eq 1 ]
-expect "FIFO: says so" grep -q "a FIFO, not a regular file" "$T/fifo.out"
-C submit /dev/zero >"$T/zero.out" 2>&1; rc=$?
-expect "/dev/zero: refused" [ $rc -eq 1 ]
-expect "/dev/zero: says so" grep -q "a character device, not a regular file" "$T/zero.out"
-C submit "$T/own" >"$T/dir.out" 2>&1; rc=$?
-expect "directory: refused" [ $rc -eq 1 ]
-expect "directory: says so" grep -q "a directory, not a regular file" "$T/dir.out"
-C status >"$T/st2.out" 2>&1; rc=$?
-expect "after the FIFO: status answers" [ $rc -eq 0 ]
 
 # 7. a job is read once, at submit. The queue is paused (step 4): job A ends away from the origin,
 # so the daemon plans job B again from there when it starts; B's file is rewritten after submit
@@ -94,16 +92,30 @@ NR=$(sed -n 's|^job 2 done: .*: \([0-9]*\)/\([0-9]*\) segments executed.*|\2|p' 
 expect "job B ran as read at submit ($NB segments, not the rewritten file)" \
     [ -n "$NR" ] && [ "${NR:-0}" -le $((NB + 2)) ]
 
+# 6. a FIFO, a character device and a directory are refused at submit; the daemon answers on.
+mkfifo "$T/job.fifo"
+C submit "$T/job.fifo" >"$T/fifo.out" 2>&1; rc=$?
+expect "FIFO: refused (exit 1)" [ $rc -eq 1 ]
+expect "FIFO: says so" grep -q "a FIFO, not a regular file" "$T/fifo.out"
+C submit /dev/zero >"$T/zero.out" 2>&1; rc=$?
+expect "/dev/zero: refused" [ $rc -eq 1 ]
+expect "/dev/zero: says so" grep -q "a character device, not a regular file" "$T/zero.out"
+C submit "$T/own" >"$T/dir.out" 2>&1; rc=$?
+expect "directory: refused" [ $rc -eq 1 ]
+expect "directory: says so" grep -q "a directory, not a regular file" "$T/dir.out"
+C status >"$T/st2.out" 2>&1; rc=$?
+expect "after the FIFO: status answers" [ $rc -eq 0 ]
+
 # 8. as root: a client of another user is refused by the daemon, and a socket served by another
 # user is refused by the client (nothing sent: the /tmp squatting attack).
 if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null; then
     NOB="setpriv --reuid=65534 --regid=65534 --clear-groups"
-    chmod 711 "$T" "$T/rt" "$T/rt/curvestep"
+    chmod 711 "$T" "$T/priv"
     chmod 666 "$S"
     $NOB timeout -k 5 30 "$CS" status --socket "$S" >"$T/nob.out" 2>&1; rc=$?
     expect "another user's client: refused" [ $rc -ne 0 ]
     expect "another user's client: permission denied" grep -q "permission denied\|not run by this user" "$T/nob.out"
-    chmod 700 "$T/rt/curvestep"
+    chmod 700 "$T/priv"
     mkdir -m 777 "$T/squat"
     $NOB timeout -k 5 60 python3 "$LIB/fakeserver.py" "$T/squat/s.sock" "$T/squat/log" \
         >"$T/fake.out" 2>&1 &
