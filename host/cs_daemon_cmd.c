@@ -27,10 +27,13 @@ static void serve_usage(FILE *f)
             "  --port DEV      serial device (required)\n"
             "  --baud N        line speed (default 115200)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
-            "  --socket PATH   the socket (default %s)\n"
+            "  --socket PATH   the socket (default %s); its directory must belong to\n"
+            "                  this user or root and be writable by nobody else (never /tmp);\n"
+            "                  only a stale socket of this user's is ever removed there\n"
+            "Only this user's (and root's) clients are answered (docs/streaming.md).\n"
             "Exit status: 0 stopped by a signal; 1 bad machine file; 2 bad command line;\n"
-            "3 the socket cannot be created or a daemon already answers on it; 4 the port\n"
-            "cannot be opened.\n",
+            "3 the socket cannot be created (unsafe directory, something else at PATH) or a\n"
+            "daemon already answers on it; 4 the port cannot be opened.\n",
             cs_daemon_default_socket(sock, sizeof sock));
 }
 
@@ -114,7 +117,7 @@ static void client_usage(FILE *f, const char *name)
             "  --socket PATH   the daemon's socket (default %s)\n"
             "Exit status: 0 the daemon said OK; 1 it refused the request (the reason is\n"
             "printed; for a bad job file: file:line:col: reason); 2 bad command line; 4 no\n"
-            "daemon answers on the socket.\n",
+            "daemon answers on the socket, or the process there is not this user's or root's.\n",
             sock);
 }
 

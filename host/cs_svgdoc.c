@@ -1410,12 +1410,10 @@ cs_err_t cs_svgdoc_read(const char *buf, size_t len, const char *name, const cs_
     if (o)
         po.xform = o->xform;
     /* Bare path data: lines and columns counted in the data itself (a BOM is no column). */
-    size_t bom = cs_readall_bom(buf, len), before = path->n;
-    cs_err_t e = cs_svgpath_parse(buf + bom, len - bom, &po, path, diag);
-    if (path->n == before)
-        return e; /* no valid prefix: the error itself is the most useful message */
-    return path_error(e, diag, o ? o->warn : NULL, o ? o->warn_ctx : NULL,
-                      stats ? &stats->warnings : NULL);
+    /* Not a document: browsers never see it, so SVG's error handling does not apply; an error
+     * anywhere in a job's one path stays an error (nothing is drawn or sent). */
+    size_t bom = cs_readall_bom(buf, len);
+    return cs_svgpath_parse(buf + bom, len - bom, &po, path, diag);
 }
 
 cs_err_t cs_svgdoc_read_file(const char *filename, const cs_svgdoc_opts_t *o, cs_path_t *path,

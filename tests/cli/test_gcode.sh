@@ -134,9 +134,9 @@ if [ -x "$SIM" ]; then
         2>"$T/sim.err" &
     simpid=$!
     pids+=($simpid)
-    wait_pty "$T/sim.out" 5
+    wait_pty "$T/sim.out" 60
     if [ -n "$PTY" ] && run "stream pen z" 0 stream --quiet --machine "$T/pen.ini" --port "$PTY" "$T/pen.nc"; then
-        wait_until 10 gone "$simpid"
+        wait_until 60 gone "$simpid"
         grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps (0.0000 mm) z=320 steps (4.0000 mm)' \
             "$T/sim.out" && ok || ko "stream pen z: $(grep '^final position' "$T/sim.out")"
     else
