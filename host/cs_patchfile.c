@@ -266,12 +266,9 @@ cs_err_t cs_patchfile_read(const char *filename, cs_patchfile_t *pf, cs_path_dia
     const char *name = use_stdin ? "<stdin>" : filename;
     char *buf = NULL;
     size_t n = 0;
-    cs_err_t re = cs_readall(filename, 0, false, &buf, &n, diag);
-    if (re != CS_OK) {
-        pf->file = strdup(name); /* diag names the file: keep the name alive with pf */
-        diag->loc.file = pf->file ? pf->file : "-";
+    cs_err_t re = cs_readall_keep_name(filename, &buf, &n, &pf->file, diag);
+    if (re != CS_OK)
         return re;
-    }
     cs_err_t e = cs_patchfile_parse(buf, n, name, pf, diag);
     free(buf);
     return e;

@@ -106,6 +106,17 @@ cs_err_t cs_readall(const char *filename, size_t max_bytes, bool regular_only, c
     return e;
 }
 
+cs_err_t cs_readall_keep_name(const char *filename, char **buf, size_t *len, char **name_out,
+                              cs_path_diag_t *diag)
+{
+    cs_err_t e = cs_readall(filename, 0, false, buf, len, diag);
+    if (e != CS_OK) {
+        *name_out = strdup(strcmp(filename, "-") == 0 ? "<stdin>" : filename);
+        diag->loc.file = *name_out ? *name_out : "-";
+    }
+    return e;
+}
+
 bool cs_readall_parse_mb(const char *s, size_t *bytes)
 {
     char *end = NULL;

@@ -28,6 +28,12 @@
 cs_err_t cs_readall(const char *filename, size_t max_bytes, bool regular_only, char **buf,
                     size_t *len, cs_path_diag_t *diag);
 
+/* cs_readall with the default limit, for a reader whose result owns the file's name: on failure
+ * *name_out = a malloc'd copy of the name shown ("<stdin>" for "-"; NULL out of memory), which
+ * diag then points at, so the message outlives filename. */
+cs_err_t cs_readall_keep_name(const char *filename, char **buf, size_t *len, char **name_out,
+                              cs_path_diag_t *diag);
+
 /* Bytes of the UTF-8 byte order mark at buf[0..len): 3 or 0. */
 size_t cs_readall_bom(const char *buf, size_t len);
 /* True when buf[0..len) holds nothing but a byte order mark and white space. */

@@ -375,12 +375,9 @@ cs_err_t cs_surffile_read(const char *filename, double scale, double rev_tol_mm,
     const char *name = use_stdin ? "<stdin>" : filename;
     char *buf = NULL;
     size_t n = 0;
-    cs_err_t re = cs_readall(filename, 0, false, &buf, &n, diag);
-    if (re != CS_OK) {
-        sf->file = strdup(name); /* diag names the file: keep the name alive with sf */
-        diag->loc.file = sf->file ? sf->file : "-";
+    cs_err_t re = cs_readall_keep_name(filename, &buf, &n, &sf->file, diag);
+    if (re != CS_OK)
         return re;
-    }
     cs_err_t e = cs_surffile_parse(buf ? buf : "", n, name, scale, rev_tol_mm, sf, diag);
     free(buf);
     return e;
