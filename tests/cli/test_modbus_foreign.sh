@@ -30,7 +30,7 @@ PORT=${ADDR##*:}
 ) &
 pids+=($!)
 # the host's progress lines (one a second on a non-terminal): wait until it has executed some
-wait_until 90 grep -qE '^stream: [1-9][0-9]*/[0-9]+ segments executed' "$T/host.err"
+wait_until 90 grep -qsE '^stream: [1-9][0-9]*/[0-9]+ segments executed' "$T/host.err"
 expect "the job is running" grep -qE '^stream: [1-9][0-9]*/' "$T/host.err"
 timeout -k 5 90 "$T/mb_foreign" "$HOST" "$PORT" write >"$T/foreign.out" 2>&1
 expect "the foreign write was taken" grep -q "foreign segment written" "$T/foreign.out"

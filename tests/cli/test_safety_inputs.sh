@@ -9,14 +9,22 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 ESC=$(printf '\033')
+# capped KB CMD...: runs CMD under an address-space cap of KB (the old unbounded readers run into
+# it); a sanitizer build cannot run under one (its shadow memory), so there the cap is left off
+# and the exit status and messages alone are checked.
+if bash -c 'ulimit -v 1048576; "$0" --help; r=$?; exit $r' "$CS" >/dev/null 2>&1; then
+    capped() { (ulimit -v "$1"; shift; exec "$@"); }
+else
+    capped() { shift; "$@"; }
+fi
 
 # 1. size limit: /dev/zero, a pipe and a regular file stop at the limit (64 MiB by default, or
 # --max-input-mb) with exit 1, under a 1 GiB address-space cap that the old unbounded reader
 # (18.9 GB in 20 s) runs into.
-(ulimit -v 1048576; exec timeout -k 5 120 "$CS" flatten /dev/zero) >/dev/null 2>"$T/err"; rc=$?
+capped 1048576 timeout -k 5 120 "$CS" flatten /dev/zero >/dev/null 2>"$T/err"; rc=$?
 expect "/dev/zero: exit 1" [ $rc -eq 1 ]
 expect_err "/dev/zero: the limit named" '^/dev/zero:0:0: larger than the input limit of 64 MiB'
-(ulimit -v 1048576; head -c 100000000 /dev/zero | timeout -k 5 120 "$CS" flatten -) \
+head -c 100000000 /dev/zero | capped 1048576 timeout -k 5 120 "$CS" flatten - \
     >/dev/null 2>"$T/err"; rc=$?
 expect "stdin pipe: exit 1" [ $rc -eq 1 ]
 expect_err "stdin pipe: the limit named" '^<stdin>:0:0: larger than the input limit'
@@ -46,7 +54,7 @@ while n < 1048577:
     pos = s.index('L', pos) + 1
     n += 1
 print(pos)")
-(ulimit -v 2097152; exec timeout -k 5 300 "$CS" plan -o /dev/null "$T/huge.txt") 2>"$T/err"; rc=$?
+capped 2097152 timeout -k 5 600 "$CS" plan -o /dev/null "$T/huge.txt" 2>"$T/err"; rc=$?
 expect "1.1 M curves: exit 1" [ $rc -eq 1 ]
 expect_err "1.1 M curves: located at curve 1,048,577" "^$T/huge.txt:1:$COL: more than 1048576 curves"
 printf 'M 0 0\nL 100 100\n' >"$T/small.txt"
