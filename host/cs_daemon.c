@@ -796,6 +796,33 @@ static void reap_idle(daemon_t *d)
         }
 }
 
+/* The machine, the port and the socket, in that order. Returns 0, or the exit status after a
+ * message on stderr (what was opened is closed again). */
+static int serve_setup(daemon_t *d)
+{
+    const cs_daemon_cfg_t *cfg = d->cfg;
+    char err[512];
+    if (cfg->machine_file) {
+        if (cs_machine_ini_load_pen(cfg->machine_file, &d->m, &d->pen, err, sizeof err) != 0) {
+            fprintf(stderr, "%s\n", err);
+            return 1;
+        }
+    } else {
+        cs_machine_ini_default(&d->m);
+        cs_machine_ini_pen_default(&d->pen);
+    }
+    if (cs_serial_open(&d->ser, cfg->port, cfg->baud) != 0) {
+        fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
+        return 4;
+    }
+    d->listen_fd = open_socket(cfg->socket_path);
+    if (d->listen_fd < 0) {
+        cs_serial_close(&d->ser);
+        return 3;
+    }
+    return 0;
+}
+
 int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
 {
     daemon_t *d = calloc(1, sizeof *d);
@@ -806,30 +833,12 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
     d->pipe_fd = -1;
     for (int k = 0; k < MAX_CLIENTS; k++)
         d->clients[k].fd = -1;
-    int rc = 0;
-    char err[512];
-    if (cfg->machine_file) {
-        if (cs_machine_ini_load_pen(cfg->machine_file, &d->m, &d->pen, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            free(d);
-            return 1;
-        }
-    } else {
-        cs_machine_ini_default(&d->m);
-        cs_machine_ini_pen_default(&d->pen);
-    }
-    if (cs_serial_open(&d->ser, cfg->port, cfg->baud) != 0) {
-        fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
+    int rc = serve_setup(d);
+    if (rc != 0) {
         free(d);
-        return 4;
+        return rc;
     }
-    int lfd = open_socket(cfg->socket_path);
-    d->listen_fd = lfd;
-    if (lfd < 0) {
-        cs_serial_close(&d->ser);
-        free(d);
-        return 3;
-    }
+    int lfd = d->listen_fd;
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_stop;

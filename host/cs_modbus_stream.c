@@ -297,6 +297,20 @@ static void lost(mrun_t *s, cs_mb_rc_t rc, const char *doing)
     finish(s, CS_STREAM_CLOSED);
 }
 
+/* True (and the outcome set) when nothing moved for o->stall_ms: no write taken, no message
+ * executed, no axis moved (a foreign HOLD, a device that refuses everything): never wait on. */
+static bool stalled(mrun_t *s, double now)
+{
+    if (s->o->stall_ms == 0 || now - s->t_progress <= s->o->stall_ms / 1000.0)
+        return false;
+    snprintf(s->r->why, sizeof s->r->why,
+             "no progress for %.0f s: the device took no message, executed none and moved no "
+             "axis (state %u; another client may hold it)",
+             now - s->t_progress, (unsigned)s->st.state);
+    finish(s, CS_STREAM_CLOSED);
+    return true;
+}
+
 /* Reads the status and follows it: executed count, credits, the device's next sequence (going
  * back when a write the host believed taken never arrived), a reset, an execution error.
  * Returns false when the stream must stop. */
@@ -548,14 +562,8 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
             break;
         }
         double now = cs_serial_now_s();
-        if (o->stall_ms > 0 && now - s->t_progress > o->stall_ms / 1000.0) {
-            snprintf(r->why, sizeof r->why,
-                     "no progress for %.0f s: the device took no message, executed none and "
-                     "moved no axis (state %u; another client may hold it)",
-                     now - s->t_progress, (unsigned)s->st.state);
-            finish(s, CS_STREAM_CLOSED);
+        if (stalled(s, now))
             break;
-        }
         bool wrote = false;
         if (s->next < job->n && s->credits > 0) {
             if (!write_next(s))
