@@ -245,6 +245,7 @@ static bool read_job(daemon_t *d, const char *file, cs_jobplan_t *jp, char *err,
 {
     cs_jobplan_init(jp);
     jp->regular_only = true;
+    jp->max_bytes = d->cfg->max_input_bytes;
     cs_err_t e = cs_jobplan_read(jp, file, &d->pen, false);
     if (e == CS_OK)
         return true;

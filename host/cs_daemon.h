@@ -23,6 +23,7 @@ typedef struct {
     const char *socket_path;  /* UNIX socket to create (0600); removed on exit */
     const char *machine_file; /* NULL: the built-in machine */
     FILE *log;                /* one line per event (job queued, started, ended); NULL: none */
+    size_t max_input_bytes;   /* job file size limit (--max-input-mb); 0: cs_readall's default */
 } cs_daemon_cfg_t;
 
 /* Runs the daemon until SIGTERM or SIGINT (the running job is then held and aborted). Returns an

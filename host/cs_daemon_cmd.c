@@ -8,6 +8,7 @@
 
 #include "cs_cmd.h"
 #include "cs_daemon.h"
+#include "cs_readall.h"
 #include "cs_serial.h"
 
 /* Exit status of the clients beyond the shared ones: no daemon answers on the socket. */
@@ -18,6 +19,7 @@ static void serve_usage(FILE *f)
     char sock[256];
     fprintf(f,
             "usage: curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH]\n"
+            "                       [--max-input-mb N]\n"
             "Keeps the serial port DEV open and streams the jobs submitted to it, one at a\n"
             "time, in the order they came (as `curvestep stream` does: planned whole at submit\n"
             "time, then streamed with the protocol of docs/protocol.md). Clients talk to it on\n"
@@ -27,6 +29,7 @@ static void serve_usage(FILE *f)
             "  --port DEV      serial device (required)\n"
             "  --baud N        line speed (default 115200)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
+            "  --max-input-mb N  refuse a submitted job file larger than N MiB (default 64)\n"
             "  --socket PATH   the socket (default %s); its directory must belong to\n"
             "                  this user or root and be writable by nobody else (never /tmp);\n"
             "                  only a stale socket of this user's is ever removed there\n"
@@ -66,6 +69,13 @@ int cs_cmd_serve(int argc, char **argv)
             cfg.socket_path = argv[++i];
         } else if (strcmp(a, "--machine") == 0 && has) {
             cfg.machine_file = argv[++i];
+        } else if (strcmp(a, "--max-input-mb") == 0 && has) {
+            if (!cs_readall_parse_mb(argv[++i], &cfg.max_input_bytes)) {
+                fprintf(stderr, "curvestep serve: --max-input-mb wants a whole number of MiB, "
+                                "1 to %u\n",
+                        CS_READALL_MAX_MB);
+                return CS_EXIT_USAGE;
+            }
         } else if (strcmp(a, "--baud") == 0 && has) {
             if (parse_baud(argv[++i], &cfg.baud) != 0) {
                 fprintf(stderr, "curvestep serve: --baud wants a termios rate (e.g. 115200)\n");

@@ -50,7 +50,7 @@ expect "default socket removed on stop" [ ! -e "$S" ]
 # The rest with --socket in a private directory (as the old daemon could be run).
 mkdir "$T/priv"
 S=$T/priv/d.sock
-timeout -k 5 120 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve2.err" &
+timeout -k 5 120 "$CS" serve --port "$PTY" --socket "$S" --max-input-mb 1 2>"$T/serve2.err" &
 DPID=$!
 pids+=($DPID)
 wait_until 20 [ -S "$S" ]
@@ -105,6 +105,12 @@ expect "directory: refused" [ $rc -eq 1 ]
 expect "directory: says so" grep -q "a directory, not a regular file" "$T/dir.out"
 C status >"$T/st2.out" 2>&1; rc=$?
 expect "after the FIFO: status answers" [ $rc -eq 0 ]
+# serve --max-input-mb 1: a 2 MB job file is refused at submit.
+head -c 2000000 /dev/zero | tr '\0' ' ' >"$T/big.txt"
+printf 'M 0 0 L 1 1\n' >>"$T/big.txt"
+C submit "$T/big.txt" >"$T/big.out" 2>&1; rc=$?
+expect "2 MB job over --max-input-mb 1: refused" [ $rc -eq 1 ]
+expect "2 MB job: says so" grep -q "larger than the input limit of 1 MiB" "$T/big.out"
 
 # 8. as root: a client of another user is refused by the daemon, and a socket served by another
 # user is refused by the client (nothing sent: the /tmp squatting attack).
