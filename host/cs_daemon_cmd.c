@@ -71,8 +71,9 @@ int cs_cmd_serve(int argc, char **argv)
             cfg.machine_file = argv[++i];
         } else if (strcmp(a, "--max-input-mb") == 0 && has) {
             if (!cs_readall_parse_mb(argv[++i], &cfg.max_input_bytes)) {
-                fprintf(stderr, "curvestep serve: --max-input-mb wants a whole number of MiB, "
-                                "1 to %u\n",
+                fprintf(stderr,
+                        "curvestep serve: --max-input-mb wants a whole number of MiB, "
+                        "1 to %u\n",
                         CS_READALL_MAX_MB);
                 return CS_EXIT_USAGE;
             }

@@ -45,8 +45,10 @@ bool cs_dsock_dir_ok(const char *path, char *err, size_t errcap)
     char dflt[4096];
     cs_dsock_default(dflt, sizeof dflt);
     if (strcmp(path, dflt) == 0 && mkdir(dir, 0700) != 0 && errno != EEXIST) {
-        snprintf(err, errcap, "%s: cannot create the socket's directory: %s (set XDG_RUNTIME_DIR "
-                 "or give --socket in a directory of your own)", dir, strerror(errno));
+        snprintf(err, errcap,
+                 "%s: cannot create the socket's directory: %s (set XDG_RUNTIME_DIR "
+                 "or give --socket in a directory of your own)",
+                 dir, strerror(errno));
         return false;
     }
     struct stat st;
@@ -54,14 +56,16 @@ bool cs_dsock_dir_ok(const char *path, char *err, size_t errcap)
         snprintf(err, errcap, "%s: %s", dir, strerror(errno));
         return false;
     }
-    const char *why = S_ISLNK(st.st_mode)                             ? "is a symbolic link"
-                      : !S_ISDIR(st.st_mode)                          ? "is not a directory"
-                      : !cs_dsock_uid_trusted(st.st_uid)              ? "belongs to another user"
-                      : (st.st_mode & (S_IWGRP | S_IWOTH)) != 0       ? "is writable by others"
-                                                                      : NULL;
+    const char *why = S_ISLNK(st.st_mode)                       ? "is a symbolic link"
+                      : !S_ISDIR(st.st_mode)                    ? "is not a directory"
+                      : !cs_dsock_uid_trusted(st.st_uid)        ? "belongs to another user"
+                      : (st.st_mode & (S_IWGRP | S_IWOTH)) != 0 ? "is writable by others"
+                                                                : NULL;
     if (why != NULL) {
-        snprintf(err, errcap, "%s %s: refusing to put the daemon's socket there (another user "
-                 "could take its place; docs/streaming.md)", dir, why);
+        snprintf(err, errcap,
+                 "%s %s: refusing to put the daemon's socket there (another user "
+                 "could take its place; docs/streaming.md)",
+                 dir, why);
         return false;
     }
     return true;
@@ -77,8 +81,7 @@ bool cs_dsock_clear_stale(const char *path, char *err, size_t errcap)
         return false;
     }
     if (!S_ISSOCK(st.st_mode) || st.st_uid != geteuid()) {
-        snprintf(err, errcap, "%s exists and is not a socket of this user's: not removed",
-                 path);
+        snprintf(err, errcap, "%s exists and is not a socket of this user's: not removed", path);
         return false;
     }
     struct sockaddr_un a;

@@ -89,11 +89,11 @@ void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_
 /* Streams job messages resume_from+1..n; fills *r like cs_stream_run. Never waits without a
  * deadline: a device whose next sequence runs ahead of what this host wrote (another Modbus
  * client wrote to the mailbox) ends it at once as CS_STREAM_DEVICE_ERROR (dev_error.code
- * CS_ERR_SEQ); no progress for stall_ms ends it as CS_STREAM_CLOSED, with the reason in r->why (r->hello from the
- * status block: version = map version; r->link.retransmits = writes sent again (timeouts,
- * garbled answers, going back after a refused gap), r->link.timeouts = tries that timed out,
- * r->link.naks = mailbox writes the device refused and the host sent again (busy, gap)).
- * CS_OK when it ran to an outcome, CS_ERR_ARG for bad options. */
+ * CS_ERR_SEQ); no progress for stall_ms ends it as CS_STREAM_CLOSED, with the reason in r->why
+ * (r->hello from the status block: version = map version; r->link.retransmits = writes sent again
+ * (timeouts, garbled answers, going back after a refused gap), r->link.timeouts = tries that timed
+ * out, r->link.naks = mailbox writes the device refused and the host sent again (busy, gap)). CS_OK
+ * when it ran to an outcome, CS_ERR_ARG for bad options. */
 cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t *o,
                           cs_stream_result_t *r);
 

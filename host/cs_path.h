@@ -44,9 +44,9 @@ typedef struct {
 typedef struct {
     cs_path_elem_t *elems;
     size_t n, cap;
-    size_t max_elems;         /* 0: CS_PATH_MAX_ELEMS */
-    bool over_limit;          /* an element was refused for the limit ... */
-    cs_path_loc_t over_loc;   /* ... this one */
+    size_t max_elems;       /* 0: CS_PATH_MAX_ELEMS */
+    bool over_limit;        /* an element was refused for the limit ... */
+    cs_path_loc_t over_loc; /* ... this one */
     char **files; /* interned file names, freed with the path */
     size_t nfiles, capfiles;
     unsigned nsubpaths;

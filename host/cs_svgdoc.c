@@ -934,8 +934,10 @@ static cs_err_t path_error(cs_err_t e, const cs_path_diag_t *err, cs_svgdoc_warn
     if (e != CS_ERR_PARSE)
         return e; /* out of range, out of memory...: errors, as before */
     cs_path_diag_t w;
-    cs_path_diag_set(&w, CS_OK, err->loc, "%.150s: path drawn up to the command before it (SVG 2 "
-                     "path data error handling)", err->reason);
+    cs_path_diag_set(&w, CS_OK, err->loc,
+                     "%.150s: path drawn up to the command before it (SVG 2 "
+                     "path data error handling)",
+                     err->reason);
     if (warnings)
         (*warnings)++;
     if (fn)

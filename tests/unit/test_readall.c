@@ -105,7 +105,9 @@ static void test_escape(void **state)
     char *s = NULL;
     size_t n = 0;
     FILE *f = open_memstream(&s, &n);
-    cs_path_loc_t l2 = {"a\x1b" "b", 3, 4};
+    cs_path_loc_t l2 = {"a\x1b"
+                        "b",
+                        3, 4};
     d.loc = l2;
     cs_path_diag_print(f, &d);
     fclose(f);
