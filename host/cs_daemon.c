@@ -19,10 +19,12 @@
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <termios.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cs_conv.h"
 #include "cs_daemon_link.h"
+#include "cs_dsock.h"
 #include "cs_err_text.h"
 #include "cs_jobplan.h"
 #include "cs_machine_ini.h"
@@ -32,6 +34,9 @@
 #include "cs_trace.h"
 
 #define MAX_CLIENTS 16
+/* A client that has not sent its whole request line this long after connecting is closed: a
+ * real client sends it at once (cs_daemon_request), so only a silent or stalled one waits. */
+#define CLIENT_IDLE_MS 5000
 
 typedef enum { JOB_QUEUED, JOB_RUNNING, JOB_DONE, JOB_FAILED, JOB_CANCELLED } job_state_t;
 
@@ -41,6 +46,7 @@ typedef struct {
     unsigned id;
     char *path;
     cs_stream_job_t job; /* freed once the job ended */
+    cs_jobplan_t jp;     /* the job as read at submit (its path; the file is never read again) */
     bool curves;         /* what SUBMIT asked, to plan it again from the device's position */
     double tol_mm, feed;
     cs_jobopts_t in; /* the shared input and layout options SUBMIT gave */
@@ -54,6 +60,7 @@ typedef struct {
     int fd;
     char buf[CS_DAEMON_LINE_MAX];
     size_t len;
+    struct timespec since; /* accepted at (CLOCK_MONOTONIC): idle clients are closed */
 } client_t;
 
 typedef struct {
@@ -112,12 +119,7 @@ static void dlog(daemon_t *d, const char *fmt, ...)
 
 char *cs_daemon_default_socket(char *buf, size_t cap)
 {
-    const char *rt = getenv("XDG_RUNTIME_DIR");
-    if (rt != NULL && rt[0] == '/')
-        snprintf(buf, cap, "%s/curvestep.sock", rt);
-    else
-        snprintf(buf, cap, "/tmp/curvestep-%u.sock", (unsigned)getuid());
-    return buf;
+    return cs_dsock_default(buf, cap);
 }
 
 static int unix_addr(struct sockaddr_un *a, const char *path)
@@ -145,6 +147,15 @@ int cs_daemon_request(const char *socket_path, const char *request, FILE *out, c
             close(fd);
         return -1;
     }
+    uid_t peer;
+    if (!cs_dsock_peer_uid(fd, &peer) || !cs_dsock_uid_trusted(peer)) {
+        snprintf(err, errcap,
+                 "%s: the process answering there is not run by this user or root: "
+                 "nothing sent (docs/streaming.md)",
+                 socket_path);
+        close(fd);
+        return -1;
+    }
     size_t len = strlen(request);
     char *line = malloc(len + 2);
     if (line == NULL) {
@@ -155,20 +166,22 @@ int cs_daemon_request(const char *socket_path, const char *request, FILE *out, c
     memcpy(line, request, len);
     line[len] = '\n';
     size_t off = 0;
-    while (off < len + 1) {
+    int werr = 0;
+    while (off < len + 1 && werr == 0) {
         ssize_t w = send(fd, line + off, len + 1 - off, MSG_NOSIGNAL);
         if (w < 0 && errno == EINTR)
             continue;
-        if (w <= 0) {
-            snprintf(err, errcap, "%s: write failed (%s)", socket_path, strerror(errno));
-            free(line);
-            close(fd);
-            return -1;
-        }
-        off += (size_t)w;
+        if (w <= 0)
+            werr = w < 0 ? errno : EPIPE; /* the daemon may have said why: read it below */
+        else
+            off += (size_t)w;
     }
     free(line);
     shutdown(fd, SHUT_WR);
+    /* a daemon that never answers (hung, or not ours) must not hang the client: a deadline far
+     * above the longest submit (planning a job at the input size limit) */
+    struct timeval tv = {CS_DAEMON_REPLY_S, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
     char buf[4096];
     int rc = -1;
     bool first = true;
@@ -185,6 +198,10 @@ int cs_daemon_request(const char *socket_path, const char *request, FILE *out, c
         fwrite(buf, 1, (size_t)r, out);
     }
     close(fd);
+    if (first && werr != 0) {
+        snprintf(err, errcap, "%s: write failed (%s)", socket_path, strerror(werr));
+        return -1;
+    }
     if (first) {
         snprintf(err, errcap, "%s: the daemon closed the connection without a reply", socket_path);
         return -1;
@@ -197,51 +214,18 @@ int cs_daemon_request(const char *socket_path, const char *request, FILE *out, c
 static void job_release(djob_t *j)
 {
     cs_stream_job_free(&j->job);
+    cs_jobplan_free(&j->jp);
 }
 
-/* Plans the file whole as `curvestep stream` does; on error a "file:line:col: reason" in err. */
-static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, double feed,
-                     const cs_jobopts_t *in, const int32_t *start_steps, cs_stream_job_t *job,
-                     char *err, size_t errcap)
+/* jp->diag (or e's sentence) as one line in err. */
+static void diag_text(const cs_jobplan_t *jp, const char *file, cs_err_t e, char *err,
+                      size_t errcap)
 {
-    cs_pos_t tol;
-    if (!cs_jobplan_tol(&d->m, tol_mm, &tol)) {
-        snprintf(err, errcap, "tol %g mm is outside the accepted range", tol_mm);
-        return false;
-    }
-    cs_jobplan_t jp;
-    cs_jobplan_init(&jp);
-    cs_stream_job_init(job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
-    cs_err_t e = cs_jobplan_read_opts(&jp, file, &d->pen, in);
-    if (e == CS_OK)
-        e = cs_jobplan_prepare(&jp, "serve", in, &d->m, &d->pen, tol, d->cfg->log);
-    /* step segments are relative: plan them from where the device is (the position the
-     * previous job left it at), rounded to the nearest LSB (far below half a step) */
-    cs_pos_t start[CS_AXES] = {0};
-    if (start_steps != NULL)
-        for (unsigned i = 0; i < d->m.n_axes && i < CS_PROTO_AXES_MAX; i++)
-            start[i] = (cs_pos_t)llround((double)start_steps[i] * 65536.0 * 65536.0 /
-                                         (double)d->m.axis[i].steps_per_mm);
-    int32_t feed_q = cs_motion_speed(feed);
-    if (e == CS_OK)
-        e = cs_jobplan_plan(&jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
-                            CS_TRACE_DEFAULT, feed_q);
-    if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, file);
-    if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(job, &jp.path, feed_q > 0 ? feed_q : d->m.default_feed,
-                                            tol, &jp.diag)
-                   : cs_stream_job_add_segments(job, jp.mo.segs.v, jp.mo.segs.n);
-    if (e == CS_OK) {
-        cs_jobplan_free(&jp);
-        return true;
-    }
-    cs_stream_job_free(job);
     char *s = NULL;
     size_t slen = 0;
     FILE *f = open_memstream(&s, &slen);
     if (f != NULL) {
-        cs_path_diag_print(f, &jp.diag);
+        cs_path_diag_print(f, &jp->diag);
         fclose(f);
     }
     if (s != NULL) {
@@ -255,7 +239,72 @@ static bool plan_job(daemon_t *d, const char *file, bool curves, double tol_mm, 
         snprintf(err, errcap, "%s: %s", file, cs_err_text(e));
     }
     free(s);
-    cs_jobplan_free(&jp); /* after the message: diag.loc.file may point into its path */
+}
+
+/* Reads the job file once (a regular file only: a FIFO or a device would block the daemon) into
+ * jp->path, laid out, ordered and pen-lifted by in (the SUBMIT words) with merge distance tol_mm;
+ * on error a "file:line:col: reason" in err. */
+static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, double tol_mm,
+                     cs_jobplan_t *jp, char *err, size_t errcap)
+{
+    cs_jobplan_init(jp);
+    jp->regular_only = true;
+    jp->max_bytes = d->cfg->max_input_bytes;
+    cs_pos_t tol;
+    if (!cs_jobplan_tol(&d->m, tol_mm, &tol)) {
+        snprintf(err, errcap, "tol %g mm is outside the accepted range", tol_mm);
+        return false;
+    }
+    cs_err_t e = cs_jobplan_read_opts(jp, file, &d->pen, in);
+    if (e == CS_OK) /* layout, merge and sort (the SUBMIT words), then the pen lifts */
+        e = cs_jobplan_prepare(jp, "serve", in, &d->m, &d->pen, tol, d->cfg->log);
+    if (e == CS_OK)
+        return true;
+    diag_text(jp, file, e, err, errcap);
+    cs_jobplan_free(jp);
+    return false;
+}
+
+/* Plans jp's path (read at submit, never re-read) whole as `curvestep stream` does, from
+ * start_steps (NULL: the origin), into *job; on error a "file:line:col: reason" in err. */
+static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curves, double tol_mm,
+                     double feed, const int32_t *start_steps, cs_stream_job_t *job, char *err,
+                     size_t errcap)
+{
+    cs_pos_t tol;
+    if (!cs_jobplan_tol(&d->m, tol_mm, &tol)) {
+        snprintf(err, errcap, "tol %g mm is outside the accepted range", tol_mm);
+        return false;
+    }
+    cs_stream_job_init(job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
+    /* step segments are relative: plan them from where the device is (the position the
+     * previous job left it at), rounded to the nearest LSB (far below half a step) */
+    cs_pos_t start[CS_AXES] = {0};
+    if (start_steps != NULL)
+        for (unsigned i = 0; i < d->m.n_axes && i < CS_PROTO_AXES_MAX; i++)
+            start[i] = (cs_pos_t)llround((double)start_steps[i] * 65536.0 * 65536.0 /
+                                         (double)d->m.axis[i].steps_per_mm);
+    int32_t feed_q = cs_motion_speed(feed);
+    if (jp->have_mo) { /* planned before (at submit): plan the same path again */
+        cs_motion_free(&jp->mo);
+        jp->have_mo = false;
+    }
+    cs_err_t e = cs_jobplan_plan(jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
+                                 CS_TRACE_DEFAULT, feed_q);
+    if (e == CS_OK)
+        e = cs_jobplan_linkable(jp, file);
+    if (e == CS_OK)
+        e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
+                                            tol, &jp->diag)
+                   : cs_stream_job_add_segments(job, jp->mo.segs.v, jp->mo.segs.n);
+    if (jp->have_mo) { /* the job holds its own copy of the segments */
+        cs_motion_free(&jp->mo);
+        jp->have_mo = false;
+    }
+    if (e == CS_OK)
+        return true;
+    cs_stream_job_free(job);
+    diag_text(jp, file, e, err, errcap);
     return false;
 }
 
@@ -303,9 +352,16 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     }
     char err[600];
     cs_stream_job_t job;
-    if (!plan_job(d, args, curves, tol, feed, &in, NULL, &job, err, sizeof err)) {
+    cs_jobplan_t jp;
+    if (!read_job(d, args, &in, tol, &jp, err, sizeof err)) {
         fprintf(out, "ERR %s\n", err);
         dlog(d, "refused %s: %s", args, err);
+        return;
+    }
+    if (!plan_job(d, &jp, args, curves, tol, feed, NULL, &job, err, sizeof err)) {
+        fprintf(out, "ERR %s\n", err);
+        dlog(d, "refused %s: %s", args, err);
+        cs_jobplan_free(&jp);
         return;
     }
     if (d->njobs == d->cap) {
@@ -313,6 +369,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
         djob_t *v = realloc(d->jobs, cap * sizeof *v);
         if (v == NULL) {
             cs_stream_job_free(&job);
+            cs_jobplan_free(&jp);
             fprintf(out, "ERR out of memory\n");
             return;
         }
@@ -324,11 +381,13 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     j->path = strdup(args);
     if (j->path == NULL) {
         cs_stream_job_free(&job);
+        cs_jobplan_free(&jp);
         fprintf(out, "ERR out of memory\n");
         return;
     }
     j->id = ++d->next_id;
     j->job = job;
+    j->jp = jp;
     j->n = job.n;
     j->curves = curves;
     j->tol_mm = tol;
@@ -475,7 +534,7 @@ static void start_next(daemon_t *d)
     if (!j->curves && moved) {
         char err[600];
         cs_stream_job_t job;
-        if (!plan_job(d, j->path, false, j->tol_mm, j->feed, &j->in, d->dev_pos, &job, err,
+        if (!plan_job(d, &j->jp, j->path, false, j->tol_mm, j->feed, d->dev_pos, &job, err,
                       sizeof err)) {
             j->state = JOB_FAILED;
             snprintf(j->end, sizeof j->end, "planning from the device's position: %.160s", err);
@@ -600,20 +659,16 @@ static void child_pump(daemon_t *d)
 static int open_socket(const char *path)
 {
     struct sockaddr_un a;
+    char err[600];
     if (unix_addr(&a, path) != 0) {
         fprintf(stderr, "curvestep serve: %s: socket path too long\n", path);
         return -1;
     }
-    int probe = socket(AF_UNIX, SOCK_STREAM, 0);
-    if (probe >= 0 && connect(probe, (struct sockaddr *)&a, sizeof a) == 0) {
-        close(probe);
-        fprintf(stderr, "curvestep serve: %s: a daemon already answers there\n", path);
+    if (!cs_dsock_dir_ok(path, err, sizeof err) || !cs_dsock_clear_stale(path, err, sizeof err)) {
+        fprintf(stderr, "curvestep serve: %s\n", err);
         return -1;
     }
-    if (probe >= 0)
-        close(probe);
-    unlink(path); /* a stale socket left by a daemon that died */
-    int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
     mode_t old = umask(077);
     int rc = fd < 0 ? -1 : bind(fd, (struct sockaddr *)&a, sizeof a);
     umask(old);
@@ -625,6 +680,18 @@ static int open_socket(const char *path)
     }
     fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
     return fd;
+}
+
+static long long now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (long long)t.tv_sec * 1000 + t.tv_nsec / 1000000;
+}
+
+static long long client_age_ms(const client_t *c, long long now)
+{
+    return now - ((long long)c->since.tv_sec * 1000 + c->since.tv_nsec / 1000000);
 }
 
 static void client_close(client_t *c)
@@ -687,6 +754,85 @@ static void client_read(daemon_t *d, client_t *c)
     }
 }
 
+/* Sends a one-line refusal (best effort, never blocking) and closes fd. */
+static void refuse(int fd, const char *msg)
+{
+    ssize_t w = send(fd, msg, strlen(msg), MSG_NOSIGNAL | MSG_DONTWAIT);
+    (void)w;
+    close(fd);
+}
+
+/* Accepts one connection: only from this user or root (SO_PEERCRED). When every slot is taken,
+ * the oldest client gets one last read (its request, if it came, is answered) and is closed:
+ * silent clients can never lock out status, pause or cancel. */
+static void accept_client(daemon_t *d)
+{
+    int cfd = accept(d->listen_fd, NULL, NULL);
+    if (cfd < 0)
+        return;
+    uid_t uid;
+    if (!cs_dsock_peer_uid(cfd, &uid) || !cs_dsock_uid_trusted(uid)) {
+        dlog(d, "refused a client of uid %ld (not this user or root)", (long)uid);
+        refuse(cfd, "ERR permission denied: not this daemon's user\n");
+        return;
+    }
+    int k = 0;
+    while (k < MAX_CLIENTS && d->clients[k].fd >= 0)
+        k++;
+    if (k == MAX_CLIENTS) {
+        long long now = now_ms();
+        k = 0;
+        for (int q = 1; q < MAX_CLIENTS; q++)
+            if (client_age_ms(&d->clients[q], now) > client_age_ms(&d->clients[k], now))
+                k = q;
+        client_read(d, &d->clients[k]);
+        if (d->clients[k].fd >= 0) {
+            refuse(d->clients[k].fd, "ERR too many clients: the oldest silent one is closed\n");
+            d->clients[k].fd = -1;
+            d->clients[k].len = 0;
+        }
+    }
+    fcntl(cfd, F_SETFL, fcntl(cfd, F_GETFL) | O_NONBLOCK);
+    d->clients[k].fd = cfd;
+    d->clients[k].len = 0;
+    clock_gettime(CLOCK_MONOTONIC, &d->clients[k].since);
+}
+
+/* Closes the clients that sent no whole request within CLIENT_IDLE_MS. */
+static void reap_idle(daemon_t *d)
+{
+    long long now = now_ms();
+    for (int k = 0; k < MAX_CLIENTS; k++)
+        if (d->clients[k].fd >= 0 && client_age_ms(&d->clients[k], now) > CLIENT_IDLE_MS) {
+            refuse(d->clients[k].fd, "ERR idle too long: no request line\n");
+            d->clients[k].fd = -1;
+            d->clients[k].len = 0;
+        }
+}
+
+/* The machine, the port and the socket, in that order. Returns 0, or the exit status after a
+ * message on stderr (what was opened is closed again). */
+static int serve_setup(daemon_t *d)
+{
+    const cs_daemon_cfg_t *cfg = d->cfg;
+    char err[512];
+    if (cs_machine_ini_open("curvestep serve", cfg->machine_file, &d->m, &d->pen, err,
+                            sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    if (cs_daemon_link_open(cfg, &d->ser) != 0) {
+        fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
+        return 4;
+    }
+    d->listen_fd = open_socket(cfg->socket_path);
+    if (d->listen_fd < 0) {
+        cs_serial_close(&d->ser);
+        return 3;
+    }
+    return 0;
+}
+
 int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
 {
     daemon_t *d = calloc(1, sizeof *d);
@@ -697,26 +843,12 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
     d->pipe_fd = -1;
     for (int k = 0; k < MAX_CLIENTS; k++)
         d->clients[k].fd = -1;
-    int rc = 0;
-    char err[512];
-    if (cs_machine_ini_open("curvestep serve", cfg->machine_file, &d->m, &d->pen, err,
-                            sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
+    int rc = serve_setup(d);
+    if (rc != 0) {
         free(d);
-        return 1;
+        return rc;
     }
-    if (cs_daemon_link_open(cfg, &d->ser) != 0) {
-        fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
-        free(d);
-        return 4;
-    }
-    int lfd = open_socket(cfg->socket_path);
-    d->listen_fd = lfd;
-    if (lfd < 0) {
-        cs_serial_close(&d->ser);
-        free(d);
-        return 3;
-    }
+    int lfd = d->listen_fd;
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_stop;
@@ -750,6 +882,7 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
                 map[n++] = k;
             }
         int pr = poll(pf, n, 200);
+        reap_idle(d);
         if (pr < 0 && errno != EINTR) {
             fprintf(stderr, "curvestep serve: poll: %s\n", strerror(errno));
             rc = 3;
@@ -761,19 +894,7 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
             if (pf[i].revents == 0)
                 continue;
             if (map[i] == -1) {
-                int cfd = accept(lfd, NULL, NULL);
-                if (cfd < 0)
-                    continue;
-                int k = 0;
-                while (k < MAX_CLIENTS && d->clients[k].fd >= 0)
-                    k++;
-                if (k == MAX_CLIENTS) {
-                    close(cfd);
-                    continue;
-                }
-                fcntl(cfd, F_SETFL, fcntl(cfd, F_GETFL) | O_NONBLOCK);
-                d->clients[k].fd = cfd;
-                d->clients[k].len = 0;
+                accept_client(d);
             } else if (map[i] == -2) {
                 if (d->pipe_fd >= 0)
                     child_pump(d);

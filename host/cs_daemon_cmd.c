@@ -9,6 +9,7 @@
 #include "cs_cmd.h"
 #include "cs_daemon.h"
 #include "cs_jobopts.h"
+#include "cs_readall.h"
 #include "cs_serial.h"
 
 /* Exit status of the clients beyond the shared ones: no daemon answers on the socket. */
@@ -20,12 +21,13 @@ static void serve_usage(FILE *f)
     fprintf(f,
             "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
             "                       [--baud N] [--parity none|even|odd] [--unit ID]\n"
-            "                       [--machine FILE.ini] [--socket PATH]\n"
+            "                       [--machine FILE.ini] [--socket PATH] [--max-input-mb N]\n"
             "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
-            "came (as `curvestep stream` does: planned whole at submit time, then streamed with\n"
-            "the protocol of docs/protocol.md, or over Modbus as in docs/modbus.md). Clients\n"
-            "talk to it on the UNIX socket PATH, created with mode 0600 (owner only): curvestep\n"
-            "submit, status, pause, resume, cancel. One line per event on standard error.\n"
+            "came (as `curvestep stream` does: read once and planned whole at submit time, then\n"
+            "streamed with the protocol of docs/protocol.md, or over Modbus as in\n"
+            "docs/modbus.md). Clients talk to it on the UNIX socket PATH, created with mode 0600\n"
+            "(owner only): curvestep submit, status, pause, resume, cancel. One line per event\n"
+            "on standard error.\n"
             "SIGTERM or SIGINT stops it: the running job is held, then aborted.\n"
             "  --port DEV      serial device, kept open (one link is required)\n"
             "  --modbus-tcp HOST:PORT  a Modbus TCP device (connected for each job)\n"
@@ -34,10 +36,14 @@ static void serve_usage(FILE *f)
             "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
             "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
-            "  --socket PATH   the socket (default %s)\n"
+            "  --max-input-mb N  refuse a submitted job file larger than N MiB (default 64)\n"
+            "  --socket PATH   the socket (default %s); its directory must belong to\n"
+            "                  this user or root and be writable by nobody else (never /tmp);\n"
+            "                  only a stale socket of this user's is ever removed there\n"
+            "Only this user's (and root's) clients are answered (docs/streaming.md).\n"
             "Exit status: 0 stopped by a signal; 1 bad machine file; 2 bad command line;\n"
-            "3 the socket cannot be created or a daemon already answers on it; 4 the port\n"
-            "cannot be opened.\n",
+            "3 the socket cannot be created (unsafe directory, something else at PATH) or a\n"
+            "daemon already answers on it; 4 the port cannot be opened.\n",
             cs_daemon_default_socket(sock, sizeof sock));
 }
 
@@ -92,6 +98,14 @@ int cs_cmd_serve(int argc, char **argv)
             cfg.socket_path = argv[++i];
         } else if (strcmp(a, "--machine") == 0 && has) {
             cfg.machine_file = argv[++i];
+        } else if (strcmp(a, "--max-input-mb") == 0 && has) {
+            if (!cs_readall_parse_mb(argv[++i], &cfg.max_input_bytes)) {
+                fprintf(stderr,
+                        "curvestep serve: --max-input-mb wants a whole number of MiB, "
+                        "1 to %u\n",
+                        CS_READALL_MAX_MB);
+                return CS_EXIT_USAGE;
+            }
         } else if (strcmp(a, "--baud") == 0 && has) {
             if (parse_baud(argv[++i], &cfg.baud) != 0) {
                 fprintf(stderr, "curvestep serve: --baud wants a termios rate (e.g. 115200)\n");
@@ -146,7 +160,7 @@ static void client_usage(FILE *f, const char *name)
             "  --socket PATH   the daemon's socket (default %s)\n"
             "Exit status: 0 the daemon said OK; 1 it refused the request (the reason is\n"
             "printed; for a bad job file: file:line:col: reason); 2 bad command line; 4 no\n"
-            "daemon answers on the socket.\n",
+            "daemon answers on the socket, or the process there is not this user's or root's.\n",
             sock);
 }
 

@@ -15,6 +15,8 @@
 #include "cs_jobopts.h"
 #include "cs_machine_ini.h"
 #include "cs_lensub.h"
+#include "cs_motion.h"
+#include "cs_readall.h"
 #include "cs_path.h"
 #include "cs_svgdoc.h"
 #include "cs_svgout.h"
@@ -86,6 +88,7 @@ static void flatten_usage(FILE *f)
             "  --svg OUT.svg   also write a picture: exact curves, chords and their vertices\n"
             "  --font FILE.jhf Hershey stroke font for SVG <text> and HP-GL LB labels (default:\n"
             "                  share/fonts/futural.jhf; a file that is not a font is an error)\n"
+            "  --max-input-mb N  refuse a FILE larger than N MiB (default 64; docs/inputs.md)\n"
             "  -h, --help      show this help\n",
             CS_POS_LIMIT_MM, FLATTEN_DEFAULT_TOL_MM, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM,
             CS_POS_LIMIT_MM, FLATTEN_DEFAULT_SEG_LEN_MM);
@@ -156,6 +159,7 @@ int cs_cmd_flatten(int argc, char **argv)
         {"font", required_argument, NULL, 'f'},
         {"seg-len", required_argument, NULL, 'L'},
         {"eval", required_argument, NULL, 'E'},
+        {"max-input-mb", required_argument, NULL, 'M'},
         {NULL, 0, NULL, 0},
     };
     double tol_mm = FLATTEN_DEFAULT_TOL_MM;
@@ -170,6 +174,7 @@ int cs_cmd_flatten(int argc, char **argv)
         return r;
     double seg_len_mm = FLATTEN_DEFAULT_SEG_LEN_MM;
     bool horner = false, eval_given = false;
+    size_t max_bytes = 0;
     int c;
     optind = 1;
     opterr = 0;
@@ -237,6 +242,15 @@ int cs_cmd_flatten(int argc, char **argv)
                 return CS_EXIT_USAGE;
             }
             break;
+        case 'M':
+            if (!cs_readall_parse_mb(optarg, &max_bytes)) {
+                fprintf(stderr,
+                        "curvestep flatten: --max-input-mb '%s': expected a whole number of MiB, "
+                        "1 to %u\n",
+                        optarg, CS_READALL_MAX_MB);
+                return CS_EXIT_USAGE;
+            }
+            break;
         case 'h':
             flatten_usage(stdout);
             return CS_EXIT_OK;
@@ -275,6 +289,7 @@ int cs_cmd_flatten(int argc, char **argv)
     cs_input_opts_init(&iopts);
     cs_jobopts_input(&in, &iopts);
     iopts.font_file = font;
+    iopts.max_bytes = max_bytes;
     cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
     cs_machine_t m;
     cs_machine_ini_default(&m); /* --fit: the built-in machine's travel */
@@ -332,14 +347,25 @@ int cs_cmd_flatten(int argc, char **argv)
         cs_vec3_t pt;
         while (e == CS_OK &&
                (e = by_length ? cs_lensub_next(&ls, &pt) : cs_trace_next(&tr, &pt)) == CS_OK) {
+            if (++nchords > CS_MOTION_MAX_SEGS) { /* bounded memory: the plan's own limit */
+                e = CS_ERR_RANGE;
+                break;
+            }
             printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
-            nchords++;
             if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
                     CS_OK ||
                 !vbuf_push(&vb, pt)) {
                 e = CS_ERR_FULL;
                 break;
             }
+        }
+        if (e == CS_ERR_RANGE) {
+            cs_path_diag_set(&diag, e, el->loc,
+                             "more than %zu chords: too large to flatten (docs/inputs.md, Limits)",
+                             CS_MOTION_MAX_SEGS);
+            cs_path_diag_print(stderr, &diag);
+            status = CS_EXIT_INPUT;
+            break;
         }
         if (e != CS_END) {
             cs_path_diag_set(&diag, e, el->loc, "cannot trace this curve: %s", cs_err_text(e));

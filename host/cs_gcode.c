@@ -20,18 +20,18 @@ cs_path_loc_t cs_gcode_loc(const gc_t *g, unsigned col)
 void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
 {
     cs_path_diag_t w;
-    w.code = CS_OK;
-    w.loc = cs_gcode_loc(g, col);
+    char msg[sizeof w.reason];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(w.reason, sizeof w.reason, fmt, ap);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    cs_path_diag_set(&w, CS_OK, cs_gcode_loc(g, col), "%s", msg);
     if (g->stats)
         g->stats->warnings++;
     if (g->o->warn)
         g->o->warn(g->o->warn_ctx, &w);
     else
-        fprintf(stderr, "%s:%u:%u: warning: %s\n", w.loc.file, w.loc.line, w.loc.col, w.reason);
+        cs_path_warn_print(stderr, &w);
 }
 
 /* An unsupported word: an error, or a warning (and CS_OK: the caller ignores it) when lenient. */

@@ -117,7 +117,7 @@ static void warn(hp_t *h, size_t off, const char *fmt, ...)
     if (h->o->warn)
         h->o->warn(h->o->warn_ctx, &w);
     else
-        fprintf(stderr, "%s:%u:%u: warning: %s\n", w.loc.file, w.loc.line, w.loc.col, w.reason);
+        cs_path_warn_print(stderr, &w);
 }
 
 /* What sits at offset off, for messages. */

@@ -8,6 +8,7 @@
 #include "cs_curvefile.h"
 #include "cs_gcode.h"
 #include "cs_hpgl.h"
+#include "cs_readall.h"
 #include "cs_svgdoc.h"
 
 void cs_input_opts_init(cs_input_opts_t *o)
@@ -78,10 +79,7 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
         return f;
     if (cs_curvefile_is(buf, len))
         return CS_INPUT_CURVES;
-    size_t i = 0;
-    if (len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
-        (unsigned char)buf[2] == 0xBF)
-        i = 3;
+    size_t i = cs_readall_bom(buf, len);
     while (i < len && (buf[i] == ' ' || buf[i] == '\t' || buf[i] == '\r' || buf[i] == '\n'))
         i++;
     if (i == len)
@@ -173,8 +171,8 @@ static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const cha
     return e;
 }
 
-cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
-                        cs_path_t *path, cs_path_diag_t *diag)
+static cs_err_t parse_format(const char *name, const char *buf, size_t len,
+                             const cs_input_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
 {
     cs_input_opts_t dflt;
     if (!o) {
@@ -208,12 +206,31 @@ cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_
     }
 }
 
+cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
+                        cs_path_t *path, cs_path_diag_t *diag)
+{
+    size_t before = path->n;
+    cs_err_t e = parse_format(name, buf, len, o, path, diag);
+    if (cs_path_over_limit(path, diag)) /* whatever the reader said about the refused element */
+        return CS_ERR_RANGE;
+    if (e == CS_OK && path->n == before) { /* empty, BOM only, comments only: never silence */
+        cs_path_loc_t loc = {name ? name : "-", 1, 1};
+        return cs_path_diag_set(diag, CS_ERR_EMPTY, loc,
+                                "no drawable geometry (the %s input is empty or holds nothing "
+                                "curvestep draws)",
+                                cs_input_format_name(o && o->format != CS_INPUT_AUTO
+                                                         ? o->format
+                                                         : cs_input_detect(name, buf, len)));
+    }
+    return e;
+}
+
 cs_err_t cs_input_load(const char *filename, const cs_input_opts_t *o, cs_path_t *path,
                        cs_path_diag_t *diag)
 {
     char *buf = NULL;
     size_t len = 0;
-    cs_err_t e = cs_svgdoc_load(filename, &buf, &len, diag);
+    cs_err_t e = cs_readall(filename, o ? o->max_bytes : 0, o && o->regular_only, &buf, &len, diag);
     if (e != CS_OK)
         return e;
     bool is_stdin = strcmp(filename, "-") == 0;

@@ -47,6 +47,7 @@ typedef struct {
     size_t max_bytes;      /* input size limit in bytes; 0: the default (docs/inputs.md) */
     cs_input_format_t
         *detected;         /* non-NULL: receives the reader used (cs_pen: G-code lifts itself) */
+    bool regular_only;     /* refuse FIFOs, devices, directories (the daemon; cs_readall) */
     cs_input_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_input_opts_t;
@@ -64,7 +65,9 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
 const char *cs_input_format_name(cs_input_format_t f);
 
 /* Parses buf[0..len) named name (for diagnostics) as format f (CS_INPUT_AUTO: detected from
- * name and content) into *path. Errors as the reader's, with *diag "file:line:col: reason". */
+ * name and content) into *path. Errors as the reader's, with *diag "file:line:col: reason";
+ * CS_ERR_EMPTY "no drawable geometry" when the input adds no element (empty, a BOM, comments);
+ * CS_ERR_RANGE past CS_PATH_MAX_ELEMS elements. */
 cs_err_t cs_input_parse(const char *name, const char *buf, size_t len, const cs_input_opts_t *o,
                         cs_path_t *path, cs_path_diag_t *diag);
 

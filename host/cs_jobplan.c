@@ -9,6 +9,7 @@
 #include "cs_conv.h"
 #include "cs_input.h"
 #include "cs_pen.h"
+#include "cs_readall.h"
 
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o)
 {
@@ -42,10 +43,29 @@ int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan
             fprintf(stderr, "curvestep %s: --feed wants a speed in (0, 32768) mm/s\n", cmd);
             return -1;
         }
+    } else if (strcmp(a, "--max-input-mb") == 0) {
+        if (!cs_readall_parse_mb(argv[++*i], &o->max_input_bytes)) {
+            fprintf(stderr, "curvestep %s: --max-input-mb wants a whole number of MiB, 1 to %u\n",
+                    cmd, CS_READALL_MAX_MB);
+            return -1;
+        }
+    } else if (strcmp(a, "--max-segments") == 0) {
+        unsigned long long v = strtoull(argv[++*i], &end, 10);
+        if (argv[*i][0] < '0' || argv[*i][0] > '9' || *end != '\0' || v < 1 || v > SIZE_MAX / 64) {
+            fprintf(stderr, "curvestep %s: --max-segments wants a positive whole number\n", cmd);
+            return -1;
+        }
+        o->max_segs = (size_t)v;
     } else {
         return 0;
     }
     return 1;
+}
+
+void cs_jobplan_limits(cs_jobplan_t *jp, const cs_jobplan_opts_t *o)
+{
+    jp->max_bytes = o->max_input_bytes;
+    jp->max_segs = o->max_segs;
 }
 
 bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol)
@@ -102,6 +122,8 @@ cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machi
     cs_input_format_t fmt = CS_INPUT_AUTO;
     iopts.detected = &fmt;
     cs_machine_ini_pen_default(&jp->pen);
+    iopts.max_bytes = jp->max_bytes;
+    iopts.regular_only = jp->regular_only;
     if (pen != NULL) {
         jp->pen = *pen;
         /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
@@ -171,6 +193,7 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
         return fail_whole(jp, file, e, "machine rejected");
     jp->have_mo = true;
     jp->mo.pen = &jp->pen; /* mode servo: pen events between the strokes */
+    jp->mo.max_segs = jp->max_segs;
     if (start != NULL && (e = cs_planner_set_position(&jp->mo.pl, start)) != CS_OK)
         return fail_whole(jp, file, e, "the device's position is outside the machine's travel");
     if (jp->pen_raise) { /* the pen up where the machine stands, before the first travel */

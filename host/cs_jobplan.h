@@ -20,6 +20,8 @@ typedef struct {
     double feed_mm_s;         /* --feed MM/S; 0: the machine's default_feed */
     const char *font_file;    /* --font FILE.jhf: stroke font for text; NULL: the default */
     cs_jobopts_t in;          /* the shared input and layout options (cs_jobopts) */
+    size_t max_input_bytes;   /* --max-input-mb N; 0: CS_READALL_DEFAULT_MAX (64 MiB) */
+    size_t max_segs;          /* --max-segments N; 0: CS_MOTION_MAX_SEGS */
 } cs_jobplan_opts_t;
 
 /* One job: read, then planned. */
@@ -33,14 +35,17 @@ typedef struct {
     bool pen_raise;        /* cs_pen lifted the job: the plan starts by raising the pen in place */
     bool gcode;            /* the job was G-code (its own M3/M5 lift the pen) */
     const char *font_file; /* stroke font for text (set before cs_jobplan_read); NULL: default */
+    size_t max_bytes;    /* input size limit (cs_readall; 0: its default) */
+    size_t max_segs;     /* segment limit (cs_motion_t.max_segs; 0: its default) */
+    bool regular_only;   /* refuse FIFOs, devices, directories (the daemon) */
 } cs_jobplan_t;
 
 /* No machine file, no --tol, no --feed, cs_jobopts_init. */
 void cs_jobplan_opts_init(cs_jobplan_opts_t *o);
-/* argv[*i] is --machine FILE, --tol MM, --feed MM/S or --font FILE with its value, or one of the
- * shared input options (cs_jobopts_option): stores it, moves *i onto the value and returns 1; any
- * other word: 0; a bad value: -1, after "curvestep CMD: --tol wants ..." on stderr (a usage
- * error). */
+/* argv[*i] is --machine FILE, --tol MM, --feed MM/S, --font FILE, --max-input-mb N or
+ * --max-segments N with its value, or one of the shared input options (cs_jobopts_option): stores
+ * it, moves *i onto the value and returns 1; any other word: 0; a bad value: -1, after "curvestep
+ * CMD: --tol wants ..." on stderr (a usage error). */
 int cs_jobplan_option(const char *cmd, int argc, char **argv, int *i, cs_jobplan_opts_t *o);
 /* Chord tolerance: tol_mm (> 0) converted, else the machine's. False when tol_mm is outside
  * what cs_conv accepts. */
@@ -52,8 +57,10 @@ bool cs_jobplan_tol(const cs_machine_t *m, double tol_mm, cs_pos_t *tol);
 int cs_jobplan_machine(const char *cmd, const cs_jobplan_opts_t *o, cs_machine_t *m,
                        cs_machine_pen_t *pen, cs_pos_t *tol);
 
-/* Empty job: no path, no segments, diag cleared. */
+/* Empty job: no path, no segments, diag cleared, default limits. */
 void cs_jobplan_init(cs_jobplan_t *jp);
+/* The limits of o (--max-input-mb, --max-segments) for the next read and plan of jp. */
+void cs_jobplan_limits(cs_jobplan_t *jp, const cs_jobplan_opts_t *o);
 /* Reads file (cs_input_load: SVG, G-code, HP-GL) into jp->path. pen (NULL: none) with mode = z
  * turns G-code M3/M4 and M5 into rapid Z moves to its down_z / up_z, and lifts the pen between
  * the strokes of SVG and HP-GL drawings (cs_pen_lift_z); lenient: unsupported G-code words are

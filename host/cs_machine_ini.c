@@ -14,6 +14,10 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_planner.h"
+#include "cs_readall.h"
+
+/* A machine file is a few dozen lines: 1 MiB is far above any (cs_readall's limit). */
+#define CS_MACHINE_INI_MAX_BYTES ((size_t)1 << 20)
 
 typedef struct {
     cs_machine_t *m;
@@ -23,7 +27,9 @@ typedef struct {
     cs_machine_pen_t pen;
     bool has_up_z, has_down_z, has_up_us, has_down_us;
     char reason[200];
-    int bad_line;
+    int bad_line;     /* the line reason is about (the first key the handler refused) */
+    int lineno;       /* lines read so far (text_reader): the line the handler is given */
+    const char *text; /* the rest of the file (text_reader) */
 } ini_ctx_t;
 
 static const char *const axis_names[CS_AXES] = {"x", "y", "z", "a"};
@@ -58,6 +64,10 @@ double cs_machine_ini_to_double(int32_t q16)
 
 static bool parse_num(const char *v, double *out)
 {
+    /* decimal only: strtod would also take "0x10" (16), "inf" and "nan" */
+    for (const char *p = v; *p != '\0'; p++)
+        if (strchr("0123456789+-.eE \t", *p) == NULL)
+            return false;
     char *end;
     errno = 0;
     double d = strtod(v, &end);
@@ -83,8 +93,39 @@ static bool to_q16_pos(double d, int32_t *out)
 
 static int fail(ini_ctx_t *c, const char *fmt, const char *section, const char *name)
 {
-    snprintf(c->reason, sizeof c->reason, fmt, section, name);
+    if (c->reason[0] == '\0') { /* libinih reports the first bad line: keep its reason */
+        snprintf(c->reason, sizeof c->reason, fmt, section, name);
+        c->bad_line = c->lineno;
+    }
     return 0;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value);
+
+/* ini_reader over c->text (fgets-like: at most num - 1 bytes, up to a newline), counting lines so
+ * the handler knows which line it is given (libinih passes no line number to it). */
+static char *text_reader(char *str, int num, void *stream)
+{
+    ini_ctx_t *c = stream;
+    if (*c->text == '\0' || num < 2)
+        return NULL;
+    int k = 0;
+    while (k < num - 1 && c->text[k] != '\0' && (k == 0 || c->text[k - 1] != '\n'))
+        k++;
+    memcpy(str, c->text, (size_t)k);
+    str[k] = '\0';
+    c->text += k;
+    if (str[k - 1] == '\n' || *c->text == '\0')
+        c->lineno++; /* a line longer than num - 1 is one line read in pieces */
+    return str;
+}
+
+/* ini_parse_string with line numbers for the handler's errors. */
+static int parse_text(ini_ctx_t *c, const char *text)
+{
+    c->text = text;
+    c->lineno = 0;
+    return ini_parse_stream(text_reader, c, handler, c);
 }
 
 void cs_machine_ini_pen_default(cs_machine_pen_t *pen)
@@ -272,9 +313,11 @@ static int finish(ini_ctx_t *c, int rc, const char *name, char *err, size_t errl
         snprintf(err, errlen, "%s:0: cannot read the machine file", name);
         return -1;
     }
-    if (rc > 0) {
+    if (rc > 0) { /* rc: the first bad line; the handler's reason only when it is that line's */
         snprintf(err, errlen, "%s:%d: %s", name, rc,
-                 c->reason[0] ? c->reason : "syntax error (expected [section] or key = value)");
+                 c->reason[0] && c->bad_line == rc
+                     ? c->reason
+                     : "syntax error (expected [section] or key = value)");
         return -1;
     }
     m->segment_ticks = (uint32_t)llround(c->segment_ms * m->tick_hz / 1000.0);
@@ -343,11 +386,19 @@ static void ctx_init(ini_ctx_t *c, cs_machine_t *m)
 int cs_machine_ini_load_pen(const char *path, cs_machine_t *m, cs_machine_pen_t *pen, char *err,
                             size_t errlen)
 {
-    ini_ctx_t c;
-    ctx_init(&c, m);
-    int rc = finish(&c, ini_parse(path, handler, &c), path, err, errlen);
-    if (rc == 0 && pen)
-        *pen = c.pen;
+    /* read whole first (cs_readall: bounded, and a directory is an error, not an empty file
+     * that would leave the built-in machine in place) */
+    char *text = NULL;
+    size_t len = 0;
+    cs_path_diag_t d;
+    if (cs_readall(path, CS_MACHINE_INI_MAX_BYTES, false, &text, &len, &d) != CS_OK) {
+        char file[512];
+        cs_path_escape(file, sizeof file, path);
+        snprintf(err, errlen, "%s:0: cannot read the machine file: %s", file, d.reason);
+        return -1;
+    }
+    int rc = cs_machine_ini_parse_pen(text, path, m, pen, err, errlen);
+    free(text);
     return rc;
 }
 
@@ -356,7 +407,7 @@ int cs_machine_ini_parse_pen(const char *text, const char *name, cs_machine_t *m
 {
     ini_ctx_t c;
     ctx_init(&c, m);
-    int rc = finish(&c, ini_parse_string(text, handler, &c), name, err, errlen);
+    int rc = finish(&c, parse_text(&c, text), name, err, errlen);
     if (rc == 0 && pen)
         *pen = c.pen;
     return rc;

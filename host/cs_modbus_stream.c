@@ -258,6 +258,8 @@ void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_
     o->hello_ms = 2000;
     o->status_ms = 50;
     o->idle_ms = 3000;
+    /* far above one segment (a few ms) or one curve's wait for the queue, far below "forever" */
+    o->stall_ms = 30000;
 }
 
 typedef struct {
@@ -276,6 +278,7 @@ typedef struct {
     double t_first;
     uint32_t resent, refused;
     bool held; /* HOLD sent for o->pause, RESUME not yet */
+    double t_progress; /* last write taken, message executed or axis moved (stall_ms) */
 } mrun_t;
 
 static void finish(mrun_t *s, cs_stream_outcome_t oc)
@@ -310,6 +313,20 @@ static void lost(mrun_t *s, cs_mb_rc_t rc, const char *doing)
     finish(s, CS_STREAM_CLOSED);
 }
 
+/* True (and the outcome set) when nothing moved for o->stall_ms: no write taken, no message
+ * executed, no axis moved (a foreign HOLD, a device that refuses everything): never wait on. */
+static bool stalled(mrun_t *s, double now)
+{
+    if (s->o->stall_ms == 0 || now - s->t_progress <= s->o->stall_ms / 1000.0)
+        return false;
+    snprintf(s->r->why, sizeof s->r->why,
+             "no progress for %.0f s: the device took no message, executed none and moved no "
+             "axis (state %u; another client may hold it)",
+             now - s->t_progress, (unsigned)s->st.state);
+    finish(s, CS_STREAM_CLOSED);
+    return true;
+}
+
 /* Reads the status and follows it: executed count, credits, the device's next sequence (going
  * back when a write the host believed taken never arrived), a reset, an execution error.
  * Returns false when the stream must stop. */
@@ -338,12 +355,15 @@ static bool poll_status(mrun_t *s)
         finish(s, CS_STREAM_RESET);
         return false;
     }
+    if (memcmp(st.pos, s->st.pos, sizeof st.pos) != 0)
+        s->t_progress = cs_serial_now_s(); /* an axis moved */
     s->st = st;
     r->dev_state = (uint8_t)st.state;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         r->dev_pos[i] = i < st.axes && i < CS_AXES ? st.pos[i] : 0;
     uint16_t d = (uint16_t)(st.last_exec - s->exec_seq);
     if (d != 0 && d <= r->sent - r->executed) {
+        s->t_progress = cs_serial_now_s();
         r->executed += d;
         s->exec_seq = st.last_exec;
     }
@@ -360,6 +380,20 @@ static bool poll_status(mrun_t *s)
         /* after going back on a stale status: the device had them all */
         s->next += ahead;
         r->delivered = s->next;
+    } else if (ahead != 0 && ahead < 0x8000u) {
+        /* ahead of anything this host wrote: another client wrote to the mailbox, and the
+         * device queued (and may have run) a message that is not the job's. Retrying would be
+         * refused forever (the sequence is taken) and the machine is no longer where the job
+         * thinks: stop, and say why. */
+        r->dev_error.code = CS_ERR_SEQ;
+        r->dev_error.seq = st.next_seq;
+        r->dev_error_msg = s->next + 1;
+        snprintf(r->why, sizeof r->why,
+                 "the device's next sequence is %u ahead of this host's: another Modbus client "
+                 "wrote to the mailbox (the machine may have moved)",
+                 (unsigned)ahead);
+        finish(s, CS_STREAM_DEVICE_ERROR);
+        return false;
     }
     s->credits = st.free_slots;
     if (st.error != 0) {
@@ -417,6 +451,7 @@ static bool write_next(mrun_t *s)
     }
     cs_mb_rc_t rc = cs_mb_write_mailbox(s->c, regs, n);
     if (rc == CS_MB_OK) {
+        s->t_progress = cs_serial_now_s();
         s->next++;
         if (s->next > r->sent)
             r->sent = s->next;
@@ -528,6 +563,7 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
     s->exec_seq = (uint16_t)(st->next_seq - 1u);
     s->credits = st->free_slots;
     s->last_status = cs_serial_now_s();
+    s->t_progress = s->last_status;
     /* 2. stream */
     s->t_first = cs_serial_now_s();
     s->prog.t_first = s->t_first;
@@ -549,6 +585,8 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
             t_all_sent = 0;
         }
         double now = cs_serial_now_s();
+        if (stalled(s, now))
+            break;
         bool wrote = false;
         if (s->next < job->n && s->credits > 0) {
             if (!write_next(s))

@@ -91,16 +91,20 @@ typedef struct {
     uint32_t hello_ms;  /* the first status must come within this */
     uint32_t status_ms; /* poll the status at least this often while streaming (ms) */
     uint32_t idle_ms;   /* all delivered, device not running, not all executed: give up */
+    uint32_t stall_ms;  /* no write taken, nothing executed, no axis moved this long: give up */
 } cs_mb_stream_opts_t;
 
-/* Defaults: hello 2 s, status every 50 ms, idle 3 s. */
+/* Defaults: hello 2 s, status every 50 ms, idle 3 s, stall 30 s. */
 void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_t axes,
                                uint32_t tick_hz);
-/* Streams job messages resume_from+1..n; fills *r like cs_stream_run (r->hello from the
- * status block: version = map version; r->link.retransmits = writes sent again (timeouts,
- * garbled answers, going back after a refused gap), r->link.timeouts = tries that timed out,
- * r->link.naks = mailbox writes the device refused and the host sent again (busy, gap)).
- * CS_OK when it ran to an outcome, CS_ERR_ARG for bad options. */
+/* Streams job messages resume_from+1..n; fills *r like cs_stream_run. Never waits without a
+ * deadline: a device whose next sequence runs ahead of what this host wrote (another Modbus
+ * client wrote to the mailbox) ends it at once as CS_STREAM_DEVICE_ERROR (dev_error.code
+ * CS_ERR_SEQ); no progress for stall_ms ends it as CS_STREAM_CLOSED, with the reason in r->why
+ * (r->hello from the status block: version = map version; r->link.retransmits = writes sent again
+ * (timeouts, garbled answers, going back after a refused gap), r->link.timeouts = tries that timed
+ * out, r->link.naks = mailbox writes the device refused and the host sent again (busy, gap)). CS_OK
+ * when it ran to an outcome, CS_ERR_ARG for bad options. */
 cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t *o,
                           cs_stream_result_t *r);
 

@@ -48,6 +48,10 @@ static cs_err_t add_pen(cs_motion_segs_t *v, size_t seg, uint16_t pulse_us)
 static cs_err_t push(cs_motion_t *mo, const cs_segment_t *s)
 {
     cs_motion_segs_t *v = &mo->segs;
+    if (v->n >= (mo->max_segs ? mo->max_segs : CS_MOTION_MAX_SEGS)) {
+        mo->over_limit = true;
+        return CS_ERR_FULL;
+    }
     if (v->n == v->cap) {
         size_t cap = v->cap ? v->cap * 2 : 1024;
         cs_segment_t *p = realloc(v->v, cap * sizeof *p);
@@ -283,6 +287,14 @@ static const char *axis_letter(unsigned i)
     return i < CS_AXES ? n[i] : "?";
 }
 
+static cs_err_t too_many(const cs_motion_t *mo, cs_path_loc_t loc, cs_path_diag_t *diag)
+{
+    return cs_path_diag_set(diag, CS_ERR_RANGE, loc,
+                            "the job needs more than %zu step segments: too large to plan "
+                            "(--max-segments; docs/inputs.md, Limits)",
+                            mo->max_segs ? mo->max_segs : CS_MOTION_MAX_SEGS);
+}
+
 static cs_err_t move_to(cs_motion_t *mo, const cs_vec3_t *p, int32_t feed, cs_path_loc_t loc,
                         cs_path_diag_t *diag)
 {
@@ -300,6 +312,8 @@ static cs_err_t move_to(cs_motion_t *mo, const cs_vec3_t *p, int32_t feed, cs_pa
                                         cs_conv_pos_to_mm(a->travel_max));
         }
     }
+    if (e != CS_OK && mo->over_limit)
+        return too_many(mo, loc, diag);
     if (e != CS_OK)
         return cs_path_diag_set(diag, e, loc, "planning failed: %s", cs_err_text(e));
     return CS_OK;
@@ -367,6 +381,8 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
     cs_err_t e = down ? cs_motion_pen(mo, (uint16_t)mo->pen->up_us, mo->pen->settle_ms) : CS_OK;
     if (e == CS_OK)
         e = cs_motion_finish(mo);
+    if (e != CS_OK && mo->over_limit && path->n > 0)
+        return too_many(mo, path->elems[path->n - 1].loc, diag);
     if (e != CS_OK) {
         cs_path_loc_t loc = {path->n ? path->elems[path->n - 1].loc.file : "job", 0, 0};
         return cs_path_diag_set(diag, e, loc, "cutting segments failed: %s", cs_err_text(e));

@@ -29,9 +29,15 @@ typedef struct {
     size_t npens, cappens;
 } cs_motion_segs_t;
 
+/* Most step segments one plan holds by default: 2^23 (8.4 M, 168 MB of segments; hours of
+ * motion on any machine). Beyond it planning stops with a located error (docs/inputs.md). */
+#define CS_MOTION_MAX_SEGS ((size_t)1 << 23)
+
 typedef struct {
     const cs_machine_t *m;
     const cs_machine_pen_t *pen; /* NULL or mode none / z: no pen events; servo: see plan_path */
+    size_t max_segs; /* 0: CS_MOTION_MAX_SEGS (set after cs_motion_init) */
+    bool over_limit; /* a segment was refused for max_segs */
     cs_planner_t pl;
     cs_segment_gen_t gen;
     cs_motion_segs_t segs;
@@ -80,7 +86,8 @@ cs_err_t cs_motion_read_job_ex(const char *file, bool lenient, cs_path_t *path,
  * after it, cs_pen_stroke_starts, and raised at the end), then the element's chords (cs_trace,
  * tolerance tol, method) at the element's own feed (G-code F), or rapid for a rapid element (G0),
  * or else at feed (mm/s Q15.16; <= 0: the machine's default feed); then cs_motion_finish. On error
- * *diag names the element's source location (CS_ERR_LIMIT: the move that leaves the travel). */
+ * *diag names the element's source location (CS_ERR_LIMIT: the move that leaves the travel;
+ * CS_ERR_RANGE: the element whose chords would pass max_segs segments). */
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag);
 /* mm/s -> Q15.16 (<= 0 stays 0: rapid). */

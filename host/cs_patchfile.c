@@ -1,5 +1,6 @@
 /* cs_patchfile: Newell's indexed patch format (see cs_patchfile.h), parsed line by line. */
 #include "cs_patchfile.h"
+#include "cs_readall.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -303,7 +304,13 @@ cs_err_t cs_patchfile_parse(const char *text, size_t len, const char *name, cs_p
     pf->file = strdup(name ? name : "-");
     if (!pf->file)
         return CS_ERR_FULL;
-    lexer_t lx = {pf->file, text, text + len, text, 0, diag};
+    if (cs_readall_blank(text, len)) {
+        cs_path_loc_t l = {pf->file, 1, 1};
+        return cs_path_diag_set(diag, CS_ERR_EMPTY, l,
+                                "no drawable geometry (the patch file is empty)");
+    }
+    size_t bom = cs_readall_bom(text, len); /* as the other readers: a leading BOM is skipped */
+    lexer_t lx = {pf->file, text + bom, text + len, text + bom, 0, diag};
     size_t np = 0;
     cs_err_t e = read_count(&lx, "patch", &np);
     if (e == CS_OK)
@@ -331,44 +338,11 @@ cs_err_t cs_patchfile_read(const char *filename, cs_patchfile_t *pf, cs_path_dia
     memset(pf, 0, sizeof *pf);
     bool use_stdin = strcmp(filename, "-") == 0;
     const char *name = use_stdin ? "<stdin>" : filename;
-    FILE *f = use_stdin ? stdin : fopen(filename, "rb");
-    if (!f) {
-        int err = errno;
-        pf->file = strdup(name);
-        cs_path_loc_t l = {pf->file ? pf->file : "-", 0, 0};
-        cs_path_diag_set(diag, CS_ERR_IO, l, "cannot open: %s", strerror(err));
-        return CS_ERR_IO;
-    }
     char *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n == cap) {
-            size_t nc = cap ? 2 * cap : 65536;
-            char *nb = realloc(buf, nc);
-            if (!nb) {
-                free(buf);
-                if (!use_stdin)
-                    fclose(f);
-                return CS_ERR_FULL;
-            }
-            buf = nb;
-            cap = nc;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    bool err = ferror(f) != 0;
-    if (!use_stdin)
-        fclose(f);
-    if (err) {
-        free(buf);
-        pf->file = strdup(name);
-        cs_path_loc_t l = {pf->file ? pf->file : "-", 0, 0};
-        cs_path_diag_set(diag, CS_ERR_IO, l, "read error");
-        return CS_ERR_IO;
-    }
+    size_t n = 0;
+    cs_err_t re = cs_readall_keep_name(filename, &buf, &n, &pf->file, diag);
+    if (re != CS_OK)
+        return re;
     cs_err_t e = cs_patchfile_parse(buf, n, name, pf, diag);
     free(buf);
     return e;

@@ -73,6 +73,11 @@ cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind
 cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
                           cs_path_loc_t loc, double feed_mm_s, bool rapid)
 {
+    if (p->n >= (p->max_elems ? p->max_elems : CS_PATH_MAX_ELEMS)) {
+        p->over_limit = true;
+        p->over_loc = loc;
+        return CS_ERR_FULL;
+    }
     void *buf = p->elems;
     if (!cs_path_grow(&buf, &p->cap, p->n + 1, sizeof *p->elems))
         return CS_ERR_FULL;
@@ -138,16 +143,62 @@ cs_err_t cs_path_diag_set(cs_path_diag_t *d, cs_err_t code, cs_path_loc_t loc, c
     d->loc = loc;
     if (!d->loc.file)
         d->loc.file = "-";
+    char raw[sizeof d->reason];
     va_start(ap, fmt);
-    vsnprintf(d->reason, sizeof d->reason, fmt, ap);
+    vsnprintf(raw, sizeof raw, fmt, ap);
     va_end(ap);
+    cs_path_escape(d->reason, sizeof d->reason, raw);
     return code;
+}
+
+void cs_path_escape(char *dst, size_t cap, const char *src)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t o = 0;
+    for (; *src != '\0' && o + 1 < cap; src++) {
+        unsigned char c = (unsigned char)*src;
+        if (c >= 0x20 && c != 0x7f) {
+            dst[o++] = (char)c;
+            continue;
+        }
+        if (o + 5 > cap)
+            break; /* no room for the whole escape: cut before it */
+        dst[o++] = '\\';
+        dst[o++] = 'x';
+        dst[o++] = hex[c >> 4];
+        dst[o++] = hex[c & 15];
+    }
+    if (cap > 0)
+        dst[o < cap ? o : cap - 1] = '\0';
+}
+
+bool cs_path_over_limit(const cs_path_t *p, cs_path_diag_t *d)
+{
+    if (!p->over_limit)
+        return false;
+    cs_path_diag_set(d, CS_ERR_RANGE, p->over_loc,
+                     "more than %zu curves: the job is too large (docs/inputs.md, Limits)",
+                     p->max_elems ? p->max_elems : CS_PATH_MAX_ELEMS);
+    return true;
+}
+
+/* The one place a located message is written: every part escaped (cs_path_escape). */
+static void diag_write(FILE *f, const cs_path_diag_t *d, const char *kind)
+{
+    char file[1024], reason[sizeof d->reason];
+    cs_path_escape(file, sizeof file, d->loc.file ? d->loc.file : "-");
+    cs_path_escape(reason, sizeof reason, d->reason); /* a reason set without cs_path_diag_set */
+    fprintf(f, "%s:%u:%u: %s%s\n", file, d->loc.line, d->loc.col, kind, reason);
 }
 
 void cs_path_diag_print(FILE *f, const cs_path_diag_t *d)
 {
-    fprintf(f, "%s:%u:%u: %s\n", d->loc.file ? d->loc.file : "-", d->loc.line, d->loc.col,
-            d->reason);
+    diag_write(f, d, "");
+}
+
+void cs_path_warn_print(FILE *f, const cs_path_diag_t *w)
+{
+    diag_write(f, w, "warning: ");
 }
 
 void cs_path_eval_mm(const cs_bezier_t *c, double t, double out[3])

@@ -49,9 +49,16 @@ typedef struct {
     bool rapid;        /* a travel move (G-code G0): at the machine's rapid rate, not drawn */
 } cs_path_elem_t;
 
+/* Most elements a path holds by default: 2^20 (1 M curves, about 190 MB), far above
+ * any real job; beyond it cs_path_add is refused (docs/inputs.md, "Limits"). */
+#define CS_PATH_MAX_ELEMS ((size_t)1 << 20)
+
 typedef struct {
     cs_path_elem_t *elems;
     size_t n, cap;
+    size_t max_elems;       /* 0: CS_PATH_MAX_ELEMS */
+    bool over_limit;        /* an element was refused for the limit ... */
+    cs_path_loc_t over_loc; /* ... this one */
     char **files; /* interned file names, freed with the path */
     size_t nfiles, capfiles;
     unsigned nsubpaths;
@@ -83,6 +90,10 @@ cs_err_t cs_path_add(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind
 cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t kind,
                           cs_path_loc_t loc, double feed_mm_s, bool rapid);
 
+/* Copies src into dst (cap bytes, NUL-terminated) with every control character (below 0x20,
+ * and 0x7f) written as \xHH: text from input files is safe to print. */
+void cs_path_escape(char *dst, size_t cap, const char *src);
+
 /* Affine map of the plane in SVG matrix order: x' = a x + c y + e, y' = b x + d y + f. */
 typedef struct {
     double a, b, c, d, e, f;
@@ -106,14 +117,21 @@ typedef struct {
     char reason[256];
 } cs_path_diag_t;
 
-/* Fills *d (printf-style reason). Returns code, so callers can `return cs_path_diag_set(...)`. */
+/* Fills *d (printf-style reason; control characters in the result are escaped as \xHH, so text
+ * quoted from a hostile file cannot drive the terminal). Returns code, so callers can
+ * `return cs_path_diag_set(...)`. */
 cs_err_t cs_path_diag_set(cs_path_diag_t *d, cs_err_t code, cs_path_loc_t loc, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 4, 5)))
 #endif
     ;
-/* Prints "file:line:col: reason\n" to f. */
+/* Prints "file:line:col: reason\n" to f (control characters in the file name escaped). */
 void cs_path_diag_print(FILE *f, const cs_path_diag_t *d);
+/* Prints "file:line:col: warning: reason\n" to f, escaped as cs_path_diag_print. */
+void cs_path_warn_print(FILE *f, const cs_path_diag_t *w);
+/* When p refused an element for its limit (CS_PATH_MAX_ELEMS): fills *d with a located
+ * CS_ERR_RANGE "more than N curves: the job is too large" and returns true. */
+bool cs_path_over_limit(const cs_path_t *p, cs_path_diag_t *d);
 
 /* Point of curve c at t in [0, 1], in mm, evaluated in double by de Casteljau (rational curves
  * in homogeneous coordinates): the exact curve the fixed-point control points describe. */

@@ -4,6 +4,7 @@
  * per line, "ticks dx dy dz". */
 #include <stdio.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 
 #include "cs_cmd.h"
@@ -36,6 +37,8 @@ static void usage(FILE *f)
           "                      any F; default: the machine's default_feed)\n"
           "  --font FILE.jhf     Hershey stroke font for SVG <text> and HP-GL LB (default:\n"
           "                      share/fonts/futural.jhf, docs/plotting.md)\n"
+          "  --max-input-mb N    refuse a job file larger than N MiB (default 64)\n"
+          "  --max-segments N    refuse a job of more than N step segments (default 8388608)\n"
           "  -o OUT              write segments to OUT\n",
           f);
     cs_jobopts_help(f);
@@ -99,6 +102,7 @@ int cs_cmd_plan(int argc, char **argv)
         return rc;
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    cs_jobplan_limits(&jp, &jo);
     jp.font_file = jo.font_file;
     cs_err_t e = cs_jobplan_read_opts(&jp, job, &pen, &jo.in);
     if (e == CS_OK)
@@ -110,13 +114,17 @@ int cs_cmd_plan(int argc, char **argv)
         rc = cs_jobplan_exit(&jp, e);
     } else {
         FILE *f = out_file ? fopen(out_file, "w") : stdout;
+        const char *name = out_file ? out_file : "<stdout>";
         if (f == NULL) {
-            perror(out_file);
+            fprintf(stderr, "curvestep plan: %s: cannot open: %s\n", name, strerror(errno));
             rc = CS_EXIT_INTERNAL;
         } else {
-            if (cs_motion_write_segs(f, &m, &jp.mo.segs) != 0 || (out_file && fclose(f) != 0) ||
-                (!out_file && fflush(f) != 0)) {
-                fprintf(stderr, "curvestep plan: write error\n");
+            int w = cs_motion_write_segs(f, &m, &jp.mo.segs);
+            int err = errno;
+            if (out_file ? fclose(f) != 0 : fflush(f) != 0)
+                w = -1, err = errno;
+            if (w != 0) {
+                fprintf(stderr, "curvestep plan: %s: write error: %s\n", name, strerror(err));
                 rc = CS_EXIT_INTERNAL;
             }
         }

@@ -334,9 +334,12 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
         on_status(s, &m.u.status);
     } else if (m.type == CS_PROTO_ERROR) {
         s->r->dev_error = m.u.error;
-        uint16_t k = (uint16_t)(m.u.error.seq - s->first_seq);
+        /* counted back from the last sequence queued, never forward from the session's first
+         * one: 16-bit sequences wrap after 65,536 messages */
+        uint16_t last = (uint16_t)(cs_link_last_acked(&s->link) + cs_link_unacked(&s->link));
+        uint16_t back = (uint16_t)(last - m.u.error.seq);
         s->r->dev_error_msg =
-            s->open && k < s->r->sent - s->o->resume_from ? s->o->resume_from + k + 1 : 0;
+            s->open && back < s->r->sent - s->o->resume_from ? s->r->sent - back : 0;
         finish(s, CS_STREAM_DEVICE_ERROR);
     }
 }
@@ -395,11 +398,11 @@ static void pump_in(run_t *s, int wait_ms)
             on_deliver(s, &ev);
     }
     if (s->open) {
-        uint16_t acked = cs_link_last_acked(&s->link);
-        uint16_t k = (uint16_t)(acked - s->first_seq + 1u);
+        /* sent minus what the link still holds unacknowledged (a window, far below 65,536):
+         * no 16-bit sequence arithmetic, so no wrap on long jobs */
         size_t in_session = s->r->sent - s->o->resume_from;
-        if (k <= in_session)
-            s->r->delivered = s->o->resume_from + k;
+        size_t unacked = cs_link_unacked(&s->link);
+        s->r->delivered = s->r->sent - (unacked < in_session ? unacked : in_session);
     }
 }
 

@@ -70,6 +70,8 @@ static void usage(FILE *f)
           "                     rational curves as cubic pieces within tol/4 of the exact curve\n"
           "  --tol MM           chord tolerance (default: the machine's)\n"
           "  --feed MM/S        drawing feed (default: the machine's default_feed)\n"
+          "  --max-input-mb N   refuse a job file larger than N MiB (default 64)\n"
+          "  --max-segments N   refuse a job of more than N step segments (default 8388608)\n"
           "  --resume-from N    messages 1..N were executed already: send from N+1 on (the\n"
           "                     number printed after a reset or a lost link). The machine must\n"
           "                     be where message N left it\n"
@@ -208,6 +210,7 @@ int cs_cmd_stream(int argc, char **argv)
      * limits in curves mode, where the device plans again itself) */
     cs_jobplan_t jp;
     cs_jobplan_init(&jp);
+    cs_jobplan_limits(&jp, &jo);
     jp.font_file = jo.font_file;
     cs_err_t e = cs_jobplan_read_opts(&jp, job_file, &pen, &jo.in);
     if (e == CS_OK)

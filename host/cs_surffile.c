@@ -1,5 +1,6 @@
 /* cs_surffile: Newell or native surface files -> core patches (see cs_surffile.h). */
 #include "cs_surffile.h"
+#include "cs_readall.h"
 
 #include <errno.h>
 #include <math.h>
@@ -410,41 +411,11 @@ cs_err_t cs_surffile_read(const char *filename, double scale, double rev_tol_mm,
     memset(sf, 0, sizeof *sf);
     bool use_stdin = strcmp(filename, "-") == 0;
     const char *name = use_stdin ? "<stdin>" : filename;
-    FILE *f = use_stdin ? stdin : fopen(filename, "rb");
     char *buf = NULL;
-    size_t n = 0, cap = 0;
-    int err = errno;
-    bool bad = !f;
-    while (f && !bad) {
-        if (n == cap) {
-            size_t nc = cap ? 2 * cap : 65536;
-            char *nb = realloc(buf, nc);
-            if (!nb) {
-                free(buf);
-                if (!use_stdin)
-                    fclose(f);
-                return CS_ERR_FULL;
-            }
-            buf = nb;
-            cap = nc;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) {
-            bad = ferror(f) != 0;
-            err = EIO;
-            break;
-        }
-    }
-    if (f && !use_stdin)
-        fclose(f);
-    if (bad) {
-        free(buf);
-        sf->file = strdup(name);
-        cs_path_loc_t l = {sf->file ? sf->file : "-", 0, 0};
-        cs_path_diag_set(diag, CS_ERR_IO, l, "cannot %s: %s", f ? "read" : "open", strerror(err));
-        return CS_ERR_IO;
-    }
+    size_t n = 0;
+    cs_err_t re = cs_readall_keep_name(filename, &buf, &n, &sf->file, diag);
+    if (re != CS_OK)
+        return re;
     cs_err_t e = cs_surffile_parse(buf ? buf : "", n, name, scale, rev_tol_mm, sf, diag);
     free(buf);
     return e;

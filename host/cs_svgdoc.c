@@ -3,6 +3,7 @@
  * the right character, the raw start tag is re-scanned from expat's byte index, the attribute's
  * value decoded here with a map from each decoded byte to its offset in the file. */
 #include "cs_svgdoc.h"
+#include "cs_readall.h"
 
 #include <errno.h>
 #include <expat.h>
@@ -28,45 +29,7 @@
 
 cs_err_t cs_svgdoc_load(const char *filename, char **buf, size_t *len, cs_path_diag_t *diag)
 {
-    bool is_stdin = strcmp(filename, "-") == 0;
-    cs_path_loc_t loc = {is_stdin ? "<stdin>" : filename, 0, 0};
-    FILE *f = is_stdin ? stdin : fopen(filename, "rb");
-    if (!f)
-        return cs_path_diag_set(diag, CS_ERR_IO, loc, "cannot open: %s", strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *b = malloc(cap);
-    cs_err_t e = CS_OK;
-    while (b) {
-        if (n + 1 >= cap) {
-            char *nb = cap < ((size_t)-1) / 2 ? realloc(b, cap * 2) : NULL;
-            if (!nb) {
-                free(b);
-                b = NULL;
-                break;
-            }
-            b = nb;
-            cap *= 2;
-        }
-        size_t got = fread(b + n, 1, cap - 1 - n, f);
-        n += got;
-        if (got == 0) {
-            if (ferror(f))
-                e = cs_path_diag_set(diag, CS_ERR_IO, loc, "read error: %s", strerror(errno));
-            break;
-        }
-    }
-    if (!is_stdin)
-        fclose(f);
-    if (!b)
-        return cs_path_diag_set(diag, CS_ERR_FULL, loc, "out of memory");
-    if (e != CS_OK) {
-        free(b);
-        return e;
-    }
-    b[n] = '\0';
-    *buf = b;
-    *len = n;
-    return CS_OK;
+    return cs_readall(filename, 0, false, buf, len, diag);
 }
 
 /* --- positions ------------------------------------------------------------------------------ */
@@ -498,7 +461,7 @@ static void warn_once(doc_t *d, const char *key, size_t raw, const char *fmt, ..
     if (d->o->warn)
         d->o->warn(d->o->warn_ctx, &w);
     else
-        fprintf(stderr, "%s:%u:%u: warning: %s\n", w.loc.file, w.loc.line, w.loc.col, w.reason);
+        cs_path_warn_print(stderr, &w);
 }
 
 static const char *att_get(const char **atts, const char *name)
@@ -983,8 +946,31 @@ static void note_fill(doc_t *d, size_t tag)
                   "without a stroke)");
 }
 
+/* A grammar error in path data as SVG 2 handles it (section 9.5.4, "Error handling in path
+ * data": "render a path element up to (but not including) the path command containing the first
+ * error"): a located warning, the valid prefix kept. Returns CS_OK after warning, or e. */
+static cs_err_t path_error(cs_err_t e, const cs_path_diag_t *err, cs_svgdoc_warn_fn fn, void *ctx,
+                           unsigned *warnings)
+{
+    if (e != CS_ERR_PARSE)
+        return e; /* out of range, out of memory...: errors, as before */
+    cs_path_diag_t w;
+    cs_path_diag_set(&w, CS_OK, err->loc,
+                     "%.150s: path drawn up to the command before it (SVG 2 "
+                     "path data error handling)",
+                     err->reason);
+    if (warnings)
+        (*warnings)++;
+    if (fn)
+        fn(ctx, &w);
+    else
+        cs_path_warn_print(stderr, &w);
+    return CS_OK;
+}
+
 /* Parses path data text[0..n) in the current element's user space; positions come from
- * locate/ctx (into an attribute, or the element's tag for generated data). */
+ * locate/ctx (into an attribute, or the element's tag for generated data). A grammar error keeps
+ * the valid prefix with a warning (path_error); the other elements are drawn. */
 static cs_err_t draw_data_in(doc_t *d, const cs_path_affine_t *m, const char *text, size_t n,
                              cs_svgpath_locate_fn locate, void *ctx)
 {
@@ -993,7 +979,8 @@ static cs_err_t draw_data_in(doc_t *d, const cs_path_affine_t *m, const char *te
     po.xform = cs_path_affine_mul(d->o->xform, *m);
     po.locate = locate;
     po.locate_ctx = ctx;
-    return cs_svgpath_parse(text, n, &po, d->path, d->diag);
+    cs_err_t e = cs_svgpath_parse(text, n, &po, d->path, d->diag);
+    return path_error(e, d->diag, d->o->warn, d->o->warn_ctx, &d->stats->warnings);
 }
 
 static cs_err_t draw_data(doc_t *d, const char *text, size_t n, cs_svgpath_locate_fn locate,
@@ -1228,8 +1215,8 @@ static void shifted_locate(void *ctx, size_t off, unsigned *line, unsigned *col)
 }
 
 /* <polyline> and <polygon> (SVG 1.1 §9.6-9.7): the points list is path data "M x y x y ..."
- * (implicit linetos), closed for a polygon. An odd number of coordinates is an error at the
- * end of the list; a single point draws nothing. */
+ * (implicit linetos), closed for a polygon. An odd number of coordinates or a stray character
+ * is an error at its place, drawn up to it (a warning); a single point draws nothing. */
 static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     bool draw;
@@ -1242,16 +1229,25 @@ static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t t
     attr_t a;
     if ((e = attr_load(d, pv, "points", tag, &a)) != CS_OK)
         return e;
-    /* Only numbers, commas and white space: path commands are not allowed in a points list. */
+    note_fill(d, tag);
+    /* Only numbers, commas and white space: path commands are not allowed in a points list.
+     * Anything else is an error handled as in path data (SVG 2, 10.6: "the same user agent
+     * behavior as occurs with an incorrectly specified path element"): drawn up to it. */
     for (size_t i = 0; i < a.n; i++) {
         char c = a.text[i];
         if (!(is_xml_space(c) || c == ',' || c == '+' || c == '-' || c == '.' || c == 'e' ||
               c == 'E' || (c >= '0' && c <= '9'))) {
             cs_path_loc_t l = {d->name, 0, 0};
             attr_locate(&a, i, &l.line, &l.col);
-            attr_free(&a);
-            return cs_path_diag_set(d->diag, CS_ERR_PARSE, l,
-                                    "points: expected numbers separated by commas or spaces");
+            e = cs_path_diag_set(d->diag, CS_ERR_PARSE, l,
+                                 "points: expected numbers separated by commas or spaces");
+            if ((e = path_error(e, d->diag, d->o->warn, d->o->warn_ctx, &d->stats->warnings)) !=
+                CS_OK) {
+                attr_free(&a);
+                return e;
+            }
+            a.n = i;
+            break;
         }
     }
     bool polygon = strcmp(local, "polygon") == 0;
@@ -1262,7 +1258,6 @@ static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t t
         attr_free(&a);
         return draw_gen(d, local, &g, tag);
     }
-    note_fill(d, tag);
     shifted_t s = {&a, 2};
     e = draw_data(d, g.s, g.n, shifted_locate, &s);
     free(g.s);
@@ -1573,11 +1568,8 @@ cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs
 cs_err_t cs_svgdoc_read(const char *buf, size_t len, const char *name, const cs_svgdoc_opts_t *o,
                         cs_path_t *path, cs_path_diag_t *diag, cs_svgdoc_stats_t *stats)
 {
-    size_t i = 0;
     /* A UTF-8 byte order mark may precede either kind of input. */
-    if (len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
-        (unsigned char)buf[2] == 0xBF)
-        i = 3;
+    size_t i = cs_readall_bom(buf, len);
     while (i < len && is_xml_space(buf[i]))
         i++;
     if (i < len && buf[i] == '<')
@@ -1589,10 +1581,9 @@ cs_err_t cs_svgdoc_read(const char *buf, size_t len, const char *name, const cs_
     if (o)
         po.xform = o->xform;
     /* Bare path data: lines and columns counted in the data itself (a BOM is no column). */
-    size_t bom = (len >= 3 && (unsigned char)buf[0] == 0xEF && (unsigned char)buf[1] == 0xBB &&
-                  (unsigned char)buf[2] == 0xBF)
-                     ? 3
-                     : 0;
+    /* Not a document: browsers never see it, so SVG's error handling does not apply; an error
+     * anywhere in a job's one path stays an error (nothing is drawn or sent). */
+    size_t bom = cs_readall_bom(buf, len);
     return cs_svgpath_parse(buf + bom, len - bom, &po, path, diag);
 }
 

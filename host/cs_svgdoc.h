@@ -36,7 +36,8 @@ typedef struct {
 void cs_svgdoc_opts_init(cs_svgdoc_opts_t *o);
 
 /* Reads the whole of filename ("-" = standard input) into a NUL-terminated heap buffer (*buf,
- * free() it; *len excludes the NUL). CS_ERR_IO with *diag ("file:0:0: reason") on failure. */
+ * free() it; *len excludes the NUL): cs_readall with the default size limit. CS_ERR_IO (or
+ * CS_ERR_RANGE past the limit) with *diag ("file:0:0: reason") on failure. */
 cs_err_t cs_svgdoc_load(const char *filename, char **buf, size_t *len, cs_path_diag_t *diag);
 
 /* Parses an SVG document held in buf[0..len) named name; appends every drawn path's and shape's

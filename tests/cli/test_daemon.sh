@@ -16,7 +16,7 @@ JOB3=tests/data/svg/w3c/paths-data-12-t.svg
 N1=$("$CS" plan -o /dev/null "$JOB1" 2>&1 | sed -n 's/.* blocks, \([0-9]*\) segments,.*/\1/p')
 S=$T/sock/curvestep.sock
 mkdir "$T/sock"
-C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
+C() { timeout -k 5 120 "$CS" "$@" --socket "$S"; }
 
 # 0. no daemon yet: the clients say so, naming the socket.
 C status >/dev/null 2>"$T/nod.err"; rc=$?
@@ -28,12 +28,12 @@ expect "no daemon: socket named" grep -q "no daemon answers on $S" "$T/nod.err"
 timeout -k 5 90 "$SIM" --pty --speed 5 >"$T/sim.out" 2>"$T/sim.err" &
 SIMPID=$!
 pids+=($SIMPID)
-wait_pty "$T/sim.out" 5
+wait_pty "$T/sim.out" 60
 expect "sim printed a pty path" [ -c "$PTY" ]
 timeout -k 5 90 "$CS" serve --port "$PTY" --socket "$S" 2>"$T/serve.err" &
 DPID=$!
 pids+=($DPID)
-wait_until 5 [ -S "$S" ]
+wait_until 60 [ -S "$S" ]
 expect "socket created" [ -S "$S" ]
 expect "socket mode 0600" [ "$(stat -c %a "$S")" = 600 ]
 
@@ -74,8 +74,10 @@ C cancel 3 >/dev/null 2>"$T/c3b.err"; rc=$?
 expect "cancel again: refused" [ $rc -eq 1 ]
 expect "cancel again: why" grep -q "job 3 is cancelled" "$T/c3b.err"
 
-# 5. pause while job 1 runs: progress stops (held), then resume.
-sleep 0.3
+# 5. pause while job 1 runs: progress stops (held), then resume. Job 1 is running and has
+# executed some segments (an event, waited for with a generous deadline) when the pause lands.
+job1_moving() { C status 2>/dev/null | grep -qE "^job 1 running: .*: [1-9][0-9]*/"; }
+wait_until 60 job1_moving
 C pause >"$T/p.out"; rc=$?
 expect "pause: exit 0" [ $rc -eq 0 ]
 expect "pause: device held" grep -q "^OK paused (device held)" "$T/p.out"

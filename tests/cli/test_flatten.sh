@@ -31,10 +31,11 @@ path 'M 10 10 L 10 20 L 20 10 z L 100 100'
 run "z then L" 0 flatten "$T/p.txt" &&
     expect_out "z then L" '10.000000 10.000000\n10.000000 20.000000\n20.000000 10.000000\n10.000000 10.000000\n\n10.000000 10.000000\n100.000000 100.000000\n'
 
-# Nothing drawn: no output, success.
+# Nothing drawn: no output, "no drawable geometry", exit 1 (issue 15 item 9: never silence).
 for d in '' 'M 5 5' 'M 30 40 Z' 'M 1 1 M 2 2'; do
     path "$d"
-    run "empty '$d'" 0 flatten "$T/p.txt" && expect_out "empty '$d'" ''
+    run "empty '$d'" 1 flatten "$T/p.txt" && expect_out "empty '$d'" '' &&
+        expect_err "empty '$d'" "^$T/p.txt:1:1: no drawable geometry"
 done
 
 # --- curves: first and last vertex exact, more than one chord, every vertex on the curve ------
@@ -95,8 +96,9 @@ path 'M 10 10 L 20'
 run "missing number" 1 flatten "$T/p.txt" && expect_err "missing number" "^$T/p.txt:1:13: .*end of data"
 path 'L 10 10'
 run "no moveto" 1 flatten "$T/p.txt" && expect_err "no moveto" "^$T/p.txt:1:1: .*moveto"
-run "svg: moveto required" 1 flatten tests/data/svg/resvg/A.svg &&
-    expect_err "svg: moveto required" '^tests/data/svg/resvg/A.svg:5:38: '
+# drawn up to the error (SVG 2, 9.5.4): the path draws nothing, the frame is drawn, a warning
+run "svg: moveto required" 0 flatten tests/data/svg/resvg/A.svg &&
+    expect_err "svg: moveto required" '^tests/data/svg/resvg/A.svg:5:38: warning: '
 # Out of the +/-4096 mm range: refused where the number is.
 path 'M 0 0 L 5000 0'
 run "out of range" 1 flatten "$T/p.txt" && expect_err "out of range" "^$T/p.txt:1:9: .*4096"

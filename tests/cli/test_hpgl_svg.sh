@@ -73,7 +73,8 @@ run "svg negative" 1 flatten "$T/neg.svg" && expect_error "svg negative" "$T/neg
 printf '<svg width="10qq" height="1">\n</svg>\n' >"$T/unit.svg"
 run "svg unit" 1 flatten "$T/unit.svg" && expect_error "svg unit" "$T/unit.svg" 1 15
 printf '<svg>\n<polygon points="1 2 3 4 5"/></svg>\n' >"$T/poly.svg"
-run "svg odd points" 1 flatten "$T/poly.svg" && expect_error "svg odd points" "$T/poly.svg" 2 27
+# drawn up to the error (SVG 2, 10.6 as 9.5.4): the lines through (1,2) (3,4), a warning at the end
+run "svg odd points" 0 flatten "$T/poly.svg" && expect_err "svg odd points" "^$T/poly.svg:2:27: warning: "
 printf '<svg viewBox="0 0 1">\n</svg>\n' >"$T/vb.svg"
 run "svg viewBox" 1 flatten "$T/vb.svg" && expect_error "svg viewBox" "$T/vb.svg" 1 20
 

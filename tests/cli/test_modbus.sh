@@ -34,15 +34,15 @@ start_dev() {
     timeout -k 5 120 "$SIM" "$@" $pace --idle-exit "${IDLE:-0.5}" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     devpid[$name]=$!
-    wait_pty "$T/$name.sim" 5
+    wait_pty "$T/$name.sim" 60
     ADDR=$PTY
 }
-# wait_dev NAME [kill]: waits (at most 10 s) for device NAME to finish its report; kill: stops it
+# wait_dev NAME [kill]: waits (at most 60 s: an event, generous under load) for device NAME to finish its report; kill: stops it
 # first (a device that executed nothing never leaves by itself).
 wait_dev() {
     local p=${devpid[$1]}
     [ "${2:-}" = kill ] && kill "$p" 2>/dev/null
-    wait_until 10 gone "$p"
+    wait_until 60 gone "$p"
     kill "$p" 2>/dev/null
     wait "$p" 2>/dev/null
 }
@@ -215,7 +215,7 @@ start_dev int rtu --speed 0.25
 timeout --foreground -k 5 60 "$CS" stream --modbus-rtu "$ADDR" "$SMALL" >"$T/int.out" 2>"$T/int.err" &
 hp=$!
 pids+=($hp)
-wait_until 10 grep -q '^stream: [1-9][0-9]*/' "$T/int.err"
+wait_until 60 grep -q '^stream: [1-9][0-9]*/' "$T/int.err"
 sleep 0.2
 kill -INT $hp
 wait $hp

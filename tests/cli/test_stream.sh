@@ -20,11 +20,11 @@ start_sim() {
     timeout -k 5 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     SIMPID=$!
-    wait_pty "$T/$name.sim" 5
+    wait_pty "$T/$name.sim" 60
 }
-# wait_sim: waits (at most 10 s) for the device started last to finish its report.
+# wait_sim: waits (at most 60 s: an event, generous under load) for the device started last to finish its report.
 wait_sim() {
-    wait_until 10 gone "$SIMPID"
+    wait_until 60 gone "$SIMPID"
     kill "$SIMPID" 2>/dev/null
     wait "$SIMPID" 2>/dev/null
 }
@@ -97,7 +97,8 @@ start_sim int --speed 1 --reference "$JOB"
 timeout --foreground -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
-sleep 1
+# an event, not a wall-clock guess: the job is streaming once a progress line counts executed
+wait_until 60 grep -qE '^stream: [1-9][0-9]*/' "$T/int.err"
 kill -INT "$spid"
 wait "$spid"; rc=$?
 wait_sim
@@ -122,11 +123,11 @@ expect "help: exit 0" [ $rc -eq 0 ]
 expect "help: exit codes" grep -q '5 the device reset mid-job' "$T/help.out"
 "$CS" stream "$JOB" >/dev/null 2>&1; rc=$?
 expect "no --port: exit 2" [ $rc -eq 2 ]
-timeout -k 5 10 "$CS" stream --port "$T/nope" "$JOB" >/dev/null 2>"$T/nope.err"; rc=$?
+timeout -k 5 120 "$CS" stream --port "$T/nope" "$JOB" >/dev/null 2>"$T/nope.err"; rc=$?
 expect "missing port: exit 4" [ $rc -eq 4 ]
 expect "missing port: named" grep -q "$T/nope" "$T/nope.err"
 printf 'M 0 0 L 10 10 Q\n' >"$T/bad.svg"
-timeout -k 5 10 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err"; rc=$?
+timeout -k 5 120 "$CS" stream --port /dev/null "$T/bad.svg" >/dev/null 2>"$T/bad.err"; rc=$?
 expect "bad job: exit 1, nothing opened" [ $rc -eq 1 ]
 expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
 

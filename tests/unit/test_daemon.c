@@ -19,6 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cs_daemon.h"
@@ -30,6 +31,20 @@
 #include "cs_trace.h"
 
 /* Sends one request; returns the client's status and the reply in buf. */
+/* Waits for the daemon's socket to appear: an event with a deadline in seconds (60, generous
+ * for a loaded machine), never a count of tries. */
+static void wait_for_socket(const char *sock, struct stat *st)
+{
+    struct timespec t0, t;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    do {
+        if (stat(sock, st) == 0)
+            return;
+        usleep(10000);
+        clock_gettime(CLOCK_MONOTONIC, &t);
+    } while (t.tv_sec - t0.tv_sec < 60);
+}
+
 static int ask(const char *sock, const char *req, char *buf, size_t cap)
 {
     char err[512];
@@ -64,14 +79,12 @@ static void test_protocol(void **state)
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        alarm(20); /* bounded whatever happens */
+        alarm(300); /* bounded whatever happens (generous: ASan on a loaded machine) */
         cs_daemon_cfg_t cfg = {.port = pty, .baud = 115200, .socket_path = sock, .log = NULL};
         _exit(cs_daemon_serve(&cfg));
     }
     struct stat st;
-    int tries = 0;
-    while (stat(sock, &st) != 0 && tries++ < 200)
-        usleep(10000);
+    wait_for_socket(sock, &st);
     assert_int_equal(stat(sock, &st), 0);
     assert_true(S_ISSOCK(st.st_mode));
     assert_int_equal(st.st_mode & 0777, 0600);
@@ -113,7 +126,7 @@ static void test_protocol(void **state)
     snprintf(bad, sizeof bad, "%s/bad.svg", dir);
     FILE *f = fopen(bad, "w");
     assert_non_null(f);
-    fputs("M 0 0 L 10 10 Q\n", f);
+    fputs("M 0 0\nQ 1\n", f); /* nothing drawable before the error: it stays an error */
     fclose(f);
     snprintf(req, sizeof req, "SUBMIT %s", bad);
     assert_int_equal(ask(sock, req, buf, sizeof buf), 1);
@@ -205,15 +218,13 @@ static void test_pen_machine(void **state)
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        alarm(20);
+        alarm(300);
         cs_daemon_cfg_t cfg = {
             .port = pty, .baud = 115200, .socket_path = sock, .machine_file = ini, .log = NULL};
         _exit(cs_daemon_serve(&cfg));
     }
     struct stat st;
-    int tries = 0;
-    while (stat(sock, &st) != 0 && tries++ < 200)
-        usleep(10000);
+    wait_for_socket(sock, &st);
     char buf[4096];
     assert_int_equal(ask(sock, "PAUSE", buf, sizeof buf), 0);
     char req[400], want[600];

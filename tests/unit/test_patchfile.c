@@ -124,7 +124,11 @@ static void test_small_and_errors(void **state)
     assert_true(pf.vert[3][0] == 1 && pf.vert[3][2] == 1);
     cs_patchfile_free(&pf);
 
-    expect("", CS_ERR_PARSE, 1, 1, "patch count");
+    /* empty, BOM-only, blank: "no drawable geometry" (issue 15 item 9), never a parse error */
+    expect("", CS_ERR_EMPTY, 1, 1, "no drawable geometry");
+    expect("\xEF\xBB\xBF", CS_ERR_EMPTY, 1, 1, "no drawable geometry");
+    expect(" \n\r\n\t", CS_ERR_EMPTY, 1, 1, "no drawable geometry");
+    expect("\xEF\xBB\xBFx\n", CS_ERR_PARSE, 1, 1, "not a finite number"); /* BOM skipped */
     expect("x\n", CS_ERR_PARSE, 1, 1, "not a finite number");
     expect("1.5\n", CS_ERR_PARSE, 1, 1, "patch count");
     expect("0\n", CS_ERR_RANGE, 1, 1, "outside");
