@@ -10,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "cs_conv.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
@@ -117,6 +118,12 @@ static void run(const char *name, cs_path_t *path, const cs_machine_pen_t *pen, 
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_check [OUT.csv]\n"
+        "The simulator check (cs_sim_check) on a 200,000-segment CAM job and a pen-plotter job:\n"
+        "its time and peak memory; a Markdown section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     result_t res[2];
     cs_machine_pen_t none, zpen;
     cs_machine_ini_pen_default(&none);

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_args.h"
 #include "cs_conv.h"
 #include "cs_order.h"
 #include "ref_xorshift32.h"
@@ -91,6 +92,12 @@ static double timed(const cs_order_opts_t *o, cs_order_stats_t *st, size_t *elem
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_merge [OUT.csv]\n"
+        "Merge and sort (cs_order) of 100,000 random subpaths: time, pen lifts and pen-up\n"
+        "travel before and after; a Markdown section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     static const struct {
         const char *what;
         int merge, sort;

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_args.h"
 #include "bench_curves.h"
 #include "cs_horner.h"
 #include "cs_lensub.h"
@@ -183,6 +184,12 @@ static size_t subdiv_count(const bench_set_t *s, double tol_mm)
 
 int main(int argc, char **argv)
 {
+    static const char usage[] = "usage: bench_seed_eval [OUT.csv]\n"
+        "Seed 003's evaluations (power form, Horner, de Casteljau) and length-based\n"
+        "subdivision: speed and chord counts; a Markdown section on stdout, the figures in OUT.csv.\n";
+    int usage_rc = bench_args_check(argc, argv, usage, 1);
+    if (usage_rc >= 0)
+        return usage_rc;
     FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
     bench_set_t cubic = {"random cubics", NULL, 0, 0}, seven = {"random degree 7", NULL, 0, 0};
     random_set(&cubic, 3);

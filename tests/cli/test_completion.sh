@@ -37,7 +37,7 @@ for c in $cmds; do
     expect "$c --: the options of $c --help" same "$want"
 done
 comp _curvestep "$cs" flatten --method ""
-expect "--method: the tracers" same "afd fd subdiv"
+expect "--method: the tracers" same "afd fd length predict subdiv"
 comp _curvestep "$cs" plan --tol ""
 expect "--tol takes a number: nothing offered" same ""
 

@@ -43,10 +43,11 @@ C submit "$T/bad.svg" >"$T/bad.out" 2>"$T/bad.err"; rc=$?
 expect "bad job: exit 1" [ $rc -eq 1 ]
 expect "bad job: file:line:col" grep -qE "^$T/bad.svg:[0-9]+:[0-9]+: " "$T/bad.err"
 # The shared input options travel as SUBMIT words: --lenient reaches the daemon's G-code reader
-# (the unsupported G64 becomes a warning) and --fit --margin its layout (no room: refused).
-printf 'G21\nG1 X1 Y1 F600\nG64 Q9\nG1 X2\n' >"$T/lenient.nc"
+# (the unsupported probe move G38.2 becomes a warning) and --fit --margin its layout (no room:
+# refused).
+printf 'G21\nG1 X1 Y1 F600\nG38.2 Z-1 F100\nG1 X2\n' >"$T/lenient.nc"
 C submit "$T/lenient.nc" >"$T/len.out" 2>&1; rc=$?
-expect "strict: G64 refused" grep -q 'G64 is not supported' "$T/len.out"
+expect "strict: G38.2 refused" grep -q 'G38.2 is not supported' "$T/len.out"
 C submit --lenient --fit --margin 1500 "$T/lenient.nc" >"$T/len.out" 2>&1; rc=$?
 expect "--lenient --fit --margin reach the daemon: exit 1, layout refused" [ $rc -eq 1 ]
 expect "--lenient --fit --margin reach the daemon: the layout's reason" grep -q 'fit: no room' "$T/len.out"
