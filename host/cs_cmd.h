@@ -31,6 +31,10 @@ int cs_cmd_toolpath(int argc, char **argv);
  * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] FILE */
 int cs_cmd_stream(int argc, char **argv);
 
+/* curvestep grbl --port DEV [--baud N] [--machine FILE.ini] [--tol MM] [--feed MM/S]
+ *                [--pty [--link PATH] | --listen [ADDR:]PORT] */
+int cs_cmd_grbl(int argc, char **argv);
+
 /* curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH] */
 int cs_cmd_serve(int argc, char **argv);
 /* curvestep submit [--socket PATH] [--mode M] [--tol MM] [--feed MM/S] FILE */
