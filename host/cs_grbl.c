@@ -716,8 +716,7 @@ static void watch_device(grbl_t *g)
     }
 }
 
-/* --listen [ADDR:]PORT: a socket listening on ADDR (default 127.0.0.1). -1 after a message. */
-static int listen_on(const char *spec, char *shown, size_t cap)
+bool cs_grbl_listen_parse(const char *spec, struct sockaddr_in *sa)
 {
     char addr[64] = "127.0.0.1";
     const char *colon = strrchr(spec, ':');
@@ -725,15 +724,26 @@ static int listen_on(const char *spec, char *shown, size_t cap)
     if (colon != NULL) {
         size_t n = (size_t)(colon - spec);
         if (n == 0 || n >= sizeof addr)
-            return -1;
+            return false;
         memcpy(addr, spec, n);
         addr[n] = '\0';
         port = colon + 1;
     }
     char *e;
     long p = strtol(port, &e, 10);
-    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)p)};
-    if (*port == '\0' || *e != '\0' || p < 0 || p > 65535 || inet_pton(AF_INET, addr, &sa.sin_addr) != 1)
+    memset(sa, 0, sizeof *sa);
+    sa->sin_family = AF_INET;
+    sa->sin_port = htons((uint16_t)p);
+    return *port != '\0' && *e == '\0' && p >= 0 && p <= 65535 &&
+           inet_pton(AF_INET, addr, &sa->sin_addr) == 1;
+}
+
+/* --listen [ADDR:]PORT: a socket listening there; its address in shown. -1: bad spec, -2: the
+ * socket failed (errno). */
+static int listen_on(const char *spec, char *shown, size_t cap)
+{
+    struct sockaddr_in sa;
+    if (!cs_grbl_listen_parse(spec, &sa))
         return -1;
     int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     int one = 1;
@@ -746,6 +756,8 @@ static int listen_on(const char *spec, char *shown, size_t cap)
         close(fd);
         return -2;
     }
+    char addr[INET_ADDRSTRLEN];
+    inet_ntop(AF_INET, &sa.sin_addr, addr, sizeof addr);
     snprintf(shown, cap, "%s:%u", addr, (unsigned)ntohs(sa.sin_port));
     return fd;
 }

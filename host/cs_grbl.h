@@ -8,6 +8,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <netinet/in.h>
 
 #include "cs_jobplan.h"
 
@@ -26,6 +27,9 @@ typedef struct {
     const char *link;      /* --link PATH: a symlink to the pty; NULL: none */
 } cs_grbl_cfg_t;
 
+/* --listen's value: [ADDR:]PORT, ADDR an IPv4 address (default 127.0.0.1), PORT 0..65535. False
+ * when it is not one. */
+bool cs_grbl_listen_parse(const char *spec, struct sockaddr_in *sa);
 /* Runs until SIGINT or SIGTERM (the running chunk is then held and aborted). Prints the pty path
  * (or ADDR:PORT) on the first line of stdout. Returns CS_EXIT_OK, CS_EXIT_INPUT (machine file),
  * CS_EXIT_USAGE (bad --listen / --tol), CS_EXIT_INTERNAL (pty, socket, thread) or 4 (the port

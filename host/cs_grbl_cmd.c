@@ -82,6 +82,12 @@ int cs_cmd_grbl(int argc, char **argv)
         fprintf(stderr, "curvestep grbl: --port DEV is required (the device's serial line)\n");
         return CS_EXIT_USAGE;
     }
+    struct sockaddr_in sa;
+    if (c.listen != NULL && !cs_grbl_listen_parse(c.listen, &sa)) {
+        fprintf(stderr, "curvestep grbl: --listen wants [ADDR:]PORT (an IPv4 address), got '%s'\n",
+                c.listen);
+        return CS_EXIT_USAGE;
+    }
     if (c.link != NULL && c.listen != NULL) {
         fprintf(stderr, "curvestep grbl: --link goes with a pty, not with --listen\n");
         return CS_EXIT_USAGE;

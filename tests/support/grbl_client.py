@@ -125,8 +125,15 @@ def wait_idle(g):
 
 
 def hold_and_resume(g):
-    g.write(b"!")
     end = time.monotonic() + g.deadline
+    last = None
+    while time.monotonic() < end:  # hold while the machine moves
+        pos = g.status().split("|")[1]
+        if last is not None and pos != last:
+            break
+        last = pos
+        time.sleep(0.05)
+    g.write(b"!")
     last = None
     while time.monotonic() < end:
         st = g.status()
