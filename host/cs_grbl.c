@@ -141,6 +141,7 @@ static void sync_from_device(grbl_t *g)
 static void drop_all(grbl_t *g)
 {
     cs_grbl_dev_cancel(&g->dev, false);
+    g->held = false;
     cs_path_free(&g->pending);
     cs_grbl_gc_free(&g->gc);
     sync_from_device(g);
@@ -644,8 +645,10 @@ static bool realtime(grbl_t *g, unsigned char b)
         soft_reset(g);
         return true;
     case 0x85: /* jog cancel: hold, then flush the jogs (nothing when not jogging) */
-        cs_grbl_dev_cancel(&g->dev, true);
-        sync_from_device(g);
+        if (cs_grbl_dev_cancel(&g->dev, true)) {
+            g->held = false;
+            sync_from_device(g);
+        }
         return true;
     default:
         return b >= 0x80;

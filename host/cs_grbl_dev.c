@@ -44,6 +44,8 @@ static ssize_t progress_write(void *cookie, const char *buf, size_t len)
     pthread_mutex_lock(&d->mu);
     if (d->cur != NULL)
         take_status(d, d->cur);
+    d->run_interrupt = d->req_cancel;
+    d->run_pause = d->req_hold;
     pthread_mutex_unlock(&d->mu);
     return (ssize_t)len;
 }
@@ -53,8 +55,8 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     cs_stream_opts_t o;
     cs_stream_opts_default(&o, d->ser, d->axes, d->tick_hz);
     cs_stream_link_timing(&o.link, d->bits_per_s);
-    o.interrupt = &d->interrupt;
-    o.pause = &d->pause;
+    o.interrupt = &d->run_interrupt;
+    o.pause = &d->run_pause;
     o.quiet_hello = true;
     cookie_io_functions_t io = {.write = progress_write};
     o.progress = fopencookie(d, "w", io);
@@ -64,6 +66,8 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     cs_stream_result_t r;
     pthread_mutex_lock(&d->mu);
     d->cur = &r;
+    d->run_interrupt = d->req_cancel;
+    d->run_pause = d->req_hold;
     pthread_mutex_unlock(&d->mu);
     tcflush(d->ser->fd, TCIFLUSH); /* what the device said between chunks */
     cs_err_t e = cs_stream_run(&it->job, &o, &r);
@@ -86,8 +90,13 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
 static void run_dwell(cs_grbl_dev_t *d, double s)
 {
     double end = cs_serial_now_s() + s;
-    while (!d->interrupt && !d->quit && (d->pause || cs_serial_now_s() < end)) {
-        if (d->pause)
+    for (;;) {
+        pthread_mutex_lock(&d->mu);
+        bool stop = d->req_cancel || d->quit, held = d->req_hold;
+        pthread_mutex_unlock(&d->mu);
+        if (stop || (!held && cs_serial_now_s() >= end))
+            return;
+        if (held)
             end += 0.01;
         struct timespec ts = {0, 10 * 1000 * 1000};
         nanosleep(&ts, NULL);
@@ -116,7 +125,7 @@ static void *worker(void *arg)
             run_job(d, &it);
         cs_stream_job_free(&it.job);
         pthread_mutex_lock(&d->mu);
-        d->interrupt = 0;
+        d->req_cancel = false;
         d->s.busy = d->s.busy_jog = false;
         pthread_cond_broadcast(&d->cv);
     }
@@ -165,7 +174,7 @@ bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it)
     return room;
 }
 
-void cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
+bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
 {
     pthread_mutex_lock(&d->mu);
     bool all_jogs = !d->s.busy || d->s.busy_jog;
@@ -173,24 +182,24 @@ void cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
         all_jogs = all_jogs && d->q[(d->head + k) % CS_GRBL_DEV_QUEUE].jog;
     if (only_jogs && !all_jogs) {
         pthread_mutex_unlock(&d->mu);
-        return;
+        return false;
     }
     for (size_t k = 0; k < d->n; k++)
         cs_stream_job_free(&d->q[(d->head + k) % CS_GRBL_DEV_QUEUE].job);
     d->n = 0;
     d->s.queued = 0;
-    if (d->s.busy)
-        d->interrupt = 1;
+    d->req_cancel = d->s.busy;
     while (d->s.busy)
         pthread_cond_wait(&d->cv, &d->mu);
-    d->pause = 0; /* a cancelled hold is over (Grbl: the hold ends with the flush) */
+    d->req_hold = false; /* a cancelled hold is over (Grbl: the hold ends with the flush) */
     pthread_mutex_unlock(&d->mu);
+    return true;
 }
 
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on)
 {
     pthread_mutex_lock(&d->mu);
-    d->pause = on;
+    d->req_hold = on;
     pthread_mutex_unlock(&d->mu);
 }
 

@@ -54,8 +54,11 @@ typedef struct {
     cs_grbl_item_t q[CS_GRBL_DEV_QUEUE];
     size_t head, n;
     bool quit, started;
-    volatile sig_atomic_t interrupt; /* > 0: cancel the running item (HOLD, ABORT) */
-    volatile sig_atomic_t pause;     /* != 0: feed hold */
+    bool req_cancel, req_hold; /* asked for (under mu): cancel the running item, feed hold */
+    /* what cs_stream_run polls (worker thread only: copied from req_* under mu when a chunk
+     * starts and at each progress call, ten times a second, so a hold or cancel takes effect
+     * within ~0.1 s and no flag is shared without the lock) */
+    volatile sig_atomic_t run_interrupt, run_pause;
     const cs_stream_result_t *cur;   /* the running chunk's result (worker thread only) */
     double t_move;                   /* when the reported position last changed */
     cs_grbl_dev_snap_t s;
@@ -70,8 +73,9 @@ bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it);
 /* True when the queue can take one more item. */
 bool cs_grbl_dev_room(cs_grbl_dev_t *d);
 /* Drops every waiting item; when only_jogs, only if everything queued and running is a jog.
- * Cancels the running item (decelerating hold, then abort) and waits until it has stopped. */
-void cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
+ * Cancels the running item (decelerating hold, then abort), waits until it has stopped and ends
+ * the feed hold. False when only_jogs and something is not a jog (then nothing is done). */
+bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
 /* Feed hold on (true) or off. */
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on);
 /* Clears the failure (Grbl's $X). */

@@ -123,7 +123,7 @@ start_sim jog --speed 1
 start_grbl jog
 client "$GPTY" jogcancel '$J=G91 X100 F600' >"$T/jog.out"; rc=$?
 client "$GPTY" cmd 'G90 G0 X0 Y0' >"$T/jog2.out"
-client "$GPTY" raw >/dev/null
+client "$GPTY" idle >"$T/jog3.out"
 stop_all
 expect "jog: client exit 0" [ $rc -eq 0 ]
 expect "jog: accepted" grep -qx 'reply: ok' "$T/jog.out"
@@ -132,6 +132,7 @@ x=$(sed -n 's/^final: <Idle|MPos:\([0-9.-]*\),.*/\1/p' "$T/jog.out")
 expect "jog: cancelled between 0 and 100 mm" awk -v x="${x:-0}" 'BEGIN {exit !(x > 0 && x < 100)}'
 expect "jog: device held and aborted" grep -q ' 1 holds, 1 aborts' "$T/jog.sim"
 expect "jog: G-code after the cancel ok" grep -qx ok "$T/jog2.out"
+expect "jog: then Idle at the origin" grep -q '^final: <Idle|MPos:0.000,0.000,0.000|' "$T/jog3.out"
 expect "jog: device back at the origin" grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps' "$T/jog.sim"
 
 # 6. TCP on loopback (port 0: any free one), a symlinked pty.

@@ -15,7 +15,9 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
   cmd LINE...     sends each line (send-response) and prints every reply line
   jogcancel LINE  sends the $J= LINE, waits for the Jog state, sends 0x85 and prints
                   "jogging: <...>" and "final: <...>" once Idle
+  idle            (no soft reset first) waits for Idle, prints "final: <...>"
   raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
+Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
 Every wait has a deadline (--deadline S, default 60); a missed one exits 3.
 """
 import os
@@ -204,8 +206,11 @@ def main(argv):
         deadline = float(argv[i + 1])
         del argv[i:i + 2]
     g = Grbl(argv[1], deadline)
-    wait_welcome(g)
     cmd = argv[2]
+    if cmd == "idle":  # no reset: waits for what runs to end
+        print("final: " + wait_idle(g), flush=True)
+        return 0
+    wait_welcome(g)
     if cmd == "stream":
         method, hold_after, every = "simple", 0, 0
         args = argv[4:]
