@@ -86,6 +86,7 @@ start_grbl dol
 client "$GPTY" cmd '$$' '$#' '$G' '$I' '$Q' '$100=5' '$10=3' '$' >"$T/dol.out"; rc=$?
 client "$GPTY" cmd '$H' >"$T/dolh.out"
 client "$GPTY" raw 3f >"$T/dolq.out"
+client "$GPTY" raw 91 9a 9d 84 3f >"$T/dolov.out"
 stop_all
 expect "\$: client exit 0" [ $rc -eq 0 ]
 expect "\$\$: steps/mm of the machine" grep -qx '\$100=80.000' "$T/dol.out"
@@ -102,6 +103,8 @@ expect "\$Q: error:3" [ "$(grep -A2 '^\[OPT:' "$T/dol.out" | tail -1)" = error:3
 expect "\$100=5: read-only, said why" grep -q '^\[MSG:\$100 is read-only here: the machine file' "$T/dol.out"
 expect "\$: help" grep -q '^\[HLP:' "$T/dol.out"
 expect "\$H: error:5 (no homing)" grep -qx 'error:5' "$T/dolh.out"
+expect "override bytes ignored: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
+expect "override bytes ignored: the status" grep -q '^<Idle|' "$T/dolov.out"
 expect "\$10=3: Bf in the status" grep -qE '^<Idle\|MPos:0\.000,0\.000,0\.000\|Bf:[0-9]+,128\|FS:0,0' "$T/dolq.out"
 
 # 4. a bad line mid-program: error:N for it alone, the rest runs (final position exact against
