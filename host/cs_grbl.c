@@ -30,6 +30,9 @@
 
 #define GRBL_WELCOME "Grbl 1.1h ['$' for help]"
 
+/* a whole receive buffer is one line for the line reader (and is_dwell's copy) */
+CS_STATIC_ASSERT(CS_GRBL_RX_SIZE < CS_GRBL_GC_LINE_MAX, rx_line_fits_reader);
+
 /* Grbl 1.1 error codes we answer (grbl wiki, "Interface", error codes). */
 enum {
     ERR_LETTER = 1,       /* expected command letter */
@@ -271,6 +274,7 @@ static void gcode_line(grbl_t *g, const char *line)
     }
     cs_grbl_gc_t before = g->gc;
     before.block = NULL; /* the line consumes (or keeps) the held block itself */
+    before.block_len = before.block_lines = 0;
     size_t n0 = g->pending.n;
     cs_path_diag_t d;
     bool end;

@@ -40,7 +40,8 @@ void cs_grbl_gc_free(cs_grbl_gc_t *g);
 void cs_grbl_gc_reset_modal(cs_grbl_gc_t *g);
 /* Reads one line (no newline; client line number lineno for messages). The line's path
  * elements are appended to *out (loc "grbl" line lineno); *end is set by M2/M30. On an error
- * the state is unchanged and *diag says why (cs_gcode's codes and reasons). */
+ * *diag says why (cs_gcode's codes and reasons) and the state is unchanged, but for an open
+ * G5.2 block: refused with its G5.3 line, it is dropped. */
 cs_err_t cs_grbl_gc_line(cs_grbl_gc_t *g, const char *line, unsigned lineno, cs_path_t *out,
                          cs_path_diag_t *diag, bool *end);
 /* Program coordinate of axis a (0..2) in the current units: (pos - off) / unit. */
