@@ -686,7 +686,8 @@ static void take_bytes(grbl_t *g, const unsigned char *b, size_t n)
 /* Reads the complete lines in the buffer while the queue has room. */
 static void take_lines(grbl_t *g)
 {
-    while (g->rxn > 0 && cs_grbl_dev_room(&g->dev)) {
+    /* room for two items: a line may close the pending chunk and queue a dwell or a jog */
+    while (g->rxn > 0 && cs_grbl_dev_room(&g->dev, 2)) {
         char *nl = memchr(g->rx, '\n', g->rxn);
         char *cr = memchr(g->rx, '\r', g->rxn);
         if (nl == NULL || (cr != NULL && cr < nl))
@@ -717,9 +718,6 @@ static void watch_device(grbl_t *g)
         say(g, "[MSG:device: %s]", s.why);
         g->alarm = true;
         drop_all(g);
-    }
-    if (!s.busy && s.queued == 0 && g->held && g->pending.n == 0) {
-        /* a hold with nothing left to hold stays until '~', as Grbl's does */
     }
 }
 

@@ -152,10 +152,10 @@ cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_
     return CS_OK;
 }
 
-bool cs_grbl_dev_room(cs_grbl_dev_t *d)
+bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need)
 {
     pthread_mutex_lock(&d->mu);
-    bool room = d->n < CS_GRBL_DEV_QUEUE;
+    bool room = d->n + need <= CS_GRBL_DEV_QUEUE;
     pthread_mutex_unlock(&d->mu);
     return room;
 }

@@ -70,8 +70,8 @@ cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_
                            uint32_t bits_per_s);
 /* Queues it (taking its job); false when the queue is full (it is then not taken). */
 bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it);
-/* True when the queue can take one more item. */
-bool cs_grbl_dev_room(cs_grbl_dev_t *d);
+/* True when the queue can take need more items. */
+bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need);
 /* Drops every waiting item; when only_jogs, only if everything queued and running is a jog.
  * Cancels the running item (decelerating hold, then abort), waits until it has stopped and ends
  * the feed hold. False when only_jogs and something is not a jog (then nothing is done). */
