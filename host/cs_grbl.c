@@ -195,8 +195,13 @@ static void flush_chunk(grbl_t *g)
         alarm_planner(g, &d);
         return;
     }
-    if (!cs_grbl_dev_push(&g->dev, &it))
-        cs_stream_job_free(&it.job); /* not reached: lines are read only with room */
+    if (!cs_grbl_dev_push(&g->dev, &it)) { /* not reached: called only with room */
+        cs_path_diag_t full = {.code = CS_ERR_FULL, .loc = {"grbl", g->lineno, 1}};
+        snprintf(full.reason, sizeof full.reason, "internal: the chunk queue is full");
+        cs_stream_job_free(&it.job);
+        alarm_planner(g, &full);
+        return;
+    }
     g->last_push_jog = false;
 }
 
@@ -798,7 +803,8 @@ static void serve_loop(grbl_t *g, int lfd)
             }
         }
         take_lines(g);
-        if (g->pending.n > 0 && cs_serial_now_s() - g->t_last_line > CS_GRBL_CHUNK_IDLE_MS / 1e3)
+        if (g->pending.n > 0 && cs_serial_now_s() - g->t_last_line > CS_GRBL_CHUNK_IDLE_MS / 1e3 &&
+            cs_grbl_dev_room(&g->dev, 1))
             flush_chunk(g);
         watch_device(g);
     }
