@@ -62,6 +62,22 @@ expect "cc: device check ok" grep -q '^check: ok$' "$T/cc.sim"
 expect "cc: final position exact" grep -q 'rounded to steps: exact' "$T/cc.sim"
 expect "cc: same final position as plan + replay" grep -qxF "$REF_POS" "$T/cc.sim"
 
+# 1b. a long program (2500 short moves: several chunks, the queue fills and ok waits for room),
+#     by character counting: every line ok, the same final position as plan + replay.
+awk 'BEGIN {print "G21 G90 F3000"; for (i = 1; i <= 2500; i++)
+    printf "G1 X%.3f Y%.3f\n", (i % 50) * 2 + 0.5 * sin(i), int(i / 50) * 1.5 + (i % 7) * 0.1
+    print "G0 X1 Y1"}' >"$T/long.nc"
+"$CS" plan "$T/long.nc" -o "$T/long.seg" 2>/dev/null
+LONG_POS=$("$SIM" --replay "$T/long.seg" 2>/dev/null | grep '^final position:')
+start_sim long
+start_grbl long
+client "$GPTY" stream "$T/long.nc" --method counting --status-every 100 >"$T/long.out"; rc=$?
+stop_all
+expect "long: client exit 0" [ $rc -eq 0 ]
+expect "long: 2502 ok, 0 errors" grep -q '^acks: 2502 0$' "$T/long.out"
+expect "long: ends Idle at (1, 1)" grep -q '^final: <Idle|MPos:1.000,1.000,0.000|' "$T/long.out"
+expect "long: same final position as plan + replay" grep -qxF "$LONG_POS" "$T/long.sim"
+
 # 2. send-response, ? every 2 lines, and a hold (!) mid-job then resume (~), in real time x20.
 start_sim sr --speed 20 --reference "$PROG" --check
 start_grbl sr
