@@ -101,6 +101,7 @@ start_sim dol
 start_grbl dol
 client "$GPTY" cmd '$$' '$#' '$G' '$I' '$Q' '$100=5' '$10=3' '$' >"$T/dol.out"; rc=$?
 client "$GPTY" cmd '$H' >"$T/dolh.out"
+client "$GPTY" cmd 'G0 X3000' '$J=X5' '$J=X5 S3 F100' '$J=G91 X-3000 F100' >"$T/dolerr.out"
 client "$GPTY" raw 3f >"$T/dolq.out"
 client "$GPTY" raw 91 9a 9d 84 3f >"$T/dolov.out"
 stop_all
@@ -119,6 +120,9 @@ expect "\$Q: error:3" [ "$(grep -A2 '^\[OPT:' "$T/dol.out" | tail -1)" = error:3
 expect "\$100=5: read-only, said why" grep -q '^\[MSG:\$100 is read-only here: the machine file' "$T/dol.out"
 expect "\$: help" grep -q '^\[HLP:' "$T/dol.out"
 expect "\$H: error:5 (no homing)" grep -qx 'error:5' "$T/dolh.out"
+expect "errors: beyond the travel error:33, said why" grep -q '^\[MSG:line [0-9]*: the move leaves the machine.s travel\]$' "$T/dolerr.out"
+expect "errors: in order 33, 22 (jog without F), 16 (bad jog word), 15 (jog beyond travel)" \
+    [ "$(grep '^error:' "$T/dolerr.out" | tr '\n' ' ')" = "error:33 error:22 error:16 error:15 " ]
 expect "override bytes ignored: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
 expect "override bytes ignored: the status" grep -q '^<Idle|' "$T/dolov.out"
 expect "\$10=3: Bf in the status" grep -qE '^<Idle\|MPos:0\.000,0\.000,0\.000\|Bf:[0-9]+,128\|FS:0,0' "$T/dolq.out"
