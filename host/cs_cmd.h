@@ -35,6 +35,9 @@ int cs_cmd_stream(int argc, char **argv);
 
 /* curvestep inspect [--json] [--tol MM] [--rel R] [--patches] FILE */
 int cs_cmd_inspect(int argc, char **argv);
+/* curvestep grbl --port DEV [--baud N] [--machine FILE.ini] [--tol MM] [--feed MM/S]
+ *                [--pty [--link PATH] | --listen [ADDR:]PORT] */
+int cs_cmd_grbl(int argc, char **argv);
 
 /* curvestep serve --port DEV [--baud N] [--machine FILE.ini] [--socket PATH] */
 int cs_cmd_serve(int argc, char **argv);

@@ -18,6 +18,7 @@ static const struct {
     {"inspect", cs_cmd_inspect, "describe a job or surfaces file: elements, lengths, continuity"},
     {"toolpath", cs_cmd_toolpath, "surface patches: projected wireframe or ball-end finishing"},
     {"stream", cs_cmd_stream, "stream a job to a device on a serial port (segments or curves)"},
+    {"grbl", cs_cmd_grbl, "speak Grbl 1.1 to a G-code sender (pty or TCP), drive a device"},
     {"serve", cs_cmd_serve, "the daemon: keep a device open, stream queued jobs one by one"},
     {"submit", cs_cmd_submit, "queue a job on the daemon (planned whole, refused if bad)"},
     {"status", cs_cmd_status, "the daemon's queue and the running job's progress"},

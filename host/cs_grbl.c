@@ -1,0 +1,918 @@
+/* cs_grbl: the Grbl 1.1 front end (see cs_grbl.h). Protocol: the Grbl 1.1 "Interface",
+ * "Commands" and "Jogging" pages of the grbl wiki (gnea/grbl): responses ok / error:N, push
+ * messages in brackets, status reports <State|MPos:...|FS:...>, real-time bytes picked out of the
+ * stream as they arrive, a 128-byte receive buffer that character-counting senders fill. */
+#define _GNU_SOURCE
+#include "cs_grbl.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "cs_cmd.h"
+#include "cs_conv.h"
+#include "cs_grbl_dev.h"
+#include "cs_grbl_gc.h"
+#include "cs_serial.h"
+#include "cs_stream_cmd.h"
+#include "cs_trace.h"
+
+#define GRBL_WELCOME "Grbl 1.1h ['$' for help]"
+
+/* a whole receive buffer is one line for the line reader (and is_dwell's copy) */
+CS_STATIC_ASSERT(CS_GRBL_RX_SIZE < CS_GRBL_GC_LINE_MAX, rx_line_fits_reader);
+
+/* Grbl 1.1 error codes we answer (grbl wiki, "Interface", error codes). */
+enum {
+    ERR_LETTER = 1,       /* expected command letter */
+    ERR_NUMBER = 2,       /* bad number format */
+    ERR_DOLLAR = 3,       /* '$' statement not recognized or supported */
+    ERR_HOMING = 5,       /* homing not enabled */
+    ERR_NOT_IDLE = 8,     /* '$' command only when idle */
+    ERR_LOCKED = 9,       /* G-code locked out during alarm */
+    ERR_OVERFLOW = 11,    /* line overflow */
+    ERR_JOG_TRAVEL = 15,  /* jog target exceeds machine travel */
+    ERR_JOG = 16,         /* invalid jog command */
+    ERR_UNSUPPORTED = 20, /* unsupported or invalid g-code command */
+    ERR_MODAL = 21,       /* modal group violation */
+    ERR_NO_FEED = 22,     /* undefined feed rate */
+    ERR_NO_AXIS = 26,     /* no axis words */
+    ERR_NO_COMMAND = 31,  /* axis words with no command that uses them */
+    ERR_TARGET = 33,      /* invalid target */
+    ERR_UNUSED = 36,      /* unused value words */
+};
+
+typedef struct {
+    const cs_grbl_cfg_t *cfg;
+    cs_machine_t m;
+    cs_pos_t tol;
+    int32_t feed; /* --feed (Q15.16 mm/s), 0: the machine's */
+    cs_serial_t ser;
+    cs_grbl_dev_t dev;
+    cs_grbl_gc_t gc;
+    cs_path_t pending;           /* read, not yet planned */
+    cs_pos_t plan_pos[CS_AXES];  /* where the last planned chunk ends */
+    bool last_push_jog;          /* the last item queued was a jog */
+    int fd;                      /* the client (-1: none) */
+    char rx[CS_GRBL_RX_SIZE];    /* Grbl's receive buffer */
+    size_t rxn;
+    bool rx_overflow;            /* a line longer than the buffer: dropped up to its newline */
+    bool after_cr;               /* the last line ended with '\r' */
+    unsigned lineno;             /* lines received since the start */
+    double t_last_line;
+    bool held, check_mode, alarm; /* alarm: a soft limit, cleared by $X */
+    int report_mask;              /* $10 */
+    unsigned reports;
+    double wco_sent[3];
+    unsigned cancelled_seen; /* device runs ended by cancel that were synced */
+} grbl_t;
+
+static volatile sig_atomic_t stop_flag;
+static void on_stop(int sig)
+{
+    (void)sig;
+    stop_flag = 1;
+}
+
+/* ---- output ---- */
+
+/* Writes a line + "\r\n" to the client; a client that does not read loses it (never blocks). */
+static void say(grbl_t *g, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(grbl_t *g, const char *fmt, ...)
+{
+    if (g->fd < 0)
+        return;
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf, sizeof buf - 2, fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return;
+    if ((size_t)n > sizeof buf - 3)
+        n = (int)sizeof buf - 3;
+    buf[n++] = '\r';
+    buf[n++] = '\n';
+    for (int off = 0, tries = 0; off < n && tries < 200;) {
+        ssize_t w = write(g->fd, buf + off, (size_t)(n - off));
+        if (w > 0) {
+            off += (int)w;
+        } else if (w < 0 && (errno == EAGAIN || errno == EINTR)) {
+            struct pollfd p = {g->fd, POLLOUT, 0};
+            poll(&p, 1, 10);
+            tries++;
+        } else {
+            return;
+        }
+    }
+}
+
+static double steps_mm(const grbl_t *g, int a, int32_t steps)
+{
+    return (double)steps * 65536.0 / g->m.axis[a].steps_per_mm;
+}
+
+/* ---- the device's position back into the reader and the planner ---- */
+
+/* After a cancel: the reader and the next chunk start where the device stopped. */
+static void sync_from_device(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    if (!s.have_pos)
+        return;
+    for (int a = 0; a < 3 && a < g->m.n_axes; a++) {
+        g->gc.pos[a] = steps_mm(g, a, s.pos[a]);
+        g->plan_pos[a] = (cs_pos_t)llround((double)s.pos[a] * 65536.0 * 65536.0 /
+                                           (double)g->m.axis[a].steps_per_mm);
+    }
+    g->cancelled_seen = s.cancelled;
+}
+
+/* Everything not yet executed is dropped; the device stops (decelerating) where it is. */
+static void drop_all(grbl_t *g)
+{
+    cs_grbl_dev_cancel(&g->dev, false);
+    g->held = false;
+    cs_path_free(&g->pending);
+    cs_grbl_gc_free(&g->gc);
+    sync_from_device(g);
+}
+
+/* ---- chunks ---- */
+
+/* Plans path (emptied) from plan_pos into it->job. CS_OK, or an error with diag. */
+static cs_err_t plan_chunk(grbl_t *g, cs_path_t *path, cs_grbl_item_t *it, cs_path_diag_t *diag)
+{
+    cs_jobplan_t jp;
+    cs_jobplan_init(&jp);
+    jp.path = *path;
+    cs_path_init(path);
+    jp.read_ok = true;
+    cs_stream_job_init(&it->job, CS_STREAM_SEGMENTS);
+    cs_err_t e = cs_jobplan_plan(&jp, "grbl", &g->m, g->plan_pos, g->tol, CS_TRACE_SUBDIV, g->feed);
+    if (e == CS_OK)
+        e = cs_stream_job_add_segments(&it->job, jp.mo.segs.v, jp.mo.segs.n);
+    if (e == CS_OK)
+        memcpy(g->plan_pos, jp.mo.pl.pos, sizeof g->plan_pos);
+    else
+        cs_stream_job_free(&it->job);
+    *diag = jp.diag;
+    diag->code = e;
+    diag->loc.file = "grbl";
+    cs_jobplan_free(&jp);
+    return e;
+}
+
+/* A soft-limit style stop (Grbl ALARM:2): the planner refused what was already answered ok. */
+static void alarm_planner(grbl_t *g, const cs_path_diag_t *d)
+{
+    say(g, "[MSG:line %u: %s]", d->loc.line, d->reason[0] ? d->reason : "cannot plan");
+    say(g, "ALARM:2");
+    g->alarm = true;
+    drop_all(g);
+}
+
+/* Plans the pending lines and queues them (there is room: lines are read only then). */
+static void flush_chunk(grbl_t *g)
+{
+    if (g->pending.n == 0)
+        return;
+    cs_grbl_item_t it = {0};
+    cs_path_diag_t d;
+    if (plan_chunk(g, &g->pending, &it, &d) != CS_OK) {
+        alarm_planner(g, &d);
+        return;
+    }
+    if (!cs_grbl_dev_push(&g->dev, &it)) { /* not reached: called only with room */
+        cs_path_diag_t full = {.code = CS_ERR_FULL, .loc = {"grbl", g->lineno, 1}};
+        snprintf(full.reason, sizeof full.reason, "internal: the chunk queue is full");
+        cs_stream_job_free(&it.job);
+        alarm_planner(g, &full);
+        return;
+    }
+    g->last_push_jog = false;
+}
+
+/* True when elements n0.. of path stay inside the machine's travel (32 samples each). */
+static bool inside_travel(const grbl_t *g, const cs_path_t *path, size_t n0)
+{
+    for (size_t k = n0; k < path->n; k++)
+        for (int s = 0; s <= 32; s++) {
+            double p[3];
+            cs_path_eval_mm(&path->elems[k].curve, s / 32.0, p);
+            for (int a = 0; a < 3 && a < g->m.n_axes; a++)
+                if (p[a] < cs_conv_pos_to_mm(g->m.axis[a].travel_min) - 1e-9 ||
+                    p[a] > cs_conv_pos_to_mm(g->m.axis[a].travel_max) + 1e-9)
+                    return false;
+        }
+    return true;
+}
+
+/* ---- G-code lines ---- */
+
+static int gcode_error(const cs_path_diag_t *d)
+{
+    const char *r = d->reason;
+    if (d->code == CS_ERR_UNSUPPORTED)
+        return ERR_UNSUPPORTED;
+    if (d->code == CS_ERR_DEGENERATE || d->code == CS_ERR_RANGE)
+        return ERR_TARGET;
+    if (strstr(r, "number") != NULL)
+        return ERR_NUMBER;
+    if (strstr(r, "two ") != NULL || strstr(r, "on one line") != NULL)
+        return ERR_MODAL;
+    if (strstr(r, "not used by anything") != NULL)
+        return ERR_UNUSED;
+    if (strstr(r, "no motion mode") != NULL)
+        return ERR_NO_COMMAND;
+    return ERR_UNSUPPORTED;
+}
+
+static void reply_error(grbl_t *g, const cs_path_diag_t *d)
+{
+    say(g, "[MSG:line %u col %u: %s]", d->loc.line, d->loc.col, d->reason);
+    say(g, "error:%d", gcode_error(d));
+}
+
+/* "G4 P<seconds>" alone on a line (Grbl: P in seconds): true with *s. */
+static bool is_dwell(const char *line, double *s)
+{
+    char c[CS_GRBL_GC_LINE_MAX];
+    size_t n = 0;
+    for (const char *p = line; *p && n + 1 < sizeof c; p++)
+        if (*p != ' ' && *p != '\t')
+            c[n++] = (char)(*p >= 'a' && *p <= 'z' ? *p - 32 : *p);
+    c[n] = '\0';
+    int used = 0;
+    if ((sscanf(c, "G4P%lf%n", s, &used) == 1 || sscanf(c, "G04P%lf%n", s, &used) == 1) &&
+        (size_t)used == n && *s >= 0)
+        return true;
+    return false;
+}
+
+static void gcode_line(grbl_t *g, const char *line)
+{
+    double dwell;
+    if (g->alarm) {
+        say(g, "error:%d", ERR_LOCKED);
+        return;
+    }
+    if (!g->check_mode && is_dwell(line, &dwell)) {
+        flush_chunk(g);
+        cs_grbl_item_t it = {.dwell = true, .dwell_s = dwell};
+        cs_grbl_dev_push(&g->dev, &it);
+        g->last_push_jog = false;
+        say(g, "ok");
+        return;
+    }
+    cs_grbl_gc_t before = g->gc;
+    before.block = NULL; /* the line consumes (or keeps) the held block itself */
+    before.block_len = before.block_lines = 0;
+    size_t n0 = g->pending.n;
+    cs_path_diag_t d;
+    bool end;
+    if (cs_grbl_gc_line(&g->gc, line, g->lineno, &g->pending, &d, &end) != CS_OK) {
+        reply_error(g, &d);
+        return;
+    }
+    if (!inside_travel(g, &g->pending, n0)) {
+        g->pending.n = n0;
+        g->gc = before;
+        say(g, "[MSG:line %u: the move leaves the machine's travel]", g->lineno);
+        say(g, "error:%d", ERR_TARGET);
+        return;
+    }
+    if (g->check_mode)
+        g->pending.n = n0; /* $C: read and checked, never run */
+    if (end) {
+        flush_chunk(g);
+        cs_grbl_gc_reset_modal(&g->gc);
+    } else if (g->pending.n >= CS_GRBL_CHUNK_ELEMS) {
+        flush_chunk(g);
+    }
+    say(g, "ok");
+}
+
+/* ---- jogging ($J=) ---- */
+
+/* Checks a jog line's words (Grbl: G20 G21 G90 G91 G53, X Y Z, F; F required). */
+static int jog_words(const char *s, bool *g53)
+{
+    bool f = false, axis = false;
+    *g53 = false;
+    while (*s) {
+        char c = (char)(*s >= 'a' && *s <= 'z' ? *s - 32 : *s);
+        if (c == ' ') {
+            s++;
+            continue;
+        }
+        char *e;
+        double v = strtod(s + 1, &e);
+        if (e == s + 1)
+            return c >= 'A' && c <= 'Z' ? ERR_NUMBER : ERR_LETTER;
+        s = e;
+        long gx = lround(v * 10);
+        if (c == 'G' && (gx == 200 || gx == 210 || gx == 900 || gx == 910 || gx == 530)) {
+            *g53 = *g53 || gx == 530;
+        } else if (c == 'X' || c == 'Y' || c == 'Z') {
+            axis = true;
+        } else if (c == 'F') {
+            f = true;
+        } else {
+            return ERR_JOG;
+        }
+    }
+    return !f ? ERR_NO_FEED : !axis ? ERR_NO_AXIS : 0;
+}
+
+static void jog_line(grbl_t *g, const char *words)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    if (g->alarm || s.failed) {
+        say(g, "error:%d", ERR_LOCKED);
+        return;
+    }
+    if (g->pending.n > 0 || (s.busy && !s.busy_jog) || (s.queued > 0 && !g->last_push_jog)) {
+        say(g, "error:%d", ERR_NOT_IDLE);
+        return;
+    }
+    bool g53;
+    int bad = jog_words(words, &g53);
+    if (bad) {
+        say(g, "error:%d", bad);
+        return;
+    }
+    /* a jog leaves the parser's modes alone: it is read with a copy of them */
+    cs_grbl_gc_t j = g->gc;
+    j.block = NULL;
+    if (g53)
+        memset(j.off, 0, sizeof j.off);
+    char line[CS_GRBL_GC_LINE_MAX + 8];
+    snprintf(line, sizeof line, "G1 %s", words);
+    if (g53) { /* G53: machine coordinates (cs_gcode has no G53: offsets cleared above) */
+        char *p = strstr(line, "G53");
+        p = p ? p : strstr(line, "g53");
+        if (p)
+            memcpy(p, "   ", 3);
+    }
+    cs_path_t path;
+    cs_path_init(&path);
+    cs_path_diag_t d;
+    bool end;
+    cs_err_t e = cs_grbl_gc_line(&j, line, g->lineno, &path, &d, &end);
+    if (e != CS_OK || !inside_travel(g, &path, 0)) {
+        cs_path_free(&path);
+        say(g, "error:%d", e != CS_OK ? ERR_JOG : ERR_JOG_TRAVEL);
+        return;
+    }
+    cs_grbl_item_t it = {.jog = true};
+    if (plan_chunk(g, &path, &it, &d) != CS_OK) {
+        say(g, "error:%d", ERR_JOG_TRAVEL);
+        return;
+    }
+    cs_grbl_dev_push(&g->dev, &it);
+    g->last_push_jog = true;
+    memcpy(g->gc.pos, j.pos, sizeof g->gc.pos);
+    say(g, "ok");
+}
+
+/* ---- status report ('?') ---- */
+
+static const char *state_name(const grbl_t *g, const cs_grbl_dev_snap_t *s)
+{
+    if (g->alarm || s->failed)
+        return "Alarm";
+    if (g->check_mode)
+        return "Check";
+    if (g->held)
+        return s->busy && s->dev_state != CS_PROTO_STATE_HELD ? "Hold:1" : "Hold:0";
+    if (s->busy_jog)
+        return "Jog";
+    if (s->busy || s->queued > 0 || g->pending.n > 0)
+        return "Run";
+    return "Idle";
+}
+
+static void status_report(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    double mpos[3] = {0, 0, 0};
+    for (int a = 0; a < 3 && a < g->m.n_axes; a++)
+        mpos[a] = s.have_pos ? steps_mm(g, a, s.pos[a]) : 0;
+    bool wpos = (g->report_mask & 1) == 0;
+    char buf[320];
+    int n = snprintf(buf, sizeof buf, "<%s|%s:%.3f,%.3f,%.3f", state_name(g, &s),
+                     wpos ? "WPos" : "MPos", mpos[0] - (wpos ? g->gc.off[0] : 0),
+                     mpos[1] - (wpos ? g->gc.off[1] : 0), mpos[2] - (wpos ? g->gc.off[2] : 0));
+    if (g->report_mask & 2)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|Bf:%zu,%zu", CS_GRBL_DEV_QUEUE - s.queued,
+                      CS_GRBL_RX_SIZE - g->rxn);
+    n += snprintf(buf + n, sizeof buf - (size_t)n, "|FS:%.0f,0",
+                  s.busy && !g->held ? s.speed_mm_min : 0.0);
+    /* Grbl sends WCO every 10 to 30 reports and when it changes, Ov now and then */
+    bool wco = g->reports % 10 == 0 || memcmp(g->wco_sent, g->gc.off, sizeof g->wco_sent) != 0;
+    if (wco) {
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|WCO:%.3f,%.3f,%.3f|Ov:100,100,100",
+                      g->gc.off[0], g->gc.off[1], g->gc.off[2]);
+        memcpy(g->wco_sent, g->gc.off, sizeof g->wco_sent);
+    }
+    g->reports++;
+    say(g, "%s>", buf);
+}
+
+/* ---- $ commands ---- */
+
+static double mm_min(int32_t q16_mm_s)
+{
+    return q16_mm_s / 65536.0 * 60.0;
+}
+
+static void dollar_settings(grbl_t *g)
+{
+    const cs_machine_t *m = &g->m;
+    int dirmask = 0;
+    for (int a = 0; a < 3 && a < m->n_axes; a++)
+        dirmask |= m->axis[a].invert_dir ? 1 << a : 0;
+    say(g, "$0=%.0f", m->axis[0].pulse_ticks * 1e6 / m->tick_hz);
+    say(g, "$1=25");
+    say(g, "$2=0");
+    say(g, "$3=%d", dirmask);
+    say(g, "$4=0");
+    say(g, "$5=0");
+    say(g, "$6=0");
+    say(g, "$10=%d", g->report_mask);
+    say(g, "$11=%.3f", cs_conv_pos_to_mm(m->junction_deviation));
+    say(g, "$12=%.3f", cs_conv_pos_to_mm(g->tol));
+    say(g, "$13=0");
+    say(g, "$20=1"); /* the planner always refuses moves outside the travel */
+    say(g, "$21=0");
+    say(g, "$22=0");
+    say(g, "$23=0");
+    say(g, "$24=25.000");
+    say(g, "$25=500.000");
+    say(g, "$26=250");
+    say(g, "$27=1.000");
+    say(g, "$30=1000");
+    say(g, "$31=0");
+    say(g, "$32=0");
+    for (int a = 0; a < 3; a++)
+        say(g, "$%d=%.3f", 100 + a, m->axis[a].steps_per_mm / 65536.0);
+    for (int a = 0; a < 3; a++)
+        say(g, "$%d=%.3f", 110 + a, mm_min(m->axis[a].max_rate));
+    for (int a = 0; a < 3; a++)
+        say(g, "$%d=%.3f", 120 + a, m->axis[a].max_accel / 65536.0);
+    for (int a = 0; a < 3; a++)
+        say(g, "$%d=%.3f", 130 + a,
+            cs_conv_pos_to_mm(m->axis[a].travel_max) - cs_conv_pos_to_mm(m->axis[a].travel_min));
+    say(g, "ok");
+}
+
+static void dollar_params(grbl_t *g)
+{
+    for (int k = 54; k <= 59; k++)
+        say(g, "[G%d:0.000,0.000,0.000]", k);
+    say(g, "[G28:0.000,0.000,0.000]");
+    say(g, "[G30:0.000,0.000,0.000]");
+    say(g, "[G92:%.3f,%.3f,%.3f]", g->gc.off[0], g->gc.off[1], g->gc.off[2]);
+    say(g, "[TLO:0.000]");
+    say(g, "[PRB:0.000,0.000,0.000:0]");
+    say(g, "ok");
+}
+
+static void dollar_modes(grbl_t *g)
+{
+    const cs_grbl_gc_t *c = &g->gc;
+    char motion[24];
+    if (c->motion < 0)
+        snprintf(motion, sizeof motion, "G80");
+    else if (c->motion % 10)
+        snprintf(motion, sizeof motion, "G%d.%d", c->motion / 10, c->motion % 10);
+    else
+        snprintf(motion, sizeof motion, "G%d", c->motion / 10);
+    say(g, "[GC:%s G54 G%d %s %s G94 M5 M9 T0 F%g S0]", motion, c->plane, c->inch ? "G20" : "G21",
+        c->incr ? "G91" : "G90", c->feed);
+    say(g, "ok");
+}
+
+/* $N=value: $10 (status report mask) is ours, in memory; the machine's settings are not. */
+static void dollar_set(grbl_t *g, const char *s)
+{
+    char *e;
+    long n = strtol(s, &e, 10);
+    if (e == s || *e != '=') {
+        say(g, "error:%d", ERR_DOLLAR);
+        return;
+    }
+    char *e2;
+    double v = strtod(e + 1, &e2);
+    if (e2 == e + 1 || *e2 != '\0') {
+        say(g, "error:%d", ERR_NUMBER);
+        return;
+    }
+    if (n == 10 && v >= 0 && v <= 3 && v == floor(v)) {
+        g->report_mask = (int)v;
+        say(g, "ok");
+        return;
+    }
+    say(g, "[MSG:$%ld is read-only here: the machine file (%s) owns the machine's settings; edit "
+           "it and restart curvestep grbl]",
+        n, g->cfg->job.machine_file ? g->cfg->job.machine_file : "built-in machine");
+    say(g, "error:%d", ERR_DOLLAR);
+}
+
+static void dollar_check(grbl_t *g)
+{
+    g->check_mode = !g->check_mode;
+    say(g, "[MSG:%s]", g->check_mode ? "Enabled" : "Disabled");
+    if (!g->check_mode) { /* Grbl soft-resets when check mode ends */
+        cs_grbl_gc_init(&g->gc);
+        sync_from_device(g);
+        say(g, "ok");
+        say(g, "%s", GRBL_WELCOME);
+        return;
+    }
+    say(g, "ok");
+}
+
+static void dollar(grbl_t *g, const char *s)
+{
+    cs_grbl_dev_snap_t st;
+    cs_grbl_dev_snap(&g->dev, &st);
+    if (strcmp(s, "$") == 0) {
+        say(g, "[HLP:$$ $# $G $I $N $x=val $J=line $C $X $H ~ ! ? ctrl-x]");
+        say(g, "ok");
+    } else if (strcmp(s, "$$") == 0) {
+        dollar_settings(g);
+    } else if (strcmp(s, "$#") == 0) {
+        dollar_params(g);
+    } else if (strcmp(s, "$G") == 0) {
+        dollar_modes(g);
+    } else if (strcmp(s, "$I") == 0) {
+        say(g, "[VER:1.1h.20190825:curvestep %s]", CS_VERSION);
+        say(g, "[OPT:,%d,%d]", CS_GRBL_DEV_QUEUE, CS_GRBL_RX_SIZE);
+        say(g, "ok");
+    } else if (strcmp(s, "$N") == 0) {
+        say(g, "$N0=");
+        say(g, "$N1=");
+        say(g, "ok");
+    } else if (strcmp(s, "$X") == 0) {
+        if (g->alarm || st.failed)
+            say(g, "[MSG:Caution: Unlocked]");
+        g->alarm = false;
+        cs_grbl_dev_clear(&g->dev);
+        sync_from_device(g);
+        say(g, "ok");
+    } else if (strcmp(s, "$C") == 0) {
+        dollar_check(g);
+    } else if (strcmp(s, "$H") == 0) {
+        say(g, "[MSG:no homing yet: curvestep has no limit switch inputs (docs/controller.md)]");
+        say(g, "error:%d", ERR_HOMING);
+    } else if (strncmp(s, "$J=", 3) == 0) {
+        jog_line(g, s + 3);
+    } else if (s[1] >= '0' && s[1] <= '9') {
+        dollar_set(g, s + 1);
+    } else {
+        say(g, "error:%d", ERR_DOLLAR);
+    }
+}
+
+/* ---- input ---- */
+
+/* One complete line from the receive buffer (no newline). Grbl drops spaces and upper-cases
+ * outside comments; cs_gcode takes either, so the line goes as it came. */
+static void do_line(grbl_t *g, char *line)
+{
+    size_t n = strlen(line);
+    while (n > 0 && (line[n - 1] == ' ' || line[n - 1] == '\t' || line[n - 1] == '\r'))
+        line[--n] = '\0';
+    while (*line == ' ' || *line == '\t')
+        line++;
+    g->lineno++;
+    g->t_last_line = cs_serial_now_s();
+    if (*line == '\0') {
+        say(g, "ok");
+    } else if (*line == '$') {
+        for (char *p = line; *p && *p != '='; p++) /* "$j=" as "$J=", "$x" as "$X" */
+            *p = (char)(*p >= 'a' && *p <= 'z' ? *p - 32 : *p);
+        dollar(g, line);
+    } else {
+        gcode_line(g, line);
+    }
+}
+
+static void soft_reset(grbl_t *g)
+{
+    drop_all(g);
+    g->rxn = 0;
+    g->rx_overflow = false;
+    g->held = false;
+    g->check_mode = false;
+    cs_grbl_gc_reset_modal(&g->gc);
+    memset(g->gc.off, 0, sizeof g->gc.off);
+    say(g, "%s", "");
+    say(g, "%s", GRBL_WELCOME);
+}
+
+/* A real-time byte (grbl wiki "Interface": picked out of the stream wherever it comes). True
+ * when b was one. Overrides 0x90..0x9D, safety door 0x84 and the toggles 0x9E..0xA1 are
+ * accepted and ignored: curvestep has no overrides yet (docs/controller.md). */
+static bool realtime(grbl_t *g, unsigned char b)
+{
+    cs_grbl_dev_snap_t s;
+    switch (b) {
+    case '?':
+        status_report(g);
+        return true;
+    case '!':
+        cs_grbl_dev_snap(&g->dev, &s);
+        if (s.busy || s.queued > 0 || g->pending.n > 0) {
+            g->held = true;
+            cs_grbl_dev_hold(&g->dev, true);
+        }
+        return true;
+    case '~':
+        if (g->held) {
+            g->held = false;
+            cs_grbl_dev_hold(&g->dev, false);
+        }
+        return true;
+    case 0x18:
+        soft_reset(g);
+        return true;
+    case 0x85: /* jog cancel: hold, then flush the jogs (nothing when not jogging) */
+        if (cs_grbl_dev_cancel(&g->dev, true)) {
+            g->held = false;
+            sync_from_device(g);
+        }
+        return true;
+    default:
+        return b >= 0x80;
+    }
+}
+
+/* Bytes from the client: real-time ones at once, the rest into the 128-byte buffer. */
+static void take_bytes(grbl_t *g, const unsigned char *b, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        if (realtime(g, b[k]))
+            continue;
+        if (g->rx_overflow) {
+            if (b[k] == '\n') {
+                g->rx_overflow = false;
+                g->lineno++;
+                say(g, "error:%d", ERR_OVERFLOW);
+            }
+            continue;
+        }
+        if (g->rxn == sizeof g->rx) { /* a sender that overfills: Grbl loses the byte too */
+            g->rx_overflow = memchr(g->rx, '\n', g->rxn) == NULL;
+            if (g->rx_overflow)
+                g->rxn = 0;
+            continue;
+        }
+        g->rx[g->rxn++] = (char)b[k];
+    }
+}
+
+/* Reads the complete lines in the buffer while the queue has room. */
+static void take_lines(grbl_t *g)
+{
+    /* room for two items: a line may close the pending chunk and queue a dwell or a jog */
+    while (g->rxn > 0 && cs_grbl_dev_room(&g->dev, 2)) {
+        char *nl = memchr(g->rx, '\n', g->rxn);
+        char *cr = memchr(g->rx, '\r', g->rxn);
+        if (nl == NULL || (cr != NULL && cr < nl))
+            nl = cr; /* Grbl ends a line at either */
+        if (nl == NULL)
+            return;
+        size_t len = (size_t)(nl - g->rx);
+        char line[CS_GRBL_RX_SIZE + 1];
+        memcpy(line, g->rx, len);
+        line[len] = '\0';
+        memmove(g->rx, nl + 1, g->rxn - len - 1);
+        g->rxn -= len + 1;
+        bool lf_after_cr = len == 0 && nl != cr && g->after_cr; /* "\r\n": one line */
+        g->after_cr = nl == cr;
+        if (!lf_after_cr)
+            do_line(g, line);
+    }
+}
+
+/* ---- the session ---- */
+
+/* A device run that failed (link closed, device error): Alarm until $X, everything dropped. */
+static void watch_device(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    if (s.failed && !g->alarm) {
+        say(g, "[MSG:device: %s]", s.why);
+        g->alarm = true;
+        drop_all(g);
+    }
+}
+
+bool cs_grbl_listen_parse(const char *spec, struct sockaddr_in *sa)
+{
+    char addr[64] = "127.0.0.1";
+    const char *colon = strrchr(spec, ':');
+    const char *port = spec;
+    if (colon != NULL) {
+        size_t n = (size_t)(colon - spec);
+        if (n == 0 || n >= sizeof addr)
+            return false;
+        memcpy(addr, spec, n);
+        addr[n] = '\0';
+        port = colon + 1;
+    }
+    char *e;
+    long p = strtol(port, &e, 10);
+    memset(sa, 0, sizeof *sa);
+    sa->sin_family = AF_INET;
+    sa->sin_port = htons((uint16_t)p);
+    return *port != '\0' && *e == '\0' && p >= 0 && p <= 65535 &&
+           inet_pton(AF_INET, addr, &sa->sin_addr) == 1;
+}
+
+/* --listen [ADDR:]PORT: a socket listening there; its address in shown. -1: bad spec, -2: the
+ * socket failed (errno). */
+static int listen_on(const char *spec, char *shown, size_t cap)
+{
+    struct sockaddr_in sa;
+    if (!cs_grbl_listen_parse(spec, &sa))
+        return -1;
+    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    int one = 1;
+    if (fd < 0)
+        return -2;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    socklen_t len = sizeof sa;
+    if (bind(fd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(fd, 1) != 0 ||
+        getsockname(fd, (struct sockaddr *)&sa, &len) != 0) {
+        close(fd);
+        return -2;
+    }
+    char addr[INET_ADDRSTRLEN];
+    inet_ntop(AF_INET, &sa.sin_addr, addr, sizeof addr);
+    snprintf(shown, cap, "%s:%u", addr, (unsigned)ntohs(sa.sin_port));
+    return fd;
+}
+
+/* Accepts a client on the listening socket (one at a time: a second waits for the first). */
+static void accept_client(grbl_t *g, int lfd)
+{
+    int c = accept4(lfd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (c < 0)
+        return;
+    g->fd = c;
+    g->rxn = 0;
+    say(g, "%s", "");
+    say(g, "%s", GRBL_WELCOME);
+}
+
+/* The loop: client bytes, lines while there is room, chunks when the sender pauses. */
+static void serve_loop(grbl_t *g, int lfd)
+{
+    while (!stop_flag) {
+        struct pollfd p = {g->fd >= 0 ? g->fd : lfd, POLLIN, 0};
+        int r = poll(&p, 1, 5);
+        if (r > 0 && g->fd < 0) {
+            accept_client(g, lfd);
+        } else if (r > 0) {
+            unsigned char buf[256];
+            ssize_t n = read(g->fd, buf, sizeof buf);
+            if (n > 0) {
+                take_bytes(g, buf, (size_t)n);
+            } else if (lfd >= 0 && (n == 0 || (errno != EAGAIN && errno != EINTR))) {
+                close(g->fd); /* the TCP client left: the machine finishes what it was given */
+                g->fd = -1;
+            }
+        }
+        take_lines(g);
+        if (g->pending.n > 0 && cs_serial_now_s() - g->t_last_line > CS_GRBL_CHUNK_IDLE_MS / 1e3 &&
+            cs_grbl_dev_room(&g->dev, 1))
+            flush_chunk(g);
+        watch_device(g);
+    }
+}
+
+/* Opens the client side: a pty (path on stdout, optional symlink) or a listening socket. */
+static int open_front(grbl_t *g, int *lfd, int *slave)
+{
+    char shown[300];
+    *lfd = *slave = -1;
+    if (g->cfg->listen != NULL) {
+        *lfd = listen_on(g->cfg->listen, shown, sizeof shown);
+        if (*lfd == -1) {
+            fprintf(stderr, "curvestep grbl: --listen wants [ADDR:]PORT (an IPv4 address), got "
+                            "'%s'\n", g->cfg->listen);
+            return CS_EXIT_USAGE;
+        }
+        if (*lfd < 0) {
+            fprintf(stderr, "curvestep grbl: cannot listen on %s: %s\n", g->cfg->listen,
+                    strerror(errno));
+            return CS_EXIT_INTERNAL;
+        }
+    } else {
+        if (cs_serial_openpty(&g->fd, slave, shown, sizeof shown) != 0) {
+            fprintf(stderr, "curvestep grbl: cannot create a pseudo-terminal: %s\n",
+                    strerror(errno));
+            return CS_EXIT_INTERNAL;
+        }
+        if (g->cfg->link != NULL && (unlink(g->cfg->link), symlink(shown, g->cfg->link)) != 0) {
+            fprintf(stderr, "curvestep grbl: cannot link %s to %s: %s\n", g->cfg->link, shown,
+                    strerror(errno));
+            return CS_EXIT_INTERNAL;
+        }
+        say(g, "%s", GRBL_WELCOME);
+    }
+    printf("%s\n", shown);
+    fflush(stdout);
+    return CS_EXIT_OK;
+}
+
+static int start(grbl_t *g)
+{
+    cs_machine_pen_t pen;
+    int rc = cs_jobplan_machine("grbl", &g->cfg->job, &g->m, &pen, &g->tol);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    g->feed = cs_motion_speed(g->cfg->job.feed_mm_s);
+    if (cs_serial_open(&g->ser, g->cfg->port, g->cfg->baud) != 0) {
+        fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", g->cfg->port, strerror(errno));
+        return CS_EXIT_NO_DEVICE;
+    }
+    /* the worker takes no signals: SIGINT and SIGTERM stop the main loop */
+    sigset_t set, old;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, &old);
+    uint32_t bps = strncmp(g->cfg->port, "/dev/pts/", 9) == 0 ? 0 : g->cfg->baud;
+    cs_err_t e = cs_grbl_dev_start(&g->dev, &g->ser, &g->m, bps);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep grbl: cannot start the device thread\n");
+        cs_serial_close(&g->ser);
+        return CS_EXIT_INTERNAL;
+    }
+    return CS_EXIT_OK;
+}
+
+int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
+{
+    grbl_t *g = calloc(1, sizeof *g);
+    if (g == NULL)
+        return CS_EXIT_INTERNAL;
+    g->cfg = cfg;
+    g->fd = -1;
+    g->report_mask = 1; /* Grbl's default $10=1: MPos */
+    cs_grbl_gc_init(&g->gc);
+    cs_path_init(&g->pending);
+    int rc = start(g);
+    if (rc != CS_EXIT_OK) {
+        free(g);
+        return rc;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    int lfd, slave;
+    rc = open_front(g, &lfd, &slave);
+    if (rc == CS_EXIT_OK) {
+        fprintf(stderr, "curvestep grbl: serving Grbl 1.1 on %s for the device on %s\n",
+                cfg->listen ? "TCP" : "a pseudo-terminal", cfg->port);
+        serve_loop(g, lfd);
+    }
+    cs_grbl_dev_stop(&g->dev);
+    cs_serial_close(&g->ser);
+    if (cfg->link != NULL && cfg->listen == NULL)
+        unlink(cfg->link);
+    if (g->fd >= 0)
+        close(g->fd);
+    if (lfd >= 0)
+        close(lfd);
+    if (slave >= 0)
+        close(slave);
+    cs_path_free(&g->pending);
+    cs_grbl_gc_free(&g->gc);
+    free(g);
+    return rc;
+}

@@ -1,0 +1,96 @@
+/* cs_grbl_cmd: `curvestep grbl`, the command line of the Grbl front end (cs_grbl). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_grbl.h"
+#include "cs_serial.h"
+
+static void usage(FILE *f)
+{
+    fputs("usage: curvestep grbl --port DEV [--baud N] [--machine FILE.ini] [--tol MM]\n"
+          "                      [--feed MM/S] [--pty [--link PATH] | --listen [ADDR:]PORT]\n"
+          "Speaks Grbl 1.1's serial protocol to a G-code sender (Universal G-code Sender,\n"
+          "cncjs, bCNC, a streaming script) and drives the curvestep device on DEV (a serial\n"
+          "line, or the pty printed by `curvestep-sim --pty`) with its wire protocol.\n"
+          "  --pty              (default) create a pseudo-terminal; its path is the first line\n"
+          "                     on standard output: open it in the sender as a serial port\n"
+          "  --link PATH        also make PATH a symlink to that pty (e.g. /tmp/ttyCURVESTEP);\n"
+          "                     removed on exit\n"
+          "  --listen [ADDR:]PORT  serve one TCP client at a time instead, on ADDR (default\n"
+          "                     127.0.0.1: loopback only); PORT 0 picks one; ADDR:PORT is\n"
+          "                     the first line on standard output\n"
+          "  --port DEV         the device's serial line; --baud N its speed (default 115200)\n"
+          "  --machine FILE     machine description (default: the built-in plotter); $$ shows\n"
+          "                     it as Grbl settings, read-only ($10 alone can be set)\n"
+          "  --tol MM           chord tolerance (default: the machine's); --feed MM/S the feed\n"
+          "                     where the program gives no F (default: the machine's)\n"
+          "Each line is answered ok when it is read into the queue (error:N, with a [MSG:...]\n"
+          "saying why, when it is refused: the stream goes on). Lines are planned in chunks:\n"
+          "a chunk ends when the sender pauses 30 ms, after 400 moves, at a G4 dwell or at\n"
+          "M2/M30, and each chunk ends at rest (no look-ahead across chunks).\n"
+          "Real-time bytes: ? status, ! feed hold, ~ resume, Ctrl-X reset, 0x85 jog cancel;\n"
+          "the override bytes 0x90-0x9D are accepted and ignored. $$ $# $G $I $N $C $X $J=\n"
+          "work; $H answers error:5 (no homing switches yet). See docs/controller.md.\n"
+          "SIGINT or SIGTERM: the running chunk is held, aborted, and the command ends.\n"
+          "Exit status: 0 stopped by a signal, 1 bad machine file, 2 bad command line,\n"
+          "3 internal error (pty, socket), 4 the port cannot be opened.\n",
+          f);
+}
+
+int cs_cmd_grbl(int argc, char **argv)
+{
+    cs_grbl_cfg_t c;
+    memset(&c, 0, sizeof c);
+    c.baud = 115200;
+    cs_jobplan_opts_init(&c.job);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        bool has = i + 1 < argc;
+        int r = cs_jobplan_option("grbl", argc, argv, &i, &c.job);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return CS_EXIT_OK;
+        } else if (strcmp(a, "--port") == 0 && has) {
+            c.port = argv[++i];
+        } else if (strcmp(a, "--baud") == 0 && has) {
+            char *e;
+            unsigned long b = strtoul(argv[++i], &e, 10);
+            if (*e != '\0' || b > 4000000 || !cs_serial_baud_ok((uint32_t)b)) {
+                fprintf(stderr, "curvestep grbl: --baud wants a termios rate (e.g. 115200)\n");
+                return CS_EXIT_USAGE;
+            }
+            c.baud = (uint32_t)b;
+        } else if (strcmp(a, "--pty") == 0) {
+            c.listen = NULL;
+        } else if (strcmp(a, "--listen") == 0 && has) {
+            c.listen = argv[++i];
+        } else if (strcmp(a, "--link") == 0 && has) {
+            c.link = argv[++i];
+        } else {
+            fprintf(stderr, "curvestep grbl: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return CS_EXIT_USAGE;
+        }
+    }
+    if (c.port == NULL) {
+        fprintf(stderr, "curvestep grbl: --port DEV is required (the device's serial line)\n");
+        return CS_EXIT_USAGE;
+    }
+    struct sockaddr_in sa;
+    if (c.listen != NULL && !cs_grbl_listen_parse(c.listen, &sa)) {
+        fprintf(stderr, "curvestep grbl: --listen wants [ADDR:]PORT (an IPv4 address), got '%s'\n",
+                c.listen);
+        return CS_EXIT_USAGE;
+    }
+    if (c.link != NULL && c.listen != NULL) {
+        fprintf(stderr, "curvestep grbl: --link goes with a pty, not with --listen\n");
+        return CS_EXIT_USAGE;
+    }
+    return cs_grbl_serve(&c);
+}

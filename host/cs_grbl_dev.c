@@ -1,0 +1,235 @@
+/* cs_grbl_dev: the worker that runs the Grbl front end's chunks on the device (see
+ * cs_grbl_dev.h). cs_stream_run owns the link while a chunk runs; it draws its progress bar on a
+ * FILE at most ten times a second, and that FILE is a cookie stream whose write function (called
+ * on the worker thread, inside cs_stream_run) copies the device's last STATUS into the shared
+ * snapshot: the position `?` reports is what the device said, never an estimate. */
+#define _GNU_SOURCE /* fopencookie */
+#include "cs_grbl_dev.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <termios.h>
+#include <time.h>
+
+/* Called with the lock held: takes the device's report from the running chunk's result. */
+static void take_status(cs_grbl_dev_t *d, const cs_stream_result_t *r)
+{
+    if (r->dev_state == 0xFF)
+        return;
+    double now = cs_serial_now_s(), dist2 = 0;
+    bool moved = false;
+    for (unsigned i = 0; i < d->axes && i < CS_PROTO_AXES_MAX; i++) {
+        if (r->dev_pos[i] != d->s.pos[i])
+            moved = true;
+        double mm = (double)(r->dev_pos[i] - d->s.pos[i]) * 65536.0 / d->steps_per_mm[i];
+        dist2 += mm * mm;
+    }
+    if (moved && d->s.have_pos && now > d->t_move)
+        d->s.speed_mm_min = sqrt(dist2) / (now - d->t_move) * 60.0;
+    else if (!moved && now - d->t_move > 0.5)
+        d->s.speed_mm_min = 0;
+    if (moved || !d->s.have_pos)
+        d->t_move = now;
+    memcpy(d->s.pos, r->dev_pos, sizeof d->s.pos);
+    d->s.have_pos = true;
+    d->s.dev_state = r->dev_state;
+}
+
+/* The progress FILE's write: the text itself is not needed, only the moment. */
+static ssize_t progress_write(void *cookie, const char *buf, size_t len)
+{
+    (void)buf;
+    cs_grbl_dev_t *d = cookie;
+    pthread_mutex_lock(&d->mu);
+    if (d->cur != NULL)
+        take_status(d, d->cur);
+    d->run_interrupt = d->req_cancel;
+    d->run_pause = d->req_hold;
+    pthread_mutex_unlock(&d->mu);
+    return (ssize_t)len;
+}
+
+static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
+{
+    cs_stream_opts_t o;
+    cs_stream_opts_default(&o, d->ser, d->axes, d->tick_hz);
+    cs_stream_link_timing(&o.link, d->bits_per_s);
+    o.interrupt = &d->run_interrupt;
+    o.pause = &d->run_pause;
+    o.quiet_hello = true;
+    cookie_io_functions_t io = {.write = progress_write};
+    o.progress = fopencookie(d, "w", io);
+    o.progress_tty = true; /* ten updates a second */
+    if (o.progress != NULL)
+        setvbuf(o.progress, NULL, _IONBF, 0);
+    cs_stream_result_t r;
+    pthread_mutex_lock(&d->mu);
+    d->cur = &r;
+    d->run_interrupt = d->req_cancel;
+    d->run_pause = d->req_hold;
+    pthread_mutex_unlock(&d->mu);
+    tcflush(d->ser->fd, TCIFLUSH); /* what the device said between chunks */
+    cs_err_t e = cs_stream_run(&it->job, &o, &r);
+    pthread_mutex_lock(&d->mu);
+    d->cur = NULL;
+    take_status(d, &r);
+    if (e != CS_OK || (r.outcome != CS_STREAM_DONE && r.outcome != CS_STREAM_INTERRUPTED)) {
+        d->s.failed = true;
+        snprintf(d->s.why, sizeof d->s.why, "%s%s%s", cs_stream_outcome_text(r.outcome),
+                 r.why[0] ? ": " : "", r.why);
+    }
+    if (r.outcome == CS_STREAM_INTERRUPTED)
+        d->s.cancelled++;
+    pthread_mutex_unlock(&d->mu);
+    if (o.progress != NULL)
+        fclose(o.progress);
+}
+
+/* G4: waits, in 10 ms steps, while held or until cancelled. */
+static void run_dwell(cs_grbl_dev_t *d, double s)
+{
+    double end = cs_serial_now_s() + s;
+    for (;;) {
+        pthread_mutex_lock(&d->mu);
+        bool stop = d->req_cancel || d->quit, held = d->req_hold;
+        pthread_mutex_unlock(&d->mu);
+        if (stop || (!held && cs_serial_now_s() >= end))
+            return;
+        if (held)
+            end += 0.01;
+        struct timespec ts = {0, 10 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+    }
+}
+
+static void *worker(void *arg)
+{
+    cs_grbl_dev_t *d = arg;
+    pthread_mutex_lock(&d->mu);
+    for (;;) {
+        while (!d->quit && (d->n == 0 || d->s.failed))
+            pthread_cond_wait(&d->cv, &d->mu);
+        if (d->quit)
+            break;
+        cs_grbl_item_t it = d->q[d->head];
+        d->head = (d->head + 1) % CS_GRBL_DEV_QUEUE;
+        d->n--;
+        d->s.queued = d->n;
+        d->s.busy = true;
+        d->s.busy_jog = it.jog;
+        pthread_mutex_unlock(&d->mu);
+        if (it.dwell)
+            run_dwell(d, it.dwell_s);
+        else
+            run_job(d, &it);
+        cs_stream_job_free(&it.job);
+        pthread_mutex_lock(&d->mu);
+        d->req_cancel = false;
+        d->s.busy = d->s.busy_jog = false;
+        pthread_cond_broadcast(&d->cv);
+    }
+    pthread_mutex_unlock(&d->mu);
+    return NULL;
+}
+
+cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_t *m,
+                           uint32_t bits_per_s)
+{
+    memset(d, 0, sizeof *d);
+    d->ser = ser;
+    d->axes = m->n_axes;
+    d->tick_hz = m->tick_hz;
+    for (unsigned i = 0; i < m->n_axes && i < CS_PROTO_AXES_MAX; i++)
+        d->steps_per_mm[i] = m->axis[i].steps_per_mm;
+    d->bits_per_s = bits_per_s;
+    d->s.dev_state = 0xFF;
+    pthread_mutex_init(&d->mu, NULL);
+    pthread_cond_init(&d->cv, NULL);
+    if (pthread_create(&d->th, NULL, worker, d) != 0)
+        return CS_ERR_STATE;
+    d->started = true;
+    return CS_OK;
+}
+
+bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need)
+{
+    pthread_mutex_lock(&d->mu);
+    bool room = d->n + need <= CS_GRBL_DEV_QUEUE;
+    pthread_mutex_unlock(&d->mu);
+    return room;
+}
+
+bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it)
+{
+    pthread_mutex_lock(&d->mu);
+    bool room = d->n < CS_GRBL_DEV_QUEUE;
+    if (room) {
+        d->q[(d->head + d->n) % CS_GRBL_DEV_QUEUE] = *it;
+        d->n++;
+        d->s.queued = d->n;
+        pthread_cond_broadcast(&d->cv);
+    }
+    pthread_mutex_unlock(&d->mu);
+    return room;
+}
+
+bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
+{
+    pthread_mutex_lock(&d->mu);
+    bool all_jogs = !d->s.busy || d->s.busy_jog;
+    for (size_t k = 0; k < d->n; k++)
+        all_jogs = all_jogs && d->q[(d->head + k) % CS_GRBL_DEV_QUEUE].jog;
+    if (only_jogs && !all_jogs) {
+        pthread_mutex_unlock(&d->mu);
+        return false;
+    }
+    for (size_t k = 0; k < d->n; k++)
+        cs_stream_job_free(&d->q[(d->head + k) % CS_GRBL_DEV_QUEUE].job);
+    d->n = 0;
+    d->s.queued = 0;
+    d->req_cancel = d->s.busy;
+    while (d->s.busy)
+        pthread_cond_wait(&d->cv, &d->mu);
+    d->req_hold = false; /* a cancelled hold is over (Grbl: the hold ends with the flush) */
+    pthread_mutex_unlock(&d->mu);
+    return true;
+}
+
+void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on)
+{
+    pthread_mutex_lock(&d->mu);
+    d->req_hold = on;
+    pthread_mutex_unlock(&d->mu);
+}
+
+void cs_grbl_dev_clear(cs_grbl_dev_t *d)
+{
+    pthread_mutex_lock(&d->mu);
+    d->s.failed = false;
+    d->s.why[0] = '\0';
+    pthread_cond_broadcast(&d->cv);
+    pthread_mutex_unlock(&d->mu);
+}
+
+void cs_grbl_dev_snap(cs_grbl_dev_t *d, cs_grbl_dev_snap_t *s)
+{
+    pthread_mutex_lock(&d->mu);
+    *s = d->s;
+    pthread_mutex_unlock(&d->mu);
+}
+
+void cs_grbl_dev_stop(cs_grbl_dev_t *d)
+{
+    if (!d->started)
+        return;
+    cs_grbl_dev_cancel(d, false);
+    pthread_mutex_lock(&d->mu);
+    d->quit = true;
+    pthread_cond_broadcast(&d->cv);
+    pthread_mutex_unlock(&d->mu);
+    pthread_join(d->th, NULL);
+    pthread_mutex_destroy(&d->mu);
+    pthread_cond_destroy(&d->cv);
+    d->started = false;
+}

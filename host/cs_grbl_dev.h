@@ -1,0 +1,88 @@
+/* cs_grbl_dev: the device side of the Grbl front end. A worker thread takes planned chunks (step
+ * segments, cs_stream_job_t) and dwells from a short queue and runs each through cs_stream_run on
+ * the serial link, one session per chunk (as the daemon runs one per job); feed hold / resume and
+ * cancel reach the running chunk through cs_stream's pause and interrupt flags. It keeps what the
+ * device last reported (position in steps, state) for the status report. Host only. */
+#ifndef CS_GRBL_DEV_H
+#define CS_GRBL_DEV_H
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cs_machine.h"
+#include "cs_proto.h"
+#include "cs_serial.h"
+#include "cs_stream.h"
+
+/* Items waiting behind the running one (the planner's look-ahead is within a chunk; this only
+ * keeps the link busy while the next chunk is read). */
+#define CS_GRBL_DEV_QUEUE 4
+
+typedef struct {
+    bool dwell;          /* a G4: wait dwell_s seconds; else run job */
+    bool jog;            /* a $J= move (cancellable with 0x85) */
+    double dwell_s;
+    cs_stream_job_t job; /* owned by the queue once pushed */
+} cs_grbl_item_t;
+
+/* What the status report needs, copied under the lock. */
+typedef struct {
+    bool busy;       /* an item is running */
+    bool busy_jog;   /* ... and it is a jog */
+    size_t queued;   /* items waiting */
+    bool have_pos;   /* the device has reported a position */
+    int32_t pos[CS_PROTO_AXES_MAX]; /* steps, from its last STATUS */
+    uint8_t dev_state;              /* CS_PROTO_STATE_*, 0xFF: none yet */
+    double speed_mm_min;            /* between the last two different reported positions */
+    bool failed;                    /* a chunk ended other than done or cancelled */
+    char why[200];                  /* ... why */
+    unsigned cancelled;             /* runs ended by cancel (interrupt) so far */
+} cs_grbl_dev_snap_t;
+
+typedef struct {
+    pthread_t th;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    cs_serial_t *ser;
+    uint8_t axes;
+    uint32_t tick_hz;
+    int32_t steps_per_mm[CS_PROTO_AXES_MAX]; /* Q15.16, for the speed */
+    uint32_t bits_per_s;                     /* link timing (0: a pty) */
+    cs_grbl_item_t q[CS_GRBL_DEV_QUEUE];
+    size_t head, n;
+    bool quit, started;
+    bool req_cancel, req_hold; /* asked for (under mu): cancel the running item, feed hold */
+    /* what cs_stream_run polls (worker thread only: copied from req_* under mu when a chunk
+     * starts and at each progress call, ten times a second, so a hold or cancel takes effect
+     * within ~0.1 s and no flag is shared without the lock) */
+    volatile sig_atomic_t run_interrupt, run_pause;
+    const cs_stream_result_t *cur;   /* the running chunk's result (worker thread only) */
+    double t_move;                   /* when the reported position last changed */
+    cs_grbl_dev_snap_t s;
+} cs_grbl_dev_t;
+
+/* Starts the worker on the open port ser for machine m (axes, tick rate, steps/mm), link timing
+ * for a line of bits_per_s (0: a pty). CS_ERR_STATE when the thread cannot start. */
+cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_t *m,
+                           uint32_t bits_per_s);
+/* Queues it (taking its job); false when the queue is full (it is then not taken). */
+bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it);
+/* True when the queue can take need more items. */
+bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need);
+/* Drops every waiting item; when only_jogs, only if everything queued and running is a jog.
+ * Cancels the running item (decelerating hold, then abort), waits until it has stopped and ends
+ * the feed hold. False when only_jogs and something is not a jog (then nothing is done). */
+bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
+/* Feed hold on (true) or off. */
+void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on);
+/* Clears the failure (Grbl's $X). */
+void cs_grbl_dev_clear(cs_grbl_dev_t *d);
+/* Copies the state. */
+void cs_grbl_dev_snap(cs_grbl_dev_t *d, cs_grbl_dev_snap_t *s);
+/* Cancels everything, ends the worker and frees the queue. */
+void cs_grbl_dev_stop(cs_grbl_dev_t *d);
+
+#endif

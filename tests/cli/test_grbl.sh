@@ -1,0 +1,186 @@
+#!/usr/bin/env bash
+# Command-line tests of `curvestep grbl`, the Grbl 1.1 front end, with tests/support/
+# grbl_client.py as the sender (Grbl's two documented streaming methods) and `curvestep-sim
+# --pty` as the device: a real G-code program (inches, modal arcs) streamed by character
+# counting and by send-response ends at the exact position `curvestep plan` + `curvestep-sim
+# --replay` give; ? during the job is well formed; ! then ~ holds and resumes with the final
+# position still exact; $$ $# $G $I answer in Grbl's format, an unknown $ gives error:3; a bad
+# line gives error:N and the stream goes on; a jog is cancelled by 0x85; TCP with --listen;
+# usage. Every process is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
+
+CLIENT=tests/support/grbl_client.py
+PROG=tests/data/gcode/one-inch-circle.nc
+
+# start_sim NAME ARGS...: the device on a pty (PTY, SIMPID); --instant unless ARGS start with --speed.
+start_sim() {
+    local name=$1; shift
+    local pace=--instant
+    [ "${1:-}" = --speed ] && pace=
+    timeout -k 5 120 "$SIM" --pty $pace --idle-exit 3 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    pids+=($!)
+    SIMPID=$!
+    wait_pty "$T/$name.sim" 5
+}
+# start_grbl NAME ARGS...: the front end on the device's pty (GPTY: its own pty, GPID).
+start_grbl() {
+    local name=$1; shift
+    timeout -k 5 120 "$CS" grbl --port "$PTY" "$@" >"$T/$name.grbl" 2>"$T/$name.grblerr" &
+    pids+=($!)
+    GPID=$!
+    wait_pty "$T/$name.grbl" 5
+    GPTY=$PTY
+}
+# stop_all: ends the front end, then waits (at most 10 s) for the device's report.
+stop_all() {
+    kill "$GPID" 2>/dev/null
+    wait "$GPID" 2>/dev/null
+    wait_until 10 gone "$SIMPID"
+    kill "$SIMPID" 2>/dev/null
+    wait "$SIMPID" 2>/dev/null
+}
+client() { timeout -k 5 90 python3 "$CLIENT" "$@"; }
+
+# The reference: the same program planned whole and replayed (an independent path to the device).
+"$CS" plan "$PROG" -o "$T/ref.seg" 2>/dev/null
+"$SIM" --replay "$T/ref.seg" >"$T/ref.out" 2>&1
+REF_POS=$(grep '^final position:' "$T/ref.out")
+expect "reference final position" [ -n "$REF_POS" ]
+
+# 1. character counting: every line ok, the device's final position exact.
+start_sim cc --reference "$PROG" --check
+start_grbl cc
+expect "cc: pty path printed" [ -c "$GPTY" ]
+client "$GPTY" stream "$PROG" --method counting >"$T/cc.out"; rc=$?
+stop_all
+expect "cc: client exit 0" [ $rc -eq 0 ]
+expect "cc: welcome line" grep -qF "welcome: Grbl 1.1h ['\$' for help]" "$T/cc.out"
+expect "cc: 11 ok, 0 errors" grep -q '^acks: 11 0$' "$T/cc.out"
+expect "cc: ends Idle at the program's end (0, 0, 0.25 in)" grep -q '^final: <Idle|MPos:0.000,0.000,6.350|' "$T/cc.out"
+expect "cc: device check ok" grep -q '^check: ok$' "$T/cc.sim"
+expect "cc: final position exact" grep -q 'rounded to steps: exact' "$T/cc.sim"
+expect "cc: same final position as plan + replay" grep -qxF "$REF_POS" "$T/cc.sim"
+
+# 1b. a long program (2500 short moves: several chunks, the queue fills and ok waits for room),
+#     by character counting: every line ok, the same final position as plan + replay.
+awk 'BEGIN {print "G21 G90 F3000"; for (i = 1; i <= 2500; i++)
+    printf "G1 X%.3f Y%.3f\n", (i % 50) * 2 + 0.5 * sin(i), int(i / 50) * 1.5 + (i % 7) * 0.1
+    print "G0 X1 Y1"}' >"$T/long.nc"
+"$CS" plan "$T/long.nc" -o "$T/long.seg" 2>/dev/null
+LONG_POS=$("$SIM" --replay "$T/long.seg" 2>/dev/null | grep '^final position:')
+start_sim long
+start_grbl long
+client "$GPTY" stream "$T/long.nc" --method counting --status-every 100 >"$T/long.out"; rc=$?
+stop_all
+expect "long: client exit 0" [ $rc -eq 0 ]
+expect "long: 2502 ok, 0 errors" grep -q '^acks: 2502 0$' "$T/long.out"
+expect "long: ends Idle at (1, 1)" grep -q '^final: <Idle|MPos:1.000,1.000,0.000|' "$T/long.out"
+expect "long: same final position as plan + replay" grep -qxF "$LONG_POS" "$T/long.sim"
+
+# 2. send-response, ? every 2 lines, and a hold (!) mid-job then resume (~), in real time x20.
+start_sim sr --speed 20 --reference "$PROG" --check
+start_grbl sr
+client "$GPTY" stream "$PROG" --method simple --status-every 2 --hold-after 6 >"$T/sr.out"; rc=$?
+stop_all
+expect "sr: client exit 0" [ $rc -eq 0 ]
+expect "sr: 11 ok, 0 errors" grep -q '^acks: 11 0$' "$T/sr.out"
+expect "sr: status while running" grep -qE '^running: <Run\|MPos:-?[0-9]+\.[0-9]{3},-?[0-9]+\.[0-9]{3},-?[0-9]+\.[0-9]{3}\|FS:[0-9]+,0' "$T/sr.out"
+expect "sr: every status well formed" bash -c "! grep -q '^malformed' '$T/sr.out'"
+expect "sr: held (Hold:0)" grep -q '^held: <Hold:0|MPos:' "$T/sr.out"
+h=$(sed -n 's/^held: <Hold:0|\(MPos:[^|]*\)|.*/\1/p' "$T/sr.out")
+expect "sr: held still 0.3 s later" grep -q "^still-held: <Hold:0|$h|" "$T/sr.out"
+expect "sr: held away from the end" bash -c "[ '$h' != 'MPos:0.000,0.000,6.350' ]"
+expect "sr: ends Idle at the program's end" grep -q '^final: <Idle|MPos:0.000,0.000,6.350|' "$T/sr.out"
+expect "sr: device saw the hold" grep -qE ' [1-9][0-9]* holds' "$T/sr.sim"
+expect "sr: device check ok" grep -q '^check: ok$' "$T/sr.sim"
+expect "sr: final position exact after hold/resume" grep -qxF "$REF_POS" "$T/sr.sim"
+
+# 3. $ commands in Grbl's format; unknown $ -> error:3; machine settings read-only; $10 sets Bf.
+start_sim dol
+start_grbl dol
+client "$GPTY" cmd '$$' '$#' '$G' '$I' '$Q' '$100=5' '$10=3' '$' >"$T/dol.out"; rc=$?
+client "$GPTY" cmd '$H' >"$T/dolh.out"
+client "$GPTY" cmd 'G0 X3000' '$J=X5' '$J=X5 S3 F100' '$J=G91 X-3000 F100' >"$T/dolerr.out"
+client "$GPTY" raw 3f >"$T/dolq.out"
+client "$GPTY" raw 91 9a 9d 84 3f >"$T/dolov.out"
+stop_all
+expect "\$: client exit 0" [ $rc -eq 0 ]
+expect "\$\$: steps/mm of the machine" grep -qx '\$100=80.000' "$T/dol.out"
+expect "\$\$: max rate mm/min" grep -qx '\$110=12000.000' "$T/dol.out"
+expect "\$\$: accel mm/s2" grep -qx '\$122=500.000' "$T/dol.out"
+n_bad=$(awk 'NR == 1 {next} /^ok$/ {exit} !/^\$[0-9]+=-?[0-9.]+$/ {n++} END {print n+0}' "$T/dol.out")
+expect "\$\$: every line \$N=value" [ "$n_bad" -eq 0 ]
+expect "\$#: G54 and G92 lines" grep -qx '\[G92:0.000,0.000,0.000\]' "$T/dol.out"
+expect "\$#: PRB line" grep -qx '\[PRB:0.000,0.000,0.000:0\]' "$T/dol.out"
+expect "\$G: modal state" grep -qx '\[GC:G80 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0\]' "$T/dol.out"
+expect "\$I: version" grep -qE '^\[VER:1\.1h\.[0-9]+:curvestep [0-9.]+\]$' "$T/dol.out"
+expect "\$I: options" grep -qE '^\[OPT:[A-Z]*,[0-9]+,128\]$' "$T/dol.out"
+expect "\$Q: error:3" [ "$(grep -A2 '^\[OPT:' "$T/dol.out" | tail -1)" = error:3 ]
+expect "\$100=5: read-only, said why" grep -q '^\[MSG:\$100 is read-only here: the machine file' "$T/dol.out"
+expect "\$: help" grep -q '^\[HLP:' "$T/dol.out"
+expect "\$H: error:5 (no homing)" grep -qx 'error:5' "$T/dolh.out"
+expect "errors: beyond the travel error:33, said why" grep -q '^\[MSG:line [0-9]*: the move leaves the machine.s travel\]$' "$T/dolerr.out"
+expect "errors: in order 33, 22 (jog without F), 16 (bad jog word), 15 (jog beyond travel)" \
+    [ "$(grep '^error:' "$T/dolerr.out" | tr '\n' ' ')" = "error:33 error:22 error:16 error:15 " ]
+expect "override bytes ignored: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
+expect "override bytes ignored: the status" grep -q '^<Idle|' "$T/dolov.out"
+expect "\$10=3: Bf in the status" grep -qE '^<Idle\|MPos:0\.000,0\.000,0\.000\|Bf:[0-9]+,128\|FS:0,0' "$T/dolq.out"
+
+# 4. a bad line mid-program: error:N for it alone, the rest runs (final position exact against
+#    the program without it).
+sed '6a G1 X0.1 Q' "$PROG" >"$T/bad.nc"
+start_sim bad --reference "$PROG" --check
+start_grbl bad
+client "$GPTY" stream "$T/bad.nc" --method counting >"$T/bad.out"; rc=$?
+stop_all
+expect "bad: client exit 0" [ $rc -eq 0 ]
+expect "bad: error:2 for line 7 only" grep -qx 'error: line 7: error:2' "$T/bad.out"
+expect "bad: 11 ok, 1 error" grep -q '^acks: 11 1$' "$T/bad.out"
+expect "bad: device check ok" grep -q '^check: ok$' "$T/bad.sim"
+expect "bad: final position exact" grep -qxF "$REF_POS" "$T/bad.sim"
+
+# 5. a jog (10 s long in real time) cancelled with 0x85: stops short of its end; then the
+#    program's G-code goes on from where the jog stopped.
+start_sim jog --speed 1
+start_grbl jog
+client "$GPTY" jogcancel '$J=G91 X100 F600' >"$T/jog.out"; rc=$?
+client "$GPTY" cmd 'G90 G0 X0 Y0' >"$T/jog2.out"
+client "$GPTY" idle >"$T/jog3.out"
+stop_all
+expect "jog: client exit 0" [ $rc -eq 0 ]
+expect "jog: accepted" grep -qx 'reply: ok' "$T/jog.out"
+expect "jog: Jog state while moving" grep -q '^jogging: <Jog|MPos:' "$T/jog.out"
+x=$(sed -n 's/^final: <Idle|MPos:\([0-9.-]*\),.*/\1/p' "$T/jog.out")
+expect "jog: cancelled between 0 and 100 mm" awk -v x="${x:-0}" 'BEGIN {exit !(x > 0 && x < 100)}'
+expect "jog: device held and aborted" grep -q ' 1 holds, 1 aborts' "$T/jog.sim"
+expect "jog: G-code after the cancel ok" grep -qx ok "$T/jog2.out"
+expect "jog: then Idle at the origin" grep -q '^final: <Idle|MPos:0.000,0.000,0.000|' "$T/jog3.out"
+expect "jog: device back at the origin" grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps' "$T/jog.sim"
+
+# 6. TCP on loopback (port 0: any free one), a symlinked pty.
+start_sim tcp
+timeout -k 5 60 "$CS" grbl --port "$PTY" --listen 0 >"$T/tcp.grbl" 2>"$T/tcp.grblerr" &
+pids+=($!)
+GPID=$!
+wait_pty "$T/tcp.grbl" 5
+expect "tcp: 127.0.0.1:PORT printed" grep -qE '^127\.0\.0\.1:[0-9]+$' "$T/tcp.grbl"
+client "$PTY" cmd '$I' >"$T/tcp.out"
+expect "tcp: \$I answered" grep -qE '^\[VER:1\.1h' "$T/tcp.out"
+stop_all
+start_sim lnk
+start_grbl lnk --link "$T/ttyCURVESTEP"
+expect "link: symlink to the pty" [ "$(readlink "$T/ttyCURVESTEP")" = "$GPTY" ]
+client "$T/ttyCURVESTEP" cmd '$G' >"$T/lnk.out"
+expect "link: answers" grep -q '^\[GC:' "$T/lnk.out"
+stop_all
+expect "link: removed on exit" [ ! -e "$T/ttyCURVESTEP" ]
+
+# 7. usage.
+run "help: exit 0" 0 grbl --help
+expect "help: names --listen and the pty" grep -q -- '--listen \[ADDR:\]PORT' "$T/out"
+run "no --port: exit 2" 2 grbl
+run "bad --listen: exit 2" 2 grbl --port /dev/null --listen nowhere:x
+run "missing port: exit 4" 4 grbl --port "$T/none"
+
+finish

@@ -1,0 +1,257 @@
+#!/usr/bin/env python3
+"""A Grbl 1.1 sender for the tests of `curvestep grbl` (tests/cli/test_grbl.sh).
+
+Implements the two streaming methods the grbl wiki documents ("Interface", streaming
+protocols): send-response (one line, then wait for its ok / error:N) and character counting
+(keep the sum of the unacknowledged lines' lengths, newline included, at most 127 of Grbl's
+128-byte receive buffer). Written from that description, not from Grbl's stream.py.
+
+usage: grbl_client.py PTY|HOST:PORT COMMAND ...
+  stream FILE [--method simple|counting] [--hold-after N] [--status-every N]
+        streams FILE; prints one line per error ("error: line L: error:N"), the first status
+        seen while running ("running: <...>"), with --hold-after N sends ! after N lines,
+        reports "held: <...>" once the state is Hold:0 and the position has stopped, then ~;
+        at the end waits for Idle and prints "final: <...>" and "acks: OK ERR".
+  cmd LINE...     sends each line (send-response) and prints every reply line
+  jogcancel LINE  sends the $J= LINE, waits for the Jog state, sends 0x85 and prints
+                  "jogging: <...>" and "final: <...>" once Idle
+  idle            (no soft reset first) waits for Idle, prints "final: <...>"
+  raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
+Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
+Every wait has a deadline (--deadline S, default 60); a missed one exits 3.
+"""
+import os
+import re
+import select
+import socket
+import sys
+import termios
+import time
+import tty
+
+RX_SIZE = 128
+STATUS_RE = re.compile(r"^<([A-Za-z]+(?::\d)?)\|(MPos|WPos):(-?\d+\.\d{3}),(-?\d+\.\d{3}),(-?\d+\.\d{3})"
+                       r"(\|Bf:\d+,\d+)?\|FS:\d+,\d+(\|WCO:-?\d+\.\d{3},-?\d+\.\d{3},-?\d+\.\d{3})?"
+                       r"(\|Ov:\d+,\d+,\d+)?>$")
+
+
+class Grbl:
+    def __init__(self, where, deadline):
+        self.deadline = deadline
+        self.buf = b""
+        if re.match(r"^[\d.]+:\d+$", where):
+            host, port = where.rsplit(":", 1)
+            self.sock = socket.create_connection((host, int(port)), timeout=deadline)
+            self.fd = self.sock.fileno()
+        else:
+            self.sock = None
+            self.fd = os.open(where, os.O_RDWR | os.O_NOCTTY)
+            tty.setraw(self.fd)
+            termios.tcflush(self.fd, termios.TCIOFLUSH)
+
+    def write(self, data):
+        if self.sock:
+            self.sock.sendall(data)
+        else:
+            os.write(self.fd, data)
+
+    def readline(self, timeout=None):
+        """One line (without \\r\\n), or None when nothing came in timeout seconds."""
+        end = time.monotonic() + (self.deadline if timeout is None else timeout)
+        while b"\n" not in self.buf:
+            left = end - time.monotonic()
+            if left <= 0:
+                return None
+            r, _, _ = select.select([self.fd], [], [], left)
+            if r:
+                chunk = self.sock.recv(4096) if self.sock else os.read(self.fd, 4096)
+                if not chunk:
+                    return None
+                self.buf += chunk
+        line, self.buf = self.buf.split(b"\n", 1)
+        return line.decode().rstrip("\r")
+
+    def need(self, timeout=None):
+        line = self.readline(timeout)
+        if line is None:
+            print("deadline: no answer", flush=True)
+            sys.exit(3)
+        return line
+
+    def status(self):
+        """Sends ? and returns the status report (other lines are kept in self.pushed)."""
+        self.write(b"?")
+        while True:
+            line = self.need()
+            if line.startswith("<"):
+                if not STATUS_RE.match(line):
+                    print("malformed: " + line, flush=True)
+                return line
+            self.pushed.append(line)
+
+    pushed = []
+
+
+def wait_welcome(g):
+    """Soft reset, then the welcome line: a known state to start from."""
+    g.write(b"\x18")
+    while True:
+        line = g.need()
+        if line.startswith("Grbl 1.1"):
+            print("welcome: " + line, flush=True)
+            return
+
+
+def is_ack(line):
+    return line == "ok" or line.startswith("error:")
+
+
+def program(path):
+    out = []
+    for raw in open(path):
+        line = raw.strip()
+        if line:
+            out.append(line)
+    return out
+
+
+def wait_idle(g):
+    end = time.monotonic() + g.deadline
+    while time.monotonic() < end:
+        st = g.status()
+        if st.startswith("<Idle"):
+            return st
+        time.sleep(0.05)
+    print("deadline: never idle", flush=True)
+    sys.exit(3)
+
+
+def hold_and_resume(g):
+    end = time.monotonic() + g.deadline
+    last = None
+    while time.monotonic() < end:  # hold while the machine moves
+        pos = g.status().split("|")[1]
+        if last is not None and pos != last:
+            break
+        last = pos
+        time.sleep(0.05)
+    g.write(b"!")
+    last = None
+    while time.monotonic() < end:
+        st = g.status()
+        pos = st.split("|")[1]
+        if st.startswith("<Hold:0") and pos == last:
+            print("held: " + st, flush=True)
+            break
+        last = pos
+        time.sleep(0.3)
+    else:
+        print("deadline: never held", flush=True)
+        sys.exit(3)
+    time.sleep(0.3)
+    st = g.status()
+    print("still-held: " + st, flush=True)
+    g.write(b"~")
+
+
+def stream(g, lines, method, hold_after, status_every):
+    acks = {"ok": 0, "err": 0}
+    sent = []  # (line number, length) not yet acknowledged
+    seen_run = False
+
+    def take(line):
+        nonlocal seen_run
+        if line.startswith("<"):
+            if not seen_run and line.startswith("<Run"):
+                print("running: " + line, flush=True)
+                seen_run = True
+            return
+        if not is_ack(line):
+            return
+        num, _ = sent.pop(0)
+        if line == "ok":
+            acks["ok"] += 1
+        else:
+            acks["err"] += 1
+            print("error: line %d: %s" % (num, line), flush=True)
+
+    for k, line in enumerate(lines, 1):
+        data = (line + "\n").encode()
+        if method == "counting":
+            while sent and sum(n for _, n in sent) + len(data) > RX_SIZE - 1:
+                take(g.need())
+        sent.append((k, len(data)))
+        g.write(data)
+        if method == "simple":
+            while sent:
+                take(g.need())
+        if status_every and k % status_every == 0:
+            g.write(b"?")
+        if hold_after and k == hold_after:
+            while sent:
+                take(g.need())
+            hold_and_resume(g)
+    while sent:
+        take(g.need())
+    if not seen_run:
+        print("running: (job ended before a report)", flush=True)
+    print("final: " + wait_idle(g), flush=True)
+    print("acks: %d %d" % (acks["ok"], acks["err"]), flush=True)
+
+
+def main(argv):
+    deadline = 60.0
+    if "--deadline" in argv:
+        i = argv.index("--deadline")
+        deadline = float(argv[i + 1])
+        del argv[i:i + 2]
+    g = Grbl(argv[1], deadline)
+    cmd = argv[2]
+    if cmd == "idle":  # no reset: waits for what runs to end
+        print("final: " + wait_idle(g), flush=True)
+        return 0
+    wait_welcome(g)
+    if cmd == "stream":
+        method, hold_after, every = "simple", 0, 0
+        args = argv[4:]
+        for i in range(0, len(args) - 1, 2):
+            if args[i] == "--method":
+                method = args[i + 1]
+            elif args[i] == "--hold-after":
+                hold_after = int(args[i + 1])
+            elif args[i] == "--status-every":
+                every = int(args[i + 1])
+        stream(g, program(argv[3]), method, hold_after, every)
+    elif cmd == "cmd":
+        for line in argv[3:]:
+            g.write((line + "\n").encode())
+            while True:
+                reply = g.need()
+                print(reply, flush=True)
+                if is_ack(reply):
+                    break
+    elif cmd == "jogcancel":
+        g.write((argv[3] + "\n").encode())
+        print("reply: " + g.need(), flush=True)
+        end = time.monotonic() + deadline
+        while time.monotonic() < end:
+            st = g.status()
+            if st.startswith("<Jog") and not st.split("|")[1].endswith(":0.000,0.000,0.000"):
+                print("jogging: " + st, flush=True)
+                break
+            time.sleep(0.05)
+        g.write(b"\x85")
+        print("final: " + wait_idle(g), flush=True)
+    elif cmd == "raw":
+        for b in argv[3:]:
+            g.write(bytes([int(b, 16)]))
+        while True:
+            line = g.readline(1.0)
+            if line is None:
+                break
+            print(line, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
