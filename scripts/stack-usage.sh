@@ -6,6 +6,16 @@
 # listed as entry points instead) and a recursive cycle is reported, not followed.
 # Usage: stack-usage.sh CC "CFLAGS" "ENTRY..." SOURCE...   (prints "entry bytes path" lines)
 set -euo pipefail
+usage='usage: stack-usage.sh CC "CFLAGS" "ENTRY..." SOURCE...\nWorst-case stack of each ENTRY (bytes and call path) from -fstack-usage and\n-fcallgraph-info=su; run by make bench (docs/firmware.md).'
+# Only the first word can be an option: CFLAGS itself starts with '-'.
+case "${1:-}" in
+-h | --help) printf '%b\n' "$usage"; exit 0 ;;
+-*) printf 'stack-usage.sh: unknown option %s\n%b\n' "$1" "$usage" >&2; exit 2 ;;
+esac
+if [ $# -lt 4 ]; then
+    printf '%b\n' "$usage" >&2
+    exit 2
+fi
 cc=$1 cflags=$2 entries=$3
 shift 3
 dir=$(mktemp -d)

@@ -215,7 +215,7 @@ run "fusion grbl path" 0 flatten --dialect grbl "$DATA/fusion360-grbl.nc" &&
         grep -qx '5.000000 25.000000' "$T/out" && [ "$(sed -n 2p "$T/out")" = "5.000000 5.000000" ] &&
         ok || ko "fusion grbl path: $(tr '\n' ' ' <"$T/out" | cut -c1-200)"; }
 run "dialect bad" 2 flatten --dialect fanuc "$DATA/fusion360-grbl.nc" &&
-    expect_err "dialect bad" "--dialect wants linuxcnc or grbl"
+    expect_err "dialect bad" "dialect wants linuxcnc or grbl"
 printf 'G1 X1.25 F10\n' >"$T/units.nc"
 run "units inch" 0 flatten --units inch "$T/units.nc" && expect_out "units inch" '0.000000 0.000000\n31.750000 0.000000\n'
 # CamBam: T0 M6 refused where it stands; with --lenient the part reads (G64 without P, G91.1, G40).
