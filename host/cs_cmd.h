@@ -28,6 +28,9 @@ int cs_cmd_plan(int argc, char **argv);
 /* curvestep toolpath --patches FILE [--view V] [--lines N] [--tol MM] [--svg OUT.svg]
  *                    [--ball R --scallop H [--safe-z Z]] */
 int cs_cmd_toolpath(int argc, char **argv);
+/* curvestep toolpath --cutter ball:R|flat:R|bull:R:r ...: drop-cutter finishing (cs_toolpath
+ * hands over any command line with --cutter; the options are in toolpath's --help). */
+int cs_cmd_toolpath_drop(int argc, char **argv);
 
 /* curvestep stream --port DEV [--baud N] [--machine FILE.ini] [--mode segments|curves]
  * [--tol MM] [--feed MM/S] [--resume-from N] [--line-rate BPS] [--quiet] [JOBOPTS] FILE */

@@ -54,7 +54,12 @@ static void tp_usage(FILE *f)
         "                          [--scale S] [--stats] [--svg OUT.svg]\n"
         "       curvestep toolpath --patches FILE --ball R --scallop H [--tol MM]\n"
         "                          [--safe-z Z] [--scale S] [--view V] [--svg OUT.svg]\n"
-        "       (either form also takes --gcode OUT.nc)\n"
+        "       curvestep toolpath --patches FILE --cutter ball:R|flat:R|bull:R:r\n"
+        "                          (--scallop H | --stepover MM) [--angle DEG] [--tol MM]\n"
+        "                          [--output tip|centre] [--feed F] [--plunge F] [--spindle S]\n"
+        "                          [--safe-z Z] [--min-z Z] [--stock X0,Y0,X1,Y1] [--scale S]\n"
+        "                          [--check [--check-step MM]] [--stats] [--gcode OUT.nc]\n"
+        "       (the first two forms also take --gcode OUT.nc)\n"
         "\n"
         "Reads surface patches and prints a path over them. FILE is in Newell's format (a\n"
         "patch count; one line of 16 one-based vertex indices per patch; a vertex count; one\n"
@@ -80,6 +85,31 @@ static void tp_usage(FILE *f)
         "folds back on itself there (loops that close within a pass are cut at the crossing)\n"
         "or faces down (undercut). n-sided patches are finished as bicubic cells fitted within\n"
         "tol / 2, one block per cell. See docs/surfaces.md.\n"
+        "\n"
+        "Drop-cutter finishing (--cutter): gouge-free from above for ball, flat and\n"
+        "bull-nose cutters. The surface is meshed within tol / 4 (a proven bound), the cutter\n"
+        "enlarged by that bound is dropped onto the mesh along a zig-zag raster (OpenCAMLib's\n"
+        "drop-cutter: facet, edge and vertex contacts), points along each pass added until\n"
+        "every chord is within tol of the drop height, and passes added between two\n"
+        "neighbours until the material left between them (measured vertically) is at most H\n"
+        "(a ball; flat and bull-nose ends take the flat-ground step-over for H, or --stepover,\n"
+        "and their scallop is reported, not promised: they leave steps on every slope).\n"
+        "Prints the programmed point \"x y z\" (mm) per line, a blank line between passes.\n"
+        "  --cutter K      ball:R, flat:R or bull:R:r (radius R, corner radius r, mm)\n"
+        "  --scallop H     largest material height left between passes, mm\n"
+        "  --stepover MM   a fixed step-over instead (no scallop refinement)\n"
+        "  --angle DEG     raster direction from +x (default 0: passes along x)\n"
+        "  --output P      tip (default) or centre (of the corner radius: the ball's centre)\n"
+        "  --feed F        cutting feed in mm/min on every G1 (default 1000)\n"
+        "  --plunge F      plunge feed in mm/min (default 300)\n"
+        "  --spindle S     M3 S<S> before cutting, M5 after (default: no spindle words)\n"
+        "  --min-z Z       the lowest the tip goes (default: the surface's lowest point)\n"
+        "  --stock BOX     X0,Y0,X1,Y1: the region the cutter's axis covers (default: the\n"
+        "                  surface's extent and R beyond)\n"
+        "  --check         measure, against dense samples of the exact surface, the deepest\n"
+        "                  penetration of the cutter along the path and the largest material\n"
+        "                  height left; exit 1 when over --tol or H (--check-step MM: the\n"
+        "                  sampling step, default H / 2 within 0.02..0.1 mm)\n"
         "\n"
         "Options:\n"
         "  --patches FILE  the surface file ('-' reads standard input)\n"
@@ -618,6 +648,12 @@ static cs_err_t write_svg(const char *file, const cs_path_poly_t *poly, const ch
 
 int cs_cmd_toolpath(int argc, char **argv)
 {
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0)
+            break;
+        if (strncmp(argv[i], "--cutter", 8) == 0 && (argv[i][8] == '\0' || argv[i][8] == '='))
+            return cs_cmd_toolpath_drop(argc, argv);
+    }
     static const struct option longopts[] = {
         {"patches", required_argument, NULL, 'p'},
         {"view", required_argument, NULL, 'v'},

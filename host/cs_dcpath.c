@@ -1,0 +1,367 @@
+/* cs_dcpath: raster passes, adaptive along each pass, refined across by scallop (cs_dcpath.h). */
+#include "cs_dcpath.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
+#define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap */
+#define DC_PASS_MAXPTS (1u << 22)
+
+/* One pass being built: points along s, in increasing s. */
+typedef struct {
+    double *s, *z;
+    size_t n, cap;
+} dc_line_t;
+
+typedef struct {
+    cs_dropcut_mesh_t *ms;
+    const cs_dropcut_tool_t *t;
+    const cs_dcpath_opts_t *o;
+    double d[2], e[2]; /* along and across unit vectors */
+    size_t drops;
+} dc_ctx_t;
+
+void cs_dcpath_init(cs_dcpath_t *p)
+{
+    memset(p, 0, sizeof *p);
+}
+
+double cs_dcpath_step(const cs_dropcut_tool_t *t, double h)
+{
+    double a = t->r_mm - t->c_mm, r = t->c_mm;
+    if (r <= 0)
+        return 2 * t->r_mm * 0.9;
+    double hh = fmin(h, r);
+    return 2 * a + 2 * sqrt(2 * r * hh - hh * hh);
+}
+
+static double tip_at(dc_ctx_t *c, double s, double w)
+{
+    bool hit;
+    double x = s * c->d[0] + w * c->e[0], y = s * c->d[1] + w * c->e[1];
+    double z = cs_dropcut_drop(c->ms, c->t, x, y, &hit);
+    c->drops++;
+    return hit ? fmax(z, c->o->min_z) : c->o->min_z;
+}
+
+static bool line_push(dc_line_t *l, double s, double z)
+{
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? 2 * l->cap : 256;
+        if (cap > DC_PASS_MAXPTS)
+            return false;
+        double *ns = realloc(l->s, cap * sizeof *ns);
+        if (!ns)
+            return false;
+        l->s = ns;
+        double *nz = realloc(l->z, cap * sizeof *nz);
+        if (!nz)
+            return false;
+        l->z = nz;
+        l->cap = cap;
+    }
+    l->s[l->n] = s;
+    l->z[l->n++] = z;
+    return true;
+}
+
+/* Adds the points strictly inside (sa, sb) that keep every chord within tol of the drop height:
+ * the midpoint and both quarter points are compared with the chord. */
+static bool refine(dc_ctx_t *c, dc_line_t *l, double w, double sa, double za, double sb,
+                   double zb, int depth)
+{
+    double sm = (sa + sb) / 2, zm = tip_at(c, sm, w);
+    /* Half the tolerance at the sampled points leaves room for what lies between them. */
+    double tol = c->o->tol_mm / 2;
+    bool split = fabs(zm - (za + zb) / 2) > tol;
+    if (!split) { /* the quarters too: near a kink (the floor, an edge) the midpoint hides it */
+        double q1 = tip_at(c, (sa + sm) / 2, w), q3 = tip_at(c, (sm + sb) / 2, w);
+        split = fabs(q1 - (3 * za + zb) / 4) > tol || fabs(q3 - (za + 3 * zb) / 4) > tol;
+    }
+    if (split && (depth >= DC_MAX_DEPTH || sb - sa < c->o->tol_mm)) {
+        /* A step too short to resolve: the drop height jumps (the cutter reaching the edge of
+         * the surface, a wall). Cross it at the higher height, rising before the move and
+         * descending after it, never along a slope that would cut into the step. */
+        return line_push(l, za >= zb ? sb : sa, fmax(za, zb));
+    }
+    if (!split)
+        return true;
+    return refine(c, l, w, sa, za, sm, zm, depth + 1) && line_push(l, sm, zm) &&
+           refine(c, l, w, sm, zm, sb, zb, depth + 1);
+}
+
+/* The s range of the line at cross offset w inside the region box; false when it misses it. */
+static bool clip(const dc_ctx_t *c, double w, double *s0, double *s1)
+{
+    const double *b = c->o->box;
+    double lo = -HUGE_VAL, hi = HUGE_VAL;
+    for (int k = 0; k < 2; k++) {
+        double p = w * c->e[k], dk = c->d[k];
+        if (fabs(dk) < 1e-12) {
+            if (p < b[k] - 1e-9 || p > b[k + 2] + 1e-9)
+                return false;
+            continue;
+        }
+        double ta = (b[k] - p) / dk, tb = (b[k + 2] - p) / dk;
+        lo = fmax(lo, fmin(ta, tb));
+        hi = fmin(hi, fmax(ta, tb));
+    }
+    *s0 = lo;
+    *s1 = hi;
+    return hi >= lo;
+}
+
+static bool build_line(dc_ctx_t *c, dc_line_t *l, double w)
+{
+    l->n = 0;
+    double s0, s1;
+    if (!clip(c, w, &s0, &s1))
+        return true;
+    /* Base samples no farther apart than a quarter of the tool radius. */
+    double base = fmax(c->t->r_mm / 4, c->o->tol_mm);
+    size_t n = (size_t)ceil((s1 - s0) / base);
+    n = n ? n : 1;
+    double sp = s0, zp = tip_at(c, s0, w);
+    if (!line_push(l, sp, zp))
+        return false;
+    for (size_t k = 1; k <= n; k++) {
+        double s = s0 + (s1 - s0) * (double)k / (double)n, z = tip_at(c, s, w);
+        if (!refine(c, l, w, sp, zp, s, z, 0) || !line_push(l, s, z))
+            return false;
+        sp = s;
+        zp = z;
+    }
+    return true;
+}
+
+/* z of a pass at s, linear between its points (the pass's own ends beyond). */
+static double line_z(const dc_line_t *l, double s)
+{
+    if (s <= l->s[0])
+        return l->z[0];
+    if (s >= l->s[l->n - 1])
+        return l->z[l->n - 1];
+    size_t lo = 0, hi = l->n - 1;
+    while (hi - lo > 1) {
+        size_t m = (lo + hi) / 2;
+        if (l->s[m] <= s)
+            lo = m;
+        else
+            hi = m;
+    }
+    if (l->s[hi] <= l->s[lo]) /* a vertical step: the higher side */
+        return fmax(l->z[lo], l->z[hi]);
+    double f = (s - l->s[lo]) / (l->s[hi] - l->s[lo]);
+    return l->z[lo] + f * (l->z[hi] - l->z[lo]);
+}
+
+/* Is the point within R of the rim of the surface's projection (seen at four points R away)? */
+static bool near_rim(dc_ctx_t *c, double x, double y)
+{
+    double r = c->t->r_mm, z;
+    return !cs_dropcut_top(c->ms, x + r, y, &z) || !cs_dropcut_top(c->ms, x - r, y, &z) ||
+           !cs_dropcut_top(c->ms, x, y + r, &z) || !cs_dropcut_top(c->ms, x, y - r, &z);
+}
+
+/* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
+ * with the cutters of every line within R of the point (at the same along-pass position); *cusp
+ * gets the gap (the lower of the two lines) whose cutters meet at the worst point: on a slope
+ * that is not gap i, for each cutter touches the surface uphill of its axis. */
+static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w, size_t n,
+                           size_t i, size_t *cusp)
+{
+    const dc_line_t *a = &lines[i], *b = &lines[i + 1];
+    const dc_line_t *fine = a->n >= b->n ? a : b;
+    double worst = 0, r = c->t->r_mm;
+    *cusp = i;
+    if (a->n == 0 || b->n == 0)
+        return 0;
+    size_t lo = i, hi = i + 1;
+    while (lo > 0 && w[i] - w[lo - 1] <= r)
+        lo--;
+    while (hi + 1 < n && w[hi + 1] - w[i + 1] <= r)
+        hi++;
+    for (size_t k = 0; k < fine->n; k++) {
+        double s = fine->s[k];
+        for (int f = 1; f <= DC_SCAN_FRACS; f++) {
+            double wp = w[i] + (w[i + 1] - w[i]) * f / (DC_SCAN_FRACS + 1.0);
+            double env = HUGE_VAL, env2 = HUGE_VAL;
+            size_t j1 = i, j2 = i + 1;
+            for (size_t j = lo; j <= hi; j++) {
+                double d = fabs(w[j] - wp);
+                if (d > r || lines[j].n == 0)
+                    continue;
+                double e = line_z(&lines[j], s) + cs_dropcut_profile(c->t, d);
+                if (e < env) {
+                    env2 = env, j2 = j1;
+                    env = e, j1 = j;
+                } else if (e < env2) {
+                    env2 = e, j2 = j;
+                }
+            }
+            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top;
+            if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y))
+                continue; /* the scallop is promised where the cutter lies over the surface */
+            double left = env - fmax(top, c->o->min_z);
+            if (left > worst) {
+                worst = left;
+                /* the gap next to the lowest cutter, towards the second lowest */
+                *cusp = j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+            }
+        }
+    }
+    return worst;
+}
+
+static cs_err_t add_pass(cs_dcpath_t *p, const dc_ctx_t *c, const dc_line_t *l, double w)
+{
+    if (p->npass + 1 >= p->pcap) {
+        size_t cap = p->pcap ? 2 * p->pcap : 64;
+        size_t *ns = realloc(p->start, (cap + 1) * sizeof *ns);
+        if (!ns)
+            return CS_ERR_FULL;
+        p->start = ns;
+        double *nw = realloc(p->w, cap * sizeof *nw);
+        if (!nw)
+            return CS_ERR_FULL;
+        p->w = nw;
+        p->pcap = cap;
+    }
+    if (p->n + l->n > p->cap) {
+        size_t cap = p->cap ? p->cap : 1024;
+        while (cap < p->n + l->n)
+            cap *= 2;
+        double(*np)[3] = realloc(p->pt, cap * sizeof *np);
+        if (!np)
+            return CS_ERR_FULL;
+        p->pt = np;
+        p->cap = cap;
+    }
+    if (p->npass == 0)
+        p->start[0] = 0;
+    bool rev = p->npass % 2 == 1; /* zig-zag */
+    for (size_t k = 0; k < l->n; k++) {
+        size_t i = rev ? l->n - 1 - k : k;
+        double *q = p->pt[p->n++];
+        q[0] = l->s[i] * c->d[0] + w * c->e[0];
+        q[1] = l->s[i] * c->d[1] + w * c->e[1];
+        q[2] = l->z[i];
+    }
+    p->w[p->npass++] = w;
+    p->start[p->npass] = p->n;
+    return CS_OK;
+}
+
+/* The lines of the raster, in cross order, while it is refined. */
+typedef struct {
+    dc_line_t *l;
+    double *w;
+    size_t n, cap;
+} dc_set_t;
+
+static cs_err_t set_insert(dc_set_t *set, size_t at, dc_line_t *l, double w)
+{
+    if (set->n == set->cap) {
+        size_t cap = set->cap ? 2 * set->cap : 64;
+        dc_line_t *nl = realloc(set->l, cap * sizeof *nl);
+        if (!nl)
+            return CS_ERR_FULL;
+        set->l = nl;
+        double *nw = realloc(set->w, cap * sizeof *nw);
+        if (!nw)
+            return CS_ERR_FULL;
+        set->w = nw;
+        set->cap = cap;
+    }
+    memmove(&set->l[at + 1], &set->l[at], (set->n - at) * sizeof *set->l);
+    memmove(&set->w[at + 1], &set->w[at], (set->n - at) * sizeof *set->w);
+    set->l[at] = *l;
+    set->w[at] = w;
+    set->n++;
+    return CS_OK;
+}
+
+/* Halves the gap whose cutters leave more than H - eps between them (found from every gap in
+ * turn), until none does or the gap is below min_gap (steep walls, concave corners narrower
+ * than the cutter: reported by max_left). */
+static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double min_gap)
+{
+    double need = c->o->scallop_mm - c->ms->eps;
+    cs_err_t e = CS_OK;
+    for (size_t i = 0; i + 1 < set->n && e == CS_OK;) {
+        size_t g;
+        double left = left_between(c, set->l, set->w, set->n, i, &g);
+        if (g + 1 >= set->n)
+            g = i;
+        if (left <= need || set->w[g + 1] - set->w[g] < 2 * min_gap ||
+            set->n >= c->o->max_passes) {
+            p->capped |= left > need && set->n >= c->o->max_passes;
+            p->max_left = fmax(p->max_left, left);
+            i++;
+            continue;
+        }
+        dc_line_t m = {0};
+        double wm = (set->w[g] + set->w[g + 1]) / 2;
+        e = build_line(c, &m, wm) ? CS_OK : CS_ERR_FULL;
+        if (e == CS_OK)
+            e = set_insert(set, g + 1, &m, wm);
+        p->refined++;
+        if (g < i)
+            i = g; /* the new line changes the estimates from gap g on */
+    }
+    return e;
+}
+
+cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                          const cs_dcpath_opts_t *o)
+{
+    double a = o->angle_deg * M_PI / 180;
+    dc_ctx_t c = {ms, t, o, {cos(a), sin(a)}, {-sin(a), cos(a)}, 0};
+    double step = o->step_mm > 0 ? o->step_mm : cs_dcpath_step(t, o->scallop_mm);
+    if (!(step > 0) || !(o->tol_mm > 0) || o->box[2] < o->box[0] || o->box[3] < o->box[1])
+        return CS_ERR_RANGE;
+    /* The cross extent of the region: its corners projected on e. */
+    double w0 = HUGE_VAL, w1 = -HUGE_VAL;
+    for (int k = 0; k < 4; k++) {
+        double x = o->box[(k & 1) ? 2 : 0], y = o->box[(k & 2) ? 3 : 1];
+        w0 = fmin(w0, x * c.e[0] + y * c.e[1]);
+        w1 = fmax(w1, x * c.e[0] + y * c.e[1]);
+    }
+    size_t n = (size_t)ceil((w1 - w0) / step);
+    n = n ? n : 1;
+    dc_set_t set = {0};
+    cs_err_t e = CS_OK;
+    for (size_t k = 0; k <= n && e == CS_OK; k++) {
+        dc_line_t l = {0};
+        double w = w0 + (w1 - w0) * (double)k / (double)n;
+        e = build_line(&c, &l, w) ? CS_OK : CS_ERR_FULL;
+        if (e == CS_OK)
+            e = set_insert(&set, set.n, &l, w);
+    }
+    /* Only a ball's scallop is a matter of step-over alone: a flat or bull-nose end leaves
+     * steps on every slope, whatever the spacing (their step-over is stated, not refined). */
+    if (e == CS_OK && o->step_mm <= 0 && t->c_mm >= t->r_mm)
+        e = refine_gaps(p, &c, &set, step / 16);
+    else if (e == CS_OK)
+        p->max_left = NAN;
+    for (size_t k = 0; k < set.n; k++) {
+        if (e == CS_OK && set.l[k].n > 0)
+            e = add_pass(p, &c, &set.l[k], set.w[k]);
+        free(set.l[k].s);
+        free(set.l[k].z);
+    }
+    free(set.l);
+    free(set.w);
+    p->drops = c.drops;
+    return e;
+}
+
+void cs_dcpath_free(cs_dcpath_t *p)
+{
+    free(p->pt);
+    free(p->start);
+    free(p->w);
+    cs_dcpath_init(p);
+}

@@ -1,0 +1,52 @@
+/* cs_dcpath: raster finishing passes over a drop-cutter mesh (issue 20). Owns the passes: each
+ * a polyline of tool-tip points (mm) along a line of the raster, sampled adaptively so that the
+ * chords stay within tol of the drop-cutter height along the line, and spaced so that the
+ * height of material left between two neighbouring passes (measured vertically above the mesh,
+ * which is within eps of the surface) stays at most H. Host only, double precision.
+ *
+ * Spacing: the nominal step-over is the flat-ground one (ball 2 sqrt(2RH - H^2); bull-nose
+ * 2(R - r) + 2 sqrt(2rH - H^2); flat end mill 2R x 0.9), then every neighbouring pair is checked
+ * at cross fractions 1/8 .. 7/8 of the gap and every sample of the finer pass: the cutter of each
+ * pass at the same along-pass position leaves E = min(zA + h(f w), zB + h((1 - f) w)) above the
+ * mesh top S; where E - S > H - eps a pass is added halfway, recursively. Cutters at other
+ * along-pass positions only cut more, so the estimate is conservative. */
+#ifndef CS_DCPATH_H
+#define CS_DCPATH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "cs_dropcut.h"
+
+typedef struct {
+    double angle_deg;  /* raster direction, degrees from +x (0: passes along x) */
+    double scallop_mm; /* H > 0 */
+    double step_mm;    /* > 0: fixed step-over (no scallop refinement); 0: from H */
+    double tol_mm;     /* chord tolerance along a pass */
+    double box[4];     /* x0 y0 x1 y1: the region the tool axis covers */
+    double min_z;      /* the floor: the tip never goes lower */
+    size_t max_passes; /* refinement stops here (a warning) */
+} cs_dcpath_opts_t;
+
+typedef struct {
+    double (*pt)[3];   /* tip points, mm */
+    size_t n, cap;
+    size_t *start;     /* pass k is pt[start[k] .. start[k + 1]) */
+    double *w;         /* pass k's cross offset, mm */
+    size_t npass, pcap;
+    double max_left;   /* largest estimated scallop left between passes, mm */
+    size_t refined;    /* passes added by the scallop check */
+    bool capped;       /* max_passes was reached */
+    size_t drops;      /* drop-cutter queries made */
+} cs_dcpath_t;
+
+void cs_dcpath_init(cs_dcpath_t *p);
+/* Nominal step-over (mm) of tool t for scallop height h (flat ground). */
+double cs_dcpath_step(const cs_dropcut_tool_t *t, double h);
+/* Plans the raster of o over mesh ms for tool t into p, passes in cutting order (zig-zag).
+ * CS_ERR_FULL out of memory, CS_ERR_RANGE for a region or step that makes no sense. */
+cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                          const cs_dcpath_opts_t *o);
+void cs_dcpath_free(cs_dcpath_t *p);
+
+#endif

@@ -1,0 +1,302 @@
+/* cs_dropcheck: gouge and scallop of a finishing path, measured against dense samples of the
+ * exact surface (cs_dropcheck.h). */
+#include "cs_dropcheck.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_finish.h"
+#include "cs_varady.h"
+
+#define CK_MAX_K 1200 /* samples a patch in each direction, at most */
+
+typedef struct {
+    /* surface samples bucketed by xy cell */
+    double (*s)[3];
+    size_t ns, scap;
+    double cell;
+    double org[2];
+    size_t gx, gy;
+    size_t *start, *idx;
+    /* the z-map over the region */
+    double box[4], step;
+    size_t mx, my;
+    double *top, *env;
+} ck_t;
+
+static cs_err_t push_sample(ck_t *k, const double p[3])
+{
+    if (k->ns == k->scap) {
+        size_t cap = k->scap ? 2 * k->scap : 65536;
+        double(*n)[3] = realloc(k->s, cap * sizeof *n);
+        if (!n)
+            return CS_ERR_FULL;
+        k->s = n;
+        k->scap = cap;
+    }
+    memcpy(k->s[k->ns++], p, 3 * sizeof *p);
+    return CS_OK;
+}
+
+/* Node index of a map coordinate, or SIZE_MAX outside. */
+static size_t node(const ck_t *k, long ix, long iy)
+{
+    if (ix < 0 || iy < 0 || (size_t)ix >= k->mx || (size_t)iy >= k->my)
+        return (size_t)-1;
+    return (size_t)iy * k->mx + (size_t)ix;
+}
+
+/* Rasterises triangle a b c into the top map (max of its interpolated z at covered nodes). */
+static void raster_tri(ck_t *k, const double *a, const double *b, const double *c)
+{
+    double x0 = fmin(fmin(a[0], b[0]), c[0]), x1 = fmax(fmax(a[0], b[0]), c[0]);
+    double y0 = fmin(fmin(a[1], b[1]), c[1]), y1 = fmax(fmax(a[1], b[1]), c[1]);
+    double det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+    if (fabs(det) < 1e-18)
+        return;
+    for (long iy = (long)ceil((y0 - k->box[1]) / k->step); iy <= (long)floor((y1 - k->box[1]) / k->step); iy++)
+        for (long ix = (long)ceil((x0 - k->box[0]) / k->step); ix <= (long)floor((x1 - k->box[0]) / k->step); ix++) {
+            size_t n = node(k, ix, iy);
+            if (n == (size_t)-1)
+                continue;
+            double x = k->box[0] + (double)ix * k->step, y = k->box[1] + (double)iy * k->step;
+            double l1 = ((b[1] - c[1]) * (x - c[0]) + (c[0] - b[0]) * (y - c[1])) / det;
+            double l2 = ((c[1] - a[1]) * (x - c[0]) + (a[0] - c[0]) * (y - c[1])) / det;
+            double l3 = 1 - l1 - l2;
+            if (l1 < -1e-12 || l2 < -1e-12 || l3 < -1e-12)
+                continue;
+            k->top[n] = fmax(k->top[n], l1 * a[2] + l2 * b[2] + l3 * c[2]);
+        }
+}
+
+/* Samples one patch densely: points for the gouge test, triangles into the top map. */
+static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
+{
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double p[3];
+            cs_finish_eval(q, i / 3.0, j / 3.0, p, NULL);
+            for (int c = 0; c < 3; c++) {
+                lo[c] = fmin(lo[c], p[c]);
+                hi[c] = fmax(hi[c], p[c]);
+            }
+        }
+    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    int kk = (int)fmin(CK_MAX_K, fmax(8, ceil(diag / k->step)));
+    double *row = malloc(2 * (size_t)(kk + 1) * 3 * sizeof *row);
+    if (!row)
+        return CS_ERR_FULL;
+    cs_err_t e = CS_OK;
+    for (int i = 0; i <= kk && e == CS_OK; i++) {
+        double *cur = row + (size_t)(i & 1) * (size_t)(kk + 1) * 3;
+        double *prev = row + (size_t)((i + 1) & 1) * (size_t)(kk + 1) * 3;
+        for (int j = 0; j <= kk && e == CS_OK; j++) {
+            cs_finish_eval(q, (double)i / kk, (double)j / kk, &cur[j * 3], NULL);
+            e = push_sample(k, &cur[j * 3]);
+        }
+        for (int j = 0; i > 0 && j < kk; j++) {
+            raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
+            raster_tri(k, &prev[j * 3], &cur[(j + 1) * 3], &prev[(j + 1) * 3]);
+        }
+    }
+    free(row);
+    return e;
+}
+
+static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
+{
+    cs_patch_t *cells = malloc(CS_VARADY_MAX_PATCHES * sizeof *cells);
+    if (!cells)
+        return CS_ERR_FULL;
+    cs_err_t e = CS_OK;
+    for (size_t i = 0; i < sf->n && e == CS_OK; i++) {
+        const cs_surf_item_t *it = &sf->items[i];
+        size_t nc = 1;
+        double fit;
+        if (it->tri)
+            e = cs_finish_tri_patch(&it->trip, &cells[0]);
+        else if (it->varady)
+            e = cs_varady_patches(&it->nside, k->step / 4, cells, NULL, CS_VARADY_MAX_PATCHES, &nc,
+                                  &fit);
+        else
+            cells[0] = it->quad;
+        for (size_t c = 0; c < nc && e == CS_OK; c++)
+            e = sample_patch(k, &cells[c]);
+    }
+    free(cells);
+    return e;
+}
+
+/* Buckets the samples by xy cells of size cell. */
+static cs_err_t bucket(ck_t *k, double cell)
+{
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    for (size_t i = 0; i < k->ns; i++)
+        for (int c = 0; c < 2; c++) {
+            lo[c] = fmin(lo[c], k->s[i][c]);
+            hi[c] = fmax(hi[c], k->s[i][c]);
+        }
+    k->cell = cell;
+    k->org[0] = lo[0];
+    k->org[1] = lo[1];
+    k->gx = (size_t)((hi[0] - lo[0]) / cell) + 1;
+    k->gy = (size_t)((hi[1] - lo[1]) / cell) + 1;
+    size_t nc = k->gx * k->gy;
+    k->start = calloc(nc + 1, sizeof *k->start);
+    k->idx = malloc((k->ns + 1) * sizeof *k->idx);
+    if (!k->start || !k->idx)
+        return CS_ERR_FULL;
+    for (size_t i = 0; i < k->ns; i++) {
+        size_t cx = (size_t)((k->s[i][0] - lo[0]) / cell), cy = (size_t)((k->s[i][1] - lo[1]) / cell);
+        k->start[cy * k->gx + cx + 1]++;
+    }
+    for (size_t c = 0; c < nc; c++)
+        k->start[c + 1] += k->start[c];
+    for (size_t i = 0; i < k->ns; i++) {
+        size_t cx = (size_t)((k->s[i][0] - lo[0]) / cell), cy = (size_t)((k->s[i][1] - lo[1]) / cell);
+        k->idx[k->start[cy * k->gx + cx]++] = i;
+    }
+    for (size_t c = nc; c > 0; c--)
+        k->start[c] = k->start[c - 1];
+    k->start[0] = 0;
+    return CS_OK;
+}
+
+/* One cutter position: its deepest penetration and its footprint on the envelope. */
+static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dropcheck_t *o)
+{
+    double r = t->r_mm;
+    long cx0 = (long)floor((p[0] - r - k->org[0]) / k->cell), cx1 = (long)floor((p[0] + r - k->org[0]) / k->cell);
+    long cy0 = (long)floor((p[1] - r - k->org[1]) / k->cell), cy1 = (long)floor((p[1] + r - k->org[1]) / k->cell);
+    for (long cy = cy0 < 0 ? 0 : cy0; cy <= cy1 && cy < (long)k->gy; cy++)
+        for (long cx = cx0 < 0 ? 0 : cx0; cx <= cx1 && cx < (long)k->gx; cx++) {
+            size_t c = (size_t)cy * k->gx + (size_t)cx;
+            for (size_t m = k->start[c]; m < k->start[c + 1]; m++) {
+                const double *s = k->s[k->idx[m]];
+                double d = hypot(s[0] - p[0], s[1] - p[1]);
+                if (d > r)
+                    continue;
+                double pen = s[2] - (p[2] + cs_dropcut_profile(t, d));
+                if (pen > o->gouge_mm) {
+                    o->gouge_mm = pen;
+                    memcpy(o->gouge_at, s, sizeof o->gouge_at);
+                    memcpy(o->gouge_tool, p, sizeof o->gouge_tool);
+                }
+            }
+        }
+    long ix0 = (long)ceil((p[0] - r - k->box[0]) / k->step), ix1 = (long)floor((p[0] + r - k->box[0]) / k->step);
+    long iy0 = (long)ceil((p[1] - r - k->box[1]) / k->step), iy1 = (long)floor((p[1] + r - k->box[1]) / k->step);
+    for (long iy = iy0; iy <= iy1; iy++)
+        for (long ix = ix0; ix <= ix1; ix++) {
+            size_t n = node(k, ix, iy);
+            if (n == (size_t)-1)
+                continue;
+            double d = hypot(k->box[0] + (double)ix * k->step - p[0], k->box[1] + (double)iy * k->step - p[1]);
+            if (d <= r)
+                k->env[n] = fmin(k->env[n], p[2] + cs_dropcut_profile(t, d));
+        }
+}
+
+static void walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3], const size_t *start,
+                 size_t npass, cs_dropcheck_t *o)
+{
+    for (size_t pass = 0; pass < npass; pass++)
+        for (size_t i = start[pass]; i < start[pass + 1]; i++) {
+            const double *a = pts[i], *b = i + 1 < start[pass + 1] ? pts[i + 1] : pts[i];
+            double len = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                              (b[2] - a[2]) * (b[2] - a[2]));
+            size_t n = (size_t)ceil(len / k->step);
+            for (size_t j = 0; j <= n || j == 0; j++) {
+                double f = n ? (double)j / (double)n : 0, p[3];
+                for (int c = 0; c < 3; c++)
+                    p[c] = a[c] + f * (b[c] - a[c]);
+                visit(k, t, p, o);
+                o->path_samples++;
+                if (n == 0)
+                    break;
+            }
+        }
+}
+
+/* Marks in far[] the nodes at least r_nodes (chessboard distance) from every node with no
+ * surface above it: the interior where a cutter of radius r lies over the surface all round.
+ * Two-pass distance transform (Rosenfeld and Pfaltz), capped at r_nodes + 1. */
+static bool interior(const ck_t *k, long r_nodes, unsigned char *far)
+{
+    size_t nn = k->mx * k->my;
+    long *d = malloc(nn * sizeof *d);
+    if (!d)
+        return false;
+    long cap = r_nodes + 1;
+    for (size_t n = 0; n < nn; n++)
+        d[n] = k->top[n] == -HUGE_VAL ? 0 : cap;
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t i = 0; i < nn; i++) {
+            size_t n = pass == 0 ? i : nn - 1 - i;
+            long ix = (long)(n % k->mx), iy = (long)(n / k->mx), s = pass == 0 ? -1 : 1;
+            long nb[4][2] = {{ix + s, iy}, {ix - 1, iy + s}, {ix, iy + s}, {ix + 1, iy + s}};
+            for (int j = 0; j < 4; j++) {
+                size_t m = node(k, nb[j][0], nb[j][1]);
+                long dm = m == (size_t)-1 ? 0 : d[m]; /* beyond the map: no surface known */
+                if (dm + 1 < d[n])
+                    d[n] = dm + 1;
+            }
+        }
+    for (size_t n = 0; n < nn; n++)
+        far[n] = d[n] > r_nodes;
+    free(d);
+    return true;
+}
+
+cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                          const double (*pts)[3], const size_t *start, size_t npass,
+                          const double box[4], double step_mm, cs_dropcheck_t *out)
+{
+    memset(out, 0, sizeof *out);
+    ck_t k;
+    memset(&k, 0, sizeof k);
+    memcpy(k.box, box, sizeof k.box);
+    k.step = step_mm;
+    k.mx = (size_t)floor((box[2] - box[0]) / step_mm) + 1;
+    k.my = (size_t)floor((box[3] - box[1]) / step_mm) + 1;
+    k.top = malloc(k.mx * k.my * sizeof *k.top);
+    k.env = malloc(k.mx * k.my * sizeof *k.env);
+    unsigned char *far = NULL;
+    cs_err_t e = k.top && k.env ? CS_OK : CS_ERR_FULL;
+    for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
+        k.top[n] = -HUGE_VAL;
+        k.env[n] = HUGE_VAL;
+    }
+    if (e == CS_OK)
+        e = sample_all(&k, sf);
+    if (e == CS_OK)
+        e = bucket(&k, fmax(t->r_mm / 2, step_mm));
+    if (e == CS_OK) {
+        walk(&k, t, pts, start, npass, out);
+        out->surf_samples = k.ns;
+        far = malloc(k.mx * k.my);
+        if (!far || !interior(&k, (long)ceil(t->r_mm / step_mm), far))
+            e = CS_ERR_FULL;
+        for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
+            if (k.top[n] == -HUGE_VAL || k.env[n] == HUGE_VAL || !far[n])
+                continue;
+            out->nodes++;
+            double left = k.env[n] - k.top[n];
+            if (left > out->scallop_mm) {
+                out->scallop_mm = left;
+                out->scallop_at[0] = box[0] + (double)(n % k.mx) * step_mm;
+                out->scallop_at[1] = box[1] + (double)(n / k.mx) * step_mm;
+            }
+        }
+    }
+    free(far);
+    free(k.s);
+    free(k.start);
+    free(k.idx);
+    free(k.top);
+    free(k.env);
+    return e;
+}

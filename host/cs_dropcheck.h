@@ -1,0 +1,36 @@
+/* cs_dropcheck: an independent check of a 3-axis finishing path against the exact surface
+ * (issue 20, `toolpath --check`). Shares nothing with the planner (cs_dropcut, cs_dcpath) but
+ * the patch evaluator: the surface is sampled on a dense (u, v) grid of every patch, in double.
+ *  - gouge: along the path (every chord sampled at spacing <= step), the deepest a surface
+ *    sample lies inside the cutter's solid, measured vertically (tip + h(d) - z < 0);
+ *  - scallop: on a z-map of the region (spacing step), the lowest cutter surface over each node
+ *    (the envelope of every sampled cutter position) minus the surface's top at the node (its
+ *    dense triangles rasterised into the map): the height of material left, vertically.
+ * Both are estimates from samples: a finer step only finds more. The scallop is measured where
+ * the cutter lies over the surface all round (nodes farther than R from the rim of the
+ * surface's projection): nearer the rim the floor (--min-z) or the rim itself holds the cutter
+ * up, and beyond it is no material of the part. Host only. */
+#ifndef CS_DROPCHECK_H
+#define CS_DROPCHECK_H
+
+#include <stddef.h>
+
+#include "cs_dropcut.h"
+#include "cs_surffile.h"
+
+typedef struct {
+    double gouge_mm;      /* deepest penetration found (0 when none) */
+    double gouge_at[3];   /* where (the surface sample) */
+    double gouge_tool[3]; /* the cutter's tip there */
+    double scallop_mm;    /* largest material height left over a node with surface below */
+    double scallop_at[2]; /* where */
+    size_t surf_samples, path_samples, nodes;
+} cs_dropcheck_t;
+
+/* Checks the passes (tip points pts[start[k] .. start[k + 1]), k < npass, mm) of tool t over sf
+ * within the region box (x0 y0 x1 y1) at sampling step step_mm. CS_ERR_FULL out of memory. */
+cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                          const double (*pts)[3], const size_t *start, size_t npass,
+                          const double box[4], double step_mm, cs_dropcheck_t *out);
+
+#endif

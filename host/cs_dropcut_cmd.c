@@ -1,0 +1,313 @@
+/* curvestep toolpath --cutter ...: drop-cutter finishing (issue 20). Parses the options, builds
+ * the mesh (cs_dropcut), plans the raster (cs_dcpath), writes the tool points and G-code a Grbl
+ * or LinuxCNC machine runs as written, and with --check measures gouge and scallop against the
+ * exact surface (cs_dropcheck). The options are listed in `curvestep toolpath --help`. */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cs_cmd.h"
+#include "cs_dcpath.h"
+#include "cs_dropcheck.h"
+#include "cs_dropcut.h"
+#include "cs_path.h"
+#include "cs_surffile.h"
+
+#define DC_DEFAULT_TOL    0.01
+#define DC_DEFAULT_FEED   1000.0 /* mm/min */
+#define DC_DEFAULT_PLUNGE 300.0  /* mm/min */
+#define DC_MAX_PASSES     20000
+
+typedef struct {
+    const char *file, *gcode, *name;
+    double scale, tol, feed, plunge, safe_z, spindle, min_z, check_step;
+    bool have_safe_z, have_min_z, have_stock, check, stats, centre;
+    cs_dropcut_tool_t tool;
+    const char *tool_kind;
+    cs_dcpath_opts_t po;
+} dc_args_t;
+
+static int bad(const char *opt, const char *val, const char *want)
+{
+    fprintf(stderr, "curvestep toolpath: %s '%s': expected %s\n", opt, val, want);
+    return CS_EXIT_USAGE;
+}
+
+static bool num(const char *s, double *out)
+{
+    char *end = NULL;
+    double v = strtod(s, &end);
+    if (!end || end == s || *end != '\0' || !isfinite(v))
+        return false;
+    *out = v;
+    return true;
+}
+
+/* ball:R, flat:R or bull:R:r (radii in mm). */
+static bool parse_cutter(const char *s, dc_args_t *a)
+{
+    char kind[8] = {0};
+    double r = 0, c = 0;
+    int used = 0;
+    if (sscanf(s, "%7[a-z]:%lf%n", kind, &r, &used) != 2 || !(r > 0) || r > 100)
+        return false;
+    const char *rest = s + used;
+    if (strcmp(kind, "ball") == 0 && *rest == '\0')
+        c = r;
+    else if (strcmp(kind, "flat") == 0 && *rest == '\0')
+        c = 0;
+    else if (strcmp(kind, "bull") != 0 || !num(rest + (*rest == ':'), &c) || *rest != ':' ||
+             !(c > 0) || c >= r)
+        return false;
+    a->tool.r_mm = r;
+    a->tool.c_mm = c;
+    a->tool_kind = strcmp(kind, "ball") == 0 ? "ball" : strcmp(kind, "flat") == 0 ? "flat" : "bull-nose";
+    return true;
+}
+
+/* X0,Y0,X1,Y1 */
+static bool parse_box(const char *s, double b[4])
+{
+    char tail;
+    return sscanf(s, "%lf,%lf,%lf,%lf%c", &b[0], &b[1], &b[2], &b[3], &tail) == 4 && b[2] > b[0] &&
+           b[3] > b[1];
+}
+
+static int parse_value(int c, const char *v, dc_args_t *a)
+{
+    switch (c) {
+    case 'p': a->file = v; return 0;
+    case 'g': a->gcode = v; return 0;
+    case 'c': return parse_cutter(v, a) ? 0 : bad("--cutter", v, "ball:R, flat:R or bull:R:r (mm, 0 < r < R <= 100)");
+    case 'H': return num(v, &a->po.scallop_mm) && a->po.scallop_mm > 0 ? 0 : bad("--scallop", v, "a height in mm > 0");
+    case 'w': return num(v, &a->po.step_mm) && a->po.step_mm > 0 ? 0 : bad("--stepover", v, "a distance in mm > 0");
+    case 'a': return num(v, &a->po.angle_deg) ? 0 : bad("--angle", v, "degrees");
+    case 't': return num(v, &a->tol) && a->tol >= 0.0001 && a->tol <= 10 ? 0 : bad("--tol", v, "a tolerance in mm, 0.0001 to 10");
+    case 'S': return num(v, &a->scale) && a->scale > 0 ? 0 : bad("--scale", v, "a number > 0");
+    case 'f': return num(v, &a->feed) && a->feed > 0 ? 0 : bad("--feed", v, "a feed in mm/min > 0");
+    case 'P': return num(v, &a->plunge) && a->plunge > 0 ? 0 : bad("--plunge", v, "a feed in mm/min > 0");
+    case 'z': a->have_safe_z = true; return num(v, &a->safe_z) ? 0 : bad("--safe-z", v, "a height in mm");
+    case 'm': a->have_min_z = true; return num(v, &a->min_z) ? 0 : bad("--min-z", v, "a height in mm");
+    case 's': return num(v, &a->spindle) && a->spindle >= 0 ? 0 : bad("--spindle", v, "a speed in rev/min >= 0");
+    case 'k': a->have_stock = true; return parse_box(v, a->po.box) ? 0 : bad("--stock", v, "X0,Y0,X1,Y1 (mm, X0 < X1, Y0 < Y1)");
+    case 'K': return num(v, &a->check_step) && a->check_step > 0 ? 0 : bad("--check-step", v, "a distance in mm > 0");
+    case 'o':
+        if (strcmp(v, "tip") && strcmp(v, "centre") && strcmp(v, "center"))
+            return bad("--output", v, "tip or centre");
+        a->centre = strcmp(v, "tip") != 0;
+        return 0;
+    default: return -1;
+    }
+}
+
+static int parse_args(int argc, char **argv, dc_args_t *a)
+{
+    static const struct option longopts[] = {
+        {"patches", required_argument, NULL, 'p'}, {"gcode", required_argument, NULL, 'g'},
+        {"cutter", required_argument, NULL, 'c'},  {"scallop", required_argument, NULL, 'H'},
+        {"stepover", required_argument, NULL, 'w'}, {"angle", required_argument, NULL, 'a'},
+        {"tol", required_argument, NULL, 't'},     {"scale", required_argument, NULL, 'S'},
+        {"feed", required_argument, NULL, 'f'},    {"plunge", required_argument, NULL, 'P'},
+        {"safe-z", required_argument, NULL, 'z'},  {"min-z", required_argument, NULL, 'm'},
+        {"spindle", required_argument, NULL, 's'}, {"stock", required_argument, NULL, 'k'},
+        {"output", required_argument, NULL, 'o'},  {"check-step", required_argument, NULL, 'K'},
+        {"check", no_argument, NULL, 'C'},         {"stats", no_argument, NULL, 'T'},
+        {NULL, 0, NULL, 0},
+    };
+    int c;
+    optind = 1;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        if (c == 'C' || c == 'T') {
+            *(c == 'C' ? &a->check : &a->stats) = true;
+            continue;
+        }
+        if (c == ':' || c == '?') {
+            fprintf(stderr, "curvestep toolpath: %s '%s' (with --cutter)\nTry 'curvestep toolpath --help'.\n",
+                    c == ':' ? "option needs a value:" : "unknown option", argv[optind - 1]);
+            return CS_EXIT_USAGE;
+        }
+        int r = parse_value(c, optarg, a);
+        if (r != 0)
+            return r;
+    }
+    if (optind != argc || !a->file) {
+        fprintf(stderr, "curvestep toolpath: %s\nTry 'curvestep toolpath --help'.\n",
+                optind != argc ? "unexpected argument (the file goes after --patches)" : "missing --patches FILE");
+        return CS_EXIT_USAGE;
+    }
+    if (a->po.scallop_mm <= 0 && a->po.step_mm <= 0) {
+        fprintf(stderr, "curvestep toolpath: --cutter needs --scallop H or --stepover MM\n");
+        return CS_EXIT_USAGE;
+    }
+    if (a->po.scallop_mm <= 0)
+        a->po.scallop_mm = HUGE_VAL;
+    return CS_EXIT_OK;
+}
+
+/* --- output ------------------------------------------------------------------------------- */
+
+/* The programmed point of a tip point: the tip, or the centre of the corner radius above it. */
+static double out_z(const dc_args_t *a, double tip)
+{
+    return a->centre ? tip + a->tool.c_mm : tip;
+}
+
+static void write_points(const dc_args_t *a, const cs_dcpath_t *p)
+{
+    for (size_t k = 0; k < p->npass; k++) {
+        for (size_t i = p->start[k]; i < p->start[k + 1]; i++)
+            printf("%.6f %.6f %.6f\n", p->pt[i][0], p->pt[i][1], out_z(a, p->pt[i][2]));
+        if (k + 1 < p->npass)
+            printf("\n");
+    }
+}
+
+/* G-code: metric, absolute, XY plane, feed per minute; the spindle on when asked; each pass:
+ * rapid at the safe height over its start, plunge at the plunge feed, cut at the feed (F on
+ * every feed move), retract. */
+static bool write_gcode(const dc_args_t *a, const cs_dcpath_t *p, double safe)
+{
+    FILE *f = fopen(a->gcode, "w");
+    if (!f)
+        return false;
+    bool plain = !strpbrk(a->name, "()");
+    fprintf(f, "(curvestep toolpath: drop-cutter finishing of %s)\n", plain ? a->name : "the input");
+    fprintf(f, "(%s cutter R %g mm, corner %g mm; programmed point: tool %s)\n", a->tool_kind,
+            a->tool.r_mm, a->tool.c_mm, a->centre ? "corner centre" : "tip");
+    fprintf(f, "G21 G90 G17 G94\nG0 Z%.4f\n", safe);
+    if (a->spindle > 0)
+        fprintf(f, "M3 S%.0f\n", a->spindle);
+    for (size_t k = 0; k < p->npass; k++) {
+        const double *s = p->pt[p->start[k]];
+        fprintf(f, "G0 X%.4f Y%.4f\nG1 Z%.4f F%.0f\n", s[0], s[1], out_z(a, s[2]), a->plunge);
+        for (size_t i = p->start[k] + 1; i < p->start[k + 1]; i++)
+            fprintf(f, "G1 X%.4f Y%.4f Z%.4f F%.0f\n", p->pt[i][0], p->pt[i][1], out_z(a, p->pt[i][2]),
+                    a->feed);
+        fprintf(f, "G0 Z%.4f\n", safe);
+    }
+    if (a->spindle > 0)
+        fprintf(f, "M5\n");
+    fprintf(f, "M2\n");
+    bool badw = ferror(f) != 0;
+    return fclose(f) == 0 && !badw;
+}
+
+static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dcpath_t *p)
+{
+    cs_dropcheck_t ck;
+    double step = a->check_step > 0 ? a->check_step : 0.05;
+    cs_err_t e = cs_dropcheck_run(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass,
+                                  a->po.box, step, &ck);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep toolpath: check: out of memory\n");
+        return CS_EXIT_INTERNAL;
+    }
+    fprintf(stderr,
+            "toolpath: check (step %g mm, %zu surface samples, %zu cutter positions, %zu nodes): "
+            "gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
+            step, ck.surf_samples, ck.path_samples, ck.nodes, ck.gouge_mm, ck.scallop_mm,
+            ck.scallop_at[0], ck.scallop_at[1]);
+    /* The scallop is a promise for a ball only (cs_dcpath.h); flat and bull-nose report it. */
+    bool ball = a->tool.c_mm >= a->tool.r_mm;
+    bool gouged = ck.gouge_mm > a->tol, high = ball && ck.scallop_mm > a->po.scallop_mm;
+    if (gouged)
+        fprintf(stderr,
+                "toolpath: check FAILED: the cutter enters the surface by %.6f mm at (%.3f, %.3f, "
+                "%.3f), tip at (%.4f, %.4f, %.4f), over the tolerance %g mm\n",
+                ck.gouge_mm, ck.gouge_at[0], ck.gouge_at[1], ck.gouge_at[2], ck.gouge_tool[0],
+                ck.gouge_tool[1], ck.gouge_tool[2], a->tol);
+    if (high)
+        fprintf(stderr, "toolpath: check FAILED: %.6f mm of material left at (%.3f, %.3f), over the scallop height %g mm\n",
+                ck.scallop_mm, ck.scallop_at[0], ck.scallop_at[1], a->po.scallop_mm);
+    return gouged || high ? CS_EXIT_INPUT : CS_EXIT_OK;
+}
+
+/* --- command ------------------------------------------------------------------------------ */
+
+static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
+{
+    cs_dropcut_mesh_t ms;
+    /* The mesh within tol / 4 of the surface (n-sided cells fitted within tol / 8 more). */
+    cs_err_t e = cs_dropcut_build(&ms, sf, a->tol / 4, a->tol / 8, a->tool.r_mm);
+    if (e != CS_OK) {
+        fprintf(stderr, "%s: cannot mesh the surface: %s\n", a->name,
+                e == CS_ERR_FULL ? "out of memory" : "no usable patch");
+        cs_dropcut_free(&ms);
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    }
+    /* By default the axis covers the surface's extent and a cutter radius beyond, so that the
+     * cutter's side finishes the edges. */
+    double r = a->tool.r_mm;
+    if (!a->have_stock)
+        memcpy(a->po.box, (double[4]){ms.box[0] - r, ms.box[1] - r, ms.box[3] + r, ms.box[4] + r},
+               sizeof a->po.box);
+    a->po.min_z = a->have_min_z ? a->min_z : ms.box[2];
+    a->po.tol_mm = a->tol;
+    a->po.max_passes = DC_MAX_PASSES;
+    double safe = a->have_safe_z ? a->safe_z : ms.box[5] + a->tool.r_mm + 5;
+    cs_dcpath_t p;
+    cs_dcpath_init(&p);
+    e = cs_dcpath_raster(&p, &ms, &a->tool, &a->po);
+    int status = CS_EXIT_OK;
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep toolpath: cannot plan the passes: %s\n",
+                e == CS_ERR_FULL ? "out of memory" : "the region or step-over is empty");
+        status = e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_USAGE;
+    }
+    if (status == CS_EXIT_OK && p.capped)
+        fprintf(stderr, "curvestep toolpath: warning: the scallop refinement stopped at %d passes; "
+                        "estimated scallop %.4f mm (steep walls want a smaller step or another strategy)\n",
+                DC_MAX_PASSES, p.max_left);
+    if (status == CS_EXIT_OK && a->stats)
+        fprintf(stderr,
+                "toolpath: %s cutter R %g mm corner %g mm: mesh %zu triangles within %.6f mm, %zu "
+                "passes (%zu added for the scallop), %zu points, %zu drops, estimated scallop "
+                "%.6f mm (nan: not estimated, flat or bull-nose)\n",
+                a->tool_kind, a->tool.r_mm, a->tool.c_mm, ms.ntri, ms.eps, p.npass, p.refined, p.n,
+                p.drops, p.max_left);
+    if (status == CS_EXIT_OK) {
+        write_points(a, &p);
+        if (a->gcode && !write_gcode(a, &p, safe)) {
+            fprintf(stderr, "%s:0:0: cannot write the G-code\n", a->gcode);
+            status = CS_EXIT_INTERNAL;
+        }
+    }
+    if (status == CS_EXIT_OK && a->check)
+        status = report_check(a, sf, &p);
+    cs_dcpath_free(&p);
+    cs_dropcut_free(&ms);
+    return status;
+}
+
+int cs_cmd_toolpath_drop(int argc, char **argv)
+{
+    dc_args_t a;
+    memset(&a, 0, sizeof a);
+    a.scale = 1;
+    a.tol = DC_DEFAULT_TOL;
+    a.feed = DC_DEFAULT_FEED;
+    a.plunge = DC_DEFAULT_PLUNGE;
+    int st = parse_args(argc, argv, &a);
+    if (st != CS_EXIT_OK)
+        return st;
+    a.name = strcmp(a.file, "-") == 0 ? "<stdin>" : a.file;
+    cs_surffile_t sf;
+    cs_path_diag_t diag;
+    cs_err_t e = cs_surffile_read(a.file, a.scale, a.tol / 4, &sf, &diag);
+    if (e != CS_OK) {
+        if (e == CS_ERR_FULL)
+            fprintf(stderr, "curvestep toolpath: out of memory\n");
+        else
+            cs_path_diag_print(stderr, &diag);
+        cs_surffile_free(&sf);
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
+    }
+    st = plan_and_write(&a, &sf);
+    if (fflush(stdout) != 0 && st == CS_EXIT_OK)
+        st = CS_EXIT_INTERNAL;
+    cs_surffile_free(&sf);
+    return st;
+}
