@@ -116,7 +116,9 @@ static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
         const cs_surf_item_t *it = &sf->items[i];
         size_t nc = 1;
         double fit;
-        if (it->tri)
+        if (it->sphere)
+            e = CS_ERR_UNSUPPORTED;
+        else if (it->tri)
             e = cs_finish_tri_patch(&it->trip, &cells[0]);
         else if (it->varady)
             e = cs_varady_patches(&it->nside, k->step / 4, cells, NULL, CS_VARADY_MAX_PATCHES, &nc,

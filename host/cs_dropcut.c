@@ -135,6 +135,8 @@ static cs_err_t mesh_item(cs_dropcut_mesh_t *ms, const cs_surf_item_t *it, doubl
                           double fit_mm, cs_patch_t *cells)
 {
     double pe = 0;
+    if (it->sphere) /* no Bézier form to bound (cs_sphere): not meshed yet */
+        return CS_ERR_UNSUPPORTED;
     if (it->tri) {
         cs_patch_t tq;
         cs_err_t e = cs_finish_tri_patch(&it->trip, &tq);

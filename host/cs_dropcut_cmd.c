@@ -234,7 +234,9 @@ static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
     cs_err_t e = cs_dropcut_build(&ms, sf, a->tol / 4, a->tol / 8, a->tool.r_mm);
     if (e != CS_OK) {
         fprintf(stderr, "%s: cannot mesh the surface: %s\n", a->name,
-                e == CS_ERR_FULL ? "out of memory" : "no usable patch");
+                e == CS_ERR_FULL          ? "out of memory"
+                : e == CS_ERR_UNSUPPORTED ? "the drop-cutter does not take a sphere item yet"
+                                          : "no usable patch");
         cs_dropcut_free(&ms);
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
     }

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# Drop-cutter finishing (`curvestep toolpath --cutter`, issue 20) on a tilted plane, where the
+# exact answer is known by hand: a ball of radius R resting on z = m y + c stands with its tip at
+# m y + c + R (sqrt(1 + m^2) - 1) wherever it touches the plane inside its edges. Also: the
+# independent --check (gouge and scallop) on every cutter, G-code a machine runs as written (F on
+# every feed move, spindle words), planned and simulated on the 3018 router, --output centre,
+# and bad command lines.
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
+need_bin "$CS" "$SIM"
+
+# z = 0.5 y - 14.5 over x, y in [5, 25] (z from -12 to -2: the router's z travel is -40..10).
+cat >"$T/slope.txt" <<'EOF'
+curvestep-surfaces 1
+bezier 1 1
+  5 5 -12   5 25 -2
+  25 5 -12  25 25 -2
+EOF
+
+# 1. A ball: every interior tip on the hand formula, the check passes, G-code written.
+run "ball slope" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 --check \
+    --stats --safe-z 5 --spindle 12000 --gcode "$T/ball.nc"
+cp "$T/out" "$T/ball.pts"
+cp "$T/err" "$T/ball.err"
+# The contact is R m / sqrt(1 + m^2) = 0.894 mm uphill of the axis: inside the plane for axis
+# y in [5, 24.1] and x in [5, 25] (a ball reaching past x = 5 or 25 touches the side edge first).
+bad=$(awk 'NF == 3 && $1 >= 5 && $1 <= 25 && $2 >= 5 && $2 <= 24 {
+    want = 0.5 * $2 - 14.5 + 2 * (sqrt(1.25) - 1); d = $3 - want; if (d < 0) d = -d;
+    if (d > 1e-5) n++ } END { print n + 0 }' "$T/ball.pts")
+expect "ball slope: interior tips on m y + c + R (sqrt(1 + m^2) - 1)" [ "$bad" = 0 ]
+interior=$(awk 'NF == 3 && $1 >= 5 && $1 <= 25 && $2 >= 5 && $2 <= 24' "$T/ball.pts" | wc -l)
+expect "ball slope: interior points exist ($interior)" [ "$interior" -gt 100 ]
+g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm.*/\1 \2/p' "$T/ball.err")
+expect "ball slope: gouge <= tol, scallop <= H ($g)" \
+    awk -v g="$g" 'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.01 && a[2] <= 0.05) }'
+# Passes along x, zig-zag: consecutive passes run in opposite directions.
+dirs=$(awk 'NF == 0 { if (n) print (last > first) ? "+" : "-"; n = 0; next }
+    { if (!n) first = $1; last = $1; n++ } END { if (n) print (last > first) ? "+" : "-" }' \
+    "$T/ball.pts" | uniq | wc -l)
+passes=$(awk 'NF == 0 { n++ } END { print n + 1 }' "$T/ball.pts")
+expect "ball slope: zig-zag ($dirs runs of direction over $passes passes)" [ "$dirs" = "$passes" ]
+
+# 2. The G-code: metric, absolute; F on every G1; spindle on before cutting and off at the end.
+expect "gcode: G21 G90 first" grep -q '^G21 G90 G17 G94$' "$T/ball.nc"
+expect "gcode: no G1 without F" bash -c "! grep '^G1' '$T/ball.nc' | grep -qv ' F[0-9]'"
+expect "gcode: M3 S12000" grep -q '^M3 S12000$' "$T/ball.nc"
+expect "gcode: M5 then M2 at the end" bash -c "tail -2 '$T/ball.nc' | tr '\n' ' ' | grep -q '^M5 M2 $'"
+nb=$(grep -c '^G1 ' "$T/ball.nc")
+np=$(grep -c . "$T/ball.pts")
+expect "gcode: one G1 per point ($nb, $np)" [ "$nb" = "$np" ]
+
+# 3. Planned and simulated on the 3018 router, as written: limits and final position checked.
+M=contrib/machines/router-3018.ini
+run "gcode plans on the router" 0 plan --machine "$M" -o "$T/ball.seg" "$T/ball.nc"
+"$SIM" --replay "$T/ball.seg" --machine "$M" --reference "$T/ball.nc" --check >"$T/sim.out" 2>&1
+src=$?
+expect "simulator check passes" [ $src -eq 0 ]
+expect "simulator: final position exact" grep -q 'rounded to steps: exact' "$T/sim.out"
+
+# 4. --output centre: the ball's centre, R above the tip, point for point.
+run "ball centre" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 \
+    --output centre
+off=$(paste -d' ' "$T/ball.pts" "$T/out" | awk 'NF == 6 { d = $6 - $3 - 2; if (d < 0) d = -d;
+    if (d > 2e-6 || $1 != $4 || $2 != $5) n++ } END { print n + 0 }')
+expect "centre = tip + R" [ "$off" = 0 ]
+
+# 5. Flat and bull-nose ends: gouge-free by the check (their scallop is reported, not promised).
+for c in flat:3 bull:3:1; do
+    run "$c slope" 0 toolpath --patches "$T/slope.txt" --cutter "$c" --scallop 0.05 --check
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm.*/\1/p' "$T/err")
+    expect "$c: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+done
+# A flat end on a plane of slope m stands on its uphill rim: tip = m (y + R) + c.
+run "flat formula" 0 toolpath --patches "$T/slope.txt" --cutter flat:3 --stepover 2
+bad=$(awk 'NF == 3 && $1 >= 8 && $1 <= 22 && $2 >= 5 && $2 <= 22 {
+    d = $3 - (0.5 * ($2 + 3) - 14.5); if (d < 0) d = -d; if (d > 1e-5) n++ } END { print n + 0 }' \
+    "$T/out")
+expect "flat: interior tips on m (y + R) + c" [ "$bad" = 0 ]
+
+# 6. Bad command lines and inputs.
+run "cutter bad" 2 toolpath --patches "$T/slope.txt" --cutter cone:3 --scallop 0.1 &&
+    expect_err "cutter bad" "ball:R, flat:R or bull:R:r"
+run "bull corner too big" 2 toolpath --patches "$T/slope.txt" --cutter bull:3:3 --scallop 0.1
+run "neither scallop nor stepover" 2 toolpath --patches "$T/slope.txt" --cutter ball:2
+printf 'curvestep-surfaces 1\nsphere 0 0 0 10\n' >"$T/sphere.txt"
+run "sphere refused" 1 toolpath --patches "$T/sphere.txt" --cutter ball:2 --scallop 0.1 &&
+    expect_err "sphere refused" "does not take a sphere"
+finish
