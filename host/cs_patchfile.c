@@ -251,11 +251,14 @@ static cs_err_t parse_newell(lexer_t *lx, cs_patchfile_t *pf)
         pf->line[i] = f.lineno;
         pf->deg[i][0] = pf->deg[i][1] = 3;
         for (unsigned k = 0; k < 16; k++) {
-            if (!f.integer[k] || f.v[k] < 1) {
+            /* Beyond the vertex count limit it cannot name a vertex (and would not fit a
+             * size_t: the fuzzer's 8.9e53). */
+            if (!f.integer[k] || f.v[k] < 1 || f.v[k] > PATCHFILE_MAX_COUNT) {
                 e = cs_path_diag_set(diag, f.integer[k] ? CS_ERR_RANGE : CS_ERR_PARSE,
                                      loc(lx, f.lineno, f.col[k]),
-                                     "vertex index must be an integer >= 1 (indices are "
-                                     "one-based)");
+                                     "vertex index must be an integer from 1 to %d (indices "
+                                     "are one-based)",
+                                     PATCHFILE_MAX_COUNT);
                 break;
             }
             pf->idx[i][k] = (size_t)f.v[k] - 1;

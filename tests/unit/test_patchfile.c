@@ -145,6 +145,10 @@ static void test_small_and_errors(void **state)
            "one-based");
     expect(grid_file("1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,2.5", "16", 16, ""), CS_ERR_PARSE, 2, 37,
            "integer");
+    /* An index too large for any vertex table (found by fuzz_patchfile: it overflowed size_t). */
+    expect(grid_file("1,2,3,4,5,6,7,8,888888888888888888888888888888888889,10,11,12,13,14,15,16",
+                     "16", 16, ""),
+           CS_ERR_RANGE, 2, 17, "one-based");
     /* Index 17 of 16 vertices: at the index itself. */
     expect(grid_file("1,2,3,4,5,6,7,8,9,10,11,12,13,17,15,16", "16", 16, ""), CS_ERR_RANGE, 2, 31,
            "17 outside 1..16");
