@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 
 cs_err_t cs_conv_mm_to_pos(double mm, cs_pos_t *out)
 {
@@ -69,4 +70,14 @@ cs_err_t cs_conv_tol_to_pos(double mm, cs_pos_t *out)
         return CS_ERR_TOLERANCE;
     *out = (cs_pos_t)lsb;
     return CS_OK;
+}
+
+bool cs_conv_number(const char *s, double *out)
+{
+    char *end = NULL;
+    double v = strtod(s, &end);
+    if (!end || end == s || *end != '\0' || !isfinite(v))
+        return false;
+    *out = v;
+    return true;
 }

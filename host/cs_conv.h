@@ -1,14 +1,18 @@
 /* cs_conv: the one place where the host turns double-precision values into the core's
- * fixed-point formats (and back). Every conversion is range-checked: a value the format cannot
+ * fixed-point formats (and back), and reads command-line numbers. Every conversion is range-checked: a value the format cannot
  * hold is refused with CS_ERR_RANGE, never clamped or wrapped. */
 #ifndef CS_CONV_H
 #define CS_CONV_H
+
+#include <stdbool.h>
 
 #include "cs_fixed.h"
 
 /* mm -> cs_pos_t (Q15.16), rounded to the nearest LSB. CS_ERR_RANGE when mm is not finite or
  * |result| > CS_POS_LIMIT (4096 mm); *out is untouched then. */
 cs_err_t cs_conv_mm_to_pos(double mm, cs_pos_t *out);
+/* A command-line number: s read whole by strtod and finite (no trailing text); false else. */
+bool cs_conv_number(const char *s, double *out);
 /* cs_pos_t -> mm, exact (every Q15.16 value is a double). */
 double cs_conv_pos_to_mm(cs_pos_t p);
 /* (x, y, z) in mm -> cs_vec3_t, each coordinate as cs_conv_mm_to_pos. */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "cs_cmd.h"
+#include "cs_conv.h"
 #include "cs_dcpath.h"
 #include "cs_dropcheck.h"
 #include "cs_dropcut.h"
@@ -35,16 +36,6 @@ static int bad(const char *opt, const char *val, const char *want)
     return CS_EXIT_USAGE;
 }
 
-static bool num(const char *s, double *out)
-{
-    char *end = NULL;
-    double v = strtod(s, &end);
-    if (!end || end == s || *end != '\0' || !isfinite(v))
-        return false;
-    *out = v;
-    return true;
-}
-
 /* ball:R, flat:R or bull:R:r (radii in mm). */
 static bool parse_cutter(const char *s, dc_args_t *a)
 {
@@ -58,7 +49,7 @@ static bool parse_cutter(const char *s, dc_args_t *a)
         c = r;
     else if (strcmp(kind, "flat") == 0 && *rest == '\0')
         c = 0;
-    else if (strcmp(kind, "bull") != 0 || !num(rest + (*rest == ':'), &c) || *rest != ':' ||
+    else if (strcmp(kind, "bull") != 0 || !cs_conv_number(rest + (*rest == ':'), &c) || *rest != ':' ||
              !(c > 0) || c >= r)
         return false;
     a->tool.r_mm = r;
@@ -81,18 +72,18 @@ static int parse_value(int c, const char *v, dc_args_t *a)
     case 'p': a->file = v; return 0;
     case 'g': a->gcode = v; return 0;
     case 'c': return parse_cutter(v, a) ? 0 : bad("--cutter", v, "ball:R, flat:R or bull:R:r (mm, 0 < r < R <= 100)");
-    case 'H': return num(v, &a->po.scallop_mm) && a->po.scallop_mm > 0 ? 0 : bad("--scallop", v, "a height in mm > 0");
-    case 'w': return num(v, &a->po.step_mm) && a->po.step_mm > 0 ? 0 : bad("--stepover", v, "a distance in mm > 0");
-    case 'a': return num(v, &a->po.angle_deg) ? 0 : bad("--angle", v, "degrees");
-    case 't': return num(v, &a->tol) && a->tol >= 0.0001 && a->tol <= 10 ? 0 : bad("--tol", v, "a tolerance in mm, 0.0001 to 10");
-    case 'S': return num(v, &a->scale) && a->scale > 0 ? 0 : bad("--scale", v, "a number > 0");
-    case 'f': return num(v, &a->feed) && a->feed > 0 ? 0 : bad("--feed", v, "a feed in mm/min > 0");
-    case 'P': return num(v, &a->plunge) && a->plunge > 0 ? 0 : bad("--plunge", v, "a feed in mm/min > 0");
-    case 'z': a->have_safe_z = true; return num(v, &a->safe_z) ? 0 : bad("--safe-z", v, "a height in mm");
-    case 'm': a->have_min_z = true; return num(v, &a->min_z) ? 0 : bad("--min-z", v, "a height in mm");
-    case 's': return num(v, &a->spindle) && a->spindle >= 0 ? 0 : bad("--spindle", v, "a speed in rev/min >= 0");
+    case 'H': return cs_conv_number(v, &a->po.scallop_mm) && a->po.scallop_mm > 0 ? 0 : bad("--scallop", v, "a height in mm > 0");
+    case 'w': return cs_conv_number(v, &a->po.step_mm) && a->po.step_mm > 0 ? 0 : bad("--stepover", v, "a distance in mm > 0");
+    case 'a': return cs_conv_number(v, &a->po.angle_deg) ? 0 : bad("--angle", v, "degrees");
+    case 't': return cs_conv_number(v, &a->tol) && a->tol >= 0.0001 && a->tol <= 10 ? 0 : bad("--tol", v, "a tolerance in mm, 0.0001 to 10");
+    case 'S': return cs_conv_number(v, &a->scale) && a->scale > 0 ? 0 : bad("--scale", v, "a number > 0");
+    case 'f': return cs_conv_number(v, &a->feed) && a->feed > 0 ? 0 : bad("--feed", v, "a feed in mm/min > 0");
+    case 'P': return cs_conv_number(v, &a->plunge) && a->plunge > 0 ? 0 : bad("--plunge", v, "a feed in mm/min > 0");
+    case 'z': a->have_safe_z = true; return cs_conv_number(v, &a->safe_z) ? 0 : bad("--safe-z", v, "a height in mm");
+    case 'm': a->have_min_z = true; return cs_conv_number(v, &a->min_z) ? 0 : bad("--min-z", v, "a height in mm");
+    case 's': return cs_conv_number(v, &a->spindle) && a->spindle >= 0 ? 0 : bad("--spindle", v, "a speed in rev/min >= 0");
     case 'k': a->have_stock = true; return parse_box(v, a->po.box) ? 0 : bad("--stock", v, "X0,Y0,X1,Y1 (mm, X0 < X1, Y0 < Y1)");
-    case 'K': return num(v, &a->check_step) && a->check_step > 0 ? 0 : bad("--check-step", v, "a distance in mm > 0");
+    case 'K': return cs_conv_number(v, &a->check_step) && a->check_step > 0 ? 0 : bad("--check-step", v, "a distance in mm > 0");
     case 'o':
         if (strcmp(v, "tip") && strcmp(v, "centre") && strcmp(v, "center"))
             return bad("--output", v, "tip or centre");

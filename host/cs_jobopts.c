@@ -8,14 +8,6 @@
 #include "cs_conv.h"
 #include "cs_order.h"
 
-/* A number that strtod reads whole, finite. */
-static bool num(const char *s, double *v)
-{
-    char *end;
-    *v = strtod(s, &end);
-    return end != s && *end == '\0' && isfinite(*v);
-}
-
 static bool set_lenient(cs_jobopts_t *o, const char *v)
 {
     (void)v;
@@ -39,7 +31,7 @@ static bool set_scale(cs_jobopts_t *o, const char *v)
 {
     double f;
     o->layout.scale = 1.0;
-    if (!num(v, &f) || !(f >= CS_LAYOUT_SCALE_MIN && f <= CS_LAYOUT_SCALE_MAX))
+    if (!cs_conv_number(v, &f) || !(f >= CS_LAYOUT_SCALE_MIN && f <= CS_LAYOUT_SCALE_MAX))
         return false;
     o->layout.scale = f;
     return true;
@@ -60,7 +52,7 @@ static bool set_page(cs_jobopts_t *o, const char *v)
 
 static bool set_margin(cs_jobopts_t *o, const char *v)
 {
-    return num(v, &o->layout.margin_mm) && o->layout.margin_mm >= 0 &&
+    return cs_conv_number(v, &o->layout.margin_mm) && o->layout.margin_mm >= 0 &&
            o->layout.margin_mm <= CS_POS_LIMIT_MM;
 }
 
@@ -72,7 +64,7 @@ static bool set_translate(cs_jobopts_t *o, const char *v)
     char x[64];
     memcpy(x, v, (size_t)(comma - v));
     x[comma - v] = '\0';
-    return num(x, &o->layout.tx_mm) && num(comma + 1, &o->layout.ty_mm) &&
+    return cs_conv_number(x, &o->layout.tx_mm) && cs_conv_number(comma + 1, &o->layout.ty_mm) &&
            fabs(o->layout.tx_mm) <= CS_POS_LIMIT_MM && fabs(o->layout.ty_mm) <= CS_POS_LIMIT_MM;
 }
 

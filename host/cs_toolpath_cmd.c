@@ -142,16 +142,6 @@ static void tp_usage(FILE *f)
         kw, TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
 }
 
-static bool parse_double(const char *s, double *out)
-{
-    char *end = NULL;
-    double v = strtod(s, &end);
-    if (!end || end == s || *end != '\0' || !isfinite(v))
-        return false;
-    *out = v;
-    return true;
-}
-
 static bool parse_view(const char *s, tp_view_t *v)
 {
     for (size_t k = 0; k < sizeof views / sizeof views[0]; k++)
@@ -696,7 +686,7 @@ int cs_cmd_toolpath(int argc, char **argv)
             }
             break;
         case 'n':
-            if (!parse_double(optarg, &d) || d != floor(d) || d < 1 || d > TP_MAX_LINES) {
+            if (!cs_conv_number(optarg, &d) || d != floor(d) || d < 1 || d > TP_MAX_LINES) {
                 fprintf(stderr, "curvestep toolpath: --lines '%s': expected an integer 1..%d\n",
                         optarg, TP_MAX_LINES);
                 return CS_EXIT_USAGE;
@@ -705,7 +695,7 @@ int cs_cmd_toolpath(int argc, char **argv)
             break;
         case 't': {
             cs_pos_t t = 0;
-            if (!parse_double(optarg, &tol_mm) || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
+            if (!cs_conv_number(optarg, &tol_mm) || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
                 t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
                 fprintf(stderr,
                         "curvestep toolpath: --tol '%s': expected a tolerance in mm, from %.7f "
@@ -716,14 +706,14 @@ int cs_cmd_toolpath(int argc, char **argv)
             break;
         }
         case 'S':
-            if (!parse_double(optarg, &scale) || scale <= 0) {
+            if (!cs_conv_number(optarg, &scale) || scale <= 0) {
                 fprintf(stderr, "curvestep toolpath: --scale '%s': expected a number > 0\n",
                         optarg);
                 return CS_EXIT_USAGE;
             }
             break;
         case 'b':
-            if (!parse_double(optarg, &bp.r_mm) || bp.r_mm <= 0 || bp.r_mm > 100) {
+            if (!cs_conv_number(optarg, &bp.r_mm) || bp.r_mm <= 0 || bp.r_mm > 100) {
                 fprintf(stderr,
                         "curvestep toolpath: --ball '%s': expected a radius in mm, "
                         "0 < R <= 100\n",
@@ -733,7 +723,7 @@ int cs_cmd_toolpath(int argc, char **argv)
             ball = true;
             break;
         case 'H':
-            if (!parse_double(optarg, &bp.h_mm) || bp.h_mm <= 0) {
+            if (!cs_conv_number(optarg, &bp.h_mm) || bp.h_mm <= 0) {
                 fprintf(stderr,
                         "curvestep toolpath: --scallop '%s': expected a height in mm "
                         "> 0\n",
@@ -743,7 +733,7 @@ int cs_cmd_toolpath(int argc, char **argv)
             have_h = true;
             break;
         case 'z':
-            if (!parse_double(optarg, &bp.safe_z_mm) || fabs(bp.safe_z_mm) > CS_POS_LIMIT_MM) {
+            if (!cs_conv_number(optarg, &bp.safe_z_mm) || fabs(bp.safe_z_mm) > CS_POS_LIMIT_MM) {
                 fprintf(stderr, "curvestep toolpath: --safe-z '%s': expected a height in mm\n",
                         optarg);
                 return CS_EXIT_USAGE;
