@@ -185,7 +185,9 @@ bool cs_hershey_default_path(char *out, size_t outlen)
     if (slash == NULL)
         return false;
     *slash = '\0'; /* the program's folder */
-    static const char *const rel[] = {"../share/fonts/futural.jhf",
+    /* build/curvestep (the repository's share/), build/asan/curvestep (a build variant's),
+     * PREFIX/bin/curvestep (installed). */
+    static const char *const rel[] = {"../share/fonts/futural.jhf", "../../share/fonts/futural.jhf",
                                       "../share/curvestep/fonts/futural.jhf"};
     for (size_t i = 0; i < sizeof rel / sizeof rel[0]; i++) {
         int k = snprintf(out, outlen, "%s/%s", exe, rel[i]);
