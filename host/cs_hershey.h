@@ -46,9 +46,10 @@ cs_err_t cs_hershey_parse(const char *name, const char *buf, size_t len, cs_hers
 /* Reads file (CS_ERR_IO when it cannot be read), then cs_hershey_parse. */
 cs_err_t cs_hershey_load(const char *file, cs_hershey_font_t *f, cs_path_diag_t *diag);
 void cs_hershey_free(cs_hershey_font_t *f);
-/* The shipped default font: share/fonts/futural.jhf beside the program's folder (a build tree:
- * build/curvestep -> share/fonts) or share/curvestep/fonts/futural.jhf (an install: bin ->
- * share), written to out. false when neither exists. */
+/* The shipped default font: share/fonts/futural.jhf one or two folders above the program's (a
+ * build tree: build/curvestep or build/asan/curvestep -> share/fonts) or
+ * share/curvestep/fonts/futural.jhf (an install: bin -> share), written to out. false when none
+ * exists. */
 bool cs_hershey_default_path(char *out, size_t outlen);
 
 /* Receives each vertex of laid-out text: (x, y) in the caller's space, move = pen lifts first. */
