@@ -8,6 +8,8 @@
  * last control point. Built and run by scripts/fuzz.sh (host sources are compiled in below, as
  * the script links only the core). With -DCS_FUZZ_SEED_MAIN it writes a seed corpus into
  * argv[1]: the instruction forms below plus every file of ../shared/data/hpgl. */
+#define _DEFAULT_SOURCE
+#define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
 #include <string.h>
 
@@ -16,8 +18,10 @@
 
 #include "../../host/cs_conv.c"
 #include "../../host/cs_err_text.c"
+#include "../../host/cs_hershey.c"
 #include "../../host/cs_hpgl.c"
 #include "../../host/cs_path.c"
+#include "../../host/cs_readall.c"
 #include "fuzz_path.h"
 
 /* HP-GL makes lines (PD/PR/PA), cubics (BZ/BR) and arc pieces (CI/AA/AR), nothing else. */

@@ -10,6 +10,8 @@
  * fuzz-libs: -lexpat -lm
  * With -DCS_FUZZ_SEED_MAIN it writes a seed corpus into argv[1]: the documents below plus every
  * file of ../shared/data/svg/<dir>/. */
+#define _DEFAULT_SOURCE
+#define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
 #include <string.h>
 
@@ -18,7 +20,9 @@
 
 #include "../../host/cs_conv.c"
 #include "../../host/cs_err_text.c"
+#include "../../host/cs_hershey.c"
 #include "../../host/cs_path.c"
+#include "../../host/cs_readall.c"
 #include "../../host/cs_svgdoc.c"
 #include "../../host/cs_svgpath.c"
 #include "fuzz_path.h"

@@ -16,6 +16,7 @@
 
 #include "cs_gcode.h"
 #include "cs_hpgl.h"
+#include "cs_hershey.h"
 #include "cs_input.h"
 #include "cs_svgdoc.h"
 
@@ -145,6 +146,17 @@ static void test_load_gcode_same_as_reader(void **state)
     cs_path_free(&b);
 }
 
+/* The stroke font cs_input uses when none is named: the shipped default if it is found from this
+ * program's folder (text drawn), else none (text skipped): the reader gets the same. */
+static const cs_hershey_font_t *default_font(cs_hershey_font_t *f)
+{
+    char path[4096];
+    cs_path_diag_t d;
+    if (!cs_hershey_default_path(path, sizeof path) || cs_hershey_load(path, f, &d) != CS_OK)
+        return NULL;
+    return f;
+}
+
 static void test_load_svg_same_as_reader(void **state)
 {
     (void)state;
@@ -155,10 +167,14 @@ static void test_load_svg_same_as_reader(void **state)
     cs_svgdoc_opts_t so;
     cs_svgdoc_opts_init(&so);
     so.warn = on_warn;
+    cs_hershey_font_t font;
+    so.font = default_font(&font);
     cs_path_init(&b);
     assert_int_equal(cs_svgdoc_read_file(name, &so, &b, &d, NULL), CS_OK);
     assert_true(a.n > 0);
     assert_same_path(&a, &b);
+    if (so.font)
+        cs_hershey_free(&font);
     cs_path_free(&a);
     cs_path_free(&b);
 }
@@ -175,12 +191,16 @@ static void test_load_hpgl_same_as_reader(void **state)
     cs_hpgl_opts_t ho;
     cs_hpgl_opts_init(&ho);
     ho.warn = on_warn;
+    cs_hershey_font_t font;
+    ho.font = default_font(&font);
     cs_path_init(&b);
     memset(&d2, 0, sizeof d2);
     assert_int_equal(cs_hpgl_read(name, buf, len, &ho, &b, &d2), e);
     assert_int_equal(e, CS_OK);
     assert_true(a.n > 0);
     assert_same_path(&a, &b);
+    if (ho.font)
+        cs_hershey_free(&font);
     free(buf);
     cs_path_free(&a);
     cs_path_free(&b);
