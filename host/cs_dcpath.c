@@ -8,6 +8,7 @@
 #define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
 #define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap */
 #define DC_PASS_MAXPTS (1u << 22)
+#define DC_WALL_D      0.05 /* mm: the step of the wall test (at_wall) */
 
 /* One pass being built: points along s, in increasing s. */
 typedef struct {
@@ -165,6 +166,21 @@ static bool near_rim(dc_ctx_t *c, double x, double y)
            !cs_dropcut_top(c->ms, x, y + r, &z) || !cs_dropcut_top(c->ms, x, y - r, &z);
 }
 
+/* Does a wall pass by (x, y): the mesh top rising more than 2 d over d = DC_WALL_D in one of four
+ * directions (slope > 2)? The height left is not defined there (the check leaves such points
+ * out too). */
+static bool at_wall(dc_ctx_t *c, double x, double y, double top)
+{
+    static const double dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    for (int i = 0; i < 4; i++) {
+        double z;
+        if (cs_dropcut_top(c->ms, x + DC_WALL_D * dx[i], y + DC_WALL_D * dy[i], &z) &&
+            z > top + 2 * DC_WALL_D)
+            return true;
+    }
+    return false;
+}
+
 /* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
  * with the cutters of every line within R of the point (at the same along-pass position); *cusp
  * gets the gap (the lower of the two lines) whose cutters meet at the worst point: on a slope
@@ -202,7 +218,8 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
                 }
             }
             double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top;
-            if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y))
+            if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y) ||
+                at_wall(c, x, y, top))
                 continue; /* the scallop is promised where the cutter lies over the surface */
             double left = env - fmax(top, c->o->min_z);
             if (left > worst) {

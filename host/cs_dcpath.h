@@ -8,8 +8,10 @@
  * 2(R - r) + 2 sqrt(2rH - H^2); flat end mill 2R x 0.9), then every neighbouring pair is checked
  * at cross fractions 1/8 .. 7/8 of the gap and every sample of the finer pass: the cutter of each
  * pass at the same along-pass position leaves E = min(zA + h(f w), zB + h((1 - f) w)) above the
- * mesh top S; where E - S > H - eps a pass is added halfway, recursively. Cutters at other
- * along-pass positions only cut more, so the estimate is conservative. */
+ * mesh top S; where E - S > H - eps a pass is added halfway between the two cutters that meet
+ * at the worst point. Cutters at other along-pass positions only cut more, so the estimate is
+ * conservative. Points within R of the rim of the surface's projection and points on a wall
+ * (slope > 2) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H
 

@@ -23,6 +23,7 @@ typedef struct {
     double box[4], step;
     size_t mx, my;
     double *top, *env;
+    double *peak; /* highest sample whose nearest node this is: a wall shows above top */
 } ck_t;
 
 static cs_err_t push_sample(ck_t *k, const double p[3])
@@ -70,6 +71,14 @@ static void raster_tri(ck_t *k, const double *a, const double *b, const double *
         }
 }
 
+/* The sample's z into the peak map at its nearest node. */
+static void splat(ck_t *k, const double *p)
+{
+    size_t n = node(k, lround((p[0] - k->box[0]) / k->step), lround((p[1] - k->box[1]) / k->step));
+    if (n != (size_t)-1)
+        k->peak[n] = fmax(k->peak[n], p[2]);
+}
+
 /* Samples one patch densely: points for the gouge test, triangles into the top map. */
 static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
 {
@@ -96,6 +105,7 @@ static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
         for (int j = 0; j <= kk && e == CS_OK; j++) {
             cs_finish_eval(q, (double)i / kk, (double)j / kk, &cur[j * 3], NULL);
             e = push_sample(k, &cur[j * 3]);
+            splat(k, &cur[j * 3]);
         }
         for (int j = 0; i > 0 && j < kk; j++) {
             raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
@@ -266,10 +276,11 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     k.my = (size_t)floor((box[3] - box[1]) / step_mm) + 1;
     k.top = malloc(k.mx * k.my * sizeof *k.top);
     k.env = malloc(k.mx * k.my * sizeof *k.env);
+    k.peak = malloc(k.mx * k.my * sizeof *k.peak);
     unsigned char *far = NULL;
-    cs_err_t e = k.top && k.env ? CS_OK : CS_ERR_FULL;
+    cs_err_t e = k.top && k.env && k.peak ? CS_OK : CS_ERR_FULL;
     for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
-        k.top[n] = -HUGE_VAL;
+        k.top[n] = k.peak[n] = -HUGE_VAL;
         k.env[n] = HUGE_VAL;
     }
     if (e == CS_OK)
@@ -283,8 +294,13 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
         if (!far || !interior(&k, (long)ceil(t->r_mm / step_mm), far))
             e = CS_ERR_FULL;
         for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
-            if (k.top[n] == -HUGE_VAL || k.env[n] == HUGE_VAL || !far[n])
+            /* A wall through the node's cell (a sample rising more than two steps above the
+             * rasterised top, slope > 2): the height left is not defined there. */
+            bool wall = k.peak[n] > k.top[n] + 2 * step_mm;
+            if (k.top[n] == -HUGE_VAL || k.env[n] == HUGE_VAL || !far[n] || wall) {
+                out->walls += wall;
                 continue;
+            }
             out->nodes++;
             double left = k.env[n] - k.top[n];
             if (left > out->scallop_mm) {
@@ -300,5 +316,6 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     free(k.idx);
     free(k.top);
     free(k.env);
+    free(k.peak);
     return e;
 }

@@ -9,7 +9,9 @@
  * Both are estimates from samples: a finer step only finds more. The scallop is measured where
  * the cutter lies over the surface all round (nodes farther than R from the rim of the
  * surface's projection): nearer the rim the floor (--min-z) or the rim itself holds the cutter
- * up, and beyond it is no material of the part. Host only. */
+ * up, and beyond it is no material of the part; and not at nodes a wall passes through (a
+ * sample nearest the node stands more than two steps above the rasterised top: slope > 2, where
+ * a height measured vertically means nothing). Host only. */
 #ifndef CS_DROPCHECK_H
 #define CS_DROPCHECK_H
 
@@ -25,6 +27,7 @@ typedef struct {
     double scallop_mm;    /* largest material height left over a node with surface below */
     double scallop_at[2]; /* where */
     size_t surf_samples, path_samples, nodes;
+    size_t walls; /* nodes left out of the scallop: a wall passes through them */
 } cs_dropcheck_t;
 
 /* Checks the passes (tip points pts[start[k] .. start[k + 1]), k < npass, mm) of tool t over sf

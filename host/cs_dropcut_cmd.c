@@ -197,9 +197,9 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
         return CS_EXIT_INTERNAL;
     }
     fprintf(stderr,
-            "toolpath: check (step %g mm, %zu surface samples, %zu cutter positions, %zu nodes): "
-            "gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
-            step, ck.surf_samples, ck.path_samples, ck.nodes, ck.gouge_mm, ck.scallop_mm,
+            "toolpath: check (step %g mm, %zu surface samples, %zu cutter positions, %zu nodes, "
+            "%zu on walls left out): gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
+            step, ck.surf_samples, ck.path_samples, ck.nodes, ck.walls, ck.gouge_mm, ck.scallop_mm,
             ck.scallop_at[0], ck.scallop_at[1]);
     /* The scallop is a promise for a ball only (cs_dcpath.h); flat and bull-nose report it. */
     bool ball = a->tool.c_mm >= a->tool.r_mm;
