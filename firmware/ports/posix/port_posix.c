@@ -14,6 +14,8 @@ struct posix_state {
     cs_stepper_t *st;
     port_posix_edge_t *edges;
     size_t n, cap;
+    port_posix_pen_t *pens;
+    size_t npens, cappens;
     bool record, record_ok;
     int64_t pos[8];
     cs_err_t fault;
@@ -34,6 +36,7 @@ static struct posix_state g = {.hz = 100000,
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
 {
     free(g.edges);
+    free(g.pens);
     cs_stepper_t *st = g.st;
     int in = g.fd_in, out = g.fd_out;
     size_t (*rd)(void *, uint8_t *, size_t) = g.rd;
@@ -124,6 +127,27 @@ void port_step_pulse(uint8_t mask)
         }
         g.edges[g.n++] = (port_posix_edge_t){g.now, (uint8_t)i, dir};
     }
+}
+
+void port_pen_set(uint16_t pulse_us)
+{
+    if (g.npens == g.cappens) {
+        size_t cap = g.cappens ? g.cappens * 2 : 64;
+        port_posix_pen_t *p = realloc(g.pens, cap * sizeof *p);
+        if (p == NULL) {
+            g.record_ok = false;
+            return;
+        }
+        g.pens = p;
+        g.cappens = cap;
+    }
+    g.pens[g.npens++] = (port_posix_pen_t){g.now, pulse_us};
+}
+
+const port_posix_pen_t *port_posix_pens(size_t *n)
+{
+    *n = g.npens;
+    return g.pens;
 }
 
 void port_dir_set(uint8_t mask)
