@@ -458,23 +458,24 @@ static void test_classification_and_boot_peek(void **state)
 static void test_pen_layout_and_range(void **state)
 {
     (void)state;
-    cs_proto_msg_t m = {0};
-    m.type = CS_PROTO_PEN;
-    m.u.pen.pulse_us = 1500;
-    const uint8_t w[] = {0x25, 0xDC, 0x05};
-    expect_encoding(&m, w, sizeof w);
-    m.u.pen.pulse_us = 400;
-    const uint8_t lo[] = {0x25, 0x90, 0x01};
-    expect_encoding(&m, lo, sizeof lo);
-    m.u.pen.pulse_us = 2600;
-    const uint8_t hi[] = {0x25, 0x28, 0x0A};
-    expect_encoding(&m, hi, sizeof hi);
-    m.u.pen.pulse_us = 399;
-    const uint8_t below[] = {0x25, 0x8F, 0x01};
-    expect_range(&m, below, sizeof below);
-    m.u.pen.pulse_us = 2601;
-    const uint8_t above[] = {0x25, 0x29, 0x0A};
-    expect_range(&m, above, sizeof above);
+    static const struct {
+        uint16_t us;
+        uint8_t bytes[CS_PROTO_LEN_PEN];
+        bool ok;
+    } cases[] = {
+        {1500, {0x25, 0xDC, 0x05}, true},  {400, {0x25, 0x90, 0x01}, true},
+        {2600, {0x25, 0x28, 0x0A}, true},  {399, {0x25, 0x8F, 0x01}, false},
+        {2601, {0x25, 0x29, 0x0A}, false},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cs_proto_msg_t m = {0};
+        m.type = CS_PROTO_PEN;
+        m.u.pen.pulse_us = cases[i].us;
+        if (cases[i].ok)
+            expect_encoding(&m, cases[i].bytes, sizeof cases[i].bytes);
+        else
+            expect_range(&m, cases[i].bytes, sizeof cases[i].bytes);
+    }
 }
 
 int main(void)

@@ -104,6 +104,21 @@ void port_irq_restore(uint32_t state)
     g.irq_depth = state;
 }
 
+/* Room for one more of n records of sz bytes at *buf (doubling, from first); false when out of
+ * memory (*buf unchanged). */
+static bool grow(void **buf, size_t *cap, size_t n, size_t sz, size_t first)
+{
+    if (n < *cap)
+        return true;
+    size_t c = *cap ? *cap * 2 : first;
+    void *p = realloc(*buf, c * sz);
+    if (p == NULL)
+        return false;
+    *buf = p;
+    *cap = c;
+    return true;
+}
+
 void port_step_pulse(uint8_t mask)
 {
     for (unsigned i = 0; i < 8; i++) {
@@ -115,15 +130,12 @@ void port_step_pulse(uint8_t mask)
         g.pos[i] += dir;
         if (!g.record)
             continue;
-        if (g.n == g.cap) {
-            size_t cap = g.cap ? g.cap * 2 : 4096;
-            port_posix_edge_t *e = realloc(g.edges, cap * sizeof *e);
-            if (e == NULL) {
-                g.record_ok = false;
-                continue;
-            }
-            g.edges = e;
-            g.cap = cap;
+        void *b = g.edges;
+        bool ok = grow(&b, &g.cap, g.n, sizeof *g.edges, 4096);
+        g.edges = b;
+        if (!ok) {
+            g.record_ok = false;
+            continue;
         }
         g.edges[g.n++] = (port_posix_edge_t){g.now, (uint8_t)i, dir};
     }
@@ -131,15 +143,12 @@ void port_step_pulse(uint8_t mask)
 
 void port_pen_set(uint16_t pulse_us)
 {
-    if (g.npens == g.cappens) {
-        size_t cap = g.cappens ? g.cappens * 2 : 64;
-        port_posix_pen_t *p = realloc(g.pens, cap * sizeof *p);
-        if (p == NULL) {
-            g.record_ok = false;
-            return;
-        }
-        g.pens = p;
-        g.cappens = cap;
+    void *b = g.pens;
+    bool ok = grow(&b, &g.cappens, g.npens, sizeof *g.pens, 64);
+    g.pens = b;
+    if (!ok) {
+        g.record_ok = false;
+        return;
     }
     g.pens[g.npens++] = (port_posix_pen_t){g.now, pulse_us};
 }
