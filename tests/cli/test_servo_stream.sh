@@ -4,7 +4,8 @@
 # events travel as PEN messages (docs/protocol.md); the device sets the pen as many times as
 # `plan` writes "pen US" lines, the simulator's pen check (by the device's pen settings) passes
 # with as many pen-downs as the plan lowers the pen, and the device executed exactly the plan's
-# segments (count and hash against the replay of the plan). Every process is bounded by
+# segments (count against the plan). The same job through the daemon (`serve --port`, `submit`)
+# gives the device the same pen settings and passes the same check. Every process is bounded by
 # `timeout`. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -41,4 +42,32 @@ expect "device: $nseg segments executed, as planned" \
     grep -qE "^log: $nseg segments hash [0-9]+," "$T/dev.sim"
 expect "device: $((nseg + pens)) messages executed" \
     grep -q "^device: served .*; $((nseg + pens)) messages executed ($nseg step segments" "$T/dev.sim"
+
+# The daemon: serve on a fresh simulated device, submit, wait for the job's end, stop both (the
+# simulator reports on SIGTERM).
+timeout -k 5 120 "$SIM" --pty --instant --machine "$MC" --reference "$JOB" --check \
+    >"$T/dd.sim" 2>"$T/dd.simerr" &
+pids+=($!)
+SIMPID=$!
+wait_pty "$T/dd.sim" 60
+S=$T/sock
+timeout -k 5 120 "$CS" serve --port "$PTY" --machine "$MC" --socket "$S" 2>"$T/serve.err" &
+DPID=$!
+pids+=($DPID)
+wait_until 60 [ -S "$S" ]
+timeout -k 5 60 "$CS" submit --socket "$S" "$JOB" >"$T/sub.out" 2>&1
+expect "daemon: submitted" [ $? -eq 0 ]
+job_done() { timeout -k 5 10 "$CS" status --socket "$S" 2>/dev/null | grep -q '^job 1 done: '; }
+wait_until 90 job_done
+expect "daemon: job 1 done" job_done
+kill "$DPID"
+wait_until 30 gone "$DPID"
+kill "$SIMPID"
+wait_until 30 gone "$SIMPID"
+wait "$SIMPID"; simrc=$?
+expect "daemon device: exit 0 (got $simrc)" [ $simrc -eq 0 ]
+expect "daemon device: check passes" grep -q '^check: ok$' "$T/dd.sim"
+expect "daemon device: set the pen $pens times" \
+    grep -q "^pen: the device set the servo pen $pens times" "$T/dd.sim"
+expect "daemon device: $lowers pen-downs" grep -q "^pen: $lowers pen-downs; .* ok\$" "$T/dd.sim"
 finish
