@@ -213,13 +213,17 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
     return cs_motion_plan_path(&jp->mo, &jp->path, tol, method, feed, &jp->diag);
 }
 
-cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file)
+cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool curves)
 {
-    if (jp->mo.segs.npens == 0)
+    if (jp->mo.segs.npens == 0 || (pens && !curves))
         return CS_OK;
+    if (curves)
+        return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
+                          "[pen] mode = servo: --mode curves does not carry pen events (the device "
+                          "plans the strokes itself); stream it in segments mode");
     return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                      "[pen] mode = servo: the device link does not carry pen events yet (plan "
-                      "and curvestep-sim --replay do); use mode = z or a G-code M3/M5 spindle pen");
+                      "[pen] mode = servo: the Modbus and GPIO links do not carry pen events yet "
+                      "(the serial link, --port, does); use mode = z or a G-code M3/M5 spindle pen");
 }
 
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)

@@ -58,6 +58,22 @@ cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, s
     return CS_OK;
 }
 
+cs_err_t cs_stream_job_add_motion(cs_stream_job_t *j, const cs_motion_segs_t *s)
+{
+    size_t p = 0;
+    cs_err_t e = CS_OK;
+    for (size_t k = 0; k <= s->n && e == CS_OK; k++) {
+        for (; p < s->npens && s->pens[p].seg <= k && e == CS_OK; p++) {
+            cs_proto_msg_t m = {.type = CS_PROTO_PEN};
+            m.u.pen.pulse_us = s->pens[p].pulse_us;
+            e = job_push(j, &m);
+        }
+        if (k < s->n && e == CS_OK)
+            e = cs_stream_job_add_segments(j, &s->v[k], 1);
+    }
+    return e;
+}
+
 static cs_err_t push_curve(cs_stream_job_t *j, const cs_vec3_t p[4], int32_t feed)
 {
     cs_proto_msg_t m = {.type = CS_PROTO_CURVE};

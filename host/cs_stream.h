@@ -13,6 +13,7 @@
 #include <stdio.h>
 
 #include "cs_link.h"
+#include "cs_motion.h"
 #include "cs_path.h"
 #include "cs_proto.h"
 #include "cs_serial.h"
@@ -37,6 +38,10 @@ void cs_stream_job_free(cs_stream_job_t *j);
 /* Appends step segments as SEGMENT messages. CS_ERR_FULL out of memory, CS_ERR_RANGE for a
  * segment the protocol cannot carry. */
 cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n);
+/* Appends a plan's segments with its servo pen events as PEN messages in their place (a pen
+ * event before segment k goes right before that segment's SEGMENT; docs/protocol.md, PEN).
+ * Errors as cs_stream_job_add_segments (CS_ERR_RANGE: a pulse width outside 400..2600 us). */
+cs_err_t cs_stream_job_add_motion(cs_stream_job_t *j, const cs_motion_segs_t *s);
 /* Appends every element of path as CURVE messages at the element's own feed (G-code F), else
  * at feed (mm/s Q15.16, > 0); a rapid element (G0) gets INT32_MAX, which the device's planner
  * limits to each axis's max rate (its rapid, as `curvestep plan` does). Lines and

@@ -224,13 +224,13 @@ int cs_cmd_stream(int argc, char **argv)
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
     e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, job_file);
+        e = cs_jobplan_linkable(&jp, job_file, port != NULL, curves);
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
         e = curves ? cs_stream_job_add_path(&job, &jp.path, feed_q > 0 ? feed_q : m.default_feed,
                                             tol, &jp.diag)
-                   : cs_stream_job_add_segments(&job, jp.mo.segs.v, jp.mo.segs.n);
+                   : cs_stream_job_add_motion(&job, &jp.mo.segs);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp.diag);
         int rc = cs_jobplan_exit(&jp, e);

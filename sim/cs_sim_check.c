@@ -2,6 +2,7 @@
 #include "cs_sim_check.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -245,4 +246,41 @@ cs_err_t cs_sim_check(const cs_machine_t *m, const cs_motion_segs_t *segs, const
     free(pc);
     free(w.t0);
     return e;
+}
+
+bool cs_sim_check_print(const cs_machine_t *m, const cs_motion_segs_t *segs,
+                         const cs_sim_exec_t *ex, const cs_sim_ref_t *ref,
+                         const cs_machine_pen_t *pen, const double end[3])
+{
+    cs_sim_check_t c;
+    if (cs_sim_check(m, segs, ex, ref, pen, &c) != CS_OK) {
+        fprintf(stderr, "curvestep-sim: out of memory in the check\n");
+        return false;
+    }
+    double bound = cs_machine_ini_to_double(m->tolerance) + cs_sim_step_mm(m);
+    bool dev_ok = c.dev <= bound, drawn_ok = !c.pen || c.undrawn <= bound;
+    printf("deviation%s: %.5f mm at (%.4f, %.4f, %.4f), segment %zu (tolerance + one step = "
+           "%.5f mm) %s\n",
+           c.pen ? " of pen-down motion (x y)" : "", c.dev, c.dev_at[0], c.dev_at[1], c.dev_at[2],
+           c.dev_seg, bound,
+           dev_ok  ? "ok"
+           : c.pen ? "OVER: a pen-down travel"
+                   : "OVER");
+    if (c.pen)
+        printf("pen: %zu pen-downs; drawn strokes reached pen down within %.5f mm, worst at "
+               "(%.4f, %.4f) %s\n",
+               c.pen_downs, c.undrawn, c.undrawn_at[0], c.undrawn_at[1],
+               drawn_ok ? "ok" : "NOT DRAWN");
+    if (!drawn_ok)
+        printf("pen: segment %zu moves pen up over a stroke the job draws\n", c.undrawn_seg);
+    bool end_ok = true;
+    for (unsigned i = 0; i < 3; i++) {
+        double spm = (double)m->axis[i].steps_per_mm / CS_MOTION_ONE;
+        long long want = llround((double)llround(end[i] * 65536.0) / 65536.0 * spm);
+        if (want != ex->pos[i])
+            end_ok = false;
+    }
+    printf("final position vs job end (%.4f, %.4f, %.4f) rounded to steps: %s\n", end[0], end[1],
+           end[2], end_ok ? "exact" : "DIFFERENT");
+    return dev_ok && drawn_ok && end_ok;
 }

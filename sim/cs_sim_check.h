@@ -33,5 +33,11 @@ typedef struct {
  * event and after one of up_us). CS_ERR_FULL when out of memory. */
 cs_err_t cs_sim_check(const cs_machine_t *m, const cs_motion_segs_t *segs, const cs_sim_exec_t *ex,
                       const cs_sim_ref_t *ref, const cs_machine_pen_t *pen, cs_sim_check_t *out);
+/* Runs cs_sim_check and prints its lines (deviation, pen-downs and strokes reached with a pen,
+ * the final position ex->pos against the job's end `end` mm rounded to steps): true when all
+ * hold. false (and a message on stderr) when out of memory. */
+bool cs_sim_check_print(const cs_machine_t *m, const cs_motion_segs_t *segs,
+                        const cs_sim_exec_t *ex, const cs_sim_ref_t *ref,
+                        const cs_machine_pen_t *pen, const double end[3]);
 
 #endif

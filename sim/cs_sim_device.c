@@ -401,6 +401,42 @@ bool cs_sim_motion_busy(const sim_dev_t *d)
     return !cs_fw_motion_done(&d->app.mo) && !d->app.mo.hold.hold;
 }
 
+/* Appends a pseudo-segment of `ticks` ticks (split below 2^31 ticks each) to s. */
+static cs_err_t pen_span(cs_motion_segs_t *s, uint64_t ticks)
+{
+    do {
+        uint64_t t = ticks > ((uint64_t)1 << 31) ? (uint64_t)1 << 31 : ticks;
+        void *b = s->v;
+        if (!cs_path_grow(&b, &s->cap, s->n + 1, sizeof *s->v))
+            return CS_ERR_FULL;
+        s->v = b;
+        s->v[s->n++] = (cs_segment_t){(uint32_t)t, {0, 0, 0, 0}};
+        ticks -= t;
+    } while (ticks > 0);
+    return CS_OK;
+}
+
+/* The device's pen settings as res->pen_segs (see cs_sim_device.h). */
+static cs_err_t keep_pens(cs_sim_device_result_t *res)
+{
+    size_t np;
+    const port_posix_pen_t *p = port_posix_pens(&np);
+    cs_motion_segs_t *s = &res->pen_segs;
+    uint64_t at = 0;
+    cs_err_t e = CS_OK;
+    for (size_t i = 0; i < np && e == CS_OK; i++) {
+        e = pen_span(s, p[i].t - at);
+        at = p[i].t;
+        void *b = s->pens;
+        if (e == CS_OK && !cs_path_grow(&b, &s->cappens, s->npens + 1, sizeof *s->pens))
+            e = CS_ERR_FULL;
+        s->pens = b;
+        if (e == CS_OK)
+            s->pens[s->npens++] = (cs_motion_pen_t){s->n, p[i].pulse_us};
+    }
+    return e == CS_OK && np > 0 ? pen_span(s, port_posix_now() - at + 1) : e;
+}
+
 /* Copies the port's recorded edges into res->ex (keep_edges). */
 static cs_err_t keep_edges(sim_dev_t *d)
 {
@@ -442,6 +478,9 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     res->log_edges = port_posix_edge_log();
     if (d->cfg->keep_edges)
         rc = keep_edges(d);
+    (void)port_posix_pens(&res->pens);
+    if (rc == CS_OK && d->cfg->keep_edges)
+        rc = keep_pens(res);
     port_posix_reset(d->m->tick_hz, d->inv); /* frees the port's copy of the edges */
     port_stepper_attach(NULL);
     free(d);
@@ -457,6 +496,7 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
 #include "cs_err_text.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
+#include "cs_sim_check.h"
 #include "cs_sim_draw.h"
 
 static volatile sig_atomic_t g_stop;
@@ -657,9 +697,11 @@ int cs_sim_device_main(int argc, char **argv)
         return USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return INPUT;
         }
@@ -749,12 +791,15 @@ int cs_sim_device_main(int argc, char **argv)
            (unsigned)res.frames.frames, (unsigned)res.frames.crc_errs, (unsigned)res.frames.bad,
            (unsigned)res.link.duplicates, (unsigned)res.link.out_of_order,
            (unsigned)res.link.retransmits);
-    cs_sim_device_out_t out = {reference, trace, svg, png, check, &ref, {0, 0, 0}};
+    cs_sim_device_out_t out = {reference, trace, svg, png, check, &ref, {0, 0, 0}, NULL};
     memcpy(out.end_mm, end_mm, sizeof end_mm);
+    if (pen.mode == CS_MACHINE_PEN_SERVO)
+        out.pen = &pen;
     rc = cs_sim_device_report(&m, &cfg, &res, &out, ok, rc);
     fflush(stdout);
     cs_sim_ref_free(&ref);
     cs_sim_exec_free(&res.ex);
+    cs_motion_segs_free(&res.pen_segs);
     return rc;
 }
 
@@ -800,7 +845,11 @@ int cs_sim_device_report(const cs_machine_t *mp, const cs_sim_device_cfg_t *cfg,
                dyn.accel_ok[i] ? "ok" : "OVER");
         ok = ok && dyn.rate_ok[i] && dyn.accel_ok[i];
     }
-    if (reference) {
+    if (res.pens > 0)
+        printf("pen: the device set the servo pen %zu times (PEN messages)\n", res.pens);
+    if (reference && o->pen != NULL) { /* the plotter check, by the device's pen settings */
+        ok = cs_sim_check_print(&m, &res.pen_segs, &res.ex, &ref, o->pen, end_mm) && ok;
+    } else if (reference) {
         double where[3];
         double dev = cs_sim_deviation(&m, &res.ex, &ref, where);
         double tol = cs_conv_pos_to_mm(cfg->tol > 0 ? cfg->tol : m.tolerance);

@@ -17,6 +17,8 @@
 #include "cs_fw_motion.h"
 #include "cs_link.h"
 #include "cs_machine.h"
+#include "cs_machine_ini.h"
+#include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_sim.h"
 
@@ -66,6 +68,11 @@ typedef struct {
     cs_sim_exec_t ex;           /* with keep_edges: every STEP edge (free with cs_sim_exec_free) */
     cs_exlog_segs_t log_segs;   /* the execution log, as a board keeps it (cs_exlog) */
     cs_exlog_edges_t log_edges; /* the STEP edges on the executor's clock (cs_exlog) */
+    size_t pens;                /* PEN messages the device set (port_pen_set) */
+    /* with keep_edges and pens: the run cut at each pen setting into pseudo-segments (segment
+     * k+1 starts at the tick of pen setting k), the settings as their pen events: what
+     * cs_sim_check reads from a segments file's "pen US" lines (free: cs_motion_segs_free) */
+    cs_motion_segs_t pen_segs;
 } cs_sim_device_result_t;
 
 /* Defaults: queue 32, real time, no faults, subdivision at the machine's tolerance. */
@@ -119,6 +126,8 @@ typedef struct {
     bool check;
     const cs_sim_ref_t *ref; /* loaded from reference (cs_sim_ref_from_path) */
     double end_mm[3];        /* the job's end */
+    const cs_machine_pen_t *pen; /* mode servo: the check is cs_sim_check's pen check on
+                                  * res->pen_segs; NULL or another mode: the 3D deviation */
 } cs_sim_device_out_t;
 int cs_sim_device_report(const cs_machine_t *m, const cs_sim_device_cfg_t *cfg,
                          const cs_sim_device_result_t *res, const cs_sim_device_out_t *o, bool ok,

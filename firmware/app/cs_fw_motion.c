@@ -36,7 +36,7 @@ bool cs_fw_motion_drained(const cs_fw_motion_t *a)
     if (a->tracing || a->gen_busy || cs_planner_count(&a->pl) != 0)
         return false;
 #endif
-    return !a->has_pend && cs_stepper_idle(&a->st);
+    return !a->has_pend && !a->pen_wait && cs_stepper_idle(&a->st);
 }
 
 bool cs_fw_motion_done(const cs_fw_motion_t *a)
@@ -204,6 +204,12 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
             return false;
         cs_fw_item_t it;
         pop_item(a, &it);
+        if (it.type == CS_PROTO_PEN) { /* applied by feed once the executor stopped */
+            a->pen_wait = true;
+            a->pen_us = it.u.pen_us;
+            a->pen_item = a->popped;
+            return false;
+        }
 #if CS_FW_CURVES
         if (it.type == CS_PROTO_CURVE) {
             start_curve(a, &it);
@@ -246,12 +252,33 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
         a->steps_pos[i] += s->steps[i];
 }
 
+/* The PEN taken from the queue, set once everything before it has run (the executor stopped:
+ * exactly between its neighbours) and not while held; true when it was set. */
+static bool apply_pen(cs_fw_motion_t *a)
+{
+    if (a->hold.hold)
+        return false;
+    uint32_t irq = port_irq_save();
+    bool idle = cs_stepper_idle(&a->st);
+    port_irq_restore(irq);
+    if (!idle)
+        return false;
+    port_pen_set(a->pen_us);
+    a->pen_wait = false;
+    a->stats.pens++;
+    a->stats.pen_us = a->pen_us;
+    mark_executed(a, a->pen_item);
+    return true;
+}
+
 /* Keeps the executor's ring full; a hold re-times what it hands over and, at rest, keeps the
- * next segment back (cs_hold). */
+ * next segment back (cs_hold). A PEN stops the feeding until it is set. */
 static void feed(cs_fw_motion_t *a)
 {
     a->more = false;
     while (cs_stepper_free(&a->st) > 0) {
+        if (a->pen_wait && !apply_pen(a))
+            break;
         if (!a->has_pend) {
             if (!next_segment(a, &a->pend, &a->pend_done))
                 break;
@@ -333,19 +360,21 @@ cs_err_t cs_fw_motion_queue(cs_fw_motion_t *a, const cs_proto_msg_t *msg, uint16
 #if CS_FW_CURVES
     curve = msg->type == CS_PROTO_CURVE;
 #endif
-    if (msg->type != CS_PROTO_SEGMENT && !curve)
+    if (msg->type != CS_PROTO_SEGMENT && msg->type != CS_PROTO_PEN && !curve)
         return CS_ERR_UNSUPPORTED;
     if (a->qcount >= a->cfg.queue_size)
         return CS_ERR_FULL;
     cs_fw_item_t *it = &a->q[(a->qhead + a->qcount) % CS_FW_QUEUE];
     it->type = msg->type;
     it->seq = seq;
-#if CS_FW_CURVES
-    if (curve)
-        it->u.curve = msg->u.curve;
-    else
-#endif
+    if (msg->type == CS_PROTO_PEN)
+        it->u.pen_us = msg->u.pen.pulse_us;
+    else if (msg->type == CS_PROTO_SEGMENT)
         it->u.seg = msg->u.segment;
+#if CS_FW_CURVES
+    else
+        it->u.curve = msg->u.curve;
+#endif
     a->qcount++;
     a->aborted = false;
     return CS_OK;
@@ -364,6 +393,7 @@ void cs_fw_motion_abort(cs_fw_motion_t *a)
     a->qcount = 0;
     a->qhead = 0;
     a->has_pend = false;
+    a->pen_wait = false;
 #if CS_FW_CURVES
     a->tracing = false;
     a->rapid_pending = false;

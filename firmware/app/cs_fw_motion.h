@@ -1,5 +1,5 @@
 /* cs_fw_motion: the device's motion side, the same on every board and in the simulator. Owns the
- * motion queue (SEGMENT and CURVE messages with their link sequence; its free slots are a link's
+ * motion queue (SEGMENT, CURVE and PEN messages with their link sequence; its free slots are a link's
  * credits), the on-board tracer and planner for CURVE messages, the step executor fed from them,
  * feed hold along the path (cs_hold) and abort, the device state, the sequence of the last
  * executed message, the errors to report and the execution log (cs_exlog). It knows no link:
@@ -51,12 +51,13 @@ CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_tw
 CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
 CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
 
-/* One motion-queue slot: a SEGMENT or (with curves) a CURVE, and its link sequence. */
+/* One motion-queue slot: a SEGMENT, a PEN or (with curves) a CURVE, and its link sequence. */
 typedef struct {
-    uint8_t type; /* CS_PROTO_SEGMENT or CS_PROTO_CURVE */
+    uint8_t type; /* CS_PROTO_SEGMENT, CS_PROTO_PEN or CS_PROTO_CURVE */
     uint16_t seq;
     union {
         cs_segment_t seg;
+        uint16_t pen_us;
 #if CS_FW_CURVES
         cs_proto_curve_t curve;
 #endif
@@ -65,9 +66,11 @@ typedef struct {
 
 /* Counters for the report (cs_fw_app_report) and the figures. */
 typedef struct {
-    uint32_t executed; /* queue items (SEGMENT, CURVE) fully executed since boot */
+    uint32_t executed; /* queue items (SEGMENT, CURVE, PEN) fully executed since boot */
     uint32_t segments; /* step segments pushed to the executor */
     uint32_t curves;   /* CURVE messages traced */
+    uint32_t pens;     /* PEN messages applied (port_pen_set calls) */
+    uint16_t pen_us;   /* the last pulse width set, us (0: none since boot) */
     uint32_t holds, aborts;
     uint32_t errors;      /* errors raised (the first CS_FW_ERRQ waiting ones are reported) */
     uint32_t rx_bytes;    /* UART bytes received (the serial front end's) */
@@ -99,6 +102,10 @@ typedef struct {
     uint32_t popped;    /* items taken from the queue */
     uint32_t take_max;  /* take no item past this number (0: no limit) */
     uint32_t exec_item; /* items executed */
+    /* a PEN taken from the queue, applied once the executor stopped after what came before it */
+    bool pen_wait;
+    uint16_t pen_us;
+    uint32_t pen_item;
     uint16_t item_seq[CS_FW_SEQMAP];
     uint16_t exec_seq;          /* sequence of the last item executed */
     int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
@@ -129,7 +136,9 @@ void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m);
 /* Empty queue, executor at 0, attached to the port's step timer (port_stepper_attach); the last
  * executed sequence reads 0xFFFF. CS_ERR_ARG for a bad machine or cfg. Not ISR-safe. */
 cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_fw_motion_cfg_t *c);
-/* Queues a SEGMENT or CURVE with its sequence: CS_ERR_FULL when no slot is free,
+/* Queues a SEGMENT, PEN or CURVE with its sequence (a PEN is applied with port_pen_set once the
+ * executor has run everything queued before it and stopped, never while held, and nothing after
+ * it starts before): CS_ERR_FULL when no slot is free,
  * CS_ERR_UNSUPPORTED for another type (or CURVE without curves). Main loop. */
 cs_err_t cs_fw_motion_queue(cs_fw_motion_t *mo, const cs_proto_msg_t *msg, uint16_t seq);
 /* HOLD (on: decelerate along the path to rest, cs_hold) or RESUME (off: from rest). */

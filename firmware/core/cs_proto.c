@@ -97,6 +97,10 @@ static cs_err_t check(const cs_proto_msg_t *m)
             if (!cs_fixed_vec_ok(&m->u.curve.p[i]))
                 return CS_ERR_RANGE;
         return m->u.curve.feed > 0 ? CS_OK : CS_ERR_RANGE;
+    case CS_PROTO_PEN:
+        return (m->u.pen.pulse_us < CS_PROTO_PEN_MIN_US || m->u.pen.pulse_us > CS_PROTO_PEN_MAX_US)
+                   ? CS_ERR_RANGE
+                   : CS_OK;
     case CS_PROTO_PING:
     case CS_PROTO_HOLD:
     case CS_PROTO_RESUME:
@@ -125,6 +129,8 @@ static size_t msg_len(uint8_t type, uint8_t axes)
         return CS_PROTO_LEN_SEGMENT;
     case CS_PROTO_CURVE:
         return CS_PROTO_LEN_CURVE;
+    case CS_PROTO_PEN:
+        return CS_PROTO_LEN_PEN;
     case CS_PROTO_HOLD:
     case CS_PROTO_RESUME:
     case CS_PROTO_ABORT:
@@ -141,7 +147,7 @@ bool cs_proto_sequenced(uint8_t type)
 
 bool cs_proto_uses_slot(uint8_t type)
 {
-    return type == CS_PROTO_SEGMENT || type == CS_PROTO_CURVE;
+    return type == CS_PROTO_SEGMENT || type == CS_PROTO_CURVE || type == CS_PROTO_PEN;
 }
 
 cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size_t *len)
@@ -200,6 +206,9 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
             puti32(buf + 9 + 12 * i, m->u.curve.p[i].z);
         }
         puti32(buf + 49, m->u.curve.feed);
+        break;
+    case CS_PROTO_PEN:
+        put16(buf + 1, m->u.pen.pulse_us);
         break;
     default: /* HOLD, RESUME, ABORT: the type byte is the whole message */
         break;
@@ -274,6 +283,9 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
             m->u.curve.p[i].z = geti32(buf + 9 + 12 * i);
         }
         m->u.curve.feed = geti32(buf + 49);
+        break;
+    case CS_PROTO_PEN:
+        m->u.pen.pulse_us = get16(buf + 1);
         break;
     default:
         break;

@@ -30,6 +30,7 @@ typedef enum {
     CS_PROTO_HOLD = 0x22,    /* feed hold: decelerate and stop, keep the queue */
     CS_PROTO_RESUME = 0x23,  /* resume after hold */
     CS_PROTO_ABORT = 0x24,   /* stop now and flush the queue */
+    CS_PROTO_PEN = 0x25,     /* servo pen pulse width, set between the queued neighbours */
 } cs_proto_type_t;
 
 /* Payload sizes in bytes (n = number of axes a status carries, 1..CS_PROTO_AXES_MAX). */
@@ -41,6 +42,7 @@ typedef enum {
 #define CS_PROTO_LEN_SEGMENT   (5 + 4 * CS_AXES)
 #define CS_PROTO_LEN_CURVE     53
 #define CS_PROTO_LEN_CONTROL   1 /* hold, resume, abort */
+#define CS_PROTO_LEN_PEN       3
 #define CS_PROTO_LEN_MAX       CS_PROTO_LEN_CURVE
 
 /* ACK flags. */
@@ -105,6 +107,16 @@ typedef struct {
     int32_t feed;   /* mm/s, Q15.16 (cs_machine.h CS_MOTION_ONE = 1 mm/s), > 0 */
 } cs_proto_curve_t;
 
+/* PEN: the RC servo's pulse width once the executor has run every queued item before it and
+ * before it starts the next one. The settle wait is not in the message: it is the zero-step
+ * SEGMENT(s) the host's planner puts after it (cs_motion_pen), timed by the executor's clock. */
+#define CS_PROTO_PEN_MIN_US 400  /* RC servo pulse range (host cs_machine_ini: up_us, down_us) */
+#define CS_PROTO_PEN_MAX_US 2600
+
+typedef struct {
+    uint16_t pulse_us; /* CS_PROTO_PEN_MIN_US..CS_PROTO_PEN_MAX_US */
+} cs_proto_pen_t;
+
 typedef struct {
     uint8_t type; /* cs_proto_type_t */
     union {
@@ -115,6 +127,7 @@ typedef struct {
         cs_proto_error_t error;
         cs_segment_t segment;
         cs_proto_curve_t curve;
+        cs_proto_pen_t pen;
     } u; /* none for HOLD, RESUME, ABORT */
 } cs_proto_msg_t;
 
@@ -128,7 +141,7 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
 cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m);
 /* True for the types cs_link delivers reliably (everything but ACK and PING). */
 bool cs_proto_sequenced(uint8_t type);
-/* True for the types that take a slot of the device's motion queue (SEGMENT, CURVE): only
+/* True for the types that take a slot of the device's motion queue (SEGMENT, CURVE, PEN): only
  * these spend flow-control credits. */
 bool cs_proto_uses_slot(uint8_t type);
 /* Boot id carried by a well-formed ACK, HELLO or STATUS payload (true), else false. */

@@ -37,6 +37,10 @@ void port_dir_set(uint8_t mask);
 size_t port_uart_read(uint8_t *buf, size_t max);
 /* Queues len bytes for the UART; returns how many were accepted (non-blocking). */
 size_t port_uart_write(const uint8_t *buf, size_t len);
+/* Sets the pen servo's pulse width, us (400..2600: a PEN message, docs/protocol.md); the port
+ * keeps it (a 50 Hz RC-servo pulse train, or a recorded value: docs/firmware.md says which
+ * port does what). Called from the main loop with the executor stopped; not ISR-safe. */
+void port_pen_set(uint16_t pulse_us);
 /* Unrecoverable error: stop the timer, drop STEP lines, report code, stay safe. */
 void port_fault(cs_err_t code);
 

@@ -110,9 +110,14 @@ done
     >"$T/svbad.sim" 2>/dev/null; rc=$?
 expect "servo: a plan without pen events fails the check" [ $rc -eq 4 ]
 expect "servo: names the segment" grep -qE '^pen: segment [0-9]+ moves pen up over a stroke' "$T/svbad.sim"
-# The device link does not carry pen events yet: stream refuses before opening the port.
-run "servo stream refused" 1 stream --machine "$T/servo.ini" --port /dev/null "$T/job.svg"
-expect_err "servo stream says why" 'mode = servo: the device link does not carry pen events'
+# The serial link carries pen events (PEN messages: test_servo_stream.sh); curves mode and the
+# Modbus and GPIO links do not: stream refuses before opening anything, saying why.
+run "servo stream curves refused" 1 stream --machine "$T/servo.ini" --port /dev/null \
+    --mode curves "$T/job.svg"
+expect_err "servo curves says why" 'mode = servo: --mode curves does not carry pen events'
+run "servo stream modbus refused" 1 stream --machine "$T/servo.ini" --modbus-tcp 127.0.0.1:9 \
+    "$T/job.svg"
+expect_err "servo modbus says why" 'mode = servo: the Modbus and GPIO links do not carry pen events'
 printf '[pen]\nmode = servo\nup_us = 1900\n' >"$T/bad2.ini"
 run "servo needs both widths" 1 plan --machine "$T/bad2.ini" "$T/job.svg"
 expect_err "servo needs both widths: says so" 'mode = servo needs up_us and down_us'

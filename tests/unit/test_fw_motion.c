@@ -3,7 +3,8 @@
  * sequence and the position as their sums say (computed here from the messages); the queue's
  * credits and its full case; feed hold mid-job stops at rest with work left and the position of
  * the executed segments, resume finishes with the same segment log as a run without a hold;
- * abort drops what is queued; the take limit; refused message types. */
+ * abort drops what is queued; the take limit; refused message types; a PEN is set exactly
+ * between the segments queued around it and the settle segment after it makes no step. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -177,6 +178,101 @@ static void test_refused_types(void **state)
     assert_int_equal(cs_fw_motion_init(&other, &machine, &c), CS_ERR_ARG);
 }
 
+/* Step edges the job's segments k0..k1-1 make (|x| + |y| steps, from job_msg by hand). */
+static size_t job_edges(unsigned k0, unsigned k1)
+{
+    size_t n = 0;
+    for (unsigned k = k0; k < k1; k++) {
+        cs_proto_msg_t m = job_msg(k);
+        n += (size_t)(m.u.segment.steps[0] + (m.u.segment.steps[1] < 0 ? -m.u.segment.steps[1]
+                                                                          : m.u.segment.steps[1]));
+    }
+    return n;
+}
+
+/* Edges recorded in the time window (t0, t1]. */
+static size_t edges_in(uint64_t t0, uint64_t t1)
+{
+    size_t n, c = 0;
+    const port_posix_edge_t *e = port_posix_edges(&n);
+    for (size_t i = 0; i < n; i++)
+        c += e[i].t > t0 && e[i].t <= t1;
+    return c;
+}
+
+/* Segments 0..9, PEN 800 us, settle 15000 ticks (no steps), segments 10..19, PEN 1700 us,
+ * settle, segments 20..29: each PEN is set after every step of the segments before it and
+ * before any step after it, the settle windows have no steps, and the PENs count as executed. */
+static void test_pen_between_segments(void **state)
+{
+    (void)state;
+    const uint32_t settle = 15000;
+    const uint16_t pulse[2] = {800, 1700};
+    uint16_t seq = 0;
+    for (unsigned part = 0; part < 3; part++) {
+        for (unsigned k = 10 * part; k < 10 * part + 10; k++) {
+            cs_proto_msg_t m = job_msg(k);
+            assert_int_equal(cs_fw_motion_queue(&mo, &m, seq++), CS_OK);
+        }
+        if (part == 2)
+            break;
+        cs_proto_msg_t p = {.type = CS_PROTO_PEN};
+        p.u.pen.pulse_us = pulse[part];
+        assert_int_equal(cs_fw_motion_queue(&mo, &p, seq++), CS_OK);
+        cs_proto_msg_t w = {.type = CS_PROTO_SEGMENT};
+        w.u.segment.ticks = settle;
+        assert_int_equal(cs_fw_motion_queue(&mo, &w, seq++), CS_OK);
+    }
+    run_until(UINT64_MAX);
+    assert_true(cs_fw_motion_done(&mo));
+    size_t np, ne;
+    const port_posix_pen_t *pe = port_posix_pens(&np);
+    (void)port_posix_edges(&ne);
+    assert_int_equal(np, 2);
+    assert_int_equal(mo.stats.pens, 2);
+    assert_int_equal(mo.stats.pen_us, 1700);
+    assert_int_equal(mo.stats.executed, seq);
+    for (unsigned i = 0; i < 2; i++) {
+        assert_int_equal(pe[i].pulse_us, pulse[i]);
+        /* everything before the PEN has stepped by then, nothing after it has */
+        assert_int_equal(edges_in(0, pe[i].t), job_edges(0, 10 * (i + 1)));
+        assert_int_equal(edges_in(pe[i].t, pe[i].t + settle), 0);
+    }
+    /* the settle waits are whole: the next steps come after them */
+    assert_true(pe[1].t >= pe[0].t + settle + 500u * 10);
+    assert_int_equal(ne, job_edges(0, 30));
+    cs_proto_status_t st;
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.last_seq, seq - 1);
+    /* the log holds the segments (settle ones included), not the PENs */
+    assert_int_equal(mo.log.n, 32);
+}
+
+/* A PEN waiting for the executor is not set while held, and is dropped by ABORT. */
+static void test_pen_hold_and_abort(void **state)
+{
+    (void)state;
+    for (unsigned k = 0; k < 4; k++) {
+        cs_proto_msg_t m = job_msg(k);
+        assert_int_equal(cs_fw_motion_queue(&mo, &m, (uint16_t)k), CS_OK);
+    }
+    cs_proto_msg_t p = {.type = CS_PROTO_PEN};
+    p.u.pen.pulse_us = 1000;
+    assert_int_equal(cs_fw_motion_queue(&mo, &p, 4), CS_OK);
+    cs_fw_motion_hold(&mo, true);
+    run_until(UINT64_MAX);
+    run_until(port_posix_now() + 100000);
+    size_t np;
+    (void)port_posix_pens(&np);
+    assert_int_equal(np, 0);
+    cs_fw_motion_abort(&mo);
+    cs_fw_motion_hold(&mo, false);
+    run_until(UINT64_MAX);
+    (void)port_posix_pens(&np);
+    assert_int_equal(np, 0);
+    assert_true(cs_fw_motion_done(&mo));
+}
+
 static int teardown(void **state)
 {
     (void)state;
@@ -192,6 +288,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_hold_resume, setup, teardown),
         cmocka_unit_test_setup_teardown(test_abort_and_limit, setup, teardown),
         cmocka_unit_test_setup_teardown(test_refused_types, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_pen_between_segments, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_pen_hold_and_abort, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

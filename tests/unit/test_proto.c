@@ -170,7 +170,7 @@ static void test_error_segment_curve_control_layout(void **state)
 static void test_unknown_types_and_empty_payload(void **state)
 {
     (void)state;
-    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24};
+    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25};
     uint8_t buf[CS_PROTO_LEN_MAX] = {0};
     cs_proto_msg_t m;
     unsigned unknown = 0;
@@ -324,7 +324,7 @@ static void test_random_round_trips(void **state)
     (void)state;
     const uint8_t types[] = {CS_PROTO_ACK,    CS_PROTO_PING,    CS_PROTO_HELLO, CS_PROTO_STATUS,
                              CS_PROTO_ERROR,  CS_PROTO_SEGMENT, CS_PROTO_CURVE, CS_PROTO_HOLD,
-                             CS_PROTO_RESUME, CS_PROTO_ABORT};
+                             CS_PROTO_RESUME, CS_PROTO_ABORT,   CS_PROTO_PEN};
     for (int t = 0; t < 20000; t++) {
         cs_proto_msg_t m;
         memset(&m, 0, sizeof m);
@@ -374,6 +374,9 @@ static void test_random_round_trips(void **state)
                     (int32_t)(rng() % (2 * (uint64_t)CS_POS_LIMIT + 1)) - CS_POS_LIMIT;
             }
             m.u.curve.feed = (int32_t)(1 + rng() % INT32_MAX);
+            break;
+        case CS_PROTO_PEN:
+            m.u.pen.pulse_us = (uint16_t)(400 + rng() % 2201);
             break;
         default:
             break;
@@ -426,10 +429,11 @@ static void test_classification_and_boot_peek(void **state)
     (void)state;
     assert_false(cs_proto_sequenced(CS_PROTO_ACK));
     assert_false(cs_proto_sequenced(CS_PROTO_PING));
-    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24};
+    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25};
     for (size_t i = 0; i < sizeof seqd; i++) {
         assert_true(cs_proto_sequenced(seqd[i]));
-        assert_int_equal(cs_proto_uses_slot(seqd[i]), seqd[i] == 0x20 || seqd[i] == 0x21);
+        assert_int_equal(cs_proto_uses_slot(seqd[i]),
+                         seqd[i] == 0x20 || seqd[i] == 0x21 || seqd[i] == 0x25);
     }
     cs_proto_msg_t m = {0};
     uint8_t buf[CS_PROTO_LEN_MAX];
@@ -448,6 +452,32 @@ static void test_classification_and_boot_peek(void **state)
     assert_false(cs_proto_peek_boot(buf, len, &boot));
 }
 
+/* PEN (docs/protocol.md): 0x25, then the pulse width in us, u16 little-endian. 1500 us =
+ * 0x05DC -> DC 05 (by hand); the range ends 400 = 0x0190 and 2600 = 0x0A28 are accepted, one
+ * past each (399 = 0x018F, 2601 = 0x0A29) refused both ways. */
+static void test_pen_layout_and_range(void **state)
+{
+    (void)state;
+    static const struct {
+        uint16_t us;
+        uint8_t bytes[CS_PROTO_LEN_PEN];
+        bool ok;
+    } cases[] = {
+        {1500, {0x25, 0xDC, 0x05}, true},  {400, {0x25, 0x90, 0x01}, true},
+        {2600, {0x25, 0x28, 0x0A}, true},  {399, {0x25, 0x8F, 0x01}, false},
+        {2601, {0x25, 0x29, 0x0A}, false},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cs_proto_msg_t m = {0};
+        m.type = CS_PROTO_PEN;
+        m.u.pen.pulse_us = cases[i].us;
+        if (cases[i].ok)
+            expect_encoding(&m, cases[i].bytes, sizeof cases[i].bytes);
+        else
+            expect_range(&m, cases[i].bytes, sizeof cases[i].bytes);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -460,6 +490,7 @@ int main(void)
         cmocka_unit_test(test_random_round_trips),
         cmocka_unit_test(test_random_bytes_get_documented_answers),
         cmocka_unit_test(test_classification_and_boot_peek),
+        cmocka_unit_test(test_pen_layout_and_range),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

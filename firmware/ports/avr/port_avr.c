@@ -237,6 +237,15 @@ void port_step_pulse(uint8_t mask)
     SREG = s;
 }
 
+/* The pen servo is not wired on this port yet (Timer1 is the step timer; a servo wants a 50 Hz
+ * 16-bit PWM): the width is kept where a debugger reads it (docs/firmware.md, "Pen servo"). */
+static volatile uint16_t pen_pulse_us;
+
+void port_pen_set(uint16_t pulse_us)
+{
+    pen_pulse_us = pulse_us;
+}
+
 void port_dir_set(uint8_t mask)
 {
     uint8_t s = SREG;

@@ -75,6 +75,13 @@ static void report(void)
     semihost_fmt_uint(b, sizeof b, &n, r.stats.aborts);
     semihost_fmt_str(b, sizeof b, &n, " aborts\n");
     semihost_write0(b);
+    n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: pen: ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.pens);
+    semihost_fmt_str(b, sizeof b, &n, " settings, last ");
+    semihost_fmt_uint(b, sizeof b, &n, r.stats.pen_us);
+    semihost_fmt_str(b, sizeof b, &n, " us\n");
+    semihost_write0(b);
     line_axes("fw: position (executor):", r.pos, true);
     line_axes("fw: position (STEP/DIR pins):", pins, true);
     line_axes("fw: step pulses:", (const int32_t *)pulses, false);

@@ -14,6 +14,8 @@ struct posix_state {
     cs_stepper_t *st;
     port_posix_edge_t *edges;
     size_t n, cap;
+    port_posix_pen_t *pens;
+    size_t npens, cappens;
     bool record, record_ok;
     int64_t pos[8];
     cs_err_t fault;
@@ -34,6 +36,7 @@ static struct posix_state g = {.hz = 100000,
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
 {
     free(g.edges);
+    free(g.pens);
     cs_stepper_t *st = g.st;
     int in = g.fd_in, out = g.fd_out;
     size_t (*rd)(void *, uint8_t *, size_t) = g.rd;
@@ -101,6 +104,21 @@ void port_irq_restore(uint32_t state)
     g.irq_depth = state;
 }
 
+/* Room for one more of n records of sz bytes at *buf (doubling, from first); false when out of
+ * memory (*buf unchanged). */
+static bool grow(void **buf, size_t *cap, size_t n, size_t sz, size_t first)
+{
+    if (n < *cap)
+        return true;
+    size_t c = *cap ? *cap * 2 : first;
+    void *p = realloc(*buf, c * sz);
+    if (p == NULL)
+        return false;
+    *buf = p;
+    *cap = c;
+    return true;
+}
+
 void port_step_pulse(uint8_t mask)
 {
     for (unsigned i = 0; i < 8; i++) {
@@ -112,18 +130,33 @@ void port_step_pulse(uint8_t mask)
         g.pos[i] += dir;
         if (!g.record)
             continue;
-        if (g.n == g.cap) {
-            size_t cap = g.cap ? g.cap * 2 : 4096;
-            port_posix_edge_t *e = realloc(g.edges, cap * sizeof *e);
-            if (e == NULL) {
-                g.record_ok = false;
-                continue;
-            }
-            g.edges = e;
-            g.cap = cap;
+        void *b = g.edges;
+        bool ok = grow(&b, &g.cap, g.n, sizeof *g.edges, 4096);
+        g.edges = b;
+        if (!ok) {
+            g.record_ok = false;
+            continue;
         }
         g.edges[g.n++] = (port_posix_edge_t){g.now, (uint8_t)i, dir};
     }
+}
+
+void port_pen_set(uint16_t pulse_us)
+{
+    void *b = g.pens;
+    bool ok = grow(&b, &g.cappens, g.npens, sizeof *g.pens, 64);
+    g.pens = b;
+    if (!ok) {
+        g.record_ok = false;
+        return;
+    }
+    g.pens[g.npens++] = (port_posix_pen_t){g.now, pulse_us};
+}
+
+const port_posix_pen_t *port_posix_pens(size_t *n)
+{
+    *n = g.npens;
+    return g.pens;
 }
 
 void port_dir_set(uint8_t mask)

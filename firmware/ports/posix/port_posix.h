@@ -20,6 +20,12 @@ typedef struct {
     int8_t dir;
 } port_posix_edge_t;
 
+/* One pen setting (port_pen_set): at tick t the servo's pulse became pulse_us. */
+typedef struct {
+    uint64_t t;
+    uint16_t pulse_us;
+} port_posix_pen_t;
+
 /* Forgets everything (time 0, timer stopped, no edges) and sets the tick rate and which axes have
  * an inverted DIR line (bit i = axis i). */
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask);
@@ -38,6 +44,8 @@ void port_posix_idle_until(uint64_t until);
 bool port_posix_step(void);
 /* The recorded edges, in time order; *n gets their count. */
 const port_posix_edge_t *port_posix_edges(size_t *n);
+/* The pen settings since reset, in time order (always recorded); *n gets their count. */
+const port_posix_pen_t *port_posix_pens(size_t *n);
 /* Turns edge recording on (the default) or off; false on out of memory while recording. */
 void port_posix_record(bool on);
 bool port_posix_record_ok(void);

@@ -54,6 +54,14 @@ void port_timer_arm(uint32_t ticks)
     (void)ticks;
 }
 
+void port_pen_set(uint16_t pulse_us)
+{
+    /* The pen servo: a 50 Hz pulse train (20 ms period) whose high time becomes pulse_us,
+     * e.g. a PWM timer channel with a 1 us count and compare = pulse_us; the new width takes
+     * effect at the next period. Without a servo output, keep the value (a debugger reads it). */
+    (void)pulse_us;
+}
+
 void port_timer_stop(void)
 {
     /* Disable the step timer interrupt. */

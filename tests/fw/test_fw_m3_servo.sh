@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# A servo-pen plot to the Cortex-M3 image under qemu (as tests/fw/test_fw_m3.sh runs it):
+# contrib/examples/plotter.svg on contrib/machines/servo-a4.ini (the image's tick rate, 100 kHz),
+# `curvestep stream --port` to the image's UART. The pen events go as PEN messages; the image's
+# report (semihosting) must show as many pen settings as `curvestep plan` writes "pen US" lines,
+# the last one the raise (up_us), and every planned segment executed (count and hash of its
+# execution log equal to the simulator's device fed the same stream). Every process is bounded
+# by `timeout`. Prints "cli: N passed, M failed".
+set -u
+B=${CS_BUILD:-build}
+FW=${FW_M3_DIR:-${B%/asan}/fw/cortex-m3}
+ELF=$FW/curvestep.elf
+MC=contrib/machines/servo-a4.ini
+JOB=contrib/examples/plotter.svg
+FEED=150 # mm/s, the machine's max_rate: the job takes 19.4 s of machine time
+QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
+    -icount shift=4
+    -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=500)
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
+
+if ! command -v qemu-system-arm >/dev/null; then
+    echo "FAIL: qemu-system-arm missing (scripts/deps.sh installs it)"
+    echo "cli: 0 passed, 1 failed"
+    exit 1
+fi
+expect "image built" [ -f "$ELF" ]
+run "plan" 0 plan --machine "$MC" --feed $FEED "$JOB" -o "$T/job.seg"
+pens=$(grep -c '^pen ' "$T/job.seg")
+up=$(grep '^up_us' "$MC" | sed 's/[^0-9]*\([0-9]*\).*/\1/')
+nseg=$(grep -vc -e '^#' -e '^pen ' "$T/job.seg")
+expect "plan has pen events ($pens)" [ "$pens" -gt 0 ]
+
+# the simulator's device, fed the same stream: its execution log is the reference
+timeout -k 5 120 "$SIM" --pty --instant --idle-exit 1 --machine "$MC" >"$T/dev.sim" 2>/dev/null &
+pids+=($!)
+SIMPID=$!
+wait_pty "$T/dev.sim" 60
+timeout -k 5 120 "$CS" stream --machine "$MC" --feed $FEED --port "$PTY" "$JOB" >/dev/null 2>&1
+expect "sim: stream exit 0" [ $? -eq 0 ]
+wait_until 60 gone "$SIMPID"
+simlog=$(sed -n 's/^log: \([0-9]* segments hash [0-9]*\),.*/\1/p' "$T/dev.sim")
+expect "sim: $nseg segments logged ($simlog)" [ "${simlog%% *}" = "$nseg" ]
+
+timeout -k 5 120 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
+QPID=$!
+pids+=("$QPID")
+wait_until 20 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
+FPTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/fw.out")
+expect "qemu: pty" [ -n "$FPTY" ]
+timeout -k 5 120 "$CS" stream --machine "$MC" --feed $FEED --line-rate 115200 --port "$FPTY" "$JOB" >"$T/st.out" 2>"$T/st.err"
+expect "image: stream exit 0" [ $? -eq 0 ]
+wait_until 60 gone "$QPID"
+wait "$QPID"; qrc=$?
+expect "image: exit 0 (got $qrc)" [ $qrc -eq 0 ]
+expect "image: $pens pen settings, last $up us" grep -q "^fw: pen: $pens settings, last $up us" "$T/fw.out"
+expect "image: $((nseg + pens)) messages, $nseg segments" \
+    grep -q "^fw: executed $((nseg + pens)) messages, $nseg step segments" "$T/fw.out"
+expect "image: the simulator's log ($simlog)" grep -q "^fw: log: $simlog," "$T/fw.out"
+finish
