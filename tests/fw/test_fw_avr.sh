@@ -117,8 +117,8 @@ timeout --foreground -k 5 50 "$CS" stream --line-rate 115200 --port "$PTY" --mac
     >"$T/is.out" 2>"$T/is.err" &
 spid=$!
 pids+=("$spid")
-end=$((SECONDS + 20)) # until the job is under way (the first progress line with work done)
-while [ $SECONDS -lt $end ] && ! grep -qE '^stream: [1-9][0-9]*/363 segments executed' "$T/is.err"; do
+end=$((SECONDS + 60)) # until the job is under way (the first progress line with work done)
+while [ $SECONDS -lt $end ] && ! grep -qE '^stream: [1-9][0-9]*/[0-9]+ segments executed' "$T/is.err"; do
     sleep 0.05
 done
 kill -INT "$spid"
