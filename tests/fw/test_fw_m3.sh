@@ -42,11 +42,11 @@ value() { sed -n "$2" "$1" | tail -n1; }
 start_fw() {
     local name=$1
     # qemu prints the pty on stdout, the semihosting console goes to stderr: one file
-    timeout -k 5 90 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
+    timeout -k 5 300 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
     QPID=$!
     pids+=("$QPID")
     PTY=
-    local end=$((SECONDS + 10))
+    local end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ]; do
         PTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/$name.fw" 2>/dev/null)
         [ -n "$PTY" ] && break
@@ -54,9 +54,10 @@ start_fw() {
     done
 }
 # wait_fw: the exit status of the qemu started last. The image exits 500 ms (its time) after the
-# host went quiet; one that has not within 10 s is killed (status 143: a failure, not a hang).
+# host went quiet; one that has not within 60 s is killed (status 143: a failure, not a hang;
+# generous: a loaded machine slows qemu down).
 wait_fw() {
-    local end=$((SECONDS + 10))
+    local end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ] && kill -0 "$QPID" 2>/dev/null; do sleep 0.05; done
     kill "$QPID" 2>/dev/null
     wait "$QPID"
@@ -72,12 +73,12 @@ expect "image built" [ -f "$ELF" ]
 
 # The curves-mode reference runs meanwhile: the simulator's device on its own pty, instant.
 (
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
+    timeout -k 5 240 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
     spid=$!
     spty=
-    end=$((SECONDS + 10))
+    end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/sim.out" 2>/dev/null); sleep 0.05; done
-    timeout -k 5 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --port "$spty" "$JOB" \
+    timeout -k 5 240 "$CS" stream --mode curves --machine "$INI" --feed $FEED --port "$spty" "$JOB" \
         >"$T/simcur.out" 2>&1
     wait "$spid"
 ) &
@@ -85,12 +86,12 @@ REFPID=$!
 pids+=("$REFPID")
 # The segments-mode twin: the simulator's device fed the plan the image gets in case 1.
 (
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
+    timeout -k 5 240 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
     spid=$!
     spty=
-    end=$((SECONDS + 10))
+    end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/simseg.out" 2>/dev/null); sleep 0.05; done
-    timeout -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --port "$spty" "$JOB" >"$T/simseg.stream" 2>&1
+    timeout -k 5 240 "$CS" stream --machine "$INI" --feed $FEED --port "$spty" "$JOB" >"$T/simseg.stream" 2>&1
     wait "$spid"
 ) &
 SEGPID=$!
@@ -107,7 +108,7 @@ ref_steps=$(sed -n 's/^replay: [0-9]* segments, \([0-9]*\) steps.*/\1/p' "$T/rep
 expect "reference: plan and replay ran" [ -n "$ref_pos" ] && [ -n "$ref_steps" ] && [ "$nseg" -gt 100 ]
 start_fw seg
 expect "qemu printed the UART's pty" [ -c "$PTY" ]
-timeout -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 --port "$PTY" "$JOB" \
+timeout -k 5 240 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 --port "$PTY" "$JOB" \
     >"$T/seg.out" 2>"$T/seg.err"
 rc=$?
 wait_fw
@@ -138,7 +139,7 @@ sim_steps=$(sed -n 's/^job time: .* simulated, \([0-9]*\) steps$/\1/p' "$T/sim.o
 ncur=$(sed -n 's/^device: .* \([0-9]*\) messages executed .*/\1/p' "$T/sim.out")
 expect "curves reference: simulator ran" [ -n "$sim_pos" ] && [ -n "$sim_steps" ] && [ -n "$ncur" ]
 start_fw cur
-timeout -k 5 60 "$CS" stream --mode curves --machine "$INI" --feed $FEED --line-rate 115200 \
+timeout -k 5 240 "$CS" stream --mode curves --machine "$INI" --feed $FEED --line-rate 115200 \
     --port "$PTY" "$JOB" >"$T/cur.out" 2>"$T/cur.err"
 rc=$?
 wait_fw
@@ -174,12 +175,12 @@ start_fw hold
 dmn_start --port "$PTY" --machine "$INI"
 C submit --feed $FEED "$JOB" >"$T/hsub.out" 2>&1
 expect "hold: submitted" grep -q "^OK job 1 queued: .*: $nseg segments$" "$T/hsub.out"
-expect "hold: a quarter ran" wait_until 40 dmn_quarter
+expect "hold: a quarter ran" wait_until 180 dmn_quarter
 C pause >"$T/hp.out"
 expect "hold: device held" grep -q "^OK paused (device held)" "$T/hp.out"
-expect "hold: progress stands still" wait_until 20 dmn_still
+expect "hold: progress stands still" wait_until 60 dmn_still
 C resume >/dev/null
-expect "hold: job ended" wait_until 60 dmn_finished
+expect "hold: job ended" wait_until 240 dmn_finished
 C status >"$T/hst.out" 2>&1
 expect "hold: every segment executed" grep -q "^job 1 done: .*: $nseg/$nseg segments executed" "$T/hst.out"
 kill -TERM "$DPID"

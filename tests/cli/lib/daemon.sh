@@ -12,12 +12,12 @@
 #   dmn_still           succeeds when job 1's count stands still across the once-a-second
 #                       status line (a held job, for wait_until);
 #   dmn_finished        succeeds once job 1 is done, failed or cancelled.
-C() { timeout -k 5 10 "$CS" "$@" --socket "$S"; }
+C() { timeout -k 5 30 "$CS" "$@" --socket "$S"; }
 dmn_start() {
-    timeout -k 5 120 "$CS" serve "$@" --socket "$S" 2>"$T/serve.err" &
+    timeout -k 5 400 "$CS" serve "$@" --socket "$S" 2>"$T/serve.err" &
     DPID=$!
     pids+=($DPID)
-    wait_until 5 [ -S "$S" ]
+    wait_until 30 [ -S "$S" ]
 }
 dmn_progress() { C status 2>/dev/null | sed -n "s/^job 1 running: .*: \([0-9]*\)\/$N segments.*/\1/p"; }
 dmn_quarter() {
