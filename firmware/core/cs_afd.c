@@ -13,10 +13,6 @@
 
 CS_STATIC_ASSERT(28 + CS_AFD_GUARD_BITS + 4 <= 62, afd_headroom);
 
-static const uint8_t binom[8][8] = {{1, 0, 0, 0, 0, 0, 0, 0},    {1, 1, 0, 0, 0, 0, 0, 0},
-                                    {1, 2, 1, 0, 0, 0, 0, 0},    {1, 3, 3, 1, 0, 0, 0, 0},
-                                    {1, 4, 6, 4, 1, 0, 0, 0},    {1, 5, 10, 10, 5, 1, 0, 0},
-                                    {1, 6, 15, 20, 15, 6, 1, 0}, {1, 7, 21, 35, 35, 21, 7, 1}};
 
 /* b_j = max over u in [0,1] of |d^2/du^2 C(u, j)| (Newton basis), rounded up, in 1/64:
  * 1, 1, 11/12, 5/6, 137/180, 7/10 (all at u = 0) -> 64, 64, 59, 54, 49, 45, plus 1 of margin. */
@@ -65,7 +61,7 @@ static bool afd_double(const int64_t *d, unsigned n, int64_t *out)
         int64_t acc = 0;
         for (unsigned i = 0; i <= m && m + i <= n; i++) {
             int64_t term;
-            if (!mul_chk(d[m + i], (uint32_t)binom[m][i] << (m - i), &term) ||
+            if (!mul_chk(d[m + i], (uint32_t)cs_fixed_binom(m, i) << (m - i), &term) ||
                 !add_chk(acc, term, &acc))
                 return false;
         }
@@ -83,7 +79,7 @@ static bool afd_halve(const int64_t *d, unsigned n, int64_t *out)
         int64_t acc = d[m];
         for (unsigned i = 1; i <= m && m + i <= n; i++) {
             int64_t term;
-            if (!mul_chk(out[m + i], (uint32_t)binom[m][i] << (m - i), &term) ||
+            if (!mul_chk(out[m + i], (uint32_t)cs_fixed_binom(m, i) << (m - i), &term) ||
                 !add_chk(acc, -term, &acc))
                 return false;
         }

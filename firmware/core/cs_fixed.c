@@ -216,3 +216,21 @@ uint64_t cs_fixed_vec_len64(int64_t x, int64_t y, int64_t z)
     az >>= s;
     return (uint64_t)cs_fixed_isqrt64(ax * ax + ay * ay + az * az) << s;
 }
+
+/* Pascal's triangle up to row CS_FIXED_BINOM_MAX (the core's highest degree); C(7, 3) = 35 fits
+ * a byte. */
+static const uint8_t binom_table[CS_FIXED_BINOM_MAX + 1][CS_FIXED_BINOM_MAX + 1] = {
+    {1},
+    {1, 1},
+    {1, 2, 1},
+    {1, 3, 3, 1},
+    {1, 4, 6, 4, 1},
+    {1, 5, 10, 10, 5, 1},
+    {1, 6, 15, 20, 15, 6, 1},
+    {1, 7, 21, 35, 35, 21, 7, 1},
+};
+
+uint8_t cs_fixed_binom(unsigned n, unsigned k)
+{
+    return n <= CS_FIXED_BINOM_MAX && k <= n ? binom_table[n][k] : 0;
+}

@@ -98,6 +98,10 @@ cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q);
  * true length) while every |component| < 2^31; above that the components are shifted right
  * until they fit, and the result is below the true length by less than 3 * 2^-30 of it. */
 uint64_t cs_fixed_vec_len64(int64_t x, int64_t y, int64_t z);
+/* The binomial coefficient C(n, k) for n <= CS_FIXED_BINOM_MAX (0 when k > n or n is beyond it):
+ * the one table the Bernstein, power-basis and forward-difference code shares. ISR-safe. */
+#define CS_FIXED_BINOM_MAX 7
+uint8_t cs_fixed_binom(unsigned n, unsigned k);
 
 
 #endif

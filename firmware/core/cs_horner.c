@@ -1,19 +1,8 @@
 /* cs_horner: power basis and Horner evaluation (see cs_horner.h). */
 #include "cs_horner.h"
 
-CS_STATIC_ASSERT(CS_BEZIER_MAX_DEGREE <= 7, binomials_up_to_7);
+CS_STATIC_ASSERT(CS_BEZIER_MAX_DEGREE <= CS_FIXED_BINOM_MAX, binomials_up_to_the_degree);
 CS_STATIC_ASSERT(40 + CS_HORNER_GUARD + 3 <= 62, horner_sums_below_2_62);
-
-static const int64_t binom[8][8] = {
-    {1},
-    {1, 1},
-    {1, 2, 1},
-    {1, 3, 3, 1},
-    {1, 4, 6, 4, 1},
-    {1, 5, 10, 10, 5, 1},
-    {1, 6, 15, 20, 15, 6, 1},
-    {1, 7, 21, 35, 35, 21, 7, 1},
-};
 
 static int32_t coord(const cs_vec3_t *p, unsigned a)
 {
@@ -35,10 +24,10 @@ cs_err_t cs_horner_init(cs_horner_t *h, const cs_bezier_t *c)
             /* a_k = C(n, k) * k-th forward difference of the control points (exact) */
             int64_t s = 0;
             for (unsigned i = 0; i <= k; i++) {
-                int64_t term = binom[k][i] * (int64_t)coord(&c->p[i], a);
+                int64_t term = (int64_t)cs_fixed_binom(k, i) * (int64_t)coord(&c->p[i], a);
                 s += ((k - i) % 2u) ? -term : term;
             }
-            h->a[k][a] = binom[n][k] * s * ((int64_t)1 << CS_HORNER_GUARD);
+            h->a[k][a] = (int64_t)cs_fixed_binom(n, k) * s * ((int64_t)1 << CS_HORNER_GUARD);
         }
     return CS_OK;
 }

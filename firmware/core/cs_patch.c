@@ -23,7 +23,7 @@
 #define HGUARD 22
 #define NPTS   CS_PATCH_MAX_POINTS
 
-CS_STATIC_ASSERT(CS_PATCH_MAX_DEGREE <= 7, binomials_up_to_7);
+CS_STATIC_ASSERT(CS_PATCH_MAX_DEGREE <= CS_FIXED_BINOM_MAX, binomials_up_to_the_degree);
 CS_STATIC_ASSERT(2 * CS_PATCH_MAX_DEGREE * CS_PATCH_MAX_DEGREE < (1 << (62 - GUARD - 29)),
                  twist_below_2_62);
 /* Raster: m (shift + 1) + 29 <= 63 at m = 3 and the largest shift (see cs_patch_raster_t). */
@@ -356,17 +356,6 @@ cs_err_t cs_patch_iso(const cs_patch_t *p, cs_patch_iso_t dir, cs_param_t t, cs_
 
 /* --- raster by forward differences ------------------------------------------------------- */
 
-static const int64_t binom[NPTS][NPTS] = {
-    {1},
-    {1, 1},
-    {1, 2, 1},
-    {1, 3, 3, 1},
-    {1, 4, 6, 4, 1},
-    {1, 5, 10, 10, 5, 1},
-    {1, 6, 15, 20, 15, 6, 1},
-    {1, 7, 21, 35, 35, 21, 7, 1},
-};
-
 unsigned cs_patch_raster_max_shift(unsigned m)
 {
     if (m == 0)
@@ -382,7 +371,7 @@ static int64_t raster_value(const cs_bezier_t *c, unsigned a, int64_t big_n, int
 {
     int64_t s = 0;
     for (unsigned j = 0; j <= c->degree; j++) {
-        int64_t b = binom[c->degree][j];
+        int64_t b = (int64_t)cs_fixed_binom(c->degree, j);
         for (unsigned q = 0; q < j; q++)
             b *= k;
         for (unsigned q = j; q < c->degree; q++)

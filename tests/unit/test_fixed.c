@@ -380,9 +380,23 @@ static void test_div_u128(void **state)
     }
 }
 
+/* The one binomial table against n! / (k! (n - k)!) computed here, and 0 outside it. */
+static void test_binom(void **state)
+{
+    (void)state;
+    for (unsigned n = 0; n <= CS_FIXED_BINOM_MAX; n++)
+        for (unsigned k = 0; k <= n + 1; k++) {
+            unsigned long long f[9] = {1, 1, 2, 6, 24, 120, 720, 5040, 40320};
+            unsigned long long want = k <= n ? f[n] / (f[k] * f[n - k]) : 0;
+            assert_int_equal(cs_fixed_binom(n, k), want);
+        }
+    assert_int_equal(cs_fixed_binom(CS_FIXED_BINOM_MAX + 1, 1), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_binom),
         cmocka_unit_test(test_add_sub),     cmocka_unit_test(test_narrow),
         cmocka_unit_test(test_round_shift), cmocka_unit_test(test_mul_shift),
         cmocka_unit_test(test_div_shift),   cmocka_unit_test(test_isqrt64),
