@@ -288,16 +288,9 @@ int cs_cmd_toolpath_drop(int argc, char **argv)
         return st;
     a.name = strcmp(a.file, "-") == 0 ? "<stdin>" : a.file;
     cs_surffile_t sf;
-    cs_path_diag_t diag;
-    cs_err_t e = cs_surffile_read(a.file, a.scale, a.tol / 4, &sf, &diag);
-    if (e != CS_OK) {
-        if (e == CS_ERR_FULL)
-            fprintf(stderr, "curvestep toolpath: out of memory\n");
-        else
-            cs_path_diag_print(stderr, &diag);
-        cs_surffile_free(&sf);
-        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
-    }
+    st = cs_surffile_load("curvestep toolpath", a.file, a.scale, a.tol / 4, &sf);
+    if (st != CS_EXIT_OK)
+        return st;
     st = plan_and_write(&a, &sf);
     if (fflush(stdout) != 0 && st == CS_EXIT_OK)
         st = CS_EXIT_INTERNAL;

@@ -420,3 +420,18 @@ cs_err_t cs_surffile_read(const char *filename, double scale, double rev_tol_mm,
     free(buf);
     return e;
 }
+
+int cs_surffile_load(const char *who, const char *filename, double scale, double rev_tol_mm,
+                     cs_surffile_t *sf)
+{
+    cs_path_diag_t diag;
+    cs_err_t e = cs_surffile_read(filename, scale, rev_tol_mm, sf, &diag);
+    if (e == CS_OK)
+        return 0;
+    if (e == CS_ERR_FULL)
+        fprintf(stderr, "%s: out of memory\n", who);
+    else
+        cs_path_diag_print(stderr, &diag);
+    cs_surffile_free(sf);
+    return e == CS_ERR_FULL ? 3 : 1;
+}

@@ -64,6 +64,10 @@ typedef struct {
  * Call cs_surffile_free in every case (the diagnostic's file name lives in *sf). */
 cs_err_t cs_surffile_read(const char *filename, double scale, double rev_tol_mm, cs_surffile_t *sf,
                           cs_path_diag_t *diag);
+/* cs_surffile_read for a command: on error "file:line:col: reason" (or "WHO: out of memory") on
+ * stderr and sf freed. Returns 0 (CS_EXIT_OK), 1 (bad input) or 3 (out of memory). */
+int cs_surffile_load(const char *who, const char *filename, double scale, double rev_tol_mm,
+                     cs_surffile_t *sf);
 /* Same from memory. */
 cs_err_t cs_surffile_parse(const char *text, size_t len, const char *name, double scale,
                            double rev_tol_mm, cs_surffile_t *sf, cs_path_diag_t *diag);

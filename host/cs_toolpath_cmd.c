@@ -781,17 +781,12 @@ int cs_cmd_toolpath(int argc, char **argv)
     cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
 
     cs_surffile_t sf;
-    cs_path_diag_t diag;
     /* Surfaces of revolution are approximated within tol / 4 before tracing. */
-    cs_err_t e = cs_surffile_read(file, scale, tol_mm / 4, &sf, &diag);
-    if (e != CS_OK) {
-        if (e == CS_ERR_FULL)
-            fprintf(stderr, "curvestep toolpath: out of memory\n");
-        else
-            cs_path_diag_print(stderr, &diag);
-        cs_surffile_free(&sf);
-        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
-    }
+    int loaded = cs_surffile_load("curvestep toolpath", file, scale, tol_mm / 4, &sf);
+    if (loaded != CS_EXIT_OK)
+        return loaded;
+    cs_path_diag_t diag;
+    cs_err_t e;
     int status = CS_EXIT_OK;
     const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
     tp_out_t o = {&view, ball, true, NULL, false, {0}, NULL, 0, 0, 0, 0, 0.0, stats};
