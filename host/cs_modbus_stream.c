@@ -366,7 +366,8 @@ static void lease_refused(mrun_t *s, const char *doing)
 
 /* Claims the writer lease before the first write. A lease another client holds (a host that
  * just died, a panel) is waited out once, for the time the device says is left plus a second;
- * then the stream stops (exit 7) rather than wait on. */
+ * then the stream stops (exit 7) rather than wait on. A map without a lease (exception 2 to
+ * LEASE) is written without a token. */
 static void claim_lease(mrun_t *s)
 {
     s->c->token = new_token();
@@ -379,6 +380,10 @@ static void claim_lease(mrun_t *s)
         }
         if (rc != CS_MB_EXCEPTION) {
             lost(s, rc, "claiming the writer lease");
+            return;
+        }
+        if (s->c->exception == CS_MODBUS_EX_ILLEGAL_ADDRESS) {
+            s->c->token = 0; /* a map without a lease (its application has none): write as is */
             return;
         }
         rc = cs_mb_read_status(s->c, &s->st);

@@ -53,12 +53,45 @@ stream() {
     pids+=($!)
 }
 
-# --- 1. a job streams while another client writes, polls flat out and misbehaves -------------
-start_sim dev1 --speed 5
-expect "device listening" [ -n "$ADDR" ]
-stream host1
-wait_until 90 grep -qsE '^stream: [1-9][0-9]*/[0-9]+ segments executed' "$T/host1.err"
-expect "the job is running" grep -qE '^stream: [1-9][0-9]*/' "$T/host1.err"
+# --- 1. a job streams while another client writes, polls flat out or misbehaves --------------
+# the job completes exactly: the host's count, the device's count, its check, the final position
+job_exact() {
+    local name=$1 rc
+    wait_until 200 [ -s "$T/$name-host.rc" ]
+    rc=$(cat "$T/$name-host.rc" 2>/dev/null)
+    expect "$name: the host finished the job (exit ${rc:-none}, expected 0)" [ "${rc:-}" = 0 ]
+    [ "${rc:-}" = 0 ] || sed 's/^/    /' "$T/$name-host.out" | head -3
+    expect "$name: the host executed every segment" \
+        grep -q "^stream: $N of $N segments executed" "$T/$name-host.out"
+    "$T/mbc" "$HOST" "$PORT" status >"$T/$name-status.out" 2>&1
+    expect "$name: the host gave the lease back at the end" grep -q "^LEASE 0 " "$T/$name-status.out"
+    stop_sim
+    expect "$name: device check passed (exit $SIMRC)" [ "$SIMRC" = 0 ]
+    expect "$name: device executed the job's segments, exactly" \
+        grep -q "; $N messages executed ($N step segments" "$T/dev-$name.out"
+    expect "$name: device: final position exact" \
+        grep -q "^final position vs job end .*: exact" "$T/dev-$name.out"
+}
+
+# with_company NAME: a device, a host streaming to it, until the job runs
+with_company() {
+    start_sim "dev-$1" --speed 10
+    expect "$1: device listening" [ -n "$ADDR" ]
+    stream "$1-host"
+    wait_until 90 grep -qsE '^stream: [1-9][0-9]*/[0-9]+ segments executed' "$T/$1-host.err"
+    expect "$1: the job is running" grep -qE '^stream: [1-9][0-9]*/' "$T/$1-host.err"
+}
+
+# a) a foreign write to the mailbox with the device's current sequence
+with_company write
+timeout -k 5 60 "$T/mbc" "$HOST" "$PORT" write >"$T/foreign.out" 2>&1
+expect "write: refused with exception 1, REFUSED 23 (leased), LEASE 1 ($(cat "$T/foreign.out"))" \
+    grep -qx "refused: exception 1 (function 0x90), REFUSED 23, LEASE 1" "$T/foreign.out"
+job_exact write
+
+# b) a client reading the status flat out, and nine that connect and say nothing
+with_company poll
+rm -f "$T/stop"
 "$T/mbc" "$HOST" "$PORT" poll "$T/stop" >"$T/poll.out" 2>&1 &
 pids+=($!)
 # the poller has spoken before the idle ones come: a connection that never said anything is
@@ -66,32 +99,26 @@ pids+=($!)
 wait_until 60 grep -qs '^polling' "$T/poll.out"
 "$T/mbc" "$HOST" "$PORT" idle 9 "$T/stop" >"$T/idle.out" 2>&1 &
 pids+=($!)
-timeout -k 5 60 "$T/mbc" "$HOST" "$PORT" write >"$T/foreign.out" 2>&1
-expect "the foreign write is refused: exception 1, REFUSED 23 (leased), LEASE 1 ($(cat "$T/foreign.out"))" \
-    grep -qx "refused: exception 1 (function 0x90), REFUSED 23, LEASE 1" "$T/foreign.out"
-timeout -k 5 120 "$T/mbc" "$HOST" "$PORT" malformed >"$T/malformed.out" 2>&1
-expect "malformed frames: every check passed" [ "$(grep -c '^ok ' "$T/malformed.out")" = 10 ]
-grep '^FAIL' "$T/malformed.out" | sed 's/^/    /'
-wait_until 200 [ -s "$T/host1.rc" ]
+wait_until 200 [ -s "$T/poll-host.rc" ]
 touch "$T/stop"
-rc=$(cat "$T/host1.rc" 2>/dev/null)
-expect "the host finished the job (exit ${rc:-none}, expected 0)" [ "${rc:-}" = 0 ]
-[ "${rc:-}" = 0 ] || sed 's/^/    /' "$T/host1.out" | head -5
-expect "the host executed every segment" grep -q "^stream: $N of $N segments executed" "$T/host1.out"
 wait_until 30 grep -qs '^polls: ' "$T/poll.out"
 polls=$(sed -n 's/^polls: \([0-9]*\) answered, 0 bad$/\1/p' "$T/poll.out")
-expect "the flat-out poller was served too, never refused (${polls:-none} reads)" [ "${polls:-0}" -ge 100 ]
-"$T/mbc" "$HOST" "$PORT" status >"$T/status.out" 2>&1
-expect "the host gave the lease back at the end" grep -q "^LEASE 0 " "$T/status.out"
-stop_sim
-expect "device check passed (exit $SIMRC)" [ "$SIMRC" = 0 ]
-expect "device: the job's segments executed, exactly" grep -q "; $N messages executed ($N step segments" "$T/dev1.out"
-expect "device: final position exact" grep -q "^final position vs job end .*: exact" "$T/dev1.out"
-expect "device: check ok" grep -qx "check: ok" "$T/dev1.out"
-expect "device: the idle connections were closed to make room, not the host's" \
-    grep -qE "^tcp: .* [1-9][0-9]* closed to make room" "$T/dev1.out"
-expect "device: a bad MBAP length closed 3 connections, a bad protocol id dropped 1 frame" \
-    grep -qE "^tcp: .* 3 closed for a bad MBAP length, 1 frames with another protocol id" "$T/dev1.out"
+expect "poll: the flat-out poller was served too, never refused (${polls:-none} reads)" \
+    [ "${polls:-0}" -ge 100 ]
+job_exact poll
+expect "poll: the silent connections were closed to make room, not the host's" \
+    grep -qE "^tcp: .* [1-9][0-9]* closed to make room" "$T/dev-poll.out"
+
+# c) malformed frames: unknown function codes, a wrong length, a bad protocol id, impossible
+# lengths
+with_company malformed
+timeout -k 5 120 "$T/mbc" "$HOST" "$PORT" malformed >"$T/malformed.out" 2>&1
+expect "malformed: every check passed" [ "$(grep -c '^ok ' "$T/malformed.out")" = 10 ]
+grep '^FAIL' "$T/malformed.out" | sed 's/^/    /'
+job_exact malformed
+expect "malformed: a bad MBAP length closed 3 connections, a bad protocol id dropped 1 frame" \
+    grep -qE "^tcp: .* 3 closed for a bad MBAP length, 1 frames with another protocol id" \
+    "$T/dev-malformed.out"
 
 # --- 2. the lease: a silent holder is waited out, a live one stops the host -----------------
 start_sim dev2 --instant

@@ -387,7 +387,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&app, 0, sizeof app);
     app.queue_size = (uint16_t)(1 + (cfg & 7));
     app.first_seq = firsts[(cfg >> 3) & 3];
-    cs_modbus_app_t hooks = {app_submit, app_command, app_status, &app};
+    cs_modbus_app_t hooks = {app_submit, app_command, app_status, NULL, &app};
     FUZZ_CHECK(cs_modbus_map_init(&map, &hooks, app.first_seq) == CS_OK);
     uint32_t baud = (cfg & 0x20) ? 9600 : 115200;
     FUZZ_CHECK(cs_modbus_rtu_init(&rtu, &map, UNIT, baud) == CS_OK);
