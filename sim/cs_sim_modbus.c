@@ -217,32 +217,44 @@ static int set_parity(int fd, char parity)
     return tcsetattr(fd, TCSANOW, &t);
 }
 
-static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity,
-                     volatile sig_atomic_t *stop, cs_modbus_rtu_stats_t *rs)
+/* Opens the line: a new pty (its path printed) or the serial device dev at baud and parity.
+ * 0, or the exit status (1: the device, 3: the pty) with the reason on stderr. */
+static int rtu_open(const char *dev, uint32_t baud, char parity, cs_serial_t *ser, int *keep)
 {
-    int fd = -1, keep = -1;
-    cs_serial_t ser;
+    *keep = -1;
     if (strcmp(dev, "pty") == 0) {
+        int fd;
         char name[256];
-        if (cs_serial_openpty(&fd, &keep, name, sizeof name) != 0) {
+        if (cs_serial_openpty(&fd, keep, name, sizeof name) != 0) {
             perror("curvestep-sim: openpty");
             return 3;
         }
         printf("%s\n", name);
         fflush(stdout);
-        cs_serial_attach(&ser, fd);
-    } else {
-        if (cs_serial_open(&ser, dev, baud) != 0) {
-            fprintf(stderr, "curvestep-sim: %s: %s\n", dev, strerror(errno));
-            return 1;
-        }
-        fd = ser.fd;
-        if (set_parity(fd, parity) != 0) {
-            fprintf(stderr, "curvestep-sim: %s: parity: %s\n", dev, strerror(errno));
-            close(fd);
-            return 1;
-        }
+        cs_serial_attach(ser, fd);
+        return 0;
     }
+    if (cs_serial_open(ser, dev, baud) != 0) {
+        fprintf(stderr, "curvestep-sim: %s: %s\n", dev, strerror(errno));
+        return 1;
+    }
+    if (set_parity(ser->fd, parity) != 0) {
+        fprintf(stderr, "curvestep-sim: %s: parity: %s\n", dev, strerror(errno));
+        close(ser->fd);
+        return 1;
+    }
+    return 0;
+}
+
+static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity,
+                     volatile sig_atomic_t *stop, cs_modbus_rtu_stats_t *rs)
+{
+    int keep;
+    cs_serial_t ser;
+    int orc = rtu_open(dev, baud, parity, &ser, &keep);
+    if (orc != 0)
+        return orc;
+    int fd = ser.fd;
     cs_serial_set_lossy(&ser, true);
     cs_modbus_rtu_t *r = calloc(1, sizeof *r);
     if (r == NULL || cs_modbus_rtu_init(r, &d->map, d->unit, baud) != CS_OK) {

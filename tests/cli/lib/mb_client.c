@@ -2,12 +2,15 @@
  * client that misbehaves beside a streaming host, on raw sockets (it must send frames no
  * library would). Register map and rules: docs/modbus.md. Every wait has a deadline.
  *   mb_client HOST PORT write          reads NEXT_SEQ and writes one zero-step SEGMENT (1000
- *                                      ticks) with it to the mailbox, without a token; prints
- *                                      "written with sequence N" or "refused: exception E,
- *                                      REFUSED R, LEASE L" (the status read after it)
- *   mb_client HOST PORT poll STOPFILE  reads the status block flat out until STOPFILE exists;
+ *                                      ticks) with it to the mailbox, without a token, until
+ *                                      the device answers it (connecting again when it lost
+ *                                      the connection); prints "written with sequence N" or
+ *                                      "refused: exception E, REFUSED R, LEASE L" (the status
+ *                                      read after it)
+ *   mb_client HOST PORT poll STOPFILE  reads the status block flat out (connecting again when
+ *                                      it lost the connection) until STOPFILE exists;
  *                                      prints "polling" after the first answer, then
- *                                      "polls: N answered, M bad"
+ *                                      "polls: N answered, M bad, R reconnections"
  *   mb_client HOST PORT malformed      sends malformed frames; one line "ok WHAT" or
  *                                      "FAIL WHAT: why" per check
  *   mb_client HOST PORT status         prints "LEASE L LEFT MS NEXT_SEQ N"
@@ -41,7 +44,8 @@ static double now_s(void)
     return (double)ts.tv_sec + ts.tv_nsec / 1e9;
 }
 
-static int connect_dev(void)
+/* A connection to the device, or -1. */
+static int try_connect(void)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
     struct sockaddr_in sa = {0};
@@ -51,10 +55,30 @@ static int connect_dev(void)
     int one = 1;
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+static int connect_dev(void)
+{
+    int fd = try_connect();
+    if (fd < 0) {
         perror("mb_client: connect");
         exit(1);
     }
     return fd;
+}
+
+/* After a failed request: a fresh connection (a client that lost its connection, to a server
+ * that closed it or gave it to someone else, connects again, as a panel would). */
+static int reconnect(int fd, unsigned long *count)
+{
+    close(fd);
+    (*count)++;
+    usleep(1000);
+    return try_connect();
 }
 
 /* Reads exactly n bytes before the deadline: n, 0 when the server closed, -1 on timeout. */
@@ -136,11 +160,13 @@ static int write_one(int fd, uint16_t addr, uint16_t v)
     return n == 5 && rsp[0] == 6 ? 0 : n == 2 ? rsp[1] : -1;
 }
 
-static int do_write(int fd)
+/* One foreign SEGMENT with the device's NEXT_SEQ: 0 written, 1 refused (printed), -1 retry
+ * (the host took that sequence first, or the connection failed). */
+static int write_once(int fd)
 {
     uint16_t ir[26];
     if (read_status(fd, ir, 24) != 0)
-        return 1;
+        return -1;
     uint16_t regs[12] = {0x20, 0, 1000, 0, 0, 0, 0, 0, 0, 0, 0, ir[11]};
     uint8_t req[6 + 24] = {16, 0x01, 0x00, 0, 12, 24}, rsp[260];
     for (int k = 0; k < 12; k++) {
@@ -152,11 +178,28 @@ static int do_write(int fd)
         printf("written with sequence %u\n", (unsigned)ir[11]);
         return 0;
     }
-    if (n != 2 || read_status(fd, ir, 26) != 0)
-        return 1;
+    if (n != 2 || rsp[1] == 3) /* no answer, or the sequence was taken meanwhile: again */
+        return -1;
+    if (read_status(fd, ir, 26) != 0)
+        ir[14] = ir[24] = 0xFFFF;
     printf("refused: exception %u (function 0x%02x), REFUSED %u, LEASE %u\n", (unsigned)rsp[1],
            (unsigned)rsp[0], (unsigned)ir[14], (unsigned)ir[24]);
-    return 0;
+    return 1;
+}
+
+/* Tries until the device answers the write (taken or refused) or 60 s pass. */
+static int do_write(int fd)
+{
+    unsigned long reconnects = 0;
+    double end = now_s() + 60;
+    while (now_s() < end) {
+        int r = fd >= 0 ? write_once(fd) : -1;
+        if (r >= 0)
+            return 0;
+        fd = reconnect(fd, &reconnects);
+    }
+    printf("no answer to the write in 60 s (%lu reconnections)\n", reconnects);
+    return 1;
 }
 
 static int exists(const char *f)
@@ -166,20 +209,24 @@ static int exists(const char *f)
 
 static int do_poll(int fd, const char *stop)
 {
-    unsigned long ok = 0, bad = 0;
+    unsigned long ok = 0, bad = 0, reconnects = 0;
     double end = now_s() + 240;
     uint16_t ir[26];
     while (!exists(stop) && now_s() < end) {
-        if (read_status(fd, ir, 24) == 0 && ir[0] >= 1)
+        if (fd >= 0 && read_status(fd, ir, 24) == 0 && ir[0] >= 1) {
             ok++;
-        else
+        } else {
             bad++;
+            fd = reconnect(fd, &reconnects);
+        }
         if (ok + bad == 1) {
             printf("polling\n"); /* the test waits for this before it opens more */
             fflush(stdout);
         }
     }
-    printf("polls: %lu answered, %lu bad\n", ok, bad);
+    printf("polls: %lu answered, %lu bad, %lu reconnections\n", ok, bad, reconnects);
+    if (fd >= 0)
+        close(fd);
     return bad == 0 && exists(stop) ? 0 : 1;
 }
 
