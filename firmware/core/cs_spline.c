@@ -25,11 +25,6 @@
 
 CS_STATIC_ASSERT(CS_SPLINE_MAX_POINTS >= 2, spline_holds_one_segment);
 
-static int64_t spline_coord(const cs_vec3_t *v, unsigned axis)
-{
-    return axis == 0 ? v->x : axis == 1 ? v->y : v->z;
-}
-
 /* Row i's off-diagonal coefficients (scaled by COEF): a multiplies m_i-1, c multiplies m_i+1. */
 static cs_err_t spline_row(const cs_spline_t *s, size_t i, int64_t *a, int64_t *c)
 {
@@ -59,7 +54,7 @@ static cs_err_t spline_row(const cs_spline_t *s, size_t i, int64_t *a, int64_t *
 /* Slope of span i along axis, scaled (see the file comment). */
 static cs_err_t spline_slope(const cs_spline_t *s, size_t i, unsigned axis, int64_t *out)
 {
-    int64_t d = spline_coord(&s->pts[i + 1], axis) - spline_coord(&s->pts[i], axis);
+    int64_t d = cs_fixed_vec_get(&s->pts[i + 1], axis) - cs_fixed_vec_get(&s->pts[i], axis);
     if (s->param == CS_SPLINE_UNIFORM) {
         *out = d * ((int64_t)1 << SLOPE_BITS_UNIFORM);
         return CS_OK;
@@ -200,8 +195,8 @@ cs_err_t cs_spline_segment(const cs_spline_t *s, size_t index, cs_bezier_t *out)
             e = cs_fixed_muldiv64(s->m[index + 1][axis], h, div, &t2);
         if (e != CS_OK)
             return e;
-        int64_t v1 = spline_coord(&s->pts[index], axis) + t1;
-        int64_t v2 = spline_coord(&s->pts[index + 1], axis) - t2;
+        int64_t v1 = cs_fixed_vec_get(&s->pts[index], axis) + t1;
+        int64_t v2 = cs_fixed_vec_get(&s->pts[index + 1], axis) - t2;
         if (!cs_fixed_pos_ok(v1) || !cs_fixed_pos_ok(v2))
             return CS_ERR_RANGE;
         in1[axis] = (int32_t)v1;
