@@ -44,7 +44,12 @@ for h in cs_sim.h cs_fw_app.h cs_jobplan.h port_posix.h; do probe SIM_CFLAGS $h 
 probe SIM_CFLAGS fw_test.h fail
 
 # The rules use those flags: the command make would run for one object of each layer.
-cmd_for() { make -n --no-print-directory CS_DEPS_DONE=1 -W "$1" "$2" 2>/dev/null | grep -E " -c $1 "; }
+variant=plain
+case "$B" in */asan) variant=asan ;; esac
+cmd_for() {
+    make -n --no-print-directory CS_DEPS_DONE=1 VARIANT=$variant -W "$1" "$2" 2>/dev/null |
+        grep -E " -c $1 "
+}
 c=$(cmd_for firmware/core/cs_fixed.c "$B/obj/firmware/core/cs_fixed.o")
 expect "core object compiled with -Ifirmware/core only" \
     test "$(grep -oE -- '-I[^ ]+' <<<"$c" | tr '\n' ' ')" = "-Ifirmware/core "
