@@ -83,6 +83,22 @@ static int64_t scurve_changes(const cs_segment_gen_t *g, int64_t v0, int64_t vp,
     return cs_fixed_div_round((v0 + vp) * *ta, hz2) + cs_fixed_div_round((vp + v1) * *td, hz2);
 }
 
+/* The cruise phase of a block whose ramps (ta, td, da) are set: dc mm at vp, its time rounded
+ * up so the block never ends before its distance is covered, and at least one tick per block. */
+static cs_err_t set_cruise(cs_segment_gen_t *g, int64_t dc, int64_t vp, uint32_t hz)
+{
+    if (dc < 0)
+        dc = 0;
+    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
+    if (tc + (int64_t)g->ta + (int64_t)g->td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
+        return CS_ERR_RANGE;
+    g->tc = (uint32_t)tc;
+    if (g->ta + g->tc + g->td == 0)
+        g->tc = 1;
+    g->dc = cs_fixed_div_round(vp * (int64_t)g->tc, hz);
+    return CS_OK;
+}
+
 /* S-curve block: peak vp = the nominal speed when both speed changes fit the block, else the
  * highest that fits, by bisection from max(v0, v1) (which the planner guarantees fits). */
 static cs_err_t load_scurve(cs_segment_gen_t *g, int64_t v0, int64_t v1, int64_t vc, int64_t len)
@@ -107,17 +123,7 @@ static cs_err_t load_scurve(cs_segment_gen_t *g, int64_t v0, int64_t v1, int64_t
     g->ta = (uint32_t)ta;
     g->td = (uint32_t)td;
     g->da = cs_fixed_div_round((v0 + vp) * ta, 2 * (int64_t)hz);
-    int64_t dc = len - both;
-    if (dc < 0)
-        dc = 0;
-    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
-    if (tc + ta + td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
-        return CS_ERR_RANGE;
-    g->tc = (uint32_t)tc;
-    if (g->ta + g->tc + g->td == 0)
-        g->tc = 1;
-    g->dc = cs_fixed_div_round(vp * (int64_t)g->tc, hz);
-    return CS_OK;
+    return set_cruise(g, len - both, vp, hz);
 }
 
 static cs_err_t load_block(cs_segment_gen_t *g, const cs_block_t *b)
@@ -168,17 +174,9 @@ static cs_err_t load_block(cs_segment_gen_t *g, const cs_block_t *b)
     g->td = (uint32_t)td;
     g->da = dist_at(g->v0, g->accel, 1, g->ta, hz);
     int64_t dd = dist_at(g->vp, g->accel, -1, g->td, hz);
-    int64_t dc = len - g->da - dd;
-    if (dc < 0)
-        dc = 0;
-    /* Cruise time rounded up: the block never ends before its distance is covered. */
-    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
-    if (tc + ta + td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
-        return CS_ERR_RANGE;
-    g->tc = (uint32_t)tc;
-    if (g->ta + g->tc + g->td == 0)
-        g->tc = 1;
-    g->dc = cs_fixed_div_round(vp * (int64_t)g->tc, hz);
+    cs_err_t e = set_cruise(g, len - g->da - dd, vp, hz);
+    if (e != CS_OK)
+        return e;
 loaded:
     g->length = len;
     for (unsigned i = 0; i < CS_AXES; i++) {
