@@ -394,7 +394,11 @@ static void claim_lease(mrun_t *s)
         double now = cs_serial_now_s();
         if (deadline == 0)
             deadline = now + s->st.lease_left_ms / 1000.0 + 1.0;
-        if (now >= deadline || (s->o->interrupt != NULL && *s->o->interrupt)) {
+        if (s->o->interrupt != NULL && *s->o->interrupt) {
+            finish(s, CS_STREAM_INTERRUPTED); /* nothing was sent: nothing to stop */
+            return;
+        }
+        if (now >= deadline) {
             lease_refused(s, "claiming the writer lease");
             return;
         }

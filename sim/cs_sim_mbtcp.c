@@ -181,9 +181,9 @@ static void serve_one(server_t *s, unsigned k)
     c->n -= whole;
     if (delay < 0 || cs_modbus_mbap_frame(&h, rsp, rn, adu, sizeof adu, &len) != CS_OK)
         return;
-    if (delay == 0) {
+    if (delay == 0 || s->ndl == CS_SIM_MBTCP_DELAYED) { /* no room to hold it: now */
         send_adu(s, k, adu, len);
-    } else if (s->ndl < CS_SIM_MBTCP_DELAYED) {
+    } else {
         delayed_t *q = &s->dl[s->ndl++];
         q->due = cs_serial_now_s() + delay;
         q->slot = k;
