@@ -23,7 +23,8 @@
 typedef struct {
     int fd;        /* -1: free slot */
     uint32_t gen;  /* which connection this slot holds (a delayed answer names it) */
-    double last_s; /* last request, for eviction */
+    double last_s; /* last request (or the connection), for eviction */
+    bool spoke;    /* has sent a request: closed after every one that has not */
     size_t n;      /* bytes buffered */
     uint8_t in[2 * CS_MODBUS_TCP_MAX];
 } conn_t;
@@ -98,8 +99,16 @@ static void drop_conn(server_t *s, unsigned k)
     s->c[k].n = 0;
 }
 
-/* A new connection: a free slot, or the one silent the longest (a silent client must never
- * lock the streaming host out). */
+/* The slot a new connection takes when all are open: a connection that never sent a request,
+ * the oldest first, else the one silent the longest. A silent client never locks the streaming
+ * host out, and a client that speaks is not closed for a moment's delay (a loaded machine)
+ * while one that never spoke is open. */
+static bool evict_before(const conn_t *a, const conn_t *b)
+{
+    return a->spoke != b->spoke ? !a->spoke : a->last_s < b->last_s;
+}
+
+/* A new connection: a free slot, or the one evict_before picks. */
 static void accept_one(server_t *s)
 {
     int fd = accept(s->ls, NULL, NULL);
@@ -118,7 +127,7 @@ static void accept_one(server_t *s)
             slot = k;
             break;
         }
-        if (slot == CS_SIM_MBTCP_CONNS || s->c[k].last_s < s->c[slot].last_s)
+        if (slot == CS_SIM_MBTCP_CONNS || evict_before(&s->c[k], &s->c[slot]))
             slot = k;
     }
     if (open == CS_SIM_MBTCP_CONNS) {
@@ -134,6 +143,7 @@ static void accept_one(server_t *s)
     c->fd = fd;
     c->gen = ++s->gen;
     c->n = 0;
+    c->spoke = false;
     c->last_s = cs_serial_now_s();
     s->st->connections++;
     if (open + 1 > s->st->most)
@@ -172,6 +182,7 @@ static void serve_one(server_t *s, unsigned k)
     size_t rn = 0, len = 0;
     double delay = -1;
     c->last_s = cs_serial_now_s();
+    c->spoke = true;
     if (e == CS_ERR_UNSUPPORTED)
         s->st->bad_proto++; /* not Modbus: dropped unanswered */
     else

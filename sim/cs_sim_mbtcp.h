@@ -2,9 +2,10 @@
  * listening socket, up to CS_SIM_MBTCP_CONNS connections at once, the MBAP framing (the core's
  * cs_modbus_mbap_parse: protocol id and length checked) and fair service: each round answers at
  * most one request per connection, in turn, so a client polling flat out gets no more than the
- * streaming host. A new connection beyond the limit closes the one silent the longest; a
- * connection whose length field is impossible, or that does not read its answers, is closed; a
- * frame whose protocol id is not 0 is dropped unanswered. What a request means is the caller's
+ * streaming host. A new connection beyond the limit closes one that never sent a request (the
+ * oldest), else the one silent the longest; a connection whose length field is impossible, or
+ * that does not read its answers, is closed; a frame whose protocol id is not 0 is dropped
+ * unanswered. What a request means is the caller's
  * (cs_sim_mbtcp_app_t.handle). Host-side POSIX code (sockets, poll), single-threaded. */
 #ifndef CS_SIM_MBTCP_H
 #define CS_SIM_MBTCP_H
@@ -34,7 +35,7 @@ typedef struct {
 
 typedef struct {
     uint64_t connections; /* accepted */
-    uint64_t evicted;     /* closed to make room for a new one (the one silent the longest) */
+    uint64_t evicted;     /* closed to make room for a new one (see cs_sim_mbtcp_serve) */
     uint64_t bad_length;  /* closed: an MBAP length outside 2..254 */
     uint64_t bad_proto;   /* frames dropped: protocol id not 0 */
     uint64_t slow;        /* closed: did not read its answers (send buffer full) */
