@@ -244,10 +244,11 @@ static void diag_text(const cs_jobplan_t *jp, const char *file, cs_err_t e, char
 /* Reads the job file once (a regular file only: a FIFO or a device would block the daemon) into
  * jp->path, laid out, ordered and pen-lifted by in (the SUBMIT words) with merge distance tol_mm;
  * on error a "file:line:col: reason" in err. */
-static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, double tol_mm,
-                     cs_jobplan_t *jp, char *err, size_t errcap)
+static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, const char *font,
+                     double tol_mm, cs_jobplan_t *jp, char *err, size_t errcap)
 {
     cs_jobplan_init(jp);
+    jp->font_file = font; /* NULL: the shipped font */
     jp->regular_only = true;
     jp->max_bytes = d->cfg->max_input_bytes;
     cs_pos_t tol;
@@ -308,12 +309,14 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     return false;
 }
 
-/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [shared option words] /ABS/PATH"
+/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [font=/ABS/FONT] [shared option words]
+ * /ABS/PATH"
  * (the shared words: cs_jobopts_word, e.g. lenient, dialect=grbl, fit, rotate=90) */
 static void req_submit(daemon_t *d, char *args, FILE *out)
 {
     bool curves = false;
     double tol = 0, feed = 0;
+    const char *font = NULL;
     cs_jobopts_t in;
     cs_jobopts_init(&in);
     while (*args == ' ')
@@ -336,6 +339,8 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
         else if (strncmp(args, "feed=", 5) == 0 &&
                  ((feed = strtod(args + 5, &end)), *end == '\0' && feed > 0 && feed < 32768))
             ;
+        else if (strncmp(args, "font=/", 6) == 0)
+            font = args + 5; /* within args, which outlives the read */
         else if (cs_jobopts_word(args, &in))
             ;
         else {
@@ -353,7 +358,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     char err[600];
     cs_stream_job_t job;
     cs_jobplan_t jp;
-    if (!read_job(d, args, &in, tol, &jp, err, sizeof err)) {
+    if (!read_job(d, args, &in, font, tol, &jp, err, sizeof err)) {
         fprintf(out, "ERR %s\n", err);
         dlog(d, "refused %s: %s", args, err);
         return;
