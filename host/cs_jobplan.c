@@ -126,10 +126,11 @@ cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machi
     iopts.regular_only = jp->regular_only;
     if (pen != NULL) {
         jp->pen = *pen;
-        /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
+        /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become Z moves at z_feed. */
         iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
         iopts.pen_up_z_mm = pen->up_z_mm;
         iopts.pen_down_z_mm = pen->down_z_mm;
+        iopts.pen_z_feed_mm_s = pen->z_feed_mm_s;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
     jp->gcode = fmt == CS_INPUT_GCODE;
