@@ -221,13 +221,14 @@ int main(int argc, char **argv)
         perror(trace);
         rc = EXIT_INTERNAL;
     }
+    cs_sim_draw_pen_t dp = {&pen, &segs}; /* pen-up travel and servo settings in the pictures */
     if (rc == EXIT_OK && svg &&
-        cs_sim_draw_svg_view(svg, &m, &ex, reference ? &ref : NULL, &view) != 0) {
+        cs_sim_draw_svg_pen(svg, &m, &ex, reference ? &ref : NULL, &view, &dp) != 0) {
         perror(svg);
         rc = EXIT_INTERNAL;
     }
     if (rc == EXIT_OK && png &&
-        cs_sim_draw_png_view(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width) != 0)
+        cs_sim_draw_png_pen(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width, &dp) != 0)
         rc = EXIT_INTERNAL;
     if (rc == EXIT_OK && check && !ok) {
         printf("check: FAILED\n");
