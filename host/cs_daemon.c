@@ -293,7 +293,10 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     cs_err_t e = cs_jobplan_plan(jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
                                  CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(jp, file, d->cfg->port != NULL, curves);
+        e = cs_jobplan_linkable(jp, file,
+                                d->cfg->port != NULL || d->cfg->modbus_tcp != NULL ||
+                                    d->cfg->modbus_rtu != NULL,
+                                curves);
     if (e == CS_OK)
         e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
                                             tol, &jp->diag)

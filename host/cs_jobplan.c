@@ -223,8 +223,8 @@ cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool
                           "[pen] mode = servo: --mode curves does not carry pen events (the device "
                           "plans the strokes itself); stream it in segments mode");
     return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                      "[pen] mode = servo: the Modbus and GPIO links do not carry pen events yet "
-                      "(the serial link, --port, does); use mode = z or a G-code M3/M5 spindle pen");
+                      "[pen] mode = servo: the GPIO link does not carry pen events yet (the serial "
+                      "and Modbus links do); use mode = z or a G-code M3/M5 spindle pen");
 }
 
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)

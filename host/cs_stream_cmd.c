@@ -224,7 +224,8 @@ int cs_cmd_stream(int argc, char **argv)
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
     e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, job_file, port != NULL, curves);
+        e = cs_jobplan_linkable(&jp, job_file, port != NULL || mb_tcp != NULL || mb_rtu != NULL,
+                                curves);
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
