@@ -31,6 +31,7 @@
 #include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_pen.h"
 #include "cs_trace.h"
 
 #define MAX_CLIENTS 16
@@ -298,8 +299,11 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
                                     d->cfg->modbus_rtu != NULL,
                                 curves);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
-                                            tol, &jp->diag)
+        e = curves ? cs_stream_job_add_path_pen(job, &jp->path,
+                                                feed_q > 0 ? feed_q : d->m.default_feed, tol,
+                                                &jp->pen, d->m.tick_hz,
+                                                &(cs_vec3_t){start[0], start[1], start[2]},
+                                                &jp->diag)
                    : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (jp->have_mo) { /* the job holds its own copy of the segments */
         cs_motion_free(&jp->mo);

@@ -216,12 +216,9 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
 
 cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool curves)
 {
-    if (jp->mo.segs.npens == 0 || (pens && !curves))
+    (void)curves; /* curves mode carries them too (cs_stream_pen) */
+    if (jp->mo.segs.npens == 0 || pens)
         return CS_OK;
-    if (curves)
-        return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                          "[pen] mode = servo: --mode curves does not carry pen events (the device "
-                          "plans the strokes itself); stream it in segments mode");
     return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
                       "[pen] mode = servo: the GPIO link does not carry pen events yet (the serial "
                       "and Modbus links do); use mode = z or a G-code M3/M5 spindle pen");

@@ -15,6 +15,7 @@
 #include "cs_jobplan.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_pen.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
 #include "cs_trace.h"
@@ -229,8 +230,9 @@ int cs_cmd_stream(int argc, char **argv)
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(&job, &jp.path, feed_q > 0 ? feed_q : m.default_feed,
-                                            tol, &jp.diag)
+        e = curves ? cs_stream_job_add_path_pen(&job, &jp.path,
+                                                feed_q > 0 ? feed_q : m.default_feed, tol, &jp.pen,
+                                                m.tick_hz, &(cs_vec3_t){0, 0, 0}, &jp.diag)
                    : cs_stream_job_add_motion(&job, &jp.mo.segs);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp.diag);
