@@ -13,6 +13,7 @@
 #include "cs_cmd.h"
 #include "cs_gpio_cfg.h"
 #include "cs_gpio_io.h"
+#include "cs_gpio_pwm.h"
 #include "cs_gpio_run.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
@@ -218,6 +219,21 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
             return CS_EXIT_INTERNAL;
         }
     }
+    /* the pen servo ([pen] mode = servo): its own line and thread (cs_gpio_pwm) */
+    cs_gpio_io_t pio = {0};
+    bool pen = p->npens > 0;
+    if (pen && cfg.pen < 0 && !record)
+        snprintf(err, sizeof err, "%s:0: [pen] mode = servo, but [gpio] wires no pen line (pen = "
+                 "OFFSET, docs/gpio.md)", a->machine_file ? a->machine_file : "machine");
+    if (pen && (cfg.pen < 0 && !record ? -1
+                                       : cs_gpio_pwm_open(&pio, chip_arg, record != NULL, cfg.pen,
+                                                          (double)p->ticks / m->tick_hz + 2.0,
+                                                          err, sizeof err)) != 0) {
+        fprintf(stderr, "curvestep stream: %s\n", err);
+        cs_gpio_io_close(&io);
+        cs_gpio_io_free(&io);
+        return cfg.pen < 0 ? CS_EXIT_INPUT : CS_EXIT_NO_DEVICE;
+    }
     const char *link = chip_arg; /* "stream: LINK: outcome" */
     fprintf(stderr, "stream: %s: %u lines (", link, l.n);
     for (unsigned i = 0; i < l.n; i++)
@@ -243,9 +259,14 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         cs_gpio_io_set(&io, (1u << l.n) - 1u, 0, 0, &(int64_t){0});
         cs_gpio_io_close(&io);
         cs_gpio_io_free(&io);
+        cs_gpio_io_close(&pio);
+        cs_gpio_io_free(&pio);
         return CS_EXIT_INTERNAL;
     }
     warn_rt(&r, &cfg);
+    cs_gpio_pwm_t pw = {0};
+    if (pen && (rc = cs_gpio_pwm_start(&pw, &pio, &r, p->pens, p->npens, cfg.spin_ns)) != 0)
+        fprintf(stderr, "curvestep stream: cannot start the pen's thread: %s\n", strerror(rc));
     progress_t pg;
     memset(&pg, 0, sizeof pg);
     pg.f = a->quiet ? NULL : stderr;
@@ -269,6 +290,9 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         nanosleep(&ts, NULL);
     }
     cs_gpio_run_join(&r);
+    cs_gpio_pwm_stop(&pw);
+    if (pen)
+        cs_gpio_io_close(&pio);
     progress(&pg, p, &r, true);
     double wall = now_s() - t_start;
     cs_gpio_io_close(&io);
@@ -310,6 +334,14 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
            "us, max %.1f us\n",
            wall, (double)r.ticks / m->tick_hz, (double)cs_gpio_run_late_quantile(&r, 0.5) / 1000.0,
            (double)cs_gpio_run_late_quantile(&r, 0.99) / 1000.0, (double)r.late_max_ns / 1000.0);
+    if (pen)
+        printf("stream: pen servo: %llu pulses at 50 Hz (software PWM), edges late by max %.1f "
+               "us%s%s\n",
+               (unsigned long long)pw.periods, (double)pw.late_max_ns / 1000.0,
+               pw.io_errno || !pw.started ? "; FAILED: " : "",
+               pw.io_errno ? strerror(pw.io_errno) : !pw.started ? "no thread" : "");
+    if (pen && (pw.io_errno || !pw.started) && exit_rc == CS_EXIT_OK)
+        exit_rc = CS_EXIT_CLOSED;
     if (exit_rc != CS_EXIT_OK && ex < p->nsegs && r.outcome != CS_GPIO_RUN_STOPPED)
         cs_stream_report_resume(stdout, "segment", ex);
     if (r.outcome == CS_GPIO_RUN_STOPPED)
@@ -323,6 +355,8 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
                  (unsigned)m->tick_hz, (unsigned)cfg.pulse_ns, (unsigned)cfg.dir_setup_ns);
         int wr = f ? cs_gpio_io_write_record(&io, f, r.t0_ns, hdr) : -1;
+        if (wr == 0 && pen) /* the pen's line after the others, its own header line */
+            wr = cs_gpio_io_write_record(&pio, f, r.t0_ns, "pen servo: software PWM, 50 Hz");
         if (f && fclose(f) != 0)
             wr = -1;
         if (wr != 0) {
@@ -337,5 +371,6 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         }
     }
     cs_gpio_io_free(&io);
+    cs_gpio_io_free(&pio);
     return exit_rc;
 }

@@ -220,8 +220,8 @@ cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool
     if (jp->mo.segs.npens == 0 || pens)
         return CS_OK;
     return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                      "[pen] mode = servo: the GPIO link does not carry pen events yet (the serial "
-                      "and Modbus links do); use mode = z or a G-code M3/M5 spindle pen");
+                      "[pen] mode = servo: this link does not carry pen events (the serial, Modbus "
+                      "and GPIO links do); use mode = z or a G-code M3/M5 spindle pen");
 }
 
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)

@@ -225,8 +225,7 @@ int cs_cmd_stream(int argc, char **argv)
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
     e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, job_file, port != NULL || mb_tcp != NULL || mb_rtu != NULL,
-                                curves);
+        e = cs_jobplan_linkable(&jp, job_file, true, curves); /* GPIO: cs_gpio_pwm */
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
@@ -278,6 +277,8 @@ int cs_cmd_stream(int argc, char **argv)
         pl.segs = jp.mo.segs.v;
         pl.nsegs = jp.mo.segs.n;
         pl.ticks = jp.mo.ticks;
+        pl.pens = jp.mo.segs.pens;
+        pl.npens = jp.mo.segs.npens;
         struct sigaction sig;
         memset(&sig, 0, sizeof sig);
         sig.sa_handler = on_sigint;

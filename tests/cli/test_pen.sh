@@ -125,12 +125,8 @@ done
     >"$T/svbad.sim" 2>/dev/null; rc=$?
 expect "servo: a plan without pen events fails the check" [ $rc -eq 4 ]
 expect "servo: names the segment" grep -qE '^pen: segment [0-9]+ moves pen up over a stroke' "$T/svbad.sim"
-# The serial and Modbus links carry pen events, in segments and curves mode (PEN messages:
-# test_servo_stream.sh, test_servo_links.sh); the GPIO link does not: stream refuses before
-# driving anything, saying why.
-run "servo stream gpio refused" 1 stream --machine "$T/servo.ini" --gpio "record:$T/gpio.rec" \
-    "$T/job.svg"
-expect_err "servo gpio says why" 'mode = servo: the GPIO link does not carry pen events'
+# Every link carries pen events, in segments and curves mode: test_servo_stream.sh (serial,
+# daemon), test_servo_links.sh (Modbus, curves), test_gpio_pen.sh (GPIO, software PWM).
 printf '[pen]\nmode = servo\nup_us = 1900\n' >"$T/bad2.ini"
 run "servo needs both widths" 1 plan --machine "$T/bad2.ini" "$T/job.svg"
 expect_err "servo needs both widths: says so" 'mode = servo needs up_us and down_us'
