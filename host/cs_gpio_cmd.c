@@ -334,13 +334,7 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
            "us, max %.1f us\n",
            wall, (double)r.ticks / m->tick_hz, (double)cs_gpio_run_late_quantile(&r, 0.5) / 1000.0,
            (double)cs_gpio_run_late_quantile(&r, 0.99) / 1000.0, (double)r.late_max_ns / 1000.0);
-    if (pen)
-        printf("stream: pen servo: %llu pulses at 50 Hz (software PWM), edges late by max %.1f "
-               "us%s%s\n",
-               (unsigned long long)pw.periods, (double)pw.late_max_ns / 1000.0,
-               pw.io_errno || !pw.started ? "; FAILED: " : "",
-               pw.io_errno ? strerror(pw.io_errno) : !pw.started ? "no thread" : "");
-    if (pen && (pw.io_errno || !pw.started) && exit_rc == CS_EXIT_OK)
+    if (pen && !cs_gpio_pwm_report(stdout, &pw) && exit_rc == CS_EXIT_OK)
         exit_rc = CS_EXIT_CLOSED;
     if (exit_rc != CS_EXIT_OK && ex < p->nsegs && r.outcome != CS_GPIO_RUN_STOPPED)
         cs_stream_report_resume(stdout, "segment", ex);

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 
 /* Sleeps in slices so a stop request is seen within this long. */
@@ -56,13 +57,24 @@ static void *thread_main(void *arg)
     cs_gpio_pwm_t *p = arg;
     size_t ev = 0;
     uint16_t w = 0;
+    unsigned since = 0;                        /* pulses made at width w */
     int64_t t = cs_gpio_io_now_ns() + 1000000; /* the first period starts 1 ms from now */
-    while (!__atomic_load_n(&p->stop, __ATOMIC_ACQUIRE)) {
-        w = width_now(p, cs_gpio_run_executed(p->run), &ev, w);
+    for (;;) {
+        uint16_t nw = width_now(p, cs_gpio_run_executed(p->run), &ev, w);
+        if (nw != w) {
+            w = nw;
+            since = 0;
+        }
+        /* asked to end (the job is over: its progress is final): once the last width in force
+         * has gone out CS_GPIO_PWM_TAIL times, so the servo gets there however late this
+         * thread ran */
+        if (__atomic_load_n(&p->stop, __ATOMIC_ACQUIRE) && (w == 0 || since >= CS_GPIO_PWM_TAIL))
+            break;
         if (w != 0) {
             if (!edge(p, t, 1u) || !edge(p, t + (int64_t)w * 1000, 0u))
                 break;
             p->periods++;
+            since++;
         }
         t += CS_GPIO_PWM_PERIOD_NS;
         wait_until(t - CS_GPIO_PWM_PERIOD_NS / 2, 0); /* half a period before the next rise */
@@ -83,13 +95,22 @@ int cs_gpio_pwm_start(cs_gpio_pwm_t *p, cs_gpio_io_t *io, const cs_gpio_run_t *r
 
 void cs_gpio_pwm_stop(cs_gpio_pwm_t *p)
 {
-    if (!p->started)
-        return;
-    if (p->joined)
+    if (!p->started || p->joined)
         return;
     __atomic_store_n(&p->stop, 1, __ATOMIC_RELEASE);
     pthread_join(p->th, NULL);
     p->joined = true;
+}
+
+bool cs_gpio_pwm_report(FILE *f, const cs_gpio_pwm_t *p)
+{
+    bool ok = p->started && p->io_errno == 0;
+    fprintf(f, "stream: pen servo: %llu pulses at 50 Hz (software PWM), edges late by max %.1f us",
+            (unsigned long long)p->periods, (double)p->late_max_ns / 1000.0);
+    if (!ok)
+        fprintf(f, "; FAILED: %s", p->io_errno ? strerror(p->io_errno) : "no thread");
+    fputc('\n', f);
+    return ok;
 }
 
 int cs_gpio_pwm_open(cs_gpio_io_t *io, const char *chip, bool record, int offset,

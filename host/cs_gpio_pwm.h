@@ -14,12 +14,14 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "cs_gpio_io.h"
 #include "cs_gpio_run.h"
 #include "cs_motion.h"
 
 #define CS_GPIO_PWM_PERIOD_NS 20000000 /* 50 Hz, the RC-servo frame */
+#define CS_GPIO_PWM_TAIL      5        /* pulses of the last width at least, before the end */
 
 typedef struct {
     cs_gpio_io_t *io;              /* opened with the pen line as line 0 */
@@ -30,7 +32,7 @@ typedef struct {
     pthread_t th;
     bool started;                  /* the thread was created */
     bool joined;                   /* ... and has ended */
-    int stop;                      /* main writes 1: end after the period under way */
+    int stop;                      /* main writes 1: end (see cs_gpio_pwm_stop) */
     /* results, read after cs_gpio_pwm_stop */
     uint64_t periods;              /* pulses made */
     int64_t late_max_ns;           /* largest lateness of an edge after its planned time */
@@ -42,8 +44,14 @@ typedef struct {
  * Main thread only. */
 int cs_gpio_pwm_start(cs_gpio_pwm_t *p, cs_gpio_io_t *io, const cs_gpio_run_t *run,
                       const cs_motion_pen_t *pens, size_t npens, int64_t spin_ns);
-/* Ends the train after the period under way (the line left low) and joins. Main thread only. */
+/* Ends the train once the last width in force (the job's progress is final: call it after
+ * cs_gpio_run_join) has gone out CS_GPIO_PWM_TAIL times (100 ms), the line left low, and joins.
+ * Main thread only. */
 void cs_gpio_pwm_stop(cs_gpio_pwm_t *p);
+/* Prints "stream: pen servo: N pulses at 50 Hz (software PWM), edges late by max X us" (and
+ * "; FAILED: why") on f, after cs_gpio_pwm_stop. false when the train failed (no thread, or a
+ * set call refused). */
+bool cs_gpio_pwm_report(FILE *f, const cs_gpio_pwm_t *p);
 /* Opens the pen line as io's line 0: [gpio] pen of cfg on chip `chip` (record false), or a
  * recorder (record true) with room for a train of `seconds`. Returns 0, -1 with one sentence in
  * err (the chip refused the line: cs_gpio_io_open_chip's reasons; out of memory). Not

@@ -61,8 +61,8 @@ static void report_servo(void)
     size_t n = 0;
     semihost_fmt_str(b, sizeof b, &n, "fw: servo: PG1 ");
     semihost_fmt_uint(b, sizeof b, &n, sv.periods);
-    semihost_fmt_str(b, sizeof b, &n, " periods in ");
-    semihost_fmt_uint(b, sizeof b, &n, sv.span_cyc);
+    semihost_fmt_str(b, sizeof b, &n, " periods, mean ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.periods ? (uint32_t)(sv.span_cyc / sv.periods) : 0);
     semihost_fmt_str(b, sizeof b, &n, " cycles (min ");
     semihost_fmt_uint(b, sizeof b, &n, sv.min_cyc);
     semihost_fmt_str(b, sizeof b, &n, " max ");

@@ -44,7 +44,7 @@ uint32_t port_m3_rx_overruns(void);
  * interrupts) and as its timers are programmed (registers read back): port_m3_servo.c. */
 typedef struct {
     uint32_t periods;    /* rise-to-rise intervals measured */
-    uint32_t span_cyc;   /* from the first rise to the last, core cycles (mean = span / periods) */
+    uint64_t span_cyc;   /* the periods summed, core cycles (mean = span / periods) */
     uint32_t min_cyc;    /* shortest period, core cycles (0 when none) */
     uint32_t max_cyc;    /* longest period, core cycles */
     uint32_t high_n;     /* pulses measured since the width last changed */

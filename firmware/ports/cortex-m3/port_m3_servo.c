@@ -28,7 +28,6 @@ CS_STATIC_ASSERT(PORT_M3_SYSCLK_HZ % 1000000u == 0, servo_whole_cycles_per_us);
 static volatile uint32_t width_cyc; /* the pulse width, cycles; 0 until the first setting */
 static volatile uint32_t rise_at;   /* port_m3_cycles at the last rise */
 static volatile bool risen;         /* a rise has been stamped */
-static uint32_t first_rise;         /* port_m3_cycles at the first rise */
 static uint32_t pulse_cyc;          /* the width of the pulse under way */
 static port_m3_servo_t meas;        /* written by the two interrupts only */
 
@@ -83,8 +82,6 @@ void Timer1A_Handler(void)
         meas.high_n = 0;
         meas.high_sum = 0;
     }
-    if (!risen)
-        first_rise = now;
     if (risen) {
         uint32_t p = now - rise_at;
         if (meas.periods == 0 || p < meas.min_cyc)
@@ -92,7 +89,7 @@ void Timer1A_Handler(void)
         if (p > meas.max_cyc)
             meas.max_cyc = p;
         meas.periods++;
-        meas.span_cyc = now - first_rise;
+        meas.span_cyc += p; /* each difference < 2^32 cycles; their sum past the counter's wrap */
     }
     rise_at = now;
     risen = true;
