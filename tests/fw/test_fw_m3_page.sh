@@ -51,6 +51,6 @@ expect "image: $((nseg + pens)) messages, $nseg segments" \
 expect "image: servo timers 20 ms, $up us" \
     grep -q "registers: period 1000000 width $((up * 50)) cycles\$" "$T/fw.out"
 mean=$(sed -n 's/^fw: servo: PG1 [0-9]* periods, mean \([0-9]*\) cycles.*/\1/p' "$T/fw.out" | tail -n1)
-expect "image: mean servo period 20 ms +- 0.1 % (${mean:-none} cycles)" \
-    [ "${mean:-0}" -gt 999000 -a "${mean:-0}" -lt 1001000 ]
+expect "image: mean servo period 20 ms +- 5 % (${mean:-none} cycles)" \
+    [ "${mean:-0}" -gt 950000 -a "${mean:-0}" -lt 1050000 ]
 finish

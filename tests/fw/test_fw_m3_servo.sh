@@ -57,10 +57,11 @@ expect "image: $pens pen settings, last $up us" grep -q "^fw: pen: $pens setting
 # the servo train on PG1 (port_m3_servo.c): its two timers' registers read back (period
 # 1,000,000 cycles = 20 ms at 50 MHz, width up_us x 50 cycles), and the train as the image
 # measured it with SysTick, a clock apart from the GPTMs: the mean period over the job within
-# 0.1 %. qemu delivers timer interrupts late by a varying amount (host scheduling while the image
-# sleeps in WFI): single intervals scatter by ~10 % and a one-shot width reads long (the last
-# setting's mean width is printed, not checked); the periodic reload keeps qemu's own deadlines,
-# so the mean period holds.
+# 5 %. qemu delivers timer interrupts late by a varying amount (host scheduling while the image
+# sleeps in WFI): single intervals scatter by ~10 %, a one-shot width reads long (the last
+# setting's mean width is printed, not checked), and on a loaded host it merges interrupts now and
+# then (a long gap: the mean comes out 0.0003 % off on a quiet run, 0.5 % on a loaded one). The
+# registers are the exact check; the mean says the train runs at 50 Hz, not at a wrong clock.
 sv=$(grep '^fw: servo: ' "$T/fw.out" | tail -n1)
 echo "  $sv"
 read -r sp smean preg wreg < <(echo "$sv" | sed -n \
@@ -68,8 +69,8 @@ read -r sp smean preg wreg < <(echo "$sv" | sed -n \
 expect "image: servo registers: period 1000000, width $((up * 50)) cycles ($preg, $wreg)" \
     [ "${preg:-0}" = 1000000 -a "${wreg:-0}" = $((up * 50)) ]
 expect "image: 500+ servo periods (${sp:-0})" [ "${sp:-0}" -ge 500 ]
-expect "image: mean period 20 ms +- 0.1 % (${smean:-0} cycles)" \
-    [ "${smean:-0}" -gt 999000 -a "${smean:-0}" -lt 1001000 ]
+expect "image: mean period 20 ms +- 5 % (${smean:-0} cycles)" \
+    [ "${smean:-0}" -gt 950000 -a "${smean:-0}" -lt 1050000 ]
 expect "image: $((nseg + pens)) messages, $nseg segments" \
     grep -q "^fw: executed $((nseg + pens)) messages, $nseg step segments" "$T/fw.out"
 expect "image: the simulator's log ($simlog)" grep -q "^fw: log: $simlog," "$T/fw.out"
