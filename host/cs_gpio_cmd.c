@@ -119,6 +119,27 @@ static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
         fprintf(stderr, "curvestep stream: note: memory not locked (AddressSanitizer build)\n");
 }
 
+/* Opens the pen servo's line for a job with pen events: [gpio] pen on the chip, or a recorder
+ * with room for the job. CS_EXIT_OK, or the exit status after the reason on stderr (no pen line
+ * wired: 1; the chip refused it: 4). */
+static int open_pen(cs_gpio_io_t *pio, const cs_stream_args_t *a, const cs_stream_plan_t *p,
+                    const cs_gpio_cfg_t *cfg, const char *chip, bool record, const cs_machine_t *m)
+{
+    char err[512];
+    if (cfg->pen < 0 && !record) {
+        fprintf(stderr,
+                "%s:0: [pen] mode = servo, but [gpio] wires no pen line (pen = OFFSET, "
+                "docs/gpio.md)\n",
+                a->machine_file ? a->machine_file : "the built-in machine");
+        return CS_EXIT_INPUT;
+    }
+    if (cs_gpio_pwm_open(pio, chip, record, cfg->pen, (double)p->ticks / m->tick_hz + 2.0, err,
+                         sizeof err) == 0)
+        return CS_EXIT_OK;
+    fprintf(stderr, "curvestep stream: %s\n", err);
+    return record ? CS_EXIT_INTERNAL : CS_EXIT_NO_DEVICE;
+}
+
 int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
                        volatile sig_atomic_t *interrupted)
 {
@@ -222,17 +243,11 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
     /* the pen servo ([pen] mode = servo): its own line and thread (cs_gpio_pwm) */
     cs_gpio_io_t pio = {0};
     bool pen = p->npens > 0;
-    if (pen && cfg.pen < 0 && !record)
-        snprintf(err, sizeof err, "%s:0: [pen] mode = servo, but [gpio] wires no pen line (pen = "
-                 "OFFSET, docs/gpio.md)", a->machine_file ? a->machine_file : "machine");
-    if (pen && (cfg.pen < 0 && !record ? -1
-                                       : cs_gpio_pwm_open(&pio, chip_arg, record != NULL, cfg.pen,
-                                                          (double)p->ticks / m->tick_hz + 2.0,
-                                                          err, sizeof err)) != 0) {
-        fprintf(stderr, "curvestep stream: %s\n", err);
+    int prc = pen ? open_pen(&pio, a, p, &cfg, chip_arg, record != NULL, m) : CS_EXIT_OK;
+    if (prc != CS_EXIT_OK) {
         cs_gpio_io_close(&io);
         cs_gpio_io_free(&io);
-        return cfg.pen < 0 ? CS_EXIT_INPUT : CS_EXIT_NO_DEVICE;
+        return prc;
     }
     const char *link = chip_arg; /* "stream: LINK: outcome" */
     fprintf(stderr, "stream: %s: %u lines (", link, l.n);
