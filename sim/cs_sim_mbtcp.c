@@ -186,8 +186,8 @@ static void serve_one(server_t *s, unsigned k)
     if (e == CS_ERR_UNSUPPORTED)
         s->st->bad_proto++; /* not Modbus: dropped unanswered */
     else
-        delay = s->app->handle(s->app->ctx, h.unit, c->in + CS_MODBUS_MBAP_LEN, h.pdu_len, rsp,
-                               &rn);
+        delay =
+            s->app->handle(s->app->ctx, h.unit, c->in + CS_MODBUS_MBAP_LEN, h.pdu_len, rsp, &rn);
     memmove(c->in, c->in + whole, c->n - whole);
     c->n -= whole;
     if (delay < 0 || cs_modbus_mbap_frame(&h, rsp, rn, adu, sizeof adu, &len) != CS_OK)
@@ -256,8 +256,8 @@ static void wait_round(server_t *s)
         accept_one(s);
 }
 
-int cs_sim_mbtcp_serve(const char *addr, const cs_sim_mbtcp_app_t *app,
-                       volatile sig_atomic_t *stop, cs_sim_mbtcp_stats_t *st)
+int cs_sim_mbtcp_serve(const char *addr, const cs_sim_mbtcp_app_t *app, volatile sig_atomic_t *stop,
+                       cs_sim_mbtcp_stats_t *st)
 {
     char host[64];
     int ls = listen_on(addr, host, sizeof host);

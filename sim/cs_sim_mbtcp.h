@@ -45,7 +45,7 @@ typedef struct {
 /* Serves Modbus TCP on addr ("IPv4:PORT", port 0: any free port; the first line of standard
  * output is the address and port bound) until *stop or app->tick says so. Returns 0, 2 for a
  * malformed addr (message on stderr), 3 when it cannot listen. */
-int cs_sim_mbtcp_serve(const char *addr, const cs_sim_mbtcp_app_t *app,
-                       volatile sig_atomic_t *stop, cs_sim_mbtcp_stats_t *st);
+int cs_sim_mbtcp_serve(const char *addr, const cs_sim_mbtcp_app_t *app, volatile sig_atomic_t *stop,
+                       cs_sim_mbtcp_stats_t *st);
 
 #endif

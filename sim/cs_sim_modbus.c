@@ -497,13 +497,15 @@ static int check_args(mb_args_t *a)
     return OK;
 }
 
-/* The machine, the device's configuration and the reference job: OK, INPUT or USAGE. */
-static int prepare(const mb_args_t *a, cs_machine_t *m, cs_sim_device_cfg_t *cfg,
-                   cs_sim_ref_t *ref, cs_sim_device_out_t *out)
+/* The machine (and its pen settings: with a servo pen the check follows them), the device's
+ * configuration and the reference job: OK, INPUT or USAGE. */
+static int prepare(const mb_args_t *a, cs_machine_t *m, cs_machine_pen_t *pen,
+                   cs_sim_device_cfg_t *cfg, cs_sim_ref_t *ref, cs_sim_device_out_t *out)
 {
     char err[512];
+    cs_machine_ini_pen_default(pen);
     if (a->o.machine_file) {
-        if (cs_machine_ini_load(a->o.machine_file, m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(a->o.machine_file, m, pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return INPUT;
         }
@@ -520,6 +522,8 @@ static int prepare(const mb_args_t *a, cs_machine_t *m, cs_sim_device_cfg_t *cfg
     }
     *out = a->o.out;
     out->ref = ref;
+    if (pen->mode == CS_MACHINE_PEN_SERVO)
+        out->pen = pen;
     if (out->reference) { /* a bad job is reported before anything is served */
         cs_jobplan_t jp;  /* read and laid out as plan / stream do (cs_jobopts) */
         cs_jobplan_init(&jp);
@@ -629,11 +633,12 @@ int cs_sim_modbus_main(int argc, char **argv)
     if (check_args(&a) != OK)
         return USAGE;
     cs_machine_t m;
+    cs_machine_pen_t pen;
     cs_sim_device_cfg_t cfg;
     cs_sim_device_out_t out;
     cs_sim_ref_t ref;
     cs_sim_ref_init(&ref);
-    rc = prepare(&a, &m, &cfg, &ref, &out);
+    rc = prepare(&a, &m, &pen, &cfg, &ref, &out);
     double start = cs_serial_now_s();
     cs_sim_device_result_t res;
     mbdev_t *d = rc == OK ? open_device(&a, &m, &cfg, &res, start) : NULL;

@@ -3,8 +3,8 @@
  * layout of a SEGMENT or CURVE (one FC16 write, last register = sequence number), the sequence
  * rule that makes retries idempotent, the writer lease's registers (the decision and the clock
  * are the application's hook), the PDU handler (FC03, FC04, FC06, FC16, exception replies),
- * CRC-16/MODBUS, RTU framing and the Modbus TCP (MBAP) header checks. Transport-agnostic: Modbus TCP servers call the PDU
- * handler directly. All state lives in caller-owned structs; nothing is ISR-safe except the CRC
+ * CRC-16/MODBUS, RTU framing and the Modbus TCP (MBAP) header checks. Transport-agnostic:
+ * Modbus TCP servers call the PDU handler directly. All state lives in caller-owned structs; nothing is ISR-safe except the CRC
  * (feed bytes from a main loop; an ISR should only queue them). */
 #ifndef CS_MODBUS_H
 #define CS_MODBUS_H
@@ -45,6 +45,7 @@
  * registers, high word first, then the sequence number in the last register written. */
 #define CS_MODBUS_MAILBOX_SEGMENT_REGS (1 + 2 + 2 * CS_AXES + 1) /* 12 */
 #define CS_MODBUS_MAILBOX_CURVE_REGS   (1 + 2 * 12 + 2 + 1)      /* 28 */
+#define CS_MODBUS_MAILBOX_PEN_REGS     (1 + 1 + 1) /* 3: type, pulse width (us), sequence */
 #define CS_MODBUS_MAILBOX_REGS         CS_MODBUS_MAILBOX_CURVE_REGS
 
 /* Commands (holding register COMMAND). */
@@ -135,8 +136,9 @@ typedef struct {
     cs_modbus_stats_t stats;
 } cs_modbus_map_t;
 
-/* Sets up the map with the application's hooks (submit, command and status required) and the first sequence the
- * mailbox takes (0 after a boot). CS_ERR_ARG for a missing hook. */
+/* Sets up the map with the application's hooks (submit, command and status required; lease
+ * optional) and the first sequence the mailbox takes (0 after a boot). CS_ERR_ARG for a missing
+ * hook. */
 cs_err_t cs_modbus_map_init(cs_modbus_map_t *mp, const cs_modbus_app_t *app, uint16_t first_seq);
 /* Handles one request PDU (function code + data, req[0..n)) and writes the response PDU (the
  * normal answer or the two-byte exception) into rsp[0..cap), *rn = its length. CS_OK (a
@@ -145,7 +147,7 @@ cs_err_t cs_modbus_map_init(cs_modbus_map_t *mp, const cs_modbus_app_t *app, uin
 cs_err_t cs_modbus_pdu(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_t *rsp, size_t cap,
                        size_t *rn);
 
-/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT or CURVE and its sequence
+/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT, CURVE or PEN and its sequence
  * into regs[0..cap), *n = registers: CS_ERR_UNSUPPORTED for another type, CS_ERR_RANGE for a
  * field outside its cs_proto range, CS_ERR_FULL when cap is too small. Pure. */
 cs_err_t cs_modbus_mailbox_encode(const cs_proto_msg_t *m, uint16_t seq, uint16_t *regs, size_t cap,

@@ -78,7 +78,8 @@ static cs_err_t app_lease(void *ctx, uint8_t op, uint16_t token)
 static cs_err_t app_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
 {
     app_t *a = ctx;
-    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE);
+    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE ||
+               m->type == CS_PROTO_PEN);
     if (a->fail_next) {
         a->fail_next = false;
         a->submits_failed++;
@@ -151,7 +152,8 @@ static void check_state(cs_modbus_map_t *mp, app_t *a)
     FUZZ_CHECK(mp->next_seq == (uint16_t)(a->first_seq + a->queued));
     FUZZ_CHECK(mp->stats.accepted == a->queued);
     FUZZ_CHECK(mp->last_n == 0 || mp->last_n == CS_MODBUS_MAILBOX_SEGMENT_REGS ||
-               mp->last_n == CS_MODBUS_MAILBOX_CURVE_REGS);
+               mp->last_n == CS_MODBUS_MAILBOX_CURVE_REGS ||
+               mp->last_n == CS_MODBUS_MAILBOX_PEN_REGS);
     FUZZ_CHECK(refused_code_ok(mp->refused));
     if (a->reset_seen && mp->stats.refused == a->refused_at_reset)
         FUZZ_CHECK(mp->refused == 0 && mp->refused_seq == 0);
@@ -261,7 +263,7 @@ static void check_reply(const uint8_t *q, size_t qn, const uint8_t *p, size_t n,
                           after->repeats == before->repeats + 1;
             FUZZ_CHECK(queued || repeat);
             FUZZ_CHECK(qty == CS_MODBUS_MAILBOX_SEGMENT_REGS ||
-                       qty == CS_MODBUS_MAILBOX_CURVE_REGS);
+                       qty == CS_MODBUS_MAILBOX_CURVE_REGS || qty == CS_MODBUS_MAILBOX_PEN_REGS);
             FUZZ_CHECK(rd16(q + 4 + 2 * (qty + token)) ==
                        (uint16_t)(a->first_seq + a->queued - 1u));
         } else {

@@ -106,8 +106,13 @@ static int read_all(int fd, uint8_t *b, size_t n, double secs)
 static void send_raw(int fd, uint16_t tid, uint16_t proto, uint16_t len, const uint8_t *pdu,
                      size_t n)
 {
-    uint8_t b[300] = {(uint8_t)(tid >> 8), (uint8_t)tid, (uint8_t)(proto >> 8), (uint8_t)proto,
-                      (uint8_t)(len >> 8), (uint8_t)len, 1};
+    uint8_t b[300] = {(uint8_t)(tid >> 8),
+                      (uint8_t)tid,
+                      (uint8_t)(proto >> 8),
+                      (uint8_t)proto,
+                      (uint8_t)(len >> 8),
+                      (uint8_t)len,
+                      1};
     memcpy(b + 7, pdu, n);
     if (send(fd, b, 7 + n, MSG_NOSIGNAL) != (ssize_t)(7 + n))
         perror("mb_client: send"); /* the answer that does not come says the rest */
