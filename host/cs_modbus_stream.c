@@ -347,8 +347,8 @@ static uint16_t new_token(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    uint32_t h = (uint32_t)ts.tv_nsec * 2654435761u ^ (uint32_t)getpid() * 40503u ^
-                 (uint32_t)ts.tv_sec;
+    uint32_t h =
+        (uint32_t)ts.tv_nsec * 2654435761u ^ (uint32_t)getpid() * 40503u ^ (uint32_t)ts.tv_sec;
     uint16_t t = (uint16_t)(h ^ (h >> 16));
     return t != 0 ? t : 1u;
 }

@@ -398,8 +398,8 @@ cs_err_t cs_modbus_mbap_parse(const uint8_t *b, size_t n, cs_modbus_mbap_t *h)
     return h->proto == 0 ? CS_OK : CS_ERR_UNSUPPORTED;
 }
 
-cs_err_t cs_modbus_mbap_frame(const cs_modbus_mbap_t *h, const uint8_t *pdu, size_t n,
-                              uint8_t *out, size_t cap, size_t *len)
+cs_err_t cs_modbus_mbap_frame(const cs_modbus_mbap_t *h, const uint8_t *pdu, size_t n, uint8_t *out,
+                              size_t cap, size_t *len)
 {
     if (h == NULL || pdu == NULL || out == NULL || len == NULL)
         return CS_ERR_ARG;

@@ -4,8 +4,9 @@
  * rule that makes retries idempotent, the writer lease's registers (the decision and the clock
  * are the application's hook), the PDU handler (FC03, FC04, FC06, FC16, exception replies),
  * CRC-16/MODBUS, RTU framing and the Modbus TCP (MBAP) header checks. Transport-agnostic:
- * Modbus TCP servers call the PDU handler directly. All state lives in caller-owned structs; nothing is ISR-safe except the CRC
- * (feed bytes from a main loop; an ISR should only queue them). */
+ * Modbus TCP servers call the PDU handler directly. All state lives in caller-owned structs;
+ * nothing is ISR-safe except the CRC (feed bytes from a main loop; an ISR should only queue them).
+ */
 #ifndef CS_MODBUS_H
 #define CS_MODBUS_H
 
@@ -27,9 +28,9 @@
 #define CS_MODBUS_FC_WRITE_MULTI  0x10
 
 /* Exception codes (Modbus Application Protocol V1.1b, section 7). */
-#define CS_MODBUS_EX_ILLEGAL_FUNCTION 0x01 /* function code not served; a write refused by the
-                                              lease ("the server is in the wrong state to
-                                              process a request of this type", spec 7) */
+/* 0x01: a function code not served; also a write refused by another client's writer lease ("the
+ * server is in the wrong state to process a request of this type", spec 7; REFUSED says which) */
+#define CS_MODBUS_EX_ILLEGAL_FUNCTION 0x01
 #define CS_MODBUS_EX_ILLEGAL_ADDRESS  0x02 /* register range outside the map */
 #define CS_MODBUS_EX_ILLEGAL_VALUE    0x03 /* bad count, bad command, refused mailbox contents */
 #define CS_MODBUS_EX_DEVICE_FAILURE   0x04 /* the device cannot act on a valid request */
@@ -83,14 +84,14 @@ typedef struct {
     uint16_t queue_size;
     uint32_t tick_hz;
     uint32_t boot_id;
-    uint8_t state;        /* cs_proto_state_t */
-    uint16_t free_slots;  /* free motion-queue slots */
-    uint16_t last_exec;   /* sequence of the last message executed */
-    uint16_t error;       /* cs_err_t of the last execution error, 0 none */
-    uint16_t error_seq;   /* its message's sequence */
-    int32_t pos[CS_AXES]; /* steps */
-    uint8_t lease;           /* 1: the mailbox is leased */
-    uint16_t lease_left_ms;  /* until it expires unless renewed */
+    uint8_t state;          /* cs_proto_state_t */
+    uint16_t free_slots;    /* free motion-queue slots */
+    uint16_t last_exec;     /* sequence of the last message executed */
+    uint16_t error;         /* cs_err_t of the last execution error, 0 none */
+    uint16_t error_seq;     /* its message's sequence */
+    int32_t pos[CS_AXES];   /* steps */
+    uint8_t lease;          /* 1: the mailbox is leased */
+    uint16_t lease_left_ms; /* until it expires unless renewed */
 } cs_modbus_status_t;
 
 /* What the lease hook is asked (docs/modbus.md, "The writer lease"). */
@@ -147,9 +148,9 @@ cs_err_t cs_modbus_map_init(cs_modbus_map_t *mp, const cs_modbus_app_t *app, uin
 cs_err_t cs_modbus_pdu(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_t *rsp, size_t cap,
                        size_t *rn);
 
-/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT, CURVE or PEN and its sequence
- * into regs[0..cap), *n = registers: CS_ERR_UNSUPPORTED for another type, CS_ERR_RANGE for a
- * field outside its cs_proto range, CS_ERR_FULL when cap is too small. Pure. */
+/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT, CURVE or PEN and its
+ * sequence into regs[0..cap), *n = registers: CS_ERR_UNSUPPORTED for another type, CS_ERR_RANGE for
+ * a field outside its cs_proto range, CS_ERR_FULL when cap is too small. Pure. */
 cs_err_t cs_modbus_mailbox_encode(const cs_proto_msg_t *m, uint16_t seq, uint16_t *regs, size_t cap,
                                   size_t *n);
 /* Decodes n registers written to the mailbox: CS_ERR_FRAME when n does not match the type in
@@ -183,8 +184,8 @@ typedef struct {
 cs_err_t cs_modbus_mbap_parse(const uint8_t *b, size_t n, cs_modbus_mbap_t *h);
 /* Writes the answer frame: h's transaction id and unit, protocol 0, the length of pdu[0..n),
  * then the PDU, into out[0..cap): *len bytes. CS_ERR_FULL when it does not fit. Pure. */
-cs_err_t cs_modbus_mbap_frame(const cs_modbus_mbap_t *h, const uint8_t *pdu, size_t n,
-                              uint8_t *out, size_t cap, size_t *len);
+cs_err_t cs_modbus_mbap_frame(const cs_modbus_mbap_t *h, const uint8_t *pdu, size_t n, uint8_t *out,
+                              size_t cap, size_t *len);
 
 /* --- RTU server ---------------------------------------------------------------------------- */
 

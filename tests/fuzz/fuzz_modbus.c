@@ -78,8 +78,7 @@ static cs_err_t app_lease(void *ctx, uint8_t op, uint16_t token)
 static cs_err_t app_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
 {
     app_t *a = ctx;
-    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE ||
-               m->type == CS_PROTO_PEN);
+    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE || m->type == CS_PROTO_PEN);
     if (a->fail_next) {
         a->fail_next = false;
         a->submits_failed++;
@@ -447,8 +446,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     app.queue_size = (uint16_t)(1 + (cfg & 7));
     app.first_seq = firsts[(cfg >> 3) & 3];
     app.lease_hook = (cfg & 0x80) != 0;
-    cs_modbus_app_t hooks = {app_submit, app_command, app_status,
-                             app.lease_hook ? app_lease : NULL, &app};
+    cs_modbus_app_t hooks = {app_submit, app_command, app_status, app.lease_hook ? app_lease : NULL,
+                             &app};
     FUZZ_CHECK(cs_modbus_map_init(&map, &hooks, app.first_seq) == CS_OK);
     uint32_t baud = (cfg & 0x20) ? 9600 : 115200;
     FUZZ_CHECK(cs_modbus_rtu_init(&rtu, &map, UNIT, baud) == CS_OK);
