@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Modbus among other clients (issue 17 item 2, docs/modbus.md "Several clients"). While
-# `curvestep stream --modbus-tcp` streams a job to `curvestep-sim --modbus-tcp`, a second client
-# (tests/cli/lib/mb_client.c, raw sockets) writes the mailbox with the device's current sequence,
-# polls the status flat out, sends malformed frames and holds idle connections open: the job
+# Modbus among other clients (issue 17 item 2, docs/modbus.md "Several clients"). Three times
+# `curvestep stream --modbus-tcp` streams a job to `curvestep-sim --modbus-tcp` while a second
+# client (tests/cli/lib/mb_client.c, raw sockets) (a) writes the mailbox with the device's
+# current sequence, (b) polls the status flat out beside nine idle connections, (c) sends
+# malformed frames: each time the job
 # completes exactly (the host's count, the device's count, its check of the drawing and the
 # final position), the foreign write gets exception 1 with REFUSED = 23 (leased), unknown
 # function codes get fc | 0x80 with exception 1, a bad protocol id is dropped, an impossible
@@ -12,7 +13,7 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 LIB=$(dirname "${BASH_SOURCE[0]}")/lib
-JOB=tests/data/gcode/one-inch-circle.nc # 15797 segments, 78.7 s of motion: 16 s at --speed 5
+JOB=tests/data/gcode/one-inch-circle.nc # 15797 segments, 78.7 s of motion: 8 s at --speed 10
 N=15797
 need_bin "$CS" "$SIM"
 
