@@ -550,27 +550,35 @@ static void run_connect(run_t *s)
     }
 }
 
+bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t tick_hz,
+                              cs_stream_mode_t mode, char *why, size_t cap)
+{
+    bool curves = mode == CS_STREAM_CURVES;
+    uint16_t need = curves ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
+    if (h->axes != axes)
+        snprintf(why, cap, "the device has %u axes, the machine file %u", (unsigned)h->axes,
+                 (unsigned)axes);
+    else if (!curves && h->tick_hz != tick_hz)
+        snprintf(why, cap, "the device ticks at %u Hz, the segments were planned for %u Hz",
+                 (unsigned)h->tick_hz, (unsigned)tick_hz);
+    else if (!(h->caps & need))
+        snprintf(why, cap, "the device cannot take %s", curves ? "curves" : "step segments");
+    else
+        return false;
+    return true;
+}
+
 /* The HELLO against the machine and the job: INCOMPATIBLE with the reason in r->why. */
 static void check_hello(run_t *s)
 {
-    const cs_stream_opts_t *o = s->o;
     cs_stream_result_t *r = s->r;
     const cs_proto_hello_t *h = &r->hello;
-    bool curves = s->job->mode == CS_STREAM_CURVES;
-    uint16_t need = curves ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
     if (h->version != CS_PROTO_VERSION)
         snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
                  (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
-    else if (h->axes != o->axes)
-        snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",
-                 (unsigned)h->axes, (unsigned)o->axes);
-    else if (!curves && h->tick_hz != o->tick_hz)
-        snprintf(r->why, sizeof r->why,
-                 "the device ticks at %u Hz, the segments were planned for %u Hz",
-                 (unsigned)h->tick_hz, (unsigned)o->tick_hz);
-    else if (!(h->caps & need))
-        snprintf(r->why, sizeof r->why, "the device cannot take %s",
-                 curves ? "curves" : "step segments");
+    else
+        (void)cs_stream_hello_mismatch(h, s->o->axes, s->o->tick_hz, s->job->mode, r->why,
+                                       sizeof r->why);
     if (r->why[0] != '\0')
         finish(s, CS_STREAM_INCOMPATIBLE);
 }
