@@ -8,9 +8,9 @@
 
 #include "cs_cmd.h"
 #include "cs_daemon.h"
+#include "cs_joblink.h"
 #include "cs_jobopts.h"
 #include "cs_readall.h"
-#include "cs_serial.h"
 
 /* Exit status of the clients beyond the shared ones: no daemon answers on the socket. */
 enum { EXIT_NO_DAEMON = 4 };
@@ -20,18 +20,23 @@ static void serve_usage(FILE *f)
     char sock[256];
     fprintf(f,
             "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
+            "                       | --gpio CHIP\n"
             "                       [--baud N] [--parity none|even|odd] [--unit ID]\n"
             "                       [--machine FILE.ini] [--socket PATH] [--max-input-mb N]\n"
             "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
             "came (as `curvestep stream` does: read once and planned whole at submit time, then\n"
-            "streamed with the protocol of docs/protocol.md, or over Modbus as in\n"
-            "docs/modbus.md). Clients talk to it on the UNIX socket PATH, created with mode 0600\n"
-            "(owner only): curvestep submit, status, pause, resume, cancel. One line per event\n"
-            "on standard error.\n"
+            "streamed with the protocol of docs/protocol.md, over Modbus as in docs/modbus.md,\n"
+            "or run here on GPIO lines as in docs/gpio.md). Clients talk to it on the UNIX\n"
+            "socket PATH, created with mode 0600 (owner only): curvestep submit, status, pause,\n"
+            "resume, cancel. One line per event on standard error.\n"
             "SIGTERM or SIGINT stops it: the running job is held, then aborted.\n"
             "  --port DEV      serial device, kept open (one link is required)\n"
             "  --modbus-tcp HOST:PORT  a Modbus TCP device (connected for each job)\n"
             "  --modbus-rtu DEV        a Modbus RTU device on serial line DEV (opened each job)\n"
+            "  --gpio CHIP     the step/dir lines of GPIO chip CHIP, wired as the machine\n"
+            "                  file's [gpio] section says (requested for each job);\n"
+            "                  --gpio record:FILE runs on no hardware and writes each job's\n"
+            "                  edges to FILE (docs/gpio.md)\n"
             "  --baud N        line speed of --port and --modbus-rtu (default 115200)\n"
             "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
             "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
@@ -47,80 +52,63 @@ static void serve_usage(FILE *f)
             cs_daemon_default_socket(sock, sizeof sock));
 }
 
-static int parse_baud(const char *s, uint32_t *out)
+/* serve's own options (the link's are cs_joblink_option's): 1 taken, 0 not one, -1 bad. */
+static int serve_option(int argc, char **argv, int *i, cs_daemon_cfg_t *cfg)
 {
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (*s == '\0' || *s == '-' || *end != '\0' || errno != 0 || v > 4000000 ||
-        !cs_serial_baud_ok((uint32_t)v))
-        return -1;
-    *out = (uint32_t)v;
-    return 0;
+    const char *a = argv[*i];
+    if (*i + 1 >= argc)
+        return 0;
+    if (strcmp(a, "--socket") == 0) {
+        cfg->socket_path = argv[++*i];
+    } else if (strcmp(a, "--machine") == 0) {
+        cfg->machine_file = argv[++*i];
+    } else if (strcmp(a, "--max-input-mb") == 0) {
+        if (!cs_readall_parse_mb(argv[++*i], &cfg->max_input_bytes)) {
+            fprintf(stderr, "curvestep serve: --max-input-mb wants a whole number of MiB, 1 to %u\n",
+                    CS_READALL_MAX_MB);
+            return -1;
+        }
+    } else {
+        return 0;
+    }
+    return 1;
 }
 
 int cs_cmd_serve(int argc, char **argv)
 {
     char sock[256];
-    cs_daemon_cfg_t cfg = {.baud = 115200, .unit = 1, .log = stderr};
+    cs_daemon_cfg_t cfg = {.link = {.baud = 115200, .unit = 1}, .log = stderr};
     cfg.socket_path = cs_daemon_default_socket(sock, sizeof sock);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool has = i + 1 < argc;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             serve_usage(stdout);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--port") == 0 && has) {
-            cfg.port = argv[++i];
-        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
-            cfg.modbus_tcp = argv[++i];
-        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
-            cfg.modbus_rtu = argv[++i];
-        } else if (strcmp(a, "--parity") == 0 && has) {
-            const char *v = argv[++i];
-            cfg.parity = strcmp(v, "none") == 0   ? 'N'
-                         : strcmp(v, "even") == 0 ? 'E'
-                         : strcmp(v, "odd") == 0  ? 'O'
-                                                  : 0;
-            if (cfg.parity == 0) {
-                fprintf(stderr, "curvestep serve: --parity wants none, even or odd\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--unit") == 0 && has) {
-            char *end;
-            long v = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || v < 1 || v > 247) {
-                fprintf(stderr, "curvestep serve: --unit wants a Modbus unit id, 1..247\n");
-                return CS_EXIT_USAGE;
-            }
-            cfg.unit = (int)v;
-        } else if (strcmp(a, "--socket") == 0 && has) {
-            cfg.socket_path = argv[++i];
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            cfg.machine_file = argv[++i];
-        } else if (strcmp(a, "--max-input-mb") == 0 && has) {
-            if (!cs_readall_parse_mb(argv[++i], &cfg.max_input_bytes)) {
-                fprintf(stderr,
-                        "curvestep serve: --max-input-mb wants a whole number of MiB, "
-                        "1 to %u\n",
-                        CS_READALL_MAX_MB);
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--baud") == 0 && has) {
-            if (parse_baud(argv[++i], &cfg.baud) != 0) {
-                fprintf(stderr, "curvestep serve: --baud wants a termios rate (e.g. 115200)\n");
-                return CS_EXIT_USAGE;
-            }
-        } else {
+        }
+        int r = cs_joblink_option("serve", argc, argv, &i, &cfg.link);
+        if (r == 0)
+            r = serve_option(argc, argv, &i, &cfg);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r == 0) {
             fprintf(stderr, "curvestep serve: unknown or incomplete option %s\n", a);
             serve_usage(stderr);
             return CS_EXIT_USAGE;
         }
     }
-    if ((cfg.port != NULL) + (cfg.modbus_tcp != NULL) + (cfg.modbus_rtu != NULL) != 1) {
-        fprintf(stderr, "curvestep serve: give one link: --port DEV, --modbus-tcp HOST:PORT or "
-                        "--modbus-rtu DEV\n");
+    cs_joblink_t probe;
+    if (cs_joblink_select(&probe, &cfg.link) != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep serve: give one link: --port DEV, --modbus-tcp HOST:PORT, "
+                        "--modbus-rtu DEV or --gpio CHIP\n");
         serve_usage(stderr);
+        return CS_EXIT_USAGE;
+    }
+    if (cfg.link.line_rate != 0) {
+        fprintf(stderr, "curvestep serve: --line-rate applies to `curvestep stream` only\n");
+        return CS_EXIT_USAGE;
+    }
+    if (cfg.link.parity != 0 && cfg.link.modbus_rtu == NULL) {
+        fprintf(stderr, "curvestep serve: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;
     }
     return cs_daemon_serve(&cfg);

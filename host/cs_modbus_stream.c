@@ -2,6 +2,8 @@
  * docs/modbus.md. */
 #include "cs_modbus_stream.h"
 
+#include "cs_linktime.h"
+
 #include <errno.h>
 #include <modbus/modbus.h>
 #include <stdlib.h>
@@ -240,7 +242,7 @@ int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_
     if (strncmp(rtu, "/dev/pts/", 9) != 0 && baud > 0) {
         /* request of CS_MODBUS_MAILBOX_REGS registers + its answer, 11 bits a byte */
         uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
-        timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / baud) + 1u;
+        timeout += cs_linktime_chars(bytes, CS_LINKTIME_BITS_RTU, baud, 1000u);
     }
     return cs_mb_open_rtu(c, rtu, baud, parity != 0 ? parity : 'E', unit, timeout, CS_MB_TRIES, why,
                           cap);
@@ -573,6 +575,9 @@ static bool mb_controls(mrun_t *s, double *t_all_sent)
         control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
                 s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
                 2000);
+        if (s->held && (s->r->dev_state == CS_PROTO_STATE_HELD ||
+                        s->r->dev_state == CS_PROTO_STATE_IDLE))
+            cs_stream_progress_held(o->progress, s->r->executed, s->job->n, what(s));
         *t_all_sent = 0;
     }
     return false;

@@ -318,7 +318,7 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     port_posix_reset(d->m->tick_hz, d->inv);
     port_posix_record(true);
     /* the application on the POSIX port, its link on the wall clock in microseconds with the
-     * timing of the simulated line (cs_stream_link_timing) */
+     * timing of the simulated line (cs_linktime_link, as the host computes it) */
     cs_fw_app_cfg_t ac;
     cs_fw_app_cfg_default(&ac, d->m);
     ac.motion.queue_size = cfg->queue_size;
@@ -326,9 +326,12 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     ac.motion.method = (uint8_t)cfg->method;
     ac.clock = clock_us;
     ac.clock_hz = 1000000u;
-    cs_stream_link_timing(&ac.link, cfg->line_rate);
     ac.link.keepalive = 0;
-    ac.link.max_retries = 20;
+    if (cs_linktime_link(&ac.link, (uint32_t)cfg->line_rate, ac.clock_hz) != CS_OK) {
+        port_stepper_attach(NULL);
+        free(d);
+        return CS_ERR_ARG;
+    }
     ac.status_ms = cfg->status_ms ? cfg->status_ms : 50;
     cs_err_t e = cs_fw_app_init_cfg(&d->app, d->m, cfg->boot_id ? cfg->boot_id : 1u, &ac);
     if (e != CS_OK) {

@@ -24,8 +24,8 @@ G2 X2 Y5 I-4 J0
 G1 X-3 Y-2 Z-1
 G0 X7 Y-4 Z2
 EOF
-# A longer one (about 2 s) to interrupt.
-printf 'G21 G90\nG1 X150 Y100 F6000\n' >"$T/long.nc"
+# A longer one (about 4 s) to interrupt once it has executed a segment.
+printf 'G21 G90\nG1 X150 Y100 F3000\n' >"$T/long.nc"
 cat >"$T/m.ini" <<'EOF'
 [y]
 invert_dir = true
@@ -110,7 +110,9 @@ timeout --foreground -k 5 60 "$CS" stream --gpio "record:$T/int.rec" --machine "
     >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
-sleep 0.6
+# the event: a progress line (once a second) that counts an executed segment
+moving() { grep -qE '^stream: [1-9][0-9]*/' "$T/int.err"; }
+expect "ctrl-c: the job is moving" wait_until 30 moving
 kill -INT "$spid"
 wait "$spid"; rc=$?
 expect "ctrl-c: exit 8" [ $rc -eq 8 ]
