@@ -152,93 +152,137 @@ static void client_usage(FILE *f, const char *name)
             sock);
 }
 
-static int client(int argc, char **argv, const char *verb)
-{
-    const char *name = argv[0];
-    char sock[256];
-    const char *socket_path = cs_daemon_default_socket(sock, sizeof sock);
-    const char *file = NULL, *mode = NULL, *tol = NULL, *feed = NULL, *job = NULL;
-    bool submit = strcmp(name, "submit") == 0, cancel = strcmp(name, "cancel") == 0;
+/* A client's command line. */
+typedef struct {
+    const char *name; /* submit, status, ... */
+    const char *socket_path;
+    const char *file, *mode, *tol, *feed, *job;
+    bool submit, cancel;
     cs_jobopts_t in; /* sent as SUBMIT words; the daemon reads and lays out the job */
-    cs_jobopts_init(&in);
+} client_args_t;
+
+/* submit's --mode / --tol / --feed: 1 taken, 0 not one, -1 a bad value (said). */
+static int submit_option(int argc, char **argv, int *i, client_args_t *c)
+{
+    const char *a = argv[*i];
+    if (!c->submit || *i + 1 >= argc)
+        return 0;
+    const char *v = argv[*i + 1];
+    char *end;
+    if (strcmp(a, "--mode") == 0) {
+        if (strcmp(v, "segments") != 0 && strcmp(v, "curves") != 0) {
+            fprintf(stderr, "curvestep submit: --mode wants segments or curves\n");
+            return -1;
+        }
+        c->mode = v;
+    } else if (strcmp(a, "--tol") == 0) {
+        if (!(strtod(v, &end) > 0) || *end != '\0' || strchr(v, ' ')) {
+            fprintf(stderr, "curvestep submit: --tol wants a positive number of mm\n");
+            return -1;
+        }
+        c->tol = v;
+    } else if (strcmp(a, "--feed") == 0) {
+        double f = strtod(v, &end);
+        if (!(f > 0) || f >= 32768 || *end != '\0') {
+            fprintf(stderr, "curvestep submit: --feed wants a speed in (0, 32768) mm/s\n");
+            return -1;
+        }
+        c->feed = v;
+    } else {
+        return 0;
+    }
+    (*i)++;
+    return 1;
+}
+
+/* A word that is not an option: submit's FILE or cancel's JOB. CS_EXIT_OK, or a usage error. */
+static int client_word(client_args_t *c, const char *a)
+{
+    if (c->submit && c->file == NULL) {
+        c->file = a;
+    } else if (c->cancel && c->job == NULL) {
+        char *end;
+        unsigned long v = strtoul(a, &end, 10);
+        if (*a == '\0' || *a == '-' || *end != '\0' || v == 0 || v > UINT_MAX) {
+            fprintf(stderr, "curvestep cancel: JOB is a job number (see `status`)\n");
+            return CS_EXIT_USAGE;
+        }
+        c->job = a;
+    } else {
+        fprintf(stderr, "curvestep %s: unexpected argument %s\n", c->name, a);
+        client_usage(stderr, c->name);
+        return CS_EXIT_USAGE;
+    }
+    return CS_EXIT_OK;
+}
+
+/* Parses a client's argv: -1 to go on, else the exit status (--help, a usage error). */
+static int client_parse(int argc, char **argv, client_args_t *c, char *sock, size_t cap)
+{
+    memset(c, 0, sizeof *c);
+    c->name = argv[0];
+    c->socket_path = cs_daemon_default_socket(sock, cap);
+    c->submit = strcmp(c->name, "submit") == 0;
+    c->cancel = strcmp(c->name, "cancel") == 0;
+    cs_jobopts_init(&c->in);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool has = i + 1 < argc;
-        int r = submit ? cs_jobopts_option(name, argc, argv, &i, &in) : 0;
+        int r = c->submit ? cs_jobopts_option(c->name, argc, argv, &i, &c->in) : 0;
+        if (r == 0)
+            r = submit_option(argc, argv, &i, c);
         if (r < 0)
             return CS_EXIT_USAGE;
         if (r > 0)
             continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            client_usage(stdout, name);
+            client_usage(stdout, c->name);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--socket") == 0 && has) {
-            socket_path = argv[++i];
-        } else if (submit && strcmp(a, "--mode") == 0 && has) {
-            mode = argv[++i];
-            if (strcmp(mode, "segments") != 0 && strcmp(mode, "curves") != 0) {
-                fprintf(stderr, "curvestep submit: --mode wants segments or curves\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (submit && strcmp(a, "--tol") == 0 && has) {
-            tol = argv[++i];
-            char *end;
-            if (!(strtod(tol, &end) > 0) || *end != '\0' || strchr(tol, ' ')) {
-                fprintf(stderr, "curvestep submit: --tol wants a positive number of mm\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (submit && strcmp(a, "--feed") == 0 && has) {
-            feed = argv[++i];
-            char *end;
-            double v = strtod(feed, &end);
-            if (!(v > 0) || v >= 32768 || *end != '\0') {
-                fprintf(stderr, "curvestep submit: --feed wants a speed in (0, 32768) mm/s\n");
-                return CS_EXIT_USAGE;
-            }
+        } else if (strcmp(a, "--socket") == 0 && i + 1 < argc) {
+            c->socket_path = argv[++i];
         } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "curvestep %s: unknown or incomplete option %s\n", name, a);
-            client_usage(stderr, name);
+            fprintf(stderr, "curvestep %s: unknown or incomplete option %s\n", c->name, a);
+            client_usage(stderr, c->name);
             return CS_EXIT_USAGE;
-        } else if (submit && file == NULL) {
-            file = a;
-        } else if (cancel && job == NULL) {
-            char *end;
-            unsigned long v = strtoul(a, &end, 10);
-            if (*a == '\0' || *a == '-' || *end != '\0' || v == 0 || v > UINT_MAX) {
-                fprintf(stderr, "curvestep cancel: JOB is a job number (see `status`)\n");
-                return CS_EXIT_USAGE;
-            }
-            job = a;
-        } else {
-            fprintf(stderr, "curvestep %s: unexpected argument %s\n", name, a);
-            client_usage(stderr, name);
-            return CS_EXIT_USAGE;
+        } else if ((r = client_word(c, a)) != CS_EXIT_OK) {
+            return r;
         }
     }
-    char req[CS_DAEMON_LINE_MAX];
-    if (submit) {
-        if (file == NULL) {
-            fprintf(stderr, "curvestep submit: no job file\n");
-            client_usage(stderr, name);
-            return CS_EXIT_USAGE;
-        }
-        char abs[PATH_MAX];
-        if (realpath(file, abs) == NULL) {
-            fprintf(stderr, "%s:0:0: cannot open the job file (%s)\n", file, strerror(errno));
-            return CS_EXIT_INPUT;
-        }
-        if (cs_jobopts_check(name, &in) != 0)
-            return CS_EXIT_USAGE;
-        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s%s %s", mode ? " mode=" : "",
-                         mode ? mode : "", tol ? " tol=" : "", tol ? tol : "", feed ? " feed=" : "",
-                         feed ? feed : "", in.words, abs);
-        if (k < 0 || (size_t)k >= sizeof req || strchr(abs, '\n')) {
-            fprintf(stderr, "%s:0:0: path too long or not on one line\n", file);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        snprintf(req, sizeof req, "%s%s%s", verb, job ? " " : "", job ? job : "");
+    return -1;
+}
+
+/* The request line: "SUBMIT [words] /ABS/PATH", or the verb [JOB]. CS_EXIT_OK, or an error. */
+static int client_request(const client_args_t *c, const char *verb, char *req, size_t cap)
+{
+    if (!c->submit) {
+        snprintf(req, cap, "%s%s%s", verb, c->job ? " " : "", c->job ? c->job : "");
+        return CS_EXIT_OK;
     }
+    if (c->file == NULL) {
+        fprintf(stderr, "curvestep submit: no job file\n");
+        client_usage(stderr, c->name);
+        return CS_EXIT_USAGE;
+    }
+    char abs[PATH_MAX];
+    if (realpath(c->file, abs) == NULL) {
+        fprintf(stderr, "%s:0:0: cannot open the job file (%s)\n", c->file, strerror(errno));
+        return CS_EXIT_INPUT;
+    }
+    if (cs_jobopts_check(c->name, &c->in) != 0)
+        return CS_EXIT_USAGE;
+    int k = snprintf(req, cap, "SUBMIT%s%s%s%s%s%s%s %s", c->mode ? " mode=" : "",
+                     c->mode ? c->mode : "", c->tol ? " tol=" : "", c->tol ? c->tol : "",
+                     c->feed ? " feed=" : "", c->feed ? c->feed : "", c->in.words, abs);
+    if (k < 0 || (size_t)k >= cap || strchr(abs, '\n')) {
+        fprintf(stderr, "%s:0:0: path too long or not on one line\n", c->file);
+        return CS_EXIT_INPUT;
+    }
+    return CS_EXIT_OK;
+}
+
+/* Sends req and prints the reply: OK on standard output, a refusal on standard error (without
+ * the "ERR "). The exit status. */
+static int client_send(const char *name, const char *socket_path, const char *req)
+{
     char err[512];
     char *reply = NULL;
     size_t rlen = 0;
@@ -249,7 +293,6 @@ static int client(int argc, char **argv, const char *verb)
     }
     int rc = cs_daemon_request(socket_path, req, out, err, sizeof err);
     fclose(out);
-    /* OK replies on standard output; a refusal on standard error, without the "ERR " */
     if (rc == 0)
         fputs(reply, stdout);
     else if (rc > 0)
@@ -261,6 +304,20 @@ static int client(int argc, char **argv, const char *verb)
         return EXIT_NO_DAEMON;
     }
     return rc == 0 ? CS_EXIT_OK : CS_EXIT_INPUT;
+}
+
+static int client(int argc, char **argv, const char *verb)
+{
+    char sock[256];
+    client_args_t c;
+    int rc = client_parse(argc, argv, &c, sock, sizeof sock);
+    if (rc >= 0)
+        return rc;
+    char req[CS_DAEMON_LINE_MAX];
+    rc = client_request(&c, verb, req, sizeof req);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    return client_send(c.name, c.socket_path, req);
 }
 
 int cs_cmd_submit(int argc, char **argv)
