@@ -2,14 +2,13 @@
  * docs/modbus.md. */
 #include "cs_modbus_stream.h"
 
-#include "cs_linktime.h"
-
 #include <errno.h>
 #include <modbus/modbus.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "cs_linktime.h"
 #include "cs_serial.h"
 
 /* --- client --------------------------------------------------------------------------------- */
