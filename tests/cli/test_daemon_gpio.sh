@@ -14,21 +14,7 @@ set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/daemon.sh"
 need_bin "$CS"
 
-cat >"$T/m.ini" <<'INI'
-[y]
-invert_dir = true
-[gpio]
-chip = gpiochip0
-x_step = 17
-x_dir = 27
-y_step = 22
-y_dir = 23
-z_step = 5
-z_dir = 6
-enable = 4
-pulse_us = 4
-dir_setup_us = 20
-INI
+cp tests/data/gpio/wired3.ini "$T/m.ini"
 # job 1: about 7 s of motion at 50 mm/s, long enough for the pause to land inside it
 printf 'G21 G90\nG1 X300 Y100 F3000\n' >"$T/out.nc"
 printf 'G21 G90\nG1 X10 Y10 F6000\nG1 X0 Y0\n' >"$T/back.nc"

@@ -26,21 +26,7 @@ G0 X7 Y-4 Z2
 EOF
 # A longer one (about 4 s) to interrupt once it has executed a segment.
 printf 'G21 G90\nG1 X150 Y100 F3000\n' >"$T/long.nc"
-cat >"$T/m.ini" <<'EOF'
-[y]
-invert_dir = true
-[gpio]
-chip = gpiochip0
-x_step = 17
-x_dir = 27
-y_step = 22
-y_dir = 23
-z_step = 5
-z_dir = 6
-enable = 4
-pulse_us = 4
-dir_setup_us = 20
-EOF
+cp tests/data/gpio/wired3.ini "$T/m.ini"
 
 # check_record REC TRACE PULSE_NS SETUP_NS: the record against the simulator's trace. Prints
 # "ok <steps>" or the first problem.
