@@ -412,8 +412,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
 
 static void req_status(daemon_t *d, FILE *out)
 {
-    fprintf(out, "OK device %s, queue %s\n", d->link.name,
-            d->paused ? "paused" : "running");
+    fprintf(out, "OK device %s, queue %s\n", d->link.name, d->paused ? "paused" : "running");
     for (size_t i = 0; i < d->njobs; i++) {
         const djob_t *j = &d->jobs[i];
         const char *what = j->job.mode == CS_STREAM_CURVES ? "curves" : "segments";

@@ -64,7 +64,8 @@ static int serve_option(int argc, char **argv, int *i, cs_daemon_cfg_t *cfg)
         cfg->machine_file = argv[++*i];
     } else if (strcmp(a, "--max-input-mb") == 0) {
         if (!cs_readall_parse_mb(argv[++*i], &cfg->max_input_bytes)) {
-            fprintf(stderr, "curvestep serve: --max-input-mb wants a whole number of MiB, 1 to %u\n",
+            fprintf(stderr,
+                    "curvestep serve: --max-input-mb wants a whole number of MiB, 1 to %u\n",
                     CS_READALL_MAX_MB);
             return -1;
         }

@@ -110,7 +110,6 @@ static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
         fprintf(stderr, "curvestep: note: memory not locked (AddressSanitizer build)\n");
 }
 
-
 /* The link's state between open and close. */
 typedef struct {
     const cs_machine_t *m;
@@ -177,8 +176,7 @@ static int wire_lines(gpio_link_t *g, const uint64_t *steps, bool *any)
 }
 
 /* The chip (a missing chip is exit 4 whatever the wiring), then the wiring's own errors. */
-static int open_chip(cs_joblink_t *l, gpio_link_t *g, const uint64_t *steps, int unwired,
-                     bool any)
+static int open_chip(cs_joblink_t *l, gpio_link_t *g, const uint64_t *steps, int unwired, bool any)
 {
     const char *chip_arg = l->cfg.gpio;
     int orc = cs_gpio_io_open_chip(&g->io, chip_arg, &g->lines, l->why, sizeof l->why);
@@ -196,8 +194,8 @@ static int open_chip(cs_joblink_t *l, gpio_link_t *g, const uint64_t *steps, int
     if (unwired >= 0) {
         snprintf(l->why, sizeof l->why,
                  "%s:0: [gpio] wires no %s_step / %s_dir, but the job moves %s (%llu steps)",
-                 l->cfg.machine_file, axis_names[unwired], axis_names[unwired],
-                 axis_names[unwired], (unsigned long long)steps[unwired]);
+                 l->cfg.machine_file, axis_names[unwired], axis_names[unwired], axis_names[unwired],
+                 (unsigned long long)steps[unwired]);
         return CS_EXIT_INPUT;
     }
     g->io_open = true;
@@ -214,8 +212,9 @@ static int gpio_config(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t *
         return CS_EXIT_USAGE;
     }
     if (j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
-        snprintf(l->why, sizeof l->why, "--gpio runs the step segments planned here: "
-                                        "--mode curves does not apply");
+        snprintf(l->why, sizeof l->why,
+                 "--gpio runs the step segments planned here: "
+                 "--mode curves does not apply");
         return CS_EXIT_USAGE;
     }
     if (l->cfg.machine_file) {
@@ -290,9 +289,9 @@ static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
     int unwired = wire_lines(g, steps, &any);
     if (!g->record) {
         rc = open_chip(l, g, steps, unwired, any);
-    } else if (cs_gpio_io_open_recorder(&g->io, &g->lines,
-                                        cs_gpio_run_record_capacity(g->segs + g->first,
-                                                                    g->nsegs - g->first)) != 0) {
+    } else if (cs_gpio_io_open_recorder(
+                   &g->io, &g->lines,
+                   cs_gpio_run_record_capacity(g->segs + g->first, g->nsegs - g->first)) != 0) {
         snprintf(l->why, sizeof l->why, "--gpio record: out of memory");
         rc = CS_EXIT_INTERNAL;
     } else {

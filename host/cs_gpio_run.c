@@ -108,20 +108,20 @@ typedef struct {
     cs_gpio_io_t *io;
     cs_stepper_t *st;
     uint32_t hz;
-    int64_t spin, pulse, setup;          /* cfg, ns */
-    uint32_t all_step, all_dir, en;      /* line masks */
-    cs_hold_t hold;                      /* the core's ramp (cs_hold) */
-    int64_t t_dir;                       /* last DIR change on the lines */
-    bool ok;                             /* every set call succeeded */
-    size_t next, pushed;                 /* job index of the next segment; segments pushed */
-    cs_stepper_out_t out;                /* the executor's last call */
-    cs_gpio_run_outcome_t oc;            /* DONE while running */
-    uint32_t dir;                        /* DIR levels on the lines */
-    uint64_t vt;                         /* executor ticks so far */
-    int64_t planned;                     /* planned time of the current call */
-    int64_t shift;                       /* ns added to the plan by pauses */
-    bool unsent;                         /* stopped with a call's steps computed, not on lines */
-    int32_t unsent_pos[CS_AXES];         /* the executor's position without them */
+    int64_t spin, pulse, setup;     /* cfg, ns */
+    uint32_t all_step, all_dir, en; /* line masks */
+    cs_hold_t hold;                 /* the core's ramp (cs_hold) */
+    int64_t t_dir;                  /* last DIR change on the lines */
+    bool ok;                        /* every set call succeeded */
+    size_t next, pushed;            /* job index of the next segment; segments pushed */
+    cs_stepper_out_t out;           /* the executor's last call */
+    cs_gpio_run_outcome_t oc;       /* DONE while running */
+    uint32_t dir;                   /* DIR levels on the lines */
+    uint64_t vt;                    /* executor ticks so far */
+    int64_t planned;                /* planned time of the current call */
+    int64_t shift;                  /* ns added to the plan by pauses */
+    bool unsent;                    /* stopped with a call's steps computed, not on lines */
+    int32_t unsent_pos[CS_AXES];    /* the executor's position without them */
 } stepper_run_t;
 
 /* Pushes segment s->next (after the hold's admission) into the executor. false when the
@@ -170,8 +170,7 @@ static void step_begin(stepper_run_t *s)
         (void)feed_next(s, false);
     cs_stepper_tick(s->st, &s->out);
     int64_t start = cs_gpio_io_now_ns();
-    r->t0_ns =
-        start + (cfg->enable_ns > START_LEAD_NS && s->en ? cfg->enable_ns : START_LEAD_NS);
+    r->t0_ns = start + (cfg->enable_ns > START_LEAD_NS && s->en ? cfg->enable_ns : START_LEAD_NS);
     s->dir = s->io->levels & s->all_dir;
     uint32_t want = dir_lines(o, s->out.dir_mask);
     if (s->ok && want != s->dir) {

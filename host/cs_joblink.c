@@ -23,9 +23,9 @@ int cs_joblink_select(cs_joblink_t *l, const cs_joblink_cfg_t *cfg)
                             : "--port, --modbus-tcp, --modbus-rtu and --gpio exclude each other");
         return CS_EXIT_USAGE;
     }
-    l->ops = cfg->port         ? &cs_joblink_serial_ops
-             : cfg->gpio       ? &cs_joblink_gpio_ops
-                               : &cs_joblink_modbus_ops;
+    l->ops = cfg->port   ? &cs_joblink_serial_ops
+             : cfg->gpio ? &cs_joblink_gpio_ops
+                         : &cs_joblink_modbus_ops;
     l->name = cfg->port         ? cfg->port
               : cfg->gpio       ? cfg->gpio
               : cfg->modbus_tcp ? cfg->modbus_tcp
@@ -67,8 +67,7 @@ int cs_joblink_option(const char *cmd, int argc, char **argv, int *i, cs_joblink
         l->unit = (int)n;
     } else if (strcmp(a, "--baud") == 0) {
         if (cs_joblink_parse_count(v, 4000000, &n) != 0 || !cs_serial_baud_ok((uint32_t)n)) {
-            fprintf(stderr, "curvestep %s: --baud wants a termios rate (e.g. 115200)\n",
-                    cmd);
+            fprintf(stderr, "curvestep %s: --baud wants a termios rate (e.g. 115200)\n", cmd);
             return -1;
         }
         l->baud = (uint32_t)n;

@@ -44,9 +44,9 @@ typedef struct {
     const cs_stream_job_t *job; /* wire messages (serial, Modbus) */
     const cs_segment_t *segs;   /* the step segments (GPIO; NULL: taken from job's SEGMENTs) */
     size_t nsegs;
-    size_t resume_from;         /* in the link's numbering: messages (GPIO: segments) done */
-    const int32_t *start_pos;   /* steps where the machine stands (GPIO reports its end
-                                 * position from it); NULL: the origin */
+    size_t resume_from;       /* in the link's numbering: messages (GPIO: segments) done */
+    const int32_t *start_pos; /* steps where the machine stands (GPIO reports its end
+                               * position from it); NULL: the origin */
 } cs_joblink_job_t;
 
 /* How the caller steers a run (all polled by run; any may be NULL / false). */

@@ -278,7 +278,7 @@ typedef struct {
     cs_stream_progress_t prog;
     double t_first;
     uint32_t resent, refused;
-    bool held; /* HOLD sent for o->pause, RESUME not yet */
+    bool held;         /* HOLD sent for o->pause, RESUME not yet */
     double t_progress; /* last write taken, message executed or axis moved (stall_ms) */
 } mrun_t;
 
@@ -572,10 +572,9 @@ static bool mb_controls(mrun_t *s, double *t_all_sent)
     if (o->pause != NULL && (*o->pause != 0) != s->held) {
         s->held = !s->held;
         control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
-                s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
-                2000);
-        if (s->held && (s->r->dev_state == CS_PROTO_STATE_HELD ||
-                        s->r->dev_state == CS_PROTO_STATE_IDLE))
+                s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
+        if (s->held &&
+            (s->r->dev_state == CS_PROTO_STATE_HELD || s->r->dev_state == CS_PROTO_STATE_IDLE))
             cs_stream_progress_held(o->progress, s->r->executed, s->job->n, what(s));
         *t_all_sent = 0;
     }
@@ -632,9 +631,8 @@ static void mb_stream(mrun_t *s)
             if (!poll_status(s))
                 break;
         }
-        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n,
-                           s->r->executed, s->r->sent, o->resume_from, s->c->retries + s->resent,
-                           what(s));
+        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n, s->r->executed,
+                           s->r->sent, o->resume_from, s->c->retries + s->resent, what(s));
         mb_check_end(s, &t_all_sent);
     }
 }

@@ -173,8 +173,10 @@ static int pick_link(stream_args_t *a, cs_joblink_t *l)
         return CS_EXIT_USAGE;
     }
     if (a->curves && !l->ops->curves) {
-        fprintf(stderr, "curvestep stream: --%s runs the step segments planned here: --mode "
-                        "curves does not apply\n", a->link.gpio ? "gpio" : "link");
+        fprintf(stderr,
+                "curvestep stream: --%s runs the step segments planned here: --mode "
+                "curves does not apply\n",
+                a->link.gpio ? "gpio" : "link");
         return CS_EXIT_USAGE;
     }
     if (a->link.parity == 0)
@@ -201,9 +203,8 @@ static int plan(const stream_args_t *a, const cs_joblink_t *l, const cs_machine_
     if (e == CS_OK)
         e = cs_jobplan_linkable(jp, a->job_file, l->ops->pens, a->curves);
     if (e == CS_OK)
-        e = a->curves ? cs_stream_job_add_path(job, &jp->path,
-                                               feed_q > 0 ? feed_q : m->default_feed, tol,
-                                               &jp->diag)
+        e = a->curves ? cs_stream_job_add_path(
+                            job, &jp->path, feed_q > 0 ? feed_q : m->default_feed, tol, &jp->diag)
                       : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp->diag);
@@ -217,8 +218,8 @@ static int plan(const stream_args_t *a, const cs_joblink_t *l, const cs_machine_
                 ? " ; arcs and other rational curves approximated by cubics within tol/4"
                 : "");
     if (a->resume_from > job->n) {
-        fprintf(stderr, "curvestep stream: --resume-from %zu: the job has %zu %s\n",
-                a->resume_from, job->n, what);
+        fprintf(stderr, "curvestep stream: --resume-from %zu: the job has %zu %s\n", a->resume_from,
+                job->n, what);
         return CS_EXIT_USAGE;
     }
     cs_path_free(&jp->path);
@@ -242,8 +243,7 @@ static int run_link(const stream_args_t *a, cs_joblink_t *l, const cs_joblink_jo
         signal(SIGINT, SIG_DFL);
         return cs_joblink_close(l, rc);
     }
-    cs_joblink_ctl_t c = {&interrupted, NULL, a->quiet ? NULL : stderr,
-                          isatty(STDERR_FILENO) != 0};
+    cs_joblink_ctl_t c = {&interrupted, NULL, a->quiet ? NULL : stderr, isatty(STDERR_FILENO) != 0};
     cs_stream_result_t r;
     cs_err_t e = cs_joblink_run(l, j, &c, &r);
     signal(SIGINT, SIG_DFL);

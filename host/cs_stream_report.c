@@ -56,8 +56,7 @@ static void outcome_line(FILE *out, const char *where, const cs_stream_result_t 
     fprintf(out, "\n");
 }
 
-void cs_stream_report_bytes(FILE *out, const cs_stream_result_t *r, size_t resume_from,
-                            bool curves)
+void cs_stream_report_bytes(FILE *out, const cs_stream_result_t *r, size_t resume_from, bool curves)
 {
     fprintf(out,
             "stream: %llu bytes sent, %llu received in %.2f s; %u retransmissions (%u timeouts, "
