@@ -854,9 +854,11 @@ static int serve_setup(daemon_t *d)
         return CS_EXIT_USAGE;
     }
     d->link.cfg.machine_file = cfg->machine_file;
-    int orc = d->link.ops->keep_open ? cs_joblink_open(&d->link, NULL) : CS_EXIT_OK;
-    if (orc != CS_EXIT_OK) {
-        fprintf(stderr, "curvestep serve: %s\n", d->link.why);
+    int orc = d->link.ops->check ? d->link.ops->check(&d->link, &d->m) : CS_EXIT_OK;
+    if (orc == CS_EXIT_OK && d->link.ops->keep_open)
+        orc = cs_joblink_open(&d->link, NULL);
+    if (orc != CS_EXIT_OK) { /* "file:line: reason" as it is */
+        fprintf(stderr, "%s%s\n", orc == CS_EXIT_INPUT ? "" : "curvestep serve: ", d->link.why);
         return orc;
     }
     d->listen_fd = open_socket(cfg->socket_path);

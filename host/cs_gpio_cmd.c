@@ -211,7 +211,7 @@ static int gpio_config(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t *
         snprintf(l->why, sizeof l->why, "--gpio record:FILE needs a file name");
         return CS_EXIT_USAGE;
     }
-    if (j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
+    if (j != NULL && j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
         snprintf(l->why, sizeof l->why,
                  "--gpio runs the step segments planned here: "
                  "--mode curves does not apply");
@@ -267,6 +267,20 @@ static void say_lines(const cs_joblink_t *l, const gpio_link_t *g)
                     ln->active_low[i] ? " active-low" : "");
     fprintf(stderr, "); STEP pulse %.3f us, DIR set-up %.3f us\n", g->cfg.pulse_ns / 1000.0,
             g->cfg.dir_setup_ns / 1000.0);
+}
+
+/* The [gpio] section against the option and machine m, before any job (the daemon's start). */
+static int gpio_check(cs_joblink_t *l, const cs_machine_t *m)
+{
+    gpio_link_t *g = calloc(1, sizeof *g);
+    if (g == NULL) {
+        snprintf(l->why, sizeof l->why, "out of memory");
+        return CS_EXIT_INTERNAL;
+    }
+    g->m = m;
+    int rc = gpio_config(l, g, NULL);
+    free(g);
+    return rc;
 }
 
 static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
@@ -478,6 +492,7 @@ const cs_joblink_ops_t cs_joblink_gpio_ops = {
     .keep_open = false,
     .curves = false,
     .pens = false,
+    .check = gpio_check,
     .open = gpio_open,
     .run = gpio_run,
     .counters = gpio_counters,

@@ -64,6 +64,9 @@ typedef struct {
     bool keep_open;   /* the daemon opens it once and keeps it (serial); else once per job */
     bool curves;      /* carries CURVE messages (--mode curves) */
     bool pens;        /* carries servo pen events (PEN messages) */
+    /* Checks the link's configuration for machine m before any job (NULL: nothing to check):
+     * the daemon refuses to start on a bad one. CS_EXIT_OK, or an exit status with l->why. */
+    int (*check)(cs_joblink_t *l, const cs_machine_t *m);
     /* Opens the link for job j (j may be NULL for a keep_open link). CS_EXIT_OK, or an exit
      * status (CS_EXIT_NO_DEVICE, _USAGE, _INPUT, _INTERNAL) with one sentence in l->why. */
     int (*open)(cs_joblink_t *l, const cs_joblink_job_t *j);

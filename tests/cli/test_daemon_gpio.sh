@@ -94,6 +94,18 @@ wait "$DPID"
 expect "serve: exit 0" [ $? -eq 0 ]
 expect "serve: log names the link" grep -q "^serve: serving record:$REC on " "$T/serve.err"
 
+# a bad [gpio] section stops serve at its start, with file:line (exit 1); a chip the file does
+# not name is a usage error (exit 2)
+printf '[gpio]\nx_step = 17\nx_dir = 17\n' >"$T/dup.ini"
+timeout -k 5 30 "$CS" serve --gpio "record:$T/x.rec" --machine "$T/dup.ini" --socket "$T/sock/b.sock" \
+    >/dev/null 2>"$T/dup.err"
+expect "bad [gpio]: exit 1" [ $? -eq 1 ]
+expect "bad [gpio]: file:line" grep -q "^$T/dup.ini:3: \[gpio\] x_dir: line 17 is already x_step" "$T/dup.err"
+timeout -k 5 30 "$CS" serve --gpio gpiochip1 --machine "$T/m.ini" --socket "$T/sock/b.sock" \
+    >/dev/null 2>"$T/mis.err"
+expect "chip mismatch: exit 2" [ $? -eq 2 ]
+expect "chip mismatch: said" grep -q "chip = gpiochip0" "$T/mis.err"
+
 # usage: --gpio and another link
 "$CS" serve --gpio gpiochip0 --port /dev/null >/dev/null 2>"$T/two.err"
 expect "two links: exit 2" [ $? -eq 2 ]
