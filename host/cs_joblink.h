@@ -1,11 +1,12 @@
 /* cs_joblink: the host's links behind one interface. A job planned whole on the host runs over
  * one link, picked by option: the framed serial protocol (--port: cs_stream), Modbus TCP or RTU
  * (--modbus-tcp, --modbus-rtu: cs_modbus_stream) or the GPIO step thread here (--gpio:
- * cs_gpio_run). Each link implements the same four calls (cs_joblink_ops_t): open, run the job
- * with progress, report its own counters, close; `curvestep stream` and the daemon (`serve`)
- * call only these. Owns: the link's open state (port, Modbus client, GPIO lines), the choice of
- * the link from the options, the one report of an outcome (cs_joblink_report: exit status and
- * summary lines, cs_stream_report), and the link timing of a serial line (cs_linktime).
+ * cs_gpio_run). Each link implements the same calls (cs_joblink_ops_t): open, run the job with
+ * progress, report its own counters, close (and an optional check of its configuration before
+ * any job); `curvestep stream` and the daemon (`serve`) call only these. Owns: the link's open
+ * state (port, Modbus client, GPIO lines), the choice of the link from the options (one parser
+ * for both commands), the one report of an outcome (cs_joblink_report: exit status and summary
+ * lines, cs_stream_report), and the rate a serial line really moves (its timing: cs_linktime).
  *
  * Hold, resume and cancel are not calls but the two flags of cs_joblink_ctl_t, polled by run:
  * they are set from signal handlers (Ctrl-C; the daemon's SIGUSR1/SIGUSR2/SIGTERM to the job's
