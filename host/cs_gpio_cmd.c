@@ -269,29 +269,32 @@ static void say_lines(const cs_joblink_t *l, const gpio_link_t *g)
             g->cfg.dir_setup_ns / 1000.0);
 }
 
+/* A new link state for machine m, or NULL with the reason in l->why. */
+static gpio_link_t *gpio_new(cs_joblink_t *l, const cs_machine_t *m)
+{
+    gpio_link_t *g = calloc(1, sizeof *g);
+    if (g == NULL)
+        snprintf(l->why, sizeof l->why, "out of memory");
+    else
+        g->m = m;
+    return g;
+}
+
 /* The [gpio] section against the option and machine m, before any job (the daemon's start). */
 static int gpio_check(cs_joblink_t *l, const cs_machine_t *m)
 {
-    gpio_link_t *g = calloc(1, sizeof *g);
-    if (g == NULL) {
-        snprintf(l->why, sizeof l->why, "out of memory");
-        return CS_EXIT_INTERNAL;
-    }
-    g->m = m;
-    int rc = gpio_config(l, g, NULL);
+    gpio_link_t *g = gpio_new(l, m);
+    int rc = g != NULL ? gpio_config(l, g, NULL) : CS_EXIT_INTERNAL;
     free(g);
     return rc;
 }
 
 static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
 {
-    gpio_link_t *g = calloc(1, sizeof *g);
-    if (g == NULL) {
-        snprintf(l->why, sizeof l->why, "out of memory");
+    gpio_link_t *g = gpio_new(l, j->m);
+    if (g == NULL)
         return CS_EXIT_INTERNAL;
-    }
     l->gpio = g;
-    g->m = j->m;
     int rc = gpio_config(l, g, j);
     if (rc == CS_EXIT_OK)
         rc = gpio_segments(l, g, j);
