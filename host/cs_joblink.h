@@ -22,6 +22,7 @@
 
 #include "cs_machine.h"
 #include "cs_modbus_stream.h"
+#include "cs_motion.h"
 #include "cs_segment.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
@@ -45,6 +46,8 @@ typedef struct {
     const cs_stream_job_t *job; /* wire messages (serial, Modbus) */
     const cs_segment_t *segs;   /* the step segments (GPIO; NULL: taken from job's SEGMENTs) */
     size_t nsegs;
+    const cs_motion_pen_t *pens; /* their servo pen events (GPIO: cs_gpio_pwm; with segs) */
+    size_t npens;
     size_t resume_from;       /* in the link's numbering: messages (GPIO: segments) done */
     const int32_t *start_pos; /* steps where the machine stands (GPIO reports its end
                                * position from it); NULL: the origin */
@@ -124,8 +127,11 @@ int cs_joblink_report(cs_joblink_t *l, FILE *out, size_t n, const cs_stream_resu
  * 0 (memory speed) for a pseudo-terminal (/dev/pts/N: bytes move at memory speed whatever its
  * baud), else baud. */
 uint32_t cs_joblink_line_bps(const char *dev, uint32_t baud, uint32_t line_rate);
-/* The step segments of a segments-mode job (its SEGMENT messages, in order; PEN messages are
- * skipped): a new array in *segs (free it), its length in *n. CS_ERR_FULL out of memory. */
-cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n);
+/* The step segments of a segments-mode job (its SEGMENT messages, in order) and its servo pen
+ * events (a PEN message before segment k: {k, pulse_us}, as cs_stream_job_add_motion laid them
+ * out): new arrays in *segs and *pens (free both), their lengths in *n and *npens. CS_ERR_FULL
+ * out of memory. */
+cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n,
+                             cs_motion_pen_t **pens, size_t *npens);
 
 #endif
