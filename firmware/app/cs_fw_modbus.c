@@ -8,13 +8,8 @@
 void cs_fw_modbus_init(cs_fw_modbus_t *fm, cs_fw_motion_t *mo, uint32_t boot_id,
                        cs_modbus_app_t *app)
 {
-    fm->mo = mo;
-    fm->boot = boot_id != 0 ? boot_id : 1u;
-    fm->error = 0;
-    fm->error_seq = 0;
-    fm->lease_token = 0;
-    fm->lease_until_ms = 0;
-    fm->now_ms = 0;
+    /* no error latched, no lease, the clock at 0 until the caller sets it */
+    *fm = (cs_fw_modbus_t){.mo = mo, .boot = boot_id != 0 ? boot_id : 1u};
     app->submit = cs_fw_modbus_submit;
     app->command = cs_fw_modbus_command;
     app->status = cs_fw_modbus_status;
