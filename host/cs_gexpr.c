@@ -74,6 +74,21 @@ cs_err_t cs_gexpr_init(cs_gexpr_store_t *st)
     return st->num ? CS_OK : CS_ERR_FULL;
 }
 
+cs_err_t cs_gexpr_copy(cs_gexpr_store_t *dst, const cs_gexpr_store_t *src)
+{
+    *dst = *src;
+    dst->num = malloc(CS_GEXPR_NUM_PARAMS * sizeof *dst->num);
+    dst->named = src->capnamed ? malloc(src->capnamed * sizeof *dst->named) : NULL;
+    if (!dst->num || (src->capnamed && !dst->named)) {
+        cs_gexpr_free(dst);
+        return CS_ERR_FULL;
+    }
+    memcpy(dst->num, src->num, CS_GEXPR_NUM_PARAMS * sizeof *dst->num);
+    if (src->nnamed)
+        memcpy(dst->named, src->named, src->nnamed * sizeof *dst->named);
+    return CS_OK;
+}
+
 void cs_gexpr_free(cs_gexpr_store_t *st)
 {
     free(st->num);
