@@ -23,6 +23,7 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_grbl_dev.h"
+#include "cs_gcode_words.h"
 #include "cs_grbl_gc.h"
 #include "cs_serial.h"
 #include "cs_stream_cmd.h"
@@ -76,6 +77,10 @@ typedef struct {
     unsigned reports;
     double wco_sent[3];
     unsigned cancelled_seen; /* device runs ended by cancel that were synced */
+    double prb[3];           /* the last probe's contact, machine mm ($# PRB) */
+    bool prb_ok;             /* ... and whether it touched */
+    const char *spindle_m;   /* "M3", "M4", "M5": the spindle state for $G */
+    double spindle_s;        /* S, for $G */
 } grbl_t;
 
 static volatile sig_atomic_t stop_flag;
@@ -132,11 +137,14 @@ static void sync_from_device(grbl_t *g)
     cs_grbl_dev_snap(&g->dev, &s);
     if (!s.have_pos)
         return;
+    double mm[3];
+    memcpy(mm, g->gc.pos, sizeof mm);
     for (int a = 0; a < 3 && a < g->m.n_axes; a++) {
-        g->gc.pos[a] = steps_mm(g, a, s.pos[a]);
+        mm[a] = steps_mm(g, a, s.pos[a]);
         g->plan_pos[a] = (cs_pos_t)llround((double)s.pos[a] * 65536.0 * 65536.0 /
                                            (double)g->m.axis[a].steps_per_mm);
     }
+    cs_grbl_gc_set_pos(&g->gc, mm);
     g->cancelled_seen = s.cancelled;
 }
 
@@ -146,7 +154,6 @@ static void drop_all(grbl_t *g)
     cs_grbl_dev_cancel(&g->dev, false);
     g->held = false;
     cs_path_free(&g->pending);
-    cs_grbl_gc_free(&g->gc);
     sync_from_device(g);
 }
 
@@ -277,9 +284,6 @@ static void gcode_line(grbl_t *g, const char *line)
         say(g, "ok");
         return;
     }
-    cs_grbl_gc_t before = g->gc;
-    before.block = NULL; /* the line consumes (or keeps) the held block itself */
-    before.block_len = before.block_lines = 0;
     size_t n0 = g->pending.n;
     cs_path_diag_t d;
     bool end;
@@ -289,7 +293,7 @@ static void gcode_line(grbl_t *g, const char *line)
     }
     if (!inside_travel(g, &g->pending, n0)) {
         g->pending.n = n0;
-        g->gc = before;
+        cs_grbl_gc_undo(&g->gc);
         say(g, "[MSG:line %u: the move leaves the machine's travel]", g->lineno);
         say(g, "error:%d", ERR_TARGET);
         return;
@@ -297,8 +301,7 @@ static void gcode_line(grbl_t *g, const char *line)
     if (g->check_mode)
         g->pending.n = n0; /* $C: read and checked, never run */
     if (end) {
-        flush_chunk(g);
-        cs_grbl_gc_reset_modal(&g->gc);
+        flush_chunk(g); /* the reader is back in its start modes (M2 / M30) */
     } else if (g->pending.n >= CS_GRBL_CHUNK_ELEMS) {
         flush_chunk(g);
     }
@@ -308,10 +311,9 @@ static void gcode_line(grbl_t *g, const char *line)
 /* ---- jogging ($J=) ---- */
 
 /* Checks a jog line's words (Grbl: G20 G21 G90 G91 G53, X Y Z, F; F required). */
-static int jog_words(const char *s, bool *g53)
+static int jog_words(const char *s)
 {
     bool f = false, axis = false;
-    *g53 = false;
     while (*s) {
         char c = (char)(*s >= 'a' && *s <= 'z' ? *s - 32 : *s);
         if (c == ' ') {
@@ -324,8 +326,8 @@ static int jog_words(const char *s, bool *g53)
             return c >= 'A' && c <= 'Z' ? ERR_NUMBER : ERR_LETTER;
         s = e;
         long gx = lround(v * 10);
-        if (c == 'G' && (gx == 200 || gx == 210 || gx == 900 || gx == 910 || gx == 530)) {
-            *g53 = *g53 || gx == 530;
+        if (c == 'G' && (gx == GC_G20 || gx == GC_G21 || gx == GC_G90 || gx == GC_G91 ||
+                         gx == GC_G53)) {
         } else if (c == 'X' || c == 'Y' || c == 'Z') {
             axis = true;
         } else if (c == 'F') {
@@ -349,30 +351,24 @@ static void jog_line(grbl_t *g, const char *words)
         say(g, "error:%d", ERR_NOT_IDLE);
         return;
     }
-    bool g53;
-    int bad = jog_words(words, &g53);
+    int bad = jog_words(words);
     if (bad) {
         say(g, "error:%d", bad);
         return;
     }
-    /* a jog leaves the parser's modes alone: it is read with a copy of them */
-    cs_grbl_gc_t j = g->gc;
-    j.block = NULL;
-    if (g53)
-        memset(j.off, 0, sizeof j.off);
+    /* a jog leaves the parser's modes alone: read, then taken back (its end position kept);
+     * G53 is the reader's own (machine coordinates for the line) */
     char line[CS_GRBL_GC_LINE_MAX + 8];
     snprintf(line, sizeof line, "G1 %s", words);
-    if (g53) { /* G53: machine coordinates (cs_gcode has no G53: offsets cleared above) */
-        char *p = strstr(line, "G53");
-        p = p ? p : strstr(line, "g53");
-        if (p)
-            memcpy(p, "   ", 3);
-    }
     cs_path_t path;
     cs_path_init(&path);
     cs_path_diag_t d;
     bool end;
-    cs_err_t e = cs_grbl_gc_line(&j, line, g->lineno, &path, &d, &end);
+    cs_err_t e = cs_grbl_gc_line(&g->gc, line, g->lineno, &path, &d, &end);
+    double jog_end[3];
+    memcpy(jog_end, g->gc.pos, sizeof jog_end);
+    if (e == CS_OK)
+        cs_grbl_gc_undo(&g->gc);
     if (e != CS_OK || !inside_travel(g, &path, 0)) {
         cs_path_free(&path);
         say(g, "error:%d", e != CS_OK ? ERR_JOG : ERR_JOG_TRAVEL);
@@ -385,7 +381,7 @@ static void jog_line(grbl_t *g, const char *words)
     }
     cs_grbl_dev_push(&g->dev, &it);
     g->last_push_jog = true;
-    memcpy(g->gc.pos, j.pos, sizeof g->gc.pos);
+    cs_grbl_gc_set_pos(&g->gc, jog_end);
     say(g, "ok");
 }
 
@@ -481,30 +477,46 @@ static void dollar_settings(grbl_t *g)
     say(g, "ok");
 }
 
+/* "[NAME:x,y,z]" from parameters #first.. (mm). */
+static void say_param3(grbl_t *g, const char *name, int first)
+{
+    say(g, "[%s:%.3f,%.3f,%.3f]", name, cs_grbl_gc_param(&g->gc, first),
+        cs_grbl_gc_param(&g->gc, first + 1), cs_grbl_gc_param(&g->gc, first + 2));
+}
+
+/* $#: the reader's parameters, where LinuxCNC keeps them (G54 #5221.., 20 apart; G28 #5161..;
+ * G30 #5181..; G92 #5211.. when #5210 says they apply); PRB in machine coordinates. */
 static void dollar_params(grbl_t *g)
 {
-    for (int k = 54; k <= 59; k++)
-        say(g, "[G%d:0.000,0.000,0.000]", k);
-    say(g, "[G28:0.000,0.000,0.000]");
-    say(g, "[G30:0.000,0.000,0.000]");
-    say(g, "[G92:%.3f,%.3f,%.3f]", g->gc.off[0], g->gc.off[1], g->gc.off[2]);
+    for (int k = 0; k < 6; k++) {
+        char name[8];
+        snprintf(name, sizeof name, "G%d", 54 + k);
+        say_param3(g, name, 5221 + 20 * k);
+    }
+    say_param3(g, "G28", 5161);
+    say_param3(g, "G30", 5181);
+    if (cs_grbl_gc_param(&g->gc, 5210) != 0)
+        say_param3(g, "G92", 5211);
+    else
+        say(g, "[G92:0.000,0.000,0.000]");
     say(g, "[TLO:0.000]");
-    say(g, "[PRB:0.000,0.000,0.000:0]");
+    say(g, "[PRB:%.3f,%.3f,%.3f:%d]", g->prb[0], g->prb[1], g->prb[2], g->prb_ok ? 1 : 0);
     say(g, "ok");
 }
 
 static void dollar_modes(grbl_t *g)
 {
     const cs_grbl_gc_t *c = &g->gc;
-    char motion[24];
+    char motion[24], wcs[16];
     if (c->motion < 0)
         snprintf(motion, sizeof motion, "G80");
-    else if (c->motion % 10)
-        snprintf(motion, sizeof motion, "G%d.%d", c->motion / 10, c->motion % 10);
     else
-        snprintf(motion, sizeof motion, "G%d", c->motion / 10);
-    say(g, "[GC:%s G54 G%d %s %s G94 M5 M9 T0 F%g S0]", motion, c->plane, c->inch ? "G20" : "G21",
-        c->incr ? "G91" : "G90", c->feed);
+        cs_gcode_code_name(motion, sizeof motion, 'G', c->motion);
+    static const int systems[] = {GC_G54, GC_G55,   GC_G56,   GC_G57,  GC_G58,
+                                  GC_G59, GC_G59_1, GC_G59_2, GC_G59_3};
+    cs_gcode_code_name(wcs, sizeof wcs, 'G', systems[c->wcs >= 1 && c->wcs <= 9 ? c->wcs - 1 : 0]);
+    say(g, "[GC:%s %s G%d %s %s G94 %s M9 T0 F%g S%g]", motion, wcs, c->plane,
+        c->inch ? "G20" : "G21", c->incr ? "G91" : "G90", g->spindle_m, c->feed, g->spindle_s);
     say(g, "ok");
 }
 
@@ -539,7 +551,7 @@ static void dollar_check(grbl_t *g)
     g->check_mode = !g->check_mode;
     say(g, "[MSG:%s]", g->check_mode ? "Enabled" : "Disabled");
     if (!g->check_mode) { /* Grbl soft-resets when check mode ends */
-        cs_grbl_gc_init(&g->gc);
+        cs_grbl_gc_reset_modal(&g->gc, true);
         sync_from_device(g);
         say(g, "ok");
         say(g, "%s", GRBL_WELCOME);
@@ -621,8 +633,7 @@ static void soft_reset(grbl_t *g)
     g->rx_overflow = false;
     g->held = false;
     g->check_mode = false;
-    cs_grbl_gc_reset_modal(&g->gc);
-    memset(g->gc.off, 0, sizeof g->gc.off);
+    cs_grbl_gc_reset_modal(&g->gc, true);
     say(g, "%s", "");
     say(g, "%s", GRBL_WELCOME);
 }
@@ -852,6 +863,10 @@ static int start(grbl_t *g)
     if (rc != CS_EXIT_OK)
         return rc;
     g->feed = cs_motion_speed(g->cfg->job.feed_mm_s);
+    if (cs_grbl_gc_init(&g->gc, NULL) != CS_OK) {
+        fprintf(stderr, "curvestep grbl: out of memory\n");
+        return CS_EXIT_INTERNAL;
+    }
     if (cs_serial_open(&g->ser, g->cfg->port, g->cfg->baud) != 0) {
         fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", g->cfg->port, strerror(errno));
         return CS_EXIT_NO_DEVICE;
@@ -881,7 +896,7 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     g->cfg = cfg;
     g->fd = -1;
     g->report_mask = 1; /* Grbl's default $10=1: MPos */
-    cs_grbl_gc_init(&g->gc);
+    g->spindle_m = "M5";
     cs_path_init(&g->pending);
     int rc = start(g);
     if (rc != CS_EXIT_OK) {
