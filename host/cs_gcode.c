@@ -239,6 +239,7 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
         if (b->w['S' - 'A'].v < 0)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->w['S' - 'A'].col),
                                     "S (spindle speed) must not be negative");
+        g->speed = b->w['S' - 'A'].v;
     }
     return CS_OK;
 }
@@ -261,6 +262,7 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
                                     "before the G5.2 or after its G5.3",
                                     m / 10);
         } else if (grp == GC_GROUP_M_SPINDLE) {
+            g->spindle = m;
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
              * with opts->pen_z a rapid Z move to the pen height. */
             cs_path_new_subpath(g->path);
@@ -893,6 +895,7 @@ void cs_gcode_start_modes(gc_t *g)
     g->ijk_abs = false;
     g->feed = 0;
     g->g5_prev = false;
+    g->spindle = GC_M5;
     /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
     g->motion = g->o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
 }

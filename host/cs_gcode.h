@@ -93,6 +93,8 @@ typedef struct {
     int plane;        /* 17, 18, 19 */
     int motion;       /* G code of the motion mode in tenths (cs_gcode_words.h), -1: none */
     double feed;      /* F in program units per minute, 0: none given */
+    int spindle;      /* M3, M4 or M5 in tenths (cs_gcode_words.h) */
+    double speed;     /* S */
     bool holding;     /* lines are held: an O-word block or G5.2 block is open */
 } cs_gcode_state_t;
 

@@ -267,6 +267,8 @@ void cs_gcode_state(const cs_gcode_session_t *s, cs_gcode_state_t *st)
     st->plane = g->plane;
     st->motion = g->motion >= 0 ? g->motion : -1;
     st->feed = g->feed;
+    st->spindle = g->spindle;
+    st->speed = g->speed;
     st->holding = s->nopen > 0 || g->nurbs != 0;
 }
 

@@ -70,6 +70,8 @@ typedef struct {
     int motion;       /* MOT_* */
     int dropped_code; /* --lenient: the unsupported motion code MOT_DROPPED stands for */
     double feed;      /* F in program units per minute; 0 = none given */
+    int spindle;      /* GC_M3, GC_M4 or GC_M5 (the spindle / laser / pen state) */
+    double speed;     /* S (spindle speed, laser power), 0 until given */
     bool g5_prev;     /* the last move was a G5: its P, Q continue */
     double g5_pq[2];
     bool last_rapid;

@@ -25,6 +25,7 @@
 #include "cs_grbl_dev.h"
 #include "cs_gcode_words.h"
 #include "cs_grbl_gc.h"
+#include "cs_grbl_ov.h"
 #include "cs_serial.h"
 #include "cs_stream_cmd.h"
 #include "cs_trace.h"
@@ -77,10 +78,10 @@ typedef struct {
     unsigned reports;
     double wco_sent[3];
     unsigned cancelled_seen; /* device runs ended by cancel that were synced */
+    cs_grbl_ov_t ov;         /* feed, rapid, spindle overrides */
+    bool ov_changed;         /* ... not yet in a status report */
     double prb[3];           /* the last probe's contact, machine mm ($# PRB) */
     bool prb_ok;             /* ... and whether it touched */
-    const char *spindle_m;   /* "M3", "M4", "M5": the spindle state for $G */
-    double spindle_s;        /* S, for $G */
 } grbl_t;
 
 static volatile sig_atomic_t stop_flag;
@@ -191,11 +192,23 @@ static void alarm_planner(grbl_t *g, const cs_path_diag_t *d)
     drop_all(g);
 }
 
+/* The overrides in force now, on moves not planned yet (Grbl applies them to what is not yet
+ * executed; curvestep to what is not yet planned: a chunk already on the device keeps its feed). */
+static void apply_overrides(grbl_t *g, cs_path_t *path)
+{
+    double rapid = INFINITY;
+    for (int a = 0; a < 3 && a < g->m.n_axes; a++)
+        rapid = fmin(rapid, g->m.axis[a].max_rate / 65536.0);
+    double dflt = (g->feed > 0 ? g->feed : g->m.default_feed) / 65536.0;
+    cs_grbl_ov_apply(&g->ov, path, 0, dflt, rapid);
+}
+
 /* Plans the pending lines and queues them (there is room: lines are read only then). */
 static void flush_chunk(grbl_t *g)
 {
     if (g->pending.n == 0)
         return;
+    apply_overrides(g, &g->pending);
     cs_grbl_item_t it = {0};
     cs_path_diag_t d;
     if (plan_chunk(g, &g->pending, &it, &d) != CS_OK) {
@@ -422,10 +435,14 @@ static void status_report(grbl_t *g)
     /* Grbl sends WCO every 10 to 30 reports and when it changes, Ov now and then */
     bool wco = g->reports % 10 == 0 || memcmp(g->wco_sent, g->gc.off, sizeof g->wco_sent) != 0;
     if (wco) {
-        n += snprintf(buf + n, sizeof buf - (size_t)n, "|WCO:%.3f,%.3f,%.3f|Ov:100,100,100",
-                      g->gc.off[0], g->gc.off[1], g->gc.off[2]);
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|WCO:%.3f,%.3f,%.3f", g->gc.off[0],
+                      g->gc.off[1], g->gc.off[2]);
         memcpy(g->wco_sent, g->gc.off, sizeof g->wco_sent);
     }
+    if (wco || g->ov_changed)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|Ov:%d,%d,%d", g->ov.feed, g->ov.rapid,
+                      g->ov.spindle);
+    g->ov_changed = false;
     g->reports++;
     say(g, "%s>", buf);
 }
@@ -515,8 +532,10 @@ static void dollar_modes(grbl_t *g)
     static const int systems[] = {GC_G54, GC_G55,   GC_G56,   GC_G57,  GC_G58,
                                   GC_G59, GC_G59_1, GC_G59_2, GC_G59_3};
     cs_gcode_code_name(wcs, sizeof wcs, 'G', systems[c->wcs >= 1 && c->wcs <= 9 ? c->wcs - 1 : 0]);
+    char spindle[8];
+    cs_gcode_code_name(spindle, sizeof spindle, 'M', c->spindle);
     say(g, "[GC:%s %s G%d %s %s G94 %s M9 T0 F%g S%g]", motion, wcs, c->plane,
-        c->inch ? "G20" : "G21", c->incr ? "G91" : "G90", g->spindle_m, c->feed, g->spindle_s);
+        c->inch ? "G20" : "G21", c->incr ? "G91" : "G90", spindle, c->feed, c->speed);
     say(g, "ok");
 }
 
@@ -634,13 +653,15 @@ static void soft_reset(grbl_t *g)
     g->held = false;
     g->check_mode = false;
     cs_grbl_gc_reset_modal(&g->gc, true);
+    cs_grbl_ov_init(&g->ov); /* Grbl's reset puts the overrides back at 100 % */
+    g->ov_changed = true;
     say(g, "%s", "");
     say(g, "%s", GRBL_WELCOME);
 }
 
 /* A real-time byte (grbl wiki "Interface": picked out of the stream wherever it comes). True
- * when b was one. Overrides 0x90..0x9D, safety door 0x84 and the toggles 0x9E..0xA1 are
- * accepted and ignored: curvestep has no overrides yet (docs/controller.md). */
+ * when b was one. The overrides 0x90..0x9D change what is planned next (cs_grbl_ov); safety
+ * door 0x84 and the toggles 0x9E..0xA1 are accepted and ignored (docs/controller.md). */
 static bool realtime(grbl_t *g, unsigned char b)
 {
     cs_grbl_dev_snap_t s;
@@ -671,6 +692,10 @@ static bool realtime(grbl_t *g, unsigned char b)
         }
         return true;
     default:
+        if (cs_grbl_ov_byte(&g->ov, b)) {
+            g->ov_changed = true;
+            return true;
+        }
         return b >= 0x80;
     }
 }
@@ -867,6 +892,12 @@ static int start(grbl_t *g)
         fprintf(stderr, "curvestep grbl: out of memory\n");
         return CS_EXIT_INTERNAL;
     }
+    cs_path_diag_t d;
+    if (g->cfg->state != NULL && cs_grbl_gc_load(&g->gc, g->cfg->state, &d) != CS_OK) {
+        fprintf(stderr, "%s:%u:%u: %s (curvestep grbl --state)\n", d.loc.file, d.loc.line,
+                d.loc.col, d.reason);
+        return CS_EXIT_INPUT;
+    }
     if (cs_serial_open(&g->ser, g->cfg->port, g->cfg->baud) != 0) {
         fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", g->cfg->port, strerror(errno));
         return CS_EXIT_NO_DEVICE;
@@ -896,10 +927,11 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     g->cfg = cfg;
     g->fd = -1;
     g->report_mask = 1; /* Grbl's default $10=1: MPos */
-    g->spindle_m = "M5";
+    cs_grbl_ov_init(&g->ov);
     cs_path_init(&g->pending);
     int rc = start(g);
     if (rc != CS_EXIT_OK) {
+        cs_grbl_gc_free(&g->gc);
         free(g);
         return rc;
     }
@@ -918,6 +950,8 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     }
     cs_grbl_dev_stop(&g->dev);
     cs_serial_close(&g->ser);
+    if (rc == CS_EXIT_OK && cfg->state != NULL && cs_grbl_gc_save(&g->gc, cfg->state) != CS_OK)
+        fprintf(stderr, "curvestep grbl: cannot write %s: %s\n", cfg->state, strerror(errno));
     if (cfg->link != NULL && cfg->listen == NULL)
         unlink(cfg->link);
     if (g->fd >= 0)

@@ -2,7 +2,12 @@
  * session named "grbl", and its state copied out after each call. */
 #include "cs_grbl_gc.h"
 
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "cs_readall.h"
 
 #define MM_PER_INCH 25.4
 
@@ -22,6 +27,8 @@ static void mirror(cs_grbl_gc_t *g)
     g->plane = st.plane;
     g->motion = st.motion;
     g->feed = st.feed;
+    g->spindle = st.spindle;
+    g->speed = st.speed;
 }
 
 cs_err_t cs_grbl_gc_init(cs_grbl_gc_t *g, const cs_gcode_opts_t *o)
@@ -80,4 +87,70 @@ double cs_grbl_gc_work(const cs_grbl_gc_t *g, int a)
 double cs_grbl_gc_param(const cs_grbl_gc_t *g, int index)
 {
     return g->s ? cs_gcode_param(g->s, index) : 0.0;
+}
+
+cs_err_t cs_grbl_gc_save(const cs_grbl_gc_t *g, const char *path)
+{
+    char tmp[4096];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+        return CS_ERR_IO;
+    FILE *f = fopen(tmp, "w");
+    if (f == NULL)
+        return CS_ERR_IO;
+    /* %.17g: every double reads back exactly */
+    fprintf(f, "(curvestep grbl --state: work offsets and homes, mm; written on exit)\nG21\n");
+    for (int n = 1; n <= 9; n++) {
+        int b = 5221 + 20 * (n - 1); /* LinuxCNC: system n's X at #5221 + 20 (n - 1) */
+        fprintf(f, "G10 L2 P%d X%.17g Y%.17g Z%.17g\n", n, cs_grbl_gc_param(g, b),
+                cs_grbl_gc_param(g, b + 1), cs_grbl_gc_param(g, b + 2));
+    }
+    for (int p = 5161; p <= 5183; p += 20) /* G28 and G30 homes */
+        fprintf(f, "#%d=%.17g #%d=%.17g #%d=%.17g\n", p, cs_grbl_gc_param(g, p), p + 1,
+                cs_grbl_gc_param(g, p + 1), p + 2, cs_grbl_gc_param(g, p + 2));
+    bool ok = fclose(f) == 0;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        return CS_ERR_IO;
+    }
+    return CS_OK;
+}
+
+cs_err_t cs_grbl_gc_load(cs_grbl_gc_t *g, const char *path, cs_path_diag_t *diag)
+{
+    cs_path_loc_t loc = {path, 0, 0};
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *probe = fopen(path, "r");
+    if (probe == NULL && errno == ENOENT)
+        return CS_OK; /* nothing stored yet */
+    if (probe != NULL)
+        fclose(probe);
+    cs_err_t e = cs_readall(path, 0, true, &buf, &len, diag);
+    if (e != CS_OK)
+        return e;
+    cs_path_t out;
+    cs_path_init(&out);
+    unsigned no = 0;
+    for (size_t i = 0; i < len && e == CS_OK;) {
+        size_t n = 0;
+        while (i + n < len && buf[i + n] != '\n')
+            n++;
+        char line[CS_GRBL_GC_LINE_MAX];
+        bool end;
+        no++;
+        if (n >= sizeof line) {
+            loc.line = no;
+            e = cs_path_diag_set(diag, CS_ERR_PARSE, loc, "line too long");
+            break;
+        }
+        memcpy(line, buf + i, n);
+        line[n] = '\0';
+        e = cs_grbl_gc_line(g, line, no, &out, diag, &end);
+        i += n + 1;
+    }
+    if (e != CS_OK)
+        diag->loc.file = path;
+    cs_path_free(&out);
+    free(buf);
+    return e;
 }

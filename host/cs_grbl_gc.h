@@ -28,6 +28,8 @@ typedef struct {
     int plane;       /* 17, 18, 19 */
     int motion;      /* G code of the motion mode in tenths (cs_gcode_words.h), -1: none */
     double feed;     /* F in program units per minute, 0: none given */
+    int spindle;     /* M3, M4, M5 in tenths */
+    double speed;    /* S */
 } cs_grbl_gc_t;
 
 /* Program start: position 0, no offsets, G54 G21 G90 G91.1 G17, no motion mode, no feed.
@@ -51,5 +53,13 @@ void cs_grbl_gc_set_pos(cs_grbl_gc_t *g, const double mm[3]);
 double cs_grbl_gc_work(const cs_grbl_gc_t *g, int a);
 /* Numbered parameter #index of the reader (the offsets for $#: G54 at #5221...). */
 double cs_grbl_gc_param(const cs_grbl_gc_t *g, int index);
+
+/* --state FILE: the coordinate systems G54 .. G59.3 and the G28 / G30 homes written as G-code
+ * (G10 L2 lines and parameter settings, millimetres) that cs_grbl_gc_load reads back; Grbl keeps
+ * the same in its EEPROM. CS_ERR_IO when the file cannot be written. */
+cs_err_t cs_grbl_gc_save(const cs_grbl_gc_t *g, const char *path);
+/* Reads a --state FILE through the reader (a missing file is no error: nothing stored yet).
+ * CS_ERR_IO (unreadable) or the reader's error, with *diag (file:line:col). */
+cs_err_t cs_grbl_gc_load(cs_grbl_gc_t *g, const char *path, cs_path_diag_t *diag);
 
 #endif

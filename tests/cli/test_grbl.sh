@@ -78,6 +78,28 @@ expect "long: 2502 ok, 0 errors" grep -q '^acks: 2502 0$' "$T/long.out"
 expect "long: ends Idle at (1, 1)" grep -q '^final: <Idle|MPos:1.000,1.000,0.000|' "$T/long.out"
 expect "long: same final position as plan + replay" grep -qxF "$LONG_POS" "$T/long.sim"
 
+# 1c. work offsets (G10 L20, G10 L2, G54/G55, G92, G92.1) and an O-word sub defined and called
+#     over several lines, by character counting: the final position is the hand-computed machine
+#     17, 18 (G54 zero at 10, 10 plus X7 Y8), the same as plan + replay; then $# shows the offsets
+#     kept (G92 cleared by the client's soft reset) and $G a coordinate system and spindle.
+WCS=tests/data/gcode/grbl-wcs-sub.ngc
+"$CS" plan "$WCS" -o "$T/wcs.seg" 2>/dev/null
+WCS_POS=$("$SIM" --replay "$T/wcs.seg" 2>/dev/null | grep '^final position:')
+expect "wcs: plan + replay at machine 17, 18" grep -q 'x=1360 steps (17.0000 mm) y=1440 steps (18.0000 mm)' <<<"$WCS_POS"
+start_sim wcs
+start_grbl wcs
+client "$GPTY" stream "$WCS" --method counting >"$T/wcs.out"; rc=$?
+client "$GPTY" cmd '$#' 'G55 G20 M3 S1000' '$G' >"$T/wcs2.out"
+stop_all
+expect "wcs: client exit 0" [ $rc -eq 0 ]
+expect "wcs: 20 ok, 0 errors" grep -q '^acks: 20 0$' "$T/wcs.out"
+expect "wcs: ends Idle at machine 17, 18" grep -q '^final: <Idle|MPos:17.000,18.000,0.000|' "$T/wcs.out"
+expect "wcs: same final position as plan + replay" grep -qxF "$WCS_POS" "$T/wcs.sim"
+expect "wcs: \$# G54 from G10 L20" grep -qx '\[G54:10.000,10.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$# G55 from G10 L2" grep -qx '\[G55:40.000,5.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$# G92 cleared" grep -qx '\[G92:0.000,0.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$G" grep -qx '\[GC:G80 G55 G17 G20 G90 G94 M3 M9 T0 F0 S1000\]' "$T/wcs2.out"
+
 # 2. send-response, ? every 2 lines, and a hold (!) mid-job then resume (~), in real time x20.
 start_sim sr --speed 20 --reference "$PROG" --check
 start_grbl sr
@@ -123,8 +145,8 @@ expect "\$H: error:5 (no homing)" grep -qx 'error:5' "$T/dolh.out"
 expect "errors: beyond the travel error:33, said why" grep -q '^\[MSG:line [0-9]*: the move leaves the machine.s travel\]$' "$T/dolerr.out"
 expect "errors: in order 33, 22 (jog without F), 16 (bad jog word), 15 (jog beyond travel)" \
     [ "$(grep '^error:' "$T/dolerr.out" | tr '\n' ' ')" = "error:33 error:22 error:16 error:15 " ]
-expect "override bytes ignored: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
-expect "override bytes ignored: the status" grep -q '^<Idle|' "$T/dolov.out"
+expect "override bytes: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
+expect "override bytes: feed +10 %, spindle +10 -1 % in Ov (0x91 0x9A 0x9D)" grep -qE '^<Idle\|.*\|Ov:110,100,109>$' "$T/dolov.out"
 expect "\$10=3: Bf in the status" grep -qE '^<Idle\|MPos:0\.000,0\.000,0\.000\|Bf:[0-9]+,128\|FS:0,0' "$T/dolq.out"
 
 # 4. a bad line mid-program: error:N for it alone, the rest runs (final position exact against
@@ -175,6 +197,22 @@ client "$T/ttyCURVESTEP" cmd '$G' >"$T/lnk.out"
 expect "link: answers" grep -q '^\[GC:' "$T/lnk.out"
 stop_all
 expect "link: removed on exit" [ ! -e "$T/ttyCURVESTEP" ]
+
+# 6b. --state FILE: G10 offsets and a G28.1 home written on exit, read back by the next run.
+start_sim st1
+start_grbl st1 --state "$T/state.ngc"
+client "$GPTY" cmd 'G10 L2 P3 X1.5 Y-2' 'G0 X4 Y5' 'G28.1' >"$T/st1.out"
+stop_all
+expect "state: written on exit" grep -qx 'G10 L2 P3 X1.5 Y-2 Z0' "$T/state.ngc"
+start_sim st2
+start_grbl st2 --state "$T/state.ngc"
+client "$GPTY" cmd '$#' >"$T/st2.out"
+stop_all
+expect "state: G56 read back" grep -qx '\[G56:1.500,-2.000,0.000\]' "$T/st2.out"
+expect "state: G28 home read back" grep -qx '\[G28:4.000,5.000,0.000\]' "$T/st2.out"
+printf 'G10 L2 P1 X1\nG10 L7 P1 X1\n' >"$T/badstate.ngc"
+run "state: a bad state file is exit 1" 1 grbl --port /dev/null --state "$T/badstate.ngc"
+expect "state: located error" grep -q "badstate.ngc:2:5: G10 sets work offsets with L2 or L20 only" "$T/err"
 
 # 7. usage.
 run "help: exit 0" 0 grbl --help
