@@ -52,6 +52,9 @@ void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
     if (t == CS_FW_TRIP_NONE)
         return;
     /* Grbl's hard limit: no deceleration, the steps issued are all counted */
+    /* segments the executor finished (cs_fw_motion's count): the one after them was cut */
+    c->trip_done = (uint8_t)(mo->pushed - (uint8_t)(mo->st.tail - mo->st.head) -
+                             (mo->st.running ? 1u : 0u));
     cs_stepper_halt(&mo->st);
     port_timer_stop();
     c->trip_code = code;
@@ -105,11 +108,9 @@ static void set_watch(cs_fw_ctl_t *c, uint16_t watch, uint16_t release)
 
 /* The alarm: everything stopped and dropped, the spindle off, an EVENT and an ERROR about what
  * was executing (a streaming host stops as on any device error). */
-static void enter_alarm(cs_fw_motion_t *mo, uint8_t code, uint16_t bits)
+static void alarm_about(cs_fw_motion_t *mo, uint8_t code, uint16_t bits, uint16_t seq, bool busy)
 {
     cs_fw_ctl_t *c = &mo->ctl;
-    bool busy = !cs_fw_motion_done(mo) || c->op != CS_FW_OP_NONE;
-    uint16_t seq = c->op != CS_FW_OP_NONE ? c->op_seq : cs_fw_motion_current_seq(mo);
     c->op = CS_FW_OP_NONE;
     c->op_wait = c->op_move = c->sp_wait = c->jogging = c->cancel = false;
     set_watch(c, 0, 0);
@@ -121,6 +122,15 @@ static void enter_alarm(cs_fw_motion_t *mo, uint8_t code, uint16_t bits)
     push_event(mo, CS_PROTO_EVENT_ALARM, code, bits);
     if (busy)
         cs_fw_motion_error(mo, code == CS_PROTO_ALARM_ESTOP ? CS_ERR_STATE : CS_ERR_LIMIT, seq);
+}
+
+/* The same about the operation, or the item executing. */
+static void enter_alarm(cs_fw_motion_t *mo, uint8_t code, uint16_t bits)
+{
+    const cs_fw_ctl_t *c = &mo->ctl;
+    bool op = c->op != CS_FW_OP_NONE;
+    alarm_about(mo, code, bits, op ? c->op_seq : cs_fw_motion_current_seq(mo),
+                op || !cs_fw_motion_done(mo));
 }
 
 /* --- operations: moves planned on the device ------------------------------------------------ */
@@ -295,13 +305,16 @@ static void handle_trip(cs_fw_motion_t *mo)
     uint32_t s = port_irq_save();
     uint8_t t = c->trip, code = c->trip_code;
     uint16_t bits = c->trip_inputs;
+    uint8_t done = c->trip_done;
     c->trip = CS_FW_TRIP_NONE;
     port_irq_restore(s);
+    bool busy = c->op != CS_FW_OP_NONE || !cs_fw_motion_done(mo);
+    uint16_t seq = cs_fw_motion_halted(mo, done);
     cs_fw_motion_flush(mo);
     for (unsigned i = 0; i < CS_AXES; i++)
         mo->steps_pos[i] = cs_fw_motion_position(mo, i);
     if (t == CS_FW_TRIP_ALARM) {
-        enter_alarm(mo, code, bits);
+        alarm_about(mo, code, bits, c->op != CS_FW_OP_NONE ? c->op_seq : seq, busy);
         return;
     }
 #if CS_FW_CURVES
@@ -441,7 +454,8 @@ void cs_fw_ctl_poll(cs_fw_motion_t *mo)
     if (c->jogging && !c->cancel && cs_fw_motion_executed(mo, c->jog_last))
         c->jogging = false;
     uint16_t in = c->inputs;
-    if (in != c->inputs_sent && c->nev < CS_FW_EVQ) {
+    /* INPUTS while idle only, into an empty queue (never crowding out an alarm or a contact) */
+    if (in != c->inputs_sent && c->nev == 0 && c->op == CS_FW_OP_NONE && cs_fw_motion_done(mo)) {
         c->inputs_sent = in;
         push_event(mo, CS_PROTO_EVENT_INPUTS, 0, in);
     }

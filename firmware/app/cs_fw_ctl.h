@@ -48,6 +48,7 @@ typedef struct {
     volatile uint8_t trip;         /* cs_fw_trip_t: the executor was halted */
     volatile uint8_t trip_code;    /* cs_proto_alarm_t of an alarm trip */
     volatile uint16_t trip_inputs; /* the bits at the trip */
+    volatile uint8_t trip_done;    /* segments finished at the trip (cs_fw_motion's count) */
     /* read by the input interrupt, written by the main loop with it masked */
     volatile uint16_t watch;   /* bits whose activation halts (homing switch, probe) */
     volatile uint16_t release; /* bits whose release halts (probe away, G38.4/.5) */

@@ -7,7 +7,7 @@
 #include "port.h"
 
 #define SEQ_MASK ((uint32_t)CS_FW_SEQMAP - 1u)
-#define TAG_MASK ((uint8_t)(CS_STEPPER_RING - 1))
+#define TAG_MASK ((uint8_t)(2 * CS_STEPPER_RING - 1))
 /* next_segment's work budget a pass (blocks cut, points traced, items taken) */
 #define NEXT_GUARD 64u
 
@@ -92,6 +92,18 @@ static void note_completed(cs_fw_motion_t *a)
     }
     if (cs_fw_motion_drained(a))
         cs_fw_motion_mark(a, a->popped); /* items that made no segment (zero moves, errors) */
+}
+
+uint16_t cs_fw_motion_halted(cs_fw_motion_t *a, uint8_t done)
+{
+    while (a->completed != done) {
+        cs_fw_motion_mark(a, a->tag[a->completed & TAG_MASK]);
+        a->completed++;
+    }
+    uint16_t seq = a->pushed != done ? a->item_seq[a->tag[done & TAG_MASK] & SEQ_MASK]
+                                     : cs_fw_motion_current_seq(a);
+    a->completed = a->pushed;
+    return seq;
 }
 
 static void pop_item(cs_fw_motion_t *a, cs_fw_item_t *out)

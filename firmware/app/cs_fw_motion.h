@@ -99,7 +99,9 @@ typedef struct cs_fw_motion_s {
     uint16_t qhead, qcount;
     /* executor and which item each queued segment finishes */
     cs_stepper_t st;
-    uint32_t tag[CS_STEPPER_RING]; /* item executed once segment k has run */
+    /* item executed once segment k has run: the ring's segments and the running one, so twice
+     * the ring (a slot is free for the next push while its segment still runs) */
+    uint32_t tag[2 * CS_STEPPER_RING];
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
     cs_segment_t pend; /* produced, held back by a hold at rest */
@@ -190,6 +192,10 @@ void cs_fw_motion_mark(cs_fw_motion_t *mo, uint32_t n);
 bool cs_fw_motion_still(const cs_fw_motion_t *mo);
 bool cs_fw_motion_executed(const cs_fw_motion_t *mo, uint32_t n);
 uint16_t cs_fw_motion_current_seq(const cs_fw_motion_t *mo);
+/* The executor was halted after `done` segments (mod 256, counted as cs_fw_motion pushes them):
+ * those count as executed, the rest of the ring as gone; returns the sequence of the item whose
+ * segment was cut (the current one when none was). */
+uint16_t cs_fw_motion_halted(cs_fw_motion_t *mo, uint8_t done);
 #if CS_FW_CURVES
 void cs_fw_motion_plan_line(cs_fw_motion_t *mo, const cs_vec3_t *target, int32_t feed, uint32_t n);
 #endif
