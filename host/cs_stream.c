@@ -348,6 +348,9 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
         s->have_hello = true;
     } else if (m.type == CS_PROTO_STATUS) {
         on_status(s, &m.u.status);
+    } else if (m.type == CS_PROTO_EVENT) {
+        if (s->o->on_event != NULL)
+            s->o->on_event(s->o->event_ctx, &m.u.event);
     } else if (m.type == CS_PROTO_ERROR) {
         s->r->dev_error = m.u.error;
         /* counted back from the last sequence queued, never forward from the session's first

@@ -264,9 +264,10 @@ void cs_fw_app_poll(cs_fw_app_t *a)
     cs_fw_motion_poll(&a->mo);
     if (cs_fw_motion_news(&a->mo))
         a->status_due = true;
-    send_errors(a);
+    /* an alarm's EVENT before its ERROR: a host that stops on the error has seen why */
     if (cs_link_state(&a->link) == CS_LINK_OPEN)
         send_events(a);
+    send_errors(a);
     now = a->cfg.clock();
     uint8_t st = a->mo.state;
     uint32_t period = ms_ticks(

@@ -346,8 +346,11 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
         enter_alarm(mo, CS_PROTO_ALARM_ESTOP, port_inputs_read());
 }
 
-cs_err_t cs_fw_ctl_admit(const cs_fw_motion_t *mo, uint8_t type)
+cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)
 {
+    /* homing is the way out of an alarm (Grbl's $H in the alarm state): an implicit UNLOCK */
+    if (mo->ctl.alarm != 0 && type == CS_PROTO_HOME && cs_fw_ctl_unlock(mo) != CS_OK)
+        return CS_ERR_STATE;
     if (mo->ctl.alarm != 0)
         return CS_ERR_STATE;
     if (!CS_FW_CURVES &&

@@ -94,9 +94,9 @@ void cs_fw_ctl_init(struct cs_fw_motion_s *mo);
 /* The input interrupt (port_inputs_attach): halts the executor on the e-stop, a limit switch
  * becoming active while hard limits are armed, or the input an operation watches. ISR. */
 void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits);
-/* Queues check: CS_ERR_STATE in alarm, CS_ERR_UNSUPPORTED for HOME / JOG / PROBE without
- * curves; CS_OK otherwise. Main loop. */
-cs_err_t cs_fw_ctl_admit(const struct cs_fw_motion_s *mo, uint8_t type);
+/* Queues check: CS_ERR_STATE in alarm (a HOME unlocks first, unless the e-stop is pressed),
+ * CS_ERR_UNSUPPORTED for HOME / JOG / PROBE without curves; CS_OK otherwise. Main loop. */
+cs_err_t cs_fw_ctl_admit(struct cs_fw_motion_s *mo, uint8_t type);
 /* A HOME, JOG, PROBE or SPINDLE item taken from the queue (item number n): starts it or sets it
  * waiting; true when the caller may go on taking items now. Main loop. */
 bool cs_fw_ctl_take(struct cs_fw_motion_s *mo, const void *item, uint32_t n);
