@@ -1,6 +1,8 @@
 /* cs_machine_ini: INI machine file -> cs_machine_t, every value range-checked. */
 #include "cs_machine_ini.h"
 
+#include "cs_ctlcfg.h"
+
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -77,6 +79,20 @@ static bool parse_num(const char *v, double *out)
         return false;
     *out = d;
     return true;
+}
+
+bool cs_machine_ini_number(const char *v, double *out)
+{
+    return parse_num(v, out);
+}
+
+int cs_machine_ini_bool(const char *v)
+{
+    if (strcasecmp(v, "true") == 0 || strcmp(v, "1") == 0 || strcasecmp(v, "yes") == 0)
+        return 1;
+    if (strcasecmp(v, "false") == 0 || strcmp(v, "0") == 0 || strcasecmp(v, "no") == 0)
+        return 0;
+    return -1;
 }
 
 /* Positive Q15.16 value in (0, 32768). */
@@ -304,6 +320,9 @@ static int handler(void *user, const char *section, const char *name, const char
      * the file; the machine itself does not depend on it. */
     if (strcasecmp(section, "gpio") == 0)
         return 1;
+    /* [homing], [limits], [probe], [spindle]: machine control, read by cs_ctlcfg likewise */
+    if (cs_ctlcfg_section(section))
+        return 1;
     if (strcasecmp(section, "machine") == 0)
         return machine_key(c, section, name, value);
     int ax = -1;
@@ -311,7 +330,9 @@ static int handler(void *user, const char *section, const char *name, const char
         if (strcasecmp(section, axis_names[i]) == 0)
             ax = i;
     if (ax < 0)
-        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z, a, pen or gpio)",
+        return fail(c,
+                    "[%s]%s: unknown section (expected machine, x, y, z, a, pen, gpio, homing, "
+                    "limits, probe or spindle)",
                     section, "");
     if (ax == CS_AXIS_A) {
         c->has_a = true;

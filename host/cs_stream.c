@@ -348,6 +348,9 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
         s->have_hello = true;
     } else if (m.type == CS_PROTO_STATUS) {
         on_status(s, &m.u.status);
+    } else if (m.type == CS_PROTO_EVENT) {
+        if (s->o->on_event != NULL)
+            s->o->on_event(s->o->event_ctx, &m.u.event);
     } else if (m.type == CS_PROTO_ERROR) {
         s->r->dev_error = m.u.error;
         /* counted back from the last sequence queued, never forward from the session's first
@@ -605,13 +608,13 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
         if (r->sent == job->n && cs_link_unacked(&s->link) == 0) {
             if (t_last_ack == 0)
                 t_last_ack = cs_serial_now_s();
-            if (r->executed == job->n && r->dev_state != CS_PROTO_STATE_RUNNING) {
+            if (r->executed == job->n && !cs_proto_state_busy(r->dev_state)) {
                 finish(s, CS_STREAM_DONE);
                 break;
             }
             /* the device reports its progress at least every 250 ms; a job whose last
              * messages are still executing keeps sending STATUS while running */
-            if (r->dev_state != CS_PROTO_STATE_RUNNING && !s->held &&
+            if (!cs_proto_state_busy(r->dev_state) && !s->held &&
                 cs_serial_now_s() - t_last_ack > o->status_ms / 1000.0) {
                 snprintf(r->why, sizeof r->why,
                          "everything was delivered but the device reports %zu executed",

@@ -77,6 +77,10 @@ typedef struct {
     uint32_t hello_ms;  /* wait this long for the connection and HELLO */
     uint32_t status_ms; /* after the last ACK, wait this long for the final STATUS */
     bool quiet_hello;
+    /* NULL: none; else called with every EVENT the device sends (alarm, probe contact, axis
+     * homed, inputs: docs/protocol.md), before the ERROR an alarm is followed by */
+    void (*on_event)(void *ctx, const cs_proto_event_t *ev);
+    void *event_ctx;
 } cs_stream_opts_t;
 
 typedef struct {

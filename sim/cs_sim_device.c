@@ -100,6 +100,12 @@ static void sync_res(sim_dev_t *d)
 {
     const cs_fw_stats_t *s = &d->app.mo.stats;
     cs_sim_device_result_t *r = d->res;
+    const cs_fw_ctl_t *c = &d->app.mo.ctl;
+    r->homings = c->homings;
+    r->alarms = c->alarms;
+    r->probes = c->probes;
+    if (c->alarm != 0)
+        r->last_alarm = c->alarm;
     r->executed = s->executed;
     r->segments = s->segments;
     r->curves = s->curves;
@@ -232,9 +238,31 @@ static int read_line(sim_dev_t *d, int wait_ms)
 }
 
 /* One pass of the device: the line read, the application run over it, time advanced. */
+static volatile sig_atomic_t g_estop, g_estop_seen;
+
+void cs_sim_device_estop(bool pressed)
+{
+    g_estop = pressed ? 1 : 0;
+}
+
+/* The simulated machine's inputs: [limits] and [probe] at the physical position (the steps on
+ * the STEP/DIR lines since start, in mm). */
+static uint16_t sim_inputs(void *ctx, const int64_t *pos)
+{
+    const sim_dev_t *d = ctx;
+    double mm[CS_AXES] = {0};
+    for (unsigned i = 0; i < d->m->n_axes; i++)
+        mm[i] = (double)pos[i] * CS_MOTION_ONE / (double)d->m->axis[i].steps_per_mm;
+    return cs_ctlcfg_inputs(d->cfg->ctl, mm);
+}
+
 static cs_err_t serve_pass(sim_dev_t *d, double *last_rx_s)
 {
     cs_fw_motion_t *mo = &d->app.mo;
+    if (g_estop != g_estop_seen) { /* the pin interrupt of the e-stop */
+        g_estop_seen = g_estop;
+        port_posix_inputs_force(CS_PROTO_IN_ESTOP, g_estop ? CS_PROTO_IN_ESTOP : 0);
+    }
     bool busy = !cs_fw_motion_done(mo) && !mo->hold.hold;
     if (read_line(d, busy ? 1 : 5) != 0)
         return CS_ERR_IO;
@@ -317,6 +345,10 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
             d->inv = (uint8_t)(d->inv | (1u << i));
     port_posix_reset(d->m->tick_hz, d->inv);
     port_posix_record(true);
+    port_posix_inputs_force(0, 0);
+    g_estop = g_estop_seen = 0;
+    bool model = cfg->ctl != NULL && cs_ctlcfg_has_inputs(cfg->ctl);
+    port_posix_inputs_model(model ? sim_inputs : NULL, d);
     /* the application on the POSIX port, its link on the wall clock in microseconds with the
      * timing of the simulated line (cs_stream_link_timing) */
     cs_fw_app_cfg_t ac;
@@ -481,6 +513,11 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     (void)port_posix_pens(&res->pens);
     if (rc == CS_OK && d->cfg->keep_edges)
         rc = keep_pens(res);
+    const port_posix_spindle_t *sp = port_posix_spindles(&res->spindles);
+    for (size_t i = 0; i < res->spindles; i++)
+        if (sp[i].duty > res->max_duty)
+            res->max_duty = sp[i].duty;
+    port_posix_inputs_model(NULL, NULL);
     port_posix_reset(d->m->tick_hz, d->inv); /* frees the port's copy of the edges */
     port_stepper_attach(NULL);
     free(d);
@@ -505,6 +542,11 @@ static void on_signal(int sig)
 {
     (void)sig;
     g_stop = 1;
+}
+
+static void on_estop(int sig)
+{
+    cs_sim_device_estop(sig == SIGUSR1);
 }
 
 static void device_usage(FILE *f)
@@ -708,8 +750,14 @@ int cs_sim_device_main(int argc, char **argv)
     } else {
         cs_machine_ini_default(&m);
     }
+    cs_ctlcfg_t ctl; /* [limits], [probe]: the switches and the probe surface */
+    if (cs_ctlcfg_load(machine_file, &m, &ctl, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return INPUT;
+    }
     cs_sim_device_cfg_t cfg;
     cs_sim_device_cfg_default(&cfg, &m);
+    cfg.ctl = &ctl;
     cfg.queue_size = (uint16_t)queue;
     cfg.speed = instant ? 0 : speed;
     cfg.line_rate = (uint32_t)line_rate;
@@ -767,6 +815,9 @@ int cs_sim_device_main(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sa.sa_handler = on_estop;
+    sigaction(SIGUSR1, &sa, NULL);
+    sigaction(SIGUSR2, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     cs_sim_device_result_t res;
     cs_err_t e = cs_sim_device_serve(fd, &cfg, &g_stop, &res);
@@ -791,6 +842,15 @@ int cs_sim_device_main(int argc, char **argv)
            (unsigned)res.frames.frames, (unsigned)res.frames.crc_errs, (unsigned)res.frames.bad,
            (unsigned)res.link.duplicates, (unsigned)res.link.out_of_order,
            (unsigned)res.link.retransmits);
+    if (res.homings || res.alarms || res.probes || res.spindles) {
+        char last[32] = "";
+        if (res.alarms)
+            snprintf(last, sizeof last, " (last ALARM:%u)", (unsigned)res.last_alarm);
+        printf("control: %u axes homed, %u alarms%s, %u probe cycles; spindle: %zu settings, "
+               "largest duty %u/1000\n",
+               (unsigned)res.homings, (unsigned)res.alarms, last, (unsigned)res.probes,
+               res.spindles, (unsigned)res.max_duty);
+    }
     cs_sim_device_out_t out = {reference, trace, svg, png, check, &ref, {0, 0, 0}, NULL};
     memcpy(out.end_mm, end_mm, sizeof end_mm);
     if (pen.mode == CS_MACHINE_PEN_SERVO)

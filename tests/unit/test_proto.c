@@ -170,7 +170,8 @@ static void test_error_segment_curve_control_layout(void **state)
 static void test_unknown_types_and_empty_payload(void **state)
 {
     (void)state;
-    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25};
+    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x13, 0x20, 0x21, 0x22, 0x23,
+                             0x24, 0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B};
     uint8_t buf[CS_PROTO_LEN_MAX] = {0};
     cs_proto_msg_t m;
     unsigned unknown = 0;
@@ -269,7 +270,7 @@ static void test_out_of_range_fields(void **state)
         size_t off, width;
         uint32_t v;
     } hello_bad[] = {{1, 1, 0}, {6, 1, 0},  {6, 1, 5},      {7, 2, 0},
-                     {9, 4, 0}, {13, 2, 4}, {13, 2, 0x8000}};
+                     {9, 4, 0}, {13, 2, 0x10}, {13, 2, 0x8000}};
     for (size_t i = 0; i < sizeof hello_bad / sizeof hello_bad[0]; i++) {
         uint8_t r2[CS_PROTO_LEN_HELLO];
         memcpy(r2, raw, sizeof r2);
@@ -278,7 +279,7 @@ static void test_out_of_range_fields(void **state)
         assert_int_equal(cs_proto_decode(r2, len, &bad), CS_ERR_RANGE);
     }
     bad = good;
-    bad.u.hello.caps = 0x0004;
+    bad.u.hello.caps = 0x0010; /* the first bit past CS_PROTO_CAP_SPINDLE */
     assert_int_equal(cs_proto_encode(&bad, buf, sizeof buf, &len), CS_ERR_RANGE);
 
     memset(&good, 0, sizeof good);
