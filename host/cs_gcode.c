@@ -239,7 +239,14 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
         if (b->w['S' - 'A'].v < 0)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->w['S' - 'A'].col),
                                     "S (spindle speed) must not be negative");
+        double was = g->speed;
         g->speed = b->w['S' - 'A'].v;
+        if (g->o->spindle && g->spindle != GC_M5 && g->speed != was) {
+            cs_err_t e = g->o->spindle(g->o->spindle_ctx, g->spindle, g->speed);
+            if (e != CS_OK)
+                return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, b->w['S' - 'A'].col),
+                                        "S: the spindle could not be set");
+        }
     }
     return CS_OK;
 }
@@ -263,6 +270,9 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
                                     m / 10);
         } else if (grp == GC_GROUP_M_SPINDLE) {
             g->spindle = m;
+            if (g->o->spindle && (e = g->o->spindle(g->o->spindle_ctx, m, g->speed)) != CS_OK)
+                return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, b->mcol[i]),
+                                        "M%d: the spindle could not be set", m / 10);
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
              * with opts->pen_z a rapid Z move to the pen height. */
             cs_path_new_subpath(g->path);

@@ -22,6 +22,11 @@ typedef cs_err_t (*cs_gcode_probe_fn)(void *ctx, int code, const double from[3],
                                       const double to[3], double feed_mm_s, bool *contact,
                                       double hit[3]);
 
+/* The spindle (or laser, or pen) changed: code GC_M3, GC_M4 or GC_M5 (tenths), s the S in force.
+ * Called at M3/M4/M5 and at an S that changes the speed of a running spindle, before the line's
+ * motion. Anything but CS_OK ends the read with that error. */
+typedef cs_err_t (*cs_gcode_spindle_fn)(void *ctx, int code, double s);
+
 /* Default largest distance (mm) between a helix (G2/G3 with a third-axis move) and the rational
  * quadratic pieces that carry it. */
 #define CS_GCODE_HELIX_TOL_MM 0.001
@@ -51,6 +56,8 @@ typedef struct {
     void *warn_ctx;
     cs_gcode_probe_fn probe; /* NULL: G38.2 .. G38.5 are unsupported (a file has no probe) */
     void *probe_ctx;
+    cs_gcode_spindle_fn spindle; /* NULL: none (M3/M4/M5 only split subpaths) */
+    void *spindle_ctx;
 } cs_gcode_opts_t;
 
 /* What a read found (for tests and --stats). */

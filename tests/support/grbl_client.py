@@ -31,7 +31,7 @@ import tty
 
 RX_SIZE = 128
 STATUS_RE = re.compile(r"^<([A-Za-z]+(?::\d)?)\|(MPos|WPos):(-?\d+\.\d{3}),(-?\d+\.\d{3}),(-?\d+\.\d{3})"
-                       r"(\|Bf:\d+,\d+)?\|FS:\d+,\d+(\|WCO:-?\d+\.\d{3},-?\d+\.\d{3},-?\d+\.\d{3})?"
+                       r"(\|Bf:\d+,\d+)?\|FS:\d+,\d+(\|Pn:[XYZPDHRS]+)?(\|WCO:-?\d+\.\d{3},-?\d+\.\d{3},-?\d+\.\d{3})?"
                        r"(\|Ov:\d+,\d+,\d+)?>$")
 
 
