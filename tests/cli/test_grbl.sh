@@ -214,6 +214,52 @@ printf 'G10 L2 P1 X1\nG10 L7 P1 X1\n' >"$T/badstate.ngc"
 run "state: a bad state file is exit 1" 1 grbl --port /dev/null --state "$T/badstate.ngc"
 expect "state: located error" grep -q "badstate.ngc:2:5: G10 sets work offsets with L2 or L20 only" "$T/err"
 
+# 8. machine control on the device (the simulator's switches and probe from the machine file):
+#    by hand, with the switches at x -5, y -5 (min) and z 3 (max), pull-off 1 and every axis
+#    set to 0 where it ends, the machine's 0 is the simulator's (-4, -4, 2); its probe surface at
+#    z -2.5 is machine z -4.5. $H homes (ok, at 0 0 0); G38.2 from 10 10 0 touches at
+#    [PRB:10.000,10.000,-4.500:1]; a G38.2 that touches nothing is ALARM:5, G-code is then
+#    locked (error:9) until $X; a G0 X-20 trips the x switch at machine -1 (ALARM:1, Pn:X);
+#    $H clears that alarm and homes again.
+printf '%s\n' '[homing]' 'order = zxy' 'x = min' 'y = min' 'z = max' 'x_pos = 0' 'y_pos = 0' \
+    'z_pos = 0' 'pulloff = 1' '[limits]' 'x_min = -5' 'y_min = -5' 'z_max = 3' '[probe]' \
+    'z = -2.5' >"$T/ctl.ini"
+start_sim ctl --speed 20 --machine "$T/ctl.ini"
+start_grbl ctl --machine "$T/ctl.ini"
+client "$GPTY" cmd '$H' '?' 'G0 X10 Y10' 'G38.2 Z-20 F100' '$#' 'G0 Z0' 'G38.2 Z-1 F100' '?' \
+    'G0 X1' '$X' 'G0 X-20' '@waitfor Alarm' '$H' '?' >"$T/ctl.out"; rc=$?
+stop_all
+expect "ctl: client exit 0" [ $rc -eq 0 ]
+expect "ctl: \$H ok, then at 0 0 0" grep -q '^<Idle|MPos:0.000,0.000,0.000|' "$T/ctl.out"
+expect "ctl: probe contact" grep -qx '\[PRB:10.000,10.000,-4.500:1\]' "$T/ctl.out"
+expect "ctl: \$# PRB" [ "$(grep -c '^\[PRB:10.000,10.000,-4.500:1\]$' "$T/ctl.out")" -eq 2 ]
+expect "ctl: probe without contact: PRB :0" grep -qx '\[PRB:10.000,10.000,-1.000:0\]' "$T/ctl.out"
+expect "ctl: ALARM:5" grep -qx 'ALARM:5' "$T/ctl.out"
+expect "ctl: Alarm state where it stopped" grep -q '^<Alarm|MPos:10.000,10.000,-1.000|' "$T/ctl.out"
+expect "ctl: locked until \$X (error:9)" grep -qx 'error:9' "$T/ctl.out"
+expect "ctl: \$X unlocks" grep -qx '\[MSG:Caution: Unlocked\]' "$T/ctl.out"
+expect "ctl: hard limit ALARM:1" grep -qx 'ALARM:1' "$T/ctl.out"
+expect "ctl: stopped on the x switch (machine -1), Pn:X" grep -q '^state: <Alarm|MPos:-1.000,10.000,-1.000|FS:0,0|Pn:X' "$T/ctl.out"
+expect "ctl: \$H again: ok at 0 0 0" [ "$(grep -c '^<Idle|MPos:0.000,0.000,0.000|' "$T/ctl.out")" -eq 2 ]
+expect "ctl: the device homed 6 axes, 2 alarms, 2 probes" grep -q '^control: 6 axes homed, 2 alarms (last ALARM:1), 2 probe cycles' "$T/ctl.sim"
+
+# 9. a laser job (Grbl's laser mode: [spindle] laser = true): M4 S600 with rapids between the
+#    cuts; the device's largest duty is 600/1000 (full power at the programmed speed) and the
+#    final position is the one plan + replay gives.
+printf '%s\n' '[spindle]' 'laser = true' 's_max = 1000' >"$T/laser.ini"
+printf '%s\n' 'G21 G90' 'M4 S600' 'G0 X5' 'G1 X25 F600' 'G0 X30 Y5' 'G1 Y25 F300' 'M5' \
+    'G0 X0 Y1' >"$T/laser.nc"
+"$CS" plan --machine "$T/laser.ini" "$T/laser.nc" -o "$T/laser.seg" 2>/dev/null
+LASER_POS=$("$SIM" --replay "$T/laser.seg" --machine "$T/laser.ini" 2>/dev/null | grep '^final position:')
+start_sim laser --machine "$T/laser.ini"
+start_grbl laser --machine "$T/laser.ini"
+client "$GPTY" stream "$T/laser.nc" --method counting >"$T/laser.out"; rc=$?
+stop_all
+expect "laser: client exit 0" [ $rc -eq 0 ]
+expect "laser: 8 ok" grep -q '^acks: 8 0$' "$T/laser.out"
+expect "laser: largest duty 600/1000" grep -q 'largest duty 600/1000' "$T/laser.sim"
+expect "laser: final position as plan + replay" grep -qxF "$LASER_POS" "$T/laser.sim"
+
 # 7. usage.
 run "help: exit 0" 0 grbl --help
 expect "help: names --listen and the pty" grep -q -- '--listen \[ADDR:\]PORT' "$T/out"
