@@ -547,7 +547,7 @@ static void say_param3(grbl_t *g, const char *name, int first)
 static void dollar_params(grbl_t *g)
 {
     for (int k = 0; k < 6; k++) {
-        char name[8];
+        char name[16];
         snprintf(name, sizeof name, "G%d", 54 + k);
         say_param3(g, name, 5221 + 20 * k);
     }
