@@ -150,32 +150,40 @@ static int run_job(const ctl_args_t *a, cs_stream_job_t *job, ctl_seen_t *seen)
 
 static void usage(FILE *f, const char *who)
 {
+    static const struct {
+        const char *who, *synopsis, *what;
+    } u[] = {
+        {"home", "home --port DEV [--baud N] [--machine FILE.ini] [--axes ORDER]",
+         "Homes the axes in the order of the machine file's [homing] (or --axes ORDER, e.g.\n"
+         "zxy): the device seeks each switch, backs off, latches slowly and pulls off, then\n"
+         "sets the axis's position to [homing] x_pos (default: the travel's end at the\n"
+         "switch). Homing also clears an alarm.\n"},
+        {"jog", "jog --port DEV [--baud N] [--machine FILE.ini] --feed MM/S X Y Z",
+         "Moves straight to the machine position X Y Z (mm) at --feed, planned and\n"
+         "accelerated on the device; Ctrl-C decelerates it to rest and drops the rest.\n"},
+        {"probe",
+         "probe --port DEV [--baud N] [--machine FILE.ini] --feed MM/S [--away]\n"
+         "                       [--no-error] X Y Z",
+         "Moves towards X Y Z at --feed until the probe touches (G38.2) and prints the\n"
+         "contact position; --away: until it lets go (G38.4); --no-error: no alarm when the\n"
+         "move ends without contact (G38.3, G38.5).\n"},
+        {"unlock", "unlock --port DEV [--baud N] [--machine FILE.ini]",
+         "Leaves the device's alarm state (Grbl's $X); refused while the e-stop is pressed.\n"},
+    };
+    size_t k = 0;
+    while (k + 1 < sizeof u / sizeof u[0] && strcmp(u[k].who, who) != 0)
+        k++;
     fprintf(f,
-            "usage: curvestep home --port DEV [--baud N] [--machine FILE.ini] [--axes ORDER]\n"
-            "       curvestep jog --port DEV [--baud N] [--machine FILE.ini] --feed MM/S X Y Z\n"
-            "       curvestep probe --port DEV [--baud N] [--machine FILE.ini] --feed MM/S\n"
-            "                       [--away] [--no-error] X Y Z\n"
-            "       curvestep unlock --port DEV [--baud N] [--machine FILE.ini]\n"
-            "The machine-control commands (this one: %s), over the serial link to a device (a\n"
-            "board or curvestep-sim --pty; docs/controller.md):\n"
-            "  home    homes the axes in the order of the machine file's [homing] (or --axes,\n"
-            "          e.g. zxy): seek the switch, back off, latch slowly, pull off; the device\n"
-            "          sets each axis's position to [homing] x_pos (default: the travel's end\n"
-            "          at the switch). Also clears an alarm.\n"
-            "  jog     moves straight to the machine position X Y Z (mm) at --feed, planned on\n"
-            "          the device; Ctrl-C decelerates it to rest and drops it.\n"
-            "  probe   moves towards X Y Z at --feed until the probe touches (G38.2), prints\n"
-            "          the contact position; --away: until it lets go (G38.4); --no-error: no\n"
-            "          alarm when the move ends without contact (G38.3, G38.5).\n"
-            "  unlock  leaves the alarm state (Grbl's $X); refused while the e-stop is pressed.\n"
+            "usage: curvestep %s\n%s"
+            "Over the serial link to a device (a board or the simulator; docs/controller.md).\n"
             "Options:\n"
             "  --port DEV         the device's serial line (required)\n"
             "  --baud N           its rate (default 115200)\n"
             "  --machine FILE     the machine file (default: as `curvestep plan`)\n"
-            "Exit status: 0 done, 1 bad input (machine file, no [homing]), 2 usage, 3 internal\n"
-            "error, 4 no device, 5 device reset, 6 link closed, 7 the device refused a message\n"
-            "or raised an alarm (ALARM:N printed), 8 interrupted (Ctrl-C).\n",
-            who);
+            "Exit status: 0 done, 1 bad input (machine file), 2 usage, 3 internal error, 4 no\n"
+            "device, 5 device reset, 6 link closed, 7 the device refused a message or raised an\n"
+            "alarm (ALARM:N printed), 8 interrupted (Ctrl-C).\n",
+            u[k].synopsis, u[k].what);
 }
 
 /* Parses the shared options and the command's own; returns -1 to go on, else an exit status. */

@@ -27,10 +27,10 @@ void cs_ctlcfg_default(cs_ctlcfg_t *c)
     c->s_max = 1000;
 }
 
-bool cs_ctlcfg_section(const char *s)
+bool cs_ctlcfg_section(const char *section)
 {
-    return strcasecmp(s, "homing") == 0 || strcasecmp(s, "limits") == 0 ||
-           strcasecmp(s, "probe") == 0 || strcasecmp(s, "spindle") == 0;
+    return strcasecmp(section, "homing") == 0 || strcasecmp(section, "limits") == 0 ||
+           strcasecmp(section, "probe") == 0 || strcasecmp(section, "spindle") == 0;
 }
 
 static int fail(ctx_t *x, const char *section, const char *name, const char *what)
