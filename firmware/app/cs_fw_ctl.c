@@ -164,7 +164,8 @@ static cs_err_t op_move_to(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES], i
 
 static uint16_t home_bit(const cs_proto_home_t *h)
 {
-    return (h->flags & CS_PROTO_HOME_MAX) ? CS_PROTO_IN_MAX(h->axis) : CS_PROTO_IN_MIN(h->axis);
+    return (uint16_t)((h->flags & CS_PROTO_HOME_MAX) ? CS_PROTO_IN_MAX(h->axis)
+                                                     : CS_PROTO_IN_MIN(h->axis));
 }
 
 /* A homing move of d mm towards the switch (d > 0) or away from it (d < 0). */
@@ -341,9 +342,8 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
     uint32_t s = port_irq_save();
     cs_stepper_on_load(&mo->st, on_load, mo);
     port_irq_restore(s);
+    /* the port reports what is active already (an e-stop pressed at boot: the alarm) */
     port_inputs_attach(cs_fw_ctl_inputs_isr, mo);
-    if (port_inputs_read() & CS_PROTO_IN_ESTOP)
-        enter_alarm(mo, CS_PROTO_ALARM_ESTOP, port_inputs_read());
 }
 
 cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)

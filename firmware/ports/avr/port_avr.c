@@ -246,8 +246,9 @@ void port_pen_set(uint16_t pulse_us)
     pen_pulse_us = pulse_us;
 }
 
-/* The machine's inputs: no switch, probe or e-stop pin is wired in this port yet
- * (docs/firmware.md, "Machine control"): every input reads inactive, no edge is reported. */
+/* The machine's inputs: none wired in this port (its build leaves machine control out,
+ * CS_FW_CTL=0: the ATmega328P's 2 KB of RAM are full; docs/firmware.md, "Machine control"):
+ * every input reads inactive, no edge is reported. */
 uint16_t port_inputs_read(void)
 {
     return 0;

@@ -161,6 +161,7 @@ void port_init(void)
     NVIC_IPR(UART0_IRQ) = 0x40u;   /* the UART may interrupt the step interrupt: its FIFO */
     NVIC_IPR(TIMER0A_IRQ) = 0x80u; /* holds 16 bytes, the step interrupt runs for microseconds */
     NVIC_ISER(0) = (1u << UART0_IRQ) | (1u << TIMER0A_IRQ);
+    port_m3_ctl_init(); /* switch, probe and e-stop pins, the spindle PWM (port_m3_ctl.c) */
     __asm volatile("cpsie i" ::: "memory");
 }
 
@@ -233,29 +234,6 @@ void port_pen_set(uint16_t pulse_us)
     pen_pulse_us = pulse_us;
 }
 
-/* The machine's inputs: no switch, probe or e-stop pin is wired in this port yet
- * (docs/firmware.md, "Machine control"): every input reads inactive, no edge is reported. */
-uint16_t port_inputs_read(void)
-{
-    return 0;
-}
-
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
-{
-    (void)fn;
-    (void)ctx;
-}
-
-/* The spindle / laser output: kept for a debugger, no PWM pin driven yet. */
-static volatile uint16_t spindle_duty;
-static volatile uint8_t spindle_mode;
-
-void port_spindle_set(uint16_t duty, uint8_t mode)
-{
-    spindle_duty = duty;
-    spindle_mode = mode;
-}
-
 void port_dir_set(uint8_t mask)
 {
     mask &= 0x0Fu;
@@ -284,6 +262,8 @@ void Timer0A_Handler(void)
         port_timer_arm(o.next_ticks);
     else
         port_timer_stop();
+    if (o.step_mask != 0)
+        port_m3_ctl_stepped(); /* simulated switches move with the pins (port_m3_ctl.c) */
 }
 
 void port_m3_edges(cs_exlog_edges_t *l)
