@@ -7,6 +7,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "cs_conv.h"
 #include "cs_machine_ini.h"
 
 static const char *const axis_names[CS_AXES] = {"x", "y", "z", "a"};
@@ -15,7 +16,6 @@ typedef struct {
     cs_ctlcfg_t *c;
     const cs_machine_t *m;
     char reason[200];
-    int line;
 } ctx_t;
 
 void cs_ctlcfg_default(cs_ctlcfg_t *c)
@@ -27,10 +27,10 @@ void cs_ctlcfg_default(cs_ctlcfg_t *c)
     c->s_max = 1000;
 }
 
-bool cs_ctlcfg_section(const char *s)
+bool cs_ctlcfg_section(const char *section)
 {
-    return strcasecmp(s, "homing") == 0 || strcasecmp(s, "limits") == 0 ||
-           strcasecmp(s, "probe") == 0 || strcasecmp(s, "spindle") == 0;
+    return strcasecmp(section, "homing") == 0 || strcasecmp(section, "limits") == 0 ||
+           strcasecmp(section, "probe") == 0 || strcasecmp(section, "spindle") == 0;
 }
 
 static int fail(ctx_t *x, const char *section, const char *name, const char *what)
@@ -103,8 +103,8 @@ static int homing_key(ctx_t *x, const char *sec, const char *name, const char *v
         return fail(x, sec, name,
                     "unknown key (expected order, seek, latch, pulloff, search, x, x_pos, ...)");
     bool speed = dst == &c->seek || dst == &c->latch;
-    if (speed ? !(d > 0 && d < 32768) : !(d >= 0 && d <= 1000))
-        return fail(x, sec, name, speed ? "must be in (0, 32768) mm/s" : "must be in [0, 1000] mm");
+    if (speed ? !(d > 0 && d <= 4096) : !(d >= 0 && d <= 1000))
+        return fail(x, sec, name, speed ? "must be in (0, 4096] mm/s" : "must be in [0, 1000] mm");
     *dst = d;
     return 1;
 }
@@ -181,7 +181,7 @@ int cs_ctlcfg_load(const char *path, const cs_machine_t *m, cs_ctlcfg_t *c, char
     cs_ctlcfg_default(c);
     if (path == NULL)
         return 0;
-    ctx_t x = {c, m, {0}, 0};
+    ctx_t x = {c, m, {0}};
     return finish(&x, ini_parse(path, handler, &x), path, err, errlen);
 }
 
@@ -189,17 +189,8 @@ int cs_ctlcfg_parse(const char *text, const char *name, const cs_machine_t *m, c
                     char *err, size_t errlen)
 {
     cs_ctlcfg_default(c);
-    ctx_t x = {c, m, {0}, 0};
+    ctx_t x = {c, m, {0}};
     return finish(&x, ini_parse_string(text, handler, &x), name, err, errlen);
-}
-
-static bool q16(double v, int32_t *out)
-{
-    double q = v * 65536.0;
-    if (!(fabs(q) < 2147483647.0))
-        return false;
-    *out = (int32_t)llround(q);
-    return true;
 }
 
 cs_err_t cs_ctlcfg_home_msg(const cs_ctlcfg_t *c, const cs_machine_t *m, unsigned k,
@@ -219,8 +210,12 @@ cs_err_t cs_ctlcfg_home_msg(const cs_ctlcfg_t *c, const cs_machine_t *m, unsigne
     cs_proto_home_t *h = &out->u.home;
     h->axis = (uint8_t)ax;
     h->flags = c->at_max[ax] ? CS_PROTO_HOME_MAX : 0;
-    if (!q16(c->seek, &h->seek) || !q16(c->latch, &h->latch) || !q16(c->pulloff, &h->pulloff) ||
-        !q16(search, &h->search) || !q16(pos, &h->home_pos))
+    /* mm and mm/s are both Q15.16 (CS_MOTION_ONE = CS_POS_ONE_MM) */
+    if (cs_conv_mm_to_pos(c->seek, &h->seek) != CS_OK ||
+        cs_conv_mm_to_pos(c->latch, &h->latch) != CS_OK ||
+        cs_conv_mm_to_pos(c->pulloff, &h->pulloff) != CS_OK ||
+        cs_conv_mm_to_pos(search, &h->search) != CS_OK ||
+        cs_conv_mm_to_pos(pos, &h->home_pos) != CS_OK)
         return CS_ERR_RANGE;
     uint8_t buf[CS_PROTO_LEN_MAX];
     size_t n;

@@ -22,12 +22,7 @@ cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm)
     return (cs_pos_t)q;
 }
 
-static int32_t pos_to_steps(cs_pos_t p, int32_t spm)
-{
-    /* round(p * spm): Q16 x Q16 = Q32 (|p| <= 2^28, spm <= 2^28) */
-    return (int32_t)cs_fixed_round_shift64((int64_t)p * spm, 32);
-}
-
+#if CS_FW_CTL
 /* --- the input interrupt and the executor's load hook --------------------------------------- */
 
 void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
@@ -53,8 +48,9 @@ void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
         return;
     /* Grbl's hard limit: no deceleration, the steps issued are all counted */
     /* segments the executor finished (cs_fw_motion's count): the one after them was cut */
-    c->trip_done = (uint8_t)(mo->pushed - (uint8_t)(mo->st.tail - mo->st.head) -
-                             (mo->st.running ? 1u : 0u));
+    uint8_t inring = (uint8_t)(mo->st.tail - mo->st.head);
+    uint8_t running = mo->st.running ? 1u : 0u;
+    c->trip_done = (uint8_t)(mo->pushed - inring - running);
     cs_stepper_halt(&mo->st);
     port_timer_stop();
     c->trip_code = code;
@@ -136,6 +132,12 @@ static void enter_alarm(cs_fw_motion_t *mo, uint8_t code, uint16_t bits)
 /* --- operations: moves planned on the device ------------------------------------------------ */
 
 #if CS_FW_CURVES
+static int32_t pos_to_steps(cs_pos_t p, int32_t spm)
+{
+    /* round(p * spm): Q16 x Q16 = Q32 (|p| <= 2^28, spm <= 2^28) */
+    return (int32_t)cs_fixed_round_shift64((int64_t)p * spm, 32);
+}
+
 /* A straight move of the operation from where the executor is to target (mm), planned on the
  * wide machine (homing) or the real one (probe: the travel is checked), watching the inputs. */
 static cs_err_t op_move_to(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t feed,
@@ -162,7 +164,8 @@ static cs_err_t op_move_to(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES], i
 
 static uint16_t home_bit(const cs_proto_home_t *h)
 {
-    return (h->flags & CS_PROTO_HOME_MAX) ? CS_PROTO_IN_MAX(h->axis) : CS_PROTO_IN_MIN(h->axis);
+    return (uint16_t)((h->flags & CS_PROTO_HOME_MAX) ? CS_PROTO_IN_MAX(h->axis)
+                                                     : CS_PROTO_IN_MIN(h->axis));
 }
 
 /* A homing move of d mm towards the switch (d > 0) or away from it (d < 0). */
@@ -194,6 +197,7 @@ static void home_phase(cs_fw_motion_t *mo, uint8_t ph)
 }
 #endif
 
+#if CS_FW_CURVES
 /* The operation is over: its item counts as executed, the planner goes back to the machine. */
 static void op_finish(cs_fw_motion_t *mo)
 {
@@ -201,15 +205,12 @@ static void op_finish(cs_fw_motion_t *mo)
     c->op = CS_FW_OP_NONE;
     c->op_move = false;
     set_watch(c, 0, 0);
-#if CS_FW_CURVES
     (void)cs_planner_init(&mo->pl, mo->m);
     mo->pl_stale = true;
-#endif
     cs_fw_motion_mark(mo, c->op_item);
     mo->news = true;
 }
 
-#if CS_FW_CURVES
 static void home_done(cs_fw_motion_t *mo)
 {
     cs_fw_ctl_t *c = &mo->ctl;
@@ -341,9 +342,8 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
     uint32_t s = port_irq_save();
     cs_stepper_on_load(&mo->st, on_load, mo);
     port_irq_restore(s);
+    /* the port reports what is active already (an e-stop pressed at boot: the alarm) */
     port_inputs_attach(cs_fw_ctl_inputs_isr, mo);
-    if (port_inputs_read() & CS_PROTO_IN_ESTOP)
-        enter_alarm(mo, CS_PROTO_ALARM_ESTOP, port_inputs_read());
 }
 
 cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)
@@ -550,3 +550,85 @@ void cs_fw_ctl_drop_event(cs_fw_motion_t *mo)
         c->ev[i - 1] = c->ev[i];
     c->nev--;
 }
+#else /* CS_FW_CTL = 0: the API answers "not here" */
+
+void cs_fw_ctl_init(cs_fw_motion_t *mo)
+{
+    cs_fw_motion_zero(&mo->ctl, sizeof mo->ctl);
+}
+
+void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
+{
+    (void)ctx;
+    (void)bits;
+}
+
+cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)
+{
+    (void)mo;
+    return type == CS_PROTO_HOME || type == CS_PROTO_JOG || type == CS_PROTO_PROBE ||
+                   type == CS_PROTO_SPINDLE
+               ? CS_ERR_UNSUPPORTED
+               : CS_OK;
+}
+
+bool cs_fw_ctl_take(cs_fw_motion_t *mo, const void *item, uint32_t n)
+{
+    (void)mo;
+    (void)item;
+    (void)n;
+    return true;
+}
+
+bool cs_fw_ctl_blocking(const cs_fw_motion_t *mo)
+{
+    (void)mo;
+    return false;
+}
+
+void cs_fw_ctl_poll(cs_fw_motion_t *mo)
+{
+    (void)mo;
+}
+
+uint16_t cs_fw_ctl_aux(const cs_fw_motion_t *mo, const cs_segment_t *s)
+{
+    (void)mo;
+    (void)s;
+    return 0;
+}
+
+cs_err_t cs_fw_ctl_unlock(cs_fw_motion_t *mo)
+{
+    (void)mo;
+    return CS_ERR_UNSUPPORTED;
+}
+
+void cs_fw_ctl_jog_cancel(cs_fw_motion_t *mo)
+{
+    (void)mo;
+}
+
+void cs_fw_ctl_abort(cs_fw_motion_t *mo)
+{
+    (void)mo;
+}
+
+uint8_t cs_fw_ctl_state(const cs_fw_motion_t *mo)
+{
+    (void)mo;
+    return NO_STATE;
+}
+
+bool cs_fw_ctl_peek_event(const cs_fw_motion_t *mo, cs_proto_event_t *e)
+{
+    (void)mo;
+    (void)e;
+    return false;
+}
+
+void cs_fw_ctl_drop_event(cs_fw_motion_t *mo)
+{
+    (void)mo;
+}
+#endif

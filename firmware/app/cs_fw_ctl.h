@@ -22,6 +22,12 @@
 #ifndef CS_FW_CURVES /* as cs_fw_motion.h: 1 = the on-board planner is there */
 #define CS_FW_CURVES 1
 #endif
+/* 1 (default): machine control built in; 0: left out (the smallest builds: the ATmega328p's
+ * 2 KB are full), HELLO then offers no CONTROL or SPINDLE capability and the messages are
+ * refused with CS_ERR_UNSUPPORTED. */
+#ifndef CS_FW_CTL
+#define CS_FW_CTL 1
+#endif
 /* EVENT messages waiting for room in the link (an alarm, a probe contact and a homed axis fit). */
 #ifndef CS_FW_EVQ
 #define CS_FW_EVQ 4
@@ -42,6 +48,7 @@ typedef enum {
     CS_FW_TRIP_ALARM = 2, /* a hard limit or the e-stop: trip_code says which alarm */
 } cs_fw_trip_t;
 
+#if CS_FW_CTL
 typedef struct {
     /* written by the input interrupt */
     volatile uint16_t inputs;      /* the last bits reported */
@@ -85,6 +92,12 @@ typedef struct {
     cs_machine_t wide; /* the machine with the travel opened up: homing moves are not limited */
 #endif
 } cs_fw_ctl_t;
+#else
+typedef struct { /* what cs_fw_motion and cs_fw_app read: never set */
+    uint8_t trip, nev;
+    bool cancel;
+} cs_fw_ctl_t;
+#endif
 
 struct cs_fw_motion_s;
 

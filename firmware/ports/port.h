@@ -46,7 +46,8 @@ void port_pen_set(uint16_t pulse_us);
 uint16_t port_inputs_read(void);
 /* The port calls fn(ctx, bits) whenever the input bits change, from an interrupt that cannot
  * preempt the step interrupt (same priority, or the step interrupt itself where the port samples
- * the inputs there); fn may halt the executor. NULL fn: none. Not ISR-safe. */
+ * the inputs there), and at once when any is active already; fn may halt the executor. NULL fn:
+ * none. Not ISR-safe. */
 void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx);
 /* The spindle / laser output: PWM duty in 1/1000 of the period (0..1000), mode 0 off (enable
  * low, duty 0), 1 clockwise, 2 counter-clockwise (direction line high). ISR-safe. */
