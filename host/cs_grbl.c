@@ -370,15 +370,12 @@ static int jog_words(const char *s)
             return c >= 'A' && c <= 'Z' ? ERR_NUMBER : ERR_LETTER;
         s = e;
         long gx = lround(v * 10);
-        if (c == 'G' && (gx == GC_G20 || gx == GC_G21 || gx == GC_G90 || gx == GC_G91 ||
-                         gx == GC_G53)) {
-        } else if (c == 'X' || c == 'Y' || c == 'Z') {
-            axis = true;
-        } else if (c == 'F') {
-            f = true;
-        } else {
+        bool mode = c == 'G' && (gx == GC_G20 || gx == GC_G21 || gx == GC_G90 || gx == GC_G91 ||
+                                 gx == GC_G53);
+        axis = axis || c == 'X' || c == 'Y' || c == 'Z';
+        f = f || c == 'F';
+        if (!mode && c != 'X' && c != 'Y' && c != 'Z' && c != 'F')
             return ERR_JOG;
-        }
     }
     return !f ? ERR_NO_FEED : !axis ? ERR_NO_AXIS : 0;
 }
