@@ -29,15 +29,6 @@ travel_max = 100
 [z]
 travel_min = -20
 travel_max = 0
-[homing]
-order = zx
-seek = 20
-latch = 1
-pulloff = 1
-z = max
-z_pos = 0
-x = min
-x_pos = -99
 [limits]
 x_min = -5
 x_max = 50
@@ -45,6 +36,7 @@ z_max = 2
 [probe]
 z = -3
 EOF
+cat tests/data/ctl-homing.ini >>"$MC"
 
 # near A B TOL: |A - B| <= TOL
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
