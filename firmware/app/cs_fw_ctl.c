@@ -450,7 +450,8 @@ void cs_fw_ctl_poll(cs_fw_motion_t *mo)
 #if CS_FW_CURVES
     if (c->op_wait && at_rest(mo))
         op_start(mo);
-    else if (c->op_move && cs_fw_motion_still(mo) && c->trip == CS_FW_TRIP_NONE)
+    else if (c->op_move && !mo->hold.hold && cs_fw_motion_still(mo) &&
+             c->trip == CS_FW_TRIP_NONE) /* a hold at rest is no end of the move */
         op_moved(mo, false, c->inputs);
 #endif
     poll_spindle(mo);
