@@ -17,9 +17,7 @@ enum { PH_SEEK, PH_BACKOFF, PH_LATCH, PH_PULLOFF };
 cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm)
 {
     /* mm Q16 = steps * 2^32 / spm(Q16), rounded to nearest */
-    int64_t num = (int64_t)steps * ((int64_t)1 << 32);
-    int64_t q = num >= 0 ? (num + spm / 2) / spm : -((-num + spm / 2) / spm);
-    return (cs_pos_t)q;
+    return (cs_pos_t)cs_fixed_div_round((int64_t)steps * ((int64_t)1 << 32), spm);
 }
 
 #if CS_FW_CTL
