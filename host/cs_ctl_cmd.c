@@ -16,6 +16,7 @@
 #include "cs_ctlcfg.h"
 #include "cs_err_text.h"
 #include "cs_machine_ini.h"
+#include "cs_path.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
@@ -260,14 +261,10 @@ static int start(int argc, char **argv, ctl_args_t *a, const char *who, const ch
 
 static int add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m)
 {
-    if (j->n == j->cap) {
-        size_t cap = j->cap ? j->cap * 2 : 8;
-        cs_proto_msg_t *v = realloc(j->v, cap * sizeof *v);
-        if (v == NULL)
-            return -1;
-        j->v = v;
-        j->cap = cap;
-    }
+    void *b = j->v;
+    if (!cs_path_grow(&b, &j->cap, j->n + 1, sizeof *j->v))
+        return -1;
+    j->v = b;
     j->v[j->n++] = *m;
     return 0;
 }

@@ -15,6 +15,7 @@
 
 #include "cs_fw_app.h"
 #include "cs_jobplan.h"
+#include "cs_path.h"
 #include "cs_stream.h"
 #include "port_posix.h"
 
@@ -44,8 +45,11 @@ struct cs_sim_motion {
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
+    uint32_t seen[3]; /* alarms, probe cycles, homings already marked (note_marks) */
 };
 typedef struct cs_sim_motion sim_dev_t;
+
+static void note_marks(sim_dev_t *d);
 
 void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
 {
@@ -148,6 +152,7 @@ static void advance(sim_dev_t *d, double wall)
             break;
     }
     cs_fw_motion_poll(mo);
+    note_marks(d);
     if (mo->stats.segments != seg0 && d->dry) {
         d->res->exec_gaps++;
         d->res->gap_wall_s += wall - d->dry_since;
@@ -238,6 +243,33 @@ static int read_line(sim_dev_t *d, int wait_ms)
 }
 
 /* One pass of the device: the line read, the application run over it, time advanced. */
+/* A machine-control event happened (a counter moved): note where the machine is. */
+static void note_marks(sim_dev_t *d)
+{
+    const cs_fw_ctl_t *c = &d->app.mo.ctl;
+    if (!d->cfg->keep_edges) /* the marks go with the edges (cs_sim_exec_free) */
+        return;
+    uint32_t now[3] = {c->alarms, c->probes, c->homings};
+    cs_sim_exec_t *ex = &d->res->ex;
+    for (unsigned k = 0; k < 3; k++) {
+        for (; d->seen[k] < now[k]; d->seen[k]++) {
+            void *b = ex->marks;
+            size_t cap = ex->nmarks;
+            if (!cs_path_grow(&b, &cap, ex->nmarks + 1, sizeof *ex->marks))
+                return;
+            ex->marks = b;
+            cs_sim_mark_t *mk = &ex->marks[ex->nmarks++];
+            mk->t = port_posix_now();
+            mk->kind = (uint8_t)(k == 0 ? CS_SIM_MARK_ALARM : k == 1 ? CS_SIM_MARK_PROBE
+                                                                      : CS_SIM_MARK_HOMED);
+            for (unsigned i = 0; i < 3; i++)
+                mk->p[i] = i < d->m->n_axes ? (double)port_posix_position(i) * CS_MOTION_ONE /
+                                                  (double)d->m->axis[i].steps_per_mm
+                                            : 0;
+        }
+    }
+}
+
 static volatile sig_atomic_t g_estop, g_estop_seen;
 
 void cs_sim_device_estop(bool pressed)
@@ -488,6 +520,16 @@ static cs_err_t keep_edges(sim_dev_t *d)
     if (res->ex.edges != NULL || ne == 0)
         res->ex.n = ne;
     res->ex.end_tick = port_posix_now();
+    size_t ns;
+    const port_posix_spindle_t *sp = port_posix_spindles(&ns);
+    if (rc == CS_OK && ns > 0) {
+        res->ex.spins = malloc(ns * sizeof *sp);
+        if (res->ex.spins == NULL)
+            rc = CS_ERR_FULL;
+        else
+            memcpy(res->ex.spins, sp, ns * sizeof *sp);
+        res->ex.nspins = res->ex.spins != NULL ? ns : 0;
+    }
     for (unsigned i = 0; i < CS_AXES; i++) {
         res->ex.pos[i] = port_posix_position(i);
         res->ex.exec_pos[i] = cs_stepper_position(&d->app.mo.st, i);

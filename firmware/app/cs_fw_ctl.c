@@ -17,9 +17,7 @@ enum { PH_SEEK, PH_BACKOFF, PH_LATCH, PH_PULLOFF };
 cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm)
 {
     /* mm Q16 = steps * 2^32 / spm(Q16), rounded to nearest */
-    int64_t num = (int64_t)steps * ((int64_t)1 << 32);
-    int64_t q = num >= 0 ? (num + spm / 2) / spm : -((-num + spm / 2) / spm);
-    return (cs_pos_t)q;
+    return (cs_pos_t)cs_fixed_div_round((int64_t)steps * ((int64_t)1 << 32), spm);
 }
 
 #if CS_FW_CTL
@@ -450,7 +448,8 @@ void cs_fw_ctl_poll(cs_fw_motion_t *mo)
 #if CS_FW_CURVES
     if (c->op_wait && at_rest(mo))
         op_start(mo);
-    else if (c->op_move && cs_fw_motion_still(mo) && c->trip == CS_FW_TRIP_NONE)
+    else if (c->op_move && !mo->hold.hold && cs_fw_motion_still(mo) &&
+             c->trip == CS_FW_TRIP_NONE) /* a hold at rest is no end of the move */
         op_moved(mo, false, c->inputs);
 #endif
     poll_spindle(mo);

@@ -14,7 +14,9 @@
 #  - the e-stop (SIGUSR1 to the simulator): unlock refused while pressed, accepted after
 #    SIGUSR2.
 #  - a jog interrupted with Ctrl-C (a real-time simulator): exit 8, the position it prints is
-#    the simulator's final position, between start and target.
+#    the simulator's final position, between start and target;
+#  - the simulator's picture rings each event: 2 axes homed (x at physical -4 mm), 3 probe
+#    cycles, the alarms.
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -29,15 +31,6 @@ travel_max = 100
 [z]
 travel_min = -20
 travel_max = 0
-[homing]
-order = zx
-seek = 20
-latch = 1
-pulloff = 1
-z = max
-z_pos = 0
-x = min
-x_pos = -99
 [limits]
 x_min = -5
 x_max = 50
@@ -45,13 +38,15 @@ z_max = 2
 [probe]
 z = -3
 EOF
+cat tests/data/ctl-homing.ini >>"$MC"
 
 # near A B TOL: |A - B| <= TOL
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
 # field N of the last line of FILE matching RE
 last_field() { grep -E "$2" "$1" | tail -1 | awk -v n="$3" '{ print $n }'; }
 
-timeout -k 5 300 "$SIM" --pty --instant --machine "$MC" >"$T/dev.sim" 2>"$T/dev.simerr" &
+timeout -k 5 300 "$SIM" --pty --instant --machine "$MC" --svg "$T/ctl.svg" >"$T/dev.sim" \
+    2>"$T/dev.simerr" &
 pids+=($!)
 SIMPID=$!
 wait_pty "$T/dev.sim" 60
@@ -113,6 +108,12 @@ kill -TERM "$SIMPID"
 wait_until 60 gone "$SIMPID"
 wait "$SIMPID"
 expect "sim: 2 axes homed, alarms counted" grep -qE '^control: 2 axes homed, [3-9] alarms' "$T/dev.sim"
+# the picture: a ring per event, blue where an axis was homed (x at physical -4 mm), green at
+# each of the 3 probe cycles' ends, red at each alarm
+expect "picture: 2 homed rings" [ "$(grep -c 'class="mark".*stroke="#1919d8"' "$T/ctl.svg")" -eq 2 ]
+expect "picture: x homed at physical -4 mm" grep -q 'class="mark" cx="-4.0000" .*#1919d8' "$T/ctl.svg"
+expect "picture: 3 probe rings" [ "$(grep -c 'class="mark".*stroke="#19a519"' "$T/ctl.svg")" -eq 3 ]
+expect "picture: alarm rings" [ "$(grep -c 'class="mark".*stroke="#d81919"' "$T/ctl.svg")" -ge 3 ]
 # physical final position: device (-60, 0, -1) + (95, 0, 1)
 expect "sim: final position physical (35, 0, 0) mm" \
     grep -q '^final position: x=2800 steps (35.0000 mm) y=0 steps (0.0000 mm) z=0 steps' "$T/dev.sim"

@@ -28,17 +28,7 @@ if ! command -v qemu-system-arm >/dev/null; then
 fi
 expect "image built" [ -f "$ELF" ]
 MC=$T/m3.ini
-cat firmware/ports/cortex-m3/machine.ini - >"$MC" <<'EOF'
-[homing]
-order = zx
-seek = 20
-latch = 1
-pulloff = 1
-z = max
-z_pos = 0
-x = min
-x_pos = -99
-EOF
+cat firmware/ports/cortex-m3/machine.ini tests/data/ctl-homing.ini >"$MC"
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
 
 timeout -k 5 400 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
