@@ -415,13 +415,29 @@ static void jog_line(grbl_t *g, const char *words)
         cs_grbl_say(g, "error:%d", e != CS_OK ? ERR_JOG : ERR_JOG_TRAVEL);
         return;
     }
+    /* the device plans the jog itself (JOG: a straight move at F with its acceleration,
+     * docs/protocol.md); 0x85 then stops it decelerating, like any item (HOLD, ABORT) */
+    double feed_mm_s = path.n > 0 ? path.elems[path.n - 1].feed_mm_s : 0;
+    size_t moves = path.n;
+    cs_path_free(&path);
+    if (moves == 0) { /* a jog to where the machine is: nothing to do */
+        cs_grbl_say(g, "ok");
+        return;
+    }
     cs_grbl_item_t it = {.jog = true};
-    if (plan_chunk(g, &path, &it, &d) != CS_OK) {
+    cs_proto_msg_t m = {.type = CS_PROTO_JOG};
+    m.u.jog.feed = cs_motion_speed(feed_mm_s);
+    cs_stream_job_init(&it.job, CS_STREAM_SEGMENTS);
+    if (cs_conv_mm_to_vec(jog_end[0], jog_end[1], jog_end[2], &m.u.jog.target) != CS_OK ||
+        cs_stream_job_add_msg(&it.job, &m) != CS_OK || !cs_grbl_dev_push(&g->dev, &it)) {
+        cs_stream_job_free(&it.job);
         cs_grbl_say(g, "error:%d", ERR_JOG_TRAVEL);
         return;
     }
-    cs_grbl_dev_push(&g->dev, &it);
     g->last_push_jog = true;
+    g->plan_pos[0] = m.u.jog.target.x; /* the next chunk starts where the jog ends */
+    g->plan_pos[1] = m.u.jog.target.y;
+    g->plan_pos[2] = m.u.jog.target.z;
     cs_grbl_gc_set_pos(&g->gc, jog_end);
     cs_grbl_say(g, "ok");
 }
