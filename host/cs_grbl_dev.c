@@ -78,6 +78,7 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     o.pause = &d->run_pause;
     o.quiet_hello = true;
     o.on_event = on_event;
+    o.jog_cancel = it->jog; /* Grbl's 0x85 on the device's JOG: JOG_CANCEL */
     o.event_ctx = d;
     cookie_io_functions_t io = {.write = progress_write};
     o.progress = fopencookie(d, "w", io);

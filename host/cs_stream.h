@@ -74,6 +74,8 @@ typedef struct {
     uint32_t tick_hz;
     size_t resume_from; /* messages 1..resume_from were executed already: start after them */
     volatile sig_atomic_t *interrupt; /* > 0: stop (HOLD, ABORT); >= 2: give up at once */
+    bool jog_cancel; /* the job is a JOG: interrupt stops it with JOG_CANCEL instead (the
+                      * device decelerates, drops its queue and is IDLE, not ABORTED) */
     volatile sig_atomic_t *pause;     /* NULL: never; != 0: HOLD (queue kept), back to 0: RESUME */
     FILE *progress;                   /* NULL: none; else progress bar (tty) or lines */
     bool progress_tty;
