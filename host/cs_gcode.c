@@ -252,6 +252,20 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
 }
 
 
+/* The pen's Z move of M3/M4/M5 (opts->pen_z) to t: at opts->pen_z_feed_mm_s when it is given
+ * (the [pen] z_feed, as cs_pen moves the pen for SVG and HP-GL), else rapid. The program's own F
+ * is kept for the moves after it. */
+static cs_err_t pen_z_move(gc_t *g, const double t[3], unsigned col)
+{
+    if (!(g->o->pen_z_feed_mm_s > 0))
+        return cs_gcode_add_line(g, g->pos, t, col, true);
+    double f = g->feed;
+    g->feed = g->o->pen_z_feed_mm_s * 60.0 / g->unit; /* cs_gcode_add: feed * unit / 60 mm/s */
+    cs_err_t e = cs_gcode_add_line(g, g->pos, t, col, false);
+    g->feed = f;
+    return e;
+}
+
 /* M words: pen / spindle before the motion; *end for M2 / M30. */
 static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
 {
@@ -274,12 +288,12 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
                 return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, b->mcol[i]),
                                         "M%d: the spindle could not be set", m / 10);
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
-             * with opts->pen_z a rapid Z move to the pen height. */
+             * with opts->pen_z a Z move to the pen height. */
             cs_path_new_subpath(g->path);
             if (g->o->pen_z) {
                 double t[3] = {g->pos[0], g->pos[1],
                                m == GC_M5 ? g->o->pen_up_z_mm : g->o->pen_down_z_mm};
-                if ((e = cs_gcode_add_line(g, g->pos, t, b->mcol[i], true)) != CS_OK)
+                if ((e = pen_z_move(g, t, b->mcol[i])) != CS_OK)
                     return e;
                 memcpy(g->pos, t, sizeof g->pos);
                 cs_path_new_subpath(g->path);
@@ -952,6 +966,17 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
     if (stats)
         memset(stats, 0, sizeof *stats);
     cs_path_new_subpath(path);
+    if (o->pen_z && o->pen_z_feed_mm_s > 0) {
+        /* the pen starts up: with a z_feed the raise from the origin is a pen move too, at
+         * that speed (else the planner's rapid to the path's start makes it) */
+        double up[3] = {g.pos[0], g.pos[1], o->pen_up_z_mm};
+        g.pos[2] = 0;
+        if ((e = pen_z_move(&g, up, 0)) != CS_OK) {
+            cs_gexpr_free(&g.st);
+            return e;
+        }
+        g.pos[2] = o->pen_up_z_mm;
+    }
     cs_gflow_t fl;
     e = cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops, diag);
     if (e == CS_OK)
