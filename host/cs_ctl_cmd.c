@@ -122,6 +122,7 @@ static int run_job(const ctl_args_t *a, cs_stream_job_t *job, ctl_seen_t *seen)
     o.on_event = on_event;
     o.event_ctx = seen;
     o.status_ms = 120000; /* a homing cycle reports nothing executed for a while */
+    o.jog_cancel = job->n > 0 && job->v[0].type == CS_PROTO_JOG; /* Ctrl-C: Grbl's 0x85 */
     job->mode = CS_STREAM_CURVES; /* planned on the device: the tick rate need not match */
     cs_stream_result_t r;
     cs_err_t e = cs_stream_run(job, &o, &r);

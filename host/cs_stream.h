@@ -81,6 +81,9 @@ typedef struct {
      * homed, inputs: docs/protocol.md), before the ERROR an alarm is followed by */
     void (*on_event)(void *ctx, const cs_proto_event_t *ev);
     void *event_ctx;
+    /* interrupt < 2: send JOG_CANCEL (decelerate to rest, drop the rest, back to IDLE) instead
+     * of HOLD then ABORT (a job of jogs) */
+    bool jog_cancel;
 } cs_stream_opts_t;
 
 typedef struct {
