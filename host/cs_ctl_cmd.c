@@ -256,8 +256,10 @@ static int parse(int argc, char **argv, ctl_args_t *a, const char **axes)
     return -1;
 }
 
-/* The common start: arguments, then the machine file. */
-static int start(int argc, char **argv, ctl_args_t *a, const char *who, const char **axes)
+/* The common start: arguments, then the machine file (and its control sections into *ctl when
+ * not NULL). */
+static int start(int argc, char **argv, ctl_args_t *a, const char *who, const char **axes,
+                 cs_ctlcfg_t *ctl)
 {
     memset(a, 0, sizeof *a);
     a->who = who;
@@ -269,7 +271,8 @@ static int start(int argc, char **argv, ctl_args_t *a, const char *who, const ch
     char err[512];
     char name[32];
     snprintf(name, sizeof name, "curvestep %s", who);
-    if (cs_machine_ini_open(name, a->machine_file, &a->m, NULL, err, sizeof err) != 0) {
+    if (cs_machine_ini_open(name, a->machine_file, &a->m, NULL, err, sizeof err) != 0 ||
+        (ctl != NULL && cs_ctlcfg_load(a->machine_file, &a->m, ctl, err, sizeof err) != 0)) {
         fprintf(stderr, "%s\n", err);
         return CS_EXIT_INPUT;
     }
@@ -290,15 +293,11 @@ int cs_cmd_home(int argc, char **argv)
 {
     ctl_args_t a;
     const char *axes = NULL;
-    int rc = start(argc, argv, &a, "home", &axes);
-    if (rc >= 0)
-        return rc;
     cs_ctlcfg_t c;
     char err[512];
-    if (cs_ctlcfg_load(a.machine_file, &a.m, &c, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
-        return CS_EXIT_INPUT;
-    }
+    int rc = start(argc, argv, &a, "home", &axes, &c);
+    if (rc >= 0)
+        return rc;
     if (axes != NULL) { /* --axes: the order, read by the machine file's own rule */
         char text[64];
         snprintf(text, sizeof text, "[homing]\norder = %s\n", axes);
@@ -361,7 +360,7 @@ static int target_msg(const ctl_args_t *a, cs_proto_msg_t *m)
 static int one_msg(int argc, char **argv, const char *who, uint8_t type)
 {
     ctl_args_t a;
-    int rc = start(argc, argv, &a, who, NULL);
+    int rc = start(argc, argv, &a, who, NULL, NULL);
     if (rc >= 0)
         return rc;
     cs_stream_job_t job;
@@ -415,15 +414,10 @@ static bool spindle_duty(const ctl_args_t *a, double s_max, uint16_t *duty)
 int cs_cmd_spindle(int argc, char **argv)
 {
     ctl_args_t a;
-    int rc = start(argc, argv, &a, "spindle", NULL);
+    cs_ctlcfg_t c;
+    int rc = start(argc, argv, &a, "spindle", NULL, &c);
     if (rc >= 0)
         return rc;
-    cs_ctlcfg_t c;
-    char err[512];
-    if (cs_ctlcfg_load(a.machine_file, &a.m, &c, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
-        return CS_EXIT_INPUT;
-    }
     cs_proto_msg_t m = {.type = CS_PROTO_SPINDLE};
     if (!spindle_duty(&a, c.s_max, &m.u.spindle.power)) {
         fprintf(stderr, "curvestep spindle: S wants one number in [0, %g] ([spindle] s_max)\n",
