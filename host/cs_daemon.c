@@ -31,6 +31,7 @@
 #include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_pen.h"
 #include "cs_trace.h"
 
 #define MAX_CLIENTS 16
@@ -244,10 +245,11 @@ static void diag_text(const cs_jobplan_t *jp, const char *file, cs_err_t e, char
 /* Reads the job file once (a regular file only: a FIFO or a device would block the daemon) into
  * jp->path, laid out, ordered and pen-lifted by in (the SUBMIT words) with merge distance tol_mm;
  * on error a "file:line:col: reason" in err. */
-static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, double tol_mm,
-                     cs_jobplan_t *jp, char *err, size_t errcap)
+static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, const char *font,
+                     double tol_mm, cs_jobplan_t *jp, char *err, size_t errcap)
 {
     cs_jobplan_init(jp);
+    jp->font_file = font; /* NULL: the shipped font */
     jp->regular_only = true;
     jp->max_bytes = d->cfg->max_input_bytes;
     cs_pos_t tol;
@@ -292,10 +294,16 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     cs_err_t e = cs_jobplan_plan(jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
                                  CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(jp, file, d->cfg->port != NULL, curves);
+        e = cs_jobplan_linkable(jp, file,
+                                d->cfg->port != NULL || d->cfg->modbus_tcp != NULL ||
+                                    d->cfg->modbus_rtu != NULL,
+                                curves);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
-                                            tol, &jp->diag)
+        e = curves ? cs_stream_job_add_path_pen(job, &jp->path,
+                                                feed_q > 0 ? feed_q : d->m.default_feed, tol,
+                                                &jp->pen, d->m.tick_hz,
+                                                &(cs_vec3_t){start[0], start[1], start[2]},
+                                                &jp->diag)
                    : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (jp->have_mo) { /* the job holds its own copy of the segments */
         cs_motion_free(&jp->mo);
@@ -308,12 +316,14 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     return false;
 }
 
-/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [shared option words] /ABS/PATH"
+/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [font=/ABS/FONT] [shared option words]
+ * /ABS/PATH"
  * (the shared words: cs_jobopts_word, e.g. lenient, dialect=grbl, fit, rotate=90) */
 static void req_submit(daemon_t *d, char *args, FILE *out)
 {
     bool curves = false;
     double tol = 0, feed = 0;
+    const char *font = NULL;
     cs_jobopts_t in;
     cs_jobopts_init(&in);
     while (*args == ' ')
@@ -336,6 +346,8 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
         else if (strncmp(args, "feed=", 5) == 0 &&
                  ((feed = strtod(args + 5, &end)), *end == '\0' && feed > 0 && feed < 32768))
             ;
+        else if (strncmp(args, "font=/", 6) == 0)
+            font = args + 5; /* within args, which outlives the read */
         else if (cs_jobopts_word(args, &in))
             ;
         else {
@@ -353,7 +365,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     char err[600];
     cs_stream_job_t job;
     cs_jobplan_t jp;
-    if (!read_job(d, args, &in, tol, &jp, err, sizeof err)) {
+    if (!read_job(d, args, &in, font, tol, &jp, err, sizeof err)) {
         fprintf(out, "ERR %s\n", err);
         dlog(d, "refused %s: %s", args, err);
         return;

@@ -133,10 +133,13 @@ static void client_usage(FILE *f, const char *name)
     cs_daemon_default_socket(sock, sizeof sock);
     if (strcmp(name, "submit") == 0)
         fprintf(f, "usage: curvestep submit [--socket PATH] [--mode segments|curves] [--tol MM]\n"
-                   "                        [--feed MM/S] [input and layout options] FILE\n"
+                   "                        [--feed MM/S] [--font FILE.jhf] [input and layout\n"
+                   "                        options] FILE\n"
                    "Queues the job FILE (SVG, G-code or HPGL) on the daemon (`curvestep serve`).\n"
                    "The daemon reads and plans it whole now: a bad file is refused at once with\n"
-                   "file:line:col: reason. Prints the job's number. Options as for `stream`.\n");
+                   "file:line:col: reason. Prints the job's number. Options as for `stream`;\n"
+                   "--font FILE.jhf: the stroke font for SVG <text> and HP-GL LB (read by the\n"
+                   "daemon at submit; a file that is not a font is refused, file:line:col).\n");
     else if (strcmp(name, "status") == 0)
         fprintf(f, "usage: curvestep status [--socket PATH]\n"
                    "Prints the daemon's device and whether its queue is paused, then one line per\n"
@@ -169,7 +172,7 @@ static int client(int argc, char **argv, const char *verb)
     const char *name = argv[0];
     char sock[256];
     const char *socket_path = cs_daemon_default_socket(sock, sizeof sock);
-    const char *file = NULL, *mode = NULL, *tol = NULL, *feed = NULL, *job = NULL;
+    const char *file = NULL, *mode = NULL, *tol = NULL, *feed = NULL, *job = NULL, *font = NULL;
     bool submit = strcmp(name, "submit") == 0, cancel = strcmp(name, "cancel") == 0;
     cs_jobopts_t in; /* sent as SUBMIT words; the daemon reads and lays out the job */
     cs_jobopts_init(&in);
@@ -207,6 +210,8 @@ static int client(int argc, char **argv, const char *verb)
                 fprintf(stderr, "curvestep submit: --feed wants a speed in (0, 32768) mm/s\n");
                 return CS_EXIT_USAGE;
             }
+        } else if (submit && strcmp(a, "--font") == 0 && has) {
+            font = argv[++i];
         } else if (a[0] == '-' && a[1] != '\0') {
             fprintf(stderr, "curvestep %s: unknown or incomplete option %s\n", name, a);
             client_usage(stderr, name);
@@ -241,9 +246,19 @@ static int client(int argc, char **argv, const char *verb)
         }
         if (cs_jobopts_check(name, &in) != 0)
             return CS_EXIT_USAGE;
-        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s%s %s", mode ? " mode=" : "",
+        /* the font goes by its absolute path, one word: the daemon reads it at submit */
+        char fabs[PATH_MAX] = "";
+        if (font != NULL && realpath(font, fabs) == NULL) {
+            fprintf(stderr, "%s:0:0: cannot open the font (%s)\n", font, strerror(errno));
+            return CS_EXIT_INPUT;
+        }
+        if (strpbrk(fabs, " \t\n") != NULL) {
+            fprintf(stderr, "%s:0:0: a font path with blanks cannot be sent to the daemon\n", font);
+            return CS_EXIT_INPUT;
+        }
+        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s%s%s%s %s", mode ? " mode=" : "",
                          mode ? mode : "", tol ? " tol=" : "", tol ? tol : "", feed ? " feed=" : "",
-                         feed ? feed : "", in.words, abs);
+                         feed ? feed : "", font ? " font=" : "", fabs, in.words, abs);
         if (k < 0 || (size_t)k >= sizeof req || strchr(abs, '\n')) {
             fprintf(stderr, "%s:0:0: path too long or not on one line\n", file);
             return CS_EXIT_INPUT;

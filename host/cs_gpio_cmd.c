@@ -13,6 +13,7 @@
 #include "cs_cmd.h"
 #include "cs_gpio_cfg.h"
 #include "cs_gpio_io.h"
+#include "cs_gpio_pwm.h"
 #include "cs_gpio_run.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
@@ -118,6 +119,27 @@ static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
         fprintf(stderr, "curvestep stream: note: memory not locked (AddressSanitizer build)\n");
 }
 
+/* Opens the pen servo's line for a job with pen events: [gpio] pen on the chip, or a recorder
+ * with room for the job. CS_EXIT_OK, or the exit status after the reason on stderr (no pen line
+ * wired: 1; the chip refused it: 4). */
+static int open_pen(cs_gpio_io_t *pio, const cs_stream_args_t *a, const cs_stream_plan_t *p,
+                    const cs_gpio_cfg_t *cfg, const char *chip, bool record, const cs_machine_t *m)
+{
+    char err[512];
+    if (cfg->pen < 0 && !record) {
+        fprintf(stderr,
+                "%s:0: [pen] mode = servo, but [gpio] wires no pen line (pen = OFFSET, "
+                "docs/gpio.md)\n",
+                a->machine_file ? a->machine_file : "the built-in machine");
+        return CS_EXIT_INPUT;
+    }
+    if (cs_gpio_pwm_open(pio, chip, record, cfg->pen, (double)p->ticks / m->tick_hz + 2.0, err,
+                         sizeof err) == 0)
+        return CS_EXIT_OK;
+    fprintf(stderr, "curvestep stream: %s\n", err);
+    return record ? CS_EXIT_INTERNAL : CS_EXIT_NO_DEVICE;
+}
+
 int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
                        volatile sig_atomic_t *interrupted)
 {
@@ -218,6 +240,15 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
             return CS_EXIT_INTERNAL;
         }
     }
+    /* the pen servo ([pen] mode = servo): its own line and thread (cs_gpio_pwm) */
+    cs_gpio_io_t pio = {0};
+    bool pen = p->npens > 0;
+    int prc = pen ? open_pen(&pio, a, p, &cfg, chip_arg, record != NULL, m) : CS_EXIT_OK;
+    if (prc != CS_EXIT_OK) {
+        cs_gpio_io_close(&io);
+        cs_gpio_io_free(&io);
+        return prc;
+    }
     const char *link = chip_arg; /* "stream: LINK: outcome" */
     fprintf(stderr, "stream: %s: %u lines (", link, l.n);
     for (unsigned i = 0; i < l.n; i++)
@@ -243,9 +274,14 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         cs_gpio_io_set(&io, (1u << l.n) - 1u, 0, 0, &(int64_t){0});
         cs_gpio_io_close(&io);
         cs_gpio_io_free(&io);
+        cs_gpio_io_close(&pio);
+        cs_gpio_io_free(&pio);
         return CS_EXIT_INTERNAL;
     }
     warn_rt(&r, &cfg);
+    cs_gpio_pwm_t pw = {0};
+    if (pen && (rc = cs_gpio_pwm_start(&pw, &pio, &r, p->pens, p->npens, cfg.spin_ns)) != 0)
+        fprintf(stderr, "curvestep stream: cannot start the pen's thread: %s\n", strerror(rc));
     progress_t pg;
     memset(&pg, 0, sizeof pg);
     pg.f = a->quiet ? NULL : stderr;
@@ -269,6 +305,9 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         nanosleep(&ts, NULL);
     }
     cs_gpio_run_join(&r);
+    cs_gpio_pwm_stop(&pw);
+    if (pen)
+        cs_gpio_io_close(&pio);
     progress(&pg, p, &r, true);
     double wall = now_s() - t_start;
     cs_gpio_io_close(&io);
@@ -310,6 +349,8 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
            "us, max %.1f us\n",
            wall, (double)r.ticks / m->tick_hz, (double)cs_gpio_run_late_quantile(&r, 0.5) / 1000.0,
            (double)cs_gpio_run_late_quantile(&r, 0.99) / 1000.0, (double)r.late_max_ns / 1000.0);
+    if (pen && !cs_gpio_pwm_report(stdout, &pw) && exit_rc == CS_EXIT_OK)
+        exit_rc = CS_EXIT_CLOSED;
     if (exit_rc != CS_EXIT_OK && ex < p->nsegs && r.outcome != CS_GPIO_RUN_STOPPED)
         cs_stream_report_resume(stdout, "segment", ex);
     if (r.outcome == CS_GPIO_RUN_STOPPED)
@@ -323,6 +364,8 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
                  (unsigned)m->tick_hz, (unsigned)cfg.pulse_ns, (unsigned)cfg.dir_setup_ns);
         int wr = f ? cs_gpio_io_write_record(&io, f, r.t0_ns, hdr) : -1;
+        if (wr == 0 && pen) /* the pen's line after the others, its own header line */
+            wr = cs_gpio_io_write_record(&pio, f, r.t0_ns, "pen servo: software PWM, 50 Hz");
         if (f && fclose(f) != 0)
             wr = -1;
         if (wr != 0) {
@@ -337,5 +380,6 @@ int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
         }
     }
     cs_gpio_io_free(&io);
+    cs_gpio_io_free(&pio);
     return exit_rc;
 }

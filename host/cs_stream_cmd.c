@@ -15,6 +15,7 @@
 #include "cs_jobplan.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_pen.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
 #include "cs_trace.h"
@@ -224,12 +225,13 @@ int cs_cmd_stream(int argc, char **argv)
     int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
     e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, job_file, port != NULL, curves);
+        e = cs_jobplan_linkable(&jp, job_file, true, curves); /* GPIO: cs_gpio_pwm */
     cs_stream_job_t job;
     cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(&job, &jp.path, feed_q > 0 ? feed_q : m.default_feed,
-                                            tol, &jp.diag)
+        e = curves ? cs_stream_job_add_path_pen(&job, &jp.path,
+                                                feed_q > 0 ? feed_q : m.default_feed, tol, &jp.pen,
+                                                m.tick_hz, &(cs_vec3_t){0, 0, 0}, &jp.diag)
                    : cs_stream_job_add_motion(&job, &jp.mo.segs);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp.diag);
@@ -275,6 +277,8 @@ int cs_cmd_stream(int argc, char **argv)
         pl.segs = jp.mo.segs.v;
         pl.nsegs = jp.mo.segs.n;
         pl.ticks = jp.mo.ticks;
+        pl.pens = jp.mo.segs.pens;
+        pl.npens = jp.mo.segs.npens;
         struct sigaction sig;
         memset(&sig, 0, sizeof sig);
         sig.sa_handler = on_sigint;

@@ -52,6 +52,8 @@ typedef struct {
     const cs_segment_t *segs; /* owned by the command; valid during the link call */
     size_t nsegs;
     uint64_t ticks; /* sum of the segments' durations (executor ticks) */
+    const cs_motion_pen_t *pens; /* servo pen events of segs (GPIO: cs_gpio_pwm), npens of them */
+    size_t npens;
 } cs_stream_plan_t;
 
 /* Links. Each runs the whole job (from args->resume_from + 1), shows progress on stderr unless

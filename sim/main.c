@@ -47,7 +47,8 @@ static void usage(FILE *f)
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
         "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
         "                    with --reference, executed travel moves (the job's G0 moves and\n"
-        "                    the jumps between its elements) thin dashed grey\n"
+        "                    the jumps between its elements) thin dashed grey; with a [pen],\n"
+        "                    pen-up motion dashed grey and each servo setting marked\n"
         "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
         "  --png-width PX    width of that picture, 100..8000 px (default 1600)\n"
         "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
@@ -221,13 +222,14 @@ int main(int argc, char **argv)
         perror(trace);
         rc = EXIT_INTERNAL;
     }
+    cs_sim_draw_pen_t dp = {&pen, &segs}; /* pen-up travel and servo settings in the pictures */
     if (rc == EXIT_OK && svg &&
-        cs_sim_draw_svg_view(svg, &m, &ex, reference ? &ref : NULL, &view) != 0) {
+        cs_sim_draw_svg_pen(svg, &m, &ex, reference ? &ref : NULL, &view, &dp) != 0) {
         perror(svg);
         rc = EXIT_INTERNAL;
     }
     if (rc == EXIT_OK && png &&
-        cs_sim_draw_png_view(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width) != 0)
+        cs_sim_draw_png_pen(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width, &dp) != 0)
         rc = EXIT_INTERNAL;
     if (rc == EXIT_OK && check && !ok) {
         printf("check: FAILED\n");
