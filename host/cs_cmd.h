@@ -58,5 +58,6 @@ int cs_cmd_home(int argc, char **argv);
 int cs_cmd_jog(int argc, char **argv);
 int cs_cmd_probe(int argc, char **argv);
 int cs_cmd_unlock(int argc, char **argv);
+int cs_cmd_spindle(int argc, char **argv);
 
 #endif

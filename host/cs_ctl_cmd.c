@@ -40,6 +40,8 @@ typedef struct {
     double xyz[3];
     int nxyz;
     bool away, no_error; /* probe */
+    int mode;            /* spindle: cs_proto_spindle_mode_t */
+    bool laser;          /* spindle: --laser */
     cs_machine_t m;
 } ctl_args_t;
 
@@ -122,6 +124,7 @@ static int run_job(const ctl_args_t *a, cs_stream_job_t *job, ctl_seen_t *seen)
     o.on_event = on_event;
     o.event_ctx = seen;
     o.status_ms = 120000; /* a homing cycle reports nothing executed for a while */
+    o.jog_cancel = job->n > 0 && job->v[0].type == CS_PROTO_JOG; /* Ctrl-C: Grbl's 0x85 */
     job->mode = CS_STREAM_CURVES; /* planned on the device: the tick rate need not match */
     cs_stream_result_t r;
     cs_err_t e = cs_stream_run(job, &o, &r);
@@ -170,6 +173,12 @@ static void usage(FILE *f, const char *who)
          "move ends without contact (G38.3, G38.5).\n"},
         {"unlock", "unlock --port DEV [--baud N] [--machine FILE.ini]",
          "Leaves the device's alarm state (Grbl's $X); refused while the e-stop is pressed.\n"},
+        {"spindle",
+         "spindle --port DEV [--baud N] [--machine FILE.ini] [--ccw | --off]\n"
+         "                       [--laser [--feed MM/S]] [S]",
+         "Sets the spindle or laser output in queue order (M3 S, M4 with --ccw, M5 with --off):\n"
+         "power S of the machine file's [spindle] s_max (default 1000). --laser: the power of\n"
+         "the moves that follow scales with their speed, full at --feed (Grbl's $32).\n"},
     };
     size_t k = 0;
     while (k + 1 < sizeof u / sizeof u[0] && strcmp(u[k].who, who) != 0)
@@ -218,11 +227,18 @@ static int parse(int argc, char **argv, ctl_args_t *a, const char **axes)
             }
         } else if (strcmp(s, "--axes") == 0 && has && axes != NULL) {
             *axes = argv[++i];
-        } else if (strcmp(s, "--feed") == 0 && has && axes == NULL) {
+        } else if (strcmp(s, "--feed") == 0 && has && axes == NULL &&
+                   strcmp(a->who, "unlock") != 0) {
             if (!cs_conv_number(argv[++i], &a->feed) || !(a->feed > 0 && a->feed <= 4096)) {
                 fprintf(stderr, "curvestep %s: --feed wants mm/s in (0, 4096]\n", a->who);
                 return CS_EXIT_USAGE;
             }
+        } else if (strcmp(s, "--ccw") == 0 && strcmp(a->who, "spindle") == 0) {
+            a->mode = CS_PROTO_SPINDLE_CCW;
+        } else if (strcmp(s, "--off") == 0 && strcmp(a->who, "spindle") == 0) {
+            a->mode = CS_PROTO_SPINDLE_OFF;
+        } else if (strcmp(s, "--laser") == 0 && strcmp(a->who, "spindle") == 0) {
+            a->laser = true;
         } else if (strcmp(s, "--away") == 0 && strcmp(a->who, "probe") == 0) {
             a->away = true;
         } else if (strcmp(s, "--no-error") == 0 && strcmp(a->who, "probe") == 0) {
@@ -240,19 +256,23 @@ static int parse(int argc, char **argv, ctl_args_t *a, const char **axes)
     return -1;
 }
 
-/* The common start: arguments, then the machine file. */
-static int start(int argc, char **argv, ctl_args_t *a, const char *who, const char **axes)
+/* The common start: arguments, then the machine file (and its control sections into *ctl when
+ * not NULL). */
+static int start(int argc, char **argv, ctl_args_t *a, const char *who, const char **axes,
+                 cs_ctlcfg_t *ctl)
 {
     memset(a, 0, sizeof *a);
     a->who = who;
     a->baud = 115200;
+    a->mode = CS_PROTO_SPINDLE_CW;
     int rc = parse(argc, argv, a, axes);
     if (rc >= 0)
         return rc;
     char err[512];
     char name[32];
     snprintf(name, sizeof name, "curvestep %s", who);
-    if (cs_machine_ini_open(name, a->machine_file, &a->m, NULL, err, sizeof err) != 0) {
+    if (cs_machine_ini_open(name, a->machine_file, &a->m, NULL, err, sizeof err) != 0 ||
+        (ctl != NULL && cs_ctlcfg_load(a->machine_file, &a->m, ctl, err, sizeof err) != 0)) {
         fprintf(stderr, "%s\n", err);
         return CS_EXIT_INPUT;
     }
@@ -273,15 +293,11 @@ int cs_cmd_home(int argc, char **argv)
 {
     ctl_args_t a;
     const char *axes = NULL;
-    int rc = start(argc, argv, &a, "home", &axes);
-    if (rc >= 0)
-        return rc;
     cs_ctlcfg_t c;
     char err[512];
-    if (cs_ctlcfg_load(a.machine_file, &a.m, &c, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
-        return CS_EXIT_INPUT;
-    }
+    int rc = start(argc, argv, &a, "home", &axes, &c);
+    if (rc >= 0)
+        return rc;
     if (axes != NULL) { /* --axes: the order, read by the machine file's own rule */
         char text[64];
         snprintf(text, sizeof text, "[homing]\norder = %s\n", axes);
@@ -344,7 +360,7 @@ static int target_msg(const ctl_args_t *a, cs_proto_msg_t *m)
 static int one_msg(int argc, char **argv, const char *who, uint8_t type)
 {
     ctl_args_t a;
-    int rc = start(argc, argv, &a, who, NULL);
+    int rc = start(argc, argv, &a, who, NULL, NULL);
     if (rc >= 0)
         return rc;
     cs_stream_job_t job;
@@ -383,4 +399,41 @@ int cs_cmd_probe(int argc, char **argv)
 int cs_cmd_unlock(int argc, char **argv)
 {
     return one_msg(argc, argv, "unlock", CS_PROTO_UNLOCK);
+}
+
+/* S of [spindle] s_max -> duty in 1/1000, rounded; false outside 0..s_max. */
+static bool spindle_duty(const ctl_args_t *a, double s_max, uint16_t *duty)
+{
+    double s = a->nxyz == 1 ? a->xyz[0] : 0;
+    if (a->nxyz > 1 || !(s >= 0 && s <= s_max))
+        return false;
+    *duty = (uint16_t)(s / s_max * CS_PROTO_SPINDLE_FULL + 0.5);
+    return true;
+}
+
+int cs_cmd_spindle(int argc, char **argv)
+{
+    ctl_args_t a;
+    cs_ctlcfg_t c;
+    int rc = start(argc, argv, &a, "spindle", NULL, &c);
+    if (rc >= 0)
+        return rc;
+    cs_proto_msg_t m = {.type = CS_PROTO_SPINDLE};
+    if (!spindle_duty(&a, c.s_max, &m.u.spindle.power)) {
+        fprintf(stderr, "curvestep spindle: S wants one number in [0, %g] ([spindle] s_max)\n",
+                c.s_max);
+        return CS_EXIT_USAGE;
+    }
+    m.u.spindle.mode = (uint8_t)a.mode;
+    m.u.spindle.flags = a.laser ? CS_PROTO_SPINDLE_LASER : 0;
+    if (a.laser && a.feed > 0 && cs_conv_mm_to_pos(a.feed, &m.u.spindle.feed) != CS_OK)
+        return CS_EXIT_USAGE;
+    cs_stream_job_t job;
+    cs_stream_job_init(&job, CS_STREAM_CURVES);
+    if (add_msg(&job, &m) != 0)
+        return CS_EXIT_INTERNAL;
+    ctl_seen_t seen = {&a, false, false, false, 0, {0}, 0};
+    rc = run_job(&a, &job, &seen);
+    cs_stream_job_free(&job);
+    return rc;
 }

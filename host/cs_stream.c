@@ -584,7 +584,7 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
         uint32_t now = cs_serial_now_us();
         if (o->interrupt != NULL && *o->interrupt) {
             if (*o->interrupt < 2 && o->jog_cancel) {
-                control(s, CS_PROTO_JOG_CANCEL, CS_PROTO_STATE_IDLE, CS_PROTO_STATE_IDLE, 2000);
+                control(s, CS_PROTO_JOG_CANCEL, CS_PROTO_STATE_IDLE, CS_PROTO_STATE_ALARM, 5000);
             } else if (*o->interrupt < 2) {
                 control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
                 control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);

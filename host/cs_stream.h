@@ -74,8 +74,6 @@ typedef struct {
     uint32_t tick_hz;
     size_t resume_from; /* messages 1..resume_from were executed already: start after them */
     volatile sig_atomic_t *interrupt; /* > 0: stop (HOLD, ABORT); >= 2: give up at once */
-    bool jog_cancel; /* the job is a JOG: interrupt stops it with JOG_CANCEL instead (the
-                      * device decelerates, drops its queue and is IDLE, not ABORTED) */
     volatile sig_atomic_t *pause;     /* NULL: never; != 0: HOLD (queue kept), back to 0: RESUME */
     FILE *progress;                   /* NULL: none; else progress bar (tty) or lines */
     bool progress_tty;
@@ -87,6 +85,9 @@ typedef struct {
      * homed, inputs: docs/protocol.md), before the ERROR an alarm is followed by */
     void (*on_event)(void *ctx, const cs_proto_event_t *ev);
     void *event_ctx;
+    /* interrupt < 2: send JOG_CANCEL (decelerate to rest, drop the rest, back to IDLE) instead
+     * of HOLD then ABORT (a job of jogs) */
+    bool jog_cancel;
 } cs_stream_opts_t;
 
 typedef struct {

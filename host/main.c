@@ -29,6 +29,7 @@ static const struct {
     {"jog", cs_cmd_jog, "move the device to a machine position (Ctrl-C decelerates, stops)"},
     {"probe", cs_cmd_probe, "probe towards a position, print the contact (G38.2..G38.5)"},
     {"unlock", cs_cmd_unlock, "leave the device's alarm state (Grbl's $X)"},
+    {"spindle", cs_cmd_spindle, "set the spindle or laser output (M3/M4/M5 S; laser mode)"},
     {"help", cmd_help, "show this help, or a command's help: curvestep help COMMAND"},
 };
 

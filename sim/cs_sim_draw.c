@@ -586,8 +586,8 @@ int cs_sim_draw_svg_pen(const char *file, const cs_machine_t *m, const cs_sim_ex
         ref_runs(ref, svg_ref_run, f, view);
         fprintf(f, "</g>\n");
     }
-    svg_control(f, ex, s, n, view, lw);
     svg_marks(f, s, n, 5 * lw, lw);
+    svg_control(f, ex, s, n, view, lw);
     fprintf(f, "</svg>\n");
     free(s);
     return fclose(f) == 0 ? 0 : -1;
@@ -743,8 +743,8 @@ int cs_sim_draw_png_pen(const char *file, const cs_machine_t *m, const cs_sim_ex
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_set_line_width(cr, 0.8 / scale);
     ref_runs(ref, png_ref_run, cr, view);
-    png_control(cr, ex, s, n, view, scale);
     png_marks(cr, s, n, 5.0 / scale, 1.5 / scale);
+    png_control(cr, ex, s, n, view, scale);
     cairo_destroy(cr);
     cairo_status_t st = cairo_surface_write_to_png(sf, file);
     cairo_surface_destroy(sf);

@@ -504,8 +504,7 @@ void cs_fw_ctl_jog_cancel(cs_fw_motion_t *mo)
     if (!c->jogging || c->cancel)
         return;
     c->cancel = true;
-    cs_hold_set(&mo->hold, true);
-    mo->news = true;
+    cs_fw_motion_hold(mo, true); /* the feed-hold ramp (counted as a hold) */
 }
 
 void cs_fw_ctl_abort(cs_fw_motion_t *mo)

@@ -13,8 +13,11 @@
 #    stopped exactly there; the next jog refused (exit 7); `unlock` (exit 0); a jog back runs.
 #  - the e-stop (SIGUSR1 to the simulator): unlock refused while pressed, accepted after
 #    SIGUSR2.
-#  - a jog interrupted with Ctrl-C (a real-time simulator): exit 8, the position it prints is
-#    the simulator's final position, between start and target;
+#  - laser mode (S 800, full power from 20 mm/s) during a 40 mm/s jog: the largest duty the
+#    device set is 800/1000, the ramps set lower ones, the picture draws the power.
+#  - a jog interrupted with Ctrl-C (a real-time simulator): JOG_CANCEL, the device decelerates
+#    (a hold) and drops the jog without an abort; exit 8, the position it prints is the
+#    simulator's final position, between start and target;
 #  - the simulator's picture rings each event: 2 axes homed (x at physical -4 mm), 3 probe
 #    cycles, the alarms.
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
@@ -104,9 +107,23 @@ kill -USR2 "$DEVPID"
 ctl unlock >"$T/u3.out" 2>&1; rc=$?
 expect "unlock after release: exit 0 (got $rc)" [ $rc -eq 0 ]
 
+# 5. laser: S 800 of 1000, full power from 20 mm/s; a jog at 40 mm/s cruises at full power and
+# ramps below it; off after
+ctl spindle --laser --feed 20 800 >"$T/sp.out" 2>&1; rc=$?
+expect "laser on: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl jog --feed 40 -- -80 0 -1 >/dev/null 2>&1; rc=$?
+expect "laser jog: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl spindle --off >/dev/null 2>&1; rc=$?
+expect "laser off: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl spindle 1001 >/dev/null 2>&1; rc=$?
+expect "S above s_max: usage (got $rc)" [ $rc -eq 2 ]
+
 kill -TERM "$SIMPID"
 wait_until 60 gone "$SIMPID"
 wait "$SIMPID"
+expect "sim: laser at most 800/1000, ramped" \
+    grep -qE '^control: .* spindle: ([4-9]|[1-9][0-9]+) settings, largest duty 800/1000$' "$T/dev.sim"
+expect "picture: the power drawn along the jog" grep -q 'class="power"' "$T/ctl.svg"
 expect "sim: 2 axes homed, alarms counted" grep -qE '^control: 2 axes homed, [3-9] alarms' "$T/dev.sim"
 # the picture: a ring per event, blue where an axis was homed (x at physical -4 mm), green at
 # each of the 3 probe cycles' ends, red at each alarm
@@ -114,11 +131,11 @@ expect "picture: 2 homed rings" [ "$(grep -c 'class="mark".*stroke="#1919d8"' "$
 expect "picture: x homed at physical -4 mm" grep -q 'class="mark" cx="-4.0000" .*#1919d8' "$T/ctl.svg"
 expect "picture: 3 probe rings" [ "$(grep -c 'class="mark".*stroke="#19a519"' "$T/ctl.svg")" -eq 3 ]
 expect "picture: alarm rings" [ "$(grep -c 'class="mark".*stroke="#d81919"' "$T/ctl.svg")" -ge 3 ]
-# physical final position: device (-60, 0, -1) + (95, 0, 1)
-expect "sim: final position physical (35, 0, 0) mm" \
-    grep -q '^final position: x=2800 steps (35.0000 mm) y=0 steps (0.0000 mm) z=0 steps' "$T/dev.sim"
+# physical final position: device (-80, 0, -1) + (95, 0, 1)
+expect "sim: final position physical (15, 0, 0) mm" \
+    grep -q '^final position: x=1200 steps (15.0000 mm) y=0 steps (0.0000 mm) z=0 steps' "$T/dev.sim"
 
-# 5. a jog cancelled by Ctrl-C on a real-time device (no switches: the built-in machine)
+# 6. a jog cancelled by Ctrl-C on a real-time device (no switches: the built-in machine)
 timeout -k 5 120 "$SIM" --pty >"$T/rt.sim" 2>"$T/rt.simerr" &
 pids+=($!)
 RTPID=$!
@@ -137,6 +154,7 @@ sx=$(grep '^final position:' "$T/rt.sim" | sed 's/.*x=-\{0,1\}[0-9]* steps (\([-
 expect "jog cancel: stopped between start and target (x $jx)" \
     awk -v x="$jx" 'BEGIN { exit !(x >= 0 && x < 30) }'
 expect "jog cancel: the position reported is the device's final one ($jx = $sx)" near "$jx" "$sx" 0
-expect "jog cancel: the device held" grep -qE '^device: .* [1-9][0-9]* holds, 1 aborts' "$T/rt.sim"
+expect "jog cancel: decelerated (a hold), not aborted" \
+    grep -qE '^device: .* [1-9][0-9]* holds, 0 aborts' "$T/rt.sim"
 
 finish

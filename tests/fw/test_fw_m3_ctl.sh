@@ -9,7 +9,9 @@
 #    mm, 0, 1 mm) from then on;
 #  - `curvestep probe` down to z = -10: contact at pin z -240, device z -4 mm;
 #  - a jog into the x max switch: ALARM:1 with the x max bit (0x010), stopped at pin x 4000
-#    (device -45 mm); `unlock`; a jog back to -60 mm (pins 2800).
+#    (device -45 mm); `unlock`; a jog back to -60 mm (pins 2800);
+#  - `curvestep spindle --ccw 250`: the port's PWM last set to duty 250/1000, mode 2 (the alarm
+#    and `unlock` set it off before).
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
 B=${CS_BUILD:-build}
@@ -57,10 +59,14 @@ ctl unlock >"$T/u.out" 2>&1; rc=$?
 expect "unlock: exit 0 (got $rc)" [ $rc -eq 0 ]
 ctl jog --feed 50 -- -60 0 -1 >"$T/back.out" 2>&1; rc=$?
 expect "jog back: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl spindle --ccw 250 >"$T/sp.out" 2>&1; rc=$?
+expect "spindle M4 S250: exit 0 (got $rc)" [ $rc -eq 0 ]
 kill -TERM "$QPID" 2>/dev/null
 wait_until 30 gone "$QPID"
 expect "image: control line" grep -q '^fw: control: 2 axes homed, [1-9] alarms (now 0), 1 probe cycles' \
     "$T/fw.out"
+expect "image: spindle last set to duty 250/1000, counter-clockwise" \
+    grep -qE '; spindle: [0-9]+ settings, last duty 250 mode 2$' "$T/fw.out"
 expect "image: STEP/DIR pins at (2800, 0, 0)" \
     grep -q '^fw: position (STEP/DIR pins): x=2800 y=0 z=0$' "$T/fw.out"
 finish

@@ -16,24 +16,6 @@ __attribute__((section(".noinit"))) static uint32_t noise[32];
 
 static const char axis_name[4] = {'x', 'y', 'z', 'a'};
 
-/* "exit-idle=MS" anywhere on the command line. */
-static uint32_t parse_exit_idle(const char *s)
-{
-    static const char key[] = "exit-idle=";
-    for (; *s != '\0'; s++) {
-        unsigned k = 0;
-        while (key[k] != '\0' && s[k] == key[k])
-            k++;
-        if (key[k] != '\0')
-            continue;
-        uint32_t v = 0;
-        for (s += k; *s >= '0' && *s <= '9' && v < 100000000u; s++)
-            v = v * 10u + (uint32_t)(*s - '0');
-        return v;
-    }
-    return 0;
-}
-
 /* "KEY=N" (N signed decimal) anywhere on the command line: true and *v. */
 static bool parse_int(const char *cmd, const char *key, int32_t *v)
 {
@@ -54,6 +36,13 @@ static bool parse_int(const char *cmd, const char *key, int32_t *v)
         return true;
     }
     return false;
+}
+
+/* "exit-idle=MS" on the command line (0: none). */
+static uint32_t parse_exit_idle(const char *cmd)
+{
+    int32_t v;
+    return parse_int(cmd, "exit-idle=", &v) && v > 0 ? (uint32_t)v : 0u;
 }
 
 /* Simulated switches and probe for qemu (its board has none to press): "x_min=STEPS" ...
