@@ -9,6 +9,7 @@ CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_sub
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_SUBDIV_TOL_MAX, trace_tol_max_within_subdiv);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_PREDICT_TOL_MIN, trace_tol_min_covers_predict);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_PREDICT_TOL_MAX, trace_tol_max_within_predict);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MIN > CS_FD3_SLACK_LSB, trace_tol_min_covers_fd3);
 
 cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
                         cs_trace_method_t method)
@@ -28,6 +29,9 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
     } else if (method == CS_TRACE_SUBDIV || method == CS_TRACE_PREDICT) {
         tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
         e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
+    } else if (method == CS_TRACE_FD && cs_fd3_accepts(c) &&
+               (e = cs_fd3_begin(&tr->u.fd3, c, tol)) != CS_ERR_UNSUPPORTED) {
+        tr->impl = CS_TRACE_IMPL_FD3; /* planar polynomial: the specialised loop */
     } else if (method == CS_TRACE_FD) {
         tr->impl = CS_TRACE_IMPL_FD;
         e = cs_fd_begin(&tr->u.fd, c, tol);
@@ -59,6 +63,9 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
     switch (tr->impl) {
     case CS_TRACE_IMPL_FD:
         e = cs_fd_next(&tr->u.fd, pt);
+        break;
+    case CS_TRACE_IMPL_FD3:
+        e = cs_fd3_next(&tr->u.fd3, pt);
         break;
     case CS_TRACE_IMPL_AFD:
         e = cs_afd_next(&tr->u.afd, pt);

@@ -8,6 +8,7 @@
 #include "cs_afd.h"
 #include "cs_bezier.h"
 #include "cs_fd.h"
+#include "cs_fd3.h"
 #include "cs_predict.h"
 #include "cs_subdiv.h"
 
@@ -46,6 +47,7 @@ typedef enum {
     CS_TRACE_IMPL_SUBDIV_DYADIC = 2, /* not run by cs_trace any more (cs_subdiv_t directly) */
     CS_TRACE_IMPL_SUBDIV_REACH = 3,
     CS_TRACE_IMPL_PREDICT = 4,
+    CS_TRACE_IMPL_FD3 = 5, /* CS_TRACE_FD on a planar polynomial curve of degree <= 3 (cs_fd3) */
 } cs_trace_impl_t;
 
 /* The tracing state: caller-owned, fixed size (one of the engine states; no dyadic stack). */
@@ -56,6 +58,7 @@ typedef struct {
     uint32_t count; /* vertices returned so far */
     union {
         cs_fd_t fd;
+        cs_fd3_t fd3;
         cs_afd_t afd;
         cs_subdiv_reach_t reach;
         cs_predict_t pr;

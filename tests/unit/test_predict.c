@@ -69,36 +69,6 @@ static cs_err_t run(const cs_bezier_t *c, cs_pos_t tol, size_t *n)
     return e;
 }
 
-/* Largest distance (LSB) of a vertex from a curve lying on the line y = P0.y (a collinear
- * fold): exact, the curve covers the x range between its extreme x on [0, 1] (sampled finely
- * enough for its own extremes, as cs_ref_eval is exact in double). cs_ref_measure places a
- * vertex on the first piece of curve within 2 LSB after the previous one, which on a curve
- * that retraces itself may be the outgoing branch for a vertex of the returning one. */
-static double fold_vertex_error(const cs_bezier_t *c, size_t n)
-{
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k <= 100000; k++) {
-        double x = cs_ref_eval(c, k / 100000.0).x / LSB;
-        lo = fmin(lo, x);
-        hi = fmax(hi, x);
-    }
-    double worst = 0;
-    for (size_t i = 0; i < n; i++) {
-        double x = verts[i].x, dy = fabs((double)verts[i].y - c->p[0].y);
-        double dx = x < lo ? lo - x : x > hi ? x - hi : 0;
-        worst = fmax(worst, hypot(dx, dy));
-    }
-    return worst * LSB;
-}
-
-static bool collinear_x(const cs_bezier_t *c)
-{
-    for (unsigned i = 1; i <= c->degree; i++)
-        if (c->p[i].y != c->p[0].y)
-            return false;
-    return true;
-}
-
 /* The promise for one curve at one tolerance; returns the chord count. */
 static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
 {
@@ -108,8 +78,8 @@ static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
     assert_memory_equal(&verts[n - 1], &c->p[c->degree], sizeof(cs_vec3_t));
     double dev, verr;
     cs_ref_measure(c, verts, n, &dev, &verr);
-    if (collinear_x(c))
-        verr = fold_vertex_error(c, n);
+    if (cs_ref_collinear_x(c))
+        verr = cs_ref_fold_vertex_error(c, verts, n);
     double tol_mm = tol * LSB;
     if (!(dev <= tol_mm) || !(verr <= LSB)) {
         print_error("%s: tol %g mm: deviation %.9g mm, vertex error %.3g LSB (%zu chords)\n", what,
