@@ -201,7 +201,8 @@ size_t cs_fd3_fill(cs_fd3_t *f, cs_vec3_t *out, size_t max)
         return 0;
     /* Inside the piece: one pass per axis, so each recurrence (8 words) stays in registers on a
      * 32-bit core; the piece's last step by cs_fd3_next (next piece, or P_n). */
-    size_t k = f->left - 1u < max ? f->left - 1u : max;
+    uint32_t inner = f->left - 1u;
+    size_t k = inner < max ? (size_t)inner : max;
     uint64_t v = f->x, d1 = f->dx1, d2 = f->dx2, d3 = f->dx3;
     for (size_t i = 0; i < k; i++) {
         v += d1;
