@@ -40,23 +40,10 @@ static uint64_t uabs64(int64_t v)
     return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
 }
 
-/* Smallest k with v >> k < 2^bits, from the bit length of v: one count-leading-zeros
- * instruction where the compiler has it (GCC, clang: the M0 and AVR get libgcc's), else by
- * halving (6 steps). */
+/* Smallest k with v >> k < 2^bits. */
 static unsigned shift_below(uint64_t v, unsigned bits)
 {
-    unsigned n;
-#if defined(__GNUC__)
-    n = v == 0 ? 0 : 64u - (unsigned)__builtin_clzll(v);
-#else
-    n = 0;
-    for (unsigned step = 32; step != 0; step >>= 1)
-        if ((v >> step) != 0) {
-            v >>= step;
-            n += step;
-        }
-    n += (unsigned)v; /* bit length: v is now 0 or 1 */
-#endif
+    unsigned n = cs_fixed_bitlen64(v);
     return n > bits ? n - bits : 0;
 }
 

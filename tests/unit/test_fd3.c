@@ -22,6 +22,7 @@
 
 #include "cs_fd3.h"
 #include "cs_ref.h"
+#include "curve_cases.h"
 #include "cs_trace.h"
 
 #define MM(v)     ((cs_pos_t)lround((v)*65536.0))
@@ -35,25 +36,7 @@ static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static cs_vec3_t verts[MAX_VERTS];
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static double unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
 
-static cs_bezier_t make(unsigned degree, const double (*p)[2], double z)
-{
-    cs_bezier_t c;
-    memset(&c, 0, sizeof c);
-    c.degree = (uint8_t)degree;
-    for (unsigned i = 0; i <= degree; i++) {
-        c.p[i] = cs_fixed_vec(MM(p[i][0]), MM(p[i][1]), MM(z));
-        c.w[i] = CS_WEIGHT_ONE;
-    }
-    return c;
-}
 
 /* Whole-curve Wang count in double from the control points as stored (LSB):
  * ceil(sqrt(n(n-1)/8 M / (tol - slack))). */
@@ -102,15 +85,6 @@ static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
     return n;
 }
 
-static cs_bezier_t random_curve(unsigned degree, double box)
-{
-    double p[4][2];
-    for (unsigned i = 0; i <= degree; i++)
-        for (unsigned a = 0; a < 2; a++)
-            p[i][a] = (unit() * 2 - 1) * box;
-    return make(degree, (const double(*)[2])p, (unit() * 2 - 1) * 10);
-}
-
 static void test_random(void **state)
 {
     (void)state;
@@ -118,41 +92,20 @@ static void test_random(void **state)
         size_t nc = degree == 3 ? 200 : degree == 2 ? 100 : 20;
         for (int ti = 0; ti < N_TOLS; ti++)
             for (size_t k = 0; k < nc; k++) {
-                cs_bezier_t c = random_curve(degree, 100);
+                cs_bezier_t c = curve_cases_random(&rng, degree, 100);
                 assert_true(check(&c, MM(tols_mm[ti]), "random") > 0);
             }
     }
 }
 
-static const struct {
-    const char *name;
-    unsigned degree;
-    double p[4][2];
-} hard[] = {
-    {"coincident", 3, {{0, 0}, {0, 0}, {50, 20}, {50, 20}}},
-    {"all points equal", 3, {{7, 7}, {7, 7}, {7, 7}, {7, 7}}},
-    {"cusp", 3, {{0, 0}, {100, 100}, {0, 100}, {100, 0}}},
-    {"loop", 3, {{0, 0}, {150, 100}, {-50, 100}, {100, 0}}},
-    {"inflection", 3, {{0, 0}, {33, 50}, {66, -50}, {100, 0}}},
-    {"collinear fold", 3, {{0, 0}, {100, 0}, {20, 0}, {60, 0}}},
-    {"closed loop (equal ends)", 3, {{0, 0}, {80, 60}, {-80, 60}, {0, 0}}},
-    {"near-equal ends", 3, {{0, 0}, {80, 60}, {-80, 60}, {0.00002, 0}}},
-    {"2 m S", 3, {{-1000, -500}, {-300, 900}, {400, -900}, {1000, 500}}},
-    {"2 m loop", 3, {{-1000, 0}, {1500, 1500}, {-1500, 1500}, {1000, 0}}},
-    {"worst-case coordinates", 3, {{-4096, -4096}, {4096, 4096}, {-4096, 4096}, {4096, -4096}}},
-    {"1 um", 3, {{0, 0}, {0.001, 0.001}, {0.002, -0.001}, {0.003, 0}}},
-    {"line", 1, {{-30, 5}, {70, -12}}},
-    {"quadratic U turn", 2, {{0, 0}, {100, 1000}, {0.5, 0}}},
-};
-
 static void test_hard(void **state)
 {
     (void)state;
-    for (size_t i = 0; i < sizeof hard / sizeof hard[0]; i++) {
-        cs_bezier_t c = make(hard[i].degree, hard[i].p, 3);
+    for (size_t i = 0; i < curve_cases_hard_n; i++) {
+        cs_bezier_t c = curve_cases_planar(curve_cases_hard[i].degree, curve_cases_hard[i].p, 3);
         for (int ti = 0; ti < N_TOLS; ti++)
-            check(&c, MM(tols_mm[ti]), hard[i].name);
-        check(&c, CS_FD3_SLACK_LSB + 3, hard[i].name);
+            check(&c, MM(tols_mm[ti]), curve_cases_hard[i].name);
+        check(&c, CS_FD3_SLACK_LSB + 3, curve_cases_hard[i].name);
     }
 }
 
@@ -161,7 +114,7 @@ static void test_small_tol(void **state)
 {
     (void)state;
     for (int k = 0; k < 200; k++) {
-        cs_bezier_t c = random_curve(3, k < 100 ? 0.05 : 5);
+        cs_bezier_t c = curve_cases_random(&rng, 3, k < 100 ? 0.05 : 5);
         check(&c, CS_TRACE_TOL_MIN + (cs_pos_t)(k % 3), "small tolerance");
     }
 }
@@ -173,7 +126,7 @@ static void test_routing(void **state)
     (void)state;
     static cs_trace_t tr;
     static cs_fd_t g;
-    cs_bezier_t c = make(3, hard[3].p, 0);
+    cs_bezier_t c = curve_cases_planar(3, curve_cases_hard[3].p, 0);
     assert_int_equal(cs_trace_begin(&tr, &c, MM(0.01), CS_TRACE_FD), CS_OK);
     assert_int_equal(tr.impl, CS_TRACE_IMPL_FD3);
     size_t n = 0, m = 0;
@@ -207,7 +160,7 @@ static void test_fill(void **state)
     static cs_fd3_t a, b;
     static cs_vec3_t blk[MAX_VERTS];
     for (int k = 0; k < 40; k++) {
-        cs_bezier_t c = random_curve(k % 3 + 1, 100);
+        cs_bezier_t c = curve_cases_random(&rng, k % 3 + 1, 100);
         cs_pos_t tol = MM(tols_mm[k % N_TOLS]);
         assert_int_equal(cs_fd3_begin(&a, &c, tol), CS_OK);
         assert_int_equal(cs_fd3_begin(&b, &c, tol), CS_OK);
