@@ -292,13 +292,13 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
     uint32_t len = approx_len(v[2][0], v[2][1], &sh);
     uint64_t allowed = k * len, f1 = (found >> sh) + 1; /* f1 > found / 2^sh */
     *room = room_q16(allowed, f1 - 1); /* both scaled by 2^-sh */
-    /* Clear cases decided on the estimate: len <= 1.0021 |D| / 2^sh, so f1 (1 + 1/32) <=
+    /* Clear cases decided on the estimate: len <= 1.0022 |D| / 2^sh, so f1 (1 + 1/32) <=
      * allowed + 1 proves found <= 3072 T |D| (docs/fixed-point.md); a bound 1/16 above the
-     * estimate fails (len >= 0.999 |D| / 2^sh). The rest exactly on squares (128 bits):
-     * found^2 <= (3072 T)^2 dd. */
+     * estimate fails when len has 10 bits or more (then len >= 0.998 |D| / 2^sh). The rest
+     * exactly on squares (128 bits): found^2 <= (3072 T)^2 dd. */
     if (f1 + (f1 >> 5) <= allowed)
         return true;
-    if (f1 - 1 >= allowed + (allowed >> 4))
+    if (len >= 1024u && f1 - 1 >= allowed + (allowed >> 4))
         return false;
     return cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
 }
@@ -354,19 +354,38 @@ static void project(const int64_t hp[3], unsigned frac, int64_t q[2])
     }
 }
 
+/* What every trial piece of a conic from t shares: the blossom's first level at t (lerps of
+ * the homogeneous points), Q0 = b(t, t), its projection and its weight W0. */
+typedef struct {
+    int64_t l01[3], l12[3], q0[2], w0;
+} conic_start_t;
+
+static void conic_start(const cs_predict_t *p, conic_start_t *c0)
+{
+    int64_t b0[3];
+    for (unsigned k = 0; k < 3; k++) {
+        c0->l01[k] = lerp(p->h[0][k], p->h[1][k], p->t);
+        c0->l12[k] = lerp(p->h[1][k], p->h[2][k], p->t);
+        b0[k] = lerp(c0->l01[k], c0->l12[k], p->t); /* = blossom(p, t, t) */
+    }
+    project(b0, F, c0->q0);
+    c0->w0 = b0[2];
+}
+
 /* Flatness test of the conic piece [t, t + h] with control points Q0, Q1, Q2 and weights W0,
  * W1, W2: its farthest point from the chord is the shoulder, at omega/(1 + omega) of Q1's
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
+static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_t h,
+                       uint32_t *room)
 {
-    int64_t b0[3], b1[3], b2[3], q0[2], q1[2], q2[2], v[2], d[2];
+    int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
+    const int64_t *q0 = c0->q0;
     cs_param_t t1 = p->t + h;
-    blossom(p, p->t, p->t, b0);
-    blossom(p, p->t, t1, b1);
+    for (unsigned k = 0; k < 3; k++) /* b(t, t + h): the first level at t is shared */
+        b1[k] = lerp(c0->l01[k], c0->l12[k], t1);
     blossom(p, t1, t1, b2);
-    project(b0, F, q0);
     project(b1, F, q1);
     project(b2, F, q2);
     uint64_t m = 0;
@@ -375,9 +394,9 @@ static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
         d[k] = q2[k] - q0[k];
         m |= uabs64(v[k]) | uabs64(d[k]);
     }
-    unsigned s = p->thr_shift;
-    while ((m >> s) >= ((uint64_t)1 << CONIC_UNIT_BITS))
-        s++;
+    unsigned s = shift_below(m, CONIC_UNIT_BITS);
+    if (s < p->thr_shift)
+        s = p->thr_shift;
     int64_t T = (((int64_t)p->thr << F) >> s) - 2;
     if (T <= 0) {
         *room = F16_ONE / 4;
@@ -388,7 +407,7 @@ static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
         d[k] = cs_fixed_round_shift64(d[k], s);
     }
     /* phi = W1 / (W1 + sqrt(W0 W2)) rounded up to 1/256 (sqrt rounded down). */
-    uint64_t sq = cs_fixed_isqrt64((uint64_t)b0[2] * (uint64_t)b2[2]);
+    uint64_t sq = cs_fixed_isqrt64((uint64_t)c0->w0 * (uint64_t)b2[2]);
     uint64_t w1 = (uint64_t)b1[2], phi = ((w1 << 8) + w1 + sq - 1) / (w1 + sq);
     uint64_t lim = (uint64_t)T << 8, lim2 = lim * lim; /* T < 2^20: lim^2 < 2^56 */
     int64_t dd = d[0] * d[0] + d[1] * d[1], dot = v[0] * d[0] + v[1] * d[1];
@@ -434,12 +453,17 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
 static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
 {
     int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? short_of(p->h_next) : rem;
+    /* What every trial step from t shares: B'(t), B''(t)/2, or the conic's start (Q0 of each
+     * trial piece and the blossom's first level at t, computed once). */
     int64_t d[2][2] = {{0, 0}, {0, 0}};
+    conic_start_t c0; /* set and read only for a conic */
     if (!p->conic)
         derivs(p, p->t, d);
+    else
+        conic_start(p, &c0);
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
                      : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
@@ -464,7 +488,7 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
                      : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
