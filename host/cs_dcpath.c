@@ -8,7 +8,8 @@
 #define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
 #define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap */
 #define DC_PASS_MAXPTS (1u << 22)
-#define DC_WALL_D      0.05 /* mm: the step of the wall test (at_wall) */
+#define DC_WALL_D      0.05 /* mm: the step of the slope test (slope_cos) */
+#define DC_WALL_SLOPE  5    /* steeper (79 deg): a wall, left to the check's report */
 
 /* One pass being built: points along s, in increasing s. */
 typedef struct {
@@ -166,27 +167,56 @@ static bool near_rim(dc_ctx_t *c, double x, double y)
            !cs_dropcut_top(c->ms, x, y + r, &z) || !cs_dropcut_top(c->ms, x, y - r, &z);
 }
 
-/* Does a wall pass by (x, y): the mesh top rising more than 2 d over d = DC_WALL_D in one of four
- * directions (slope > 2)? The height left is not defined there (the check leaves such points
- * out too). */
-static bool at_wall(dc_ctx_t *c, double x, double y, double top)
+/* The cosine of the surface's slope at (x, y) (central differences of the mesh top over
+ * DC_WALL_D), or 0 on a wall: the top rising or falling more than DC_WALL_SLOPE d over d in one of
+ * four directions. The height left, measured vertically, times it is the scallop across the
+ * surface (for a plane exactly: the vertical through a point meets the envelope 1 / cos above
+ * it); the check (cs_dropcheck.h) measures the distance to the cutters, never more. */
+static double slope_cos(dc_ctx_t *c, double x, double y, double top, double g[2])
 {
     static const double dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    double z[4];
     for (int i = 0; i < 4; i++) {
-        double z;
-        if (cs_dropcut_top(c->ms, x + DC_WALL_D * dx[i], y + DC_WALL_D * dy[i], &z) &&
-            z > top + 2 * DC_WALL_D)
-            return true;
+        if (!cs_dropcut_top(c->ms, x + DC_WALL_D * dx[i], y + DC_WALL_D * dy[i], &z[i]))
+            z[i] = top;
+        if (fabs(z[i] - top) > DC_WALL_SLOPE * DC_WALL_D)
+            return 0;
     }
-    return false;
+    double gx = (z[0] - z[1]) / (2 * DC_WALL_D), gy = (z[2] - z[3]) / (2 * DC_WALL_D);
+    g[0] = gx;
+    g[1] = gy;
+    return 1 / sqrt(1 + gx * gx + gy * gy);
+}
+
+/* The cross offset of the axis of a cutter touching the surface at cross offset wp where its
+ * slope is g (the contact normal n = (-g, 1) / |(-g, 1)|): the axis stands at q + r n_xy +
+ * (R - r) n_xy / |n_xy| (the corner centre along the normal, the axis R - r beyond it). */
+static double contact_axis(const dc_ctx_t *c, double wp, const double g[2])
+{
+    double gl = sqrt(g[0] * g[0] + g[1] * g[1]);
+    if (gl < 1e-12)
+        return wp;
+    double ge = (g[0] * c->e[0] + g[1] * c->e[1]) / gl; /* uphill, across the passes */
+    double off = c->t->c_mm * gl / sqrt(1 + gl * gl) + (c->t->r_mm - c->t->c_mm);
+    return wp - off * ge;
+}
+
+/* The gap (lines g, g + 1) holding cross offset w, or SIZE_MAX. */
+static size_t gap_of(const double *ws, size_t n, double w)
+{
+    for (size_t g = 0; g + 1 < n; g++)
+        if (ws[g] <= w && w < ws[g + 1])
+            return g;
+    return (size_t)-1;
 }
 
 /* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
  * with the cutters of every line within R of the point (at the same along-pass position); *cusp
- * gets the gap (the lower of the two lines) whose cutters meet at the worst point: on a slope
- * that is not gap i, for each cutter touches the surface uphill of its axis. */
+ * gets the gap to refine for the worst point: the gap holding the axis of a cutter that touches
+ * the surface there (on a slope not gap i: each cutter touches the surface uphill of its axis),
+ * else the gap next to the lowest cutter, towards the second lowest. */
 static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w, size_t n,
-                           size_t i, size_t *cusp)
+                           size_t i, double min_gap, size_t *cusp, double *stuck)
 {
     const dc_line_t *a = &lines[i], *b = &lines[i + 1];
     const dc_line_t *fine = a->n >= b->n ? a : b;
@@ -217,15 +247,23 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
                     env2 = e, j2 = j;
                 }
             }
-            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top;
+            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top, cs;
+            double g[2];
             if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y) ||
-                at_wall(c, x, y, top))
+                (cs = slope_cos(c, x, y, top, g)) == 0)
                 continue; /* the scallop is promised where the cutter lies over the surface */
-            double left = env - fmax(top, c->o->min_z);
+            double left = (env - fmax(top, c->o->min_z)) * cs;
             if (left > worst) {
+                size_t ga = gap_of(w, n, contact_axis(c, wp, g));
+                ga = ga != (size_t)-1 ? ga : j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+                if (ga + 1 >= n || w[ga + 1] - w[ga] < 2 * min_gap) {
+                    /* no pass can be added there: rest material (a slot narrower than the
+                     * cutter, a corner) or a wall; reported, not chased */
+                    *stuck = fmax(*stuck, left);
+                    continue;
+                }
                 worst = left;
-                /* the gap next to the lowest cutter, towards the second lowest */
-                *cusp = j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+                *cusp = ga;
             }
         }
     }
@@ -309,13 +347,12 @@ static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double m
     cs_err_t e = CS_OK;
     for (size_t i = 0; i + 1 < set->n && e == CS_OK;) {
         size_t g;
-        double left = left_between(c, set->l, set->w, set->n, i, &g);
-        if (g + 1 >= set->n)
-            g = i;
-        if (left <= need || set->w[g + 1] - set->w[g] < 2 * min_gap ||
-            set->n >= c->o->max_passes) {
+        double stuck = 0;
+        double left = left_between(c, set->l, set->w, set->n, i, min_gap, &g, &stuck);
+        if (left <= need || set->n >= c->o->max_passes) {
             p->capped |= left > need && set->n >= c->o->max_passes;
             p->max_left = fmax(p->max_left, left);
+            p->max_stuck = fmax(p->max_stuck, stuck);
             i++;
             continue;
         }

@@ -37,6 +37,7 @@ typedef struct {
     double *w;         /* pass k's cross offset, mm */
     size_t npass, pcap;
     double max_left;   /* largest estimated scallop left between passes, mm */
+    double max_stuck;  /* largest left where no pass can be added (rest material, walls), mm */
     size_t refined;    /* passes added by the scallop check */
     bool capped;       /* max_passes was reached */
     size_t drops;      /* drop-cutter queries made */

@@ -11,7 +11,14 @@
  * surface's projection): nearer the rim the floor (--min-z) or the rim itself holds the cutter
  * up, and beyond it is no material of the part; and not at nodes a wall passes through (a
  * sample nearest the node stands more than two steps above the rasterised top: slope > 2, where
- * a height measured vertically means nothing). Host only. */
+ * a height measured vertically means nothing).
+ *  - rest material: where more than H is left, the check asks whether any cutter from above could
+ *    do better: the ideal envelope (the cutter dropped onto the rasterised top at every position
+ *    of a 0.1 mm lattice within R, the lowest of their surfaces over the node) is a grayscale
+ *    closing of the top by the cutter. What the ideal leaves above the surface is rest material
+ *    (slots narrower than the cutter, the foot of a wall, the gap between the teapot's lid and
+ *    its rim): reported apart as unreachable; the scallop there is what the path leaves above
+ *    the ideal envelope. Host only. */
 #ifndef CS_DROPCHECK_H
 #define CS_DROPCHECK_H
 
@@ -28,12 +35,16 @@ typedef struct {
     double scallop_at[2]; /* where */
     size_t surf_samples, path_samples, nodes;
     size_t walls; /* nodes left out of the scallop: a wall passes through them */
+    size_t rest_nodes; /* nodes where even the ideal cutter leaves more than H: unreachable */
+    double rest_mm;    /* the deepest such rest material, mm */
+    double rest_at[2]; /* where */
 } cs_dropcheck_t;
 
 /* Checks the passes (tip points pts[start[k] .. start[k + 1]), k < npass, mm) of tool t over sf
- * within the region box (x0 y0 x1 y1) at sampling step step_mm. CS_ERR_FULL out of memory. */
+ * within the region box (x0 y0 x1 y1) at sampling step step_mm; nodes left more than h_mm get
+ * the ideal envelope (rest material). CS_ERR_FULL out of memory. */
 cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, cs_dropcheck_t *out);
+                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out);
 
 #endif

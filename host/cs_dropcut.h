@@ -50,6 +50,10 @@ typedef struct {
     size_t *idx;      /* triangle numbers, by cell */
     unsigned *stamp;  /* per triangle: the query that last visited it */
     unsigned query;   /* the current query's number */
+    double (*bb)[5];  /* per triangle: x0 y0 x1 y1 of its xy box and its highest z, mm */
+    double *ctop;     /* per cell: the highest z of the triangles listed in it, mm */
+    struct cs_dropcut_cq *cq; /* scratch: the cells of one query's footprint, by bound */
+    size_t cqcap;
 } cs_dropcut_mesh_t;
 
 /* Height of the profile of tool t at horizontal distance d (0 <= d <= R) above its tip, mm. */

@@ -191,7 +191,7 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
     cs_dropcheck_t ck;
     double step = a->check_step > 0 ? a->check_step : 0.05;
     cs_err_t e = cs_dropcheck_run(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass,
-                                  a->po.box, step, &ck);
+                                  a->po.box, step, a->po.scallop_mm, &ck);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep toolpath: check: out of memory\n");
         return CS_EXIT_INTERNAL;
@@ -201,6 +201,12 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
             "%zu on walls left out): gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
             step, ck.surf_samples, ck.path_samples, ck.nodes, ck.walls, ck.gouge_mm, ck.scallop_mm,
             ck.scallop_at[0], ck.scallop_at[1]);
+    if (ck.rest_nodes > 0)
+        fprintf(stderr,
+                "toolpath: check: unreachable: %zu nodes (%.2f mm^2) where no cutter of this shape "
+                "reaches from above, up to %.4f mm of rest material at (%.3f, %.3f)\n",
+                ck.rest_nodes, (double)ck.rest_nodes * step * step, ck.rest_mm, ck.rest_at[0],
+                ck.rest_at[1]);
     /* The scallop is a promise for a ball only (cs_dcpath.h); flat and bull-nose report it. */
     bool ball = a->tool.c_mm >= a->tool.r_mm;
     bool gouged = ck.gouge_mm > a->tol, high = ball && ck.scallop_mm > a->po.scallop_mm;
@@ -258,9 +264,10 @@ static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
         fprintf(stderr,
                 "toolpath: %s cutter R %g mm corner %g mm: mesh %zu triangles within %.6f mm, %zu "
                 "passes (%zu added for the scallop), %zu points, %zu drops, estimated scallop "
-                "%.6f mm (nan: not estimated, flat or bull-nose)\n",
+                "%.6f mm (nan: not estimated), %.6f mm where no pass can be added (rest material, "
+                "walls)\n",
                 a->tool_kind, a->tool.r_mm, a->tool.c_mm, ms.ntri, ms.eps, p.npass, p.refined, p.n,
-                p.drops, p.max_left);
+                p.drops, p.max_left, p.max_stuck);
     if (status == CS_EXIT_OK) {
         write_points(a, &p);
         if (a->gcode && !write_gcode(a, &p, safe)) {
