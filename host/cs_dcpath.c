@@ -412,6 +412,40 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
     return e;
 }
 
+/* Does the straight move a -> b keep the cutter no lower than the drop height less slack? */
+static bool link_clear(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, const double a[3],
+                       const double b[3], double step, double slack)
+{
+    double len = hypot(b[0] - a[0], b[1] - a[1]);
+    size_t n = (size_t)ceil(len / step) + 1;
+    for (size_t k = 0; k <= n; k++) {
+        double f = (double)k / (double)n, z = a[2] + f * (b[2] - a[2]);
+        bool hit;
+        double d = cs_dropcut_drop(ms, t, a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), &hit);
+        if (hit && d - slack > z)
+            return false;
+    }
+    return true;
+}
+
+void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                    double step_mm, double tol_mm)
+{
+    size_t out = 0; /* passes kept: pass k joins pass out - 1 or starts anew */
+    for (size_t k = 0; k < p->npass; k++) {
+        size_t s0 = p->start[k], s1 = p->start[k + 1];
+        bool join = out > 0 && s1 > s0 &&
+                    link_clear(ms, t, p->pt[s0 - 1], p->pt[s0], step_mm, tol_mm / 2);
+        if (join) {
+            p->links++;
+        } else {
+            p->start[out++] = s0;
+        }
+    }
+    p->start[out] = p->n;
+    p->npass = out;
+}
+
 void cs_dcpath_free(cs_dcpath_t *p)
 {
     free(p->pt);

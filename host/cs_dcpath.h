@@ -41,6 +41,7 @@ typedef struct {
     size_t refined;    /* passes added by the scallop check */
     bool capped;       /* max_passes was reached */
     size_t drops;      /* drop-cutter queries made */
+    size_t links;      /* passes joined to the one before at cutting height (cs_dcpath_link) */
 } cs_dcpath_t;
 
 void cs_dcpath_init(cs_dcpath_t *p);
@@ -50,6 +51,12 @@ double cs_dcpath_step(const cs_dropcut_tool_t *t, double h);
  * CS_ERR_FULL out of memory, CS_ERR_RANGE for a region or step that makes no sense. */
 cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                           const cs_dcpath_opts_t *o);
+/* Joins each pass to the one before it where the straight move between the end of one and the
+ * start of the next stays within tol_mm / 2 of the drop-cutter height of tool t or above it
+ * (sampled every step_mm along the move; the passes' own chords are held to the same): one
+ * polyline, no retract. The passes keep their order. */
+void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                    double step_mm, double tol_mm);
 void cs_dcpath_free(cs_dcpath_t *p);
 
 #endif

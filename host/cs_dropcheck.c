@@ -85,7 +85,49 @@ static void splat(ck_t *k, const double *p)
         k->peak[n] = fmax(k->peak[n], p[2]);
 }
 
-/* Samples one patch densely: points for the gouge test, triangles into the top map. */
+typedef void (*ck_eval_fn)(const void *ctx, double u, double v, double p[3]);
+
+static void eval_patch(const void *ctx, double u, double v, double p[3])
+{
+    cs_finish_eval(ctx, u, v, p, NULL);
+}
+
+/* The sphere in the seed's parametrisation (cs_sphere.h), u and v in [0, 1]. */
+static void eval_sphere(const void *ctx, double u, double v, double p[3])
+{
+    const cs_sphere_t *s = ctx;
+    double lat = -M_PI / 2 + M_PI * u, lon = 2 * M_PI * v;
+    p[0] = s->c[0] + s->r * cos(lat) * cos(lon);
+    p[1] = s->c[1] + s->r * cos(lat) * sin(lon);
+    p[2] = s->c[2] + s->r * sin(lat);
+}
+
+/* Samples one surface on a (nu + 1) x (nv + 1) grid: points for the gouge test, triangles into
+ * the top map. */
+static cs_err_t sample_grid(ck_t *k, ck_eval_fn ev, const void *ctx, int nu, int nv)
+{
+    double *row = malloc(2 * (size_t)(nv + 1) * 3 * sizeof *row);
+    if (!row)
+        return CS_ERR_FULL;
+    cs_err_t e = CS_OK;
+    for (int i = 0; i <= nu && e == CS_OK; i++) {
+        double *cur = row + (size_t)(i & 1) * (size_t)(nv + 1) * 3;
+        double *prev = row + (size_t)((i + 1) & 1) * (size_t)(nv + 1) * 3;
+        for (int j = 0; j <= nv && e == CS_OK; j++) {
+            ev(ctx, (double)i / nu, (double)j / nv, &cur[j * 3]);
+            e = push_sample(k, &cur[j * 3]);
+            splat(k, &cur[j * 3]);
+        }
+        for (int j = 0; i > 0 && j < nv; j++) {
+            raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
+            raster_tri(k, &prev[j * 3], &cur[(j + 1) * 3], &prev[(j + 1) * 3]);
+        }
+    }
+    free(row);
+    return e;
+}
+
+/* A patch: as many samples each way as its control box's diagonal has steps. */
 static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
 {
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -101,25 +143,14 @@ static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
     double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
     int kk = (int)fmin(CK_MAX_K, fmax(8, ceil(diag / k->step)));
-    double *row = malloc(2 * (size_t)(kk + 1) * 3 * sizeof *row);
-    if (!row)
-        return CS_ERR_FULL;
-    cs_err_t e = CS_OK;
-    for (int i = 0; i <= kk && e == CS_OK; i++) {
-        double *cur = row + (size_t)(i & 1) * (size_t)(kk + 1) * 3;
-        double *prev = row + (size_t)((i + 1) & 1) * (size_t)(kk + 1) * 3;
-        for (int j = 0; j <= kk && e == CS_OK; j++) {
-            cs_finish_eval(q, (double)i / kk, (double)j / kk, &cur[j * 3], NULL);
-            e = push_sample(k, &cur[j * 3]);
-            splat(k, &cur[j * 3]);
-        }
-        for (int j = 0; i > 0 && j < kk; j++) {
-            raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
-            raster_tri(k, &prev[j * 3], &cur[(j + 1) * 3], &prev[(j + 1) * 3]);
-        }
-    }
-    free(row);
-    return e;
+    return sample_grid(k, eval_patch, q, kk, kk);
+}
+
+/* A sphere: a meridian's half circle and the equator at spacing <= step. */
+static cs_err_t sample_sphere(ck_t *k, const cs_sphere_t *s)
+{
+    int nu = (int)fmin(CK_MAX_K, fmax(8, ceil(M_PI * s->r / k->step)));
+    return sample_grid(k, eval_sphere, s, nu, 2 * nu);
 }
 
 static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
@@ -132,9 +163,11 @@ static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
         const cs_surf_item_t *it = &sf->items[i];
         size_t nc = 1;
         double fit;
-        if (it->sphere)
-            e = CS_ERR_UNSUPPORTED;
-        else if (it->tri)
+        if (it->sphere) {
+            e = sample_sphere(k, &it->sph);
+            continue;
+        }
+        if (it->tri)
             e = cs_finish_tri_patch(&it->trip, &cells[0]);
         else if (it->varady)
             e = cs_varady_patches(&it->nside, k->step / 4, cells, NULL, CS_VARADY_MAX_PATCHES, &nc,
@@ -360,16 +393,34 @@ static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy)
     return best;
 }
 
+/* Is there a wall at node n: the rasterised top of a neighbour more than CK_WALL steps above or
+ * below (slope > CK_WALL, the planner's own bound, cs_dcpath.h), or a sample of the node's cell
+ * that far above the top (a thin lip seen through)? The raster does not promise its scallop
+ * there; such nodes are counted apart. */
+static bool wall_at(const ck_t *k, size_t n)
+{
+    long ix = (long)(n % k->mx), iy = (long)(n / k->mx);
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    double lim = CK_WALL * k->step;
+    if (k->peak[n] > k->top[n] + lim)
+        return true;
+    for (int i = 0; i < 4; i++) {
+        size_t m = node(k, ix + dx[i], iy + dy[i]);
+        if (m != (size_t)-1 && k->top[m] > -HUGE_VAL && fabs(k->top[m] - k->top[n]) > lim)
+            return true;
+    }
+    return false;
+}
+
 /* The scallop and rest material over every node with the cutter over the surface all round. */
 static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *far, double h_mm,
                     cs_dropcheck_t *out)
 {
     for (size_t n = 0; n < k->mx * k->my; n++) {
-        /* A wall through the node's cell (a sample rising more than CK_WALL steps above the
-         * rasterised top): the top there is not the surface the cutter meets. */
-        bool wall = k->peak[n] > k->top[n] + CK_WALL * k->step;
-        if (k->top[n] == -HUGE_VAL || !far[n] || wall) {
-            out->walls += wall && k->top[n] > -HUGE_VAL && far[n];
+        if (k->top[n] == -HUGE_VAL || !far[n])
+            continue;
+        if (wall_at(k, n)) {
+            out->walls++;
             continue;
         }
         out->nodes++;

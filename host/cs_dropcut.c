@@ -130,13 +130,66 @@ static cs_err_t mesh_patch(cs_dropcut_mesh_t *ms, const cs_patch_t *q, double ep
     return e;
 }
 
+/* Circumradius of triangle a b c (half the longest edge when degenerate), mm. */
+static double circumradius(const double a[3], const double b[3], const double c[3])
+{
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = c[k] - b[k];
+    }
+    double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    double lu = norm3(u), lv = norm3(v), lw = norm3(w), a2 = norm3(n); /* a2: twice the area */
+    if (a2 < 1e-15 * fmax(lu * lv, 1e-300))
+        return fmax(fmax(lu, lv), lw) / 2;
+    return lu * lv * lw / (2 * a2);
+}
+
+/* A sphere (centre c, radius r) on a latitude-longitude grid fine enough for eps: every point of
+ * the sphere projects radially into the triangle whose cap holds it, at most the cap's height
+ * r - sqrt(r^2 - rho^2) away (rho the triangle's circumradius); *eps_out gets the largest. The
+ * angular step 2 sqrt(eps / r) makes a cell's half-diagonal about sqrt(2 eps r). */
+static cs_err_t mesh_sphere(cs_dropcut_mesh_t *ms, const cs_sphere_t *sp, double eps,
+                            double *eps_out)
+{
+    double r = sp->r, step = 2 * sqrt(eps / r);
+    int nlat = (int)fmin(DC_GRID_MAX, fmax(4, ceil(M_PI / step)));
+    int nlon = 2 * nlat;
+    double prev[2 * DC_GRID_MAX + 1][3], cur[2 * DC_GRID_MAX + 1][3];
+    cs_err_t e = CS_OK;
+    *eps_out = 0;
+    for (int i = 0; i <= nlat && e == CS_OK; i++) {
+        double u = -M_PI / 2 + M_PI * i / nlat;
+        for (int j = 0; j <= nlon; j++) {
+            double w = 2 * M_PI * j / nlon;
+            cur[j][0] = sp->c[0] + r * cos(u) * cos(w);
+            cur[j][1] = sp->c[1] + r * cos(u) * sin(w);
+            cur[j][2] = sp->c[2] + r * sin(u);
+        }
+        for (int j = 0; i > 0 && j < nlon && e == CS_OK; j++) {
+            const double *t[2][3] = {{prev[j], cur[j], cur[j + 1]}, {prev[j], cur[j + 1], prev[j + 1]}};
+            for (int k = 0; k < 2 && e == CS_OK; k++) {
+                double rho = fmin(circumradius(t[k][0], t[k][1], t[k][2]), r);
+                *eps_out = fmax(*eps_out, r - sqrt(r * r - rho * rho));
+                e = cs_dropcut_add(ms, t[k][0], t[k][1], t[k][2]);
+            }
+        }
+        memcpy(prev, cur, sizeof prev);
+    }
+    return e;
+}
+
 /* The tensor patches of one item: itself, its collapsed tensor form, or fitted cells. */
 static cs_err_t mesh_item(cs_dropcut_mesh_t *ms, const cs_surf_item_t *it, double eps,
                           double fit_mm, cs_patch_t *cells)
 {
     double pe = 0;
-    if (it->sphere) /* no Bézier form to bound (cs_sphere): not meshed yet */
-        return CS_ERR_UNSUPPORTED;
+    if (it->sphere) {
+        cs_err_t e = mesh_sphere(ms, &it->sph, eps, &pe);
+        ms->eps = fmax(ms->eps, pe);
+        return e;
+    }
     if (it->tri) {
         cs_patch_t tq;
         cs_err_t e = cs_finish_tri_patch(&it->trip, &tq);
