@@ -6,7 +6,8 @@
 #include <string.h>
 
 #define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
-#define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap */
+#define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap, at least */
+#define DC_SCAN_MAX    64 /* cross points in one gap, at most */
 #define DC_PASS_MAXPTS (1u << 22)
 #define DC_WALL_D      0.05 /* mm: the step of the slope test (slope_cos) */
 #define DC_WALL_SLOPE  5    /* steeper (79 deg): a wall, left to the check's report */
@@ -229,10 +230,13 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
         lo--;
     while (hi + 1 < n && w[hi + 1] - w[i + 1] <= r)
         hi++;
+    /* Across the gap at least every min_gap (a flat end's step changes abruptly where a
+     * neighbour's rim passes), at least DC_SCAN_FRACS points, at most DC_SCAN_MAX. */
+    int nf = (int)fmin(DC_SCAN_MAX, fmax(DC_SCAN_FRACS, ceil((w[i + 1] - w[i]) / min_gap)));
     for (size_t k = 0; k < fine->n; k++) {
         double s = fine->s[k];
-        for (int f = 1; f <= DC_SCAN_FRACS; f++) {
-            double wp = w[i] + (w[i + 1] - w[i]) * f / (DC_SCAN_FRACS + 1.0);
+        for (int f = 1; f <= nf; f++) {
+            double wp = w[i] + (w[i + 1] - w[i]) * f / (nf + 1.0);
             double env = HUGE_VAL, env2 = HUGE_VAL;
             size_t j1 = i, j2 = i + 1;
             for (size_t j = lo; j <= hi; j++) {
@@ -252,7 +256,10 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
             if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y) ||
                 (cs = slope_cos(c, x, y, top, g)) == 0)
                 continue; /* the scallop is promised where the cutter lies over the surface */
-            double left = (env - fmax(top, c->o->min_z)) * cs;
+            /* A ball's envelope runs parallel to the surface: across it the height left is the
+             * vertical one times cos. A flat or bull-nose end's bottom is level, not parallel:
+             * the vertical height bounds the distance to it (the check's measure). */
+            double left = (env - fmax(top, c->o->min_z)) * (c->t->c_mm >= c->t->r_mm ? cs : 1);
             if (left > worst) {
                 size_t ga = gap_of(w, n, contact_axis(c, wp, g));
                 ga = ga != (size_t)-1 ? ga : j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
@@ -343,7 +350,9 @@ static cs_err_t set_insert(dc_set_t *set, size_t at, dc_line_t *l, double w)
  * than the cutter: reported by max_left). */
 static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double min_gap)
 {
-    double need = c->o->scallop_mm - c->ms->eps;
+    /* The mesh stands up to eps off the surface and a pass's chords up to tol / 2 off the drop
+     * height (refine): both may add to what the cutters leave. */
+    double need = c->o->scallop_mm - c->ms->eps - c->o->tol_mm / 2;
     cs_err_t e = CS_OK;
     for (size_t i = 0; i + 1 < set->n && e == CS_OK;) {
         size_t g;
@@ -394,10 +403,11 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
         if (e == CS_OK)
             e = set_insert(&set, set.n, &l, w);
     }
-    /* Only a ball's scallop is a matter of step-over alone: a flat or bull-nose end leaves
-     * steps on every slope, whatever the spacing (their step-over is stated, not refined). */
-    if (e == CS_OK && o->step_mm <= 0 && t->c_mm >= t->r_mm)
-        e = refine_gaps(p, &c, &set, step / 16);
+    /* Every cutter's gaps are refined: a flat or bull-nose end leaves a step on a slope about
+     * the slope times the gap, which the refinement brings under H like a ball's cusp. The
+     * least gap: a sixteenth of a ball's flat-ground step of the same radius. */
+    if (e == CS_OK && o->step_mm <= 0)
+        e = refine_gaps(p, &c, &set, 2 * sqrt(2 * t->r_mm * o->scallop_mm) / 16);
     else if (e == CS_OK)
         p->max_left = NAN;
     for (size_t k = 0; k < set.n; k++) {

@@ -208,9 +208,7 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
                 "reaches from above, up to %.4f mm of rest material at (%.3f, %.3f)\n",
                 ck.rest_nodes, (double)ck.rest_nodes * step * step, ck.rest_mm, ck.rest_at[0],
                 ck.rest_at[1]);
-    /* The scallop is a promise for a ball only (cs_dcpath.h); flat and bull-nose report it. */
-    bool ball = a->tool.c_mm >= a->tool.r_mm;
-    bool gouged = ck.gouge_mm > a->tol, high = ball && ck.scallop_mm > a->po.scallop_mm;
+    bool gouged = ck.gouge_mm > a->tol, high = ck.scallop_mm > a->po.scallop_mm;
     if (gouged)
         fprintf(stderr,
                 "toolpath: check FAILED: the cutter enters the surface by %.6f mm at (%.3f, %.3f, "
