@@ -38,11 +38,11 @@ QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none 
 # value NAME FILE SED-EXPR: the last match of a report line (for messages).
 value() { sed -n "$2" "$1" | tail -n1; }
 
-# start_fw NAME: qemu in the background (90 s at most), PTY = the guest UART's pty.
+# start_fw NAME: qemu in the background (600 s at most: the hold case alone may wait 480 s on a loaded machine), PTY = the guest UART's pty.
 start_fw() {
     local name=$1
     # qemu prints the pty on stdout, the semihosting console goes to stderr: one file
-    timeout -k 5 300 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
+    timeout -k 5 600 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
     QPID=$!
     pids+=("$QPID")
     PTY=
@@ -156,7 +156,9 @@ timeout --foreground -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-r
     --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
-sleep 2
+# interrupt once the image has executed something (an event, not a guess of how long that takes
+# on a loaded machine): the host's progress line names executed segments
+wait_until 120 grep -q '^stream: [1-9][0-9]*/' "$T/int.err"
 kill -INT "$spid"
 wait "$spid"
 rc=$?
