@@ -1,17 +1,20 @@
 /* cs_dcpath: raster finishing passes over a drop-cutter mesh (issue 20). Owns the passes: each
  * a polyline of tool-tip points (mm) along a line of the raster, sampled adaptively so that the
  * chords stay within tol of the drop-cutter height along the line, and spaced so that the
- * height of material left between two neighbouring passes (measured vertically above the mesh,
- * which is within eps of the surface) stays at most H. Host only, double precision.
+ * scallop between neighbouring passes, measured across the surface, stays at most H. Host only,
+ * double precision.
  *
  * Spacing: the nominal step-over is the flat-ground one (ball 2 sqrt(2RH - H^2); bull-nose
  * 2(R - r) + 2 sqrt(2rH - H^2); flat end mill 2R x 0.9), then every neighbouring pair is checked
- * at cross fractions 1/8 .. 7/8 of the gap and every sample of the finer pass: the cutter of each
- * pass at the same along-pass position leaves E = min(zA + h(f w), zB + h((1 - f) w)) above the
- * mesh top S; where E - S > H - eps a pass is added halfway between the two cutters that meet
- * at the worst point. Cutters at other along-pass positions only cut more, so the estimate is
- * conservative. Points within R of the rim of the surface's projection and points on a wall
- * (slope > 2) are left out, as in the check (cs_dropcheck.h). */
+ * at cross points (at least 7, no farther apart than the least gap) and every sample of the
+ * finer pass: the cutters of the passes within R at the same along-pass position leave
+ * E = min(z_j + h(|w_j - w|)) above the mesh top S; the scallop is (E - S) cos(slope) for a ball
+ * (its envelope is parallel to the surface), E - S for a flat or bull-nose end (a level bottom).
+ * Where it exceeds H - eps - tol / 2 a pass is added in the gap holding the axis of a cutter
+ * touching the surface there (r sin(slope) + R - r downhill of the point). Points whose gap is at
+ * the least width (rest material, walls) are reported, not chased. Cutters at other along-pass
+ * positions only cut more, so the estimate is conservative. Points within R of the rim of the
+ * surface's projection and on walls (slope > 5) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H
 

@@ -3,22 +3,21 @@
  * the patch evaluator: the surface is sampled on a dense (u, v) grid of every patch, in double.
  *  - gouge: along the path (every chord sampled at spacing <= step), the deepest a surface
  *    sample lies inside the cutter's solid, measured vertically (tip + h(d) - z < 0);
- *  - scallop: on a z-map of the region (spacing step), the lowest cutter surface over each node
- *    (the envelope of every sampled cutter position) minus the surface's top at the node (its
- *    dense triangles rasterised into the map): the height of material left, vertically.
+ *  - scallop: on a z-map of the region (spacing step, the surface's dense triangles
+ *    rasterised into it), the distance from the surface point over each node to the nearest
+ *    sampled cutter position's solid (closed form: the solid is convex), capped at twice H.
  * Both are estimates from samples: a finer step only finds more. The scallop is measured where
  * the cutter lies over the surface all round (nodes farther than R from the rim of the
  * surface's projection): nearer the rim the floor (--min-z) or the rim itself holds the cutter
- * up, and beyond it is no material of the part; and not at nodes a wall passes through (a
- * sample nearest the node stands more than two steps above the rasterised top: slope > 2, where
- * a height measured vertically means nothing).
- *  - rest material: where more than H is left, the check asks whether any cutter from above could
- *    do better: the ideal envelope (the cutter dropped onto the rasterised top at every position
- *    of a 0.1 mm lattice within R, the lowest of their surfaces over the node) is a grayscale
- *    closing of the top by the cutter. What the ideal leaves above the surface is rest material
- *    (slots narrower than the cutter, the foot of a wall, the gap between the teapot's lid and
- *    its rim): reported apart as unreachable; the scallop there is what the path leaves above
- *    the ideal envelope. Host only. */
+ * up, and beyond it is no material of the part; and not on walls (a neighbour's top more than
+ * 5 steps away, slope > 5 as the planner's bound, or a sample of the node's cell that far above
+ * the top: a thin lip seen through), counted apart.
+ *  - rest material: where more than H is left, the check asks how near any cutter from above
+ *    could come: the cutter dropped onto the rasterised top at every position of a 0.1 mm
+ *    lattice within R + cap (a grayscale closing of the top by the cutter). Where even that
+ *    ideal cutter stays more than H away (slots narrower than the cutter, the foot of a wall, the
+ *    gap between the teapot's lid and its rim) the node is unreachable: reported apart; its
+ *    scallop is what the path leaves beyond the ideal. Host only. */
 #ifndef CS_DROPCHECK_H
 #define CS_DROPCHECK_H
 
