@@ -6,9 +6,11 @@
 #include <string.h>
 
 #define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
-#define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap */
+#define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap, at least */
+#define DC_SCAN_MAX    64 /* cross points in one gap, at most */
 #define DC_PASS_MAXPTS (1u << 22)
-#define DC_WALL_D      0.05 /* mm: the step of the wall test (at_wall) */
+#define DC_WALL_D      0.05 /* mm: the step of the slope test (slope_cos) */
+#define DC_WALL_SLOPE  5    /* steeper (79 deg): a wall, left to the check's report */
 
 /* One pass being built: points along s, in increasing s. */
 typedef struct {
@@ -166,27 +168,56 @@ static bool near_rim(dc_ctx_t *c, double x, double y)
            !cs_dropcut_top(c->ms, x, y + r, &z) || !cs_dropcut_top(c->ms, x, y - r, &z);
 }
 
-/* Does a wall pass by (x, y): the mesh top rising more than 2 d over d = DC_WALL_D in one of four
- * directions (slope > 2)? The height left is not defined there (the check leaves such points
- * out too). */
-static bool at_wall(dc_ctx_t *c, double x, double y, double top)
+/* The cosine of the surface's slope at (x, y) (central differences of the mesh top over
+ * DC_WALL_D), or 0 on a wall: the top rising or falling more than DC_WALL_SLOPE d over d in one of
+ * four directions. The height left, measured vertically, times it is the scallop across the
+ * surface (for a plane exactly: the vertical through a point meets the envelope 1 / cos above
+ * it); the check (cs_dropcheck.h) measures the distance to the cutters, never more. */
+static double slope_cos(dc_ctx_t *c, double x, double y, double top, double g[2])
 {
     static const double dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    double z[4];
     for (int i = 0; i < 4; i++) {
-        double z;
-        if (cs_dropcut_top(c->ms, x + DC_WALL_D * dx[i], y + DC_WALL_D * dy[i], &z) &&
-            z > top + 2 * DC_WALL_D)
-            return true;
+        if (!cs_dropcut_top(c->ms, x + DC_WALL_D * dx[i], y + DC_WALL_D * dy[i], &z[i]))
+            z[i] = top;
+        if (fabs(z[i] - top) > DC_WALL_SLOPE * DC_WALL_D)
+            return 0;
     }
-    return false;
+    double gx = (z[0] - z[1]) / (2 * DC_WALL_D), gy = (z[2] - z[3]) / (2 * DC_WALL_D);
+    g[0] = gx;
+    g[1] = gy;
+    return 1 / sqrt(1 + gx * gx + gy * gy);
+}
+
+/* The cross offset of the axis of a cutter touching the surface at cross offset wp where its
+ * slope is g (the contact normal n = (-g, 1) / |(-g, 1)|): the axis stands at q + r n_xy +
+ * (R - r) n_xy / |n_xy| (the corner centre along the normal, the axis R - r beyond it). */
+static double contact_axis(const dc_ctx_t *c, double wp, const double g[2])
+{
+    double gl = sqrt(g[0] * g[0] + g[1] * g[1]);
+    if (gl < 1e-12)
+        return wp;
+    double ge = (g[0] * c->e[0] + g[1] * c->e[1]) / gl; /* uphill, across the passes */
+    double off = c->t->c_mm * gl / sqrt(1 + gl * gl) + (c->t->r_mm - c->t->c_mm);
+    return wp - off * ge;
+}
+
+/* The gap (lines g, g + 1) holding cross offset w, or SIZE_MAX. */
+static size_t gap_of(const double *ws, size_t n, double w)
+{
+    for (size_t g = 0; g + 1 < n; g++)
+        if (ws[g] <= w && w < ws[g + 1])
+            return g;
+    return (size_t)-1;
 }
 
 /* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
  * with the cutters of every line within R of the point (at the same along-pass position); *cusp
- * gets the gap (the lower of the two lines) whose cutters meet at the worst point: on a slope
- * that is not gap i, for each cutter touches the surface uphill of its axis. */
+ * gets the gap to refine for the worst point: the gap holding the axis of a cutter that touches
+ * the surface there (on a slope not gap i: each cutter touches the surface uphill of its axis),
+ * else the gap next to the lowest cutter, towards the second lowest. */
 static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w, size_t n,
-                           size_t i, size_t *cusp)
+                           size_t i, double min_gap, size_t *cusp, double *stuck)
 {
     const dc_line_t *a = &lines[i], *b = &lines[i + 1];
     const dc_line_t *fine = a->n >= b->n ? a : b;
@@ -199,10 +230,13 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
         lo--;
     while (hi + 1 < n && w[hi + 1] - w[i + 1] <= r)
         hi++;
+    /* Across the gap at least every min_gap (a flat end's step changes abruptly where a
+     * neighbour's rim passes), at least DC_SCAN_FRACS points, at most DC_SCAN_MAX. */
+    int nf = (int)fmin(DC_SCAN_MAX, fmax(DC_SCAN_FRACS, ceil((w[i + 1] - w[i]) / min_gap)));
     for (size_t k = 0; k < fine->n; k++) {
         double s = fine->s[k];
-        for (int f = 1; f <= DC_SCAN_FRACS; f++) {
-            double wp = w[i] + (w[i + 1] - w[i]) * f / (DC_SCAN_FRACS + 1.0);
+        for (int f = 1; f <= nf; f++) {
+            double wp = w[i] + (w[i + 1] - w[i]) * f / (nf + 1.0);
             double env = HUGE_VAL, env2 = HUGE_VAL;
             size_t j1 = i, j2 = i + 1;
             for (size_t j = lo; j <= hi; j++) {
@@ -217,15 +251,26 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
                     env2 = e, j2 = j;
                 }
             }
-            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top;
+            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top, cs;
+            double g[2];
             if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y) ||
-                at_wall(c, x, y, top))
+                (cs = slope_cos(c, x, y, top, g)) == 0)
                 continue; /* the scallop is promised where the cutter lies over the surface */
-            double left = env - fmax(top, c->o->min_z);
+            /* A ball's envelope runs parallel to the surface: across it the height left is the
+             * vertical one times cos. A flat or bull-nose end's bottom is level, not parallel:
+             * the vertical height bounds the distance to it (the check's measure). */
+            double left = (env - fmax(top, c->o->min_z)) * (c->t->c_mm >= c->t->r_mm ? cs : 1);
             if (left > worst) {
+                size_t ga = gap_of(w, n, contact_axis(c, wp, g));
+                ga = ga != (size_t)-1 ? ga : j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+                if (ga + 1 >= n || w[ga + 1] - w[ga] < 2 * min_gap) {
+                    /* no pass can be added there: rest material (a slot narrower than the
+                     * cutter, a corner) or a wall; reported, not chased */
+                    *stuck = fmax(*stuck, left);
+                    continue;
+                }
                 worst = left;
-                /* the gap next to the lowest cutter, towards the second lowest */
-                *cusp = j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+                *cusp = ga;
             }
         }
     }
@@ -305,17 +350,18 @@ static cs_err_t set_insert(dc_set_t *set, size_t at, dc_line_t *l, double w)
  * than the cutter: reported by max_left). */
 static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double min_gap)
 {
-    double need = c->o->scallop_mm - c->ms->eps;
+    /* The mesh stands up to eps off the surface and a pass's chords up to tol / 2 off the drop
+     * height (refine): both may add to what the cutters leave. */
+    double need = c->o->scallop_mm - c->ms->eps - c->o->tol_mm / 2;
     cs_err_t e = CS_OK;
     for (size_t i = 0; i + 1 < set->n && e == CS_OK;) {
         size_t g;
-        double left = left_between(c, set->l, set->w, set->n, i, &g);
-        if (g + 1 >= set->n)
-            g = i;
-        if (left <= need || set->w[g + 1] - set->w[g] < 2 * min_gap ||
-            set->n >= c->o->max_passes) {
+        double stuck = 0;
+        double left = left_between(c, set->l, set->w, set->n, i, min_gap, &g, &stuck);
+        if (left <= need || set->n >= c->o->max_passes) {
             p->capped |= left > need && set->n >= c->o->max_passes;
             p->max_left = fmax(p->max_left, left);
+            p->max_stuck = fmax(p->max_stuck, stuck);
             i++;
             continue;
         }
@@ -357,10 +403,11 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
         if (e == CS_OK)
             e = set_insert(&set, set.n, &l, w);
     }
-    /* Only a ball's scallop is a matter of step-over alone: a flat or bull-nose end leaves
-     * steps on every slope, whatever the spacing (their step-over is stated, not refined). */
-    if (e == CS_OK && o->step_mm <= 0 && t->c_mm >= t->r_mm)
-        e = refine_gaps(p, &c, &set, step / 16);
+    /* Every cutter's gaps are refined: a flat or bull-nose end leaves a step on a slope about
+     * the slope times the gap, which the refinement brings under H like a ball's cusp. The
+     * least gap: a sixteenth of a ball's flat-ground step of the same radius. */
+    if (e == CS_OK && o->step_mm <= 0)
+        e = refine_gaps(p, &c, &set, 2 * sqrt(2 * t->r_mm * o->scallop_mm) / 16);
     else if (e == CS_OK)
         p->max_left = NAN;
     for (size_t k = 0; k < set.n; k++) {
@@ -373,6 +420,40 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
     free(set.w);
     p->drops = c.drops;
     return e;
+}
+
+/* Does the straight move a -> b keep the cutter no lower than the drop height less slack? */
+static bool link_clear(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, const double a[3],
+                       const double b[3], double step, double slack)
+{
+    double len = hypot(b[0] - a[0], b[1] - a[1]);
+    size_t n = (size_t)ceil(len / step) + 1;
+    for (size_t k = 0; k <= n; k++) {
+        double f = (double)k / (double)n, z = a[2] + f * (b[2] - a[2]);
+        bool hit;
+        double d = cs_dropcut_drop(ms, t, a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), &hit);
+        if (hit && d - slack > z)
+            return false;
+    }
+    return true;
+}
+
+void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                    double step_mm, double tol_mm)
+{
+    size_t out = 0; /* passes kept: pass k joins pass out - 1 or starts anew */
+    for (size_t k = 0; k < p->npass; k++) {
+        size_t s0 = p->start[k], s1 = p->start[k + 1];
+        bool join = out > 0 && s1 > s0 &&
+                    link_clear(ms, t, p->pt[s0 - 1], p->pt[s0], step_mm, tol_mm / 2);
+        if (join) {
+            p->links++;
+        } else {
+            p->start[out++] = s0;
+        }
+    }
+    p->start[out] = p->n;
+    p->npass = out;
 }
 
 void cs_dcpath_free(cs_dcpath_t *p)

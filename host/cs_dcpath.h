@@ -1,17 +1,20 @@
 /* cs_dcpath: raster finishing passes over a drop-cutter mesh (issue 20). Owns the passes: each
  * a polyline of tool-tip points (mm) along a line of the raster, sampled adaptively so that the
  * chords stay within tol of the drop-cutter height along the line, and spaced so that the
- * height of material left between two neighbouring passes (measured vertically above the mesh,
- * which is within eps of the surface) stays at most H. Host only, double precision.
+ * scallop between neighbouring passes, measured across the surface, stays at most H. Host only,
+ * double precision.
  *
  * Spacing: the nominal step-over is the flat-ground one (ball 2 sqrt(2RH - H^2); bull-nose
  * 2(R - r) + 2 sqrt(2rH - H^2); flat end mill 2R x 0.9), then every neighbouring pair is checked
- * at cross fractions 1/8 .. 7/8 of the gap and every sample of the finer pass: the cutter of each
- * pass at the same along-pass position leaves E = min(zA + h(f w), zB + h((1 - f) w)) above the
- * mesh top S; where E - S > H - eps a pass is added halfway between the two cutters that meet
- * at the worst point. Cutters at other along-pass positions only cut more, so the estimate is
- * conservative. Points within R of the rim of the surface's projection and points on a wall
- * (slope > 2) are left out, as in the check (cs_dropcheck.h). */
+ * at cross points (at least 7, no farther apart than the least gap) and every sample of the
+ * finer pass: the cutters of the passes within R at the same along-pass position leave
+ * E = min(z_j + h(|w_j - w|)) above the mesh top S; the scallop is (E - S) cos(slope) for a ball
+ * (its envelope is parallel to the surface), E - S for a flat or bull-nose end (a level bottom).
+ * Where it exceeds H - eps - tol / 2 a pass is added in the gap holding the axis of a cutter
+ * touching the surface there (r sin(slope) + R - r downhill of the point). Points whose gap is at
+ * the least width (rest material, walls) are reported, not chased. Cutters at other along-pass
+ * positions only cut more, so the estimate is conservative. Points within R of the rim of the
+ * surface's projection and on walls (slope > 5) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H
 
@@ -37,9 +40,11 @@ typedef struct {
     double *w;         /* pass k's cross offset, mm */
     size_t npass, pcap;
     double max_left;   /* largest estimated scallop left between passes, mm */
+    double max_stuck;  /* largest left where no pass can be added (rest material, walls), mm */
     size_t refined;    /* passes added by the scallop check */
     bool capped;       /* max_passes was reached */
     size_t drops;      /* drop-cutter queries made */
+    size_t links;      /* passes joined to the one before at cutting height (cs_dcpath_link) */
 } cs_dcpath_t;
 
 void cs_dcpath_init(cs_dcpath_t *p);
@@ -49,6 +54,12 @@ double cs_dcpath_step(const cs_dropcut_tool_t *t, double h);
  * CS_ERR_FULL out of memory, CS_ERR_RANGE for a region or step that makes no sense. */
 cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                           const cs_dcpath_opts_t *o);
+/* Joins each pass to the one before it where the straight move between the end of one and the
+ * start of the next stays within tol_mm / 2 of the drop-cutter height of tool t or above it
+ * (sampled every step_mm along the move; the passes' own chords are held to the same): one
+ * polyline, no retract. The passes keep their order. */
+void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                    double step_mm, double tol_mm);
 void cs_dcpath_free(cs_dcpath_t *p);
 
 #endif

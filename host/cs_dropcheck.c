@@ -10,6 +10,8 @@
 #include "cs_varady.h"
 
 #define CK_MAX_K 1200 /* samples a patch in each direction, at most */
+#define CK_IDEAL_STEP 0.1 /* mm: the lattice of the ideal cutter's positions (ideal_dist) */
+#define CK_WALL       5   /* a wall: the surface rises more than 5 map steps within one (79 deg) */
 
 typedef struct {
     /* surface samples bucketed by xy cell */
@@ -22,8 +24,12 @@ typedef struct {
     /* the z-map over the region */
     double box[4], step;
     size_t mx, my;
-    double *top, *env;
+    double *top, *env; /* env: per node, the nearest any cutter position came to the surface */
+    double dcap;       /* mm: distances beyond this are not measured (env stays there) */
     double *peak; /* highest sample whose nearest node this is: a wall shows above top */
+    double *cmax; /* per sample cell: its highest sample z (prunes the gouge test) */
+    double *dropm; /* per node: the ideal drop height there, NAN until needed (rest_at) */
+    long stride;  /* nodes between the ideal cutter's positions (rest_at) */
 } ck_t;
 
 static cs_err_t push_sample(ck_t *k, const double p[3])
@@ -79,7 +85,49 @@ static void splat(ck_t *k, const double *p)
         k->peak[n] = fmax(k->peak[n], p[2]);
 }
 
-/* Samples one patch densely: points for the gouge test, triangles into the top map. */
+typedef void (*ck_eval_fn)(const void *ctx, double u, double v, double p[3]);
+
+static void eval_patch(const void *ctx, double u, double v, double p[3])
+{
+    cs_finish_eval(ctx, u, v, p, NULL);
+}
+
+/* The sphere in the seed's parametrisation (cs_sphere.h), u and v in [0, 1]. */
+static void eval_sphere(const void *ctx, double u, double v, double p[3])
+{
+    const cs_sphere_t *s = ctx;
+    double lat = -M_PI / 2 + M_PI * u, lon = 2 * M_PI * v;
+    p[0] = s->c[0] + s->r * cos(lat) * cos(lon);
+    p[1] = s->c[1] + s->r * cos(lat) * sin(lon);
+    p[2] = s->c[2] + s->r * sin(lat);
+}
+
+/* Samples one surface on a (nu + 1) x (nv + 1) grid: points for the gouge test, triangles into
+ * the top map. */
+static cs_err_t sample_grid(ck_t *k, ck_eval_fn ev, const void *ctx, int nu, int nv)
+{
+    double *row = malloc(2 * (size_t)(nv + 1) * 3 * sizeof *row);
+    if (!row)
+        return CS_ERR_FULL;
+    cs_err_t e = CS_OK;
+    for (int i = 0; i <= nu && e == CS_OK; i++) {
+        double *cur = row + (size_t)(i & 1) * (size_t)(nv + 1) * 3;
+        double *prev = row + (size_t)((i + 1) & 1) * (size_t)(nv + 1) * 3;
+        for (int j = 0; j <= nv && e == CS_OK; j++) {
+            ev(ctx, (double)i / nu, (double)j / nv, &cur[j * 3]);
+            e = push_sample(k, &cur[j * 3]);
+            splat(k, &cur[j * 3]);
+        }
+        for (int j = 0; i > 0 && j < nv; j++) {
+            raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
+            raster_tri(k, &prev[j * 3], &cur[(j + 1) * 3], &prev[(j + 1) * 3]);
+        }
+    }
+    free(row);
+    return e;
+}
+
+/* A patch: as many samples each way as its control box's diagonal has steps. */
 static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
 {
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -95,25 +143,14 @@ static cs_err_t sample_patch(ck_t *k, const cs_patch_t *q)
     double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
     int kk = (int)fmin(CK_MAX_K, fmax(8, ceil(diag / k->step)));
-    double *row = malloc(2 * (size_t)(kk + 1) * 3 * sizeof *row);
-    if (!row)
-        return CS_ERR_FULL;
-    cs_err_t e = CS_OK;
-    for (int i = 0; i <= kk && e == CS_OK; i++) {
-        double *cur = row + (size_t)(i & 1) * (size_t)(kk + 1) * 3;
-        double *prev = row + (size_t)((i + 1) & 1) * (size_t)(kk + 1) * 3;
-        for (int j = 0; j <= kk && e == CS_OK; j++) {
-            cs_finish_eval(q, (double)i / kk, (double)j / kk, &cur[j * 3], NULL);
-            e = push_sample(k, &cur[j * 3]);
-            splat(k, &cur[j * 3]);
-        }
-        for (int j = 0; i > 0 && j < kk; j++) {
-            raster_tri(k, &prev[j * 3], &cur[j * 3], &cur[(j + 1) * 3]);
-            raster_tri(k, &prev[j * 3], &cur[(j + 1) * 3], &prev[(j + 1) * 3]);
-        }
-    }
-    free(row);
-    return e;
+    return sample_grid(k, eval_patch, q, kk, kk);
+}
+
+/* A sphere: a meridian's half circle and the equator at spacing <= step. */
+static cs_err_t sample_sphere(ck_t *k, const cs_sphere_t *s)
+{
+    int nu = (int)fmin(CK_MAX_K, fmax(8, ceil(M_PI * s->r / k->step)));
+    return sample_grid(k, eval_sphere, s, nu, 2 * nu);
 }
 
 static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
@@ -126,9 +163,11 @@ static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
         const cs_surf_item_t *it = &sf->items[i];
         size_t nc = 1;
         double fit;
-        if (it->sphere)
-            e = CS_ERR_UNSUPPORTED;
-        else if (it->tri)
+        if (it->sphere) {
+            e = sample_sphere(k, &it->sph);
+            continue;
+        }
+        if (it->tri)
             e = cs_finish_tri_patch(&it->trip, &cells[0]);
         else if (it->varady)
             e = cs_varady_patches(&it->nside, k->step / 4, cells, NULL, CS_VARADY_MAX_PATCHES, &nc,
@@ -159,11 +198,15 @@ static cs_err_t bucket(ck_t *k, double cell)
     size_t nc = k->gx * k->gy;
     k->start = calloc(nc + 1, sizeof *k->start);
     k->idx = malloc((k->ns + 1) * sizeof *k->idx);
-    if (!k->start || !k->idx)
+    k->cmax = malloc(nc * sizeof *k->cmax);
+    if (!k->start || !k->idx || !k->cmax)
         return CS_ERR_FULL;
+    for (size_t c = 0; c < nc; c++)
+        k->cmax[c] = -HUGE_VAL;
     for (size_t i = 0; i < k->ns; i++) {
         size_t cx = (size_t)((k->s[i][0] - lo[0]) / cell), cy = (size_t)((k->s[i][1] - lo[1]) / cell);
         k->start[cy * k->gx + cx + 1]++;
+        k->cmax[cy * k->gx + cx] = fmax(k->cmax[cy * k->gx + cx], k->s[i][2]);
     }
     for (size_t c = 0; c < nc; c++)
         k->start[c + 1] += k->start[c];
@@ -177,8 +220,19 @@ static cs_err_t bucket(ck_t *k, double cell)
     return CS_OK;
 }
 
-/* One cutter position: its deepest penetration and its footprint on the envelope. */
-static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dropcheck_t *o)
+/* Horizontal distance from (x, y) to the box of sample cell (cx, cy): no sample in it is nearer. */
+static double cell_dist(const ck_t *k, long cx, long cy, double x, double y)
+{
+    double x0 = k->org[0] + (double)cx * k->cell, y0 = k->org[1] + (double)cy * k->cell;
+    double dx = x < x0 ? x0 - x : x > x0 + k->cell ? x - x0 - k->cell : 0;
+    double dy = y < y0 ? y0 - y : y > y0 + k->cell ? y - y0 - k->cell : 0;
+    return sqrt(dx * dx + dy * dy);
+}
+
+/* One cutter position's deepest penetration: the samples within R, cell by cell; a cell whose
+ * highest sample stands no more above the cutter's lowest point over it than the deepest found
+ * so far cannot hold a deeper one (h is non-decreasing in d). */
+static void visit_gouge(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dropcheck_t *o)
 {
     double r = t->r_mm;
     long cx0 = (long)floor((p[0] - r - k->org[0]) / k->cell), cx1 = (long)floor((p[0] + r - k->org[0]) / k->cell);
@@ -186,12 +240,15 @@ static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dro
     for (long cy = cy0 < 0 ? 0 : cy0; cy <= cy1 && cy < (long)k->gy; cy++)
         for (long cx = cx0 < 0 ? 0 : cx0; cx <= cx1 && cx < (long)k->gx; cx++) {
             size_t c = (size_t)cy * k->gx + (size_t)cx;
+            double cd = cell_dist(k, cx, cy, p[0], p[1]);
+            if (cd > r || k->cmax[c] - (p[2] + cs_dropcut_profile(t, cd)) <= o->gouge_mm)
+                continue;
             for (size_t m = k->start[c]; m < k->start[c + 1]; m++) {
                 const double *s = k->s[k->idx[m]];
-                double d = hypot(s[0] - p[0], s[1] - p[1]);
-                if (d > r)
+                double dx = s[0] - p[0], dy = s[1] - p[1], d2 = dx * dx + dy * dy;
+                if (d2 > r * r || s[2] - p[2] <= o->gouge_mm)
                     continue;
-                double pen = s[2] - (p[2] + cs_dropcut_profile(t, d));
+                double pen = s[2] - (p[2] + cs_dropcut_profile(t, sqrt(d2)));
                 if (pen > o->gouge_mm) {
                     o->gouge_mm = pen;
                     memcpy(o->gouge_at, s, sizeof o->gouge_at);
@@ -199,17 +256,46 @@ static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dro
                 }
             }
         }
-    long ix0 = (long)ceil((p[0] - r - k->box[0]) / k->step), ix1 = (long)floor((p[0] + r - k->box[0]) / k->step);
+}
+
+/* Distance (mm) from point s to the solid of tool t with its tip at p: the disk of radius
+ * R - r at the corner centres' height swept by the ball of radius r, the shank (radius R) above;
+ * 0 inside. The solid is convex: below the corner centres the nearest point lies on the swept
+ * ball, above them on the shank's side. */
+static double tool_dist(const cs_dropcut_tool_t *t, const double p[3], double sx, double sy,
+                        double sz)
+{
+    double dx = sx - p[0], dy = sy - p[1], rho = sqrt(dx * dx + dy * dy);
+    double dz = sz - (p[2] + t->c_mm);
+    if (dz >= 0)
+        return rho > t->r_mm ? rho - t->r_mm : 0;
+    double e = rho - (t->r_mm - t->c_mm);
+    e = e > 0 ? e : 0;
+    double d = sqrt(e * e + dz * dz) - t->c_mm;
+    return d > 0 ? d : 0;
+}
+
+/* One cutter position: the distance from the surface point over each node within R + the
+ * largest distance that matters (dcap), row by row, into the distance map. */
+static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dropcheck_t *o)
+{
+    visit_gouge(k, t, p, o);
+    double r = t->r_mm + k->dcap;
     long iy0 = (long)ceil((p[1] - r - k->box[1]) / k->step), iy1 = (long)floor((p[1] + r - k->box[1]) / k->step);
-    for (long iy = iy0; iy <= iy1; iy++)
-        for (long ix = ix0; ix <= ix1; ix++) {
-            size_t n = node(k, ix, iy);
-            if (n == (size_t)-1)
+    for (long iy = iy0 < 0 ? 0 : iy0; iy <= iy1 && iy < (long)k->my; iy++) {
+        double y = k->box[1] + (double)iy * k->step, dy = y - p[1], w2 = r * r - dy * dy;
+        if (w2 < 0)
+            continue;
+        double w = sqrt(w2);
+        long ix0 = (long)ceil((p[0] - w - k->box[0]) / k->step), ix1 = (long)floor((p[0] + w - k->box[0]) / k->step);
+        for (long ix = ix0 < 0 ? 0 : ix0; ix <= ix1 && ix < (long)k->mx; ix++) {
+            size_t n = (size_t)iy * k->mx + (size_t)ix;
+            if (k->env[n] == 0 || k->top[n] == -HUGE_VAL)
                 continue;
-            double d = hypot(k->box[0] + (double)ix * k->step - p[0], k->box[1] + (double)iy * k->step - p[1]);
-            if (d <= r)
-                k->env[n] = fmin(k->env[n], p[2] + cs_dropcut_profile(t, d));
+            double d = tool_dist(t, p, k->box[0] + (double)ix * k->step, y, k->top[n]);
+            k->env[n] = fmin(k->env[n], d);
         }
+    }
 }
 
 static void walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3], const size_t *start,
@@ -263,59 +349,157 @@ static bool interior(const ck_t *k, long r_nodes, unsigned char *far)
     return true;
 }
 
+/* The ideal drop at node c (on the stride lattice): the highest the rasterised top within R holds
+ * a cutter whose axis stands at c, max over nodes q of top(q) - h(|q - c|). Memoised. */
+static double ideal_drop(ck_t *k, const cs_dropcut_tool_t *t, long cx, long cy)
+{
+    size_t c = node(k, cx, cy);
+    if (!isnan(k->dropm[c]))
+        return k->dropm[c];
+    double r = t->r_mm, best = -HUGE_VAL;
+    long rn = (long)floor(r / k->step / (double)k->stride) * k->stride;
+    for (long qy = cy - rn; qy <= cy + rn; qy += k->stride)
+        for (long qx = cx - rn; qx <= cx + rn; qx += k->stride) {
+            size_t q = node(k, qx, qy);
+            if (q == (size_t)-1 || k->top[q] == -HUGE_VAL)
+                continue;
+            double d = hypot((double)(qx - cx), (double)(qy - cy)) * k->step;
+            if (d <= r)
+                best = fmax(best, k->top[q] - cs_dropcut_profile(t, d));
+        }
+    return k->dropm[c] = best;
+}
+
+/* How near any cutter position from above comes to the surface point over node (ix, iy): min
+ * over axis positions c (the stride lattice) within R + dcap of the distance to the cutter
+ * dropped at c. More than H: rest material, no 3-axis cutter of this shape reaches it. */
+static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy)
+{
+    double r = t->r_mm + k->dcap, best = HUGE_VAL;
+    long rn = (long)ceil(r / k->step / (double)k->stride) * k->stride;
+    long bx = ix / k->stride * k->stride, by = iy / k->stride * k->stride;
+    double sx = k->box[0] + (double)ix * k->step, sy = k->box[1] + (double)iy * k->step;
+    double sz = k->top[node(k, ix, iy)];
+    for (long cy = by - rn; cy <= by + rn && best > 0; cy += k->stride)
+        for (long cx = bx - rn; cx <= bx + rn && best > 0; cx += k->stride) {
+            double d = hypot((double)(cx - ix), (double)(cy - iy)) * k->step;
+            if (d > r || node(k, cx, cy) == (size_t)-1)
+                continue;
+            double z = ideal_drop(k, t, cx, cy);
+            double pc[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
+            if (z > -HUGE_VAL)
+                best = fmin(best, tool_dist(t, pc, sx, sy, sz));
+        }
+    return best;
+}
+
+/* Is there a wall at node n: the rasterised top of a neighbour more than CK_WALL steps above or
+ * below (slope > CK_WALL, the planner's own bound, cs_dcpath.h), or a sample of the node's cell
+ * that far above the top (a thin lip seen through)? The raster does not promise its scallop
+ * there; such nodes are counted apart. */
+static bool wall_at(const ck_t *k, size_t n)
+{
+    long ix = (long)(n % k->mx), iy = (long)(n / k->mx);
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    double lim = CK_WALL * k->step;
+    if (k->peak[n] > k->top[n] + lim)
+        return true;
+    for (int i = 0; i < 4; i++) {
+        size_t m = node(k, ix + dx[i], iy + dy[i]);
+        if (m != (size_t)-1 && k->top[m] > -HUGE_VAL && fabs(k->top[m] - k->top[n]) > lim)
+            return true;
+    }
+    return false;
+}
+
+/* The scallop and rest material over every node with the cutter over the surface all round. */
+static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *far, double h_mm,
+                    cs_dropcheck_t *out)
+{
+    for (size_t n = 0; n < k->mx * k->my; n++) {
+        if (k->top[n] == -HUGE_VAL || !far[n])
+            continue;
+        if (wall_at(k, n)) {
+            out->walls++;
+            continue;
+        }
+        out->nodes++;
+        double left = k->env[n];
+        if (left > h_mm) { /* is it within reach at all? */
+            double ideal = ideal_dist(k, t, (long)(n % k->mx), (long)(n / k->mx));
+            if (ideal > h_mm) {
+                out->rest_nodes++;
+                if (ideal > out->rest_mm) {
+                    out->rest_mm = ideal;
+                    out->rest_at[0] = k->box[0] + (double)(n % k->mx) * k->step;
+                    out->rest_at[1] = k->box[1] + (double)(n / k->mx) * k->step;
+                }
+                left -= ideal; /* what the path leaves beyond the best it could do */
+            }
+        }
+        if (left > out->scallop_mm) {
+            out->scallop_mm = left;
+            out->scallop_at[0] = k->box[0] + (double)(n % k->mx) * k->step;
+            out->scallop_at[1] = k->box[1] + (double)(n / k->mx) * k->step;
+        }
+    }
+}
+
+/* The maps over the region: top and peak empty, the envelope infinitely high. */
+static cs_err_t maps(ck_t *k, const double box[4], double step_mm)
+{
+    memcpy(k->box, box, sizeof k->box);
+    k->step = step_mm;
+    k->stride = lround(fmax(1, CK_IDEAL_STEP / step_mm));
+    k->mx = (size_t)floor((box[2] - box[0]) / step_mm) + 1;
+    k->my = (size_t)floor((box[3] - box[1]) / step_mm) + 1;
+    size_t nn = k->mx * k->my;
+    k->top = malloc(nn * sizeof *k->top);
+    k->env = malloc(nn * sizeof *k->env);
+    k->peak = malloc(nn * sizeof *k->peak);
+    k->dropm = malloc(nn * sizeof *k->dropm);
+    if (!k->top || !k->env || !k->peak || !k->dropm)
+        return CS_ERR_FULL;
+    for (size_t n = 0; n < nn; n++) {
+        k->top[n] = k->peak[n] = -HUGE_VAL;
+        k->env[n] = k->dcap;
+        k->dropm[n] = NAN;
+    }
+    return CS_OK;
+}
+
 cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, cs_dropcheck_t *out)
+                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out)
 {
     memset(out, 0, sizeof *out);
     ck_t k;
     memset(&k, 0, sizeof k);
-    memcpy(k.box, box, sizeof k.box);
-    k.step = step_mm;
-    k.mx = (size_t)floor((box[2] - box[0]) / step_mm) + 1;
-    k.my = (size_t)floor((box[3] - box[1]) / step_mm) + 1;
-    k.top = malloc(k.mx * k.my * sizeof *k.top);
-    k.env = malloc(k.mx * k.my * sizeof *k.env);
-    k.peak = malloc(k.mx * k.my * sizeof *k.peak);
     unsigned char *far = NULL;
-    cs_err_t e = k.top && k.env && k.peak ? CS_OK : CS_ERR_FULL;
-    for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
-        k.top[n] = k.peak[n] = -HUGE_VAL;
-        k.env[n] = HUGE_VAL;
-    }
+    /* Twice the promise (a failure still shows its size), within half the cutter. */
+    k.dcap = fmin(fmax(2 * h_mm, 0.1), t->r_mm / 2);
+    cs_err_t e = maps(&k, box, step_mm);
     if (e == CS_OK)
         e = sample_all(&k, sf);
     if (e == CS_OK)
-        e = bucket(&k, fmax(t->r_mm / 2, step_mm));
+        e = bucket(&k, fmax(t->r_mm / 8, 2 * step_mm));
     if (e == CS_OK) {
         walk(&k, t, pts, start, npass, out);
         out->surf_samples = k.ns;
         far = malloc(k.mx * k.my);
         if (!far || !interior(&k, (long)ceil(t->r_mm / step_mm), far))
             e = CS_ERR_FULL;
-        for (size_t n = 0; e == CS_OK && n < k.mx * k.my; n++) {
-            /* A wall through the node's cell (a sample rising more than two steps above the
-             * rasterised top, slope > 2): the height left is not defined there. */
-            bool wall = k.peak[n] > k.top[n] + 2 * step_mm;
-            if (k.top[n] == -HUGE_VAL || k.env[n] == HUGE_VAL || !far[n] || wall) {
-                out->walls += wall;
-                continue;
-            }
-            out->nodes++;
-            double left = k.env[n] - k.top[n];
-            if (left > out->scallop_mm) {
-                out->scallop_mm = left;
-                out->scallop_at[0] = box[0] + (double)(n % k.mx) * step_mm;
-                out->scallop_at[1] = box[1] + (double)(n / k.mx) * step_mm;
-            }
-        }
     }
+    if (e == CS_OK)
+        measure(&k, t, far, h_mm, out);
     free(far);
     free(k.s);
     free(k.start);
     free(k.idx);
+    free(k.cmax);
     free(k.top);
     free(k.env);
     free(k.peak);
+    free(k.dropm);
     return e;
 }

@@ -3,15 +3,21 @@
  * the patch evaluator: the surface is sampled on a dense (u, v) grid of every patch, in double.
  *  - gouge: along the path (every chord sampled at spacing <= step), the deepest a surface
  *    sample lies inside the cutter's solid, measured vertically (tip + h(d) - z < 0);
- *  - scallop: on a z-map of the region (spacing step), the lowest cutter surface over each node
- *    (the envelope of every sampled cutter position) minus the surface's top at the node (its
- *    dense triangles rasterised into the map): the height of material left, vertically.
+ *  - scallop: on a z-map of the region (spacing step, the surface's dense triangles
+ *    rasterised into it), the distance from the surface point over each node to the nearest
+ *    sampled cutter position's solid (closed form: the solid is convex), capped at twice H.
  * Both are estimates from samples: a finer step only finds more. The scallop is measured where
  * the cutter lies over the surface all round (nodes farther than R from the rim of the
  * surface's projection): nearer the rim the floor (--min-z) or the rim itself holds the cutter
- * up, and beyond it is no material of the part; and not at nodes a wall passes through (a
- * sample nearest the node stands more than two steps above the rasterised top: slope > 2, where
- * a height measured vertically means nothing). Host only. */
+ * up, and beyond it is no material of the part; and not on walls (a neighbour's top more than
+ * 5 steps away, slope > 5 as the planner's bound, or a sample of the node's cell that far above
+ * the top: a thin lip seen through), counted apart.
+ *  - rest material: where more than H is left, the check asks how near any cutter from above
+ *    could come: the cutter dropped onto the rasterised top at every position of a 0.1 mm
+ *    lattice within R + cap (a grayscale closing of the top by the cutter). Where even that
+ *    ideal cutter stays more than H away (slots narrower than the cutter, the foot of a wall, the
+ *    gap between the teapot's lid and its rim) the node is unreachable: reported apart; its
+ *    scallop is what the path leaves beyond the ideal. Host only. */
 #ifndef CS_DROPCHECK_H
 #define CS_DROPCHECK_H
 
@@ -28,12 +34,16 @@ typedef struct {
     double scallop_at[2]; /* where */
     size_t surf_samples, path_samples, nodes;
     size_t walls; /* nodes left out of the scallop: a wall passes through them */
+    size_t rest_nodes; /* nodes where even the ideal cutter leaves more than H: unreachable */
+    double rest_mm;    /* the deepest such rest material, mm */
+    double rest_at[2]; /* where */
 } cs_dropcheck_t;
 
 /* Checks the passes (tip points pts[start[k] .. start[k + 1]), k < npass, mm) of tool t over sf
- * within the region box (x0 y0 x1 y1) at sampling step step_mm. CS_ERR_FULL out of memory. */
+ * within the region box (x0 y0 x1 y1) at sampling step step_mm; nodes left more than h_mm get
+ * the ideal envelope (rest material). CS_ERR_FULL out of memory. */
 cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, cs_dropcheck_t *out);
+                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out);
 
 #endif

@@ -130,13 +130,66 @@ static cs_err_t mesh_patch(cs_dropcut_mesh_t *ms, const cs_patch_t *q, double ep
     return e;
 }
 
+/* Circumradius of triangle a b c (half the longest edge when degenerate), mm. */
+static double circumradius(const double a[3], const double b[3], const double c[3])
+{
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = c[k] - b[k];
+    }
+    double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    double lu = norm3(u), lv = norm3(v), lw = norm3(w), a2 = norm3(n); /* a2: twice the area */
+    if (a2 < 1e-15 * fmax(lu * lv, 1e-300))
+        return fmax(fmax(lu, lv), lw) / 2;
+    return lu * lv * lw / (2 * a2);
+}
+
+/* A sphere (centre c, radius r) on a latitude-longitude grid fine enough for eps: every point of
+ * the sphere projects radially into the triangle whose cap holds it, at most the cap's height
+ * r - sqrt(r^2 - rho^2) away (rho the triangle's circumradius); *eps_out gets the largest. The
+ * angular step 2 sqrt(eps / r) makes a cell's half-diagonal about sqrt(2 eps r). */
+static cs_err_t mesh_sphere(cs_dropcut_mesh_t *ms, const cs_sphere_t *sp, double eps,
+                            double *eps_out)
+{
+    double r = sp->r, step = 2 * sqrt(eps / r);
+    int nlat = (int)fmin(DC_GRID_MAX, fmax(4, ceil(M_PI / step)));
+    int nlon = 2 * nlat;
+    double prev[2 * DC_GRID_MAX + 1][3], cur[2 * DC_GRID_MAX + 1][3];
+    cs_err_t e = CS_OK;
+    *eps_out = 0;
+    for (int i = 0; i <= nlat && e == CS_OK; i++) {
+        double u = -M_PI / 2 + M_PI * i / nlat;
+        for (int j = 0; j <= nlon; j++) {
+            double w = 2 * M_PI * j / nlon;
+            cur[j][0] = sp->c[0] + r * cos(u) * cos(w);
+            cur[j][1] = sp->c[1] + r * cos(u) * sin(w);
+            cur[j][2] = sp->c[2] + r * sin(u);
+        }
+        for (int j = 0; i > 0 && j < nlon && e == CS_OK; j++) {
+            const double *t[2][3] = {{prev[j], cur[j], cur[j + 1]}, {prev[j], cur[j + 1], prev[j + 1]}};
+            for (int k = 0; k < 2 && e == CS_OK; k++) {
+                double rho = fmin(circumradius(t[k][0], t[k][1], t[k][2]), r);
+                *eps_out = fmax(*eps_out, r - sqrt(r * r - rho * rho));
+                e = cs_dropcut_add(ms, t[k][0], t[k][1], t[k][2]);
+            }
+        }
+        memcpy(prev, cur, sizeof prev);
+    }
+    return e;
+}
+
 /* The tensor patches of one item: itself, its collapsed tensor form, or fitted cells. */
 static cs_err_t mesh_item(cs_dropcut_mesh_t *ms, const cs_surf_item_t *it, double eps,
                           double fit_mm, cs_patch_t *cells)
 {
     double pe = 0;
-    if (it->sphere) /* no Bézier form to bound (cs_sphere): not meshed yet */
-        return CS_ERR_UNSUPPORTED;
+    if (it->sphere) {
+        cs_err_t e = mesh_sphere(ms, &it->sph, eps, &pe);
+        ms->eps = fmax(ms->eps, pe);
+        return e;
+    }
     if (it->tri) {
         cs_patch_t tq;
         cs_err_t e = cs_finish_tri_patch(&it->trip, &tq);
@@ -190,6 +243,24 @@ static size_t cell_of(const cs_dropcut_mesh_t *ms, double v, int axis)
     return c >= (double)lim ? lim - 1 : (size_t)c;
 }
 
+/* The xy box and top of every triangle, and the grid's cell tops (for the query's bounds). */
+static cs_err_t index_boxes(cs_dropcut_mesh_t *ms)
+{
+    ms->bb = malloc(ms->ntri * sizeof *ms->bb);
+    if (!ms->bb)
+        return CS_ERR_FULL;
+    for (size_t t = 0; t < ms->ntri; t++) {
+        const cs_dropcut_tri_t *tr = &ms->tri[t];
+        double *b = ms->bb[t];
+        b[0] = fmin(fmin(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
+        b[1] = fmin(fmin(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
+        b[2] = fmax(fmax(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
+        b[3] = fmax(fmax(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
+        b[4] = fmax(fmax(tr->v[0][2], tr->v[1][2]), tr->v[2][2]);
+    }
+    return CS_OK;
+}
+
 cs_err_t cs_dropcut_index(cs_dropcut_mesh_t *ms, double rmax_mm)
 {
     if (ms->ntri == 0)
@@ -205,22 +276,23 @@ cs_err_t cs_dropcut_index(cs_dropcut_mesh_t *ms, double rmax_mm)
     size_t nc = ms->gx * ms->gy;
     ms->start = calloc(nc + 1, sizeof *ms->start);
     ms->stamp = calloc(ms->ntri, sizeof *ms->stamp);
-    if (!ms->start || !ms->stamp)
+    ms->ctop = malloc(nc * sizeof *ms->ctop);
+    if (!ms->start || !ms->stamp || !ms->ctop || index_boxes(ms) != CS_OK)
         return CS_ERR_FULL;
+    for (size_t c = 0; c < nc; c++)
+        ms->ctop[c] = -HUGE_VAL;
     for (int pass = 0; pass < 2; pass++) {
         for (size_t t = 0; t < ms->ntri; t++) {
-            const cs_dropcut_tri_t *tr = &ms->tri[t];
-            double x0 = fmin(fmin(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
-            double x1 = fmax(fmax(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
-            double y0 = fmin(fmin(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
-            double y1 = fmax(fmax(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
-            for (size_t cy = cell_of(ms, y0, 1); cy <= cell_of(ms, y1, 1); cy++)
-                for (size_t cx = cell_of(ms, x0, 0); cx <= cell_of(ms, x1, 0); cx++) {
+            const double *b = ms->bb[t];
+            for (size_t cy = cell_of(ms, b[1], 1); cy <= cell_of(ms, b[3], 1); cy++)
+                for (size_t cx = cell_of(ms, b[0], 0); cx <= cell_of(ms, b[2], 0); cx++) {
                     size_t c = cy * ms->gx + cx;
-                    if (pass == 0)
+                    if (pass == 0) {
                         ms->start[c + 1]++;
-                    else
+                        ms->ctop[c] = fmax(ms->ctop[c], b[4]);
+                    } else {
                         ms->idx[ms->start[c]++] = t;
+                    }
                 }
         }
         if (pass == 0) {
@@ -327,7 +399,7 @@ static double facet_drop(const cs_dropcut_tool_t *t, const cs_dropcut_tri_t *tr,
         n[k] /= len;
     if (n[2] < 1e-9) /* vertical: its edges carry the contact */
         return -HUGE_VAL;
-    double nh = hypot(n[0], n[1]), a_r = t->r_mm - t->c_mm;
+    double nh = sqrt(n[0] * n[0] + n[1] * n[1]), a_r = t->r_mm - t->c_mm;
     double qx = x, qy = y;
     if (nh > 0) {
         qx -= a_r * n[0] / nh;
@@ -343,17 +415,14 @@ static double facet_drop(const cs_dropcut_tool_t *t, const cs_dropcut_tri_t *tr,
 
 /* --- queries ------------------------------------------------------------------------------- */
 
-/* Lower bounds on the horizontal distance from the axis (x, y) to a triangle (its bounding box)
- * and to a segment: h is non-decreasing, so no point there holds the cutter higher than the
- * highest vertex z minus h(that distance). */
-static double box_dist(const cs_dropcut_tri_t *tr, double x, double y)
+/* Lower bounds on the horizontal distance from the axis (x, y) to a box x0 y0 x1 y1 (a
+ * triangle's, a cell's) and to a segment: h is non-decreasing, so no point there holds the
+ * cutter higher than the box's highest z minus h(that distance). */
+static double box_dist(const double *b, double x, double y)
 {
-    double x0 = fmin(fmin(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
-    double x1 = fmax(fmax(tr->v[0][0], tr->v[1][0]), tr->v[2][0]);
-    double y0 = fmin(fmin(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
-    double y1 = fmax(fmax(tr->v[0][1], tr->v[1][1]), tr->v[2][1]);
-    double dx = x < x0 ? x0 - x : x > x1 ? x - x1 : 0, dy = y < y0 ? y0 - y : y > y1 ? y - y1 : 0;
-    return hypot(dx, dy);
+    double dx = x < b[0] ? b[0] - x : x > b[2] ? x - b[2] : 0;
+    double dy = y < b[1] ? b[1] - y : y > b[3] ? y - b[3] : 0;
+    return sqrt(dx * dx + dy * dy);
 }
 
 static double seg_dist(const double a[3], const double b[3], double x, double y)
@@ -361,13 +430,75 @@ static double seg_dist(const double a[3], const double b[3], double x, double y)
     double bx = b[0] - a[0], by = b[1] - a[1], l2 = bx * bx + by * by;
     double s = l2 > 0 ? ((x - a[0]) * bx + (y - a[1]) * by) / l2 : 0;
     s = s < 0 ? 0 : s > 1 ? 1 : s;
-    return hypot(a[0] + s * bx - x, a[1] + s * by - y);
+    double ex = a[0] + s * bx - x, ey = a[1] + s * by - y;
+    return sqrt(ex * ex + ey * ey);
 }
 
-/* The highest vertex of a triangle: no point of it can hold the cutter higher. */
-static double tri_top(const cs_dropcut_tri_t *tr)
+/* A cell of the footprint and the most it can hold the cutter up (its top - h(distance)). */
+struct cs_dropcut_cq {
+    double bound;
+    size_t cell;
+};
+
+static int cq_desc(const void *a, const void *b)
 {
-    return fmax(fmax(tr->v[0][2], tr->v[1][2]), tr->v[2][2]);
+    double x = ((const struct cs_dropcut_cq *)a)->bound, y = ((const struct cs_dropcut_cq *)b)->bound;
+    return x < y ? 1 : x > y ? -1 : 0;
+}
+
+/* The footprint's cells that can hold the cutter up at all, highest bound first; false out of
+ * memory. */
+static bool footprint(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, double x, double y,
+                      size_t *n)
+{
+    double r = t->r_mm;
+    size_t cx0 = cell_of(ms, x - r, 0), cx1 = cell_of(ms, x + r, 0);
+    size_t cy0 = cell_of(ms, y - r, 1), cy1 = cell_of(ms, y + r, 1);
+    size_t need = (cx1 - cx0 + 1) * (cy1 - cy0 + 1);
+    if (need > ms->cqcap) {
+        struct cs_dropcut_cq *q = realloc(ms->cq, need * sizeof *q);
+        if (!q)
+            return false;
+        ms->cq = q;
+        ms->cqcap = need;
+    }
+    *n = 0;
+    for (size_t cy = cy0; cy <= cy1; cy++)
+        for (size_t cx = cx0; cx <= cx1; cx++) {
+            size_t c = cy * ms->gx + cx;
+            if (ms->start[c] == ms->start[c + 1])
+                continue;
+            double b[4] = {ms->box[0] + (double)cx * ms->cell, ms->box[1] + (double)cy * ms->cell};
+            b[2] = b[0] + ms->cell;
+            b[3] = b[1] + ms->cell;
+            double d = box_dist(b, x, y);
+            if (d > r)
+                continue;
+            ms->cq[*n].bound = ms->ctop[c] - cs_dropcut_profile(t, d);
+            ms->cq[(*n)++].cell = c;
+        }
+    qsort(ms->cq, *n, sizeof *ms->cq, cq_desc);
+    return true;
+}
+
+/* One triangle's contribution (facet, then its edges while they can still beat best). */
+static double tri_drop(const cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, size_t i,
+                       double x, double y, double best)
+{
+    const cs_dropcut_tri_t *tr = &ms->tri[i];
+    double d = box_dist(ms->bb[i], x, y);
+    if (d > t->r_mm || ms->bb[i][4] - cs_dropcut_profile(t, d) <= best)
+        return best;
+    best = fmax(best, facet_drop(t, tr, x, y));
+    if (ms->bb[i][4] - cs_dropcut_profile(t, d) <= best)
+        return best;
+    for (int e = 0; e < 3; e++) {
+        const double *a = tr->v[e], *b = tr->v[(e + 1) % 3];
+        double de = seg_dist(a, b, x, y);
+        if (de <= t->r_mm && fmax(a[2], b[2]) - cs_dropcut_profile(t, de) > best)
+            best = fmax(best, edge_drop(t, a, b, x, y));
+    }
+    return best;
 }
 
 double cs_dropcut_drop_exact(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, double x,
@@ -378,38 +509,27 @@ double cs_dropcut_drop_exact(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, 
         memset(ms->stamp, 0, ms->ntri * sizeof *ms->stamp);
         ms->query = 0;
     }
-    ms->query++; /* this query's facet sweep; its edge sweep is query + 1 */
+    ms->query++;
     double r = t->r_mm;
-    if (x + r >= ms->box[0] && x - r <= ms->box[3] && y + r >= ms->box[1] && y - r <= ms->box[4]) {
-        size_t cx0 = cell_of(ms, x - r, 0), cx1 = cell_of(ms, x + r, 0);
-        size_t cy0 = cell_of(ms, y - r, 1), cy1 = cell_of(ms, y + r, 1);
-        /* Two sweeps: facets first (closed form, cheap) to raise the bound, then the edges of
-         * the triangles whose highest vertex is still above it (f(p) <= p.z). */
-        for (int sweep = 0; sweep < 2; sweep++)
-            for (size_t cy = cy0; cy <= cy1; cy++)
-                for (size_t cx = cx0; cx <= cx1; cx++) {
-                    size_t c = cy * ms->gx + cx;
-                    for (size_t k = ms->start[c]; k < ms->start[c + 1]; k++) {
-                        size_t i = ms->idx[k];
-                        if (ms->stamp[i] == ms->query + (unsigned)sweep)
-                            continue;
-                        ms->stamp[i] = ms->query + (unsigned)sweep;
-                        const cs_dropcut_tri_t *tr = &ms->tri[i];
-                        if (sweep == 0) {
-                            best = fmax(best, facet_drop(t, tr, x, y));
-                            continue;
-                        }
-                        if (tri_top(tr) - cs_dropcut_profile(t, box_dist(tr, x, y)) <= best)
-                            continue;
-                        for (int e = 0; e < 3; e++) {
-                            const double *a = tr->v[e], *b = tr->v[(e + 1) % 3];
-                            double d = seg_dist(a, b, x, y);
-                            if (d <= r && fmax(a[2], b[2]) - cs_dropcut_profile(t, d) > best)
-                                best = fmax(best, edge_drop(t, a, b, x, y));
-                        }
-                    }
-                }
-        ms->query++; /* the second sweep's stamp */
+    size_t n = 0;
+    *hit = false;
+    if (x + r < ms->box[0] || x - r > ms->box[3] || y + r < ms->box[1] || y - r > ms->box[4])
+        return best;
+    if (!footprint(ms, t, x, y, &n)) { /* out of memory: stand above the whole mesh */
+        *hit = true;
+        return ms->box[5];
+    }
+    /* Cells in decreasing bound: once a cell's bound is at or below the best contact found, no
+     * later cell can raise it (a branch-and-bound over the grid). */
+    for (size_t q = 0; q < n && ms->cq[q].bound > best; q++) {
+        size_t c = ms->cq[q].cell;
+        for (size_t k = ms->start[c]; k < ms->start[c + 1]; k++) {
+            size_t i = ms->idx[k];
+            if (ms->stamp[i] == ms->query)
+                continue;
+            ms->stamp[i] = ms->query;
+            best = tri_drop(ms, t, i, x, y, best);
+        }
     }
     *hit = best > -HUGE_VAL;
     return best;
@@ -457,5 +577,8 @@ void cs_dropcut_free(cs_dropcut_mesh_t *ms)
     free(ms->start);
     free(ms->idx);
     free(ms->stamp);
+    free(ms->bb);
+    free(ms->ctop);
+    free(ms->cq);
     cs_dropcut_init(ms);
 }

@@ -50,6 +50,10 @@ typedef struct {
     size_t *idx;      /* triangle numbers, by cell */
     unsigned *stamp;  /* per triangle: the query that last visited it */
     unsigned query;   /* the current query's number */
+    double (*bb)[5];  /* per triangle: x0 y0 x1 y1 of its xy box and its highest z, mm */
+    double *ctop;     /* per cell: the highest z of the triangles listed in it, mm */
+    struct cs_dropcut_cq *cq; /* scratch: the cells of one query's footprint, by bound */
+    size_t cqcap;
 } cs_dropcut_mesh_t;
 
 /* Height of the profile of tool t at horizontal distance d (0 <= d <= R) above its tip, mm. */
@@ -65,11 +69,11 @@ double cs_dropcut_grid_eps(const double *p, int m, int n, int nu, int nv);
 /* Empty mesh. */
 void cs_dropcut_init(cs_dropcut_mesh_t *ms);
 /* Triangulates every item of sf (quads directly, triangles as their collapsed tensor form,
- * n-sided patches as their bicubic cells fitted within fit_mm, whose fit adds to eps) on grids
- * fine enough that each patch's bound is <= eps_mm (at most 512 x 512 a patch), then builds the
- * index for tools up to radius rmax_mm. CS_ERR_FULL out of memory, CS_ERR_DEGENERATE when sf
- * holds no surface, CS_ERR_UNSUPPORTED for a sphere item (not meshed yet), a patch
- * constructor's code otherwise. */
+ * n-sided patches as their bicubic cells fitted within fit_mm, whose fit adds to eps, spheres on
+ * a latitude-longitude grid bounded by the caps of its triangles) on grids fine enough that each
+ * item's bound is <= eps_mm (at most 512 x 512 a patch), then builds the index for tools up to
+ * radius rmax_mm. CS_ERR_FULL out of memory, CS_ERR_DEGENERATE when sf holds no surface, a
+ * patch constructor's code otherwise. */
 cs_err_t cs_dropcut_build(cs_dropcut_mesh_t *ms, const cs_surffile_t *sf, double eps_mm,
                           double fit_mm, double rmax_mm);
 /* Adds one triangle (before cs_dropcut_index; the tests build meshes by hand). */

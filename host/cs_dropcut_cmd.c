@@ -24,7 +24,7 @@
 typedef struct {
     const char *file, *gcode, *name;
     double scale, tol, feed, plunge, safe_z, spindle, min_z, check_step;
-    bool have_safe_z, have_min_z, have_stock, check, stats, centre;
+    bool have_safe_z, have_min_z, have_stock, check, stats, centre, no_link, waterline;
     cs_dropcut_tool_t tool;
     const char *tool_kind;
     cs_dcpath_opts_t po;
@@ -105,14 +105,15 @@ static int parse_args(int argc, char **argv, dc_args_t *a)
         {"spindle", required_argument, NULL, 's'}, {"stock", required_argument, NULL, 'k'},
         {"output", required_argument, NULL, 'o'},  {"check-step", required_argument, NULL, 'K'},
         {"check", no_argument, NULL, 'C'},         {"stats", no_argument, NULL, 'T'},
+        {"no-link", no_argument, NULL, 'L'},
         {NULL, 0, NULL, 0},
     };
     int c;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
-        if (c == 'C' || c == 'T') {
-            *(c == 'C' ? &a->check : &a->stats) = true;
+        if (c == 'C' || c == 'T' || c == 'L') {
+            *(c == 'C' ? &a->check : c == 'T' ? &a->stats : &a->no_link) = true;
             continue;
         }
         if (c == ':' || c == '?') {
@@ -191,7 +192,7 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
     cs_dropcheck_t ck;
     double step = a->check_step > 0 ? a->check_step : 0.05;
     cs_err_t e = cs_dropcheck_run(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass,
-                                  a->po.box, step, &ck);
+                                  a->po.box, step, a->po.scallop_mm, &ck);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep toolpath: check: out of memory\n");
         return CS_EXIT_INTERNAL;
@@ -201,9 +202,13 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
             "%zu on walls left out): gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
             step, ck.surf_samples, ck.path_samples, ck.nodes, ck.walls, ck.gouge_mm, ck.scallop_mm,
             ck.scallop_at[0], ck.scallop_at[1]);
-    /* The scallop is a promise for a ball only (cs_dcpath.h); flat and bull-nose report it. */
-    bool ball = a->tool.c_mm >= a->tool.r_mm;
-    bool gouged = ck.gouge_mm > a->tol, high = ball && ck.scallop_mm > a->po.scallop_mm;
+    if (ck.rest_nodes > 0)
+        fprintf(stderr,
+                "toolpath: check: unreachable: %zu nodes (%.2f mm^2) where no cutter of this shape "
+                "reaches from above, up to %.4f mm of rest material at (%.3f, %.3f)\n",
+                ck.rest_nodes, (double)ck.rest_nodes * step * step, ck.rest_mm, ck.rest_at[0],
+                ck.rest_at[1]);
+    bool gouged = ck.gouge_mm > a->tol, high = ck.scallop_mm > a->po.scallop_mm;
     if (gouged)
         fprintf(stderr,
                 "toolpath: check FAILED: the cutter enters the surface by %.6f mm at (%.3f, %.3f, "
@@ -218,49 +223,65 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
 
 /* --- command ------------------------------------------------------------------------------ */
 
-static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
+/* The mesh within tol / 4 of the surface (n-sided cells fitted within tol / 8 more); the region
+ * and the floor from it unless given. */
+static int build_mesh(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms)
 {
-    cs_dropcut_mesh_t ms;
-    /* The mesh within tol / 4 of the surface (n-sided cells fitted within tol / 8 more). */
-    cs_err_t e = cs_dropcut_build(&ms, sf, a->tol / 4, a->tol / 8, a->tool.r_mm);
+    cs_err_t e = cs_dropcut_build(ms, sf, a->tol / 4, a->tol / 8, a->tool.r_mm);
     if (e != CS_OK) {
         fprintf(stderr, "%s: cannot mesh the surface: %s\n", a->name,
-                e == CS_ERR_FULL          ? "out of memory"
-                : e == CS_ERR_UNSUPPORTED ? "the drop-cutter does not take a sphere item yet"
-                                          : "no usable patch");
-        cs_dropcut_free(&ms);
+                e == CS_ERR_FULL ? "out of memory" : "no usable patch");
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_INPUT;
     }
     /* By default the axis covers the surface's extent and a cutter radius beyond, so that the
      * cutter's side finishes the edges. */
     double r = a->tool.r_mm;
     if (!a->have_stock)
-        memcpy(a->po.box, (double[4]){ms.box[0] - r, ms.box[1] - r, ms.box[3] + r, ms.box[4] + r},
+        memcpy(a->po.box, (double[4]){ms->box[0] - r, ms->box[1] - r, ms->box[3] + r, ms->box[4] + r},
                sizeof a->po.box);
-    a->po.min_z = a->have_min_z ? a->min_z : ms.box[2];
+    a->po.min_z = a->have_min_z ? a->min_z : ms->box[2];
     a->po.tol_mm = a->tol;
     a->po.max_passes = DC_MAX_PASSES;
-    double safe = a->have_safe_z ? a->safe_z : ms.box[5] + a->tool.r_mm + 5;
-    cs_dcpath_t p;
-    cs_dcpath_init(&p);
-    e = cs_dcpath_raster(&p, &ms, &a->tool, &a->po);
-    int status = CS_EXIT_OK;
+    return CS_EXIT_OK;
+}
+
+/* The passes of the chosen strategy, joined where the link is clear (unless --no-link). */
+static int plan(dc_args_t *a, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
+{
+    cs_err_t e = cs_dcpath_raster(p, ms, &a->tool, &a->po);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep toolpath: cannot plan the passes: %s\n",
                 e == CS_ERR_FULL ? "out of memory" : "the region or step-over is empty");
-        status = e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_USAGE;
+        return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_USAGE;
     }
-    if (status == CS_EXIT_OK && p.capped)
+    size_t before = p->npass;
+    if (!a->no_link)
+        cs_dcpath_link(p, ms, &a->tool, a->tol, a->tol);
+    if (p->capped)
         fprintf(stderr, "curvestep toolpath: warning: the scallop refinement stopped at %d passes; "
                         "estimated scallop %.4f mm (steep walls want a smaller step or another strategy)\n",
-                DC_MAX_PASSES, p.max_left);
-    if (status == CS_EXIT_OK && a->stats)
+                DC_MAX_PASSES, p->max_left);
+    if (a->stats)
         fprintf(stderr,
-                "toolpath: %s cutter R %g mm corner %g mm: mesh %zu triangles within %.6f mm, %zu "
-                "passes (%zu added for the scallop), %zu points, %zu drops, estimated scallop "
-                "%.6f mm (nan: not estimated, flat or bull-nose)\n",
-                a->tool_kind, a->tool.r_mm, a->tool.c_mm, ms.ntri, ms.eps, p.npass, p.refined, p.n,
-                p.drops, p.max_left);
+                "toolpath: %s cutter R %g mm corner %g mm, %s: mesh %zu triangles within %.6f mm, "
+                "%zu passes (%zu added for the scallop), %zu linked at cutting height (%zu "
+                "retracts), %zu points, %zu drops, estimated scallop %.6f mm (nan: not estimated), "
+                "%.6f mm where no pass can be added (rest material, walls)\n",
+                a->tool_kind, a->tool.r_mm, a->tool.c_mm, a->waterline ? "waterline" : "raster",
+                ms->ntri, ms->eps, before, p->refined, p->links, p->npass, p->n, p->drops,
+                p->max_left, p->max_stuck);
+    return CS_EXIT_OK;
+}
+
+static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
+{
+    cs_dropcut_mesh_t ms;
+    cs_dcpath_t p;
+    cs_dcpath_init(&p);
+    int status = build_mesh(a, sf, &ms);
+    double safe = a->have_safe_z ? a->safe_z : ms.box[5] + a->tool.r_mm + 5;
+    if (status == CS_EXIT_OK)
+        status = plan(a, &ms, &p);
     if (status == CS_EXIT_OK) {
         write_points(a, &p);
         if (a->gcode && !write_gcode(a, &p, safe)) {

@@ -230,129 +230,158 @@ void cs_surffile_keyword_list(char *buf, size_t cap)
     }
 }
 
-/* One statement after its keyword (in lx->tok). */
-static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
+/* bezier DU DV then (DU + 1)(DV + 1) control points. */
+static cs_err_t bezier_stmt(cs_lex_t *lx, cs_patch_t *p)
 {
-    char kw[64];
-    snprintf(kw, sizeof kw, "%s", lx->tok);
-    cs_path_loc_t at = cs_lex_here(lx);
+    int du, dv;
+    cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
+    cs_err_t e = cs_lex_integer(lx, "degree in u", 1, CS_PATCH_MAX_DEGREE, &du);
+    if (e == CS_OK)
+        e = cs_lex_integer(lx, "degree in v", 1, CS_PATCH_MAX_DEGREE, &dv);
+    for (int k = 0; e == CS_OK && k < (du + 1) * (dv + 1); k++)
+        e = cs_lex_vec(lx, "control point", &pts[k], NULL);
+    return e == CS_OK ? cs_patch_init(p, (unsigned)du, (unsigned)dv, pts) : e;
+}
+
+/* tri N then (N + 1)(N + 2) / 2 control points: pushed as a triangular item. */
+static cs_err_t tri_stmt(cs_lex_t *lx, int line, cs_surffile_t *sf, bool *pushed)
+{
+    int n;
+    cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
+    cs_err_t e = cs_lex_integer(lx, "degree", 1, CS_TRIPATCH_MAX_DEGREE, &n);
+    for (int k = 0; e == CS_OK && k < (n + 1) * (n + 2) / 2; k++)
+        e = cs_lex_vec(lx, "control point", &pts[k], NULL);
+    cs_surf_item_t it;
+    memset(&it, 0, sizeof it);
+    if (e == CS_OK && (e = cs_tripatch_init(&it.trip, (unsigned)n, pts)) == CS_OK) {
+        it.tri = true;
+        it.line = line;
+        *pushed = true;
+        return push(sf, &it);
+    }
+    return e;
+}
+
+/* hermite (16 vectors: P, Pu, Pv, Puv at the four corners) or power (16 coefficients). */
+static cs_err_t hermite_power_stmt(cs_lex_t *lx, bool herm, cs_patch_t *p)
+{
+    cs_vec3_t v[16];
     cs_err_t e = CS_OK;
-    cs_patch_t p;
-    if (strcmp(kw, "bezier") == 0) {
-        int du, dv;
-        cs_vec3_t pts[CS_PATCH_MAX_POINTS * CS_PATCH_MAX_POINTS];
-        e = cs_lex_integer(lx, "degree in u", 1, CS_PATCH_MAX_DEGREE, &du);
-        if (e == CS_OK)
-            e = cs_lex_integer(lx, "degree in v", 1, CS_PATCH_MAX_DEGREE, &dv);
-        for (int k = 0; e == CS_OK && k < (du + 1) * (dv + 1); k++)
-            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
-        if (e == CS_OK && (e = cs_patch_init(&p, (unsigned)du, (unsigned)dv, pts)) == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "tri") == 0) {
-        int n;
-        cs_vec3_t pts[CS_TRIPATCH_MAX_POINTS];
-        e = cs_lex_integer(lx, "degree", 1, CS_TRIPATCH_MAX_DEGREE, &n);
-        for (int k = 0; e == CS_OK && k < (n + 1) * (n + 2) / 2; k++)
-            e = cs_lex_vec(lx, "control point", &pts[k], NULL);
-        cs_surf_item_t it;
-        memset(&it, 0, sizeof it);
-        if (e == CS_OK && (e = cs_tripatch_init(&it.trip, (unsigned)n, pts)) == CS_OK) {
-            it.tri = true;
-            it.line = at.line;
-            return push(sf, &it);
+    for (int k = 0; e == CS_OK && k < 16; k++)
+        e = cs_lex_vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
+    if (e != CS_OK)
+        return e;
+    if (herm) {
+        cs_patch_hermite_t h;
+        for (int k = 0; k < 4; k++) {
+            int a = k % 2, b = k / 2;
+            h.p[a][b] = v[k];
+            h.pu[a][b] = v[4 + k];
+            h.pv[a][b] = v[8 + k];
+            h.puv[a][b] = v[12 + k];
         }
-    } else if (strcmp(kw, "hermite") == 0 || strcmp(kw, "power") == 0) {
-        bool herm = kw[0] == 'h';
-        cs_vec3_t v[16];
-        for (int k = 0; e == CS_OK && k < 16; k++)
-            e = cs_lex_vec(lx, herm ? "Hermite vector" : "coefficient", &v[k], NULL);
-        if (e == CS_OK) {
-            if (herm) {
-                cs_patch_hermite_t h;
-                for (int k = 0; k < 4; k++) {
-                    int a = k % 2, b = k / 2;
-                    h.p[a][b] = v[k];
-                    h.pu[a][b] = v[4 + k];
-                    h.pv[a][b] = v[8 + k];
-                    h.puv[a][b] = v[12 + k];
-                }
-                e = cs_patch_from_hermite(&p, &h);
-            } else {
-                cs_vec3_t a[4][4];
-                for (int k = 0; k < 16; k++)
-                    a[k / 4][k % 4] = v[k];
-                e = cs_patch_from_power(&p, a);
-            }
-            if (e == CS_OK)
-                return push_quad(sf, &p, at.line);
-        }
-    } else if (strcmp(kw, "coons-bilinear") == 0) {
-        cs_bezier_t c[4];
-        for (int k = 0; e == CS_OK && k < 4; k++)
-            e = curve(lx, &c[k]);
-        if (e == CS_OK && (e = cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], &p)) == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "coons-bicubic") == 0) {
-        e = coons_bicubic(lx, &p);
-        if (e == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "coons-blend") == 0) {
+        return cs_patch_from_hermite(p, &h);
+    }
+    cs_vec3_t a[4][4];
+    for (int k = 0; k < 16; k++)
+        a[k / 4][k % 4] = v[k];
+    return cs_patch_from_power(p, a);
+}
+
+/* The patches built from boundary curves: coons-bilinear, coons-blend, ruled, extrude. */
+static cs_err_t curves_stmt(cs_lex_t *lx, const char *kw, cs_patch_t *p)
+{
+    cs_bezier_t c[4];
+    cs_err_t e = CS_OK;
+    if (strcmp(kw, "coons-blend") == 0) {
         cs_gcoons_blend_t f, g;
-        cs_bezier_t c[4];
         e = blend(lx, &f);
         if (e == CS_OK)
             e = blend(lx, &g);
         for (int k = 0; e == CS_OK && k < 4; k++)
             e = curve(lx, &c[k]);
-        if (e == CS_OK && (e = cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, &p)) == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "sphere") == 0) {
-        return sphere(lx, at.line, sf);
-    } else if (strcmp(kw, "ruled") == 0) {
-        cs_bezier_t c[2];
-        for (int k = 0; e == CS_OK && k < 2; k++)
-            e = curve(lx, &c[k]);
-        if (e == CS_OK && (e = cs_coons_ruled(&c[0], &c[1], &p)) == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "extrude") == 0) {
-        cs_bezier_t c;
+        return e == CS_OK ? cs_gcoons_build(&c[0], &c[1], &c[2], &c[3], &f, &g, p) : e;
+    }
+    if (strcmp(kw, "extrude") == 0) {
         cs_vec3_t d;
-        e = curve(lx, &c);
+        e = curve(lx, &c[0]);
         if (e == CS_OK)
             e = cs_lex_vec(lx, "direction", &d, NULL);
-        if (e == CS_OK && (e = cs_coons_extrude(&c, &d, &p)) == CS_OK)
-            return push_quad(sf, &p, at.line);
-    } else if (strcmp(kw, "revolve") == 0) {
-        double o[3], ax[3], rf[3], sweep;
-        cs_bezier_t c;
-        e = cs_lex_vec(lx, "axis origin", NULL, o);
-        if (e == CS_OK)
-            e = cs_lex_vec(lx, "axis direction", NULL, ax);
-        if (e == CS_OK)
-            e = cs_lex_vec(lx, "reference direction", NULL, rf);
-        if (e == CS_OK)
-            e = cs_lex_number(lx, "sweep in degrees", &sweep);
-        if (e == CS_OK)
-            e = curve(lx, &c);
-        if (e == CS_OK) {
-            cs_patch_t out[CS_REVOLVE_MAX_ARCS];
-            size_t n = 0;
-            e = cs_revolve(&c, o, ax, rf, sweep, rev_tol, out, CS_REVOLVE_MAX_ARCS, &n, NULL);
-            for (size_t k = 0; e == CS_OK && k < n; k++)
-                e = push_quad(sf, &out[k], at.line);
-            if (e == CS_OK || e == CS_ERR_FULL)
-                return e;
-        }
-    } else if (strcmp(kw, "varady") == 0 || strcmp(kw, "varady-scheme") == 0) {
+        return e == CS_OK ? cs_coons_extrude(&c[0], &d, p) : e;
+    }
+    bool ruled = strcmp(kw, "ruled") == 0;
+    for (int k = 0; e == CS_OK && k < (ruled ? 2 : 4); k++)
+        e = curve(lx, &c[k]);
+    if (e != CS_OK)
+        return e;
+    return ruled ? cs_coons_ruled(&c[0], &c[1], p) : cs_coons_bilinear(&c[0], &c[1], &c[2], &c[3], p);
+}
+
+/* revolve ORIGIN AXIS REF SWEEP CURVE: the arcs' patches pushed. */
+static cs_err_t revolve_stmt(cs_lex_t *lx, int line, double rev_tol, cs_surffile_t *sf,
+                             bool *pushed)
+{
+    double o[3], ax[3], rf[3], sweep;
+    cs_bezier_t c;
+    cs_err_t e = cs_lex_vec(lx, "axis origin", NULL, o);
+    if (e == CS_OK)
+        e = cs_lex_vec(lx, "axis direction", NULL, ax);
+    if (e == CS_OK)
+        e = cs_lex_vec(lx, "reference direction", NULL, rf);
+    if (e == CS_OK)
+        e = cs_lex_number(lx, "sweep in degrees", &sweep);
+    if (e == CS_OK)
+        e = curve(lx, &c);
+    if (e != CS_OK)
+        return e;
+    cs_patch_t out[CS_REVOLVE_MAX_ARCS];
+    size_t n = 0;
+    e = cs_revolve(&c, o, ax, rf, sweep, rev_tol, out, CS_REVOLVE_MAX_ARCS, &n, NULL);
+    for (size_t k = 0; e == CS_OK && k < n; k++)
+        e = push_quad(sf, &out[k], line);
+    *pushed = e == CS_OK || e == CS_ERR_FULL;
+    return e;
+}
+
+/* One statement after its keyword (in lx->tok). Items that push themselves set pushed: their
+ * code is returned as is; the others' patch is pushed here, and a constructor's failure gets
+ * its located diagnostic. */
+static cs_err_t statement(cs_lex_t *lx, cs_surffile_t *sf, double rev_tol)
+{
+    char kw[64];
+    snprintf(kw, sizeof kw, "%s", lx->tok);
+    cs_path_loc_t at = cs_lex_here(lx);
+    cs_err_t e;
+    cs_patch_t p;
+    bool pushed = false;
+    if (strcmp(kw, "bezier") == 0)
+        e = bezier_stmt(lx, &p);
+    else if (strcmp(kw, "tri") == 0)
+        e = tri_stmt(lx, at.line, sf, &pushed);
+    else if (strcmp(kw, "hermite") == 0 || strcmp(kw, "power") == 0)
+        e = hermite_power_stmt(lx, kw[0] == 'h', &p);
+    else if (strcmp(kw, "coons-bicubic") == 0)
+        e = coons_bicubic(lx, &p);
+    else if (strcmp(kw, "coons-bilinear") == 0 || strcmp(kw, "coons-blend") == 0 ||
+             strcmp(kw, "ruled") == 0 || strcmp(kw, "extrude") == 0)
+        e = curves_stmt(lx, kw, &p);
+    else if (strcmp(kw, "sphere") == 0)
+        return sphere(lx, at.line, sf);
+    else if (strcmp(kw, "revolve") == 0)
+        e = revolve_stmt(lx, at.line, rev_tol, sf, &pushed);
+    else if (strcmp(kw, "varady") == 0 || strcmp(kw, "varady-scheme") == 0) {
         e = varady(lx, strcmp(kw, "varady-scheme") == 0, at.line, sf);
-        if (e == CS_OK || e == CS_ERR_FULL)
-            return e;
+        pushed = e == CS_OK || e == CS_ERR_FULL;
     } else {
         char list[256];
         cs_surffile_keyword_list(list, sizeof list);
         return cs_path_diag_set(lx->diag, CS_ERR_PARSE, at, "unknown surface '%s' (%s)", kw, list);
     }
-    if (e != CS_OK && lx->diag->code != e)
+    if (pushed)
+        return e;
+    if (e == CS_OK)
+        return push_quad(sf, &p, at.line);
+    if (lx->diag->code != e)
         return cs_path_diag_set(lx->diag, e, at, "%s: %s", kw, cs_err_text(e));
     return e;
 }

@@ -58,7 +58,8 @@ static void tp_usage(FILE *f)
         "                          (--scallop H | --stepover MM) [--angle DEG] [--tol MM]\n"
         "                          [--output tip|centre] [--feed F] [--plunge F] [--spindle S]\n"
         "                          [--safe-z Z] [--min-z Z] [--stock X0,Y0,X1,Y1] [--scale S]\n"
-        "                          [--check [--check-step MM]] [--stats] [--gcode OUT.nc]\n"
+        "                          [--check [--check-step MM]] [--no-link] [--stats]\n"
+        "                          [--gcode OUT.nc]\n"
         "       (the first two forms also take --gcode OUT.nc)\n"
         "\n"
         "Reads surface patches and prints a path over them. FILE is in Newell's format (a\n"
@@ -91,10 +92,10 @@ static void tp_usage(FILE *f)
         "enlarged by that bound is dropped onto the mesh along a zig-zag raster (OpenCAMLib's\n"
         "drop-cutter: facet, edge and vertex contacts), points along each pass added until\n"
         "every chord is within tol of the drop height, and passes added between two\n"
-        "neighbours until the material left between them (measured vertically) is at most H\n"
-        "(a ball; flat and bull-nose ends take the flat-ground step-over for H, or --stepover,\n"
-        "and their scallop is reported, not promised: they leave steps on every slope).\n"
-        "Prints the programmed point \"x y z\" (mm) per line, a blank line between passes.\n"
+        "neighbours until the scallop between them (measured across the surface) is at most H\n"
+        "for every cutter; passes joined at cutting height where the straight link stays above\n"
+        "the drop surface. Sphere items are meshed too. Prints the programmed point \"x y z\"\n"
+        "(mm) per line, a blank line between polylines.\n"
         "  --cutter K      ball:R, flat:R or bull:R:r (radius R, corner radius r, mm)\n"
         "  --scallop H     largest material height left between passes, mm\n"
         "  --stepover MM   a fixed step-over instead (no scallop refinement)\n"
@@ -107,9 +108,12 @@ static void tp_usage(FILE *f)
         "  --stock BOX     X0,Y0,X1,Y1: the region the cutter's axis covers (default: the\n"
         "                  surface's extent and R beyond)\n"
         "  --check         measure, against dense samples of the exact surface, the deepest\n"
-        "                  penetration of the cutter along the path and the largest material\n"
-        "                  height left; exit 1 when over --tol or, for a ball, H (--check-step\n"
-        "                  MM: the sampling step, default 0.05 mm)\n"
+        "                  penetration of the cutter along the path and the scallop (distance\n"
+        "                  from the surface to the nearest cutter; what no cutter from above\n"
+        "                  reaches is reported apart as unreachable); exit 1 when over --tol\n"
+        "                  or H (--check-step MM: the sampling step, default 0.05 mm)\n"
+        "  --no-link       retract after every pass (default: link at cutting height where\n"
+        "                  the straight move stays above the drop surface)\n"
         "\n"
         "Options:\n"
         "  --patches FILE  the surface file ('-' reads standard input)\n"
@@ -636,188 +640,155 @@ static cs_err_t write_svg(const char *file, const cs_path_poly_t *poly, const ch
 
 /* --- command ------------------------------------------------------------------------------ */
 
-int cs_cmd_toolpath(int argc, char **argv)
+/* The command line of the wireframe and normal-offset modes. */
+typedef struct {
+    const char *file, *svg_out, *gcode_out;
+    tp_view_t view;
+    double tol_mm, scale;
+    unsigned lines;
+    bool stats, ball, have_h;
+    tp_ball_t bp;
+} tp_args_t;
+
+/* One option's value into *a: CS_EXIT_OK, CS_EXIT_USAGE (message printed), or -1 for --help. */
+static int tp_option(int c, const char *v, char **argv, tp_args_t *a)
 {
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0)
-            break;
-        if (strncmp(argv[i], "--cutter", 8) == 0 && (argv[i][8] == '\0' || argv[i][8] == '='))
-            return cs_cmd_toolpath_drop(argc, argv);
+    double d = 0;
+    cs_pos_t t = 0;
+    switch (c) {
+    case 'p': a->file = v; return CS_EXIT_OK;
+    case 'o': a->svg_out = v; return CS_EXIT_OK;
+    case 'g': a->gcode_out = v; return CS_EXIT_OK;
+    case 's': a->stats = true; return CS_EXIT_OK;
+    case 'h': return -1;
+    case 'v':
+        if (parse_view(v, &a->view))
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --view '%s': expected top, front, side, iso or 12 "
+                        "comma-separated numbers\n", v);
+        return CS_EXIT_USAGE;
+    case 'n':
+        if (!cs_conv_number(v, &d) || d != floor(d) || d < 1 || d > TP_MAX_LINES) {
+            fprintf(stderr, "curvestep toolpath: --lines '%s': expected an integer 1..%d\n", v,
+                    TP_MAX_LINES);
+            return CS_EXIT_USAGE;
+        }
+        a->lines = (unsigned)d;
+        return CS_EXIT_OK;
+    case 't':
+        if (cs_conv_number(v, &a->tol_mm) && cs_conv_tol_to_pos(a->tol_mm, &t) == CS_OK &&
+            t >= CS_TRACE_TOL_MIN && t <= CS_TRACE_TOL_MAX)
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --tol '%s': expected a tolerance in mm, from %.7f to %d\n",
+                v, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_POS_LIMIT_MM);
+        return CS_EXIT_USAGE;
+    case 'S':
+        if (cs_conv_number(v, &a->scale) && a->scale > 0)
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --scale '%s': expected a number > 0\n", v);
+        return CS_EXIT_USAGE;
+    case 'b':
+        a->ball = true;
+        if (cs_conv_number(v, &a->bp.r_mm) && a->bp.r_mm > 0 && a->bp.r_mm <= 100)
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --ball '%s': expected a radius in mm, 0 < R <= 100\n", v);
+        return CS_EXIT_USAGE;
+    case 'H':
+        a->have_h = true;
+        if (cs_conv_number(v, &a->bp.h_mm) && a->bp.h_mm > 0)
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --scallop '%s': expected a height in mm > 0\n", v);
+        return CS_EXIT_USAGE;
+    case 'z':
+        a->bp.have_safe_z = true;
+        if (cs_conv_number(v, &a->bp.safe_z_mm) && fabs(a->bp.safe_z_mm) <= CS_POS_LIMIT_MM)
+            return CS_EXIT_OK;
+        fprintf(stderr, "curvestep toolpath: --safe-z '%s': expected a height in mm\n", v);
+        return CS_EXIT_USAGE;
+    default:
+        fprintf(stderr, "curvestep toolpath: %s '%s'\nTry 'curvestep toolpath --help'.\n",
+                c == ':' ? "option needs a value:" : "unknown option", argv[optind - 1]);
+        return CS_EXIT_USAGE;
     }
+}
+
+/* Parses the command line into *a: CS_EXIT_OK, CS_EXIT_USAGE, or -1 after --help (printed). */
+static int tp_parse(int argc, char **argv, tp_args_t *a)
+{
     static const struct option longopts[] = {
-        {"patches", required_argument, NULL, 'p'},
-        {"view", required_argument, NULL, 'v'},
-        {"lines", required_argument, NULL, 'n'},
-        {"tol", required_argument, NULL, 't'},
-        {"scale", required_argument, NULL, 'S'},
-        {"ball", required_argument, NULL, 'b'},
-        {"scallop", required_argument, NULL, 'H'},
-        {"safe-z", required_argument, NULL, 'z'},
-        {"stats", no_argument, NULL, 's'},
-        {"svg", required_argument, NULL, 'o'},
-        {"gcode", required_argument, NULL, 'g'},
-        {"help", no_argument, NULL, 'h'},
+        {"patches", required_argument, NULL, 'p'}, {"view", required_argument, NULL, 'v'},
+        {"lines", required_argument, NULL, 'n'},   {"tol", required_argument, NULL, 't'},
+        {"scale", required_argument, NULL, 'S'},   {"ball", required_argument, NULL, 'b'},
+        {"scallop", required_argument, NULL, 'H'}, {"safe-z", required_argument, NULL, 'z'},
+        {"stats", no_argument, NULL, 's'},         {"svg", required_argument, NULL, 'o'},
+        {"gcode", required_argument, NULL, 'g'},   {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
-    const char *file = NULL, *svg_out = NULL, *gcode_out = NULL;
-    tp_view_t view = views[3];
-    double tol_mm = TP_DEFAULT_TOL_MM, scale = 1.0;
-    unsigned lines = TP_DEFAULT_LINES;
-    bool stats = false, ball = false, have_h = false;
-    tp_ball_t bp = {0, 0, 0, false};
-    cs_finish_stats_t fst = {0, 0, 0, 0, 0.0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
-    double varady_fit = 0; /* n-sided patches: largest sampled distance of the fitted cells */
     int c;
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
-        double d = 0;
-        switch (c) {
-        case 'p':
-            file = optarg;
-            break;
-        case 'v':
-            if (!parse_view(optarg, &view)) {
-                fprintf(stderr,
-                        "curvestep toolpath: --view '%s': expected top, front, side, iso "
-                        "or 12 comma-separated numbers\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        case 'n':
-            if (!cs_conv_number(optarg, &d) || d != floor(d) || d < 1 || d > TP_MAX_LINES) {
-                fprintf(stderr, "curvestep toolpath: --lines '%s': expected an integer 1..%d\n",
-                        optarg, TP_MAX_LINES);
-                return CS_EXIT_USAGE;
-            }
-            lines = (unsigned)d;
-            break;
-        case 't': {
-            cs_pos_t t = 0;
-            if (!cs_conv_number(optarg, &tol_mm) || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
-                t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
-                fprintf(stderr,
-                        "curvestep toolpath: --tol '%s': expected a tolerance in mm, from %.7f "
-                        "to %d\n",
-                        optarg, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_POS_LIMIT_MM);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        }
-        case 'S':
-            if (!cs_conv_number(optarg, &scale) || scale <= 0) {
-                fprintf(stderr, "curvestep toolpath: --scale '%s': expected a number > 0\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        case 'b':
-            if (!cs_conv_number(optarg, &bp.r_mm) || bp.r_mm <= 0 || bp.r_mm > 100) {
-                fprintf(stderr,
-                        "curvestep toolpath: --ball '%s': expected a radius in mm, "
-                        "0 < R <= 100\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            ball = true;
-            break;
-        case 'H':
-            if (!cs_conv_number(optarg, &bp.h_mm) || bp.h_mm <= 0) {
-                fprintf(stderr,
-                        "curvestep toolpath: --scallop '%s': expected a height in mm "
-                        "> 0\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            have_h = true;
-            break;
-        case 'z':
-            if (!cs_conv_number(optarg, &bp.safe_z_mm) || fabs(bp.safe_z_mm) > CS_POS_LIMIT_MM) {
-                fprintf(stderr, "curvestep toolpath: --safe-z '%s': expected a height in mm\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            bp.have_safe_z = true;
-            break;
-        case 's':
-            stats = true;
-            break;
-        case 'o':
-            svg_out = optarg;
-            break;
-        case 'g':
-            gcode_out = optarg;
-            break;
-        case 'h':
+        int r = tp_option(c, optarg, argv, a);
+        if (r == -1)
             tp_usage(stdout);
-            return CS_EXIT_OK;
-        case ':':
-            fprintf(stderr, "curvestep toolpath: option '%s' needs a value\n", argv[optind - 1]);
-            fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
-            return CS_EXIT_USAGE;
-        default:
-            fprintf(stderr, "curvestep toolpath: unknown option '%s'\n", argv[optind - 1]);
-            fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
-            return CS_EXIT_USAGE;
-        }
+        if (r != CS_EXIT_OK)
+            return r;
     }
-    if (optind != argc || !file) {
-        fprintf(stderr, "curvestep toolpath: %s\n",
+    if (optind != argc || !a->file) {
+        fprintf(stderr, "curvestep toolpath: %s\nTry 'curvestep toolpath --help'.\n",
                 optind != argc ? "unexpected argument (the file goes after --patches)"
                                : "missing --patches FILE");
-        fprintf(stderr, "Try 'curvestep toolpath --help'.\n");
         return CS_EXIT_USAGE;
     }
-    if (ball != have_h || (ball && bp.h_mm >= bp.r_mm)) {
+    if (a->ball != a->have_h || (a->ball && a->bp.h_mm >= a->bp.r_mm)) {
         fprintf(stderr, "curvestep toolpath: --ball R and --scallop H go together, 0 < H < R\n");
         return CS_EXIT_USAGE;
     }
-    if (!ball && bp.have_safe_z) {
+    if (!a->ball && a->bp.have_safe_z) {
         fprintf(stderr, "curvestep toolpath: --safe-z needs --ball\n");
         return CS_EXIT_USAGE;
     }
-    cs_pos_t tol;
-    cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
+    return CS_EXIT_OK;
+}
 
-    cs_surffile_t sf;
-    /* Surfaces of revolution are approximated within tol / 4 before tracing. */
-    int loaded = cs_surffile_load("curvestep toolpath", file, scale, tol_mm / 4, &sf);
-    if (loaded != CS_EXIT_OK)
-        return loaded;
-    cs_path_diag_t diag;
-    cs_err_t e;
-    int status = CS_EXIT_OK;
-    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
-    tp_out_t o = {&view, ball, true, NULL, false, {0}, NULL, 0, 0, 0, 0, 0.0, stats};
-    cs_path_poly_init(&o.poly);
-    if (gcode_out) {
-        o.gcode = fopen(gcode_out, "w");
-        if (!o.gcode) {
-            fprintf(stderr, "%s:0:0: cannot write the G-code\n", gcode_out);
-            cs_path_poly_free(&o.poly);
-            cs_surffile_free(&sf);
-            return CS_EXIT_INTERNAL;
-        }
-        /* Parentheses would end the comment early: the file name is only cited when it has none. */
-        bool plain = strchr(shown, '(') == NULL && strchr(shown, ')') == NULL;
-        if (ball)
-            fprintf(o.gcode, "(curvestep toolpath: finishing of %s, ball R %g mm, tool centre)\n",
-                    plain ? shown : "the input", bp.r_mm);
-        else
-            fprintf(o.gcode, "(curvestep toolpath: wireframe of %s, view %s)\n",
-                    plain ? shown : "the input", view.name);
-        fprintf(o.gcode, "G21 G90\n");
+/* The G-code file's header; false when it cannot be opened (reported). */
+static bool tp_gcode_open(const tp_args_t *a, tp_out_t *o, const char *shown)
+{
+    o->gcode = fopen(a->gcode_out, "w");
+    if (!o->gcode) {
+        fprintf(stderr, "%s:0:0: cannot write the G-code\n", a->gcode_out);
+        return false;
     }
-    if (status == CS_EXIT_OK && ball)
-        status = finish_all(&o, &sf, tol, &bp, &fst, &varady_fit);
-    for (size_t i = 0; i < sf.n && status == CS_EXIT_OK && !ball; i++) {
-        e = sf.items[i].tri      ? wire_tri(&o, &sf.items[i].trip, lines, tol)
-            : sf.items[i].varady ? wire_varady(&o, &sf.items[i].nside, lines, tol)
-            : sf.items[i].sphere ? wire_sphere(&o, &sf.items[i].sph, lines, tol)
-                                 : wire_patch(&o, &sf.items[i].quad, lines, tol);
+    /* Parentheses would end the comment early: the file name is only cited when it has none. */
+    bool plain = strchr(shown, '(') == NULL && strchr(shown, ')') == NULL;
+    if (a->ball)
+        fprintf(o->gcode, "(curvestep toolpath: finishing of %s, ball R %g mm, tool centre)\n",
+                plain ? shown : "the input", a->bp.r_mm);
+    else
+        fprintf(o->gcode, "(curvestep toolpath: wireframe of %s, view %s)\n",
+                plain ? shown : "the input", a->view.name);
+    fprintf(o->gcode, "G21 G90\n");
+    return true;
+}
+
+/* Traces every item (wireframe) or finishes them (--ball); closes the G-code. */
+static int tp_run(tp_args_t *a, const cs_surffile_t *sf, tp_out_t *o, cs_finish_stats_t *fst,
+                  double *varady_fit)
+{
+    cs_pos_t tol;
+    cs_conv_tol_to_pos(a->tol_mm, &tol); /* validated by tp_option */
+    int status = CS_EXIT_OK;
+    if (a->ball)
+        status = finish_all(o, sf, tol, &a->bp, fst, varady_fit);
+    for (size_t i = 0; i < sf->n && status == CS_EXIT_OK && !a->ball; i++) {
+        const cs_surf_item_t *it = &sf->items[i];
+        cs_err_t e = it->tri      ? wire_tri(o, &it->trip, a->lines, tol)
+                     : it->varady ? wire_varady(o, &it->nside, a->lines, tol)
+                     : it->sphere ? wire_sphere(o, &it->sph, a->lines, tol)
+                                  : wire_patch(o, &it->quad, a->lines, tol);
         if (e != CS_OK) {
-            cs_path_loc_t l = {sf.file, sf.items[i].line, 1};
+            cs_path_diag_t diag;
+            cs_path_loc_t l = {sf->file, it->line, 1};
             cs_path_diag_set(&diag, e, l, "patch %zu: %s", i + 1, cs_err_text(e));
             cs_path_diag_print(stderr, &diag);
             status = CS_EXIT_INTERNAL;
@@ -828,37 +799,76 @@ int cs_cmd_toolpath(int argc, char **argv)
         if (status == CS_EXIT_OK)
             status = CS_EXIT_INTERNAL;
     }
-    if (o.gcode) {
-        fprintf(o.gcode, "%sM2\n", o.pen ? "M5\n" : "");
-        bool bad = ferror(o.gcode) != 0;
-        if ((fclose(o.gcode) != 0 || bad) && status == CS_EXIT_OK) {
-            fprintf(stderr, "%s:0:0: cannot write the G-code\n", gcode_out);
+    if (o->gcode) {
+        fprintf(o->gcode, "%sM2\n", o->pen ? "M5\n" : "");
+        bool bad = ferror(o->gcode) != 0;
+        if ((fclose(o->gcode) != 0 || bad) && status == CS_EXIT_OK) {
+            fprintf(stderr, "%s:0:0: cannot write the G-code\n", a->gcode_out);
             status = CS_EXIT_INTERNAL;
         }
     }
-    if (stats && status == CS_EXIT_OK) {
-        fprintf(stderr, "toolpath: %s: %zu patches, %zu curves, %zu chords, view %s\n", shown, sf.n,
-                o.curves, o.chords, view.name);
-        if (ball)
+    return status;
+}
+
+/* --stats on stderr and the --svg picture. */
+static int tp_report(const tp_args_t *a, const cs_surffile_t *sf, const tp_out_t *o,
+                     const cs_finish_stats_t *fst, double varady_fit, const char *shown)
+{
+    if (a->stats) {
+        fprintf(stderr, "toolpath: %s: %zu patches, %zu curves, %zu chords, view %s\n", shown,
+                sf->n, o->curves, o->chords, a->view.name);
+        if (a->ball)
             fprintf(stderr,
                     "toolpath: ball R %.6g mm, scallop %.6g mm: %zu passes, measured scallop "
                     "%.6f mm (between pass centres, double)\n",
-                    bp.r_mm, bp.h_mm, fst.passes, fst.max_scallop);
-        if (ball && varady_fit > 0)
+                    a->bp.r_mm, a->bp.h_mm, fst->passes, fst->max_scallop);
+        if (a->ball && varady_fit > 0)
             fprintf(stderr,
                     "toolpath: n-sided patches finished as fitted bicubic cells within %.6f mm "
                     "(sampled, 9 x 9 per cell)\n",
                     varady_fit);
-        if (!ball)
+        if (!a->ball)
             fprintf(stderr,
                     "toolpath: tolerance %.6g mm, max deviation %.6f mm (chords against their "
                     "exact curves, 3D, measured in double)\n",
-                    tol_mm, o.maxdev);
+                    a->tol_mm, o->maxdev);
     }
-    if (svg_out && status == CS_EXIT_OK && write_svg(svg_out, &o.poly, shown) != CS_OK) {
-        fprintf(stderr, "%s:0:0: cannot write the picture\n", svg_out);
+    if (a->svg_out && write_svg(a->svg_out, &o->poly, shown) != CS_OK) {
+        fprintf(stderr, "%s:0:0: cannot write the picture\n", a->svg_out);
+        return CS_EXIT_INTERNAL;
+    }
+    return CS_EXIT_OK;
+}
+
+int cs_cmd_toolpath(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0)
+            break;
+        if (strncmp(argv[i], "--cutter", 8) == 0 && (argv[i][8] == '\0' || argv[i][8] == '='))
+            return cs_cmd_toolpath_drop(argc, argv);
+    }
+    tp_args_t a = {NULL, NULL, NULL, views[3], TP_DEFAULT_TOL_MM, 1.0, TP_DEFAULT_LINES,
+                   false, false, false, {0, 0, 0, false}};
+    int status = tp_parse(argc, argv, &a);
+    if (status != CS_EXIT_OK)
+        return status == -1 ? CS_EXIT_OK : status;
+    cs_surffile_t sf;
+    /* Surfaces of revolution are approximated within tol / 4 before tracing. */
+    status = cs_surffile_load("curvestep toolpath", a.file, a.scale, a.tol_mm / 4, &sf);
+    if (status != CS_EXIT_OK)
+        return status;
+    const char *shown = strcmp(a.file, "-") == 0 ? "<stdin>" : a.file;
+    cs_finish_stats_t fst = {0, 0, 0, 0, 0.0, HUGE_VAL, 0, 0, 0, 0, 0, 0};
+    double varady_fit = 0; /* n-sided patches: largest sampled distance of the fitted cells */
+    tp_out_t o = {&a.view, a.ball, true, NULL, false, {0}, NULL, 0, 0, 0, 0, 0.0, a.stats};
+    cs_path_poly_init(&o.poly);
+    if (a.gcode_out && !tp_gcode_open(&a, &o, shown))
         status = CS_EXIT_INTERNAL;
-    }
+    if (status == CS_EXIT_OK)
+        status = tp_run(&a, &sf, &o, &fst, &varady_fit);
+    if (status == CS_EXIT_OK)
+        status = tp_report(&a, &sf, &o, &fst, varady_fit, shown);
     free(o.v);
     cs_path_poly_free(&o.poly);
     cs_surffile_free(&sf);

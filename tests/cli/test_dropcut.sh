@@ -19,7 +19,7 @@ EOF
 
 # 1. A ball: every interior tip on the hand formula, the check passes, G-code written.
 run "ball slope" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 --check \
-    --stats --safe-z 5 --spindle 12000 --gcode "$T/ball.nc"
+    --stats --safe-z 5 --spindle 12000 --no-link --gcode "$T/ball.nc"
 cp "$T/out" "$T/ball.pts"
 cp "$T/err" "$T/ball.err"
 # The contact is R m / sqrt(1 + m^2) = 0.894 mm uphill of the axis: inside the plane for axis
@@ -57,18 +57,36 @@ src=$?
 expect "simulator check passes" [ $src -eq 0 ]
 expect "simulator: final position exact" grep -q 'rounded to steps: exact' "$T/sim.out"
 
+# 3b. Linking: neighbouring passes joined at cutting height where the straight link stays above
+# the drop-cutter surface (on a plane every link does): fewer retracts, still no gouge.
+run "ball slope linked" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 \
+    --check --safe-z 5 --gcode "$T/link.nc"
+cp "$T/err" "$T/link.err"
+r_plain=$(grep -c '^G0 Z5' "$T/ball.nc")
+r_link=$(grep -c '^G0 Z5' "$T/link.nc")
+expect "link: fewer retracts ($r_link < $r_plain)" [ "$r_link" -lt "$r_plain" ]
+g=$(sed -n 's/.*gouge \([0-9.]*\) mm.*/\1/p' "$T/link.err")
+expect "link: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+run "linked gcode plans on the router" 0 plan --machine contrib/machines/router-3018.ini \
+    -o "$T/link.seg" "$T/link.nc"
+"$SIM" --replay "$T/link.seg" --machine contrib/machines/router-3018.ini --reference "$T/link.nc" \
+    --check >"$T/simlink.out" 2>&1
+expect "linked: simulator check passes" [ $? -eq 0 ]
+
 # 4. --output centre: the ball's centre, R above the tip, point for point.
 run "ball centre" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 \
-    --output centre
+    --output centre --no-link
 off=$(paste -d' ' "$T/ball.pts" "$T/out" | awk 'NF == 6 { d = $6 - $3 - 2; if (d < 0) d = -d;
     if (d > 2e-6 || $1 != $4 || $2 != $5) n++ } END { print n + 0 }')
 expect "centre = tip + R" [ "$off" = 0 ]
 
-# 5. Flat and bull-nose ends: gouge-free by the check (their scallop is reported, not promised).
+# 5. Flat and bull-nose ends: gouge-free by the check, and their scallop (the step a level bottom
+# leaves on a slope) within H too: the raster refines their gaps like a ball's.
 for c in flat:3 bull:3:1; do
     run "$c slope" 0 toolpath --patches "$T/slope.txt" --cutter "$c" --scallop 0.05 --check
-    g=$(sed -n 's/.*gouge \([0-9.]*\) mm.*/\1/p' "$T/err")
-    expect "$c: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm.*/\1 \2/p' "$T/err")
+    expect "$c: gouge <= 0.01, scallop <= 0.05 ($g)" \
+        awk -v g="$g" 'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.01 && a[2] <= 0.05) }'
 done
 # A flat end on a plane of slope m stands on its uphill rim: tip = m (y + R) + c.
 run "flat formula" 0 toolpath --patches "$T/slope.txt" --cutter flat:3 --stepover 2
@@ -82,7 +100,21 @@ run "cutter bad" 2 toolpath --patches "$T/slope.txt" --cutter cone:3 --scallop 0
     expect_err "cutter bad" "ball:R, flat:R or bull:R:r"
 run "bull corner too big" 2 toolpath --patches "$T/slope.txt" --cutter bull:3:3 --scallop 0.1
 run "neither scallop nor stepover" 2 toolpath --patches "$T/slope.txt" --cutter ball:2
-printf 'curvestep-surfaces 1\nsphere 0 0 0 10\n' >"$T/sphere.txt"
-run "sphere refused" 1 toolpath --patches "$T/sphere.txt" --cutter ball:2 --scallop 0.1 &&
-    expect_err "sphere refused" "does not take a sphere"
+
+# 7. A sphere item (radius 10, centre 15 15 -20 inside the router's travel): meshed on a
+# latitude-longitude grid with a cap bound. Over the pole a ball of radius R stands on the sphere
+# with its tip at zc + sqrt((r + R)^2 - d^2) - R (its centre on the offset sphere r + R).
+printf 'curvestep-surfaces 1\nsphere 15 15 -20 10\n' >"$T/sphere.txt"
+for c in ball:2 flat:3 bull:3:1; do
+    run "sphere $c" 0 toolpath --patches "$T/sphere.txt" --cutter "$c" --scallop 0.05 --check
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm.*/\1 \2/p' "$T/err")
+    expect "sphere $c: gouge <= 0.01, scallop <= 0.05 ($g)" \
+        awk -v g="$g" 'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.01 && a[2] <= 0.05) }'
+    [ "$c" = ball:2 ] && cp "$T/out" "$T/sph.pts"
+done
+bad=$(awk 'NF == 3 { d2 = ($1 - 15) ^ 2 + ($2 - 15) ^ 2; if (d2 <= 49) {
+    want = -20 + sqrt(144 - d2) - 2; e = $3 - want; if (e < 0) e = -e; if (e > 0.01) n++; m++ } }
+    END { print n + 0, m + 0 }' "$T/sph.pts")
+expect "sphere ball: tips within 0.01 mm of the offset sphere ($bad: bad, checked)" \
+    bash -c "set -- $bad; [ \$1 = 0 ] && [ \$2 -gt 50 ]"
 finish
