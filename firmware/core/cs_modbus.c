@@ -3,6 +3,7 @@
  * V1.1b3" (PDU formats, section 6; exceptions, section 7) and "MODBUS over Serial Line V1.02"
  * (RTU framing, CRC, t3.5). */
 #include "cs_modbus.h"
+#include "cs_linktime.h"
 
 #include "cs_machine.h"
 
@@ -425,8 +426,10 @@ cs_err_t cs_modbus_rtu_init(cs_modbus_rtu_t *r, cs_modbus_map_t *map, uint8_t un
     r->map = map;
     r->unit = unit;
     /* 3.5 characters of 11 bits (start, 8 data, parity or second stop, stop); the spec fixes
-     * 1750 us above 19200 baud, where the timer would be too short to keep */
-    r->gap_us = baud > 19200u ? 1750u : (uint32_t)((38500000ull + baud - 1u) / baud);
+     * 1750 us above 19200 baud, where the timer would be too short to keep. 3.5 characters =
+     * 7 half characters at twice the rate: cs_linktime's one rounding (up). */
+    r->gap_us = baud > 19200u ? 1750u
+                              : cs_linktime_chars(7u, CS_LINKTIME_BITS_RTU, 2u * baud, 1000000u);
     return CS_OK;
 }
 
