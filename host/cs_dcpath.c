@@ -277,7 +277,8 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
     return worst;
 }
 
-static cs_err_t add_pass(cs_dcpath_t *p, const dc_ctx_t *c, const dc_line_t *l, double w)
+/* Room for one more pass of n points. */
+static cs_err_t reserve(cs_dcpath_t *p, size_t n)
 {
     if (p->npass + 1 >= p->pcap) {
         size_t cap = p->pcap ? 2 * p->pcap : 64;
@@ -291,9 +292,9 @@ static cs_err_t add_pass(cs_dcpath_t *p, const dc_ctx_t *c, const dc_line_t *l, 
         p->w = nw;
         p->pcap = cap;
     }
-    if (p->n + l->n > p->cap) {
+    if (p->n + n > p->cap) {
         size_t cap = p->cap ? p->cap : 1024;
-        while (cap < p->n + l->n)
+        while (cap < p->n + n)
             cap *= 2;
         double(*np)[3] = realloc(p->pt, cap * sizeof *np);
         if (!np)
@@ -303,6 +304,24 @@ static cs_err_t add_pass(cs_dcpath_t *p, const dc_ctx_t *c, const dc_line_t *l, 
     }
     if (p->npass == 0)
         p->start[0] = 0;
+    return CS_OK;
+}
+
+cs_err_t cs_dcpath_append(cs_dcpath_t *p, const double (*pts)[3], size_t n, double w)
+{
+    if (reserve(p, n) != CS_OK)
+        return CS_ERR_FULL;
+    memcpy(p->pt[p->n], pts, n * sizeof *pts);
+    p->n += n;
+    p->w[p->npass++] = w;
+    p->start[p->npass] = p->n;
+    return CS_OK;
+}
+
+static cs_err_t add_pass(cs_dcpath_t *p, const dc_ctx_t *c, const dc_line_t *l, double w)
+{
+    if (reserve(p, l->n) != CS_OK)
+        return CS_ERR_FULL;
     bool rev = p->npass % 2 == 1; /* zig-zag */
     for (size_t k = 0; k < l->n; k++) {
         size_t i = rev ? l->n - 1 - k : k;

@@ -60,6 +60,8 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
  * polyline, no retract. The passes keep their order. */
 void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                     double step_mm, double tol_mm);
+/* Appends one pass of n tip points (mm), cross offset or level w. CS_ERR_FULL out of memory. */
+cs_err_t cs_dcpath_append(cs_dcpath_t *p, const double (*pts)[3], size_t n, double w);
 void cs_dcpath_free(cs_dcpath_t *p);
 
 #endif
