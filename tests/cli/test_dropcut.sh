@@ -117,4 +117,47 @@ bad=$(awk 'NF == 3 { d2 = ($1 - 15) ^ 2 + ($2 - 15) ^ 2; if (d2 <= 49) {
     END { print n + 0, m + 0 }' "$T/sph.pts")
 expect "sphere ball: tips within 0.01 mm of the offset sphere ($bad: bad, checked)" \
     bash -c "set -- $bad; [ \$1 = 0 ] && [ \$2 -gt 50 ]"
+# 8. --strategy waterline: constant-z contours of the drop surface. On the sphere the ball's drop
+# height is known in closed form (section 7): z_d(d) = zc + sqrt((r + R)^2 - d^2) - R for
+# d < r + R, the floor (-30, the sphere's bottom) beyond. Levels are at most
+# dz = 2 sqrt(2 R H - H^2) apart (the scallop on a vertical wall), from just below the top down
+# to the floor; every contour point must not gouge (z_d <= z + tol) and lie within tol of the
+# level, in z or in xy (d within tol of the contour's radius d_k = sqrt((r+R)^2 - (z-zc+R)^2), or
+# of the silhouette r + R below zc - R). The check measures the gouge independently.
+run "sphere waterline" 0 toolpath --patches "$T/sphere.txt" --cutter ball:2 --scallop 0.05 \
+    --strategy waterline --check --no-link --gcode "$T/wl.nc"
+cp "$T/out" "$T/wl.pts"
+g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop.*/\1/p' "$T/err")
+expect "sphere waterline: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+lv=$(awk 'NF == 3 { print $3 }' "$T/wl.pts" | sort -gu | awk -v dz="$(awk 'BEGIN { print 2 * sqrt(0.2 - 0.0025) }')" '
+    { if (n && $1 - last > dz + 1e-9) bad++; last = $1; if (!n) first = $1; n++ }
+    END { if (last < -10 - dz || last > -10 || first > -30 + 1e-6) bad++;
+          print n + 0, bad + 0, (n >= 20 / dz) }')
+expect "sphere waterline: levels every <= dz from the top to the floor ($lv: levels, bad, enough)" \
+    bash -c "set -- $lv; [ \$2 = 0 ] && [ \$3 = 1 ]"
+far=$(awk 'NF == 3 { d = sqrt(($1 - 15) ^ 2 + ($2 - 15) ^ 2); z = $3;
+    zd = d < 12 ? -22 + sqrt(144 - d * d) : -30; if (zd > z + 0.01) gouge++;
+    dk = z > -22 ? sqrt(144 - (z + 22) ^ 2) : 12; dd = d - dk; if (dd < 0) dd = -dd;
+    ez = zd - z; if (ez < 0) ez = -ez; if (dd > 0.01 && ez > 0.01) far++; m++ }
+    END { print gouge + 0, far + 0, m + 0 }' "$T/wl.pts")
+expect "sphere waterline: every point on its level within tol ($far: gouging, off, points)" \
+    bash -c "set -- $far; [ \$1 = 0 ] && [ \$2 = 0 ] && [ \$3 -gt 1000 ]"
+# Each level above the silhouette is one closed loop (first point = last point).
+loops=$(awk 'NF == 0 { if (n) { c += (f == l); t++ } n = 0; next }
+    { if (!n) f = $0; l = $0; n++ } END { if (n) { c += (f == l); t++ } print c + 0, t + 0 }' "$T/wl.pts")
+expect "sphere waterline: contours closed above the silhouette ($loops: closed, passes)" \
+    bash -c "set -- $loops; [ \$1 -ge 12 ]"
+run "waterline gcode plans on the router" 0 plan --machine "$M" -o "$T/wl.seg" "$T/wl.nc"
+for c in flat:3 bull:3:1; do
+    run "sphere waterline $c" 0 toolpath --patches "$T/sphere.txt" --cutter "$c" --scallop 0.05 \
+        --strategy waterline --check
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop.*/\1/p' "$T/err")
+    expect "sphere waterline $c: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+done
+run "slope waterline" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.05 \
+    --strategy waterline --check
+g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop.*/\1/p' "$T/err")
+expect "slope waterline: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
+run "strategy bad" 2 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.1 --strategy spiral &&
+    expect_err "strategy bad" "raster or waterline"
 finish
