@@ -47,6 +47,11 @@ static cs_err_t job_push(cs_stream_job_t *j, const cs_proto_msg_t *m)
     return CS_OK;
 }
 
+cs_err_t cs_stream_job_add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m)
+{
+    return job_push(j, m);
+}
+
 cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n)
 {
     for (size_t k = 0; k < n; k++) {

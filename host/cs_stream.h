@@ -38,6 +38,10 @@ void cs_stream_job_free(cs_stream_job_t *j);
 /* Appends step segments as SEGMENT messages. CS_ERR_FULL out of memory, CS_ERR_RANGE for a
  * segment the protocol cannot carry. */
 cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n);
+/* Appends one message as it is (HOME, JOG, PROBE, SPINDLE, UNLOCK: docs/protocol.md).
+ * CS_ERR_RANGE (or the encoder's error) for a message the protocol cannot carry, CS_ERR_FULL out
+ * of memory. */
+cs_err_t cs_stream_job_add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m);
 /* Appends a plan's segments with its servo pen events as PEN messages in their place (a pen
  * event before segment k goes right before that segment's SEGMENT; docs/protocol.md, PEN).
  * Errors as cs_stream_job_add_segments (CS_ERR_RANGE: a pulse width outside 400..2600 us). */
