@@ -745,7 +745,6 @@ typedef struct {
     cs_sim_ref_t ref;
     double end_mm[3];
     int fd, keep;
-    cs_ctlcfg_t ctl; /* [limits], [probe]: the switches and the probe surface */
 } device_run_t;
 
 /* Parses argv into d: -1 to go on, else the exit status (--help, a usage error). */
