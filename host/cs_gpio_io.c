@@ -15,6 +15,31 @@ int64_t cs_gpio_io_now_ns(void)
     return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
+bool cs_gpio_io_wait_until(int64_t t, int64_t spin, int64_t slice, bool (*stop)(const void *ctx),
+                           const void *ctx)
+{
+    for (;;) {
+        int64_t now = cs_gpio_io_now_ns();
+        if (now >= t)
+            return true;
+        if (t - now <= spin)
+            break;
+        int64_t wake = t - spin;
+        if (wake - now > slice)
+            wake = now + slice;
+        struct timespec ts = {(time_t)(wake / 1000000000), (long)(wake % 1000000000)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+        if (stop && stop(ctx))
+            return false;
+    }
+    while (cs_gpio_io_now_ns() < t) {
+#if defined(__x86_64__) || defined(__i386__)
+        __builtin_ia32_pause();
+#endif
+    }
+    return true;
+}
+
 static void io_init(cs_gpio_io_t *io, cs_gpio_io_kind_t kind, const cs_gpio_lines_t *l)
 {
     memset(io, 0, sizeof *io);

@@ -75,5 +75,10 @@ void cs_gpio_io_free(cs_gpio_io_t *io);
 int cs_gpio_io_write_record(const cs_gpio_io_t *io, FILE *f, int64_t t0_ns, const char *header);
 /* CLOCK_MONOTONIC in ns. */
 int64_t cs_gpio_io_now_ns(void);
+/* Waits until CLOCK_MONOTONIC reaches t ns: sleeps (clock_nanosleep, slices of at most slice ns)
+ * until spin ns before t, then spins. Returns false as soon as stop(ctx) is true (asked after
+ * each slice; stop may be NULL), true at t. Not for a signal handler. */
+bool cs_gpio_io_wait_until(int64_t t, int64_t spin, int64_t slice, bool (*stop)(const void *ctx),
+                           const void *ctx);
 
 #endif

@@ -9,24 +9,10 @@
 /* Sleeps in slices so a stop request is seen within this long. */
 #define SLEEP_SLICE_NS 5000000
 
-/* Waits until CLOCK_MONOTONIC reaches t: clock_nanosleep to spin before it, then spins. */
+/* Waits until CLOCK_MONOTONIC reaches t (the pulse train has no early stop of its own). */
 static void wait_until(int64_t t, int64_t spin)
 {
-    for (;;) {
-        int64_t now = cs_gpio_io_now_ns();
-        if (t - now <= spin)
-            break;
-        int64_t wake = t - spin;
-        if (wake - now > SLEEP_SLICE_NS)
-            wake = now + SLEEP_SLICE_NS;
-        struct timespec ts = {(time_t)(wake / 1000000000), (long)(wake % 1000000000)};
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
-    }
-    while (cs_gpio_io_now_ns() < t) {
-#if defined(__x86_64__) || defined(__i386__)
-        __builtin_ia32_pause();
-#endif
-    }
+    (void)cs_gpio_io_wait_until(t, spin, SLEEP_SLICE_NS, NULL, NULL);
 }
 
 /* The width in force once `executed` segments are done: the last event before segment index

@@ -39,29 +39,16 @@ static int load_hold(const cs_gpio_run_t *r)
     return __atomic_load_n(&r->hold, __ATOMIC_ACQUIRE);
 }
 
+/* True when the run is asked to stop at once (a cancel): ends a wait early. */
+static bool stop_now(const void *ctx)
+{
+    return load_hold((const cs_gpio_run_t *)ctx) >= 2;
+}
+
 /* Waits until CLOCK_MONOTONIC reaches t. false when asked to stop at once meanwhile. */
 static bool wait_until(const cs_gpio_run_t *r, int64_t t, int64_t spin)
 {
-    for (;;) {
-        int64_t now = cs_gpio_io_now_ns();
-        if (now >= t)
-            return true;
-        if (t - now <= spin)
-            break;
-        int64_t wake = t - spin;
-        if (wake - now > SLEEP_SLICE_NS)
-            wake = now + SLEEP_SLICE_NS;
-        struct timespec ts = {(time_t)(wake / 1000000000), (long)(wake % 1000000000)};
-        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
-        if (load_hold(r) >= 2)
-            return false;
-    }
-    while (cs_gpio_io_now_ns() < t) {
-#if defined(__x86_64__) || defined(__i386__)
-        __builtin_ia32_pause();
-#endif
-    }
-    return true;
+    return cs_gpio_io_wait_until(t, spin, SLEEP_SLICE_NS, stop_now, r);
 }
 
 static void note_late(cs_gpio_run_t *r, int64_t late)

@@ -629,13 +629,13 @@ static void check_end(run_t *s, double *t_last_ack)
         return;
     if (*t_last_ack == 0)
         *t_last_ack = cs_serial_now_s();
-    if (r->executed == s->job->n && r->dev_state != CS_PROTO_STATE_RUNNING) {
+    if (r->executed == s->job->n && !cs_proto_state_busy(r->dev_state)) {
         finish(s, CS_STREAM_DONE);
         return;
     }
     /* the device reports its progress at least every 250 ms; a job whose last messages are
      * still executing keeps sending STATUS while running */
-    if (r->dev_state != CS_PROTO_STATE_RUNNING && !s->held &&
+    if (!cs_proto_state_busy(r->dev_state) && !s->held &&
         cs_serial_now_s() - *t_last_ack > s->o->status_ms / 1000.0) {
         snprintf(r->why, sizeof r->why,
                  "everything was delivered but the device reports %zu executed", r->executed);

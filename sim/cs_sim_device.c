@@ -741,10 +741,10 @@ typedef struct {
     cs_machine_t m;
     cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
     cs_sim_device_cfg_t cfg;
+    cs_ctlcfg_t ctl; /* [limits], [probe]: the simulated switches and probe surface */
     cs_sim_ref_t ref;
     double end_mm[3];
     int fd, keep;
-    cs_ctlcfg_t ctl; /* [limits], [probe]: the switches and the probe surface */
 } device_run_t;
 
 /* Parses argv into d: -1 to go on, else the exit status (--help, a usage error). */

@@ -143,7 +143,9 @@ wait_pty "$T/rt.sim" 60
 timeout -k 5 60 "$CS" jog --port "$PTY" --feed 5 -- 30 0 0 >"$T/jc.out" 2>"$T/jc.err" &
 JPID=$!
 sleep 2
-kill -INT "$JPID"
+# one Ctrl-C to curvestep itself: `timeout` would pass it on to its whole process group too, and
+# a second Ctrl-C means "give up at once" (no wait for the device to come to rest)
+kill -INT "$(pgrep -P "$JPID" -x curvestep)"
 wait "$JPID"; rc=$?
 expect "jog cancel: exit 8 (got $rc)" [ $rc -eq 8 ]
 jx=$(last_field "$T/jc.out" '^jog: machine position' 4)

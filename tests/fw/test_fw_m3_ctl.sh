@@ -14,21 +14,7 @@
 #    and `unlock` set it off before).
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
-B=${CS_BUILD:-build}
-FW=${FW_M3_DIR:-${B%/asan}/fw/cortex-m3}
-ELF=$FW/curvestep.elf
-QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
-    -icount shift=4
-    -semihosting-config
-    enable=on,target=native,arg=curvestep,arg=x_min=-400,arg=x_max=4000,arg=z_max=160,arg=probe_z=-240)
-. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
-
-if ! command -v qemu-system-arm >/dev/null; then
-    echo "FAIL: qemu-system-arm missing (scripts/deps.sh installs it)"
-    echo "cli: 0 passed, 1 failed"
-    exit 1
-fi
-expect "image built" [ -f "$ELF" ]
+. "$(dirname "${BASH_SOURCE[0]}")/lib/m3.sh" x_min=-400 x_max=4000 z_max=160 probe_z=-240
 MC=$T/m3.ini
 cat firmware/ports/cortex-m3/machine.ini tests/data/ctl-homing.ini >"$MC"
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }

@@ -8,24 +8,11 @@
 # planned segment executed, and its servo timers programmed for 20 ms and up_us. Every process is
 # bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
-B=${CS_BUILD:-build}
-FW=${FW_M3_DIR:-${B%/asan}/fw/cortex-m3}
-ELF=$FW/curvestep.elf
 JOB=tests/data/plot/inkscape-page.svg
 LAY=(--page 200x140mm --margin 5 --feed 150)
 # exit-idle 2 s: a link stall on a loaded host must not end the image mid-job (it happened at
 # 500 ms once, beside two qemu runs and a build)
-QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
-    -icount shift=4
-    -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=2000)
-. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
-
-if ! command -v qemu-system-arm >/dev/null; then
-    echo "FAIL: qemu-system-arm missing (scripts/deps.sh installs it)"
-    echo "cli: 0 passed, 1 failed"
-    exit 1
-fi
-expect "image built" [ -f "$ELF" ]
+. "$(dirname "${BASH_SOURCE[0]}")/lib/m3.sh" exit-idle=2000
 sed 's/^settle_ms *=.*/settle_ms = 40/' contrib/machines/servo-a4.ini >"$T/m.ini"
 MC=$T/m.ini
 up=$(sed -n 's/^up_us *= *\([0-9]*\).*/\1/p' "$MC")

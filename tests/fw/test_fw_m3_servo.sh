@@ -8,25 +8,12 @@
 # the image drives on PG1 measured 20 ms a period, the last pulse up_us wide. Every process is bounded
 # by `timeout`. Prints "cli: N passed, M failed".
 set -u
-B=${CS_BUILD:-build}
-FW=${FW_M3_DIR:-${B%/asan}/fw/cortex-m3}
-ELF=$FW/curvestep.elf
 MC=contrib/machines/servo-a4.ini
 JOB=contrib/examples/plotter.svg
 FEED=150 # mm/s, the machine's max_rate: the job takes 19.4 s of machine time
 # exit-idle 2 s: a link stall on a loaded host must not end the image mid-job (it happened at
 # 500 ms once, beside two qemu runs and a build)
-QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
-    -icount shift=4
-    -semihosting-config enable=on,target=native,arg=curvestep,arg=exit-idle=2000)
-. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
-
-if ! command -v qemu-system-arm >/dev/null; then
-    echo "FAIL: qemu-system-arm missing (scripts/deps.sh installs it)"
-    echo "cli: 0 passed, 1 failed"
-    exit 1
-fi
-expect "image built" [ -f "$ELF" ]
+. "$(dirname "${BASH_SOURCE[0]}")/lib/m3.sh" exit-idle=2000
 run "plan" 0 plan --machine "$MC" --feed $FEED "$JOB" -o "$T/job.seg"
 pens=$(grep -c '^pen ' "$T/job.seg")
 up=$(grep '^up_us' "$MC" | sed 's/[^0-9]*\([0-9]*\).*/\1/')
