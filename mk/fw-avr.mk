@@ -12,11 +12,11 @@ AVR_DIR     := $(BUILD)/fw/avr
 AVR_PORT    := firmware/ports/avr
 AVR_MCU     := -mmcu=atmega328p -DF_CPU=16000000UL
 # The 2 KB build: segments only (the host plans; no tracer or planner on board), an 8-slot
-# motion queue, a 2-frame link window with 27-byte payloads (STATUS with 4 axes is the longest
+# motion queue, a 2-frame link window with 40-byte payloads (STATUS with 4 axes is the longest
 # message the device sends or needs), an 8-segment executor ring; x/y at 100 mm/s (8000 steps/s
 # at 80 steps/mm), what the step interrupt sustains with room for the link (docs/firmware-avr.md).
 # machine.ini in $(AVR_PORT) says the same for the host.
-AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_QUEUE=8 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=27 \
+AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_QUEUE=8 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40 \
                -DCS_STEPPER_RING=8 -DCS_FW_XY_RATE=100 -DCS_FW_XY_ACCEL=2000
 # -flto: the executor's call (cs_stepper_tick, in the core) is inlined into the step interrupt
 # at link time, so the interrupt saves only the registers it uses and passes its answer in

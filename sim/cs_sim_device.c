@@ -15,6 +15,7 @@
 
 #include "cs_fw_app.h"
 #include "cs_jobplan.h"
+#include "cs_sim_exlog.h"
 #include "cs_stream.h"
 #include "port_posix.h"
 
@@ -44,6 +45,7 @@ struct cs_sim_motion {
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
+    cs_sim_exlog_t xl; /* cfg->exlog: the executed log on disk (xl.fd < 0: none) */
 };
 typedef struct cs_sim_motion sim_dev_t;
 
@@ -245,6 +247,8 @@ static cs_err_t serve_pass(sim_dev_t *d, double *last_rx_s)
     while (d->rx_off < d->rx_len);
     advance(d, cs_serial_now_s());
     cs_fw_app_poll(&d->app); /* STATUS, ERROR and acknowledgements after the motion moved */
+    if (d->xl.fd >= 0 && cs_sim_exlog_flush(&d->xl, &d->app.mo) != CS_OK)
+        return CS_ERR_IO;
     return CS_OK;
 }
 
@@ -337,6 +341,12 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
         return CS_ERR_ARG;
     }
     res->seg_hash = d->app.mo.log.hash;
+    d->xl.fd = -1;
+    if (cfg->exlog != NULL && cs_sim_exlog_open(&d->xl, cfg->exlog, &d->app.mo) != CS_OK) {
+        port_stepper_attach(NULL);
+        free(d);
+        return CS_ERR_IO;
+    }
     *out = d;
     return CS_OK;
 }
@@ -471,9 +481,15 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     port_posix_run(UINT64_MAX);
     cs_fw_motion_poll(&d->app.mo);
     sync_res(d);
+    if (d->xl.fd >= 0) {
+        if (cs_sim_exlog_flush(&d->xl, &d->app.mo) != CS_OK)
+            rc = CS_ERR_IO;
+        cs_sim_exlog_close(&d->xl, &d->app.mo);
+    }
     res->ticks = port_posix_now();
+    /* the lines' count, plus what SETPOS stated (the lines did not move for that) */
     for (unsigned i = 0; i < CS_AXES; i++)
-        res->pos[i] = port_posix_position(i);
+        res->pos[i] = port_posix_position(i) + d->app.mo.set_delta[i];
     res->log_segs = d->app.mo.log;
     res->log_edges = port_posix_edge_log();
     if (d->cfg->keep_edges)
@@ -536,6 +552,9 @@ static void device_usage(FILE *f)
           "                    the input and layout options given to stream (--lenient,\n"
           "                    --fit, --merge ...: curvestep-sim --help lists them)\n"
           "  --check           exit 4 when a check of the report fails\n"
+          "  --exlog FILE      append a line `JOB_NO TICKS X Y Z A` for every step segment the\n"
+          "                    executor finished (written as they finish: a killed device\n"
+          "                    leaves what it did; restarts append to the same file)\n"
           "  --svg/--png/--trace  drawings and the CSV of every step edge, as with --replay\n"
           "SIGINT or SIGTERM ends the service: what the executor holds is finished, then the\n"
           "report goes to standard output: messages executed, link counters, retransmissions,\n"
@@ -646,7 +665,7 @@ int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o)
 int cs_sim_device_main(int argc, char **argv)
 {
     enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3, CHECK = 4 };
-    const char *port = NULL;
+    const char *port = NULL, *exlog = NULL;
     bool pty = false;
     long line_rate = 0;
     cs_sim_device_opts_t o;
@@ -667,6 +686,8 @@ int cs_sim_device_main(int argc, char **argv)
             pty = true;
         } else if (strcmp(a, "--port") == 0 && has) {
             port = argv[++i];
+        } else if (strcmp(a, "--exlog") == 0 && has) {
+            exlog = argv[++i];
         } else if (strcmp(a, "--line-rate") == 0 && has) {
             line_rate = strtol(argv[++i], &end, 10);
             if (*end != '\0' || line_rate < 0) {
@@ -715,6 +736,15 @@ int cs_sim_device_main(int argc, char **argv)
     cfg.line_rate = (uint32_t)line_rate;
     cfg.idle_exit_s = idle_exit;
     cfg.keep_edges = true;
+    cfg.exlog = exlog;
+    if (exlog != NULL) { /* say now when the log cannot be written, not as a closed line */
+        int xfd = open(exlog, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+        if (xfd < 0) {
+            fprintf(stderr, "curvestep-sim: --exlog %s: %s\n", exlog, strerror(errno));
+            return INPUT;
+        }
+        close(xfd);
+    }
     if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &cfg.tol) != CS_OK) {
         fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", tol_mm);
         return USAGE;

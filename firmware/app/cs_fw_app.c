@@ -145,6 +145,15 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
     case CS_PROTO_ABORT:
         cs_fw_motion_abort(&a->mo);
         break;
+    case CS_PROTO_QUERY: /* a host that (re)connected asks where the job stands */
+        a->status_due = true;
+        break;
+    case CS_PROTO_SETPOS:
+        e = cs_fw_motion_setpos(&a->mo, &m.u.setpos);
+        if (e != CS_OK)
+            cs_fw_motion_error(&a->mo, e, ev->seq);
+        a->status_due = true;
+        break;
     default: /* SEGMENT, CURVE; CURVE without curves or a device-to-host type is refused */
         e = cs_fw_motion_queue(&a->mo, &m, ev->seq);
         if (e != CS_OK) /* CS_ERR_FULL: cs_link refuses it first; belt and braces */

@@ -248,6 +248,8 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     }
     a->stats.segments++;
     cs_exlog_segment(&a->log, orig);
+    if (a->pushed_hook != NULL)
+        a->pushed_hook(a->hook_ctx, orig, cs_fw_motion_job_no(a, done));
     for (unsigned i = 0; i < CS_AXES; i++)
         a->steps_pos[i] += s->steps[i];
 }
@@ -428,6 +430,44 @@ void cs_fw_motion_reboot(cs_fw_motion_t *a)
     a->aborted = false;
     a->nerr = 0;
     a->news = true;
+    /* a rebooted device knows neither the job nor where the machine is */
+    a->job_flags = 0;
+    a->job_id = a->job_base = 0;
+}
+
+uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *a, uint32_t item)
+{
+    if (!(a->job_flags & CS_PROTO_STATUS_JOB))
+        return 0;
+    /* items before the SETPOS belong to the previous job: nothing of this one */
+    return item_after(item, a->job_item0) ? a->job_base + (item - a->job_item0) : a->job_base;
+}
+
+cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
+{
+    if (sp->flags & CS_PROTO_SETPOS_POS) {
+        if (!cs_fw_motion_done(a))
+            return CS_ERR_STATE;
+        uint32_t irq = port_irq_save();
+        cs_err_t e = cs_stepper_set_position(&a->st, sp->pos);
+        port_irq_restore(irq);
+        if (e != CS_OK)
+            return e;
+        for (unsigned i = 0; i < CS_AXES; i++) {
+            a->set_delta[i] += sp->pos[i] - a->steps_pos[i];
+            a->steps_pos[i] = sp->pos[i];
+        }
+#if CS_FW_CURVES
+        a->pl_stale = true;
+#endif
+        a->job_flags |= CS_PROTO_STATUS_POS;
+    }
+    a->job_id = sp->job_id;
+    a->job_base = sp->base;
+    a->job_item0 = a->popped + a->qcount; /* the next item received is base + 1 */
+    a->job_flags |= CS_PROTO_STATUS_JOB;
+    a->news = true;
+    return CS_OK;
 }
 
 void cs_fw_motion_take_limit(cs_fw_motion_t *a, uint32_t n)
@@ -455,6 +495,10 @@ void cs_fw_motion_status(const cs_fw_motion_t *a, cs_proto_status_t *st)
     st->axes = a->m->n_axes;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         st->pos[i] = i < a->m->n_axes ? cs_fw_motion_position(a, i) : 0;
+    st->flags = a->job_flags;
+    st->job_id = a->job_id;
+    st->done = cs_fw_motion_job_no(a, a->exec_item);
+    st->recv = cs_fw_motion_job_no(a, a->popped + a->qcount);
 }
 
 bool cs_fw_motion_peek_error(const cs_fw_motion_t *a, cs_proto_error_t *e)

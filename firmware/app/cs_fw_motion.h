@@ -108,6 +108,15 @@ typedef struct {
     uint32_t pen_item;
     uint16_t item_seq[CS_FW_SEQMAP];
     uint16_t exec_seq;          /* sequence of the last item executed */
+    /* the job's numbering (SETPOS): item i (counted like popped) is job number
+     * job_base + i - job_item0; flags CS_PROTO_STATUS_*, forgotten at a reboot */
+    uint32_t job_id, job_base, job_item0;
+    uint8_t job_flags;
+    int32_t set_delta[CS_AXES]; /* position changes SETPOS made (the STEP lines did not move) */
+    /* segments-mode hook for a simulator's executed log (NULL on boards): called for every
+     * segment handed to the executor with the job number of the item it finishes */
+    void (*pushed_hook)(void *ctx, const cs_segment_t *s, uint32_t job_no);
+    void *hook_ctx;
     int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
 #if CS_FW_CURVES
     cs_planner_t pl;
@@ -152,6 +161,12 @@ void cs_fw_motion_poll(cs_fw_motion_t *mo);
 /* A new boot of the link (a reset that keeps the machine where it is): the queue, the errors and
  * the sequences are forgotten; the executor, its position and what it holds are kept. */
 void cs_fw_motion_reboot(cs_fw_motion_t *mo);
+/* SETPOS: numbers the items received from now on base+1, ... in job job_id; with
+ * CS_PROTO_SETPOS_POS sets the position counters to pos[] (steps), which needs the queue empty
+ * and the executor idle: CS_ERR_STATE otherwise (nothing changed). Main loop. */
+cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *mo, const cs_proto_setpos_t *sp);
+/* Job number of item (counted from 1 since init like the queue's items): 0 without a job. */
+uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *mo, uint32_t item);
 /* Takes no queue item numbered past n (items count from 1 since init; 0: no limit). */
 void cs_fw_motion_take_limit(cs_fw_motion_t *mo, uint32_t n);
 /* Free queue slots (the link's credits). */
@@ -161,7 +176,8 @@ bool cs_fw_motion_drained(const cs_fw_motion_t *mo);
 bool cs_fw_motion_done(const cs_fw_motion_t *mo);
 /* True (once) when the state changed or a hold/resume/abort came since the last call. */
 bool cs_fw_motion_news(cs_fw_motion_t *mo);
-/* State, queue fill, last executed sequence, axes and position (boot_id left as it is). Masks
+/* State, queue fill, last executed sequence, axes, position and the job's progress (flags,
+ * job id, last item finished, last item received; boot_id left as it is). Masks
  * the step interrupt while it reads the executor. Main loop. */
 void cs_fw_motion_status(const cs_fw_motion_t *mo, cs_proto_status_t *st);
 /* Executor position of axis, steps (interrupt masked while read). Main loop. */

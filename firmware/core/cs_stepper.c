@@ -170,6 +170,15 @@ int32_t cs_stepper_position(const cs_stepper_t *st, unsigned axis)
     return axis < CS_AXES ? st->pos[axis] : 0;
 }
 
+cs_err_t cs_stepper_set_position(cs_stepper_t *st, const int32_t pos[CS_AXES])
+{
+    if (!cs_stepper_idle(st))
+        return CS_ERR_STATE;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        st->pos[i] = pos[i];
+    return CS_OK;
+}
+
 /* Makes *p the current segment. Starting the period error at C - 1 makes call j end at
  * ceil(j T / C): never before the ideal. Accumulators start at C/2 (e = C/2 - C): step k comes
  * at the first call past (k - 1/2) C / n, i.e. where the ideal position crosses a half step. */

@@ -97,5 +97,8 @@ void cs_stepper_tick(cs_stepper_t *st, cs_stepper_out_t *out);
 /* Position in steps of axis (0 when out of range). Read it with the timer interrupt masked on
  * targets where a 32-bit read is not atomic. */
 int32_t cs_stepper_position(const cs_stepper_t *st, unsigned axis);
+/* Sets the position counters to pos[0..CS_AXES) steps (a position the user or a homing stated).
+ * CS_ERR_STATE unless the executor is idle. Call with the timer interrupt masked. */
+cs_err_t cs_stepper_set_position(cs_stepper_t *st, const int32_t pos[CS_AXES]);
 
 #endif
