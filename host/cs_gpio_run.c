@@ -101,144 +101,209 @@ static uint32_t dir_lines(const cs_gpio_run_opts_t *o, uint8_t dir_mask)
     return v;
 }
 
-static void *thread_main(void *arg)
-{
-    cs_gpio_run_t *r = arg;
-    const cs_gpio_run_opts_t *o = &r->o;
-    const cs_gpio_cfg_t *cfg = o->cfg;
-    cs_gpio_io_t *io = o->io;
-    cs_stepper_t *st = &r->st;
-    const uint32_t hz = o->m->tick_hz;
-    const int64_t spin = cfg->spin_ns, pulse = cfg->pulse_ns, setup = cfg->dir_setup_ns;
-    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL); /* ns-precise sleeps without SCHED_FIFO */
+/* The step thread's working state (one per run, on its stack). */
+typedef struct {
+    cs_gpio_run_t *r;
+    const cs_gpio_run_opts_t *o;
+    cs_gpio_io_t *io;
+    cs_stepper_t *st;
+    uint32_t hz;
+    int64_t spin, pulse, setup;          /* cfg, ns */
+    uint32_t all_step, all_dir, en;      /* line masks */
+    cs_hold_t hold;                      /* the core's ramp (cs_hold) */
+    int64_t t_dir;                       /* last DIR change on the lines */
+    bool ok;                             /* every set call succeeded */
+    size_t next, pushed;                 /* job index of the next segment; segments pushed */
+    cs_stepper_out_t out;                /* the executor's last call */
+    cs_gpio_run_outcome_t oc;            /* DONE while running */
+    uint32_t dir;                        /* DIR levels on the lines */
+    uint64_t vt;                         /* executor ticks so far */
+    int64_t planned;                     /* planned time of the current call */
+    bool unsent;                         /* stopped with a call's steps computed, not on lines */
+    int32_t unsent_pos[CS_AXES];         /* the executor's position without them */
+} stepper_run_t;
 
-    uint32_t all_step = step_lines(o, 0xff), all_dir = dir_lines(o, 0xff);
-    uint32_t en = o->enable_line >= 0 ? 1u << o->enable_line : 0;
+/* Pushes segment s->next (after the hold's admission) into the executor. false when the
+ * executor refused it (BAD_SEGMENT) or the hold keeps it back. */
+static bool feed_next(stepper_run_t *s, bool admit)
+{
+    cs_segment_t sg = s->o->segs[s->next];
+    if (admit && !cs_hold_admit(&s->hold, &sg))
+        return false;
+    if (cs_stepper_push(s->st, &sg) != CS_OK) {
+        s->oc = CS_GPIO_RUN_BAD_SEGMENT; /* the executor refused it: stop here */
+        s->r->bad_segment = s->next + 1;
+        return false;
+    }
+    s->next++;
+    s->pushed++;
+    return true;
+}
+
+/* ENABLE on, the first segment loaded (the kick: no step), tick 0 planned, first DIR levels. */
+static void step_begin(stepper_run_t *s)
+{
+    cs_gpio_run_t *r = s->r;
+    const cs_gpio_run_opts_t *o = s->o;
+    const cs_gpio_cfg_t *cfg = o->cfg;
+    int64_t t;
+    s->st = &r->st;
+    s->io = o->io;
+    s->hz = o->m->tick_hz;
+    s->spin = cfg->spin_ns;
+    s->pulse = cfg->pulse_ns;
+    s->setup = cfg->dir_setup_ns;
+    s->all_step = step_lines(o, 0xff);
+    s->all_dir = dir_lines(o, 0xff);
+    s->en = o->enable_line >= 0 ? 1u << o->enable_line : 0;
     /* The hold: the core's ramp (cs_hold), the one every device runs: segments re-timed along
      * the job's own path down to rest, then feeding stops at a segment end. */
-    cs_hold_t hold;
-    (void)cs_hold_init(&hold, o->m); /* the executor accepted the machine: so does the ramp */
-    int64_t t, t_dir = INT64_MIN / 2;
-    bool ok = true;
-    if (en)
-        ok = cs_gpio_io_set(io, en, en, cs_gpio_io_now_ns(), &t) == 0;
-    size_t next = o->first, pushed = 0;
-    cs_stepper_out_t out = {0, 0, 0};
-    cs_gpio_run_outcome_t oc = CS_GPIO_RUN_DONE;
-    if (ok && next < o->nsegs) {
-        if (cs_stepper_push(st, &o->segs[next]) == CS_OK) {
-            next++;
-            pushed++;
-        } else {
-            oc = CS_GPIO_RUN_BAD_SEGMENT;
-            r->bad_segment = next + 1;
-        }
-    }
-    cs_stepper_tick(st, &out); /* the kick: loads the first segment, no step */
+    (void)cs_hold_init(&s->hold, o->m); /* the executor accepted the machine: so does the ramp */
+    s->t_dir = INT64_MIN / 2;
+    s->ok = true;
+    if (s->en)
+        s->ok = cs_gpio_io_set(s->io, s->en, s->en, cs_gpio_io_now_ns(), &t) == 0;
+    s->next = o->first;
+    s->oc = CS_GPIO_RUN_DONE;
+    if (s->ok && s->next < o->nsegs)
+        (void)feed_next(s, false);
+    cs_stepper_tick(s->st, &s->out);
     int64_t start = cs_gpio_io_now_ns();
-    r->t0_ns = start + (cfg->enable_ns > START_LEAD_NS && en ? cfg->enable_ns : START_LEAD_NS);
-    uint32_t dir = io->levels & all_dir;
-    uint32_t want = dir_lines(o, out.dir_mask);
-    if (ok && want != dir) {
-        ok = cs_gpio_io_set(io, all_dir, want, start, &t_dir) == 0;
-        dir = want;
+    r->t0_ns =
+        start + (cfg->enable_ns > START_LEAD_NS && s->en ? cfg->enable_ns : START_LEAD_NS);
+    s->dir = s->io->levels & s->all_dir;
+    uint32_t want = dir_lines(o, s->out.dir_mask);
+    if (s->ok && want != s->dir) {
+        s->ok = cs_gpio_io_set(s->io, s->all_dir, want, start, &s->t_dir) == 0;
+        s->dir = want;
     }
-    uint64_t vt = 0;
-    int64_t planned = r->t0_ns;
-    bool unsent = false; /* stopped with a call's steps computed but not on the lines */
-    int32_t unsent_pos[CS_AXES];
-    while (ok && oc == CS_GPIO_RUN_DONE) {
-        if (out.next_ticks == 0) {
-            oc = hold.hold ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
-            break;
-        }
-        int h = load_hold(r);
-        if (h >= 2) {
-            oc = CS_GPIO_RUN_STOPPED;
-            break;
-        }
-        if (h == 1 && !hold.hold)
-            cs_hold_set(&hold, true);
-        vt += out.next_ticks;
-        planned = r->t0_ns + ticks_to_ns(vt, hz);
-        /* one segment queued behind the running one is enough (this thread refills before
-         * every call); once the hold has come to rest, nothing more is fed */
-        if (next < o->nsegs && cs_stepper_free(st) == CS_STEPPER_RING) {
-            cs_segment_t sg = o->segs[next];
-            if (cs_hold_admit(&hold, &sg)) {
-                if (cs_stepper_push(st, &sg) != CS_OK) {
-                    oc = CS_GPIO_RUN_BAD_SEGMENT; /* the executor refused it: stop here */
-                    r->bad_segment = next + 1;
-                    break;
-                }
-                next++;
-                pushed++;
-            }
-        }
-        int32_t before[CS_AXES]; /* the executor's position without this call's steps */
+    s->planned = r->t0_ns;
+}
+
+/* The STEP pulse of the call just computed (before[]: the position without its steps): rise at
+ * the planned time (not before the DIR set-up), fall a pulse width later. false to stop. */
+static bool emit_steps(stepper_run_t *s, const int32_t before[CS_AXES])
+{
+    cs_gpio_run_t *r = s->r;
+    uint32_t lines = step_lines(s->o, s->out.step_mask);
+    int64_t at = s->planned > s->t_dir + s->setup ? s->planned : s->t_dir + s->setup;
+    if (!wait_until(r, at, s->spin)) {
+        s->oc = CS_GPIO_RUN_STOPPED;
+        s->unsent = true;
         for (unsigned i = 0; i < CS_AXES; i++)
-            before[i] = cs_stepper_position(st, i);
-        cs_stepper_tick(st, &out);
-        if (out.step_mask) {
-            uint32_t s = step_lines(o, out.step_mask);
-            int64_t at = planned > t_dir + setup ? planned : t_dir + setup;
-            if (!wait_until(r, at, spin)) {
-                oc = CS_GPIO_RUN_STOPPED;
-                unsent = true;
-                for (unsigned i = 0; i < CS_AXES; i++)
-                    unsent_pos[i] = before[i];
-                break;
-            }
-            int64_t t_rise, t_fall;
-            if (cs_gpio_io_set(io, s, s, planned, &t_rise) != 0) {
-                ok = false;
-                break;
-            }
-            note_late(r, t_rise - planned);
-            for (unsigned i = 0; i < CS_AXES; i++)
-                if (out.step_mask >> i & 1u)
-                    r->steps[i]++;
-            wait_until(r, t_rise + pulse, spin);
-            if (cs_gpio_io_set(io, s, 0, planned + pulse, &t_fall) != 0) {
-                ok = false;
-                break;
-            }
-        }
-        want = dir_lines(o, out.dir_mask);
-        if (want != dir) {
-            if (!out.step_mask && !wait_until(r, planned, spin)) {
-                oc = CS_GPIO_RUN_STOPPED;
-                break;
-            }
-            if (cs_gpio_io_set(io, all_dir, want, out.step_mask ? planned + pulse : planned,
-                               &t_dir) != 0) {
-                ok = false;
-                break;
-            }
-            dir = want;
-        }
-        /* segments popped by the executor; all but the running one are done */
-        size_t popped = pushed - (CS_STEPPER_RING - cs_stepper_free(st));
-        size_t done = popped - (out.next_ticks != 0 && popped > 0 ? 1u : 0u);
-        __atomic_store_n(&r->executed, o->first + done, __ATOMIC_RELEASE);
+            s->unsent_pos[i] = before[i];
+        return false;
     }
-    if (!ok) {
-        oc = CS_GPIO_RUN_IO_ERROR;
+    int64_t t_rise, t_fall;
+    if (cs_gpio_io_set(s->io, lines, lines, s->planned, &t_rise) != 0) {
+        s->ok = false;
+        return false;
+    }
+    note_late(r, t_rise - s->planned);
+    for (unsigned i = 0; i < CS_AXES; i++)
+        if (s->out.step_mask >> i & 1u)
+            r->steps[i]++;
+    wait_until(r, t_rise + s->pulse, s->spin);
+    if (cs_gpio_io_set(s->io, lines, 0, s->planned + s->pulse, &t_fall) != 0) {
+        s->ok = false;
+        return false;
+    }
+    return true;
+}
+
+/* The DIR levels of the call just computed, after its STEP pulse. false to stop. */
+static bool emit_dir(stepper_run_t *s)
+{
+    uint32_t want = dir_lines(s->o, s->out.dir_mask);
+    if (want == s->dir)
+        return true;
+    if (!s->out.step_mask && !wait_until(s->r, s->planned, s->spin)) {
+        s->oc = CS_GPIO_RUN_STOPPED;
+        return false;
+    }
+    int64_t at = s->out.step_mask ? s->planned + s->pulse : s->planned;
+    if (cs_gpio_io_set(s->io, s->all_dir, want, at, &s->t_dir) != 0) {
+        s->ok = false;
+        return false;
+    }
+    s->dir = want;
+    return true;
+}
+
+/* One executor call: hold request, refill, tick, lines, progress. false when the run ends. */
+static bool step_call(stepper_run_t *s)
+{
+    cs_gpio_run_t *r = s->r;
+    const cs_gpio_run_opts_t *o = s->o;
+    if (s->out.next_ticks == 0) {
+        s->oc = s->hold.hold ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
+        return false;
+    }
+    int h = load_hold(r);
+    if (h >= 2) {
+        s->oc = CS_GPIO_RUN_STOPPED;
+        return false;
+    }
+    if (h == 1 && !s->hold.hold)
+        cs_hold_set(&s->hold, true);
+    s->vt += s->out.next_ticks;
+    s->planned = r->t0_ns + ticks_to_ns(s->vt, s->hz);
+    /* one segment queued behind the running one is enough (this thread refills before every
+     * call); once the hold has come to rest, nothing more is fed */
+    if (s->next < o->nsegs && cs_stepper_free(s->st) == CS_STEPPER_RING) {
+        (void)feed_next(s, true);
+        if (s->oc != CS_GPIO_RUN_DONE)
+            return false;
+    }
+    int32_t before[CS_AXES]; /* the executor's position without this call's steps */
+    for (unsigned i = 0; i < CS_AXES; i++)
+        before[i] = cs_stepper_position(s->st, i);
+    cs_stepper_tick(s->st, &s->out);
+    if (s->out.step_mask && !emit_steps(s, before))
+        return false;
+    if (!emit_dir(s))
+        return false;
+    /* segments popped by the executor; all but the running one are done */
+    size_t popped = s->pushed - (CS_STEPPER_RING - cs_stepper_free(s->st));
+    size_t done = popped - (s->out.next_ticks != 0 && popped > 0 ? 1u : 0u);
+    __atomic_store_n(&r->executed, o->first + done, __ATOMIC_RELEASE);
+    return true;
+}
+
+/* Leaves the lines safe (every STEP inactive, ENABLE off, DIR as it is) and the results. */
+static void step_end(stepper_run_t *s)
+{
+    cs_gpio_run_t *r = s->r;
+    const cs_gpio_run_opts_t *o = s->o;
+    if (!s->ok) {
+        s->oc = CS_GPIO_RUN_IO_ERROR;
         r->io_errno = errno;
     }
-    /* safe: every STEP inactive, ENABLE off (DIR as it is) */
-    cs_gpio_io_set(io, all_step | en, 0, cs_gpio_io_now_ns(), &r->t_end_ns);
-    r->ticks = vt;
+    cs_gpio_io_set(s->io, s->all_step | s->en, 0, cs_gpio_io_now_ns(), &r->t_end_ns);
+    r->ticks = s->vt;
     for (unsigned i = 0; i < CS_AXES; i++)
-        r->pos[i] = unsent ? unsent_pos[i] : cs_stepper_position(st, i);
-    if (oc == CS_GPIO_RUN_DONE || oc == CS_GPIO_RUN_HELD) {
-        size_t popped = pushed - (CS_STEPPER_RING - cs_stepper_free(st));
+        r->pos[i] = s->unsent ? s->unsent_pos[i] : cs_stepper_position(s->st, i);
+    if (s->oc == CS_GPIO_RUN_DONE || s->oc == CS_GPIO_RUN_HELD) {
+        size_t popped = s->pushed - (CS_STEPPER_RING - cs_stepper_free(s->st));
         __atomic_store_n(&r->executed, o->first + popped, __ATOMIC_RELEASE);
         if (o->first + popped >= o->nsegs) /* a hold that came too late to stop anything */
-            oc = CS_GPIO_RUN_DONE;
+            s->oc = CS_GPIO_RUN_DONE;
     }
-    r->outcome = oc;
+    r->outcome = s->oc;
     __atomic_store_n(&r->finished, 1, __ATOMIC_RELEASE);
+}
+
+static void *thread_main(void *arg)
+{
+    stepper_run_t s;
+    memset(&s, 0, sizeof s);
+    s.r = arg;
+    s.o = &s.r->o;
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL); /* ns-precise sleeps without SCHED_FIFO */
+    step_begin(&s);
+    while (s.ok && s.oc == CS_GPIO_RUN_DONE && step_call(&s))
+        ;
+    step_end(&s);
     return NULL;
 }
 

@@ -492,28 +492,18 @@ static bool write_next(mrun_t *s)
     return false;
 }
 
-cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t *o,
-                          cs_stream_result_t *r)
+/* Phase 1: the status block, the device's identity (the serial link's HELLO), read until it
+ * answers or o->hello_ms pass; NO_DEVICE or INCOMPATIBLE with the reason in r->why. */
+static void mb_connect(mrun_t *s, double t0)
 {
-    memset(r, 0, sizeof *r);
-    r->dev_state = 0xFF;
-    if (job == NULL || o == NULL || o->c == NULL || o->c->ctx == NULL || o->resume_from > job->n)
-        return CS_ERR_ARG;
-    mrun_t s0 = {0}, *s = &s0;
-    s->job = job;
-    s->o = o;
-    s->r = r;
-    s->c = o->c;
-    r->sent = r->delivered = r->executed = o->resume_from;
-    s->next = o->resume_from;
-    double t0 = cs_serial_now_s();
-    /* 1. the status block: the device's identity (the serial link's HELLO) */
+    const cs_mb_stream_opts_t *o = s->o;
+    cs_stream_result_t *r = s->r;
+    const cs_mb_status_t *st = &s->st;
     cs_mb_rc_t rc;
     do {
         rc = cs_mb_read_status(s->c, &s->st);
     } while (rc == CS_MB_NO_ANSWER && cs_serial_now_s() - t0 < o->hello_ms / 1000.0 &&
              !(o->interrupt && *o->interrupt));
-    const cs_mb_status_t *st = &s->st;
     if (rc == CS_MB_IO) {
         snprintf(r->why, sizeof r->why, "the %s failed", s->c->tcp ? "connection" : "line");
         finish(s, CS_STREAM_NO_DEVICE);
@@ -536,22 +526,21 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
         r->hello.queue_size = st->queue_size;
         r->hello.tick_hz = st->tick_hz;
         r->hello.caps = st->caps;
-        uint16_t need = job->mode == CS_STREAM_CURVES ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
         if (st->version != CS_MODBUS_MAP_VERSION)
             snprintf(r->why, sizeof r->why, "register map version %u, this host reads %u",
                      (unsigned)st->version, (unsigned)CS_MODBUS_MAP_VERSION);
-        else if (st->axes != o->axes)
-            snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",
-                     (unsigned)st->axes, (unsigned)o->axes);
-        else if (job->mode == CS_STREAM_SEGMENTS && st->tick_hz != o->tick_hz)
-            snprintf(r->why, sizeof r->why,
-                     "the device ticks at %u Hz, the segments were planned for %u Hz",
-                     (unsigned)st->tick_hz, (unsigned)o->tick_hz);
-        else if (!(st->caps & need))
-            snprintf(r->why, sizeof r->why, "the device cannot take %s", what(s));
+        else
+            (void)cs_stream_hello_mismatch(&r->hello, o->axes, o->tick_hz, s->job->mode, r->why,
+                                           sizeof r->why);
         if (r->why[0] != '\0')
             finish(s, CS_STREAM_INCOMPATIBLE);
     }
+}
+
+/* Clears an error an earlier job left, and starts the sequence at the device's next one. */
+static void mb_prepare(mrun_t *s)
+{
+    const cs_mb_status_t *st = &s->st;
     if (!s->stop && (st->error != 0 || st->state == CS_PROTO_STATE_FAULT)) {
         /* an error left by an earlier job: clear it, or it would stop this one at once */
         if (cs_mb_write_command(s->c, CS_MODBUS_CMD_RESET) != CS_MB_OK ||
@@ -564,26 +553,66 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
     s->credits = st->free_slots;
     s->last_status = cs_serial_now_s();
     s->t_progress = s->last_status;
-    /* 2. stream */
+}
+
+/* The user's interrupt (HOLD then ABORT; at once on a second one) and the daemon's pause (HOLD
+ * / RESUME, the queue kept). Returns true when the run must stop. */
+static bool mb_controls(mrun_t *s, double *t_all_sent)
+{
+    const cs_mb_stream_opts_t *o = s->o;
+    if (o->interrupt != NULL && *o->interrupt) {
+        if (*o->interrupt < 2) {
+            control(s, CS_MODBUS_CMD_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
+            control(s, CS_MODBUS_CMD_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
+        }
+        finish(s, CS_STREAM_INTERRUPTED);
+        return true;
+    }
+    if (o->pause != NULL && (*o->pause != 0) != s->held) {
+        s->held = !s->held;
+        control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
+                s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
+                2000);
+        *t_all_sent = 0;
+    }
+    return false;
+}
+
+/* Once everything is written: DONE when the device reports the last message executed and is
+ * no longer running, CLOSED when it stays idle without that for o->idle_ms. */
+static void mb_check_end(mrun_t *s, double *t_all_sent)
+{
+    cs_stream_result_t *r = s->r;
+    if (s->next < s->job->n) {
+        *t_all_sent = 0;
+        return;
+    }
+    if (*t_all_sent == 0)
+        *t_all_sent = cs_serial_now_s();
+    if (r->executed == s->job->n && s->st.state != CS_PROTO_STATE_RUNNING) {
+        finish(s, CS_STREAM_DONE);
+        return;
+    }
+    if (s->st.state == CS_PROTO_STATE_RUNNING || s->st.state == CS_PROTO_STATE_HELD)
+        *t_all_sent = cs_serial_now_s();
+    else if (cs_serial_now_s() - *t_all_sent > s->o->idle_ms / 1000.0) {
+        snprintf(r->why, sizeof r->why,
+                 "everything was delivered but the device reports %zu executed", r->executed);
+        finish(s, CS_STREAM_CLOSED);
+    }
+}
+
+/* Phase 2: writes while there are credits, polls the status, until an outcome. */
+static void mb_stream(mrun_t *s)
+{
+    const cs_mb_stream_opts_t *o = s->o;
+    const cs_stream_job_t *job = s->job;
     s->t_first = cs_serial_now_s();
     s->prog.t_first = s->t_first;
     double t_all_sent = 0;
     while (!s->stop) {
-        if (o->interrupt != NULL && *o->interrupt) {
-            if (*o->interrupt < 2) {
-                control(s, CS_MODBUS_CMD_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
-                control(s, CS_MODBUS_CMD_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
-            }
-            finish(s, CS_STREAM_INTERRUPTED);
+        if (mb_controls(s, &t_all_sent))
             break;
-        }
-        if (o->pause != NULL && (*o->pause != 0) != s->held) {
-            s->held = !s->held; /* the daemon's pause: the queue is kept */
-            control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
-                    s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
-                    2000);
-            t_all_sent = 0;
-        }
         double now = cs_serial_now_s();
         if (stalled(s, now))
             break;
@@ -599,32 +628,23 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
             if (!poll_status(s))
                 break;
         }
-        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n, r->executed,
-                           r->sent, o->resume_from, s->c->retries + s->resent, what(s));
-        if (s->next >= job->n) {
-            if (t_all_sent == 0)
-                t_all_sent = cs_serial_now_s();
-            if (r->executed == job->n && s->st.state != CS_PROTO_STATE_RUNNING) {
-                finish(s, CS_STREAM_DONE);
-                break;
-            }
-            if (s->st.state == CS_PROTO_STATE_RUNNING || s->st.state == CS_PROTO_STATE_HELD)
-                t_all_sent = cs_serial_now_s();
-            else if (cs_serial_now_s() - t_all_sent > o->idle_ms / 1000.0) {
-                snprintf(r->why, sizeof r->why,
-                         "everything was delivered but the device reports %zu executed",
-                         r->executed);
-                finish(s, CS_STREAM_CLOSED);
-            }
-        } else {
-            t_all_sent = 0;
-        }
+        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n,
+                           s->r->executed, s->r->sent, o->resume_from, s->c->retries + s->resent,
+                           what(s));
+        mb_check_end(s, &t_all_sent);
     }
+}
+
+/* Phase 3: aborts after a device error, the last progress line, the counters. */
+static void mb_finish(mrun_t *s, double t0)
+{
+    const cs_mb_stream_opts_t *o = s->o;
+    cs_stream_result_t *r = s->r;
     if (r->outcome == CS_STREAM_DEVICE_ERROR)
         control(s, CS_MODBUS_CMD_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
     double t_end = cs_serial_now_s();
-    cs_stream_progress(&s->prog, o->progress, o->progress_tty, true, job->n, r->executed, r->sent,
-                       o->resume_from, s->c->retries + s->resent, what(s));
+    cs_stream_progress(&s->prog, o->progress, o->progress_tty, true, s->job->n, r->executed,
+                       r->sent, o->resume_from, s->c->retries + s->resent, what(s));
     r->link.retransmits = s->c->retries + s->resent;
     r->link.timeouts = s->c->timeouts;
     r->link.naks = s->refused;
@@ -633,5 +653,26 @@ cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t 
     r->bytes_in = s->c->bytes_in;
     r->wall_s = t_end - t0;
     r->stream_s = t_end - s->t_first;
+}
+
+cs_err_t cs_mb_stream_run(const cs_stream_job_t *job, const cs_mb_stream_opts_t *o,
+                          cs_stream_result_t *r)
+{
+    memset(r, 0, sizeof *r);
+    r->dev_state = 0xFF;
+    if (job == NULL || o == NULL || o->c == NULL || o->c->ctx == NULL || o->resume_from > job->n)
+        return CS_ERR_ARG;
+    mrun_t s0 = {0}, *s = &s0;
+    s->job = job;
+    s->o = o;
+    s->r = r;
+    s->c = o->c;
+    r->sent = r->delivered = r->executed = o->resume_from;
+    s->next = o->resume_from;
+    double t0 = cs_serial_now_s();
+    mb_connect(s, t0);
+    mb_prepare(s);
+    mb_stream(s);
+    mb_finish(s, t0);
     return CS_OK;
 }

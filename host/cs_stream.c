@@ -507,15 +507,11 @@ static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint
     }
 }
 
-cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs_stream_result_t *r)
+/* Sets up s for job (link endpoint with a fresh boot id and nonce). CS_ERR_ARG when the link
+ * refuses the options. */
+static cs_err_t run_init(run_t *s, const cs_stream_job_t *job, const cs_stream_opts_t *o,
+                         cs_stream_result_t *r)
 {
-    memset(r, 0, sizeof *r);
-    r->dev_state = 0xFF;
-    if (job == NULL || o == NULL || o->ser == NULL || o->resume_from > job->n)
-        return CS_ERR_ARG;
-    run_t *s = calloc(1, sizeof *s);
-    if (s == NULL)
-        return CS_ERR_FULL;
     s->job = job;
     s->o = o;
     s->r = r;
@@ -529,15 +525,17 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
     uint32_t boot = seed ? seed : 1u;
     uint32_t nonce = seed * 1664525u + 1013904223u;
     cs_err_t e = cs_link_init(&s->link, &o->link, boot, nonce ? nonce : 1u, 0, cs_serial_now_us());
-    if (e != CS_OK) {
-        free(s);
-        return CS_ERR_ARG;
-    }
-    /* 1. connect and wait for the HELLO */
+    return e == CS_OK ? CS_OK : CS_ERR_ARG;
+}
+
+/* Phase 1: connects and waits for the HELLO (o->hello_ms). */
+static void run_connect(run_t *s)
+{
+    const cs_stream_opts_t *o = s->o;
     double t_hello = s->t0 + o->hello_ms / 1000.0;
     while (!s->stop && !(s->open && s->have_hello)) {
         if (cs_serial_now_s() > t_hello) {
-            snprintf(r->why, sizeof r->why, "%s within %u ms",
+            snprintf(s->r->why, sizeof s->r->why, "%s within %u ms",
                      s->open ? "connected, but no HELLO" : "no answer to the connection",
                      (unsigned)o->hello_ms);
             finish(s, CS_STREAM_NO_DEVICE);
@@ -550,51 +548,103 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
         pump_out(s, cs_serial_now_us());
         pump_in(s, 5);
     }
-    if (!s->stop) {
-        const cs_proto_hello_t *h = &r->hello;
-        uint16_t need = job->mode == CS_STREAM_CURVES ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
-        if (h->version != CS_PROTO_VERSION)
-            snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
-                     (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
-        else if (h->axes != o->axes)
-            snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",
-                     (unsigned)h->axes, (unsigned)o->axes);
-        else if (job->mode == CS_STREAM_SEGMENTS && h->tick_hz != o->tick_hz)
-            snprintf(r->why, sizeof r->why,
-                     "the device ticks at %u Hz, the segments were planned for %u Hz",
-                     (unsigned)h->tick_hz, (unsigned)o->tick_hz);
-        else if (!(h->caps & need))
-            snprintf(r->why, sizeof r->why, "the device cannot take %s",
-                     job->mode == CS_STREAM_CURVES ? "curves" : "step segments");
-        if (r->why[0] != '\0')
-            finish(s, CS_STREAM_INCOMPATIBLE);
+}
+
+bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t tick_hz,
+                              cs_stream_mode_t mode, char *why, size_t cap)
+{
+    bool curves = mode == CS_STREAM_CURVES;
+    uint16_t need = curves ? CS_PROTO_CAP_CURVES : CS_PROTO_CAP_SEGMENTS;
+    if (h->axes != axes)
+        snprintf(why, cap, "the device has %u axes, the machine file %u", (unsigned)h->axes,
+                 (unsigned)axes);
+    else if (!curves && h->tick_hz != tick_hz)
+        snprintf(why, cap, "the device ticks at %u Hz, the segments were planned for %u Hz",
+                 (unsigned)h->tick_hz, (unsigned)tick_hz);
+    else if (!(h->caps & need))
+        snprintf(why, cap, "the device cannot take %s", curves ? "curves" : "step segments");
+    else
+        return false;
+    return true;
+}
+
+/* The HELLO against the machine and the job: INCOMPATIBLE with the reason in r->why. */
+static void check_hello(run_t *s)
+{
+    cs_stream_result_t *r = s->r;
+    const cs_proto_hello_t *h = &r->hello;
+    if (h->version != CS_PROTO_VERSION)
+        snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
+                 (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
+    else
+        (void)cs_stream_hello_mismatch(h, s->o->axes, s->o->tick_hz, s->job->mode, r->why,
+                                       sizeof r->why);
+    if (r->why[0] != '\0')
+        finish(s, CS_STREAM_INCOMPATIBLE);
+}
+
+/* The user's interrupt (HOLD then ABORT; at once on a second one) and pause (HOLD / RESUME).
+ * Returns true when the run must stop. */
+static bool run_controls(run_t *s, double *t_last_ack)
+{
+    const cs_stream_opts_t *o = s->o;
+    if (o->interrupt != NULL && *o->interrupt) {
+        if (*o->interrupt < 2) {
+            control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
+            control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
+        }
+        finish(s, CS_STREAM_INTERRUPTED);
+        return true;
     }
-    /* 2. stream */
+    if (o->pause != NULL && (*o->pause != 0) != s->held && s->nctl + 2 <= CS_STREAM_CTL_MAX) {
+        s->held = !s->held;
+        if (s->held)
+            control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
+        else
+            control(s, CS_PROTO_RESUME, CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
+        *t_last_ack = 0;
+    }
+    return false;
+}
+
+/* Once everything is acknowledged: DONE when the device reports the last message executed and
+ * is no longer running, CLOSED when it stays silent about it for o->status_ms. */
+static void check_end(run_t *s, double *t_last_ack)
+{
+    cs_stream_result_t *r = s->r;
+    if (r->sent != s->job->n || cs_link_unacked(&s->link) != 0)
+        return;
+    if (*t_last_ack == 0)
+        *t_last_ack = cs_serial_now_s();
+    if (r->executed == s->job->n && r->dev_state != CS_PROTO_STATE_RUNNING) {
+        finish(s, CS_STREAM_DONE);
+        return;
+    }
+    /* the device reports its progress at least every 250 ms; a job whose last messages are
+     * still executing keeps sending STATUS while running */
+    if (r->dev_state != CS_PROTO_STATE_RUNNING && !s->held &&
+        cs_serial_now_s() - *t_last_ack > s->o->status_ms / 1000.0) {
+        snprintf(r->why, sizeof r->why,
+                 "everything was delivered but the device reports %zu executed", r->executed);
+        finish(s, CS_STREAM_CLOSED);
+    }
+}
+
+/* Phase 2: keeps the window and the credits full until an outcome. */
+static void run_stream(run_t *s)
+{
+    const cs_stream_job_t *job = s->job;
     double t_last_ack = 0;
     s->t_first = cs_serial_now_s();
     while (!s->stop) {
         uint32_t now = cs_serial_now_us();
-        if (o->interrupt != NULL && *o->interrupt) {
-            if (*o->interrupt < 2) {
-                control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
-                control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
-            }
-            finish(s, CS_STREAM_INTERRUPTED);
+        if (run_controls(s, &t_last_ack))
             break;
-        }
-        if (o->pause != NULL && (*o->pause != 0) != s->held && s->nctl + 2 <= CS_STREAM_CTL_MAX) {
-            s->held = !s->held;
-            if (s->held)
-                control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
-            else
-                control(s, CS_PROTO_RESUME, CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
-            t_last_ack = 0;
-        }
         while (s->next < job->n && cs_link_can_send(&s->link, job->v[s->next].type)) {
             if (cs_link_send_msg(&s->link, &job->v[s->next], NULL) != CS_OK)
                 break;
             s->next++;
-            r->sent = s->next;
+            s->r->sent = s->next;
         }
         if (pump_out(s, now) != 0)
             break;
@@ -602,24 +652,15 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
         if (s->stop)
             break;
         progress(s, false);
-        if (r->sent == job->n && cs_link_unacked(&s->link) == 0) {
-            if (t_last_ack == 0)
-                t_last_ack = cs_serial_now_s();
-            if (r->executed == job->n && r->dev_state != CS_PROTO_STATE_RUNNING) {
-                finish(s, CS_STREAM_DONE);
-                break;
-            }
-            /* the device reports its progress at least every 250 ms; a job whose last
-             * messages are still executing keeps sending STATUS while running */
-            if (r->dev_state != CS_PROTO_STATE_RUNNING && !s->held &&
-                cs_serial_now_s() - t_last_ack > o->status_ms / 1000.0) {
-                snprintf(r->why, sizeof r->why,
-                         "everything was delivered but the device reports %zu executed",
-                         r->executed);
-                finish(s, CS_STREAM_CLOSED);
-            }
-        }
+        check_end(s, &t_last_ack);
     }
+}
+
+/* Phase 3: aborts after a device error, flushes the ACKs still due, fills the counters. */
+static void run_finish(run_t *s)
+{
+    cs_stream_result_t *r = s->r;
+    const cs_stream_opts_t *o = s->o;
     if (r->outcome == CS_STREAM_DEVICE_ERROR && cs_link_state(&s->link) == CS_LINK_OPEN)
         control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
     double t_end = cs_serial_now_s();
@@ -631,6 +672,26 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
     r->bytes_in = o->ser->bytes_in;
     r->wall_s = t_end - s->t0;
     r->stream_s = t_end - s->t_first;
+}
+
+cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs_stream_result_t *r)
+{
+    memset(r, 0, sizeof *r);
+    r->dev_state = 0xFF;
+    if (job == NULL || o == NULL || o->ser == NULL || o->resume_from > job->n)
+        return CS_ERR_ARG;
+    run_t *s = calloc(1, sizeof *s);
+    if (s == NULL)
+        return CS_ERR_FULL;
+    if (run_init(s, job, o, r) != CS_OK) {
+        free(s);
+        return CS_ERR_ARG;
+    }
+    run_connect(s);
+    if (!s->stop)
+        check_hello(s);
+    run_stream(s);
+    run_finish(s);
     free(s);
     return CS_OK;
 }

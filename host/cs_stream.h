@@ -104,6 +104,11 @@ void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes,
 /* Link timing for a line of bits_per_s (0: a pty at memory speed): rto = 40 ms + three windows
  * of the largest frame, NAK hold-off = two largest frames + 0.3 ms (docs/protocol.md 3.6). */
 void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s);
+/* The device's identity (HELLO, or the Modbus status block) against the machine and the job:
+ * true with a sentence in why when the axes, the tick rate (segments only) or the capabilities
+ * do not match; the version is each link's own check. */
+bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t tick_hz,
+                              cs_stream_mode_t mode, char *why, size_t cap);
 /* Streams job messages resume_from+1..n (the port is switched to lossy writes: a peer that
  * stops reading never blocks the host). Always fills *r; returns CS_OK when it ran to an
  * outcome (see r->outcome), CS_ERR_ARG for bad options, CS_ERR_IO for a write error. */
