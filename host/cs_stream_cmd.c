@@ -17,6 +17,7 @@
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
+#include "cs_stream_resume.h"
 #include "cs_trace.h"
 
 #define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
@@ -34,7 +35,8 @@ static void usage(FILE *f)
 {
     fputs("usage: curvestep stream --port DEV [--baud N] [--machine FILE.ini]\n"
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
-          "                        [--resume-from N] [--line-rate BPS] [--font FILE.jhf]\n"
+          "                        [--resume | --resume-from N [--position X,Y,Z]]\n"
+          "                        [--line-rate BPS] [--font FILE.jhf]\n"
           "                        [--quiet] [input and layout options] FILE\n"
           "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
           "       curvestep stream --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
@@ -72,16 +74,23 @@ static void usage(FILE *f)
           "  --feed MM/S        drawing feed (default: the machine's default_feed)\n"
           "  --max-input-mb N   refuse a job file larger than N MiB (default 64)\n"
           "  --max-segments N   refuse a job of more than N step segments (default 8388608)\n"
-          "  --resume-from N    messages 1..N were executed already: send from N+1 on (the\n"
-          "                     number printed after a reset or a lost link). The machine must\n"
-          "                     be where message N left it\n"
+          "  --resume           (--port) the link was lost but the device did not reset: ask\n"
+          "                     it where this job stands and go on after the last message it\n"
+          "                     received (refused, saying what to do, if it reset)\n"
+          "  --resume-from N    messages 1..N were executed already: send from N+1 on. With\n"
+          "                     --port, a device that did not reset must agree (else use\n"
+          "                     --resume); one that reset needs --position\n"
+          "  --position X,Y,Z   (--port, with --resume-from) where the machine is, mm: sent to\n"
+          "                     the device (SETPOS) before any motion. In segments mode it must\n"
+          "                     be where message N left the machine\n"
           "  --line-rate BPS    pace writes as a real line of BPS bits/s would (10 bits a byte),\n"
           "                     for measurements on a pseudo-terminal\n"
           "  --quiet            no progress\n"
           "Progress goes to standard error: a bar (percent, ETA, messages per second,\n"
           "retransmissions) on a terminal, else one line a second. Ctrl-C holds the motion,\n"
           "then aborts it (the device's queue is flushed); a second Ctrl-C leaves at once.\n"
-          "The summary line names the last executed message, to use with --resume-from.\n",
+          "When the link dies the summary names the last message the device confirmed and the\n"
+          "last one it may have executed, and how to resume (docs/streaming.md, Resume).\n",
           f);
     cs_jobopts_help(f);
     fputs("Exit status: 0 the whole job was executed; 1 bad input (file:line:col: reason);\n"
@@ -103,10 +112,41 @@ static int parse_count(const char *s, unsigned long long max, unsigned long long
     return 0;
 }
 
+/* --position X,Y,Z in steps; in segments mode it must be where message n left the machine
+ * (the segments are relative moves: from anywhere else the rest of the job would be offset). */
+static int check_position(const char *text, const cs_machine_t *m, const cs_stream_job_t *job,
+                          size_t n, int32_t steps[CS_AXES])
+{
+    cs_err_t e = cs_stream_resume_position(text, m, steps);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep stream: --position %s: %s\n", text,
+                e == CS_ERR_RANGE ? "outside the coordinate range"
+                                  : "wants one number of mm per axis, comma-separated");
+        return -1;
+    }
+    if (job->mode != CS_STREAM_SEGMENTS)
+        return 0; /* curves: the device travels to the next curve's start itself */
+    int64_t want[CS_AXES];
+    cs_stream_resume_steps_after(job, n, want);
+    for (unsigned i = 0; i < m->n_axes; i++)
+        if (want[i] != steps[i]) {
+            static const char names[] = "xyza";
+            fprintf(stderr,
+                    "curvestep stream: --position %s: message %zu left the machine at %c = %.4f mm "
+                    "(%lld steps), not %.4f mm: move it there first (the segments are relative "
+                    "moves), or give the right N\n",
+                    text, n, names[i], (double)want[i] * CS_MOTION_ONE / m->axis[i].steps_per_mm,
+                    (long long)want[i], (double)steps[i] * CS_MOTION_ONE / m->axis[i].steps_per_mm);
+            return -1;
+        }
+    return 0;
+}
+
 int cs_cmd_stream(int argc, char **argv)
 {
     const char *port = NULL, *job_file = NULL;
-    const char *mb_tcp = NULL, *mb_rtu = NULL, *gpio = NULL;
+    const char *mb_tcp = NULL, *mb_rtu = NULL, *gpio = NULL, *position = NULL;
+    bool resume_ask = false;
     unsigned long long baud = 115200, resume = 0, line_rate = 0, unit = 1;
     cs_jobplan_opts_t jo;
     cs_jobplan_opts_init(&jo);
@@ -156,6 +196,10 @@ int cs_cmd_stream(int argc, char **argv)
                 fprintf(stderr, "curvestep stream: --resume-from wants a message number\n");
                 return CS_EXIT_USAGE;
             }
+        } else if (strcmp(a, "--resume") == 0) {
+            resume_ask = true;
+        } else if (strcmp(a, "--position") == 0 && has) {
+            position = argv[++i];
         } else if (strcmp(a, "--line-rate") == 0 && has) {
             if (parse_count(argv[++i], 100000000, &line_rate) != 0 || line_rate < 10) {
                 fprintf(stderr, "curvestep stream: --line-rate wants bits/s (>= 10)\n");
@@ -191,6 +235,20 @@ int cs_cmd_stream(int argc, char **argv)
                 : links > 1 ? "--port, --modbus-tcp, --modbus-rtu and --gpio exclude each other"
                             : "no job file");
         usage(stderr);
+        return CS_EXIT_USAGE;
+    }
+    if ((resume_ask || position != NULL) && port == NULL) {
+        fprintf(stderr, "curvestep stream: --resume and --position need --port (the serial "
+                        "protocol; docs/streaming.md, Resume)\n");
+        return CS_EXIT_USAGE;
+    }
+    if (resume_ask && (resume != 0 || position != NULL)) {
+        fprintf(stderr, "curvestep stream: --resume asks the device where to go on: it takes "
+                        "neither --resume-from nor --position\n");
+        return CS_EXIT_USAGE;
+    }
+    if (position != NULL && resume == 0) {
+        fprintf(stderr, "curvestep stream: --position needs --resume-from N\n");
         return CS_EXIT_USAGE;
     }
     if (parity != 0 && mb_rtu == NULL) {
@@ -252,6 +310,12 @@ int cs_cmd_stream(int argc, char **argv)
         cs_jobplan_free(&jp);
         return CS_EXIT_USAGE;
     }
+    int32_t pos_steps[CS_AXES] = {0};
+    if (position != NULL && check_position(position, &m, &job, (size_t)resume, pos_steps) != 0) {
+        cs_stream_job_free(&job);
+        cs_jobplan_free(&jp);
+        return CS_EXIT_USAGE;
+    }
     cs_path_free(&jp.path);
     if (port == NULL) { /* 2'. another link: Modbus or GPIO */
         cs_stream_args_t sa;
@@ -309,6 +373,9 @@ int cs_cmd_stream(int argc, char **argv)
                                    : strncmp(port, "/dev/pts/", 9) == 0 ? 0
                                                                         : (uint32_t)baud);
     o.resume_from = (size_t)resume;
+    o.resume_ask = resume_ask;
+    o.set_pos = position != NULL;
+    memcpy(o.pos, pos_steps, sizeof pos_steps);
     o.interrupt = &interrupted;
     o.progress = quiet ? NULL : stderr;
     o.progress_tty = isatty(STDERR_FILENO) != 0;
@@ -321,7 +388,8 @@ int cs_cmd_stream(int argc, char **argv)
         cs_stream_job_free(&job);
         return CS_EXIT_INTERNAL;
     }
-    int rc = cs_stream_report(stdout, port, &job, &r, o.resume_from, curves);
+    int rc = cs_stream_report(stdout, port, &job, &r, r.resume_from, curves);
+    cs_stream_resume_hint(stdout, &job, &r, &m, job_file);
     cs_stream_job_free(&job);
     return rc;
 }

@@ -69,8 +69,11 @@ int cs_stream_report(FILE *out, const char *where, const cs_stream_job_t *job,
             (unsigned long long)r->bytes_out, (unsigned long long)r->bytes_in, r->wall_s,
             (unsigned)r->link.retransmits, (unsigned)r->link.timeouts, (unsigned)r->link.naks,
             r->stream_s > 0 ? (double)(r->executed - resume_from) / r->stream_s : 0.0, what);
+    /* a device that numbers the job (serial link) gets the confirmed / in-flight lines and the
+     * resume rules from the command (cs_stream_resume_hint); a refusal at the start said why */
+    bool refused = r->outcome == CS_STREAM_RESET && r->new_boot == 0;
     if (rc != CS_EXIT_OK && r->executed < job->n && r->outcome != CS_STREAM_NO_DEVICE &&
-        r->outcome != CS_STREAM_INCOMPATIBLE)
+        r->outcome != CS_STREAM_INCOMPATIBLE && !r->numbered && !refused)
         cs_stream_report_resume(out, one, r->executed);
     fflush(out);
     return rc;
