@@ -665,7 +665,7 @@ static void resume_point(run_t *s)
     } else if (same && (o->resume_ask || o->resume_from == st->recv) && st->recv <= s->job->n) {
         r->numbered = true; /* go on after the last message it received (its queue runs on) */
         r->resume_from = r->sent = r->delivered = s->next = st->recv;
-        r->executed = st->done;
+        r->executed = r->resume_done = st->done;
         r->dev_recv = st->recv;
     } else if (same) {
         snprintf(r->why, sizeof r->why,

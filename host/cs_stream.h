@@ -97,6 +97,7 @@ typedef struct {
     int32_t dev_pos[CS_PROTO_AXES_MAX];
     size_t resume_from;   /* the run started after this message (o->resume_from, or the
                            * device's answer to --resume) */
+    size_t resume_done;   /* --resume: the last message the device had finished then */
     bool numbered;        /* the device numbers this job's messages: executed is its word */
     size_t dev_recv;      /* last STATUS: the last message of the job the device received */
     uint32_t job_id;      /* cs_stream_job_id of the job */

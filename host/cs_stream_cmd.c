@@ -388,6 +388,11 @@ int cs_cmd_stream(int argc, char **argv)
         cs_stream_job_free(&job);
         return CS_EXIT_INTERNAL;
     }
+    if (resume_ask && r.numbered) /* where the device's word put the start */
+        fprintf(stdout,
+                "stream: resumed: the device had received %s 1..%zu of this job and finished "
+                "%zu of them; sent from %zu on\n",
+                what, r.resume_from, r.resume_done, r.resume_from + 1);
     int rc = cs_stream_report(stdout, port, &job, &r, r.resume_from, curves);
     cs_stream_resume_hint(stdout, &job, &r, &m, job_file);
     cs_stream_job_free(&job);
