@@ -75,6 +75,10 @@ static size_t uart_read(void *ctx, uint8_t *buf, size_t max)
 static size_t uart_write(void *ctx, const uint8_t *buf, size_t n)
 {
     sim_dev_t *d = ctx;
+    /* the executed log first: whatever a STATUS about to go out says finished is on disk, even
+     * if the process is killed right after (a log never behind what the host was told) */
+    if (d->xl.fd >= 0)
+        (void)cs_sim_exlog_flush(&d->xl, &d->app.mo);
     if (cs_serial_write(&d->ser, buf, n) != 0)
         d->ser.lost += n; /* a device UART never blocks: bytes nobody takes are gone */
     return n;

@@ -7,7 +7,7 @@
 #include "port.h"
 
 #define SEQ_MASK ((uint32_t)CS_FW_SEQMAP - 1u)
-#define TAG_MASK ((uint8_t)(CS_STEPPER_RING - 1))
+#define TAG_MASK ((uint8_t)(CS_FW_TAGS - 1))
 /* next_segment's work budget a pass (blocks cut, points traced, items taken) */
 #define NEXT_GUARD 64u
 
@@ -392,6 +392,15 @@ void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
 
 void cs_fw_motion_abort(cs_fw_motion_t *a)
 {
+    /* Items taken from the queue but not wholly handed to the executor (the segment held back,
+     * a PEN waiting, a curve being traced or planned) are dropped unexecuted: they are given
+     * back their numbers, so "executed" and the job's numbers (STATUS done/recv) stay the truth
+     * and a resume sends them again. The ring's segments finish; the last one's tag is the
+     * last item they complete. */
+    uint32_t keep = a->pushed != a->completed ? a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK]
+                                              : a->exec_item;
+    if (item_after(a->popped, keep))
+        a->popped = keep;
     a->qcount = 0;
     a->qhead = 0;
     a->has_pend = false;

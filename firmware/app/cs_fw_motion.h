@@ -48,6 +48,9 @@ CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + CS_PLANNER_RING + 3, fw_seqma
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + 3, fw_seqmap_room);
 #endif
 CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_two);
+/* Segment tags: a power of two above the segments in flight (the ring and the running one). */
+#define CS_FW_TAGS (2 * CS_STEPPER_RING)
+CS_STATIC_ASSERT(CS_FW_TAGS >= CS_STEPPER_RING + 1 && CS_FW_TAGS <= 256, fw_tags_room);
 CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
 CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
 
@@ -92,7 +95,10 @@ typedef struct {
     uint16_t qhead, qcount;
     /* executor and which item each queued segment finishes */
     cs_stepper_t st;
-    uint32_t tag[CS_STEPPER_RING]; /* item executed once segment k has run */
+    /* item executed once segment k has run: one per segment in flight, which is the ring's
+     * CS_STEPPER_RING plus the one running (a ring of only CS_STEPPER_RING tags had the newest
+     * overwrite the running segment's, counting up to a ring of items executed early) */
+    uint32_t tag[CS_FW_TAGS];
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
     cs_segment_t pend; /* produced, held back by a hold at rest */

@@ -12,7 +12,8 @@
 # finished segment, `JOB_NO TICKS X Y Z A`, appended across restarts) identical to the log of an
 # uninterrupted run (count + sha256: every segment exactly once, in order) and the final
 # position exactly the uninterrupted run's end (itself checked against the job's exact end by the
-# simulator's --reference --check).
+# simulator's --reference --check); after a device death the host's "confirmed" and "may have
+# executed up to" numbers must bracket what the device's log says it executed.
 # CS_RESUME_TRIALS (default 12) trials; CS_RESUME_SEED (default from the clock) seeds the kill
 # points and kinds, printed first so a failure can be replayed. Every wait is on an event (a
 # line count, a process gone) with a generous deadline. Prints "cli: N passed, M failed".
@@ -105,6 +106,12 @@ for i in $(seq 1 "$TRIALS"); do
             { ko "trial $i ($kind at $k): no confirmed number"; ok_trial=0; }
         # what the user reads off the machine: the last finished segment and where it is
         N=$(lines "$log")
+        # the host's two numbers bracket the truth: confirmed <= executed <= possibly executed
+        K=$(sed -n 's/^stream: confirmed by the device: segment no. \([0-9]*\) finished.*/\1/p' "$T/t$i.h1")
+        MX=$(sed -n 's/.* it may have executed up to no. \([0-9]*\) .*/\1/p' "$T/t$i.h1")
+        MX=${MX:-$K}
+        { [ -n "$K" ] && [ "$K" -le "$N" ] && [ "$N" -le "$MX" ]; } ||
+            { ko "trial $i ($kind at $k): host said confirmed ${K:-?}, at most ${MX:-?}; the device executed $N"; ok_trial=0; }
         read -r px py pz <<<"$(log_pos "$log")"
         pos=$(awk -v x="$px" -v y="$py" -v z="$pz" 'BEGIN {printf "%.4f,%.4f,%.4f", x / 80, y / 80, z / 80}')
         start_sim "t$i.b" --exlog "$log"
