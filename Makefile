@@ -68,7 +68,7 @@ PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lpthread -l
 INCLUDES  := -Ifirmware/core -Ifirmware/app -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim \
              -Itests/support
 # The host's build of the application offers the simulator's largest queue (--queue 1..256).
-FW_HOST_DEFS := -DCS_FW_QUEUE=256
+FW_HOST_DEFS := -DCS_FW_QUEUE=256 -DCS_FW_SIM_HOOKS=1
 WARN      := -Wall -Wextra -Werror
 CORE_CFLAGS := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS) $(INCLUDES)
 HOST_CFLAGS := -std=c99 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L $(WARN) $(OPT) $(SANFLAGS) \

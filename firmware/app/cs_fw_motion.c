@@ -49,6 +49,14 @@ static bool item_after(uint32_t x, uint32_t y)
     return (int32_t)(x - y) > 0;
 }
 
+/* The item a 16-bit tag names: the one within 2^15 of the last executed (items in flight are a
+ * ring and a planner of segments ahead, far fewer). */
+static uint32_t tag_item(const cs_fw_motion_t *a, uint16_t tag)
+{
+    uint16_t d = (uint16_t)(tag - (uint16_t)a->exec_item);
+    return d < 0x8000u ? a->exec_item + d : a->exec_item - (uint32_t)(0x10000u - d);
+}
+
 static void mark_executed(cs_fw_motion_t *a, uint32_t item)
 {
     if (item_after(item, a->exec_item)) {
@@ -67,7 +75,7 @@ static void note_completed(cs_fw_motion_t *a)
     port_irq_restore(s);
     uint8_t done = (uint8_t)(a->pushed - inring - running);
     while (a->completed != done) {
-        mark_executed(a, a->tag[a->completed & TAG_MASK]);
+        mark_executed(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
         a->completed++;
     }
     if (cs_fw_motion_drained(a))
@@ -236,7 +244,7 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     bool was_idle = cs_stepper_idle(&a->st);
     cs_err_t e = cs_stepper_push(&a->st, s);
     if (e == CS_OK) {
-        a->tag[a->pushed & TAG_MASK] = done;
+        a->tag[a->pushed & TAG_MASK] = (uint16_t)done;
         a->pushed++;
         if (was_idle)
             port_timer_arm(1);
@@ -248,8 +256,10 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     }
     a->stats.segments++;
     cs_exlog_segment(&a->log, orig);
+#if CS_FW_SIM_HOOKS
     if (a->pushed_hook != NULL)
         a->pushed_hook(a->hook_ctx, orig, cs_fw_motion_job_no(a, done));
+#endif
     for (unsigned i = 0; i < CS_AXES; i++)
         a->steps_pos[i] += s->steps[i];
 }
@@ -397,8 +407,9 @@ void cs_fw_motion_abort(cs_fw_motion_t *a)
      * back their numbers, so "executed" and the job's numbers (STATUS done/recv) stay the truth
      * and a resume sends them again. The ring's segments finish; the last one's tag is the
      * last item they complete. */
-    uint32_t keep = a->pushed != a->completed ? a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK]
-                                              : a->exec_item;
+    uint32_t keep = a->pushed != a->completed
+                        ? tag_item(a, a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK])
+                        : a->exec_item;
     if (item_after(a->popped, keep))
         a->popped = keep;
     a->qcount = 0;
@@ -463,7 +474,9 @@ cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
         if (e != CS_OK)
             return e;
         for (unsigned i = 0; i < CS_AXES; i++) {
+#if CS_FW_SIM_HOOKS
             a->set_delta[i] += sp->pos[i] - a->steps_pos[i];
+#endif
             a->steps_pos[i] = sp->pos[i];
         }
 #if CS_FW_CURVES

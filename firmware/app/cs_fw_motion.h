@@ -31,6 +31,10 @@
 #ifndef CS_FW_ERRQ
 #define CS_FW_ERRQ 4
 #endif
+/* 1 (the host build of the simulator): the executed-log hook and SETPOS's position delta. */
+#ifndef CS_FW_SIM_HOOKS
+#define CS_FW_SIM_HOOKS 0
+#endif
 
 #if CS_FW_CURVES
 #include "cs_planner.h"
@@ -98,7 +102,7 @@ typedef struct {
     /* item executed once segment k has run: one per segment in flight, which is the ring's
      * CS_STEPPER_RING plus the one running (a ring of only CS_STEPPER_RING tags had the newest
      * overwrite the running segment's, counting up to a ring of items executed early) */
-    uint32_t tag[CS_FW_TAGS];
+    uint16_t tag[CS_FW_TAGS]; /* low 16 bits (items in flight are within 2^15 of exec_item) */
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
     cs_segment_t pend; /* produced, held back by a hold at rest */
@@ -118,11 +122,14 @@ typedef struct {
      * job_base + i - job_item0; flags CS_PROTO_STATUS_*, forgotten at a reboot */
     uint32_t job_id, job_base, job_item0;
     uint8_t job_flags;
-    int32_t set_delta[CS_AXES]; /* position changes SETPOS made (the STEP lines did not move) */
-    /* segments-mode hook for a simulator's executed log (NULL on boards): called for every
-     * segment handed to the executor with the job number of the item it finishes */
+#if CS_FW_SIM_HOOKS
+    /* for the simulator (host builds only): its executed log's hook (NULL: none), called for
+     * every segment handed to the executor with the job number of the item it finishes; and
+     * the position changes SETPOS made (the STEP lines did not move for them) */
     void (*pushed_hook)(void *ctx, const cs_segment_t *s, uint32_t job_no);
     void *hook_ctx;
+    int32_t set_delta[CS_AXES];
+#endif
     int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
 #if CS_FW_CURVES
     cs_planner_t pl;
