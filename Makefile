@@ -65,14 +65,28 @@ PKGS      := cairo expat libmodbus libgpiod
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -linih -lpthread -lm
 
-INCLUDES  := -Ifirmware/core -Ifirmware/app -Ifirmware/ports -Ifirmware/ports/posix -Ihost -Isim \
-             -Itests/support
+# Layers the compiler enforces (docs/architecture.md): each layer sees only the include paths
+# of the layers below it, so a header from above is "No such file" at compile time, and the
+# host program links without the simulator's library, so a call from above is an undefined
+# symbol. tests/cli/test_layers.sh proves both.
+CORE_INC  := -Ifirmware/core
+APP_INC   := $(CORE_INC) -Ifirmware/ports -Ifirmware/app
+PORT_INC  := $(APP_INC) -Ifirmware/ports/posix
+HOST_INC  := $(CORE_INC) -Ihost
+SIM_INC   := $(PORT_INC) -Ihost -Isim
+# tests, benchmarks and fuzz targets may look at every layer
+INCLUDES  := $(SIM_INC) -Itests/support
 # The host's build of the application offers the simulator's largest queue (--queue 1..256).
 FW_HOST_DEFS := -DCS_FW_QUEUE=256 -DCS_FW_SIM_HOOKS=1
 WARN      := -Wall -Wextra -Werror
-CORE_CFLAGS := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS) $(INCLUDES)
-HOST_CFLAGS := -std=c99 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L $(WARN) $(OPT) $(SANFLAGS) \
-               $(INCLUDES) $(FW_HOST_DEFS) $(PKG_CFLAGS)
+CORE_BASE   := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS)
+CORE_CFLAGS := $(CORE_BASE) $(CORE_INC)
+APP_CFLAGS  := $(CORE_BASE) $(APP_INC) $(FW_HOST_DEFS)
+POSIX_BASE  := -std=c99 -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L $(WARN) $(OPT) $(SANFLAGS) \
+               $(FW_HOST_DEFS) $(PKG_CFLAGS)
+HOST_ONLY_CFLAGS := $(POSIX_BASE) $(HOST_INC)
+SIM_CFLAGS  := $(POSIX_BASE) $(SIM_INC)
+HOST_CFLAGS := $(POSIX_BASE) $(INCLUDES)
 LDFLAGS_ALL := $(SANFLAGS)
 
 CORE_OBJ := $(CORE_SRC:%.c=$(OUT)/obj/%.o)
@@ -86,6 +100,9 @@ BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
 
 CORE_LIB := $(OUT)/libcscore.a
 HOST_LIB := $(OUT)/libcshost.a
+# the simulator: its own code, the device application and the POSIX port it runs on
+SIM_LIB  := $(OUT)/libcssim.a
+TEST_LIBS := $(SIM_LIB) $(HOST_LIB) $(CORE_LIB)
 
 .SECONDARY:
 
@@ -107,7 +124,19 @@ $(OUT)/obj/firmware/core/%.o: firmware/core/%.c $(wildcard firmware/core/*.h)
 # the application under the core's rules (-Wconversion), with the host's sizes
 $(OUT)/obj/firmware/app/%.o: firmware/app/%.c $(wildcard firmware/core/*.h firmware/app/*.h firmware/ports/*.h)
 	@mkdir -p $(@D)
-	$(CC) $(CORE_CFLAGS) $(FW_HOST_DEFS) -c $< -o $@
+	$(CC) $(APP_CFLAGS) -c $< -o $@
+
+$(OUT)/obj/host/%.o: host/%.c $(wildcard firmware/core/*.h host/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(HOST_ONLY_CFLAGS) -c $< -o $@
+
+$(OUT)/obj/sim/%.o: sim/%.c $(wildcard firmware/core/*.h firmware/app/*.h firmware/ports/*.h firmware/ports/posix/*.h host/*.h sim/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(SIM_CFLAGS) -c $< -o $@
+
+$(OUT)/obj/firmware/ports/posix/%.o: firmware/ports/posix/%.c $(wildcard firmware/core/*.h firmware/app/*.h firmware/ports/*.h firmware/ports/posix/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(POSIX_BASE) $(PORT_INC) -c $< -o $@
 
 $(OUT)/obj/%.o: %.c $(wildcard firmware/core/*.h firmware/app/*.h host/*.h sim/*.h tests/support/*.h firmware/ports/*.h firmware/ports/posix/*.h)
 	@mkdir -p $(@D)
@@ -117,19 +146,28 @@ $(CORE_LIB): $(CORE_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
-$(HOST_LIB): $(HOST_OBJ) $(SIM_OBJ) $(PORT_POSIX_OBJ) $(FW_HOST_OBJ)
+$(HOST_LIB): $(HOST_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^ $(if $^,,/dev/null)
+
+$(SIM_LIB): $(SIM_OBJ) $(PORT_POSIX_OBJ) $(FW_HOST_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^ $(if $^,,/dev/null)
 
 $(OUT)/curvestep: $(OUT)/obj/host/main.o $(HOST_LIB) $(CORE_LIB)
 	$(CC) $(LDFLAGS_ALL) $^ -o $@ $(PKG_LIBS)
 
-$(OUT)/curvestep-sim: $(OUT)/obj/sim/main.o $(HOST_LIB) $(CORE_LIB)
+$(OUT)/curvestep-sim: $(OUT)/obj/sim/main.o $(TEST_LIBS)
 	$(CC) $(LDFLAGS_ALL) $^ -o $@ $(PKG_LIBS)
 
-$(OUT)/tests/%: $(OUT)/obj/tests/unit/%.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+$(OUT)/tests/%: $(OUT)/obj/tests/unit/%.o $(SUP_OBJ) $(TEST_LIBS)
 	@mkdir -p $(@D)
-	$(CC) $(LDFLAGS_ALL) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ -lcmocka $(PKG_LIBS)
+	$(CC) $(LDFLAGS_ALL) $< $(SUP_OBJ) $(TEST_LIBS) -o $@ -lcmocka $(PKG_LIBS)
+
+# `make -s CS_DEPS_DONE=1 print-VAR`: the value of a variable (tests/cli/test_layers.sh reads
+# the layers' flags this way instead of copying them).
+print-%:
+	@echo '$($*)'
 
 # --- tests ----------------------------------------------------------------------------------
 # Each variant builds everything (host program and simulator too: tests may run them) and runs
@@ -183,9 +221,9 @@ fw-test: firmware $(BUILD)/curvestep $(BUILD)/curvestep-sim
 demo: deps all
 	@bash scripts/demo.sh
 
-$(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+$(BUILD)/bench/%: tests/bench/%.c $(SUP_OBJ) $(TEST_LIBS)
 	@mkdir -p $(@D)
-	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ $(PKG_LIBS)
+	$(CC) $(HOST_CFLAGS) $< $(SUP_OBJ) $(TEST_LIBS) -o $@ $(PKG_LIBS)
 
 # bench_peers also links AGG (C++ headers + static lib, pkg-config libagg) via agg_flat.cpp.
 AGG_CFLAGS := $(shell pkg-config --cflags libagg 2>/dev/null)
@@ -196,10 +234,10 @@ $(BUILD)/bench/agg_flat.o: tests/bench/agg_flat.cpp tests/bench/agg_flat.h
 	$(CXX) -O2 -Wall -Wextra $(AGG_CFLAGS) -Itests/bench -c $< -o $@
 
 $(BUILD)/bench/bench_peers: tests/bench/bench_peers.c tests/bench/agg_flat.h \
-		$(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB)
+		$(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(TEST_LIBS)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CFLAGS) -Itests/bench -c $< -o $@.o
-	$(CXX) $@.o $(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(HOST_LIB) $(CORE_LIB) -o $@ \
+	$(CXX) $@.o $(BUILD)/bench/agg_flat.o $(SUP_OBJ) $(TEST_LIBS) -o $@ \
 		$(PKG_LIBS) $(AGG_LIBS)
 
 bench: deps all $(BENCH_BIN)

@@ -39,7 +39,7 @@ rm -f "${TMPDIR:-/tmp}/deb-check.$$"
 run=$(mktemp -d)
 /usr/bin/curvestep-sim --pty --idle-exit 30 >"$run/sim.out" 2>&1 &
 simpid=$!
-for _ in $(seq 100); do [ -s "$run/sim.out" ] && break; sleep 0.1; done
+for _ in $(seq 1200); do [ -s "$run/sim.out" ] && break; sleep 0.1; done # 120 s at most
 pty=$(head -n1 "$run/sim.out")
 chgrp dialout "$pty" && chmod 0660 "$pty"
 mkdir -p "$run/rt" && chown curvestep:curvestep "$run/rt" && chmod 0700 "$run/rt"
@@ -49,7 +49,7 @@ cmd=$(sed -n 's/^ExecStart=//p' /lib/systemd/system/curvestep.service |
 runuser -u curvestep -- $cmd 2>"$run/serve.err" &
 servepid=$!
 answered=no
-for _ in $(seq 100); do
+for _ in $(seq 1200); do # 120 s at most: a loaded machine starts the daemon late
     if runuser -u curvestep -- /usr/bin/curvestep status --socket "$run/rt/curvestep.sock" >"$run/status.out" 2>&1; then
         answered=yes; break
     fi

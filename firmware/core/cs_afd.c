@@ -23,21 +23,11 @@ static bool in_lim(int64_t v)
     return v <= AFD_LIM && v >= -AFD_LIM;
 }
 
-static unsigned bitlen(uint32_t k)
-{
-    unsigned b = 0;
-    while (k) {
-        b++;
-        k >>= 1;
-    }
-    return b;
-}
-
-/* *out = v * k, refused (false) unless |v| < 2^(62 - bitlen(k)). */
+/* *out = v * k, refused (false) unless |v| < 2^(62 - cs_fixed_bitlen64(k)). */
 static bool mul_chk(int64_t v, uint32_t k, int64_t *out)
 {
     uint64_t m = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
-    if (m >= ((uint64_t)1 << (62 - bitlen(k))))
+    if (m >= ((uint64_t)1 << (62 - cs_fixed_bitlen64(k))))
         return false;
     *out = v * (int64_t)k;
     return true;
@@ -185,13 +175,11 @@ static cs_err_t start_piece(cs_afd_t *a)
 cs_err_t cs_afd_begin(cs_afd_t *a, const cs_bezier_t *c, cs_pos_t tol)
 {
     a->done = true;
-    if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
-        return CS_ERR_DEGREE;
+    cs_err_t ce = cs_bezier_check(c);
+    if (ce != CS_OK)
+        return ce;
     if (c->rational)
         return CS_ERR_UNSUPPORTED;
-    for (unsigned i = 0; i <= c->degree; i++)
-        if (!cs_fixed_vec_ok(&c->p[i]))
-            return CS_ERR_RANGE;
     if (tol < 1 || tol > CS_POS_LIMIT)
         return CS_ERR_TOLERANCE;
     a->degree = c->degree;

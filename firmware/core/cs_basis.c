@@ -4,18 +4,6 @@
  * (|K_ij G_j| <= 6 * 2^31), so nothing can wrap before the final range check. */
 #include "cs_basis.h"
 
-/* round(n / d) half away from zero, d > 0. */
-static int64_t basis_round_div(int64_t n, int64_t d)
-{
-    int64_t q = (n < 0 ? -n + d / 2 : n + d / 2) / d;
-    return n < 0 ? -q : q;
-}
-
-static int64_t basis_coord(const cs_vec3_t *v, unsigned axis)
-{
-    return axis == 0 ? v->x : axis == 1 ? v->y : v->z;
-}
-
 /* out = (K . G) / d, degree-3 polynomial Bézier; every result checked against CS_POS_LIMIT. */
 static cs_err_t basis_apply(const int8_t k[4][4], int64_t d, const cs_vec3_t *const g[4],
                             cs_bezier_t *out)
@@ -26,8 +14,8 @@ static cs_err_t basis_apply(const int8_t k[4][4], int64_t d, const cs_vec3_t *co
         for (unsigned axis = 0; axis < 3; axis++) {
             int64_t sum = 0;
             for (unsigned j = 0; j < 4; j++)
-                sum += (int64_t)k[i][j] * basis_coord(g[j], axis);
-            r[axis] = basis_round_div(sum, d);
+                sum += (int64_t)k[i][j] * cs_fixed_vec_get(g[j], axis);
+            r[axis] = cs_fixed_div_round(sum, d);
             if (!cs_fixed_pos_ok(r[axis]))
                 return CS_ERR_RANGE;
         }
@@ -176,7 +164,7 @@ cs_err_t cs_basis_beta(const cs_basis_beta_mat_t *m, const cs_vec3_t g[4], cs_be
             /* |w| <= 2^30, |G| <= 2^28: four terms stay below 2^60. */
             int64_t sum = 0;
             for (unsigned j = 0; j < 4; j++)
-                sum += (int64_t)m->w[i][j] * basis_coord(&g[j], axis);
+                sum += (int64_t)m->w[i][j] * cs_fixed_vec_get(&g[j], axis);
             r[axis] = cs_fixed_round_shift64(sum, 30);
             if (!cs_fixed_pos_ok(r[axis]))
                 return CS_ERR_RANGE;

@@ -22,26 +22,6 @@ CS_STATIC_ASSERT(CS_BEZIER_MAX_POINTS == 8, max_points_is_8);
 CS_STATIC_ASSERT(GUARD + 31 <= 59, guarded_values_below_2_59);
 CS_STATIC_ASSERT(CS_BEZIER_MAX_FRAC <= GUARD, frac_within_guard);
 
-static int64_t lerp(int64_t a, int64_t b, cs_param_t t)
-{
-    return a + cs_fixed_mul64_q30(b - a, t);
-}
-
-static int32_t coord(const cs_vec3_t *p, unsigned axis)
-{
-    return axis == 0 ? p->x : axis == 1 ? p->y : p->z;
-}
-
-static void set_coord(cs_vec3_t *p, unsigned axis, int32_t v)
-{
-    if (axis == 0)
-        p->x = v;
-    else if (axis == 1)
-        p->y = v;
-    else
-        p->z = v;
-}
-
 static bool weights_ok(const cs_weight_t *w, unsigned n)
 {
     for (unsigned i = 0; i <= n; i++)
@@ -57,9 +37,9 @@ static void load_axis(const cs_bezier_t *c, unsigned axis, int64_t *v)
         if (axis == 3)
             v[i] = (int64_t)c->w[i] << RGUARD;
         else if (c->rational)
-            v[i] = (int64_t)c->w[i] * coord(&c->p[i], axis);
+            v[i] = (int64_t)c->w[i] * cs_fixed_vec_get(&c->p[i], axis);
         else
-            v[i] = (int64_t)coord(&c->p[i], axis) * ((int64_t)1 << GUARD);
+            v[i] = (int64_t)cs_fixed_vec_get(&c->p[i], axis) * ((int64_t)1 << GUARD);
     }
 }
 
@@ -68,7 +48,7 @@ static int64_t blossom_axis(int64_t *v, unsigned n, const cs_param_t *ts)
 {
     for (unsigned r = 1; r <= n; r++)
         for (unsigned i = 0; i + r <= n; i++)
-            v[i] = lerp(v[i], v[i + 1], ts[r - 1]);
+            v[i] = cs_fixed_lerp64(v[i], v[i + 1], ts[r - 1]);
     return v[0];
 }
 
@@ -153,6 +133,18 @@ static cs_err_t check(const cs_bezier_t *c)
     return CS_OK;
 }
 
+cs_err_t cs_bezier_check(const cs_bezier_t *c)
+{
+    if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
+        return CS_ERR_DEGREE;
+    for (unsigned i = 0; i <= c->degree; i++)
+        if (!cs_fixed_vec_ok(&c->p[i]))
+            return CS_ERR_RANGE;
+    if (c->rational && !weights_ok(c->w, c->degree))
+        return CS_ERR_WEIGHT;
+    return CS_OK;
+}
+
 cs_err_t cs_bezier_blossom(const cs_bezier_t *c, const cs_param_t *ts, unsigned frac,
                            cs_vec3w_t *out)
 {
@@ -233,7 +225,7 @@ static void split_axis(int64_t *v, unsigned n, cs_param_t t, int64_t *L, int64_t
     R[n] = v[n];
     for (unsigned r = 1; r <= n; r++) {
         for (unsigned i = 0; i + r <= n; i++)
-            v[i] = lerp(v[i], v[i + 1], t);
+            v[i] = cs_fixed_lerp64(v[i], v[i + 1], t);
         L[r] = v[0];
         R[n - r] = v[n - r];
     }
@@ -300,9 +292,9 @@ cs_err_t cs_bezier_split(const cs_bezier_t *c, cs_param_t t, cs_bezier_t *left, 
             if (cs_fixed_narrow(pl, &xl) != CS_OK || cs_fixed_narrow(pr, &xr) != CS_OK)
                 return CS_ERR_OVERFLOW;
             if (left)
-                set_coord(&left->p[i], a, xl);
+                cs_fixed_vec_set(&left->p[i], a, xl);
             if (right)
-                set_coord(&right->p[i], a, xr);
+                cs_fixed_vec_set(&right->p[i], a, xr);
         }
     }
     if (left && (e = finish_half(left, c, WL)) != CS_OK)
@@ -310,14 +302,6 @@ cs_err_t cs_bezier_split(const cs_bezier_t *c, cs_param_t t, cs_bezier_t *left, 
     if (right && (e = finish_half(right, c, WR)) != CS_OK)
         return e;
     return CS_OK;
-}
-
-static int64_t div_round(int64_t num, int64_t den)
-{
-    /* den > 0; round half away from zero. */
-    int64_t m = num < 0 ? -num : num;
-    int64_t q = (m + den / 2) / den;
-    return num < 0 ? -q : q;
 }
 
 cs_err_t cs_bezier_elevate(const cs_bezier_t *c, cs_bezier_t *out)
@@ -341,13 +325,13 @@ cs_err_t cs_bezier_elevate(const cs_bezier_t *c, cs_bezier_t *out)
         Wn[i] = a * wa + b * wb;
         Wmax = Wn[i] > Wmax ? Wn[i] : Wmax;
         for (unsigned ax = 0; ax < 3; ax++) {
-            int64_t pa = i > 0 ? coord(&c->p[i - 1], ax) : 0;
-            int64_t pb = i <= n ? coord(&c->p[i], ax) : 0;
-            int64_t v = div_round(a * wa * pa + b * wb * pb, Wn[i]);
+            int64_t pa = i > 0 ? cs_fixed_vec_get(&c->p[i - 1], ax) : 0;
+            int64_t pb = i <= n ? cs_fixed_vec_get(&c->p[i], ax) : 0;
+            int64_t v = cs_fixed_div_round(a * wa * pa + b * wb * pb, Wn[i]);
             int32_t x;
             if (cs_fixed_narrow(v, &x) != CS_OK)
                 return CS_ERR_OVERFLOW;
-            set_coord(&r.p[i], ax, x);
+            cs_fixed_vec_set(&r.p[i], ax, x);
         }
     }
     for (unsigned i = 0; i <= n + 1; i++) {
@@ -382,11 +366,11 @@ cs_err_t cs_bezier_hodograph(const cs_bezier_t *c, cs_bezier_t *out)
     }
     for (unsigned i = 0; i < n; i++)
         for (unsigned a = 0; a < 3; a++) {
-            int64_t d = (int64_t)n * ((int64_t)coord(&c->p[i + 1], a) - coord(&c->p[i], a));
+            int64_t d = (int64_t)n * ((int64_t)cs_fixed_vec_get(&c->p[i + 1], a) - cs_fixed_vec_get(&c->p[i], a));
             int32_t x;
             if (cs_fixed_narrow(d, &x) != CS_OK)
                 return CS_ERR_OVERFLOW;
-            set_coord(&r.p[i], a, x);
+            cs_fixed_vec_set(&r.p[i], a, x);
         }
     *out = r;
     return CS_OK;
@@ -402,7 +386,7 @@ static int64_t bern1(const int64_t *coef, unsigned n, cs_param_t t)
         v[i] = coef[i];
     for (unsigned r = 1; r <= n; r++)
         for (unsigned i = 0; i + r <= n; i++)
-            v[i] = lerp(v[i], v[i + 1], t);
+            v[i] = cs_fixed_lerp64(v[i], v[i + 1], t);
     return v[0];
 }
 
@@ -448,15 +432,15 @@ static cs_err_t axis_extent(const cs_bezier_t *c, unsigned axis, int32_t *mn, in
     unsigned nc = 0;
     load_axis(c, axis, p); /* polynomial: coordinate << GUARD */
     for (unsigned i = 0; i < n; i++)
-        d1[i] = (int64_t)n * ((int64_t)coord(&c->p[i + 1], axis) - coord(&c->p[i], axis)) *
+        d1[i] = (int64_t)n * ((int64_t)cs_fixed_vec_get(&c->p[i + 1], axis) - cs_fixed_vec_get(&c->p[i], axis)) *
                 ((int64_t)1 << 24);
     cs_param_t pieces[4] = {0, CS_PARAM_ONE, 0, 0};
     unsigned np = 1;
     if (n == 3) {
         for (unsigned i = 0; i < 2; i++)
             d2[i] = (int64_t)6 *
-                    ((int64_t)coord(&c->p[i + 2], axis) - 2 * (int64_t)coord(&c->p[i + 1], axis) +
-                     coord(&c->p[i], axis)) *
+                    ((int64_t)cs_fixed_vec_get(&c->p[i + 2], axis) - 2 * (int64_t)cs_fixed_vec_get(&c->p[i + 1], axis) +
+                     cs_fixed_vec_get(&c->p[i], axis)) *
                     ((int64_t)1 << 24);
         if (sgn(d2[0]) * sgn(d2[1]) < 0) {
             cs_param_t lo = 0, hi = CS_PARAM_ONE;
@@ -511,19 +495,19 @@ cs_err_t cs_bezier_bbox(const cs_bezier_t *c, cs_vec3_t *min, cs_vec3_t *max)
             int32_t mn, mx;
             if ((e = axis_extent(c, a, &mn, &mx)) != CS_OK)
                 return e;
-            set_coord(&lo, a, mn);
-            set_coord(&hi, a, mx);
+            cs_fixed_vec_set(&lo, a, mn);
+            cs_fixed_vec_set(&hi, a, mx);
         }
     } else {
         /* Convex-hull property (positive weights for rational curves): the box of the control
          * points contains the curve. */
         for (unsigned i = 1; i <= n; i++)
             for (unsigned a = 0; a < 3; a++) {
-                int32_t v = coord(&c->p[i], a);
-                if (v < coord(&lo, a))
-                    set_coord(&lo, a, v);
-                if (v > coord(&hi, a))
-                    set_coord(&hi, a, v);
+                int32_t v = cs_fixed_vec_get(&c->p[i], a);
+                if (v < cs_fixed_vec_get(&lo, a))
+                    cs_fixed_vec_set(&lo, a, v);
+                if (v > cs_fixed_vec_get(&hi, a))
+                    cs_fixed_vec_set(&hi, a, v);
             }
     }
     *min = lo;

@@ -48,6 +48,10 @@ cs_err_t cs_bezier_init(cs_bezier_t *c, unsigned degree, const cs_vec3_t *pts);
 /* Rational segment: as cs_bezier_init plus weights (CS_ERR_WEIGHT outside the accepted range). */
 cs_err_t cs_bezier_init_rational(cs_bezier_t *c, unsigned degree, const cs_vec3_t *pts,
                                  const cs_weight_t *w);
+/* The check every tracer makes before it starts (cs_fd, cs_afd, cs_subdiv, cs_join): degree in
+ * 1..7 (CS_ERR_DEGREE), every point inside CS_POS_LIMIT (CS_ERR_RANGE), rational weights in
+ * CS_WEIGHT_MIN..CS_WEIGHT_ONE (CS_ERR_WEIGHT), checked in that order. ISR-safe (pure). */
+cs_err_t cs_bezier_check(const cs_bezier_t *c);
 /* Point at t in [0, CS_PARAM_ONE] by de Casteljau (rational: in homogeneous space, then
  * divided); CS_ERR_ARG for t outside [0, 1]. Result rounded to the nearest LSB: within
  * 0.5 + 2^-25 LSB of the exact polynomial of the fixed-point control points at t (rational:

@@ -12,21 +12,6 @@
 
 typedef int64_t e3_t[4][3]; /* 3 x the control points of a curve elevated to degree 3 */
 
-static int32_t coord(const cs_vec3_t *p, unsigned a)
-{
-    return a == 0 ? p->x : a == 1 ? p->y : p->z;
-}
-
-static void set_coord(cs_vec3_t *p, unsigned a, int32_t v)
-{
-    if (a == 0)
-        p->x = v;
-    else if (a == 1)
-        p->y = v;
-    else
-        p->z = v;
-}
-
 static cs_err_t check_curve(const cs_bezier_t *c, bool in_range)
 {
     if (!c)
@@ -45,21 +30,21 @@ static cs_err_t check_curve(const cs_bezier_t *c, bool in_range)
 static void elev3x(const cs_bezier_t *c, e3_t out)
 {
     for (unsigned a = 0; a < 3; a++) {
-        int64_t p0 = coord(&c->p[0], a), p1 = coord(&c->p[1], a);
+        int64_t p0 = cs_fixed_vec_get(&c->p[0], a), p1 = cs_fixed_vec_get(&c->p[1], a);
         if (c->degree == 1) {
             out[0][a] = 3 * p0;
             out[1][a] = 2 * p0 + p1;
             out[2][a] = p0 + 2 * p1;
             out[3][a] = 3 * p1;
         } else if (c->degree == 2) {
-            int64_t p2 = coord(&c->p[2], a);
+            int64_t p2 = cs_fixed_vec_get(&c->p[2], a);
             out[0][a] = 3 * p0;
             out[1][a] = p0 + 2 * p1;
             out[2][a] = 2 * p1 + p2;
             out[3][a] = 3 * p2;
         } else {
             for (unsigned i = 0; i < 4; i++)
-                out[i][a] = 3 * (int64_t)coord(&c->p[i], a);
+                out[i][a] = 3 * (int64_t)cs_fixed_vec_get(&c->p[i], a);
         }
     }
 }
@@ -99,7 +84,7 @@ static cs_err_t finish9(const int64_t net9[4][4][3], cs_patch_t *out)
                 int64_t q;
                 if (cs_fixed_muldiv64(net9[i][j][a], 1, 9, &q) != CS_OK || !cs_fixed_pos_ok(q))
                     return CS_ERR_RANGE;
-                set_coord(&r.p[i][j], a, (int32_t)q);
+                cs_fixed_vec_set(&r.p[i][j], a, (int32_t)q);
             }
     *out = r;
     return CS_OK;
@@ -127,8 +112,8 @@ cs_err_t cs_coons_bilinear(const cs_bezier_t *p1, const cs_bezier_t *p2, const c
                 /* S1: (1 - v) p1 + v p2; S2: (1 - u) q1 + u q2; S3: bilinear in the corners. */
                 int64_t s1 = (3 - j) * e1[i][a] + j * e2[i][a];
                 int64_t s2 = (3 - i) * f1[j][a] + i * f2[j][a];
-                int64_t s3 = (3 - i) * (3 - j) * coord(ca, a) + i * (3 - j) * coord(cb, a) +
-                             (3 - i) * j * coord(cd, a) + i * j * coord(cc, a);
+                int64_t s3 = (3 - i) * (3 - j) * cs_fixed_vec_get(ca, a) + i * (3 - j) * cs_fixed_vec_get(cb, a) +
+                             (3 - i) * j * cs_fixed_vec_get(cd, a) + i * j * cs_fixed_vec_get(cc, a);
                 net9[i][j][a] = s1 + s2 - s3;
             }
     return finish9(net9, out);
@@ -138,8 +123,8 @@ cs_err_t cs_coons_bilinear(const cs_bezier_t *p1, const cs_bezier_t *p2, const c
 static int64_t end_tangent(const cs_bezier_t *c, bool end, unsigned a)
 {
     unsigned n = c->degree;
-    return end ? (int64_t)n * ((int64_t)coord(&c->p[n], a) - coord(&c->p[n - 1], a))
-               : (int64_t)n * ((int64_t)coord(&c->p[1], a) - coord(&c->p[0], a));
+    return end ? (int64_t)n * ((int64_t)cs_fixed_vec_get(&c->p[n], a) - cs_fixed_vec_get(&c->p[n - 1], a))
+               : (int64_t)n * ((int64_t)cs_fixed_vec_get(&c->p[1], a) - cs_fixed_vec_get(&c->p[0], a));
 }
 
 cs_err_t cs_coons_bicubic(const cs_bezier_t *p1, const cs_bezier_t *p2, const cs_bezier_t *q1,
@@ -173,8 +158,8 @@ cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2, co
             for (unsigned a = 0; a < 3; a++) {
                 int64_t ta = end_tangent(from[k], at_end[k], a),
                         tb = end_tangent(to[k], at_end[k], a);
-                int64_t s0 = twist ? coord(&twist[slope[k][0][0]][slope[k][0][1]], a) : 0;
-                int64_t s1 = twist ? coord(&twist[slope[k][1][0]][slope[k][1][1]], a) : 0;
+                int64_t s0 = twist ? cs_fixed_vec_get(&twist[slope[k][0][0]][slope[k][0][1]], a) : 0;
+                int64_t s1 = twist ? cs_fixed_vec_get(&twist[slope[k][1][0]][slope[k][1][1]], a) : 0;
                 g[k][0][a] = 3 * ta;
                 g[k][1][a] = 3 * ta + s0;
                 g[k][2][a] = 3 * tb - s1;
@@ -202,14 +187,14 @@ cs_err_t cs_coons_bicubic_twist(const cs_bezier_t *p1, const cs_bezier_t *p2, co
          * the twists A^uv (zero unless given). Rows (A(0,.), A(1,.), A^u(0,.), A^u(1,.)),
          * columns (v = 0, v = 1, d/dv at 0, d/dv at 1). */
         int64_t bm[4][4] = {
-            {coord(&p1->p[0], a), coord(&p2->p[0], a), end_tangent(q1, false, a),
+            {cs_fixed_vec_get(&p1->p[0], a), cs_fixed_vec_get(&p2->p[0], a), end_tangent(q1, false, a),
              end_tangent(q1, true, a)},
-            {coord(&p1->p[p1->degree], a), coord(&p2->p[p2->degree], a), end_tangent(q2, false, a),
+            {cs_fixed_vec_get(&p1->p[p1->degree], a), cs_fixed_vec_get(&p2->p[p2->degree], a), end_tangent(q2, false, a),
              end_tangent(q2, true, a)},
             {end_tangent(p1, false, a), end_tangent(p2, false, a),
-             twist ? coord(&twist[0][0], a) : 0, twist ? coord(&twist[0][1], a) : 0},
-            {end_tangent(p1, true, a), end_tangent(p2, true, a), twist ? coord(&twist[1][0], a) : 0,
-             twist ? coord(&twist[1][1], a) : 0},
+             twist ? cs_fixed_vec_get(&twist[0][0], a) : 0, twist ? cs_fixed_vec_get(&twist[0][1], a) : 0},
+            {end_tangent(p1, true, a), end_tangent(p2, true, a), twist ? cs_fixed_vec_get(&twist[1][0], a) : 0,
+             twist ? cs_fixed_vec_get(&twist[1][1], a) : 0},
         };
         for (unsigned i = 0; i < 4; i++) {
             for (unsigned j = 0; j < 4; j++) {
@@ -285,10 +270,10 @@ cs_err_t cs_coons_extrude(const cs_bezier_t *p, const cs_vec3_t *d, cs_patch_t *
     for (unsigned i = 0; i <= p->degree; i++) {
         r.p[i][0] = p->p[i];
         for (unsigned a = 0; a < 3; a++) {
-            int64_t s = (int64_t)coord(&p->p[i], a) + coord(d, a);
+            int64_t s = (int64_t)cs_fixed_vec_get(&p->p[i], a) + cs_fixed_vec_get(d, a);
             if (!cs_fixed_pos_ok(s))
                 return CS_ERR_RANGE;
-            set_coord(&r.p[i][1], a, (int32_t)s);
+            cs_fixed_vec_set(&r.p[i][1], a, (int32_t)s);
         }
     }
     *out = r;

@@ -148,97 +148,27 @@ void cs_fd_init_diffs(const cs_fd_pt_t *p, unsigned degree, unsigned k,
 #if CS_FD_RATIONAL
 /* --- rational curves: exact homogeneous differences in 128 bits ------------------------- */
 
-static cs_fd_i128_t i128_from64(int64_t v)
-{
-    cs_fd_i128_t r;
-    r.lo = (uint64_t)v;
-    r.hi = v < 0 ? UINT64_MAX : 0u;
-    return r;
-}
-
-static cs_fd_i128_t i128_add(cs_fd_i128_t a, cs_fd_i128_t b)
-{
-    cs_fd_i128_t r;
-    r.lo = a.lo + b.lo;
-    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
-    return r;
-}
-
-static cs_fd_i128_t i128_sub(cs_fd_i128_t a, cs_fd_i128_t b)
-{
-    cs_fd_i128_t r;
-    r.lo = a.lo - b.lo;
-    r.hi = a.hi - b.hi - (a.lo < b.lo ? 1u : 0u);
-    return r;
-}
-
-static bool i128_is_neg(cs_fd_i128_t a)
-{
-    return (a.hi >> 63) != 0;
-}
-
-static cs_fd_i128_t i128_negate(cs_fd_i128_t a)
-{
-    cs_fd_i128_t zero = {0u, 0u};
-    return i128_sub(zero, a);
-}
-
-/* a * m for m <= 2^32 and |a * m| < 2^127 (callers keep values below 2^126). */
-static cs_fd_i128_t i128_mul_small(cs_fd_i128_t a, uint64_t m)
-{
-    bool neg = i128_is_neg(a);
-    cs_fd_i128_t mag = neg ? i128_negate(a) : a, r;
-    uint64_t h;
-    cs_fixed_mul_u64(mag.lo, m, &h, &r.lo);
-    r.hi = mag.hi * m + h;
-    return neg ? i128_negate(r) : r;
-}
-
-static unsigned bitlen64(uint64_t v)
-{
-    unsigned b = 0;
-    while (v) {
-        b++;
-        v >>= 1;
-    }
-    return b;
-}
-
-/* Magnitude a >> s, 0 < s < 128. */
-static cs_fd_i128_t u128_shr(cs_fd_i128_t a, unsigned s)
-{
-    cs_fd_i128_t r;
-    if (s >= 64) {
-        r.lo = a.hi >> (s - 64);
-        r.hi = 0u;
-    } else {
-        r.lo = (a.lo >> s) | (a.hi << (64 - s));
-        r.hi = a.hi >> s;
-    }
-    return r;
-}
-
 /* round(x / w) for w > 0: both are normalised so w < 2^62 (relative error <= 2^-61, i.e. far
  * below 2^-30 LSB here), then 31 restoring-division steps (|x / w| < 2^31 LSB). */
-static cs_err_t rat_project(cs_fd_i128_t x, cs_fd_i128_t w, cs_pos_t *out)
+static cs_err_t rat_project(cs_i128_t x, cs_i128_t w, cs_pos_t *out)
 {
-    bool neg = i128_is_neg(x);
-    cs_fd_i128_t m = neg ? i128_negate(x) : x;
-    unsigned bl = w.hi ? 64 + bitlen64(w.hi) : bitlen64(w.lo);
+    bool neg = cs_fixed_i128_is_neg(x);
+    cs_i128_t m = neg ? cs_fixed_i128_neg(x) : x;
+    unsigned bl = w.hi ? 64 + cs_fixed_bitlen64(w.hi) : cs_fixed_bitlen64(w.lo);
     if (bl > 62) {
-        m = u128_shr(m, bl - 62);
-        w = u128_shr(w, bl - 62);
+        m = cs_fixed_u128_shr(m, bl - 62);
+        w = cs_fixed_u128_shr(w, bl - 62);
     }
     uint64_t wd = w.lo;
     if (wd == 0)
         return CS_ERR_OVERFLOW;
     uint64_t q = 0;
     for (unsigned b = 31; b-- > 0;) {
-        cs_fd_i128_t t;
+        cs_i128_t t;
         t.lo = wd << b;
         t.hi = b ? wd >> (64 - b) : 0u;
         if (m.hi > t.hi || (m.hi == t.hi && m.lo >= t.lo)) {
-            m = i128_sub(m, t);
+            m = cs_fixed_i128_sub(m, t);
             q |= (uint64_t)1 << b;
         }
     }
@@ -307,7 +237,7 @@ unsigned cs_fd_rational_k(const cs_bezier_t *c, cs_pos_t tol)
         om2 = ad2w > om2 ? ad2w : om2;
     }
     /* 1/W <= 2^(30-e) with 2^e <= wmin (weights in Q30). */
-    unsigned e = bitlen64(wmin) - 1u, f = CS_WEIGHT_FRAC_BITS - e;
+    unsigned e = cs_fixed_bitlen64(wmin) - 1u, f = CS_WEIGHT_FRAC_BITS - e;
     uint64_t r1 = sat_add(sat_mul(sat_mul(n, b), (uint64_t)1 << f),
                           (sat_mul(sat_mul(rho, n), om1) >> e) + 1u);
     uint64_t t = sat_add(sat_mul(sat_mul(2u * n, r1), om1),
@@ -328,32 +258,32 @@ unsigned cs_fd_rational_k(const cs_bezier_t *c, cs_pos_t tol)
 
 /* Exact homogeneous differences (x, y, z = w P in LSB x Q30; w in Q30) at step 2^-k, x 2^(n k). */
 static void rat_init_diffs(const cs_bezier_t *c, unsigned k,
-                           cs_fd_i128_t d[4][CS_BEZIER_MAX_POINTS])
+                           cs_i128_t d[4][CS_BEZIER_MAX_POINTS])
 {
     unsigned n = c->degree;
     uint64_t steps = (uint64_t)1 << k;
     unsigned m = steps < n ? (unsigned)steps : n;
     for (unsigned a = 0; a < 4; a++) {
-        cs_fd_i128_t x[CS_BEZIER_MAX_POINTS];
+        cs_i128_t x[CS_BEZIER_MAX_POINTS];
         for (unsigned i = 0; i <= m; i++) {
-            cs_fd_i128_t v[CS_BEZIER_MAX_POINTS];
+            cs_i128_t v[CS_BEZIER_MAX_POINTS];
             for (unsigned q = 0; q <= n; q++) {
                 int64_t w = c->w[q];
-                v[q] = i128_from64(a == 0   ? w * c->p[q].x
+                v[q] = cs_fixed_i128_from64(a == 0   ? w * c->p[q].x
                                    : a == 1 ? w * c->p[q].y
                                    : a == 2 ? w * c->p[q].z
                                             : w);
             }
             for (unsigned r = 1; r <= n; r++)
                 for (unsigned q = 0; q + r <= n; q++)
-                    v[q] = i128_add(i128_mul_small(v[q], steps - i), i128_mul_small(v[q + 1], i));
+                    v[q] = cs_fixed_i128_add(cs_fixed_i128_mul_u64(v[q], steps - i), cs_fixed_i128_mul_u64(v[q + 1], i));
             x[i] = v[0];
         }
         for (unsigned r = 1; r <= m; r++)
             for (unsigned i = m; i >= r; i--)
-                x[i] = i128_sub(x[i], x[i - 1]);
+                x[i] = cs_fixed_i128_sub(x[i], x[i - 1]);
         for (unsigned j = 0; j < CS_BEZIER_MAX_POINTS; j++)
-            d[a][j] = j <= m ? x[j] : i128_from64(0);
+            d[a][j] = j <= m ? x[j] : cs_fixed_i128_from64(0);
     }
 }
 #endif /* CS_FD_RATIONAL */
@@ -377,14 +307,9 @@ static bool piece_ok(const cs_fd_t *f)
 cs_err_t cs_fd_begin(cs_fd_t *f, const cs_bezier_t *c, cs_pos_t tol)
 {
     f->done = true;
-    if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
-        return CS_ERR_DEGREE;
-    for (unsigned i = 0; i <= c->degree; i++) {
-        if (!cs_fixed_vec_ok(&c->p[i]))
-            return CS_ERR_RANGE;
-        if (c->rational && (c->w[i] < CS_WEIGHT_MIN || c->w[i] > CS_WEIGHT_ONE))
-            return CS_ERR_WEIGHT;
-    }
+    cs_err_t ce = cs_bezier_check(c);
+    if (ce != CS_OK)
+        return ce;
     if (tol < 1 || tol > CS_POS_LIMIT)
         return CS_ERR_TOLERANCE;
     f->rational = c->rational;
@@ -452,10 +377,10 @@ cs_err_t cs_fd_next(cs_fd_t *f, cs_vec3_t *pt)
 #if CS_FD_RATIONAL
     if (f->rational) {
         for (unsigned a = 0; a < 4; a++) {
-            cs_fd_i128_t *d = f->rd[a];
-            d[0] = i128_add(d[0], d[1]);
+            cs_i128_t *d = f->rd[a];
+            d[0] = cs_fixed_i128_add(d[0], d[1]);
             for (unsigned j = 1; j <= top; j++)
-                d[j] = i128_add(d[j], d[j + 1]);
+                d[j] = cs_fixed_i128_add(d[j], d[j + 1]);
         }
         f->step++;
         cs_err_t e = rat_project(f->rd[0][0], f->rd[3][0], &pt->x);

@@ -25,10 +25,6 @@ typedef struct {
     int64_t x, y, z;
 } cs_fd_pt_t;
 
-/* Two's-complement 128-bit integer (rational FD accumulators; no __int128 on small targets). */
-typedef struct {
-    uint64_t lo, hi;
-} cs_fd_i128_t;
 
 /* Rational FD: homogeneous numerator w*P (Q30 x LSB, <= 2^58) and weight w (Q30) differenced
  * exactly with n*K guard bits in 128 bits: n*K <= CS_FD_RAT_GUARD_BITS. Build with
@@ -51,7 +47,7 @@ typedef struct {
     cs_pos_t tol_eff;
     int64_t d[3][CS_BEZIER_MAX_POINTS]; /* [axis][order] x 2^(guard + n*k) */
 #if CS_FD_RATIONAL
-    cs_fd_i128_t rd[4][CS_BEZIER_MAX_POINTS]; /* rational: [x, y, z, w][order] x 2^(n*k) */
+    cs_i128_t rd[4][CS_BEZIER_MAX_POINTS]; /* rational: [x, y, z, w][order] x 2^(n*k) */
 #endif
     cs_bezier_t curve;
 } cs_fd_t;

@@ -234,3 +234,42 @@ uint8_t cs_fixed_binom(unsigned n, unsigned k)
 {
     return n <= CS_FIXED_BINOM_MAX && k <= n ? binom_table[n][k] : 0;
 }
+
+int64_t cs_fixed_div_round(int64_t n, int64_t d)
+{
+    int64_t m = n < 0 ? -n : n, q = (m + d / 2) / d;
+    return n < 0 ? -q : q;
+}
+
+unsigned cs_fixed_bitlen64(uint64_t v)
+{
+    unsigned b = 0;
+    while (v) {
+        b++;
+        v >>= 1;
+    }
+    return b;
+}
+
+cs_i128_t cs_fixed_i128_mul_u64(cs_i128_t a, uint64_t m)
+{
+    bool neg = cs_fixed_i128_is_neg(a);
+    cs_i128_t mag = neg ? cs_fixed_i128_neg(a) : a, r;
+    uint64_t h;
+    cs_fixed_mul_u64(mag.lo, m, &h, &r.lo);
+    r.hi = mag.hi * m + h;
+    return neg ? cs_fixed_i128_neg(r) : r;
+}
+
+cs_i128_t cs_fixed_u128_shr(cs_i128_t a, unsigned s)
+{
+    cs_i128_t r;
+    if (s >= 64) {
+        r.lo = a.hi >> (s - 64);
+        r.hi = 0u;
+    } else {
+        r.lo = (a.lo >> s) | (a.hi << (64 - s));
+        r.hi = a.hi >> s;
+    }
+    return r;
+}

@@ -90,6 +90,12 @@ cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out);
  * intermediate overflow (64x32 product done in two halves): the de Casteljau step on int64
  * values that carry guard bits. ISR-safe (pure). */
 int64_t cs_fixed_mul64_q30(int64_t x, int32_t t);
+/* a + round((b - a) * t / 2^30): the de Casteljau step between two int64 values, |b - a| < 2^62,
+ * t a Q1.30 parameter. ISR-safe (pure). */
+static inline int64_t cs_fixed_lerp64(int64_t a, int64_t b, int32_t t)
+{
+    return a + cs_fixed_mul64_q30(b - a, t);
+}
 /* *q = round((hi * 2^64 + lo) / d) (half up), by restoring long division (no libc, no 128-bit
  * type). CS_ERR_ARG when d == 0 or d >= 2^63; CS_ERR_OVERFLOW when the quotient needs more
  * than 64 bits. ISR-safe (pure). */
@@ -103,5 +109,71 @@ uint64_t cs_fixed_vec_len64(int64_t x, int64_t y, int64_t z);
 #define CS_FIXED_BINOM_MAX 7
 uint8_t cs_fixed_binom(unsigned n, unsigned k);
 
+
+/* --- primitives every module shares, each with its rounding rule stated here once --- */
+/* round(n / d) for d > 0, half away from zero (-2.5 -> -3); |n| + d/2 must not overflow int64.
+ * ISR-safe (pure). */
+int64_t cs_fixed_div_round(int64_t n, int64_t d);
+/* Number of significant bits of v (0 for 0, 64 for 2^63..). ISR-safe (pure). */
+unsigned cs_fixed_bitlen64(uint64_t v);
+
+/* Coordinate `axis` (0 = x, 1 = y, 2 = z) of a vector: the one accessor the per-axis loops of
+ * the curve, surface and basis code share. axis must be < 3. */
+static inline cs_pos_t cs_fixed_vec_get(const cs_vec3_t *p, unsigned axis)
+{
+    return axis == 0 ? p->x : axis == 1 ? p->y : p->z;
+}
+/* Sets coordinate `axis` (0..2) of *p to v. */
+static inline void cs_fixed_vec_set(cs_vec3_t *p, unsigned axis, cs_pos_t v)
+{
+    if (axis == 0)
+        p->x = v;
+    else if (axis == 1)
+        p->y = v;
+    else
+        p->z = v;
+}
+
+/* Two's-complement 128-bit integer as two words (no __int128 on the 8- and 32-bit targets).
+ * Add, subtract and negate wrap modulo 2^128 like unsigned C arithmetic; callers bound their
+ * values (cs_fd keeps rational accumulators below 2^126). All ISR-safe (pure). */
+typedef struct {
+    uint64_t lo, hi;
+} cs_i128_t;
+
+static inline cs_i128_t cs_fixed_i128_from64(int64_t v)
+{
+    cs_i128_t r;
+    r.lo = (uint64_t)v;
+    r.hi = v < 0 ? UINT64_MAX : 0u;
+    return r;
+}
+static inline cs_i128_t cs_fixed_i128_add(cs_i128_t a, cs_i128_t b)
+{
+    cs_i128_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+static inline cs_i128_t cs_fixed_i128_sub(cs_i128_t a, cs_i128_t b)
+{
+    cs_i128_t r;
+    r.lo = a.lo - b.lo;
+    r.hi = a.hi - b.hi - (a.lo < b.lo ? 1u : 0u);
+    return r;
+}
+static inline bool cs_fixed_i128_is_neg(cs_i128_t a)
+{
+    return (a.hi >> 63) != 0;
+}
+static inline cs_i128_t cs_fixed_i128_neg(cs_i128_t a)
+{
+    cs_i128_t zero = {0u, 0u};
+    return cs_fixed_i128_sub(zero, a);
+}
+/* a * m, exact while |a * m| < 2^127 (the caller's bound), sign kept. */
+cs_i128_t cs_fixed_i128_mul_u64(cs_i128_t a, uint64_t m);
+/* Logical a >> s of a non-negative (magnitude) value, 0 < s < 128. */
+cs_i128_t cs_fixed_u128_shr(cs_i128_t a, unsigned s);
 
 #endif

@@ -4,11 +4,6 @@
 CS_STATIC_ASSERT(CS_BEZIER_MAX_DEGREE <= CS_FIXED_BINOM_MAX, binomials_up_to_the_degree);
 CS_STATIC_ASSERT(40 + CS_HORNER_GUARD + 3 <= 62, horner_sums_below_2_62);
 
-static int32_t coord(const cs_vec3_t *p, unsigned a)
-{
-    return a == 0 ? p->x : a == 1 ? p->y : p->z;
-}
-
 cs_err_t cs_horner_init(cs_horner_t *h, const cs_bezier_t *c)
 {
     if (!h || !c)
@@ -24,7 +19,7 @@ cs_err_t cs_horner_init(cs_horner_t *h, const cs_bezier_t *c)
             /* a_k = C(n, k) * k-th forward difference of the control points (exact) */
             int64_t s = 0;
             for (unsigned i = 0; i <= k; i++) {
-                int64_t term = (int64_t)cs_fixed_binom(k, i) * (int64_t)coord(&c->p[i], a);
+                int64_t term = (int64_t)cs_fixed_binom(k, i) * (int64_t)cs_fixed_vec_get(&c->p[i], a);
                 s += ((k - i) % 2u) ? -term : term;
             }
             h->a[k][a] = (int64_t)cs_fixed_binom(n, k) * s * ((int64_t)1 << CS_HORNER_GUARD);

@@ -49,13 +49,6 @@ static bool is_zero(const int64_t *a, cs_pos_t pos)
     return vlen2(a) <= (uint64_t)pos * (uint64_t)pos;
 }
 
-/* round(num / den), den > 0, half away from zero */
-static int64_t div_round(int64_t num, int64_t den)
-{
-    int64_t m = num < 0 ? -num : num, q = (m + den / 2) / den;
-    return num < 0 ? -q : q;
-}
-
 static void side_init(const cs_bezier_t *c, bool end, cs_pos_t pos, side_t *s)
 {
     unsigned n = c->degree;
@@ -85,7 +78,7 @@ static void side_init(const cs_bezier_t *c, bool end, cs_pos_t pos, side_t *s)
     int64_t wn = c->w[end ? n : 0], wn1 = c->w[end ? n - 1 : 1];
     for (unsigned a = 0; a < 3; a++) {
         if (c->rational) {
-            s->D1[a] = div_round((int64_t)n * wn1 * s->d1[a], wn);
+            s->D1[a] = cs_fixed_div_round((int64_t)n * wn1 * s->d1[a], wn);
             s->D2[a] = 0;
         } else {
             s->D1[a] = (int64_t)n * s->d1[a];
@@ -108,7 +101,7 @@ static void unit(const int64_t *d, int64_t *u)
 {
     int64_t l = (int64_t)vlen(d);
     for (unsigned i = 0; i < 3; i++)
-        u[i] = div_round(d[i] * ((int64_t)1 << 30), l);
+        u[i] = cs_fixed_div_round(d[i] * ((int64_t)1 << 30), l);
 }
 
 /* G1 test on the two tangent directions (Q30 unit vectors): |ua x ub| <= s and ua . ub > 0. */
@@ -151,19 +144,6 @@ static cs_err_t curvature(const side_t *s, int64_t *k)
     return CS_OK;
 }
 
-static cs_err_t check_seg(const cs_bezier_t *c)
-{
-    if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
-        return CS_ERR_DEGREE;
-    for (unsigned i = 0; i <= c->degree; i++) {
-        if (!cs_fixed_vec_ok(&c->p[i]))
-            return CS_ERR_RANGE;
-        if (c->rational && (c->w[i] < CS_WEIGHT_MIN || c->w[i] > CS_WEIGHT_ONE))
-            return CS_ERR_WEIGHT;
-    }
-    return CS_OK;
-}
-
 cs_err_t cs_join_classify(const cs_bezier_t *a, const cs_bezier_t *b, const cs_join_tol_t *tol,
                           unsigned *flags)
 {
@@ -171,7 +151,7 @@ cs_err_t cs_join_classify(const cs_bezier_t *a, const cs_bezier_t *b, const cs_j
     if (tol->pos < 0 || tol->sin_angle < 0 || tol->sin_angle > CS_PARAM_ONE || tol->rel < 0 ||
         tol->rel > CS_PARAM_ONE)
         return CS_ERR_TOLERANCE;
-    if ((e = check_seg(a)) != CS_OK || (e = check_seg(b)) != CS_OK)
+    if ((e = cs_bezier_check(a)) != CS_OK || (e = cs_bezier_check(b)) != CS_OK)
         return e;
     side_t sa, sb;
     v3_t u, v;

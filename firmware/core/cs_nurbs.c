@@ -69,11 +69,6 @@ void cs_nurbs_iter_begin(const cs_nurbs_t *c, cs_nurbs_iter_t *it)
         it->span = c != NULL ? c->degree : 0;
 }
 
-static int64_t nurbs_coord(const cs_vec3_t *v, unsigned axis)
-{
-    return axis == 0 ? v->x : axis == 1 ? v->y : v->z;
-}
-
 /* Bézier segment of the non-empty span j (degree <= j < count). */
 static cs_err_t nurbs_span(const cs_nurbs_t *c, size_t j, cs_bezier_t *out)
 {
@@ -97,7 +92,7 @@ static cs_err_t nurbs_span(const cs_nurbs_t *c, size_t j, cs_bezier_t *out)
             size_t idx = j - p + r;
             int64_t w = (int64_t)(c->weights != NULL ? c->weights[idx] : 1) << shift;
             for (unsigned axis = 0; axis < 3; axis++)
-                d[r][axis] = w * nurbs_coord(&c->pts[idx], axis); /* |.| < 2^59 */
+                d[r][axis] = w * cs_fixed_vec_get(&c->pts[idx], axis); /* |.| < 2^59 */
             d[r][3] = w;
         }
         /* Blossom f(k_j^(p-i), k_{j+1}^i): the first p-i levels insert k_j, the rest k_{j+1}. */

@@ -31,26 +31,6 @@ CS_STATIC_ASSERT(3 * (CS_PATCH_RASTER_MAX_SHIFT + 1) + 29 <= 63, cubic_raster_fu
 
 typedef int64_t wnet_t[NPTS][NPTS][3];
 
-static int32_t coord(const cs_vec3_t *p, unsigned axis)
-{
-    return axis == 0 ? p->x : axis == 1 ? p->y : p->z;
-}
-
-static void set_coord(cs_vec3_t *p, unsigned axis, int32_t v)
-{
-    if (axis == 0)
-        p->x = v;
-    else if (axis == 1)
-        p->y = v;
-    else
-        p->z = v;
-}
-
-static int64_t lerp(int64_t a, int64_t b, cs_param_t t)
-{
-    return a + cs_fixed_mul64_q30(b - a, t);
-}
-
 static bool param_ok(cs_param_t t)
 {
     return t >= 0 && t <= CS_PARAM_ONE;
@@ -62,14 +42,14 @@ static bool degrees_ok(unsigned du, unsigned dv)
 }
 
 /* Reduce w[0..n] by de Casteljau at t down to two points w[0], w[1]; returns the point
- * lerp(w0, w1, t) and stores the derivative n (w1 - w0) in *d. */
+ * cs_fixed_lerp64(w0, w1, t) and stores the derivative n (w1 - w0) in *d. */
 static int64_t decast_pd(int64_t *w, unsigned n, cs_param_t t, int64_t *d)
 {
     for (unsigned m = n; m > 1; m--)
         for (unsigned j = 0; j < m; j++)
-            w[j] = lerp(w[j], w[j + 1], t);
+            w[j] = cs_fixed_lerp64(w[j], w[j + 1], t);
     *d = (int64_t)n * (w[1] - w[0]);
-    return lerp(w[0], w[1], t);
+    return cs_fixed_lerp64(w[0], w[1], t);
 }
 
 /* P, Pu, Pv, Puv (out[0..3]) of the guarded net at (u, v), in the net's units. */
@@ -93,7 +73,7 @@ static void load_net(const cs_patch_t *p, wnet_t net)
     for (unsigned i = 0; i <= p->deg_u; i++)
         for (unsigned j = 0; j <= p->deg_v; j++)
             for (unsigned a = 0; a < 3; a++)
-                net[i][j][a] = (int64_t)coord(&p->p[i][j], a) * ((int64_t)1 << GUARD);
+                net[i][j][a] = (int64_t)cs_fixed_vec_get(&p->p[i][j], a) * ((int64_t)1 << GUARD);
 }
 
 static cs_err_t narrow_vec(const int64_t w[3], unsigned shift, cs_vec3_t *out)
@@ -103,7 +83,7 @@ static cs_err_t narrow_vec(const int64_t w[3], unsigned shift, cs_vec3_t *out)
         int32_t c;
         if (cs_fixed_narrow(cs_fixed_round_shift64(w[a], shift), &c) != CS_OK)
             return CS_ERR_OVERFLOW;
-        set_coord(&r, a, c);
+        cs_fixed_vec_set(&r, a, c);
     }
     *out = r;
     return CS_OK;
@@ -376,7 +356,7 @@ static int64_t raster_value(const cs_bezier_t *c, unsigned a, int64_t big_n, int
             b *= k;
         for (unsigned q = j; q < c->degree; q++)
             b *= big_n - k;
-        s += b * coord(&c->p[j], a);
+        s += b * cs_fixed_vec_get(&c->p[j], a);
     }
     return s;
 }
@@ -432,7 +412,7 @@ cs_err_t cs_patch_raster_next(cs_patch_raster_t *r, cs_bezier_t *out, cs_param_t
                     cs_fixed_round_shift64(r->f[i][a][0], (unsigned)r->order * r->shift), &v) !=
                 CS_OK)
                 return CS_ERR_OVERFLOW;
-            set_coord(&c.p[i], a, v);
+            cs_fixed_vec_set(&c.p[i], a, v);
         }
         c.w[i] = CS_WEIGHT_ONE;
     }
@@ -464,7 +444,7 @@ static void tensor9(const int64_t m[4][4], const cs_vec3_t g[4][4], wnet_t out)
                 int64_t s = 0;
                 for (unsigned k = 0; k < 4; k++)
                     for (unsigned l = 0; l < 4; l++)
-                        s += m[i][k] * m[j][l] * coord(&g[k][l], a);
+                        s += m[i][k] * m[j][l] * cs_fixed_vec_get(&g[k][l], a);
                 out[i][j][a] = s;
             }
 }
@@ -499,7 +479,7 @@ static cs_err_t net9_to_patch(const wnet_t n9, cs_patch_t *p)
                 cs_pos_t c;
                 if (div_pos(n9[i][j][a], 9, &c) != CS_OK)
                     return CS_ERR_RANGE;
-                set_coord(&r.p[i][j], a, c);
+                cs_fixed_vec_set(&r.p[i][j], a, c);
             }
     *p = r;
     return CS_OK;
@@ -557,16 +537,16 @@ cs_err_t cs_patch_to_hermite(const cs_patch_t *p, cs_patch_hermite_t *h)
             int64_t su = ca ? 1 : -1, sv = cb ? 1 : -1;
             r.p[ca][cb] = p->p[i0][j0];
             for (unsigned a = 0; a < 3; a++) {
-                int64_t c00 = coord(&p->p[i0][j0], a), c10 = coord(&p->p[i1][j0], a);
-                int64_t c01 = coord(&p->p[i0][j1], a), c11 = coord(&p->p[i1][j1], a);
+                int64_t c00 = cs_fixed_vec_get(&p->p[i0][j0], a), c10 = cs_fixed_vec_get(&p->p[i1][j0], a);
+                int64_t c01 = cs_fixed_vec_get(&p->p[i0][j1], a), c11 = cs_fixed_vec_get(&p->p[i1][j1], a);
                 int32_t vu, vv, vuv;
                 if (cs_fixed_narrow(3 * su * (c00 - c10), &vu) != CS_OK ||
                     cs_fixed_narrow(3 * sv * (c00 - c01), &vv) != CS_OK ||
                     cs_fixed_narrow(9 * su * sv * (c00 - c10 - c01 + c11), &vuv) != CS_OK)
                     return CS_ERR_OVERFLOW;
-                set_coord(&r.pu[ca][cb], a, vu);
-                set_coord(&r.pv[ca][cb], a, vv);
-                set_coord(&r.puv[ca][cb], a, vuv);
+                cs_fixed_vec_set(&r.pu[ca][cb], a, vu);
+                cs_fixed_vec_set(&r.pv[ca][cb], a, vv);
+                cs_fixed_vec_set(&r.puv[ca][cb], a, vuv);
             }
         }
     }
@@ -619,10 +599,10 @@ cs_err_t cs_patch_hermite_split9(const cs_patch_hermite_t *h, const cs_param_t u
                         if (div_i32(tu, den, &vu) != CS_OK || div_i32(tv, den, &vv) != CS_OK ||
                             div_i32(tuv, den, &vuv) != CS_OK)
                             return CS_ERR_OVERFLOW;
-                        set_coord(&q.p[ca][cb], x, vp);
-                        set_coord(&q.pu[ca][cb], x, vu);
-                        set_coord(&q.pv[ca][cb], x, vv);
-                        set_coord(&q.puv[ca][cb], x, vuv);
+                        cs_fixed_vec_set(&q.p[ca][cb], x, vp);
+                        cs_fixed_vec_set(&q.pu[ca][cb], x, vu);
+                        cs_fixed_vec_set(&q.pv[ca][cb], x, vv);
+                        cs_fixed_vec_set(&q.puv[ca][cb], x, vuv);
                     }
                 }
             }
@@ -654,7 +634,7 @@ cs_err_t cs_patch_transpose(const cs_patch_t *p, cs_patch_t *out)
 static bool close_vec(const cs_vec3_t *a, const cs_vec3_t *b, int64_t tol)
 {
     for (unsigned k = 0; k < 3; k++) {
-        int64_t d = (int64_t)coord(a, k) - coord(b, k);
+        int64_t d = (int64_t)cs_fixed_vec_get(a, k) - cs_fixed_vec_get(b, k);
         if (d > tol || d < -tol)
             return false;
     }
@@ -671,10 +651,10 @@ static cs_vec3_t cross_ctrl(const cs_patch_t *p, unsigned j, bool far, bool *ok)
     cs_vec3_t r = {0, 0, 0};
     for (unsigned a = 0; a < 3; a++) {
         int32_t v;
-        if (cs_fixed_narrow((int64_t)n * ((int64_t)coord(hi, a) - coord(lo, a)), &v) != CS_OK)
+        if (cs_fixed_narrow((int64_t)n * ((int64_t)cs_fixed_vec_get(hi, a) - cs_fixed_vec_get(lo, a)), &v) != CS_OK)
             *ok = false;
         else
-            set_coord(&r, a, v);
+            cs_fixed_vec_set(&r, a, v);
     }
     return r;
 }
@@ -690,7 +670,7 @@ static int64_t second_ctrl(const cs_patch_t *p, unsigned j, bool far, unsigned a
     const cs_vec3_t *e = far ? &p->p[n][j] : &p->p[0][j];
     const cs_vec3_t *m = far ? &p->p[n - 1][j] : &p->p[1][j];
     const cs_vec3_t *f = far ? &p->p[n - 2][j] : &p->p[2][j];
-    return (int64_t)n * (n - 1) * ((int64_t)coord(e, a) - 2 * (int64_t)coord(m, a) + coord(f, a));
+    return (int64_t)n * (n - 1) * ((int64_t)cs_fixed_vec_get(e, a) - 2 * (int64_t)cs_fixed_vec_get(m, a) + cs_fixed_vec_get(f, a));
 }
 
 /* The second cross-boundary derivatives of a (u = 1) and b (u = 0) agree within tol. */

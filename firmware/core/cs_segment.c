@@ -10,12 +10,6 @@
 
 CS_STATIC_ASSERT(sizeof(cs_segment_t) == 4 + 4 * CS_AXES, segment_is_packed);
 
-/* round(a / b), b > 0, half away from zero. */
-static int64_t div_round(int64_t a, int64_t b)
-{
-    return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b);
-}
-
 cs_err_t cs_segment_init(cs_segment_gen_t *g, const cs_machine_t *m)
 {
     if (g == NULL || m == NULL || m->tick_hz == 0 || m->segment_ticks == 0)
@@ -39,7 +33,7 @@ uint32_t cs_segment_block_ticks(const cs_segment_gen_t *g)
 /* Speed change a * t / hz (Q16 mm/s) after t ticks at accel (Q16 mm/s^2). */
 static int64_t dv_at(int32_t accel, uint32_t t, uint32_t hz)
 {
-    return div_round((int64_t)accel * t, hz);
+    return cs_fixed_div_round((int64_t)accel * t, hz);
 }
 
 /* Distance (Q16 mm) covered in t ticks starting at speed v (Q16) while the speed changes by
@@ -47,7 +41,7 @@ static int64_t dv_at(int32_t accel, uint32_t t, uint32_t hz)
 static int64_t dist_at(int32_t v, int32_t accel, int sign, uint32_t t, uint32_t hz)
 {
     int64_t vsum = 2 * (int64_t)v + sign * dv_at(accel, t, hz);
-    return div_round(vsum * t, 2 * (int64_t)hz);
+    return cs_fixed_div_round(vsum * t, 2 * (int64_t)hz);
 }
 
 /* S-curve phase of T ticks changing the speed by dv from v: ticks = ceil(T_seconds * hz). */
@@ -74,7 +68,7 @@ static int64_t scurve_dist(int64_t v, int64_t dv, int sign, uint32_t t, uint32_t
     int64_t S = x3 - x4 / 2, part;
     if (cs_fixed_muldiv64(dv * T, S, (int64_t)hz << 30, &part) != CS_OK)
         part = 0; /* unreachable: dv * T < 2^61, S <= 2^30 */
-    return div_round(v * t, hz) + sign * part;
+    return cs_fixed_div_round(v * t, hz) + sign * part;
 }
 
 /* Length (Q16 mm) of an S-curve block's two speed changes with peak vp; ticks in *ta, *td. */
@@ -86,7 +80,23 @@ static int64_t scurve_changes(const cs_segment_gen_t *g, int64_t v0, int64_t vp,
     *td = scurve_ticks(g, vp - v1);
     if (*ta >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS || *td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
         return INT64_MAX;
-    return div_round((v0 + vp) * *ta, hz2) + div_round((vp + v1) * *td, hz2);
+    return cs_fixed_div_round((v0 + vp) * *ta, hz2) + cs_fixed_div_round((vp + v1) * *td, hz2);
+}
+
+/* The cruise phase of a block whose ramps (ta, td, da) are set: dc mm at vp, its time rounded
+ * up so the block never ends before its distance is covered, and at least one tick per block. */
+static cs_err_t set_cruise(cs_segment_gen_t *g, int64_t dc, int64_t vp, uint32_t hz)
+{
+    if (dc < 0)
+        dc = 0;
+    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
+    if (tc + (int64_t)g->ta + (int64_t)g->td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
+        return CS_ERR_RANGE;
+    g->tc = (uint32_t)tc;
+    if (g->ta + g->tc + g->td == 0)
+        g->tc = 1;
+    g->dc = cs_fixed_div_round(vp * (int64_t)g->tc, hz);
+    return CS_OK;
 }
 
 /* S-curve block: peak vp = the nominal speed when both speed changes fit the block, else the
@@ -112,18 +122,8 @@ static cs_err_t load_scurve(cs_segment_gen_t *g, int64_t v0, int64_t v1, int64_t
     g->vp = (int32_t)vp;
     g->ta = (uint32_t)ta;
     g->td = (uint32_t)td;
-    g->da = div_round((v0 + vp) * ta, 2 * (int64_t)hz);
-    int64_t dc = len - both;
-    if (dc < 0)
-        dc = 0;
-    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
-    if (tc + ta + td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
-        return CS_ERR_RANGE;
-    g->tc = (uint32_t)tc;
-    if (g->ta + g->tc + g->td == 0)
-        g->tc = 1;
-    g->dc = div_round(vp * (int64_t)g->tc, hz);
-    return CS_OK;
+    g->da = cs_fixed_div_round((v0 + vp) * ta, 2 * (int64_t)hz);
+    return set_cruise(g, len - both, vp, hz);
 }
 
 static cs_err_t load_block(cs_segment_gen_t *g, const cs_block_t *b)
@@ -174,17 +174,9 @@ static cs_err_t load_block(cs_segment_gen_t *g, const cs_block_t *b)
     g->td = (uint32_t)td;
     g->da = dist_at(g->v0, g->accel, 1, g->ta, hz);
     int64_t dd = dist_at(g->vp, g->accel, -1, g->td, hz);
-    int64_t dc = len - g->da - dd;
-    if (dc < 0)
-        dc = 0;
-    /* Cruise time rounded up: the block never ends before its distance is covered. */
-    int64_t tc = vp > 0 ? (dc * hz + vp - 1) / vp : 0;
-    if (tc + ta + td >= (int64_t)CS_SEGMENT_MAX_BLOCK_TICKS)
-        return CS_ERR_RANGE;
-    g->tc = (uint32_t)tc;
-    if (g->ta + g->tc + g->td == 0)
-        g->tc = 1;
-    g->dc = div_round(vp * (int64_t)g->tc, hz);
+    cs_err_t e = set_cruise(g, len - g->da - dd, vp, hz);
+    if (e != CS_OK)
+        return e;
 loaded:
     g->length = len;
     for (unsigned i = 0; i < CS_AXES; i++) {
@@ -211,7 +203,7 @@ static int64_t dist_of(const cs_segment_gen_t *g, uint32_t t)
         d = g->scurve ? scurve_dist(g->v0, g->vp - g->v0, 1, t, g->ta, hz)
                       : dist_at(g->v0, g->accel, 1, t, hz);
     else if (t <= g->ta + g->tc)
-        d = g->da + div_round((int64_t)g->vp * (t - g->ta), hz);
+        d = g->da + cs_fixed_div_round((int64_t)g->vp * (t - g->ta), hz);
     else if (g->scurve)
         d = g->da + g->dc + scurve_dist(g->vp, g->vp - g->v1, -1, t - g->ta - g->tc, g->td, hz);
     else
@@ -227,7 +219,7 @@ static int32_t chord_steps(const cs_segment_gen_t *g, unsigned i, int64_t d)
     if (g->steps[i] == 0)
         return 0;
     if (cs_fixed_muldiv64(g->exact[i], d, g->length, &x) != CS_OK)
-        return (int32_t)div_round((int64_t)g->steps[i] * d, g->length);
+        return (int32_t)cs_fixed_div_round((int64_t)g->steps[i] * d, g->length);
     int64_t n = cs_fixed_round_shift64(g->frac0[i] + x, 16);
     int64_t lo = g->steps[i] < 0 ? g->steps[i] : 0, hi = g->steps[i] < 0 ? 0 : g->steps[i];
     return (int32_t)(n < lo ? lo : n > hi ? hi : n);

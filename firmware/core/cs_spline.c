@@ -25,11 +25,6 @@
 
 CS_STATIC_ASSERT(CS_SPLINE_MAX_POINTS >= 2, spline_holds_one_segment);
 
-static int64_t spline_coord(const cs_vec3_t *v, unsigned axis)
-{
-    return axis == 0 ? v->x : axis == 1 ? v->y : v->z;
-}
-
 /* Row i's off-diagonal coefficients (scaled by COEF): a multiplies m_i-1, c multiplies m_i+1. */
 static cs_err_t spline_row(const cs_spline_t *s, size_t i, int64_t *a, int64_t *c)
 {
@@ -59,7 +54,7 @@ static cs_err_t spline_row(const cs_spline_t *s, size_t i, int64_t *a, int64_t *
 /* Slope of span i along axis, scaled (see the file comment). */
 static cs_err_t spline_slope(const cs_spline_t *s, size_t i, unsigned axis, int64_t *out)
 {
-    int64_t d = spline_coord(&s->pts[i + 1], axis) - spline_coord(&s->pts[i], axis);
+    int64_t d = cs_fixed_vec_get(&s->pts[i + 1], axis) - cs_fixed_vec_get(&s->pts[i], axis);
     if (s->param == CS_SPLINE_UNIFORM) {
         *out = d * ((int64_t)1 << SLOPE_BITS_UNIFORM);
         return CS_OK;
@@ -68,26 +63,12 @@ static cs_err_t spline_slope(const cs_spline_t *s, size_t i, unsigned axis, int6
                              out);
 }
 
-cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
-                         cs_spline_param_t param)
+/* Span lengths h_i: 1 (uniform) or the chord |P_i+1 - P_i| with H_FRAC_BITS fraction bits. */
+static cs_err_t spline_spans(cs_spline_t *s)
 {
-    if (s == NULL || pts == NULL)
-        return CS_ERR_ARG;
-    if (param != CS_SPLINE_UNIFORM && param != CS_SPLINE_CHORD)
-        return CS_ERR_ARG;
-    s->count = 0;
-    if (count < 2)
-        return CS_ERR_DEGENERATE;
-    if (count > CS_SPLINE_MAX_POINTS)
-        return CS_ERR_FULL;
-    for (size_t i = 0; i < count; i++)
-        if (!cs_fixed_vec_ok(&pts[i]))
-            return CS_ERR_RANGE;
-    s->pts = pts;
-    s->count = count;
-    s->param = param;
-    for (size_t i = 0; i + 1 < count; i++) {
-        if (param == CS_SPLINE_UNIFORM) {
+    const cs_vec3_t *pts = s->pts;
+    for (size_t i = 0; i + 1 < s->count; i++) {
+        if (s->param == CS_SPLINE_UNIFORM) {
             s->h[i] = 1;
             continue;
         }
@@ -95,10 +76,8 @@ cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
         int64_t dx = (int64_t)pts[i + 1].x - pts[i].x, dy = (int64_t)pts[i + 1].y - pts[i].y,
                 dz = (int64_t)pts[i + 1].z - pts[i].z;
         uint64_t sq = (uint64_t)(dx * dx + dy * dy + dz * dz);
-        if (sq == 0) {
-            s->count = 0;
+        if (sq == 0)
             return CS_ERR_DEGENERATE;
-        }
         /* |d| in LSB with H_FRAC_BITS fraction bits: scale sq by 4^k as far as 64 bits allow
          * (k <= 16), so the root keeps >= 31 significant bits whenever |d| >= 2^15 LSB; a
          * rounding of h changes the slope by the same relative amount, which the neighbouring
@@ -112,9 +91,13 @@ cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
             r++;
         s->h[i] = r << (H_FRAC_BITS - k);
     }
-    const size_t n = count - 1;
+    return CS_OK;
+}
+
+/* Right-hand sides of the tridiagonal system, per axis, into m[][]. */
+static cs_err_t spline_rhs(cs_spline_t *s, size_t n)
+{
     cs_err_t e = CS_OK;
-    /* Right-hand sides, per axis, into m[][]. */
     for (unsigned axis = 0; axis < 3 && e == CS_OK; axis++) {
         int64_t prev = 0, cur = 0;
         for (size_t i = 0; i <= n && e == CS_OK; i++) {
@@ -139,7 +122,13 @@ cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
             prev = cur;
         }
     }
-    /* Forward elimination: piv_i = 2 - a_i c_i-1 / piv_i-1, d_i -= a_i d_i-1 / piv_i-1. */
+    return e;
+}
+
+/* Forward elimination: piv_i = 2 - a_i c_i-1 / piv_i-1, d_i -= a_i d_i-1 / piv_i-1. */
+static cs_err_t spline_eliminate(cs_spline_t *s, size_t n)
+{
+    cs_err_t e = CS_OK;
     s->piv[0] = 2 * COEF;
     int64_t c_prev = COEF;
     for (size_t i = 1; i <= n && e == CS_OK; i++) {
@@ -157,7 +146,13 @@ cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
         }
         c_prev = c;
     }
-    /* Back substitution: m_n = d_n / piv_n, m_i = (d_i - c_i m_i+1) / piv_i. */
+    return e;
+}
+
+/* Back substitution: m_n = d_n / piv_n, m_i = (d_i - c_i m_i+1) / piv_i. */
+static cs_err_t spline_back(cs_spline_t *s, size_t n)
+{
+    cs_err_t e = CS_OK;
     for (unsigned axis = 0; axis < 3 && e == CS_OK; axis++) {
         e = cs_fixed_muldiv64(s->m[n][axis], COEF, s->piv[n], &s->m[n][axis]);
         for (size_t k = n; k-- > 0 && e == CS_OK;) {
@@ -169,8 +164,36 @@ cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
                 e = cs_fixed_muldiv64(s->m[k][axis] - t, COEF, s->piv[k], &s->m[k][axis]);
         }
     }
+    return e;
+}
+
+cs_err_t cs_spline_solve(cs_spline_t *s, const cs_vec3_t *pts, size_t count,
+                         cs_spline_param_t param)
+{
+    if (s == NULL || pts == NULL)
+        return CS_ERR_ARG;
+    if (param != CS_SPLINE_UNIFORM && param != CS_SPLINE_CHORD)
+        return CS_ERR_ARG;
+    s->count = 0;
+    if (count < 2)
+        return CS_ERR_DEGENERATE;
+    if (count > CS_SPLINE_MAX_POINTS)
+        return CS_ERR_FULL;
+    for (size_t i = 0; i < count; i++)
+        if (!cs_fixed_vec_ok(&pts[i]))
+            return CS_ERR_RANGE;
+    s->pts = pts;
+    s->count = count;
+    s->param = param;
+    cs_err_t e = spline_spans(s);
+    if (e == CS_OK)
+        e = spline_rhs(s, count - 1);
+    if (e == CS_OK)
+        e = spline_eliminate(s, count - 1);
+    if (e == CS_OK)
+        e = spline_back(s, count - 1);
     if (e != CS_OK)
-        s->count = 0; /* cannot happen within the stated bounds; never leave half a solve */
+        s->count = 0; /* degenerate span, or (never within the stated bounds) an overflow */
     return e;
 }
 
@@ -200,8 +223,8 @@ cs_err_t cs_spline_segment(const cs_spline_t *s, size_t index, cs_bezier_t *out)
             e = cs_fixed_muldiv64(s->m[index + 1][axis], h, div, &t2);
         if (e != CS_OK)
             return e;
-        int64_t v1 = spline_coord(&s->pts[index], axis) + t1;
-        int64_t v2 = spline_coord(&s->pts[index + 1], axis) - t2;
+        int64_t v1 = cs_fixed_vec_get(&s->pts[index], axis) + t1;
+        int64_t v2 = cs_fixed_vec_get(&s->pts[index + 1], axis) - t2;
         if (!cs_fixed_pos_ok(v1) || !cs_fixed_pos_ok(v2))
             return CS_ERR_RANGE;
         in1[axis] = (int32_t)v1;

@@ -15,19 +15,6 @@ CS_STATIC_ASSERT(sizeof(cs_subdiv_hcurve_t) == 32 * CS_BEZIER_MAX_POINTS, hcurve
 /* thr <= 2 * CS_SUBDIV_TOL_MAX keeps thr^2 < 2^62 (see cs_subdiv_dist_ok). */
 CS_STATIC_ASSERT(CS_SUBDIV_TOL_MAX <= ((int32_t)1 << 29), tol_max_fits_thr_squared);
 
-static cs_err_t check_curve(const cs_bezier_t *c)
-{
-    if (c->degree < 1 || c->degree > CS_BEZIER_MAX_DEGREE)
-        return CS_ERR_DEGREE;
-    for (unsigned i = 0; i <= c->degree; i++) {
-        if (!cs_fixed_vec_ok(&c->p[i]))
-            return CS_ERR_RANGE;
-        if (c->rational && (c->w[i] < CS_WEIGHT_MIN || c->w[i] > CS_WEIGHT_ONE))
-            return CS_ERR_WEIGHT;
-    }
-    return CS_OK;
-}
-
 void cs_subdiv_to_homogeneous(const cs_bezier_t *c, cs_subdiv_hcurve_t *h)
 {
     for (unsigned i = 0; i <= c->degree; i++) {
@@ -196,7 +183,7 @@ cs_err_t cs_subdiv_reach_begin(cs_subdiv_reach_t *s, const cs_bezier_t *c, cs_po
     s->done = true;
     if (tol < CS_SUBDIV_TOL_MIN || tol > CS_SUBDIV_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    cs_err_t e = check_curve(c);
+    cs_err_t e = cs_bezier_check(c);
     if (e != CS_OK)
         return e;
     s->degree = c->degree;
@@ -335,7 +322,7 @@ cs_err_t cs_subdiv_next(cs_subdiv_t *s, cs_vec3_t *pt)
 
 bool cs_subdiv_is_flat(const cs_bezier_t *c, cs_pos_t tol)
 {
-    if (tol < CS_SUBDIV_TOL_MIN || tol > CS_SUBDIV_TOL_MAX || check_curve(c) != CS_OK)
+    if (tol < CS_SUBDIV_TOL_MIN || tol > CS_SUBDIV_TOL_MAX || cs_bezier_check(c) != CS_OK)
         return false;
     cs_subdiv_hcurve_t h;
     cs_subdiv_to_homogeneous(c, &h);

@@ -17,21 +17,6 @@ unsigned cs_tripatch_index(unsigned n, unsigned i, unsigned j)
     return i * (n + 1) - (i * (i - 1)) / 2 + j;
 }
 
-static int32_t coord(const cs_vec3_t *p, unsigned a)
-{
-    return a == 0 ? p->x : a == 1 ? p->y : p->z;
-}
-
-static void set_coord(cs_vec3_t *p, unsigned a, int32_t v)
-{
-    if (a == 0)
-        p->x = v;
-    else if (a == 1)
-        p->y = v;
-    else
-        p->z = v;
-}
-
 cs_err_t cs_tripatch_init(cs_tripatch_t *t, unsigned degree, const cs_vec3_t *pts)
 {
     if (!t || !pts)
@@ -62,7 +47,7 @@ static int64_t blossom(const cs_tripatch_t *t, unsigned a, const cs_param_t (*uv
     unsigned n = t->degree;
     int64_t b[CS_TRIPATCH_MAX_POINTS];
     for (unsigned k = 0; k < (n + 1) * (n + 2) / 2; k++)
-        b[k] = (int64_t)coord(&t->p[k], a) * ((int64_t)1 << GUARD);
+        b[k] = (int64_t)cs_fixed_vec_get(&t->p[k], a) * ((int64_t)1 << GUARD);
     for (unsigned r = 0; r < n; r++) {
         unsigned m = n - r; /* current degree */
         cs_param_t u = uv[r][0], v = uv[r][1];
@@ -87,7 +72,7 @@ static cs_err_t to_point(const cs_tripatch_t *t, const cs_param_t (*uv)[2], cs_v
         int32_t c;
         if (cs_fixed_narrow(cs_fixed_round_shift64(blossom(t, a, uv), GUARD), &c) != CS_OK)
             return CS_ERR_OVERFLOW;
-        set_coord(&r, a, c);
+        cs_fixed_vec_set(&r, a, c);
     }
     *out = r;
     return CS_OK;

@@ -156,7 +156,9 @@ timeout --foreground -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-r
     --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
-sleep 2
+# interrupt once the image has executed something (an event, not a guess of how long that takes
+# on a loaded machine): the host's progress line names executed segments
+wait_until 120 grep -q '^stream: [1-9][0-9]*/' "$T/int.err"
 kill -INT "$spid"
 wait "$spid"
 rc=$?

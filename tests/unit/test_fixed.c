@@ -393,10 +393,96 @@ static void test_binom(void **state)
     assert_int_equal(cs_fixed_binom(CS_FIXED_BINOM_MAX + 1, 1), 0);
 }
 
+/* cs_fixed_div_round against long double rounding half away from zero (ties built exactly). */
+static void test_div_round(void **state)
+{
+    (void)state;
+    uint64_t r = 0x9e3779b97f4a7c15ull;
+    for (int i = 0; i < 20000; i++) {
+        r = r * 6364136223846793005ull + 1442695040888963407ull;
+        int64_t n = (int64_t)(r >> 3) >> (r & 31);
+        if (r & 64)
+            n = -n;
+        int64_t d = (int64_t)((r >> 40) % 100000u) + 1;
+        i128 q = (i128)n / d, rem = (i128)n % d; /* truncated */
+        i128 twice = rem < 0 ? -2 * rem : 2 * rem;
+        if (twice >= d)
+            q += n < 0 ? -1 : 1;
+        assert_true(cs_fixed_div_round(n, d) == (int64_t)q);
+    }
+    assert_int_equal(cs_fixed_div_round(5, 2), 3);
+    assert_int_equal(cs_fixed_div_round(-5, 2), -3);
+    assert_int_equal(cs_fixed_div_round(-4, 3), -1);
+    assert_int_equal(cs_fixed_div_round(7, 1), 7);
+}
+
+/* Bit length against the position of the highest set bit, every power of two and its neighbours. */
+static void test_bitlen64(void **state)
+{
+    (void)state;
+    assert_int_equal(cs_fixed_bitlen64(0), 0);
+    for (unsigned b = 0; b < 64; b++) {
+        uint64_t v = (uint64_t)1 << b;
+        assert_int_equal(cs_fixed_bitlen64(v), b + 1);
+        assert_int_equal(cs_fixed_bitlen64(v | (v - 1)), b + 1);
+        if (b > 0)
+            assert_int_equal(cs_fixed_bitlen64(v - 1), b);
+    }
+}
+
+/* The 3-vector accessor reads and writes the named field and no other. */
+static void test_vec_access(void **state)
+{
+    (void)state;
+    cs_vec3_t p = {1, -2, 3};
+    assert_int_equal(cs_fixed_vec_get(&p, 0), 1);
+    assert_int_equal(cs_fixed_vec_get(&p, 1), -2);
+    assert_int_equal(cs_fixed_vec_get(&p, 2), 3);
+    cs_fixed_vec_set(&p, 1, 77);
+    assert_int_equal(p.x, 1);
+    assert_int_equal(p.y, 77);
+    assert_int_equal(p.z, 3);
+    cs_fixed_vec_set(&p, 2, -9);
+    cs_fixed_vec_set(&p, 0, 5);
+    assert_int_equal(p.x, 5);
+    assert_int_equal(p.z, -9);
+}
+
+static i128 from_pair(cs_i128_t a)
+{
+    return (i128)(((u128)a.hi << 64) | a.lo);
+}
+
+/* 128-bit add/sub/neg/mul/shift against __int128 on random values below 2^120. */
+static void test_i128(void **state)
+{
+    (void)state;
+    uint64_t r = 12345;
+    for (int i = 0; i < 20000; i++) {
+        r = r * 6364136223846793005ull + 1442695040888963407ull;
+        int64_t a64 = (int64_t)r;
+        r = r * 6364136223846793005ull + 1442695040888963407ull;
+        int64_t b64 = (int64_t)r >> (r & 15);
+        cs_i128_t a = cs_fixed_i128_from64(a64), b = cs_fixed_i128_from64(b64);
+        assert_true(from_pair(a) == (i128)a64);
+        assert_true(from_pair(cs_fixed_i128_add(a, b)) == (i128)a64 + b64);
+        assert_true(from_pair(cs_fixed_i128_sub(a, b)) == (i128)a64 - b64);
+        assert_true(from_pair(cs_fixed_i128_neg(a)) == -(i128)a64);
+        assert_true(cs_fixed_i128_is_neg(a) == (a64 < 0));
+        uint64_t m = (r >> 8) & 0xffffffffffffull; /* < 2^48: |a * m| < 2^111 */
+        assert_true(from_pair(cs_fixed_i128_mul_u64(a, m)) == (i128)a64 * (i128)m);
+        cs_i128_t big = cs_fixed_i128_mul_u64(cs_fixed_i128_from64(a64 < 0 ? -(a64 / 2) : a64), m);
+        unsigned s = 1u + (unsigned)(r % 127u);
+        assert_true((u128)from_pair(cs_fixed_u128_shr(big, s)) == ((u128)from_pair(big) >> s));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_binom),
+        cmocka_unit_test(test_binom),       cmocka_unit_test(test_div_round),
+        cmocka_unit_test(test_bitlen64),    cmocka_unit_test(test_vec_access),
+        cmocka_unit_test(test_i128),
         cmocka_unit_test(test_add_sub),     cmocka_unit_test(test_narrow),
         cmocka_unit_test(test_round_shift), cmocka_unit_test(test_mul_shift),
         cmocka_unit_test(test_div_shift),   cmocka_unit_test(test_isqrt64),
