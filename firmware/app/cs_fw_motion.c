@@ -49,12 +49,12 @@ static bool item_after(uint32_t x, uint32_t y)
     return (int32_t)(x - y) > 0;
 }
 
-/* The item a 16-bit tag names: the one within 2^15 of the last executed (items in flight are a
- * ring and a planner of segments ahead, far fewer). */
-static uint32_t tag_item(const cs_fw_motion_t *a, uint16_t tag)
+/* The item an 8-bit tag names: the one within 2^7 of the last executed (items in flight are
+ * fewer than CS_FW_SEQMAP <= 128). */
+static uint32_t tag_item(const cs_fw_motion_t *a, uint8_t tag)
 {
-    uint16_t d = (uint16_t)(tag - (uint16_t)a->exec_item);
-    return d < 0x8000u ? a->exec_item + d : a->exec_item - (uint32_t)(0x10000u - d);
+    uint8_t d = (uint8_t)(tag - (uint8_t)a->exec_item);
+    return d < 0x80u ? a->exec_item + d : a->exec_item - (uint32_t)(0x100u - d);
 }
 
 static void mark_executed(cs_fw_motion_t *a, uint32_t item)
@@ -244,7 +244,7 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     bool was_idle = cs_stepper_idle(&a->st);
     cs_err_t e = cs_stepper_push(&a->st, s);
     if (e == CS_OK) {
-        a->tag[a->pushed & TAG_MASK] = (uint16_t)done;
+        a->tag[a->pushed & TAG_MASK] = (uint8_t)done;
         a->pushed++;
         if (was_idle)
             port_timer_arm(1);

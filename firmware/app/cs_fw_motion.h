@@ -55,6 +55,9 @@ CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_tw
 /* Segment tags: a power of two above the segments in flight (the ring and the running one). */
 #define CS_FW_TAGS (2 * CS_STEPPER_RING)
 CS_STATIC_ASSERT(CS_FW_TAGS >= CS_STEPPER_RING + 1 && CS_FW_TAGS <= 256, fw_tags_room);
+/* 8-bit tags name an item within 2^7 of the last executed: items in flight stay below
+ * CS_FW_SEQMAP (the sequence map relies on it too). */
+CS_STATIC_ASSERT(CS_FW_SEQMAP <= 128, fw_tags_8_bits);
 CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
 CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
 
@@ -102,7 +105,7 @@ typedef struct {
     /* item executed once segment k has run: one per segment in flight, which is the ring's
      * CS_STEPPER_RING plus the one running (a ring of only CS_STEPPER_RING tags had the newest
      * overwrite the running segment's, counting up to a ring of items executed early) */
-    uint16_t tag[CS_FW_TAGS]; /* low 16 bits (items in flight are within 2^15 of exec_item) */
+    uint8_t tag[CS_FW_TAGS]; /* low 8 bits (items in flight: fewer than CS_FW_SEQMAP <= 128) */
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
     cs_segment_t pend; /* produced, held back by a hold at rest */
