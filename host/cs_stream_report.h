@@ -23,7 +23,8 @@ int cs_stream_report(FILE *out, const char *where, const cs_stream_job_t *job,
 void cs_stream_report_counts(FILE *out, size_t executed, size_t n, size_t delivered, size_t sent,
                              const char *what);
 /* "stream: to continue once the machine is where ONE no. E left it: ..." (one: "segment" or
- * "curve"). */
+ * "curve"): the hint of links whose device does not number the job (Modbus, GPIO); a serial
+ * run the device numbered gets cs_stream_resume_hint instead. */
 void cs_stream_report_resume(FILE *out, const char *one, size_t executed);
 
 #endif
