@@ -112,6 +112,21 @@ static int parse_count(const char *s, unsigned long long max, unsigned long long
     return 0;
 }
 
+/* --resume, --resume-from and --position together: true (said on stderr) when they clash. */
+static bool resume_opts_bad(bool serial, bool ask, bool from, bool pos)
+{
+    const char *why = (ask || pos) && !serial
+                          ? "--resume and --position need --port (the serial protocol; "
+                            "docs/streaming.md, Resume)"
+                      : ask && (from || pos) ? "--resume asks the device where to go on: it takes "
+                                               "neither --resume-from nor --position"
+                      : pos && !from ? "--position needs --resume-from N"
+                                     : NULL;
+    if (why != NULL)
+        fprintf(stderr, "curvestep stream: %s\n", why);
+    return why != NULL;
+}
+
 /* --position X,Y,Z in steps; in segments mode it must be where message n left the machine
  * (the segments are relative moves: from anywhere else the rest of the job would be offset). */
 static int check_position(const char *text, const cs_machine_t *m, const cs_stream_job_t *job,
@@ -237,20 +252,8 @@ int cs_cmd_stream(int argc, char **argv)
         usage(stderr);
         return CS_EXIT_USAGE;
     }
-    if ((resume_ask || position != NULL) && port == NULL) {
-        fprintf(stderr, "curvestep stream: --resume and --position need --port (the serial "
-                        "protocol; docs/streaming.md, Resume)\n");
+    if (resume_opts_bad(port != NULL, resume_ask, resume != 0, position != NULL))
         return CS_EXIT_USAGE;
-    }
-    if (resume_ask && (resume != 0 || position != NULL)) {
-        fprintf(stderr, "curvestep stream: --resume asks the device where to go on: it takes "
-                        "neither --resume-from nor --position\n");
-        return CS_EXIT_USAGE;
-    }
-    if (position != NULL && resume == 0) {
-        fprintf(stderr, "curvestep stream: --position needs --resume-from N\n");
-        return CS_EXIT_USAGE;
-    }
     if (parity != 0 && mb_rtu == NULL) {
         fprintf(stderr, "curvestep stream: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;

@@ -47,7 +47,7 @@ static void outcome_line(FILE *out, const char *where, const cs_stream_result_t 
     fprintf(out, "stream: %s: %s", where, cs_stream_outcome_text(r->outcome));
     if (r->why[0] && r->outcome != CS_STREAM_DEVICE_ERROR)
         fprintf(out, " (%s)", r->why);
-    if (r->outcome == CS_STREAM_RESET)
+    if (r->outcome == CS_STREAM_RESET && r->new_boot != 0) /* 0: a resume refused at the start */
         fprintf(out, " (boot id %08x -> %08x; %u messages were in flight)", (unsigned)r->old_boot,
                 (unsigned)r->new_boot, (unsigned)r->unacked);
     if (r->outcome == CS_STREAM_DEVICE_ERROR)

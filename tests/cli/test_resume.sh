@@ -70,6 +70,25 @@ REF_POS=$(final_pos "$T/ref.sim")
 expect "reference run: log sums to the end" [ "$(log_pos "$T/ref.log")" = "$REF_POS" ]
 REF_SHA=$(sha256sum <"$T/ref.log" | cut -d' ' -f1)
 
+# the options' rules, before any device: refused as usage (exit 2)
+run "usage: --resume with --resume-from" 2 stream --port /dev/null --resume --resume-from 5 "$JOB"
+expect_err "usage: --resume takes no number" 'takes neither --resume-from nor --position'
+run "usage: --position alone" 2 stream --port /dev/null --position 1,2,0 "$JOB"
+expect_err "usage: --position needs --resume-from" 'needs --resume-from'
+run "usage: --resume over Modbus" 2 stream --modbus-tcp 127.0.0.1:1 --resume "$JOB"
+expect_err "usage: serial only" 'need --port'
+run "usage: --position with a missing axis" 2 stream "${M[@]}" --port /dev/null --resume-from 100 --position 1,2 "$JOB"
+# segments mode: the stated position must be where message 100 leaves the machine (the sum of
+# the uninterrupted run's first 100 segments); one step off is refused naming it, the exact one
+# passes the check (then no device answers on /dev/null: exit 4)
+head -n 100 "$T/ref.log" >"$T/first100.log"
+read -r px py pz <<<"$(log_pos "$T/first100.log")"
+at100=$(awk -v x="$px" -v y="$py" -v z="$pz" 'BEGIN {printf "%.4f,%.4f,%.4f", x / 80, y / 80, z / 80}')
+off100=$(awk -v x="$px" -v y="$py" -v z="$pz" 'BEGIN {printf "%.4f,%.4f,%.4f", (x + 1) / 80, y / 80, z / 80}')
+run "--position one step off message 100's end" 2 stream "${M[@]}" --port /dev/null --resume-from 100 --position "$off100" "$JOB"
+expect_err "names where message 100 left the machine" "message 100 left the machine at x = $(awk -v x="$px" 'BEGIN {printf "%.4f", x / 80}') mm \\($px steps\\)"
+run "--position at message 100's end passes the check" 4 stream "${M[@]}" --port /dev/null --resume-from 100 --position "$at100" "$JOB"
+
 kinds=(dev-TERM dev-KILL dev-close host-KILL host-TERM)
 exact=0 doubled=0 t_start=$(date +%s)
 for i in $(seq 1 "$TRIALS"); do
