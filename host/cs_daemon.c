@@ -1,7 +1,9 @@
 /* cs_daemon: a single-threaded server (poll on the listening socket, the clients and the running
- * job's progress pipe). A job runs in a child process that inherits the open port and calls
- * cs_stream_run: SIGUSR1 holds it (HOLD), SIGUSR2 resumes it (RESUME), SIGTERM cancels it (HOLD
- * then ABORT). The child writes cs_stream's progress lines and a final RESULT line to a pipe. */
+ * job's progress pipe). A job runs in a child process that inherits the open port (or opens its
+ * link itself) and runs the job through cs_joblink: SIGUSR1 holds it (pause), SIGUSR2 resumes
+ * it, SIGTERM cancels it (hold, then abort). The child writes the link's progress lines (and
+ * "stream: device held ..." once a pause's hold is confirmed) and a final RESULT line to a
+ * pipe. */
 #include "cs_daemon.h"
 
 #include <errno.h>
@@ -22,10 +24,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cs_cmd.h"
 #include "cs_conv.h"
-#include "cs_daemon_link.h"
 #include "cs_dsock.h"
 #include "cs_err_text.h"
+#include "cs_joblink.h"
 #include "cs_jobplan.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
@@ -53,6 +56,7 @@ typedef struct {
     job_state_t state;
     size_t executed;
     size_t n;
+    bool held;     /* the link confirmed the pause's hold (a "device held" line) */
     char end[200]; /* how it ended */
 } djob_t;
 
@@ -67,7 +71,7 @@ typedef struct {
     const cs_daemon_cfg_t *cfg;
     cs_machine_t m;
     cs_machine_pen_t pen; /* [pen]: G-code M3/M4/M5 as Z moves, as `stream` does */
-    cs_serial_t ser;
+    cs_joblink_t link;    /* a keep_open link (serial) is open while serving */
     djob_t *jobs;
     size_t njobs, cap;
     unsigned next_id;
@@ -291,8 +295,14 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     }
     cs_err_t e = cs_jobplan_plan(jp, file, &d->m, start_steps != NULL ? start : NULL, tol,
                                  CS_TRACE_DEFAULT, feed_q);
+    if (e == CS_OK && curves && !d->link.ops->curves) {
+        snprintf(err, errcap, "mode=curves: the %s link runs the step segments planned here",
+                 d->link.ops->kind);
+        cs_stream_job_free(job);
+        return false;
+    }
     if (e == CS_OK)
-        e = cs_jobplan_linkable(jp, file, d->cfg->port != NULL, curves);
+        e = cs_jobplan_linkable(jp, file, d->link.ops->pens, curves);
     if (e == CS_OK)
         e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
                                             tol, &jp->diag)
@@ -402,15 +412,14 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
 
 static void req_status(daemon_t *d, FILE *out)
 {
-    fprintf(out, "OK device %s, queue %s\n", cs_daemon_link_name(d->cfg),
-            d->paused ? "paused" : "running");
+    fprintf(out, "OK device %s, queue %s\n", d->link.name, d->paused ? "paused" : "running");
     for (size_t i = 0; i < d->njobs; i++) {
         const djob_t *j = &d->jobs[i];
         const char *what = j->job.mode == CS_STREAM_CURVES ? "curves" : "segments";
         fprintf(out, "job %u %s: %s: %zu/%zu %s executed", j->id, state_names[j->state], j->path,
                 j->executed, j->n, what);
         if (j->state == JOB_RUNNING && d->paused)
-            fprintf(out, " (held)");
+            fprintf(out, j->held ? " (held)" : " (holding)");
         if (j->end[0] != '\0')
             fprintf(out, " (%s)", j->end);
         fputc('\n', out);
@@ -474,8 +483,10 @@ static void handle_request(daemon_t *d, char *line, FILE *out)
         dlog(d, "paused");
     } else if (strcmp(line, "RESUME") == 0) {
         d->paused = false;
-        if (d->running != SIZE_MAX)
+        if (d->running != SIZE_MAX) {
             kill(d->child, SIGUSR2);
+            d->jobs[d->running].held = false;
+        }
         fprintf(out, "OK resumed\n");
         dlog(d, "resumed");
     } else if (strcmp(line, "CANCEL") == 0 || strncmp(line, "CANCEL ", 7) == 0) {
@@ -487,6 +498,8 @@ static void handle_request(daemon_t *d, char *line, FILE *out)
 
 /* ---- running a job ---- */
 
+/* The job's process: the signals as the link's controls, the link opened (unless the daemon
+ * keeps it open), the job run from the device's position, the RESULT line. Never returns. */
 static void child_run(daemon_t *d, djob_t *j, int wfd)
 {
     struct sigaction sa;
@@ -505,14 +518,27 @@ static void child_run(daemon_t *d, djob_t *j, int wfd)
     if (f == NULL)
         _exit(3);
     cs_stream_result_t r;
-    cs_err_t e =
-        cs_daemon_link_run(d->cfg, &d->ser, &d->m, &j->job, &child_interrupt, &child_pause, f, &r);
+    memset(&r, 0, sizeof r);
+    cs_joblink_job_t jj = {&d->m, &j->job, NULL, 0, 0, d->have_pos ? d->dev_pos : NULL, false,
+                           NULL};
+    cs_joblink_ctl_t c = {&child_interrupt, &child_pause, f, false};
+    cs_err_t e = CS_OK;
+    int orc = d->link.ops->keep_open ? CS_EXIT_OK : cs_joblink_open(&d->link, &jj);
+    if (orc != CS_EXIT_OK) { /* the device is not there: as a link that never answered */
+        r.outcome = CS_STREAM_NO_DEVICE;
+        r.dev_state = 0xFF;
+        snprintf(r.why, sizeof r.why, "%.159s", d->link.why);
+    } else {
+        e = cs_joblink_run(&d->link, &jj, &c, &r);
+    }
+    if (!d->link.ops->keep_open)
+        cs_joblink_close(&d->link, 0);
     if (e != CS_OK)
         fprintf(f, "RESULT -1 %zu %s\n", r.executed, cs_err_text(e));
     else
         fprintf(f, "RESULT %d %zu %d %ld %ld %ld %ld %s%s%s%s\n", (int)r.outcome, r.executed,
                 r.dev_state != 0xFF, (long)r.dev_pos[0], (long)r.dev_pos[1], (long)r.dev_pos[2],
-                (long)r.dev_pos[3], cs_stream_outcome_text(r.outcome), r.why[0] ? " (" : "", r.why,
+                (long)r.dev_pos[3], cs_stream_result_text(&r), r.why[0] ? " (" : "", r.why,
                 r.why[0] ? ")" : "");
     fflush(f);
     _exit(0);
@@ -598,6 +624,9 @@ static void child_line(daemon_t *d, const char *line)
     int pos = 0;
     if (sscanf(line, "stream: %zu/%zu", &ex, &n) == 2) {
         j->executed = ex;
+    } else if (sscanf(line, "stream: device held at %zu of %zu", &ex, &n) == 2) {
+        j->executed = ex;
+        j->held = d->paused;
     } else if (sscanf(line, "RESULT %d %zu %d %ld %ld %ld %ld %n", &oc, &ex, &have, &p[0], &p[1],
                       &p[2], &p[3], &pos) == 7) {
         j->executed = ex;
@@ -821,13 +850,20 @@ static int serve_setup(daemon_t *d)
         fprintf(stderr, "%s\n", err);
         return 1;
     }
-    if (cs_daemon_link_open(cfg, &d->ser) != 0) {
-        fprintf(stderr, "curvestep serve: %s: %s\n", cfg->port, strerror(errno));
-        return 4;
+    if (cs_joblink_select(&d->link, &cfg->link) != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep serve: %s\n", d->link.why);
+        return CS_EXIT_USAGE;
+    }
+    d->link.cfg.machine_file = cfg->machine_file;
+    int orc = d->link.ops->keep_open ? cs_joblink_open(&d->link, NULL) : CS_EXIT_OK;
+    if (orc != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep serve: %s\n", d->link.why);
+        return orc;
     }
     d->listen_fd = open_socket(cfg->socket_path);
     if (d->listen_fd < 0) {
-        cs_serial_close(&d->ser);
+        if (d->link.ops->keep_open)
+            cs_joblink_close(&d->link, 0);
         return 3;
     }
     return 0;
@@ -856,7 +892,7 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
     sigaction(SIGINT, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     stop_serving = 0;
-    dlog(d, "serving %s on %s", cs_daemon_link_name(cfg), cfg->socket_path);
+    dlog(d, "serving %s on %s", d->link.name, cfg->socket_path);
     bool told_child = false;
     while (!(stop_serving && d->running == SIZE_MAX)) {
         if (stop_serving && d->running != SIZE_MAX && !told_child) {
@@ -917,7 +953,8 @@ int cs_daemon_serve(const cs_daemon_cfg_t *cfg)
             client_close(&d->clients[k]);
     close(lfd);
     unlink(cfg->socket_path);
-    cs_serial_close(&d->ser);
+    if (d->link.ops->keep_open)
+        cs_joblink_close(&d->link, 0);
     for (size_t i = 0; i < d->njobs; i++) {
         if (d->jobs[i].state == JOB_QUEUED)
             job_release(&d->jobs[i]);

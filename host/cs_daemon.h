@@ -1,5 +1,5 @@
 /* cs_daemon: the streaming daemon (`curvestep serve`) and its client side. The daemon keeps one
- * link (a serial port kept open, or a Modbus TCP/RTU device: cs_daemon_link), reads every
+ * link (cs_joblink: a serial port kept open, a Modbus TCP/RTU device or GPIO lines), reads every
  * submitted job once (regular files only) and plans it whole at submit time, and streams the jobs
  * one at a time (each in a child process running the link's stream); clients talk to it over a
  * UNIX socket (mode 0600, in a directory of its own: cs_dsock) with the one-line text protocol of
@@ -12,6 +12,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "cs_joblink.h"
+
 /* How long a client waits for the daemon's reply, in seconds. */
 #define CS_DAEMON_REPLY_S 600
 
@@ -19,13 +21,9 @@
 #define CS_DAEMON_LINE_MAX 4400
 
 typedef struct {
-    /* the link: exactly one of port, modbus_tcp, modbus_rtu (cs_daemon_link) */
-    const char *port;         /* serial device, opened once and kept open */
-    const char *modbus_tcp;   /* HOST:PORT of a Modbus TCP device (a connection a job) */
-    const char *modbus_rtu;   /* a Modbus RTU device's serial line (opened a job) */
-    char parity;              /* Modbus RTU: 'E' (0: E), 'O' or 'N' */
-    int unit;                 /* Modbus unit id */
-    uint32_t baud;            /* termios rate (serial and Modbus RTU) */
+    /* the link, exactly one (a serial port is opened once and kept open; a Modbus connection
+     * and the GPIO lines are opened for each job); link.machine_file is set from machine_file */
+    cs_joblink_cfg_t link;
     const char *socket_path;  /* UNIX socket to create (0600); removed on exit */
     const char *machine_file; /* NULL: the built-in machine */
     FILE *log;                /* one line per event (job queued, started, ended); NULL: none */
@@ -33,8 +31,8 @@ typedef struct {
 } cs_daemon_cfg_t;
 
 /* Runs the daemon until SIGTERM or SIGINT (the running job is then held and aborted). Returns an
- * exit status: 0 after a clean stop, 1 bad machine file, 3 socket error (or a daemon already
- * answers on the socket), 4 the port cannot be opened. Not reentrant (installs signal handlers). */
+ * exit status: 0 after a clean stop, 1 bad machine file, 2 no link or two, 3 socket error (or a
+ * daemon already answers on the socket), 4 the port cannot be opened. Not reentrant (installs signal handlers). */
 int cs_daemon_serve(const cs_daemon_cfg_t *cfg);
 
 /* The default socket path (cs_dsock_default): $XDG_RUNTIME_DIR/curvestep/curvestep.sock, else

@@ -8,9 +8,9 @@
 
 #include "cs_cmd.h"
 #include "cs_daemon.h"
+#include "cs_joblink.h"
 #include "cs_jobopts.h"
 #include "cs_readall.h"
-#include "cs_serial.h"
 
 /* Exit status of the clients beyond the shared ones: no daemon answers on the socket. */
 enum { EXIT_NO_DAEMON = 4 };
@@ -20,18 +20,23 @@ static void serve_usage(FILE *f)
     char sock[256];
     fprintf(f,
             "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
+            "                       | --gpio CHIP\n"
             "                       [--baud N] [--parity none|even|odd] [--unit ID]\n"
             "                       [--machine FILE.ini] [--socket PATH] [--max-input-mb N]\n"
             "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
             "came (as `curvestep stream` does: read once and planned whole at submit time, then\n"
-            "streamed with the protocol of docs/protocol.md, or over Modbus as in\n"
-            "docs/modbus.md). Clients talk to it on the UNIX socket PATH, created with mode 0600\n"
-            "(owner only): curvestep submit, status, pause, resume, cancel. One line per event\n"
-            "on standard error.\n"
+            "streamed with the protocol of docs/protocol.md, over Modbus as in docs/modbus.md,\n"
+            "or run here on GPIO lines as in docs/gpio.md). Clients talk to it on the UNIX\n"
+            "socket PATH, created with mode 0600 (owner only): curvestep submit, status, pause,\n"
+            "resume, cancel. One line per event on standard error.\n"
             "SIGTERM or SIGINT stops it: the running job is held, then aborted.\n"
             "  --port DEV      serial device, kept open (one link is required)\n"
             "  --modbus-tcp HOST:PORT  a Modbus TCP device (connected for each job)\n"
             "  --modbus-rtu DEV        a Modbus RTU device on serial line DEV (opened each job)\n"
+            "  --gpio CHIP     the step/dir lines of GPIO chip CHIP, wired as the machine\n"
+            "                  file's [gpio] section says (requested for each job);\n"
+            "                  --gpio record:FILE runs on no hardware and writes each job's\n"
+            "                  edges to FILE (docs/gpio.md)\n"
             "  --baud N        line speed of --port and --modbus-rtu (default 115200)\n"
             "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
             "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
@@ -47,80 +52,64 @@ static void serve_usage(FILE *f)
             cs_daemon_default_socket(sock, sizeof sock));
 }
 
-static int parse_baud(const char *s, uint32_t *out)
+/* serve's own options (the link's are cs_joblink_option's): 1 taken, 0 not one, -1 bad. */
+static int serve_option(int argc, char **argv, int *i, cs_daemon_cfg_t *cfg)
 {
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (*s == '\0' || *s == '-' || *end != '\0' || errno != 0 || v > 4000000 ||
-        !cs_serial_baud_ok((uint32_t)v))
-        return -1;
-    *out = (uint32_t)v;
-    return 0;
+    const char *a = argv[*i];
+    if (*i + 1 >= argc)
+        return 0;
+    if (strcmp(a, "--socket") == 0) {
+        cfg->socket_path = argv[++*i];
+    } else if (strcmp(a, "--machine") == 0) {
+        cfg->machine_file = argv[++*i];
+    } else if (strcmp(a, "--max-input-mb") == 0) {
+        if (!cs_readall_parse_mb(argv[++*i], &cfg->max_input_bytes)) {
+            fprintf(stderr,
+                    "curvestep serve: --max-input-mb wants a whole number of MiB, 1 to %u\n",
+                    CS_READALL_MAX_MB);
+            return -1;
+        }
+    } else {
+        return 0;
+    }
+    return 1;
 }
 
 int cs_cmd_serve(int argc, char **argv)
 {
     char sock[256];
-    cs_daemon_cfg_t cfg = {.baud = 115200, .unit = 1, .log = stderr};
+    cs_daemon_cfg_t cfg = {.link = {.baud = 115200, .unit = 1}, .log = stderr};
     cfg.socket_path = cs_daemon_default_socket(sock, sizeof sock);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool has = i + 1 < argc;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             serve_usage(stdout);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--port") == 0 && has) {
-            cfg.port = argv[++i];
-        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
-            cfg.modbus_tcp = argv[++i];
-        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
-            cfg.modbus_rtu = argv[++i];
-        } else if (strcmp(a, "--parity") == 0 && has) {
-            const char *v = argv[++i];
-            cfg.parity = strcmp(v, "none") == 0   ? 'N'
-                         : strcmp(v, "even") == 0 ? 'E'
-                         : strcmp(v, "odd") == 0  ? 'O'
-                                                  : 0;
-            if (cfg.parity == 0) {
-                fprintf(stderr, "curvestep serve: --parity wants none, even or odd\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--unit") == 0 && has) {
-            char *end;
-            long v = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || v < 1 || v > 247) {
-                fprintf(stderr, "curvestep serve: --unit wants a Modbus unit id, 1..247\n");
-                return CS_EXIT_USAGE;
-            }
-            cfg.unit = (int)v;
-        } else if (strcmp(a, "--socket") == 0 && has) {
-            cfg.socket_path = argv[++i];
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            cfg.machine_file = argv[++i];
-        } else if (strcmp(a, "--max-input-mb") == 0 && has) {
-            if (!cs_readall_parse_mb(argv[++i], &cfg.max_input_bytes)) {
-                fprintf(stderr,
-                        "curvestep serve: --max-input-mb wants a whole number of MiB, "
-                        "1 to %u\n",
-                        CS_READALL_MAX_MB);
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--baud") == 0 && has) {
-            if (parse_baud(argv[++i], &cfg.baud) != 0) {
-                fprintf(stderr, "curvestep serve: --baud wants a termios rate (e.g. 115200)\n");
-                return CS_EXIT_USAGE;
-            }
-        } else {
+        }
+        int r = cs_joblink_option("serve", argc, argv, &i, &cfg.link);
+        if (r == 0)
+            r = serve_option(argc, argv, &i, &cfg);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r == 0) {
             fprintf(stderr, "curvestep serve: unknown or incomplete option %s\n", a);
             serve_usage(stderr);
             return CS_EXIT_USAGE;
         }
     }
-    if ((cfg.port != NULL) + (cfg.modbus_tcp != NULL) + (cfg.modbus_rtu != NULL) != 1) {
-        fprintf(stderr, "curvestep serve: give one link: --port DEV, --modbus-tcp HOST:PORT or "
-                        "--modbus-rtu DEV\n");
+    cs_joblink_t probe;
+    if (cs_joblink_select(&probe, &cfg.link) != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep serve: give one link: --port DEV, --modbus-tcp HOST:PORT, "
+                        "--modbus-rtu DEV or --gpio CHIP\n");
         serve_usage(stderr);
+        return CS_EXIT_USAGE;
+    }
+    if (cfg.link.line_rate != 0) {
+        fprintf(stderr, "curvestep serve: --line-rate applies to `curvestep stream` only\n");
+        return CS_EXIT_USAGE;
+    }
+    if (cfg.link.parity != 0 && cfg.link.modbus_rtu == NULL) {
+        fprintf(stderr, "curvestep serve: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;
     }
     return cs_daemon_serve(&cfg);
@@ -164,93 +153,137 @@ static void client_usage(FILE *f, const char *name)
             sock);
 }
 
-static int client(int argc, char **argv, const char *verb)
-{
-    const char *name = argv[0];
-    char sock[256];
-    const char *socket_path = cs_daemon_default_socket(sock, sizeof sock);
-    const char *file = NULL, *mode = NULL, *tol = NULL, *feed = NULL, *job = NULL;
-    bool submit = strcmp(name, "submit") == 0, cancel = strcmp(name, "cancel") == 0;
+/* A client's command line. */
+typedef struct {
+    const char *name; /* submit, status, ... */
+    const char *socket_path;
+    const char *file, *mode, *tol, *feed, *job;
+    bool submit, cancel;
     cs_jobopts_t in; /* sent as SUBMIT words; the daemon reads and lays out the job */
-    cs_jobopts_init(&in);
+} client_args_t;
+
+/* submit's --mode / --tol / --feed: 1 taken, 0 not one, -1 a bad value (said). */
+static int submit_option(int argc, char **argv, int *i, client_args_t *c)
+{
+    const char *a = argv[*i];
+    if (!c->submit || *i + 1 >= argc)
+        return 0;
+    const char *v = argv[*i + 1];
+    char *end;
+    if (strcmp(a, "--mode") == 0) {
+        if (strcmp(v, "segments") != 0 && strcmp(v, "curves") != 0) {
+            fprintf(stderr, "curvestep submit: --mode wants segments or curves\n");
+            return -1;
+        }
+        c->mode = v;
+    } else if (strcmp(a, "--tol") == 0) {
+        if (!(strtod(v, &end) > 0) || *end != '\0' || strchr(v, ' ')) {
+            fprintf(stderr, "curvestep submit: --tol wants a positive number of mm\n");
+            return -1;
+        }
+        c->tol = v;
+    } else if (strcmp(a, "--feed") == 0) {
+        double f = strtod(v, &end);
+        if (!(f > 0) || f >= 32768 || *end != '\0') {
+            fprintf(stderr, "curvestep submit: --feed wants a speed in (0, 32768) mm/s\n");
+            return -1;
+        }
+        c->feed = v;
+    } else {
+        return 0;
+    }
+    (*i)++;
+    return 1;
+}
+
+/* A word that is not an option: submit's FILE or cancel's JOB. CS_EXIT_OK, or a usage error. */
+static int client_word(client_args_t *c, const char *a)
+{
+    if (c->submit && c->file == NULL) {
+        c->file = a;
+    } else if (c->cancel && c->job == NULL) {
+        char *end;
+        unsigned long v = strtoul(a, &end, 10);
+        if (*a == '\0' || *a == '-' || *end != '\0' || v == 0 || v > UINT_MAX) {
+            fprintf(stderr, "curvestep cancel: JOB is a job number (see `status`)\n");
+            return CS_EXIT_USAGE;
+        }
+        c->job = a;
+    } else {
+        fprintf(stderr, "curvestep %s: unexpected argument %s\n", c->name, a);
+        client_usage(stderr, c->name);
+        return CS_EXIT_USAGE;
+    }
+    return CS_EXIT_OK;
+}
+
+/* Parses a client's argv: -1 to go on, else the exit status (--help, a usage error). */
+static int client_parse(int argc, char **argv, client_args_t *c, char *sock, size_t cap)
+{
+    memset(c, 0, sizeof *c);
+    c->name = argv[0];
+    c->socket_path = cs_daemon_default_socket(sock, cap);
+    c->submit = strcmp(c->name, "submit") == 0;
+    c->cancel = strcmp(c->name, "cancel") == 0;
+    cs_jobopts_init(&c->in);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        bool has = i + 1 < argc;
-        int r = submit ? cs_jobopts_option(name, argc, argv, &i, &in) : 0;
+        int r = c->submit ? cs_jobopts_option(c->name, argc, argv, &i, &c->in) : 0;
+        if (r == 0)
+            r = submit_option(argc, argv, &i, c);
         if (r < 0)
             return CS_EXIT_USAGE;
         if (r > 0)
             continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            client_usage(stdout, name);
+            client_usage(stdout, c->name);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--socket") == 0 && has) {
-            socket_path = argv[++i];
-        } else if (submit && strcmp(a, "--mode") == 0 && has) {
-            mode = argv[++i];
-            if (strcmp(mode, "segments") != 0 && strcmp(mode, "curves") != 0) {
-                fprintf(stderr, "curvestep submit: --mode wants segments or curves\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (submit && strcmp(a, "--tol") == 0 && has) {
-            tol = argv[++i];
-            char *end;
-            if (!(strtod(tol, &end) > 0) || *end != '\0' || strchr(tol, ' ')) {
-                fprintf(stderr, "curvestep submit: --tol wants a positive number of mm\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (submit && strcmp(a, "--feed") == 0 && has) {
-            feed = argv[++i];
-            char *end;
-            double v = strtod(feed, &end);
-            if (!(v > 0) || v >= 32768 || *end != '\0') {
-                fprintf(stderr, "curvestep submit: --feed wants a speed in (0, 32768) mm/s\n");
-                return CS_EXIT_USAGE;
-            }
+        } else if (strcmp(a, "--socket") == 0 && i + 1 < argc) {
+            c->socket_path = argv[++i];
         } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "curvestep %s: unknown or incomplete option %s\n", name, a);
-            client_usage(stderr, name);
+            fprintf(stderr, "curvestep %s: unknown or incomplete option %s\n", c->name, a);
+            client_usage(stderr, c->name);
             return CS_EXIT_USAGE;
-        } else if (submit && file == NULL) {
-            file = a;
-        } else if (cancel && job == NULL) {
-            char *end;
-            unsigned long v = strtoul(a, &end, 10);
-            if (*a == '\0' || *a == '-' || *end != '\0' || v == 0 || v > UINT_MAX) {
-                fprintf(stderr, "curvestep cancel: JOB is a job number (see `status`)\n");
-                return CS_EXIT_USAGE;
-            }
-            job = a;
-        } else {
-            fprintf(stderr, "curvestep %s: unexpected argument %s\n", name, a);
-            client_usage(stderr, name);
-            return CS_EXIT_USAGE;
+        } else if ((r = client_word(c, a)) != CS_EXIT_OK) {
+            return r;
         }
     }
-    char req[CS_DAEMON_LINE_MAX];
-    if (submit) {
-        if (file == NULL) {
-            fprintf(stderr, "curvestep submit: no job file\n");
-            client_usage(stderr, name);
-            return CS_EXIT_USAGE;
-        }
-        char abs[PATH_MAX];
-        if (realpath(file, abs) == NULL) {
-            fprintf(stderr, "%s:0:0: cannot open the job file (%s)\n", file, strerror(errno));
-            return CS_EXIT_INPUT;
-        }
-        if (cs_jobopts_check(name, &in) != 0)
-            return CS_EXIT_USAGE;
-        int k = snprintf(req, sizeof req, "SUBMIT%s%s%s%s%s%s%s %s", mode ? " mode=" : "",
-                         mode ? mode : "", tol ? " tol=" : "", tol ? tol : "", feed ? " feed=" : "",
-                         feed ? feed : "", in.words, abs);
-        if (k < 0 || (size_t)k >= sizeof req || strchr(abs, '\n')) {
-            fprintf(stderr, "%s:0:0: path too long or not on one line\n", file);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        snprintf(req, sizeof req, "%s%s%s", verb, job ? " " : "", job ? job : "");
+    return -1;
+}
+
+/* The request line: "SUBMIT [words] /ABS/PATH", or the verb [JOB]. CS_EXIT_OK, or an error. */
+static int client_request(const client_args_t *c, const char *verb, char *req, size_t cap)
+{
+    if (!c->submit) {
+        snprintf(req, cap, "%s%s%s", verb, c->job ? " " : "", c->job ? c->job : "");
+        return CS_EXIT_OK;
     }
+    if (c->file == NULL) {
+        fprintf(stderr, "curvestep submit: no job file\n");
+        client_usage(stderr, c->name);
+        return CS_EXIT_USAGE;
+    }
+    char abs[PATH_MAX];
+    if (realpath(c->file, abs) == NULL) {
+        fprintf(stderr, "%s:0:0: cannot open the job file (%s)\n", c->file, strerror(errno));
+        return CS_EXIT_INPUT;
+    }
+    if (cs_jobopts_check(c->name, &c->in) != 0)
+        return CS_EXIT_USAGE;
+    int k = snprintf(req, cap, "SUBMIT%s%s%s%s%s%s%s %s", c->mode ? " mode=" : "",
+                     c->mode ? c->mode : "", c->tol ? " tol=" : "", c->tol ? c->tol : "",
+                     c->feed ? " feed=" : "", c->feed ? c->feed : "", c->in.words, abs);
+    if (k < 0 || (size_t)k >= cap || strchr(abs, '\n')) {
+        fprintf(stderr, "%s:0:0: path too long or not on one line\n", c->file);
+        return CS_EXIT_INPUT;
+    }
+    return CS_EXIT_OK;
+}
+
+/* Sends req and prints the reply: OK on standard output, a refusal on standard error (without
+ * the "ERR "). The exit status. */
+static int client_send(const char *name, const char *socket_path, const char *req)
+{
     char err[512];
     char *reply = NULL;
     size_t rlen = 0;
@@ -261,7 +294,6 @@ static int client(int argc, char **argv, const char *verb)
     }
     int rc = cs_daemon_request(socket_path, req, out, err, sizeof err);
     fclose(out);
-    /* OK replies on standard output; a refusal on standard error, without the "ERR " */
     if (rc == 0)
         fputs(reply, stdout);
     else if (rc > 0)
@@ -273,6 +305,20 @@ static int client(int argc, char **argv, const char *verb)
         return EXIT_NO_DAEMON;
     }
     return rc == 0 ? CS_EXIT_OK : CS_EXIT_INPUT;
+}
+
+static int client(int argc, char **argv, const char *verb)
+{
+    char sock[256];
+    client_args_t c;
+    int rc = client_parse(argc, argv, &c, sock, sizeof sock);
+    if (rc >= 0)
+        return rc;
+    char req[CS_DAEMON_LINE_MAX];
+    rc = client_request(&c, verb, req, sizeof req);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    return client_send(c.name, c.socket_path, req);
 }
 
 int cs_cmd_submit(int argc, char **argv)

@@ -1,8 +1,9 @@
-/* The GPIO link of `curvestep stream` (cs_stream_cmd.h): the job's step segments run here, on
+/* The GPIO link's operations (cs_joblink.h: --gpio CHIP): the job's step segments run here, on
  * the step thread (cs_gpio_run) driving a GPIO chip's lines through libgpiod, or a recorder
- * (`--gpio record:FILE`) that writes every edge with its time. The main thread shows progress,
- * turns Ctrl-C into a hold (a second one: stop at once), and prints the summary every link
- * prints (docs/gpio.md). */
+ * (`--gpio record:FILE`) that writes every edge with its time. The calling thread shows
+ * progress and passes on the hold, pause and stop requests; the summary is every link's
+ * (cs_joblink_report) with this link's counters (steps, lateness of the STEP edges). Used by
+ * `curvestep stream --gpio` and `curvestep serve --gpio` (docs/gpio.md). */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +15,7 @@
 #include "cs_gpio_cfg.h"
 #include "cs_gpio_io.h"
 #include "cs_gpio_run.h"
+#include "cs_joblink.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
 
@@ -38,7 +40,8 @@ static double now_s(void)
 
 /* The progress display of cs_stream (docs/streaming.md "Progress"): a bar ten times a second
  * on a terminal, else one line a second. The ETA is exact here: the planned time left. */
-static void progress(progress_t *pg, const cs_stream_plan_t *p, const cs_gpio_run_t *r, bool final)
+static void progress(progress_t *pg, const cs_segment_t *segs, size_t nsegs, uint64_t ticks,
+                     uint32_t tick_hz, const cs_gpio_run_t *r, bool final)
 {
     if (pg->f == NULL)
         return;
@@ -55,9 +58,9 @@ static void progress(progress_t *pg, const cs_stream_plan_t *p, const cs_gpio_ru
     }
     if (final && now > pg->t0) /* the summary: the average over the whole run */
         pg->rate = (double)(ex - pg->first) / (now - pg->t0);
-    while (pg->eta_k < ex && pg->eta_k < p->nsegs)
-        pg->eta_done += p->segs[pg->eta_k++].ticks;
-    double eta = (double)(p->ticks - pg->eta_done) / p->m.tick_hz;
+    while (pg->eta_k < ex && pg->eta_k < nsegs)
+        pg->eta_done += segs[pg->eta_k++].ticks;
+    double eta = (double)(ticks - pg->eta_done) / tick_hz;
     double pct = pg->n ? 100.0 * (double)ex / (double)pg->n : 100.0;
     double late_us = (double)__atomic_load_n(&r->late_max_ns, __ATOMIC_RELAXED) / 1000.0;
     if (pg->tty) {
@@ -80,17 +83,6 @@ static void progress(progress_t *pg, const cs_stream_plan_t *p, const cs_gpio_ru
     fflush(pg->f);
 }
 
-/* Steps the job makes on each axis (from segment `first` on). */
-static void job_steps(const cs_stream_plan_t *p, size_t first, uint64_t *steps)
-{
-    for (unsigned i = 0; i < CS_AXES; i++)
-        steps[i] = 0;
-    for (size_t k = first; k < p->nsegs; k++)
-        for (unsigned i = 0; i < CS_AXES; i++)
-            steps[i] += (uint64_t)(p->segs[k].steps[i] < 0 ? -(int64_t)p->segs[k].steps[i]
-                                                           : p->segs[k].steps[i]);
-}
-
 static void add_line(cs_gpio_lines_t *l, unsigned offset, bool active_low, const char *name)
 {
     unsigned i = l->n++;
@@ -103,239 +95,391 @@ static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
 {
     if (r->sched_err > 0)
         fprintf(stderr,
-                "curvestep stream: warning: SCHED_FIFO priority %d not granted (%s): the step "
+                "curvestep: warning: SCHED_FIFO priority %d not granted (%s): the step "
                 "thread runs at normal priority and its edges may be late under load; grant it "
                 "with CAP_SYS_NICE (sudo setcap cap_sys_nice+ep build/curvestep) or an rtprio "
                 "limit (/etc/security/limits.d: @gpio - rtprio %d), README \"GPIO\"\n",
                 cfg->rt_priority, strerror(r->sched_err), cfg->rt_priority);
     if (r->mlock_err > 0)
         fprintf(stderr,
-                "curvestep stream: warning: memory not locked (mlockall: %s): a page fault can "
+                "curvestep: warning: memory not locked (mlockall: %s): a page fault can "
                 "delay an edge; grant it with CAP_IPC_LOCK or a memlock limit "
                 "(/etc/security/limits.d: @gpio - memlock unlimited), README \"GPIO\"\n",
                 strerror(r->mlock_err));
     if (r->mlock_err == -2)
-        fprintf(stderr, "curvestep stream: note: memory not locked (AddressSanitizer build)\n");
+        fprintf(stderr, "curvestep: note: memory not locked (AddressSanitizer build)\n");
 }
 
-int cs_stream_cmd_gpio(const cs_stream_args_t *a, const cs_stream_plan_t *p,
-                       volatile sig_atomic_t *interrupted)
-{
-    const char *chip_arg = a->gpio_chip;
-    const char *record = strncmp(chip_arg, "record:", 7) == 0 ? chip_arg + 7 : NULL;
-    if (record && record[0] == '\0') {
-        fprintf(stderr, "curvestep stream: --gpio record:FILE needs a file name\n");
-        return CS_EXIT_USAGE;
-    }
-    if (a->curves) {
-        fprintf(stderr, "curvestep stream: --gpio runs the step segments planned here: "
-                        "--mode curves does not apply\n");
-        return CS_EXIT_USAGE;
-    }
-    const cs_machine_t *m = &p->m;
+/* The link's state between open and close. */
+typedef struct {
+    const cs_machine_t *m;
+    const char *record; /* record:FILE: the file; NULL: a chip */
     cs_gpio_cfg_t cfg;
-    char err[640];
-    if (a->machine_file) {
-        if (cs_gpio_cfg_load(a->machine_file, m, &cfg, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return CS_EXIT_INPUT;
-        }
-    } else {
-        cs_gpio_cfg_default(&cfg, m);
-    }
-    char chip[64];
-    cs_gpio_cfg_chip_name(chip_arg, chip, sizeof chip);
-    if (!record && cfg.chip[0] && strcmp(cfg.chip, chip) != 0) {
-        fprintf(stderr,
-                "curvestep stream: --gpio %s, but %s says [gpio] chip = %s: its line offsets "
-                "are for that chip (give --gpio %s, or change the file)\n",
-                chip_arg, a->machine_file, cfg.chip, cfg.chip);
-        return CS_EXIT_USAGE;
-    }
-    /* The lines: STEP and DIR of every wired axis, ENABLE. The recorder stands for a board
-     * wired in full: an axis or ENABLE the file leaves unwired gets a line of its own there. */
-    uint64_t steps[CS_AXES];
-    job_steps(p, a->resume_from, steps);
-    cs_gpio_lines_t l;
-    memset(&l, 0, sizeof l);
+    cs_gpio_lines_t lines;
     cs_gpio_run_opts_t ro;
-    memset(&ro, 0, sizeof ro);
-    bool any = false;
-    int unwired = -1; /* an axis the job moves that has no lines */
+    cs_gpio_io_t io;
+    bool io_open;
+    cs_segment_t *own; /* segments taken from the job's messages (the daemon) */
+    const cs_segment_t *segs;
+    size_t nsegs, first;
+    uint64_t ticks; /* the job's planned time from segment `first` on, executor ticks */
+    cs_gpio_run_t run;
+    double wall;
+} gpio_link_t;
+
+/* Steps the job makes on each axis (from segment `first` on). */
+static void job_steps(const gpio_link_t *g, uint64_t *steps)
+{
+    for (unsigned i = 0; i < CS_AXES; i++)
+        steps[i] = 0;
+    for (size_t k = g->first; k < g->nsegs; k++)
+        for (unsigned i = 0; i < CS_AXES; i++)
+            steps[i] += (uint64_t)(g->segs[k].steps[i] < 0 ? -(int64_t)g->segs[k].steps[i]
+                                                           : g->segs[k].steps[i]);
+}
+
+/* The lines: STEP and DIR of every wired axis, ENABLE. The recorder stands for a board wired in
+ * full: an axis or ENABLE the file leaves unwired gets a line of its own there. Returns the
+ * first axis the job moves that has no lines (-1: none); *any: an axis is wired. */
+static int wire_lines(gpio_link_t *g, const uint64_t *steps, bool *any)
+{
+    cs_gpio_lines_t *l = &g->lines;
+    cs_gpio_run_opts_t *ro = &g->ro;
+    int unwired = -1;
+    *any = false;
     for (unsigned i = 0; i < CS_AXES; i++) {
-        ro.step_line[i] = ro.dir_line[i] = -1;
-        if (i >= m->n_axes)
+        ro->step_line[i] = ro->dir_line[i] = -1;
+        if (i >= g->m->n_axes)
             continue;
-        bool wired = cs_gpio_cfg_wired(&cfg, i);
-        if (!wired && !record) {
+        bool wired = cs_gpio_cfg_wired(&g->cfg, i);
+        if (!wired && !g->record) {
             if (steps[i] > 0 && unwired < 0)
                 unwired = (int)i;
             continue;
         }
         char name[12];
-        ro.step_line[i] = (int)l.n;
+        ro->step_line[i] = (int)l->n;
         snprintf(name, sizeof name, "%s_step", axis_names[i]);
-        add_line(&l, wired ? (unsigned)cfg.step[i] : 0, cfg.step_active_low, name);
-        ro.dir_line[i] = (int)l.n;
+        add_line(l, wired ? (unsigned)g->cfg.step[i] : 0, g->cfg.step_active_low, name);
+        ro->dir_line[i] = (int)l->n;
         snprintf(name, sizeof name, "%s_dir", axis_names[i]);
-        add_line(&l, wired ? (unsigned)cfg.dir[i] : 0, false, name);
-        any = any || wired;
+        add_line(l, wired ? (unsigned)g->cfg.dir[i] : 0, false, name);
+        *any = *any || wired;
     }
-    ro.enable_line = -1;
-    if (cfg.enable >= 0 || record) {
-        ro.enable_line = (int)l.n;
-        add_line(&l, cfg.enable >= 0 ? (unsigned)cfg.enable : 0, cfg.enable_active_low, "enable");
+    ro->enable_line = -1;
+    if (g->cfg.enable >= 0 || g->record) {
+        ro->enable_line = (int)l->n;
+        add_line(l, g->cfg.enable >= 0 ? (unsigned)g->cfg.enable : 0, g->cfg.enable_active_low,
+                 "enable");
     }
-    cs_gpio_io_t io;
-    if (!record) { /* the chip first: a missing chip is exit 4 whatever the wiring */
-        int orc = cs_gpio_io_open_chip(&io, chip_arg, &l, err, sizeof err);
-        if (orc == -1) {
-            fprintf(stderr, "curvestep stream: %s\n", err);
-            return CS_EXIT_NO_DEVICE;
-        }
-        if (orc == 0 && (unwired >= 0 || !any))
-            cs_gpio_io_close(&io);
-        if (!any) {
-            fprintf(stderr,
-                    "curvestep stream: --gpio %s: %s wires no axis: give a machine file with a "
-                    "[gpio] section (x_step, x_dir, ...; docs/gpio.md, contrib/gpio-rpi.ini)\n",
-                    chip_arg, a->machine_file ? a->machine_file : "the built-in machine");
-            return CS_EXIT_USAGE;
-        }
-        if (unwired >= 0) {
-            fprintf(stderr,
-                    "%s:0: [gpio] wires no %s_step / %s_dir, but the job moves %s (%llu steps)\n",
-                    a->machine_file, axis_names[unwired], axis_names[unwired], axis_names[unwired],
-                    (unsigned long long)steps[unwired]);
+    return unwired;
+}
+
+/* The chip (a missing chip is exit 4 whatever the wiring), then the wiring's own errors. */
+static int open_chip(cs_joblink_t *l, gpio_link_t *g, const uint64_t *steps, int unwired, bool any)
+{
+    const char *chip_arg = l->cfg.gpio;
+    int orc = cs_gpio_io_open_chip(&g->io, chip_arg, &g->lines, l->why, sizeof l->why);
+    if (orc == -1)
+        return CS_EXIT_NO_DEVICE;
+    if (orc == 0 && (unwired >= 0 || !any))
+        cs_gpio_io_close(&g->io);
+    if (!any) {
+        snprintf(l->why, sizeof l->why,
+                 "--gpio %s: %s wires no axis: give a machine file with a [gpio] section "
+                 "(x_step, x_dir, ...; docs/gpio.md, contrib/gpio-rpi.ini)",
+                 chip_arg, l->cfg.machine_file ? l->cfg.machine_file : "the built-in machine");
+        return CS_EXIT_USAGE;
+    }
+    if (unwired >= 0) {
+        snprintf(l->why, sizeof l->why,
+                 "%s:0: [gpio] wires no %s_step / %s_dir, but the job moves %s (%llu steps)",
+                 l->cfg.machine_file, axis_names[unwired], axis_names[unwired], axis_names[unwired],
+                 (unsigned long long)steps[unwired]);
+        return CS_EXIT_INPUT;
+    }
+    g->io_open = true;
+    return CS_EXIT_OK;
+}
+
+/* The [gpio] section and the checks of the option against it. */
+static int gpio_config(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t *j)
+{
+    const char *chip_arg = l->cfg.gpio;
+    g->record = strncmp(chip_arg, "record:", 7) == 0 ? chip_arg + 7 : NULL;
+    if (g->record && g->record[0] == '\0') {
+        snprintf(l->why, sizeof l->why, "--gpio record:FILE needs a file name");
+        return CS_EXIT_USAGE;
+    }
+    if (j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
+        snprintf(l->why, sizeof l->why,
+                 "--gpio runs the step segments planned here: "
+                 "--mode curves does not apply");
+        return CS_EXIT_USAGE;
+    }
+    if (l->cfg.machine_file) {
+        if (cs_gpio_cfg_load(l->cfg.machine_file, g->m, &g->cfg, l->why, sizeof l->why) != 0)
             return CS_EXIT_INPUT;
-        }
     } else {
-        if (cs_gpio_io_open_recorder(&io, &l,
-                                     cs_gpio_run_record_capacity(p->segs + a->resume_from,
-                                                                 p->nsegs - a->resume_from)) != 0) {
-            fprintf(stderr, "curvestep stream: --gpio record: out of memory\n");
-            cs_gpio_io_free(&io);
+        cs_gpio_cfg_default(&g->cfg, g->m);
+    }
+    char chip[64];
+    cs_gpio_cfg_chip_name(chip_arg, chip, sizeof chip);
+    if (!g->record && g->cfg.chip[0] && strcmp(g->cfg.chip, chip) != 0) {
+        snprintf(l->why, sizeof l->why,
+                 "--gpio %s, but %s says [gpio] chip = %s: its line offsets are for that chip "
+                 "(give --gpio %s, or change the file)",
+                 chip_arg, l->cfg.machine_file, g->cfg.chip, g->cfg.chip);
+        return CS_EXIT_USAGE;
+    }
+    return CS_EXIT_OK;
+}
+
+/* The job's segments: the plan's, or the SEGMENT messages of the job. */
+static int gpio_segments(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t *j)
+{
+    g->segs = j->segs;
+    g->nsegs = j->nsegs;
+    if (g->segs == NULL) {
+        if (cs_joblink_segments(j->job, &g->own, &g->nsegs) != CS_OK) {
+            snprintf(l->why, sizeof l->why, "out of memory");
             return CS_EXIT_INTERNAL;
         }
+        g->segs = g->own;
     }
-    const char *link = chip_arg; /* "stream: LINK: outcome" */
-    fprintf(stderr, "stream: %s: %u lines (", link, l.n);
-    for (unsigned i = 0; i < l.n; i++)
-        if (record)
-            fprintf(stderr, "%s%s", i ? ", " : "", l.name[i]);
-        else
-            fprintf(stderr, "%s%s %u%s", i ? ", " : "", l.name[i], l.offset[i],
-                    l.active_low[i] ? " active-low" : "");
-    fprintf(stderr, "); STEP pulse %.3f us, DIR set-up %.3f us\n", cfg.pulse_ns / 1000.0,
-            cfg.dir_setup_ns / 1000.0);
+    g->first = j->resume_from < g->nsegs ? j->resume_from : g->nsegs;
+    g->ticks = 0;
+    for (size_t k = 0; k < g->nsegs; k++)
+        g->ticks += g->segs[k].ticks;
+    return CS_EXIT_OK;
+}
 
-    ro.m = m;
-    ro.cfg = &cfg;
-    ro.io = &io;
-    ro.segs = p->segs;
-    ro.nsegs = p->nsegs;
-    ro.first = a->resume_from;
-    ro.realtime = true;
-    cs_gpio_run_t r;
-    int rc = cs_gpio_run_start(&r, &ro);
-    if (rc != 0) {
-        fprintf(stderr, "curvestep stream: cannot start the step thread: %s\n", strerror(rc));
-        cs_gpio_io_set(&io, (1u << l.n) - 1u, 0, 0, &(int64_t){0});
-        cs_gpio_io_close(&io);
-        cs_gpio_io_free(&io);
+/* "stream: LINK: 7 lines (x_step 17, ...); STEP pulse 4.000 us, DIR set-up 20.000 us" */
+static void say_lines(const cs_joblink_t *l, const gpio_link_t *g)
+{
+    const cs_gpio_lines_t *ln = &g->lines;
+    fprintf(stderr, "stream: %s: %u lines (", l->name, ln->n);
+    for (unsigned i = 0; i < ln->n; i++)
+        if (g->record)
+            fprintf(stderr, "%s%s", i ? ", " : "", ln->name[i]);
+        else
+            fprintf(stderr, "%s%s %u%s", i ? ", " : "", ln->name[i], ln->offset[i],
+                    ln->active_low[i] ? " active-low" : "");
+    fprintf(stderr, "); STEP pulse %.3f us, DIR set-up %.3f us\n", g->cfg.pulse_ns / 1000.0,
+            g->cfg.dir_setup_ns / 1000.0);
+}
+
+static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
+{
+    gpio_link_t *g = calloc(1, sizeof *g);
+    if (g == NULL) {
+        snprintf(l->why, sizeof l->why, "out of memory");
         return CS_EXIT_INTERNAL;
     }
-    warn_rt(&r, &cfg);
-    progress_t pg;
-    memset(&pg, 0, sizeof pg);
-    pg.f = a->quiet ? NULL : stderr;
-    pg.tty = isatty(STDERR_FILENO) != 0;
-    pg.n = p->nsegs;
-    double t_start = now_s();
-    pg.t0 = t_start;
-    pg.first = a->resume_from;
+    l->gpio = g;
+    g->m = j->m;
+    int rc = gpio_config(l, g, j);
+    if (rc == CS_EXIT_OK)
+        rc = gpio_segments(l, g, j);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    uint64_t steps[CS_AXES];
+    job_steps(g, steps);
+    bool any;
+    int unwired = wire_lines(g, steps, &any);
+    if (!g->record) {
+        rc = open_chip(l, g, steps, unwired, any);
+    } else if (cs_gpio_io_open_recorder(
+                   &g->io, &g->lines,
+                   cs_gpio_run_record_capacity(g->segs + g->first, g->nsegs - g->first)) != 0) {
+        snprintf(l->why, sizeof l->why, "--gpio record: out of memory");
+        rc = CS_EXIT_INTERNAL;
+    } else {
+        g->io_open = true;
+    }
+    if (rc == CS_EXIT_OK)
+        say_lines(l, g);
+    return rc;
+}
+
+/* The calling thread while the step thread runs: the interrupt (1: hold then end, 2: stop at
+ * once) and pause requests passed on, progress shown, the confirmed pause said once. */
+static void gpio_watch(gpio_link_t *g, const cs_joblink_ctl_t *c, progress_t *pg)
+{
+    cs_gpio_run_t *r = &g->run;
     int held = 0;
-    while (!cs_gpio_run_finished(&r)) {
-        int want = *interrupted >= 2 ? 2 : *interrupted >= 1 ? 1 : 0;
+    bool paused = false, told = false;
+    while (!cs_gpio_run_finished(r)) {
+        int want = c->interrupt == NULL ? 0 : *c->interrupt >= 2 ? 2 : *c->interrupt >= 1 ? 1 : 0;
         if (want > held) {
-            cs_gpio_run_hold(&r, want);
+            cs_gpio_run_hold(r, want);
             held = want;
-            if (want == 1)
-                fprintf(stderr, "\nstream: Ctrl-C: holding (slowing down, then stopping at the "
-                                "end of a segment); Ctrl-C again stops at once\n");
+            if (want == 1 && c->progress)
+                fprintf(c->progress, "\nstream: Ctrl-C: holding (slowing down, then stopping at "
+                                     "the end of a segment); Ctrl-C again stops at once\n");
         }
-        progress(&pg, p, &r, false);
+        bool p = c->pause != NULL && *c->pause != 0;
+        if (p != paused) {
+            cs_gpio_run_pause(r, p);
+            paused = p;
+            told = false;
+        }
+        if (paused && !told && cs_gpio_run_paused(r)) {
+            cs_stream_progress_held(c->progress, cs_gpio_run_executed(r), g->nsegs, "segments");
+            told = true;
+        }
+        progress(pg, g->segs, g->nsegs, g->ticks, g->m->tick_hz, r, false);
         struct timespec ts = {0, 20000000};
         nanosleep(&ts, NULL);
     }
-    cs_gpio_run_join(&r);
-    progress(&pg, p, &r, true);
-    double wall = now_s() - t_start;
-    cs_gpio_io_close(&io);
+}
 
-    int exit_rc = CS_EXIT_OK;
-    const char *what = "job executed";
-    char why[200] = "";
-    switch (r.outcome) {
+/* The step thread's outcome as every link's result. */
+static void gpio_result(const gpio_link_t *g, const cs_joblink_job_t *j, cs_stream_result_t *r)
+{
+    const cs_gpio_run_t *run = &g->run;
+    memset(r, 0, sizeof *r);
+    r->executed = r->delivered = r->sent = cs_gpio_run_executed(run);
+    r->wall_s = r->stream_s = g->wall;
+    r->dev_state = CS_PROTO_STATE_IDLE; /* the lines are safe: the position below is known */
+    for (unsigned i = 0; i < CS_AXES && i < CS_PROTO_AXES_MAX; i++)
+        r->dev_pos[i] = (j->start_pos ? j->start_pos[i] : 0) + run->pos[i];
+    switch (run->outcome) {
     case CS_GPIO_RUN_DONE:
+        r->outcome = CS_STREAM_DONE;
         break;
     case CS_GPIO_RUN_HELD:
-        exit_rc = CS_EXIT_INTERRUPTED;
-        what = "interrupted: held, then stopped at the end of a segment (STEP low, ENABLE off)";
+        r->outcome = CS_STREAM_INTERRUPTED;
+        r->what = "interrupted: held, then stopped at the end of a segment (STEP low, ENABLE off)";
         break;
     case CS_GPIO_RUN_STOPPED:
-        exit_rc = CS_EXIT_INTERRUPTED;
-        what = "interrupted: stopped at once, mid-segment (STEP low, ENABLE off)";
+        r->outcome = CS_STREAM_INTERRUPTED;
+        r->what = "interrupted: stopped at once, mid-segment (STEP low, ENABLE off)";
+        r->mid_message = true;
         break;
     case CS_GPIO_RUN_BAD_SEGMENT:
-        exit_rc = CS_EXIT_INTERNAL;
-        what = "the executor refused a segment";
-        snprintf(why, sizeof why, " (no. %zu: ticks 0 or over 2^24, or more steps than ticks)",
-                 r.bad_segment);
+        r->outcome = CS_STREAM_DEVICE_ERROR;
+        r->what = "the executor refused a segment";
+        r->dev_error.code = (uint8_t)CS_ERR_RANGE;
+        r->dev_error_msg = run->bad_segment;
+        snprintf(r->why, sizeof r->why, "ticks 0 or over 2^24, or more steps than ticks");
         break;
     case CS_GPIO_RUN_IO_ERROR:
-        exit_rc = CS_EXIT_CLOSED;
-        what = "setting the lines failed";
-        snprintf(why, sizeof why, " (%s)", strerror(r.io_errno));
+        r->outcome = CS_STREAM_CLOSED;
+        r->what = "setting the lines failed";
+        snprintf(r->why, sizeof r->why, "%s", strerror(run->io_errno));
         break;
     }
-    size_t ex = cs_gpio_run_executed(&r);
-    printf("stream: %s: %s%s\n", link, what, why);
-    cs_stream_report_counts(stdout, ex, p->nsegs, ex, ex, "segments");
-    printf("stream: %llu steps (",
-           (unsigned long long)(r.steps[0] + r.steps[1] + r.steps[2] + r.steps[3]));
-    for (unsigned i = 0; i < m->n_axes; i++)
-        printf("%s%s %llu", i ? ", " : "", axis_names[i], (unsigned long long)r.steps[i]);
-    printf(") in %.2f s (job time %.3f s); STEP edges late by: median <= %.0f us, 99 %% <= %.0f "
-           "us, max %.1f us\n",
-           wall, (double)r.ticks / m->tick_hz, (double)cs_gpio_run_late_quantile(&r, 0.5) / 1000.0,
-           (double)cs_gpio_run_late_quantile(&r, 0.99) / 1000.0, (double)r.late_max_ns / 1000.0);
-    if (exit_rc != CS_EXIT_OK && ex < p->nsegs && r.outcome != CS_GPIO_RUN_STOPPED)
-        cs_stream_report_resume(stdout, "segment", ex);
-    if (r.outcome == CS_GPIO_RUN_STOPPED)
-        printf("stream: (stopped mid-segment: the machine is past segment no. %zu, re-home it "
-               "before resuming)\n",
-               ex);
-    fflush(stdout);
-    if (record) {
-        FILE *f = fopen(record, "w");
-        char hdr[200];
-        snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
-                 (unsigned)m->tick_hz, (unsigned)cfg.pulse_ns, (unsigned)cfg.dir_setup_ns);
-        int wr = f ? cs_gpio_io_write_record(&io, f, r.t0_ns, hdr) : -1;
-        if (f && fclose(f) != 0)
-            wr = -1;
-        if (wr != 0) {
-            fprintf(stderr, "curvestep stream: %s: %s\n", record, strerror(errno));
-            if (exit_rc == CS_EXIT_OK)
-                exit_rc = CS_EXIT_INTERNAL;
-        } else if (io.dropped) {
-            fprintf(stderr, "curvestep stream: %s: %zu set calls did not fit the record\n", record,
-                    io.dropped);
-            if (exit_rc == CS_EXIT_OK)
-                exit_rc = CS_EXIT_INTERNAL;
+}
+
+static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_joblink_ctl_t *c,
+                         cs_stream_result_t *r)
+{
+    gpio_link_t *g = l->gpio;
+    cs_gpio_run_opts_t *ro = &g->ro;
+    ro->m = g->m;
+    ro->cfg = &g->cfg;
+    ro->io = &g->io;
+    ro->segs = g->segs;
+    ro->nsegs = g->nsegs;
+    ro->first = g->first;
+    ro->realtime = true;
+    int rc = cs_gpio_run_start(&g->run, ro);
+    if (rc != 0) {
+        fprintf(stderr, "curvestep: cannot start the step thread: %s\n", strerror(rc));
+        cs_gpio_io_set(&g->io, (1u << g->lines.n) - 1u, 0, 0, &(int64_t){0});
+        memset(r, 0, sizeof *r);
+        return CS_ERR_IO;
+    }
+    warn_rt(&g->run, &g->cfg);
+    progress_t pg;
+    memset(&pg, 0, sizeof pg);
+    pg.f = c->progress;
+    pg.tty = c->progress_tty;
+    pg.n = g->nsegs;
+    double t_start = now_s();
+    pg.t0 = t_start;
+    pg.first = g->first;
+    gpio_watch(g, c, &pg);
+    cs_gpio_run_join(&g->run);
+    progress(&pg, g->segs, g->nsegs, g->ticks, g->m->tick_hz, &g->run, true);
+    g->wall = now_s() - t_start;
+    gpio_result(g, j, r);
+    return CS_OK;
+}
+
+/* "stream: S steps (x .., y ..) in T s (job time ..); STEP edges late by: ..." and, after a stop
+ * at once, the note that the machine is past the last executed segment. */
+static void gpio_counters(cs_joblink_t *l, FILE *out, const cs_stream_result_t *res)
+{
+    const gpio_link_t *g = l->gpio;
+    const cs_gpio_run_t *r = &g->run;
+    fprintf(out, "stream: %llu steps (",
+            (unsigned long long)(r->steps[0] + r->steps[1] + r->steps[2] + r->steps[3]));
+    for (unsigned i = 0; i < g->m->n_axes; i++)
+        fprintf(out, "%s%s %llu", i ? ", " : "", axis_names[i], (unsigned long long)r->steps[i]);
+    fprintf(out,
+            ") in %.2f s (job time %.3f s); STEP edges late by: median <= %.0f us, 99 %% <= "
+            "%.0f us, max %.1f us\n",
+            g->wall, (double)r->ticks / g->m->tick_hz,
+            (double)cs_gpio_run_late_quantile(r, 0.5) / 1000.0,
+            (double)cs_gpio_run_late_quantile(r, 0.99) / 1000.0, (double)r->late_max_ns / 1000.0);
+    if (res->mid_message)
+        fprintf(out,
+                "stream: (stopped mid-segment: the machine is past segment no. %zu, re-home it "
+                "before resuming)\n",
+                res->executed);
+}
+
+/* Writes the recorder's edges to its file: CS_EXIT_OK, or CS_EXIT_INTERNAL (said on stderr). */
+static int write_record(const gpio_link_t *g)
+{
+    FILE *f = fopen(g->record, "w");
+    char hdr[200];
+    snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
+             (unsigned)g->m->tick_hz, (unsigned)g->cfg.pulse_ns, (unsigned)g->cfg.dir_setup_ns);
+    int wr = f ? cs_gpio_io_write_record(&g->io, f, g->run.t0_ns, hdr) : -1;
+    if (f && fclose(f) != 0)
+        wr = -1;
+    if (wr != 0) {
+        fprintf(stderr, "curvestep: %s: %s\n", g->record, strerror(errno));
+        return CS_EXIT_INTERNAL;
+    }
+    if (g->io.dropped) {
+        fprintf(stderr, "curvestep: %s: %zu set calls did not fit the record\n", g->record,
+                g->io.dropped);
+        return CS_EXIT_INTERNAL;
+    }
+    return CS_EXIT_OK;
+}
+
+static int gpio_close(cs_joblink_t *l, int rc)
+{
+    gpio_link_t *g = l->gpio;
+    if (g == NULL)
+        return rc;
+    if (g->io_open) {
+        cs_gpio_io_close(&g->io);
+        if (g->record && g->run.t0_ns != 0) {
+            int wrc = write_record(g);
+            if (rc == CS_EXIT_OK)
+                rc = wrc;
         }
     }
-    cs_gpio_io_free(&io);
-    return exit_rc;
+    cs_gpio_io_free(&g->io);
+    free(g->own);
+    free(g);
+    l->gpio = NULL;
+    return rc;
 }
+
+const cs_joblink_ops_t cs_joblink_gpio_ops = {
+    .kind = "GPIO",
+    .keep_open = false,
+    .curves = false,
+    .pens = false,
+    .open = gpio_open,
+    .run = gpio_run,
+    .counters = gpio_counters,
+    .close = gpio_close,
+};

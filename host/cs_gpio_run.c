@@ -108,19 +108,20 @@ typedef struct {
     cs_gpio_io_t *io;
     cs_stepper_t *st;
     uint32_t hz;
-    int64_t spin, pulse, setup;          /* cfg, ns */
-    uint32_t all_step, all_dir, en;      /* line masks */
-    cs_hold_t hold;                      /* the core's ramp (cs_hold) */
-    int64_t t_dir;                       /* last DIR change on the lines */
-    bool ok;                             /* every set call succeeded */
-    size_t next, pushed;                 /* job index of the next segment; segments pushed */
-    cs_stepper_out_t out;                /* the executor's last call */
-    cs_gpio_run_outcome_t oc;            /* DONE while running */
-    uint32_t dir;                        /* DIR levels on the lines */
-    uint64_t vt;                         /* executor ticks so far */
-    int64_t planned;                     /* planned time of the current call */
-    bool unsent;                         /* stopped with a call's steps computed, not on lines */
-    int32_t unsent_pos[CS_AXES];         /* the executor's position without them */
+    int64_t spin, pulse, setup;     /* cfg, ns */
+    uint32_t all_step, all_dir, en; /* line masks */
+    cs_hold_t hold;                 /* the core's ramp (cs_hold) */
+    int64_t t_dir;                  /* last DIR change on the lines */
+    bool ok;                        /* every set call succeeded */
+    size_t next, pushed;            /* job index of the next segment; segments pushed */
+    cs_stepper_out_t out;           /* the executor's last call */
+    cs_gpio_run_outcome_t oc;       /* DONE while running */
+    uint32_t dir;                   /* DIR levels on the lines */
+    uint64_t vt;                    /* executor ticks so far */
+    int64_t planned;                /* planned time of the current call */
+    int64_t shift;                  /* ns added to the plan by pauses */
+    bool unsent;                    /* stopped with a call's steps computed, not on lines */
+    int32_t unsent_pos[CS_AXES];    /* the executor's position without them */
 } stepper_run_t;
 
 /* Pushes segment s->next (after the hold's admission) into the executor. false when the
@@ -169,8 +170,7 @@ static void step_begin(stepper_run_t *s)
         (void)feed_next(s, false);
     cs_stepper_tick(s->st, &s->out);
     int64_t start = cs_gpio_io_now_ns();
-    r->t0_ns =
-        start + (cfg->enable_ns > START_LEAD_NS && s->en ? cfg->enable_ns : START_LEAD_NS);
+    r->t0_ns = start + (cfg->enable_ns > START_LEAD_NS && s->en ? cfg->enable_ns : START_LEAD_NS);
     s->dir = s->io->levels & s->all_dir;
     uint32_t want = dir_lines(o, s->out.dir_mask);
     if (s->ok && want != s->dir) {
@@ -230,24 +230,73 @@ static bool emit_dir(stepper_run_t *s)
     return true;
 }
 
+/* Held at rest for a pause: waits (in sleep slices) for the resume, then loads the next segment
+ * with the ramp back up (cs_hold) and shifts the plan to start again START_LEAD_NS from now.
+ * false when the run ends instead (a hold or stop while paused, or nothing left to run). */
+static bool pause_wait(stepper_run_t *s)
+{
+    cs_gpio_run_t *r = s->r;
+    if (s->next >= s->o->nsegs) { /* the hold came too late to stop anything */
+        s->oc = CS_GPIO_RUN_DONE;
+        return false;
+    }
+    __atomic_store_n(&r->paused, 1, __ATOMIC_RELEASE);
+    while (__atomic_load_n(&r->pause, __ATOMIC_ACQUIRE) && load_hold(r) == 0) {
+        struct timespec ts = {0, SLEEP_SLICE_NS};
+        nanosleep(&ts, NULL);
+    }
+    __atomic_store_n(&r->paused, 0, __ATOMIC_RELEASE);
+    int h = load_hold(r);
+    if (h != 0) {
+        s->oc = h >= 2 ? CS_GPIO_RUN_STOPPED : CS_GPIO_RUN_HELD;
+        return false;
+    }
+    cs_hold_set(&s->hold, false);
+    if (!feed_next(s, true))
+        return false;
+    cs_stepper_tick(s->st, &s->out); /* the kick: loads the segment, no step */
+    int64_t now = cs_gpio_io_now_ns();
+    s->shift = now + START_LEAD_NS - (r->t0_ns + ticks_to_ns(s->vt, s->hz));
+    uint32_t want = dir_lines(s->o, s->out.dir_mask);
+    if (want != s->dir) {
+        s->ok = cs_gpio_io_set(s->io, s->all_dir, want, now, &s->t_dir) == 0;
+        s->dir = want;
+    }
+    return s->ok && s->out.next_ticks != 0;
+}
+
+/* The hold, pause and stop requests: false when the run ends here. */
+static bool step_requests(stepper_run_t *s)
+{
+    cs_gpio_run_t *r = s->r;
+    int h = load_hold(r);
+    bool p = __atomic_load_n(&r->pause, __ATOMIC_ACQUIRE) != 0;
+    if (s->out.next_ticks == 0) { /* the executor ran dry: the end, or a hold at rest */
+        if (s->hold.hold && p && h == 0)
+            return pause_wait(s);
+        s->oc = s->hold.hold ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
+        return false;
+    }
+    if (h >= 2) {
+        s->oc = CS_GPIO_RUN_STOPPED;
+        return false;
+    }
+    if ((h == 1 || p) && !s->hold.hold)
+        cs_hold_set(&s->hold, true);
+    else if (h == 0 && !p && s->hold.hold)
+        cs_hold_set(&s->hold, false); /* resumed before coming to rest: back up to speed */
+    return true;
+}
+
 /* One executor call: hold request, refill, tick, lines, progress. false when the run ends. */
 static bool step_call(stepper_run_t *s)
 {
     cs_gpio_run_t *r = s->r;
     const cs_gpio_run_opts_t *o = s->o;
-    if (s->out.next_ticks == 0) {
-        s->oc = s->hold.hold ? CS_GPIO_RUN_HELD : CS_GPIO_RUN_DONE;
+    if (!step_requests(s))
         return false;
-    }
-    int h = load_hold(r);
-    if (h >= 2) {
-        s->oc = CS_GPIO_RUN_STOPPED;
-        return false;
-    }
-    if (h == 1 && !s->hold.hold)
-        cs_hold_set(&s->hold, true);
     s->vt += s->out.next_ticks;
-    s->planned = r->t0_ns + ticks_to_ns(s->vt, s->hz);
+    s->planned = r->t0_ns + s->shift + ticks_to_ns(s->vt, s->hz);
     /* one segment queued behind the running one is enough (this thread refills before every
      * call); once the hold has come to rest, nothing more is fed */
     if (s->next < o->nsegs && cs_stepper_free(s->st) == CS_STEPPER_RING) {
@@ -358,6 +407,16 @@ void cs_gpio_run_hold(cs_gpio_run_t *r, int level)
     int cur = __atomic_load_n(&r->hold, __ATOMIC_ACQUIRE);
     if (level > cur)
         __atomic_store_n(&r->hold, level, __ATOMIC_RELEASE);
+}
+
+void cs_gpio_run_pause(cs_gpio_run_t *r, bool on)
+{
+    __atomic_store_n(&r->pause, on ? 1 : 0, __ATOMIC_RELEASE);
+}
+
+bool cs_gpio_run_paused(const cs_gpio_run_t *r)
+{
+    return __atomic_load_n(&r->paused, __ATOMIC_ACQUIRE) != 0;
 }
 
 size_t cs_gpio_run_executed(const cs_gpio_run_t *r)

@@ -54,6 +54,8 @@ typedef struct {
     size_t executed; /* job numbering: segments 1..executed are done (thread writes) */
     int finished;    /* thread writes 1 when the lines are safe and it is about to return */
     int hold;        /* main writes: 1 hold, 2 stop at once */
+    int pause;       /* main writes: 1 hold and wait (the job kept), 0 resume */
+    int paused;      /* thread writes: 1 while held at rest for a pause */
     /* what real-time features were granted (set by cs_gpio_run_start) */
     int sched_err; /* 0: SCHED_FIFO granted; else errno (-1: not asked) */
     int mlock_err; /* 0: memory locked; else errno (-1: not asked, -2: skipped under ASan) */
@@ -81,6 +83,12 @@ int cs_gpio_run_start(cs_gpio_run_t *r, const cs_gpio_run_opts_t *opts);
  * core's ramp, cs_hold, every axis within its max_accel, then stop at a segment end) or to stop
  * at once (2). Any thread. */
 void cs_gpio_run_hold(cs_gpio_run_t *r, int level);
+/* Pauses (on: decelerate as for a hold, then wait at rest with ENABLE on and the job kept) or
+ * resumes (off: back up to speed with the core's ramp, the job's time shifted by the pause).
+ * A hold or stop requested while paused ends the run (HELD / STOPPED). Any thread. */
+void cs_gpio_run_pause(cs_gpio_run_t *r, bool on);
+/* True while the thread is at rest for a pause (the hold confirmed). Any thread. */
+bool cs_gpio_run_paused(const cs_gpio_run_t *r);
 /* Segments executed so far, job numbering (includes opts->first). Any thread. */
 size_t cs_gpio_run_executed(const cs_gpio_run_t *r);
 /* True once the thread has left the lines safe. Any thread. */

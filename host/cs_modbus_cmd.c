@@ -1,45 +1,57 @@
-/* The Modbus link of `curvestep stream` (--modbus-tcp HOST:PORT, --modbus-rtu DEV): opens the
- * libmodbus client, streams the planned job with cs_mb_stream_run and prints the summary lines
- * and exit status every link prints (cs_stream_report). See docs/modbus.md. */
+/* The Modbus link's operations (cs_joblink.h: --modbus-tcp HOST:PORT, --modbus-rtu DEV): opens
+ * the libmodbus client, streams the planned job with cs_mb_stream_run, closes. Its summary lines
+ * and exit status are every link's (cs_joblink_report). See docs/modbus.md. */
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "cs_cmd.h"
-#include "cs_err_text.h"
+#include "cs_joblink.h"
 #include "cs_modbus_stream.h"
 #include "cs_stream_cmd.h"
-#include "cs_stream_report.h"
 
-int cs_stream_cmd_modbus(const cs_stream_args_t *a, const cs_stream_plan_t *p,
-                         volatile sig_atomic_t *interrupted)
+static int modbus_open(cs_joblink_t *l, const cs_joblink_job_t *j)
 {
-    if (a->line_rate != 0) {
-        fprintf(stderr, "curvestep stream: --line-rate applies to --port only\n");
+    (void)j;
+    if (l->cfg.line_rate != 0) {
+        snprintf(l->why, sizeof l->why, "--line-rate applies to --port only");
         return CS_EXIT_USAGE;
     }
-    cs_mb_client_t c;
-    char why[256];
-    int orc;
-    const char *where = a->modbus_tcp ? a->modbus_tcp : a->modbus_rtu;
-    orc = cs_mb_open_link(&c, a->modbus_tcp, a->modbus_rtu, a->baud, a->parity, a->unit, why,
-                          sizeof why);
-    if (orc != 0) {
-        fprintf(stderr, "curvestep stream: %s\n", why);
+    int orc = cs_mb_open_link(&l->mb, l->cfg.modbus_tcp, l->cfg.modbus_rtu, l->cfg.baud,
+                              l->cfg.parity, l->cfg.unit, l->why, sizeof l->why);
+    if (orc != 0)
         return orc == -2 ? CS_EXIT_USAGE : CS_EXIT_NO_DEVICE;
-    }
-    cs_mb_stream_opts_t o;
-    cs_mb_stream_opts_default(&o, &c, p->m.n_axes, p->m.tick_hz);
-    o.resume_from = a->resume_from;
-    o.interrupt = interrupted;
-    o.progress = a->quiet ? NULL : stderr;
-    o.progress_tty = isatty(STDERR_FILENO) != 0;
-    cs_stream_result_t r;
-    cs_err_t e = cs_mb_stream_run(&p->job, &o, &r);
-    cs_mb_close(&c);
-    if (e != CS_OK) {
-        fprintf(stderr, "curvestep stream: %s\n", cs_err_text(e));
-        return CS_EXIT_INTERNAL;
-    }
-    return cs_stream_report(stdout, where, &p->job, &r, o.resume_from, a->curves);
+    l->mb_open = true;
+    return CS_EXIT_OK;
 }
+
+static cs_err_t modbus_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_joblink_ctl_t *c,
+                           cs_stream_result_t *r)
+{
+    cs_mb_stream_opts_t o;
+    cs_mb_stream_opts_default(&o, &l->mb, j->m->n_axes, j->m->tick_hz);
+    o.resume_from = j->resume_from;
+    o.interrupt = c->interrupt;
+    o.pause = c->pause;
+    o.progress = c->progress;
+    o.progress_tty = c->progress_tty;
+    return cs_mb_stream_run(j->job, &o, r);
+}
+
+static int modbus_close(cs_joblink_t *l, int rc)
+{
+    if (l->mb_open)
+        cs_mb_close(&l->mb);
+    l->mb_open = false;
+    return rc;
+}
+
+const cs_joblink_ops_t cs_joblink_modbus_ops = {
+    .kind = "Modbus",
+    .keep_open = false,
+    .curves = true,
+    .pens = false,
+    .open = modbus_open,
+    .run = modbus_run,
+    .counters = NULL,
+    .close = modbus_close,
+};

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "cs_linktime.h"
 #include "cs_serial.h"
 
 /* --- client --------------------------------------------------------------------------------- */
@@ -240,7 +241,7 @@ int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_
     if (strncmp(rtu, "/dev/pts/", 9) != 0 && baud > 0) {
         /* request of CS_MODBUS_MAILBOX_REGS registers + its answer, 11 bits a byte */
         uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;
-        timeout += (uint32_t)((uint64_t)bytes * 11u * 1000u / baud) + 1u;
+        timeout += cs_linktime_chars(bytes, CS_LINKTIME_BITS_RTU, baud, 1000u);
     }
     return cs_mb_open_rtu(c, rtu, baud, parity != 0 ? parity : 'E', unit, timeout, CS_MB_TRIES, why,
                           cap);
@@ -277,7 +278,7 @@ typedef struct {
     cs_stream_progress_t prog;
     double t_first;
     uint32_t resent, refused;
-    bool held; /* HOLD sent for o->pause, RESUME not yet */
+    bool held;         /* HOLD sent for o->pause, RESUME not yet */
     double t_progress; /* last write taken, message executed or axis moved (stall_ms) */
 } mrun_t;
 
@@ -571,8 +572,10 @@ static bool mb_controls(mrun_t *s, double *t_all_sent)
     if (o->pause != NULL && (*o->pause != 0) != s->held) {
         s->held = !s->held;
         control(s, s->held ? CS_MODBUS_CMD_HOLD : CS_MODBUS_CMD_RESUME,
-                s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE,
-                2000);
+                s->held ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
+        if (s->held &&
+            (s->r->dev_state == CS_PROTO_STATE_HELD || s->r->dev_state == CS_PROTO_STATE_IDLE))
+            cs_stream_progress_held(o->progress, s->r->executed, s->job->n, what(s));
         *t_all_sent = 0;
     }
     return false;
@@ -628,9 +631,8 @@ static void mb_stream(mrun_t *s)
             if (!poll_status(s))
                 break;
         }
-        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n,
-                           s->r->executed, s->r->sent, o->resume_from, s->c->retries + s->resent,
-                           what(s));
+        cs_stream_progress(&s->prog, o->progress, o->progress_tty, false, job->n, s->r->executed,
+                           s->r->sent, o->resume_from, s->c->retries + s->resent, what(s));
         mb_check_end(s, &t_all_sent);
     }
 }

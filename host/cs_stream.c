@@ -11,6 +11,7 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_exlog.h"
+#include "cs_linktime.h"
 #include "cs_motion.h"
 
 /* --- the job ------------------------------------------------------------------------------ */
@@ -249,6 +250,11 @@ const char *cs_stream_outcome_text(cs_stream_outcome_t oc)
     return "?";
 }
 
+const char *cs_stream_result_text(const cs_stream_result_t *r)
+{
+    return r->what != NULL ? r->what : cs_stream_outcome_text(r->outcome);
+}
+
 void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes, uint32_t tick_hz)
 {
     memset(o, 0, sizeof *o);
@@ -263,21 +269,7 @@ void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes,
 
 void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s)
 {
-    if (bits_per_s == 0) {
-        /* memory speed (a pty): a round trip is tens of microseconds, shorter than any useful
-         * hold-off, so every NAK rewinds (repeats cost a few duplicate frames). A receiver
-         * answers a burst of frames with one ACK, so a damaged ACK can hide a NAK: short 5 ms
-         * timeouts repair that quickly, and 200 of them in a row (1 s of silence) close the
-         * link */
-        c->rto = 5000;
-        c->nak_holdoff = 0;
-        c->max_retries = 200;
-        return;
-    }
-    double frame_us = CS_FRAME_WIRE_MAX * 10.0 * 1e6 / bits_per_s;
-    c->rto = (uint32_t)(40000 + 3 * CS_LINK_WINDOW * frame_us);
-    c->nak_holdoff = (uint32_t)(2 * frame_us);
-    c->max_retries = 20;
+    (void)cs_linktime_link(c, bits_per_s, 1000000u); /* CS_ERR_RANGE below 5 bits/s: c kept */
 }
 
 typedef struct {
@@ -450,6 +442,14 @@ void cs_stream_progress(cs_stream_progress_t *p, FILE *f, bool tty, bool final, 
     fflush(f);
 }
 
+void cs_stream_progress_held(FILE *f, size_t ex, size_t n, const char *what)
+{
+    if (f == NULL)
+        return;
+    fprintf(f, "stream: device held at %zu of %zu %s\n", ex, n, what);
+    fflush(f);
+}
+
 static void progress(run_t *s, bool final)
 {
     s->prog.t_first = s->t_first;
@@ -585,9 +585,12 @@ static bool run_controls(run_t *s, double *t_last_ack)
     }
     if (o->pause != NULL && (*o->pause != 0) != s->held) {
         s->held = !s->held;
-        if (s->held)
+        if (s->held) {
             control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
-        else
+            if (s->r->dev_state == CS_PROTO_STATE_HELD || s->r->dev_state == CS_PROTO_STATE_IDLE)
+                cs_stream_progress_held(o->progress, s->r->executed, s->job->n,
+                                        s->job->mode == CS_STREAM_CURVES ? "curves" : "segments");
+        } else
             control(s, CS_PROTO_RESUME, CS_PROTO_STATE_RUNNING, CS_PROTO_STATE_IDLE, 2000);
         *t_last_ack = 0;
     }

@@ -106,14 +106,15 @@ typedef struct {
     double wall_s;   /* from the connection to the end */
     double stream_s; /* from the first message sent to the last one executed */
     char why[320];   /* one sentence for NO_DEVICE / INCOMPATIBLE / CLOSED / RESET */
+    const char *what; /* the link's own sentence for the outcome (a static string; NULL:
+                       * cs_stream_outcome_text): the GPIO link's "held, then stopped ..." */
+    bool mid_message; /* stopped inside message `executed` + 1: the machine is past the last
+                       * executed one, so no --resume-from hint (GPIO: stop at once) */
 } cs_stream_result_t;
 
-/* Defaults: link timing for a pty at memory speed (cs_stream_link_timing(.., 0)), keepalive
+/* Defaults: link timing for a pty at memory speed (cs_linktime_link(.., 0, 1000000)), keepalive
  * 500 ms, HELLO within 5 s, final STATUS within 3 s. */
 void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes, uint32_t tick_hz);
-/* Link timing for a line of bits_per_s (0: a pty at memory speed): rto = 40 ms + three windows
- * of the largest frame, NAK hold-off = two largest frames + 0.3 ms (docs/protocol.md 3.6). */
-void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s);
 /* The device's identity (HELLO, or the Modbus status block) against the machine and the job:
  * true with a sentence in why when the axes, the tick rate (segments only) or the capabilities
  * do not match; the version is each link's own check. */
@@ -122,6 +123,10 @@ bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t 
 /* The job's name on the device (SETPOS, STATUS): FNV-1a 32 over every message as encoded, never
  * 0. A different file, mode or plan gives another id, so --resume refuses it. */
 uint32_t cs_stream_job_id(const cs_stream_job_t *job);
+/* Link timing for a line of bits_per_s (0: a pty at memory speed) in cs_serial_now_us
+ * microseconds: the core's cs_linktime_link (docs/protocol.md 3.6), the one every end computes
+ * (below 5 bits/s the timeout does not fit 32 bits: c is left as it was). */
+void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s);
 /* Streams job messages resume_from+1..n (the port is switched to lossy writes: a peer that
  * stops reading never blocks the host). Always fills *r; returns CS_OK when it ran to an
  * outcome (see r->outcome), CS_ERR_ARG for bad options, CS_ERR_IO for a write error. */
@@ -140,7 +145,13 @@ typedef struct {
 } cs_stream_progress_t;
 void cs_stream_progress(cs_stream_progress_t *p, FILE *f, bool tty, bool final, size_t n, size_t ex,
                         size_t sent, size_t resume_from, unsigned retx, const char *what);
+/* "stream: device held at E of N WHAT": the line every link prints on the progress stream
+ * once the device confirmed a pause's hold (the daemon's `status` shows "(held)" from then).
+ * f NULL prints nothing. */
+void cs_stream_progress_held(FILE *f, size_t ex, size_t n, const char *what);
 /* One line for an outcome ("device reset", ...). */
 const char *cs_stream_outcome_text(cs_stream_outcome_t oc);
+/* r->what, else cs_stream_outcome_text(r->outcome). */
+const char *cs_stream_result_text(const cs_stream_result_t *r);
 
 #endif

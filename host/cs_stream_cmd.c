@@ -1,7 +1,6 @@
-/* curvestep stream: plans a job whole (nothing is sent before the whole job planned without an
- * error), then streams it to a device over a serial port with cs_stream (or hands it to the
- * Modbus or GPIO link, cs_stream_cmd.h), showing progress, and reports how it ended
- * (docs/streaming.md). */
+/* curvestep stream: parses its options, plans a job whole (nothing is sent before the whole job
+ * planned without an error), then runs it over the link the options pick (cs_joblink: serial,
+ * Modbus TCP/RTU or GPIO), showing progress, and reports how it ended (docs/streaming.md). */
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>
@@ -13,14 +12,12 @@
 #include "cs_conv.h"
 #include "cs_err_text.h"
 #include "cs_jobplan.h"
+#include "cs_joblink.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
-#include "cs_stream_report.h"
 #include "cs_stream_resume.h"
 #include "cs_trace.h"
-
-#define EXIT_NO_DEVICE CS_EXIT_NO_DEVICE
 
 static volatile sig_atomic_t interrupted;
 
@@ -101,15 +98,81 @@ static void usage(FILE *f)
           f);
 }
 
-static int parse_count(const char *s, unsigned long long max, unsigned long long *out)
+/* The command line. */
+typedef struct {
+    const char *job_file;
+    cs_jobplan_opts_t jo;
+    cs_joblink_cfg_t link;
+    size_t resume_from; /* --resume-from N */
+    bool resume_ask;      /* --resume */
+    const char *position; /* --position X,Y,Z (mm) */
+    int32_t pos[CS_AXES]; /* --position in steps */
+    bool curves, quiet;
+} stream_args_t;
+
+/* The command's own options: 1 taken, 0 not one of them, -1 a bad value (said). */
+static int stream_option(int argc, char **argv, int *i, stream_args_t *a)
 {
-    char *end;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (*s == '\0' || *s == '-' || *end != '\0' || errno != 0 || v > max)
-        return -1;
-    *out = v;
-    return 0;
+    const char *o = argv[*i];
+    bool has = *i + 1 < argc;
+    unsigned long long n;
+    if (strcmp(o, "--resume-from") == 0 && has) {
+        if (cs_joblink_parse_count(argv[++*i], (unsigned long long)SIZE_MAX / 2, &n) != 0) {
+            fprintf(stderr, "curvestep stream: --resume-from wants a message number\n");
+            return -1;
+        }
+        a->resume_from = (size_t)n;
+    } else if (strcmp(o, "--resume") == 0) {
+        a->resume_ask = true;
+    } else if (strcmp(o, "--position") == 0 && has) {
+        a->position = argv[++*i];
+    } else if (strcmp(o, "--mode") == 0 && has) {
+        const char *m = argv[++*i];
+        if (strcmp(m, "segments") != 0 && strcmp(m, "curves") != 0) {
+            fprintf(stderr, "curvestep stream: --mode wants segments or curves\n");
+            return -1;
+        }
+        a->curves = strcmp(m, "curves") == 0;
+    } else if (strcmp(o, "--quiet") == 0) {
+        a->quiet = true;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* Parses argv into *a: -1 to go on, else the exit status (--help, a usage error). */
+static int parse_args(int argc, char **argv, stream_args_t *a)
+{
+    memset(a, 0, sizeof *a);
+    cs_jobplan_opts_init(&a->jo);
+    a->link.baud = 115200;
+    a->link.unit = 1;
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i];
+        int r = cs_jobplan_option("stream", argc, argv, &i, &a->jo);
+        if (r == 0)
+            r = cs_joblink_option("stream", argc, argv, &i, &a->link);
+        if (r == 0)
+            r = stream_option(argc, argv, &i, a);
+        if (r < 0)
+            return CS_EXIT_USAGE;
+        if (r > 0)
+            continue;
+        if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
+            usage(stdout);
+            return CS_EXIT_OK;
+        } else if (o[0] == '-' && o[1] != '\0') {
+            fprintf(stderr, "curvestep stream: unknown or incomplete option %s\n", o);
+            usage(stderr);
+            return CS_EXIT_USAGE;
+        } else if (a->job_file != NULL) {
+            fprintf(stderr, "curvestep stream: one job file only\n");
+            return CS_EXIT_USAGE;
+        }
+        a->job_file = o;
+    }
+    return -1;
 }
 
 /* --resume, --resume-from and --position together: true (said on stderr) when they clash. */
@@ -157,247 +220,156 @@ static int check_position(const char *text, const cs_machine_t *m, const cs_stre
     return 0;
 }
 
-int cs_cmd_stream(int argc, char **argv)
+/* The link the options pick, checked against the other options. */
+static int pick_link(stream_args_t *a, cs_joblink_t *l)
 {
-    const char *port = NULL, *job_file = NULL;
-    const char *mb_tcp = NULL, *mb_rtu = NULL, *gpio = NULL, *position = NULL;
-    bool resume_ask = false;
-    unsigned long long baud = 115200, resume = 0, line_rate = 0, unit = 1;
-    cs_jobplan_opts_t jo;
-    cs_jobplan_opts_init(&jo);
-    bool curves = false, quiet = false;
-    char parity = 0; /* --parity: 0 = not given (even) */
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        int r = cs_jobplan_option("stream", argc, argv, &i, &jo);
-        if (r < 0)
-            return CS_EXIT_USAGE;
-        if (r > 0)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return CS_EXIT_OK;
-        } else if (strcmp(a, "--port") == 0 && has) {
-            port = argv[++i];
-        } else if (strcmp(a, "--modbus-tcp") == 0 && has) {
-            mb_tcp = argv[++i];
-        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
-            mb_rtu = argv[++i];
-        } else if (strcmp(a, "--gpio") == 0 && has) {
-            gpio = argv[++i];
-        } else if (strcmp(a, "--unit") == 0 && has) {
-            if (parse_count(argv[++i], 247, &unit) != 0 || unit < 1) {
-                fprintf(stderr, "curvestep stream: --unit wants a Modbus unit id, 1..247\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--baud") == 0 && has) {
-            if (parse_count(argv[++i], 4000000, &baud) != 0 || !cs_serial_baud_ok((uint32_t)baud)) {
-                fprintf(stderr, "curvestep stream: --baud wants a termios rate (e.g. 115200)\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--parity") == 0 && has) {
-            const char *v = argv[++i];
-            parity = strcmp(v, "none") == 0   ? 'N'
-                     : strcmp(v, "even") == 0 ? 'E'
-                     : strcmp(v, "odd") == 0  ? 'O'
-                                              : 0;
-            if (parity == 0) {
-                fprintf(stderr, "curvestep stream: --parity wants none, even or odd\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--resume-from") == 0 && has) {
-            if (parse_count(argv[++i], (unsigned long long)SIZE_MAX / 2, &resume) != 0) {
-                fprintf(stderr, "curvestep stream: --resume-from wants a message number\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--resume") == 0) {
-            resume_ask = true;
-        } else if (strcmp(a, "--position") == 0 && has) {
-            position = argv[++i];
-        } else if (strcmp(a, "--line-rate") == 0 && has) {
-            if (parse_count(argv[++i], 100000000, &line_rate) != 0 || line_rate < 10) {
-                fprintf(stderr, "curvestep stream: --line-rate wants bits/s (>= 10)\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--mode") == 0 && has) {
-            const char *m = argv[++i];
-            if (strcmp(m, "segments") == 0)
-                curves = false;
-            else if (strcmp(m, "curves") == 0)
-                curves = true;
-            else {
-                fprintf(stderr, "curvestep stream: --mode wants segments or curves\n");
-                return CS_EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--quiet") == 0) {
-            quiet = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "curvestep stream: unknown or incomplete option %s\n", a);
-            usage(stderr);
-            return CS_EXIT_USAGE;
-        } else if (job_file == NULL) {
-            job_file = a;
-        } else {
-            fprintf(stderr, "curvestep stream: one job file only\n");
-            return CS_EXIT_USAGE;
-        }
-    }
-    int links = (port != NULL) + (mb_tcp != NULL) + (mb_rtu != NULL) + (gpio != NULL);
-    if (job_file == NULL || links != 1) {
-        fprintf(stderr, "curvestep stream: %s\n",
-                links == 0  ? "one of --port, --modbus-tcp, --modbus-rtu or --gpio is required"
-                : links > 1 ? "--port, --modbus-tcp, --modbus-rtu and --gpio exclude each other"
-                            : "no job file");
+    int rc = cs_joblink_select(l, &a->link);
+    if (rc != CS_EXIT_OK || a->job_file == NULL) {
+        fprintf(stderr, "curvestep stream: %s\n", rc != CS_EXIT_OK ? l->why : "no job file");
         usage(stderr);
         return CS_EXIT_USAGE;
     }
-    if (resume_opts_bad(port != NULL, resume_ask, resume != 0, position != NULL))
+    if (resume_opts_bad(l->ops == &cs_joblink_serial_ops, a->resume_ask, a->resume_from != 0,
+                        a->position != NULL))
         return CS_EXIT_USAGE;
-    if (parity != 0 && mb_rtu == NULL) {
+    if (a->link.parity != 0 && a->link.modbus_rtu == NULL) {
         fprintf(stderr, "curvestep stream: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;
     }
-    cs_machine_t m;
-    cs_machine_pen_t pen;
-    cs_pos_t tol;
-    char found[4096]; /* the default machine file, named for the Modbus and GPIO links too */
-    if (jo.machine_file == NULL && cs_machine_ini_find(found, sizeof found))
-        jo.machine_file = found;
-    int mrc = cs_jobplan_machine("stream", &jo, &m, &pen, &tol);
-    if (mrc != CS_EXIT_OK)
-        return mrc;
-    /* 1. the whole job, planned before anything is sent (the plan also checks the travel
-     * limits in curves mode, where the device plans again itself) */
-    cs_jobplan_t jp;
-    cs_jobplan_init(&jp);
-    cs_jobplan_limits(&jp, &jo);
-    jp.font_file = jo.font_file;
-    cs_err_t e = cs_jobplan_read_opts(&jp, job_file, &pen, &jo.in);
-    if (e == CS_OK)
-        e = cs_jobplan_prepare(&jp, "stream", &jo.in, &m, &pen, tol, stderr);
-    if (e != CS_OK) {
-        cs_path_diag_print(stderr, &jp.diag);
-        int rc = cs_jobplan_exit(&jp, e);
-        cs_jobplan_free(&jp);
-        return rc;
+    if (a->curves && !l->ops->curves) {
+        fprintf(stderr,
+                "curvestep stream: --%s runs the step segments planned here: --mode "
+                "curves does not apply\n",
+                a->link.gpio ? "gpio" : "link");
+        return CS_EXIT_USAGE;
     }
-    int32_t feed_q = cs_motion_speed(jo.feed_mm_s);
-    e = cs_jobplan_plan(&jp, job_file, &m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
+    if (a->link.parity == 0)
+        a->link.parity = 'E';
+    l->cfg.parity = a->link.parity;
+    return CS_EXIT_OK;
+}
+
+/* Reads and plans the job whole (the plan also checks the travel limits in curves mode, where
+ * the device plans again itself) into jp and its wire messages into job. */
+static int plan(const stream_args_t *a, const cs_joblink_t *l, const cs_machine_t *m,
+                const cs_machine_pen_t *pen, cs_pos_t tol, cs_jobplan_t *jp, cs_stream_job_t *job)
+{
+    cs_jobplan_init(jp);
+    cs_jobplan_limits(jp, &a->jo);
+    jp->font_file = a->jo.font_file;
+    cs_stream_job_init(job, a->curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
+    cs_err_t e = cs_jobplan_read_opts(jp, a->job_file, pen, &a->jo.in);
     if (e == CS_OK)
-        e = cs_jobplan_linkable(&jp, job_file, port != NULL, curves);
-    cs_stream_job_t job;
-    cs_stream_job_init(&job, curves ? CS_STREAM_CURVES : CS_STREAM_SEGMENTS);
+        e = cs_jobplan_prepare(jp, "stream", &a->jo.in, m, pen, tol, stderr);
+    int32_t feed_q = cs_motion_speed(a->jo.feed_mm_s);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(&job, &jp.path, feed_q > 0 ? feed_q : m.default_feed,
-                                            tol, &jp.diag)
-                   : cs_stream_job_add_motion(&job, &jp.mo.segs);
+        e = cs_jobplan_plan(jp, a->job_file, m, NULL, tol, CS_TRACE_DEFAULT, feed_q);
+    if (e == CS_OK)
+        e = cs_jobplan_linkable(jp, a->job_file, l->ops->pens, a->curves);
+    if (e == CS_OK)
+        e = a->curves ? cs_stream_job_add_path(
+                            job, &jp->path, feed_q > 0 ? feed_q : m->default_feed, tol, &jp->diag)
+                      : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (e != CS_OK) {
-        cs_path_diag_print(stderr, &jp.diag);
-        int rc = cs_jobplan_exit(&jp, e);
-        cs_stream_job_free(&job);
-        cs_jobplan_free(&jp);
-        return rc;
+        cs_path_diag_print(stderr, &jp->diag);
+        return cs_jobplan_exit(jp, e);
     }
-    const char *what = curves ? "curves" : "segments";
+    const char *what = a->curves ? "curves" : "segments";
     fprintf(stderr,
             "stream: %s: %zu elements -> %zu %s (%zu segments planned here, job time %.3f s)%s\n",
-            job_file, jp.path.n, job.n, what, jp.mo.segs.n, (double)jp.mo.ticks / m.tick_hz,
-            curves && job.approximated
+            a->job_file, jp->path.n, job->n, what, jp->mo.segs.n, (double)jp->mo.ticks / m->tick_hz,
+            a->curves && job->approximated
                 ? " ; arcs and other rational curves approximated by cubics within tol/4"
                 : "");
-    if (resume > job.n) {
-        fprintf(stderr, "curvestep stream: --resume-from %llu: the job has %zu %s\n", resume, job.n,
-                what);
-        cs_stream_job_free(&job);
-        cs_jobplan_free(&jp);
+    if (a->resume_from > job->n) {
+        fprintf(stderr, "curvestep stream: --resume-from %zu: the job has %zu %s\n", a->resume_from,
+                job->n, what);
         return CS_EXIT_USAGE;
     }
-    int32_t pos_steps[CS_AXES] = {0};
-    if (position != NULL && check_position(position, &m, &job, (size_t)resume, pos_steps) != 0) {
-        cs_stream_job_free(&job);
-        cs_jobplan_free(&jp);
-        return CS_EXIT_USAGE;
-    }
-    cs_path_free(&jp.path);
-    if (port == NULL) { /* 2'. another link: Modbus or GPIO */
-        cs_stream_args_t sa;
-        memset(&sa, 0, sizeof sa);
-        sa.job_file = job_file;
-        sa.machine_file = jo.machine_file;
-        sa.modbus_tcp = mb_tcp;
-        sa.modbus_rtu = mb_rtu;
-        sa.gpio_chip = gpio;
-        sa.baud = (uint32_t)baud;
-        sa.parity = parity != 0 ? parity : 'E';
-        sa.unit = (int)unit;
-        sa.resume_from = (size_t)resume;
-        sa.line_rate = (uint32_t)line_rate;
-        sa.curves = curves;
-        sa.quiet = quiet;
-        cs_stream_plan_t pl;
-        pl.m = m;
-        pl.pen = pen;
-        pl.job = job;
-        pl.segs = jp.mo.segs.v;
-        pl.nsegs = jp.mo.segs.n;
-        pl.ticks = jp.mo.ticks;
-        struct sigaction sig;
-        memset(&sig, 0, sizeof sig);
-        sig.sa_handler = on_sigint;
-        sigaction(SIGINT, &sig, NULL);
-        signal(SIGPIPE, SIG_IGN);
-        int lrc = gpio ? cs_stream_cmd_gpio(&sa, &pl, &interrupted)
-                       : cs_stream_cmd_modbus(&sa, &pl, &interrupted);
-        signal(SIGINT, SIG_DFL);
-        fflush(stdout);
-        cs_stream_job_free(&job);
-        cs_jobplan_free(&jp);
-        return lrc;
-    }
-    cs_jobplan_free(&jp);
-    /* 2. the port */
-    cs_serial_t ser;
-    if (cs_serial_open(&ser, port, (uint32_t)baud) != 0) {
-        fprintf(stderr, "curvestep stream: %s: %s\n", port, strerror(errno));
-        cs_stream_job_free(&job);
-        return EXIT_NO_DEVICE;
-    }
-    cs_serial_set_line_rate(&ser, (uint32_t)line_rate);
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
-    sigaction(SIGINT, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
-    cs_stream_opts_t o;
-    cs_stream_opts_default(&o, &ser, m.n_axes, m.tick_hz);
-    /* a pty moves bytes at memory speed whatever its baud: time the link for the real rate */
-    cs_stream_link_timing(&o.link, line_rate                            ? (uint32_t)line_rate
-                                   : strncmp(port, "/dev/pts/", 9) == 0 ? 0
-                                                                        : (uint32_t)baud);
-    o.resume_from = (size_t)resume;
-    o.resume_ask = resume_ask;
-    o.set_pos = position != NULL;
-    memcpy(o.pos, pos_steps, sizeof pos_steps);
-    o.interrupt = &interrupted;
-    o.progress = quiet ? NULL : stderr;
-    o.progress_tty = isatty(STDERR_FILENO) != 0;
-    cs_stream_result_t r;
-    e = cs_stream_run(&job, &o, &r);
-    cs_serial_close(&ser);
-    signal(SIGINT, SIG_DFL);
-    if (e != CS_OK) {
-        fprintf(stderr, "curvestep stream: %s\n", cs_err_text(e));
-        cs_stream_job_free(&job);
-        return CS_EXIT_INTERNAL;
-    }
-    if (resume_ask && r.numbered) /* where the device's word put the start */
+    cs_path_free(&jp->path);
+    return CS_EXIT_OK;
+}
+
+/* What a serial run says beyond the one report: where --resume started, and after a lost link
+ * the device's confirmed and possibly executed numbers and how to resume. */
+static void resume_lines(const stream_args_t *a, const cs_joblink_job_t *j,
+                         const cs_stream_result_t *r)
+{
+    if (a->resume_ask && r->numbered)
         fprintf(stdout,
                 "stream: resumed: the device had received %s 1..%zu of this job and finished "
                 "%zu of them; sent from %zu on\n",
-                what, r.resume_from, r.resume_done, r.resume_from + 1);
-    int rc = cs_stream_report(stdout, port, &job, &r, r.resume_from, curves);
-    cs_stream_resume_hint(stdout, &job, &r, &m, job_file);
+                a->curves ? "curves" : "segments", r->resume_from, r->resume_done,
+                r->resume_from + 1);
+    cs_stream_resume_hint(stdout, j->job, r, j->m, a->job_file);
+}
+
+/* Opens the link, runs the job with Ctrl-C as a hold, reports, closes. */
+static int run_link(const stream_args_t *a, cs_joblink_t *l, const cs_joblink_job_t *j, size_t n)
+{
+    struct sigaction sig;
+    memset(&sig, 0, sizeof sig);
+    sig.sa_handler = on_sigint;
+    sigaction(SIGINT, &sig, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    int rc = cs_joblink_open(l, j);
+    if (rc != CS_EXIT_OK) {
+        if (rc == CS_EXIT_INPUT) /* "file:line: reason" as it is */
+            fprintf(stderr, "%s\n", l->why);
+        else
+            fprintf(stderr, "curvestep stream: %s\n", l->why);
+        signal(SIGINT, SIG_DFL);
+        return cs_joblink_close(l, rc);
+    }
+    cs_joblink_ctl_t c = {&interrupted, NULL, a->quiet ? NULL : stderr, isatty(STDERR_FILENO) != 0};
+    cs_stream_result_t r;
+    cs_err_t e = cs_joblink_run(l, j, &c, &r);
+    signal(SIGINT, SIG_DFL);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep stream: %s\n", cs_err_text(e));
+        return cs_joblink_close(l, CS_EXIT_INTERNAL);
+    }
+    rc = cs_joblink_report(l, stdout, n, &r);
+    resume_lines(a, j, &r);
+    fflush(stdout);
+    return cs_joblink_close(l, rc);
+}
+
+int cs_cmd_stream(int argc, char **argv)
+{
+    stream_args_t a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0)
+        return rc;
+    cs_joblink_t l;
+    rc = pick_link(&a, &l);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_pos_t tol;
+    char found[4096]; /* the default machine file, named for the GPIO link too */
+    if (a.jo.machine_file == NULL && cs_machine_ini_find(found, sizeof found))
+        a.jo.machine_file = found;
+    l.cfg.machine_file = a.jo.machine_file;
+    rc = cs_jobplan_machine("stream", &a.jo, &m, &pen, &tol);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    cs_jobplan_t jp;
+    cs_stream_job_t job;
+    rc = plan(&a, &l, &m, &pen, tol, &jp, &job);
+    if (rc == CS_EXIT_OK) {
+        /* GPIO runs the segments planned here (numbered as segments), the others the messages */
+        bool segs = l.ops == &cs_joblink_gpio_ops;
+        cs_joblink_job_t j = {&m,   &job,         jp.mo.segs.v,
+                              jp.mo.segs.n, a.resume_from, NULL,
+                              a.resume_ask, a.position != NULL ? a.pos : NULL};
+        if (a.position != NULL && check_position(a.position, &m, &job, a.resume_from, a.pos) != 0)
+            rc = CS_EXIT_USAGE;
+        else
+            rc = run_link(&a, &l, &j, segs ? jp.mo.segs.n : job.n);
+    }
     cs_stream_job_free(&job);
+    cs_jobplan_free(&jp);
     return rc;
 }

@@ -44,7 +44,7 @@ void cs_stream_report_resume(FILE *out, const char *one, size_t executed)
 /* "stream: LINK: outcome (why)" with the reset's boot ids or the device's error. */
 static void outcome_line(FILE *out, const char *where, const cs_stream_result_t *r, const char *one)
 {
-    fprintf(out, "stream: %s: %s", where, cs_stream_outcome_text(r->outcome));
+    fprintf(out, "stream: %s: %s", where, cs_stream_result_text(r));
     if (r->why[0] && r->outcome != CS_STREAM_DEVICE_ERROR)
         fprintf(out, " (%s)", r->why);
     if (r->outcome == CS_STREAM_RESET && r->new_boot != 0) /* 0: a resume refused at the start */
@@ -56,24 +56,34 @@ static void outcome_line(FILE *out, const char *where, const cs_stream_result_t 
     fprintf(out, "\n");
 }
 
-int cs_stream_report(FILE *out, const char *where, const cs_stream_job_t *job,
-                     const cs_stream_result_t *r, size_t resume_from, bool curves)
+void cs_stream_report_bytes(FILE *out, const cs_stream_result_t *r, size_t resume_from, bool curves)
 {
-    const char *what = curves ? "curves" : "segments", *one = curves ? "curve" : "segment";
-    int rc = cs_stream_exit_code(r->outcome);
-    outcome_line(out, where, r, one);
-    cs_stream_report_counts(out, r->executed, job->n, r->delivered, r->sent, what);
     fprintf(out,
             "stream: %llu bytes sent, %llu received in %.2f s; %u retransmissions (%u timeouts, "
             "%u NAKs); %.0f %s/s\n",
             (unsigned long long)r->bytes_out, (unsigned long long)r->bytes_in, r->wall_s,
             (unsigned)r->link.retransmits, (unsigned)r->link.timeouts, (unsigned)r->link.naks,
-            r->stream_s > 0 ? (double)(r->executed - resume_from) / r->stream_s : 0.0, what);
+            r->stream_s > 0 ? (double)(r->executed - resume_from) / r->stream_s : 0.0,
+            curves ? "curves" : "segments");
+}
+
+int cs_stream_report(FILE *out, const char *where, size_t n, const cs_stream_result_t *r,
+                     size_t resume_from, bool curves, cs_stream_report_fn counters, void *ctx)
+{
+    const char *what = curves ? "curves" : "segments", *one = curves ? "curve" : "segment";
+    int rc = cs_stream_exit_code(r->outcome);
+    outcome_line(out, where, r, one);
+    cs_stream_report_counts(out, r->executed, n, r->delivered, r->sent, what);
+    if (counters != NULL)
+        counters(ctx, out, r);
+    else
+        cs_stream_report_bytes(out, r, resume_from, curves);
     /* a device that numbers the job (serial link) gets the confirmed / in-flight lines and the
      * resume rules from the command (cs_stream_resume_hint); a refusal at the start said why */
     bool refused = r->outcome == CS_STREAM_RESET && r->new_boot == 0;
-    if (rc != CS_EXIT_OK && r->executed < job->n && r->outcome != CS_STREAM_NO_DEVICE &&
-        r->outcome != CS_STREAM_INCOMPATIBLE && !r->numbered && !refused)
+    if (rc != CS_EXIT_OK && r->executed < n && !r->mid_message &&
+        r->outcome != CS_STREAM_NO_DEVICE && r->outcome != CS_STREAM_INCOMPATIBLE &&
+        !r->numbered && !refused)
         cs_stream_report_resume(out, one, r->executed);
     fflush(out);
     return rc;

@@ -326,7 +326,7 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     port_posix_reset(d->m->tick_hz, d->inv);
     port_posix_record(true);
     /* the application on the POSIX port, its link on the wall clock in microseconds with the
-     * timing of the simulated line (cs_stream_link_timing) */
+     * timing of the simulated line (cs_linktime_link, as the host computes it) */
     cs_fw_app_cfg_t ac;
     cs_fw_app_cfg_default(&ac, d->m);
     ac.motion.queue_size = cfg->queue_size;
@@ -334,9 +334,12 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
     ac.motion.method = (uint8_t)cfg->method;
     ac.clock = clock_us;
     ac.clock_hz = 1000000u;
-    cs_stream_link_timing(&ac.link, cfg->line_rate);
     ac.link.keepalive = 0;
-    ac.link.max_retries = 20;
+    if (cs_linktime_link(&ac.link, (uint32_t)cfg->line_rate, ac.clock_hz) != CS_OK) {
+        port_stepper_attach(NULL);
+        free(d);
+        return CS_ERR_ARG;
+    }
     ac.status_ms = cfg->status_ms ? cfg->status_ms : 50;
     cs_err_t e = cs_fw_app_init_cfg(&d->app, d->m, cfg->boot_id ? cfg->boot_id : 1u, &ac);
     if (e != CS_OK) {
@@ -666,136 +669,152 @@ int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o)
     return 1;
 }
 
-int cs_sim_device_main(int argc, char **argv)
-{
-    enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3, CHECK = 4 };
-    const char *port = NULL, *exlog = NULL;
-    bool pty = false;
-    long line_rate = 0;
+enum { DEV_OK = 0, DEV_INPUT = 1, DEV_USAGE = 2, DEV_INTERNAL = 3 };
+
+/* One run of the device program: its options, machine, configuration, reference, line. */
+typedef struct {
     cs_sim_device_opts_t o;
-    cs_sim_device_opts_default(&o);
+    const char *port;
+    const char *exlog; /* --exlog FILE (cs_sim_exlog) */
+    bool pty;
+    long line_rate;
+    cs_machine_t m;
+    cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
+    cs_sim_device_cfg_t cfg;
+    cs_sim_ref_t ref;
+    double end_mm[3];
+    int fd, keep;
+} device_run_t;
+
+/* Parses argv into d: -1 to go on, else the exit status (--help, a usage error). */
+static int device_parse(int argc, char **argv, device_run_t *d)
+{
+    cs_sim_device_opts_default(&d->o);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
         char *end = NULL;
-        int took = cs_sim_device_opt(argc, argv, &i, &o);
+        int took = cs_sim_device_opt(argc, argv, &i, &d->o);
         if (took < 0)
-            return USAGE;
+            return DEV_USAGE;
         if (took > 0)
             continue;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             device_usage(stdout);
-            return OK;
+            return DEV_OK;
         } else if (strcmp(a, "--pty") == 0) {
-            pty = true;
+            d->pty = true;
         } else if (strcmp(a, "--port") == 0 && has) {
-            port = argv[++i];
+            d->port = argv[++i];
         } else if (strcmp(a, "--exlog") == 0 && has) {
-            exlog = argv[++i];
+            d->exlog = argv[++i];
         } else if (strcmp(a, "--line-rate") == 0 && has) {
-            line_rate = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || line_rate < 0) {
+            d->line_rate = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || d->line_rate < 0) {
                 fprintf(stderr, "curvestep-sim: %s wants a number\n", a);
-                return USAGE;
+                return DEV_USAGE;
             }
         } else {
             fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
             device_usage(stderr);
-            return USAGE;
+            return DEV_USAGE;
         }
     }
-    const char *machine_file = o.machine_file, *reference = o.out.reference, *svg = o.out.svg,
-               *png = o.out.png, *trace = o.out.trace, *faults = o.faults;
-    bool check = o.out.check, instant = o.instant;
-    double speed = o.speed, idle_exit = o.idle_exit, tol_mm = o.tol_mm;
-    long queue = o.queue, baud = o.baud;
-    if (pty == (port != NULL)) {
+    if (d->pty == (d->port != NULL)) {
         fprintf(stderr, "curvestep-sim: give exactly one of --pty and --port DEV\n");
-        return USAGE;
+        return DEV_USAGE;
     }
-    if (queue < 1 || queue > CS_SIM_DEVICE_QUEUE_MAX) {
+    if (d->o.queue < 1 || d->o.queue > CS_SIM_DEVICE_QUEUE_MAX) {
         fprintf(stderr, "curvestep-sim: --queue wants 1..%d\n", CS_SIM_DEVICE_QUEUE_MAX);
-        return USAGE;
+        return DEV_USAGE;
     }
-    if (port != NULL && !cs_serial_baud_ok((uint32_t)baud)) {
-        fprintf(stderr, "curvestep-sim: --baud %ld is not a termios rate\n", baud);
-        return USAGE;
+    if (d->port != NULL && !cs_serial_baud_ok((uint32_t)d->o.baud)) {
+        fprintf(stderr, "curvestep-sim: --baud %ld is not a termios rate\n", d->o.baud);
+        return DEV_USAGE;
     }
-    cs_machine_t m;
-    cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
-    cs_machine_ini_pen_default(&pen);
+    return -1;
+}
+
+/* The machine, the device's configuration and the reference job (loaded first: a bad job is
+ * reported before anything is served). DEV_OK or the exit status. */
+static int device_setup(device_run_t *d)
+{
+    const cs_sim_device_opts_t *o = &d->o;
+    cs_machine_ini_pen_default(&d->pen);
     char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
+    if (o->machine_file) {
+        if (cs_machine_ini_load_pen(o->machine_file, &d->m, &d->pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
-            return INPUT;
+            return DEV_INPUT;
         }
     } else {
-        cs_machine_ini_default(&m);
+        cs_machine_ini_default(&d->m);
     }
-    cs_sim_device_cfg_t cfg;
-    cs_sim_device_cfg_default(&cfg, &m);
-    cfg.queue_size = (uint16_t)queue;
-    cfg.speed = instant ? 0 : speed;
-    cfg.line_rate = (uint32_t)line_rate;
-    cfg.idle_exit_s = idle_exit;
-    cfg.keep_edges = true;
-    cfg.exlog = exlog;
-    if (exlog != NULL) { /* say now when the log cannot be written, not as a closed line */
-        int xfd = open(exlog, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    cs_sim_device_cfg_t *cfg = &d->cfg;
+    cs_sim_device_cfg_default(cfg, &d->m);
+    cfg->queue_size = (uint16_t)o->queue;
+    cfg->speed = o->instant ? 0 : o->speed;
+    cfg->line_rate = (uint32_t)d->line_rate;
+    cfg->idle_exit_s = o->idle_exit;
+    cfg->keep_edges = true;
+    cfg->exlog = d->exlog;
+    if (d->exlog != NULL) { /* said now when the log cannot be written, not as a closed line */
+        int xfd = open(d->exlog, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
         if (xfd < 0) {
-            fprintf(stderr, "curvestep-sim: --exlog %s: %s\n", exlog, strerror(errno));
-            return INPUT;
+            fprintf(stderr, "curvestep-sim: --exlog %s: %s\n", d->exlog, strerror(errno));
+            return DEV_INPUT;
         }
         close(xfd);
     }
-    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &cfg.tol) != CS_OK) {
-        fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", tol_mm);
-        return USAGE;
+    if (o->tol_mm > 0 && cs_conv_tol_to_pos(o->tol_mm, &cfg->tol) != CS_OK) {
+        fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", o->tol_mm);
+        return DEV_USAGE;
     }
-    if (faults != NULL && parse_faults(faults, &cfg) != 0) {
-        fprintf(stderr, "curvestep-sim: --faults: bad list '%s' (see --help)\n", faults);
-        return USAGE;
+    if (o->faults != NULL && parse_faults(o->faults, cfg) != 0) {
+        fprintf(stderr, "curvestep-sim: --faults: bad list '%s' (see --help)\n", o->faults);
+        return DEV_USAGE;
     }
-    /* load the reference first: a bad job is reported before anything is served */
-    cs_sim_ref_t ref;
-    cs_sim_ref_init(&ref);
-    double end_mm[3] = {0, 0, 0};
-    if (reference) {
-        cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
-        cs_jobplan_init(&jp);
-        cs_err_t e = cs_jobplan_reference(&jp, reference, &o.in, machine_file, &m);
-        if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &jp.path, end_mm);
-        else
-            cs_path_diag_print(stderr, &jp.diag);
-        cs_jobplan_free(&jp);
-        if (e != CS_OK) {
-            cs_sim_ref_free(&ref);
-            return INPUT;
-        }
-    }
-    int fd = -1, keep = -1;
-    cs_serial_t ser;
-    if (pty) {
+    if (o->out.reference == NULL)
+        return DEV_OK;
+    cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
+    cs_jobplan_init(&jp);
+    cs_err_t e = cs_jobplan_reference(&jp, o->out.reference, &o->in, o->machine_file, &d->m);
+    if (e == CS_OK)
+        e = cs_sim_ref_from_path(&d->ref, &jp.path, d->end_mm);
+    else
+        cs_path_diag_print(stderr, &jp.diag);
+    cs_jobplan_free(&jp);
+    return e == CS_OK ? DEV_OK : DEV_INPUT;
+}
+
+/* The line: a new pseudo-terminal (its path printed) or the --port tty. DEV_OK or the status. */
+static int device_line(device_run_t *d)
+{
+    if (d->pty) {
         char name[256];
-        if (cs_serial_openpty(&fd, &keep, name, sizeof name) != 0) {
+        if (cs_serial_openpty(&d->fd, &d->keep, name, sizeof name) != 0) {
             perror("curvestep-sim: openpty");
-            cs_sim_ref_free(&ref);
-            return INTERNAL;
+            return DEV_INTERNAL;
         }
         /* keep our own slave fd open: the master never sees a hang-up between two hosts, and
          * a host that opens the path flushes what piled up meanwhile */
         printf("%s\n", name);
         fflush(stdout);
-    } else {
-        if (cs_serial_open(&ser, port, (uint32_t)baud) != 0) {
-            fprintf(stderr, "curvestep-sim: %s: %s\n", port, strerror(errno));
-            cs_sim_ref_free(&ref);
-            return INPUT;
-        }
-        fd = ser.fd;
+        return DEV_OK;
     }
+    cs_serial_t ser;
+    if (cs_serial_open(&ser, d->port, (uint32_t)d->o.baud) != 0) {
+        fprintf(stderr, "curvestep-sim: %s: %s\n", d->port, strerror(errno));
+        return DEV_INPUT;
+    }
+    d->fd = ser.fd;
+    return DEV_OK;
+}
+
+/* Serves until the line closes or a signal, then the device's and the link's lines and the
+ * report (checks, pictures). The exit status. */
+static int device_serve(device_run_t *d)
+{
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -803,16 +822,15 @@ int cs_sim_device_main(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     cs_sim_device_result_t res;
-    cs_err_t e = cs_sim_device_serve(fd, &cfg, &g_stop, &res);
-    close(fd);
-    if (keep >= 0)
-        close(keep);
-    int rc = OK;
+    cs_err_t e = cs_sim_device_serve(d->fd, &d->cfg, &g_stop, &res);
+    close(d->fd);
+    if (d->keep >= 0)
+        close(d->keep);
+    int rc = DEV_OK;
     if (e != CS_OK && e != CS_ERR_IO) {
         fprintf(stderr, "curvestep-sim: device failed: %s\n", cs_err_text(e));
-        rc = INTERNAL;
+        rc = DEV_INTERNAL;
     }
-    bool ok = true;
     printf("device: served %.2f s; %llu messages executed (%llu step segments, %llu curves); "
            "%u resets, %u holds, %u aborts, %u errors sent%s\n",
            res.wall_s, (unsigned long long)res.executed, (unsigned long long)res.segments,
@@ -825,15 +843,36 @@ int cs_sim_device_main(int argc, char **argv)
            (unsigned)res.frames.frames, (unsigned)res.frames.crc_errs, (unsigned)res.frames.bad,
            (unsigned)res.link.duplicates, (unsigned)res.link.out_of_order,
            (unsigned)res.link.retransmits);
-    cs_sim_device_out_t out = {reference, trace, svg, png, check, &ref, {0, 0, 0}, NULL};
-    memcpy(out.end_mm, end_mm, sizeof end_mm);
-    if (pen.mode == CS_MACHINE_PEN_SERVO)
-        out.pen = &pen;
-    rc = cs_sim_device_report(&m, &cfg, &res, &out, ok, rc);
+    const cs_sim_device_opts_t *o = &d->o;
+    cs_sim_device_out_t out = {o->out.reference, o->out.trace, o->out.svg, o->out.png,
+                               o->out.check,     &d->ref,      {0, 0, 0},  NULL};
+    memcpy(out.end_mm, d->end_mm, sizeof d->end_mm);
+    if (d->pen.mode == CS_MACHINE_PEN_SERVO)
+        out.pen = &d->pen;
+    rc = cs_sim_device_report(&d->m, &d->cfg, &res, &out, true, rc);
     fflush(stdout);
-    cs_sim_ref_free(&ref);
     cs_sim_exec_free(&res.ex);
     cs_motion_segs_free(&res.pen_segs);
+    return rc;
+}
+
+int cs_sim_device_main(int argc, char **argv)
+{
+    device_run_t *d = calloc(1, sizeof *d);
+    if (d == NULL)
+        return DEV_INTERNAL;
+    d->fd = d->keep = -1;
+    cs_sim_ref_init(&d->ref);
+    int rc = device_parse(argc, argv, d); /* >= 0: --help or a usage error, nothing to run */
+    if (rc < 0) {
+        rc = device_setup(d);
+        if (rc == DEV_OK)
+            rc = device_line(d);
+        if (rc == DEV_OK)
+            rc = device_serve(d);
+    }
+    cs_sim_ref_free(&d->ref);
+    free(d);
     return rc;
 }
 

@@ -37,7 +37,8 @@ static void usage(FILE *f)
         "    window, acceleration = change of that between windows; the estimator's own error\n"
         "    (2 steps/W, 4 steps/W^2) is allowed on top of the limit and printed;\n"
         "  - with --reference FILE (the job: SVG, G-code or HP-GL, read as `plan` reads it;\n"
-        "    --font and the input and layout options as for plan; the machine's [pen] lifts included), the\n"
+        "    --font and the input and layout options as for plan; the machine's [pen] lifts "
+        "included), the\n"
         "    largest distance from any position the steps visit to the exact geometry\n"
         "    (evaluated in double), against the tolerance plus one step, and whether the final\n"
         "    position is the job's end rounded to steps. With a [pen] (mode z: the pen is down\n"
@@ -82,6 +83,184 @@ static cs_err_t read_reference(const char *file, const char *font, const cs_jobo
 
 /* Prints the geometric check (cs_sim_check) and the final position; true when both pass. */
 
+/* The replay's command line. */
+typedef struct {
+    const char *replay, *machine_file, *reference, *trace, *svg, *png, *font;
+    bool check;
+    cs_jobopts_t in; /* --reference is read, laid out, merged and sorted as plan does */
+    double window_ms;
+    long png_width;
+    cs_sim_view_t view;
+} replay_args_t;
+
+/* The replay's options with a value check: 1 taken, 0 not one of them, -1 bad (said). */
+static int replay_number_option(int argc, char **argv, int *i, replay_args_t *a)
+{
+    const char *o = argv[*i];
+    if (*i + 1 >= argc)
+        return 0;
+    char *end;
+    if (strcmp(o, "--window") == 0) {
+        a->window_ms = strtod(argv[++*i], &end);
+        if (*end != '\0' || !(a->window_ms > 0) || a->window_ms > 10000) {
+            fprintf(stderr, "curvestep-sim: --window wants milliseconds in (0, 10000]\n");
+            return -1;
+        }
+    } else if (strcmp(o, "--png-width") == 0) {
+        a->png_width = strtol(argv[++*i], &end, 10);
+        if (*end != '\0' || a->png_width < 100 || a->png_width > 8000) {
+            fprintf(stderr, "curvestep-sim: --png-width wants pixels in 100..8000\n");
+            return -1;
+        }
+    } else if (strcmp(o, "--view") == 0) {
+        if (!cs_sim_view_parse(argv[++*i], &a->view)) {
+            fprintf(stderr, "curvestep-sim: --view wants top, front, side or iso\n");
+            return -1;
+        }
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* The replay's file options: 1 taken, 0 not one of them. */
+static int replay_file_option(int argc, char **argv, int *i, replay_args_t *a)
+{
+    static const char *const names[] = {"--replay", "--machine", "--reference", "--trace",
+                                        "--svg",    "--png",     "--font"};
+    const char **dst[] = {&a->replay, &a->machine_file, &a->reference, &a->trace,
+                          &a->svg,    &a->png,          &a->font};
+    if (*i + 1 >= argc)
+        return 0;
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+        if (strcmp(argv[*i], names[k]) == 0) {
+            *dst[k] = argv[++*i];
+            return 1;
+        }
+    return 0;
+}
+
+/* Parses argv into *a: -1 to go on, else the exit status (--help, a usage error). */
+static int replay_parse(int argc, char **argv, replay_args_t *a)
+{
+    memset(a, 0, sizeof *a);
+    cs_jobopts_init(&a->in);
+    a->window_ms = 50;
+    a->png_width = 1600;
+    cs_sim_view_default(&a->view);
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i];
+        int r = cs_jobopts_option("sim", argc, argv, &i, &a->in);
+        if (r == 0)
+            r = replay_file_option(argc, argv, &i, a);
+        if (r == 0)
+            r = replay_number_option(argc, argv, &i, a);
+        if (r < 0)
+            return EXIT_USAGE;
+        if (r > 0)
+            continue;
+        if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
+            usage(stdout);
+            return EXIT_OK;
+        } else if (strcmp(o, "--check") == 0) {
+            a->check = true;
+        } else {
+            fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", o);
+            usage(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (a->replay == NULL || cs_jobopts_check("sim", &a->in) != 0) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
+/* The segments file (- : standard input), read against machine m. EXIT_OK or EXIT_INPUT. */
+static int replay_read(const char *replay, const cs_machine_t *m, cs_motion_segs_t *segs)
+{
+    char err[512];
+    FILE *f = strcmp(replay, "-") == 0 ? stdin : fopen(replay, "r");
+    if (f == NULL) {
+        fprintf(stderr, "%s:0: cannot open the segments file\n", replay);
+        return EXIT_INPUT;
+    }
+    int r = cs_motion_read(f, replay, m, segs, err, sizeof err);
+    if (f != stdin)
+        fclose(f);
+    if (r != 0) {
+        fprintf(stderr, "%s\n", err);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+/* "replay: ...", "final position: ..." and each axis's peaks against its limits; false when a
+ * limit is exceeded. */
+static bool replay_dynamics(const cs_machine_t *m, const cs_motion_segs_t *segs,
+                            const cs_sim_exec_t *ex, double window_ms)
+{
+    bool ok = true;
+    static const char names[] = "xyza";
+    printf("replay: %zu segments, %zu steps, job time %.4f s\n", segs->n, ex->n,
+           (double)ex->end_tick / m->tick_hz);
+    printf("final position:");
+    for (unsigned i = 0; i < m->n_axes; i++)
+        printf(" %c=%lld steps (%.4f mm)", names[i], (long long)ex->pos[i],
+               (double)ex->pos[i] * CS_MOTION_ONE / m->axis[i].steps_per_mm);
+    printf("\n");
+    cs_sim_dyn_t dyn;
+    cs_sim_dynamics(m, ex, window_ms / 1000.0, &dyn);
+    for (unsigned i = 0; i < m->n_axes; i++) {
+        double rate = cs_machine_ini_to_double(m->axis[i].max_rate);
+        double acc = cs_machine_ini_to_double(m->axis[i].max_accel);
+        printf("axis %c: peak velocity %.3f mm/s at %.3f s (limit %.3f + %.3f) %s; "
+               "peak acceleration %.1f mm/s^2 at %.3f s (limit %.1f + %.1f) %s\n",
+               names[i], dyn.peak_rate[i], dyn.t_rate[i], rate, dyn.rate_allow[i],
+               dyn.rate_ok[i] ? "ok" : "OVER", dyn.peak_accel[i], dyn.t_accel[i], acc,
+               dyn.accel_allow[i], dyn.accel_ok[i] ? "ok" : "OVER");
+        ok = ok && dyn.rate_ok[i] && dyn.accel_ok[i];
+    }
+    return ok;
+}
+
+/* The reference check, the trace and the pictures, then "check: ...". The exit status. */
+static int replay_outputs(const replay_args_t *a, const cs_machine_t *m,
+                          const cs_machine_pen_t *pen, const cs_motion_segs_t *segs,
+                          const cs_sim_exec_t *ex, bool ok)
+{
+    cs_sim_ref_t ref;
+    cs_sim_ref_init(&ref);
+    int rc = EXIT_OK;
+    if (a->reference) {
+        double end[3];
+        cs_err_t e = read_reference(a->reference, a->font, &a->in, a->machine_file, m, &ref, end);
+        if (e != CS_OK)
+            rc = EXIT_INPUT;
+        else
+            ok = cs_sim_check_print(m, segs, ex, &ref, pen, end) && ok;
+    }
+    const cs_sim_ref_t *r = a->reference ? &ref : NULL;
+    if (rc == EXIT_OK && a->trace && cs_sim_write_trace(a->trace, m, ex) != 0) {
+        perror(a->trace);
+        rc = EXIT_INTERNAL;
+    }
+    if (rc == EXIT_OK && a->svg && cs_sim_draw_svg_view(a->svg, m, ex, r, &a->view) != 0) {
+        perror(a->svg);
+        rc = EXIT_INTERNAL;
+    }
+    if (rc == EXIT_OK && a->png &&
+        cs_sim_draw_png_view(a->png, m, ex, r, &a->view, (int)a->png_width) != 0)
+        rc = EXIT_INTERNAL;
+    if (rc == EXIT_OK && a->check) {
+        printf("check: %s\n", ok ? "ok" : "FAILED");
+        rc = ok ? EXIT_OK : EXIT_CHECK;
+    }
+    cs_sim_ref_free(&ref);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     for (int i = 1; i < argc; i++) /* device mode: the simulator behind a serial line */
@@ -90,153 +269,30 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) /* the device behind Modbus TCP or RTU (sim/cs_sim_modbus.h) */
         if (strcmp(argv[i], "--modbus-tcp") == 0 || strcmp(argv[i], "--modbus-rtu") == 0)
             return cs_sim_modbus_main(argc, argv);
-    const char *replay = NULL, *machine_file = NULL, *reference = NULL, *trace = NULL, *svg = NULL,
-               *png = NULL;
-    const char *font = NULL;
-    bool check = false;
-    cs_jobopts_t in; /* --reference is read, laid out, merged and sorted as plan does */
-    cs_jobopts_init(&in);
-    double window_ms = 50;
-    long png_width = 1600;
-    cs_sim_view_t view;
-    cs_sim_view_default(&view);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        bool has = i + 1 < argc;
-        int r = cs_jobopts_option("sim", argc, argv, &i, &in);
-        if (r < 0)
-            return EXIT_USAGE;
-        if (r > 0)
-            continue;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return EXIT_OK;
-        } else if (strcmp(a, "--replay") == 0 && has) {
-            replay = argv[++i];
-        } else if (strcmp(a, "--machine") == 0 && has) {
-            machine_file = argv[++i];
-        } else if (strcmp(a, "--reference") == 0 && has) {
-            reference = argv[++i];
-        } else if (strcmp(a, "--trace") == 0 && has) {
-            trace = argv[++i];
-        } else if (strcmp(a, "--svg") == 0 && has) {
-            svg = argv[++i];
-        } else if (strcmp(a, "--png") == 0 && has) {
-            png = argv[++i];
-        } else if (strcmp(a, "--window") == 0 && has) {
-            char *end;
-            window_ms = strtod(argv[++i], &end);
-            if (*end != '\0' || !(window_ms > 0) || window_ms > 10000) {
-                fprintf(stderr, "curvestep-sim: --window wants milliseconds in (0, 10000]\n");
-                return EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--png-width") == 0 && has) {
-            char *end;
-            png_width = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || png_width < 100 || png_width > 8000) {
-                fprintf(stderr, "curvestep-sim: --png-width wants pixels in 100..8000\n");
-                return EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--view") == 0 && has) {
-            if (!cs_sim_view_parse(argv[++i], &view)) {
-                fprintf(stderr, "curvestep-sim: --view wants top, front, side or iso\n");
-                return EXIT_USAGE;
-            }
-        } else if (strcmp(a, "--check") == 0) {
-            check = true;
-        } else if (strcmp(a, "--font") == 0 && has) {
-            font = argv[++i];
-        } else {
-            fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
-            usage(stderr);
-            return EXIT_USAGE;
-        }
-    }
-    if (replay == NULL || cs_jobopts_check("sim", &in) != 0) {
-        usage(stderr);
-        return EXIT_USAGE;
-    }
+    replay_args_t a;
+    int rc = replay_parse(argc, argv, &a);
+    if (rc >= 0)
+        return rc;
     cs_machine_t m;
     cs_machine_pen_t pen;
     cs_machine_ini_pen_default(&pen);
     char err[512];
-    if (cs_machine_ini_open("curvestep-sim", machine_file, &m, &pen, err, sizeof err) != 0) {
+    if (cs_machine_ini_open("curvestep-sim", a.machine_file, &m, &pen, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
-        return EXIT_INPUT;
-    }
-    FILE *f = strcmp(replay, "-") == 0 ? stdin : fopen(replay, "r");
-    if (f == NULL) {
-        fprintf(stderr, "%s:0: cannot open the segments file\n", replay);
         return EXIT_INPUT;
     }
     cs_motion_segs_t segs = {0};
-    int r = cs_motion_read(f, replay, &m, &segs, err, sizeof err);
-    if (f != stdin)
-        fclose(f);
-    if (r != 0) {
-        fprintf(stderr, "%s\n", err);
-        cs_motion_segs_free(&segs);
-        return EXIT_INPUT;
-    }
+    rc = replay_read(a.replay, &m, &segs);
     cs_sim_exec_t ex;
-    cs_err_t e = cs_sim_execute(&m, segs.v, segs.n, &ex);
-    if (e != CS_OK) {
+    cs_err_t e = rc == EXIT_OK ? cs_sim_execute(&m, segs.v, segs.n, &ex) : CS_OK;
+    if (rc == EXIT_OK && e != CS_OK) {
         fprintf(stderr, "curvestep-sim: execution failed: %s\n", cs_err_text(e));
-        cs_motion_segs_free(&segs);
-        return EXIT_INTERNAL;
-    }
-    bool ok = true;
-    static const char names[] = "xyza";
-    printf("replay: %zu segments, %zu steps, job time %.4f s\n", segs.n, ex.n,
-           (double)ex.end_tick / m.tick_hz);
-    printf("final position:");
-    for (unsigned i = 0; i < m.n_axes; i++)
-        printf(" %c=%lld steps (%.4f mm)", names[i], (long long)ex.pos[i],
-               (double)ex.pos[i] * CS_MOTION_ONE / m.axis[i].steps_per_mm);
-    printf("\n");
-    cs_sim_dyn_t dyn;
-    cs_sim_dynamics(&m, &ex, window_ms / 1000.0, &dyn);
-    for (unsigned i = 0; i < m.n_axes; i++) {
-        double rate = cs_machine_ini_to_double(m.axis[i].max_rate);
-        double acc = cs_machine_ini_to_double(m.axis[i].max_accel);
-        printf("axis %c: peak velocity %.3f mm/s at %.3f s (limit %.3f + %.3f) %s; "
-               "peak acceleration %.1f mm/s^2 at %.3f s (limit %.1f + %.1f) %s\n",
-               names[i], dyn.peak_rate[i], dyn.t_rate[i], rate, dyn.rate_allow[i],
-               dyn.rate_ok[i] ? "ok" : "OVER", dyn.peak_accel[i], dyn.t_accel[i], acc,
-               dyn.accel_allow[i], dyn.accel_ok[i] ? "ok" : "OVER");
-        ok = ok && dyn.rate_ok[i] && dyn.accel_ok[i];
-    }
-    cs_sim_ref_t ref;
-    cs_sim_ref_init(&ref);
-    int rc = EXIT_OK;
-    if (reference) {
-        double end[3];
-        e = read_reference(reference, font, &in, machine_file, &m, &ref, end);
-        if (e != CS_OK)
-            rc = EXIT_INPUT;
-        else
-            ok = cs_sim_check_print(&m, &segs, &ex, &ref, &pen, end) && ok;
-    }
-    if (rc == EXIT_OK && trace && cs_sim_write_trace(trace, &m, &ex) != 0) {
-        perror(trace);
         rc = EXIT_INTERNAL;
+    } else if (rc == EXIT_OK) {
+        bool ok = replay_dynamics(&m, &segs, &ex, a.window_ms);
+        rc = replay_outputs(&a, &m, &pen, &segs, &ex, ok);
+        cs_sim_exec_free(&ex);
     }
-    if (rc == EXIT_OK && svg &&
-        cs_sim_draw_svg_view(svg, &m, &ex, reference ? &ref : NULL, &view) != 0) {
-        perror(svg);
-        rc = EXIT_INTERNAL;
-    }
-    if (rc == EXIT_OK && png &&
-        cs_sim_draw_png_view(png, &m, &ex, reference ? &ref : NULL, &view, (int)png_width) != 0)
-        rc = EXIT_INTERNAL;
-    if (rc == EXIT_OK && check && !ok) {
-        printf("check: FAILED\n");
-        rc = EXIT_CHECK;
-    } else if (rc == EXIT_OK && check) {
-        printf("check: ok\n");
-    }
-    cs_sim_ref_free(&ref);
-    cs_sim_exec_free(&ex);
     cs_motion_segs_free(&segs);
     return rc;
 }

@@ -193,10 +193,9 @@ void cs_fw_app_cfg_default(cs_fw_app_cfg_t *c, const cs_machine_t *m)
     cs_fw_motion_cfg_default(&c->motion, m);
     c->clock = port_ticks_now;
     c->clock_hz = port_tick_hz();
-    c->link.rto = (c->clock_hz / 1000u) * CS_FW_RTO_MS;
-    c->link.nak_holdoff = (c->clock_hz / 1000u) * CS_FW_NAK_MS;
+    /* the timing every end of the link computes the same way (cs_linktime, protocol.md 3.6) */
     c->link.keepalive = 0;
-    c->link.max_retries = 20;
+    (void)cs_linktime_link(&c->link, CS_FW_LINE_BPS, c->clock_hz);
     c->status_ms = 50;
 }
 

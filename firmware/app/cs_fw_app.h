@@ -25,8 +25,8 @@
  *   CS_FW_ERRQ        ERROR messages waiting for room in the link window, default 4 (4 B each).
  *   CS_FW_RX_CHUNK    UART bytes read per poll, on the stack, default 32.
  *   CS_FW_TRACE       tracer for CURVE messages (cs_trace_method_t), default CS_TRACE_DEFAULT.
- *   CS_FW_RTO_MS      link retransmission timeout, ms, default 50 (>= a full window at the line
- *                     rate plus a round trip: docs/protocol.md 3.6); CS_FW_NAK_MS, default 2.
+ *   CS_FW_LINE_BPS    the line's bits/s, default 115200: the link's retransmission timeout and
+ *                     NAK hold-off follow from it (cs_linktime_link, docs/protocol.md 3.6).
  *   CS_FW_XY_RATE, CS_FW_XY_ACCEL  x/y limits of cs_fw_machine_default (500 mm/s, 5000 mm/s^2).
  * The core's own sizes apply too: CS_LINK_WINDOW (default 8: cs_link_t 896 B on the M3, 863 B on
  * the AVR; 266 B on the AVR with CS_LINK_WINDOW=2 and CS_FRAME_PAYLOAD_MAX=27),
@@ -43,17 +43,15 @@
 #include "cs_err.h"
 #include "cs_fw_motion.h"
 #include "cs_link.h"
+#include "cs_linktime.h"
 #include "cs_machine.h"
 #include "cs_proto.h"
 
 #ifndef CS_FW_RX_CHUNK
 #define CS_FW_RX_CHUNK 32
 #endif
-#ifndef CS_FW_RTO_MS
-#define CS_FW_RTO_MS 50
-#endif
-#ifndef CS_FW_NAK_MS
-#define CS_FW_NAK_MS 2
+#ifndef CS_FW_LINE_BPS
+#define CS_FW_LINE_BPS 115200u
 #endif
 #if CS_FW_CURVES
 CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_CURVE, fw_payload_carries_curve);
@@ -105,7 +103,8 @@ typedef struct {
  * port (firmware/ports/<target>/machine.ini) says the same for the host. Not ISR-safe. */
 void cs_fw_machine_default(cs_machine_t *m, uint32_t tick_hz);
 /* A board's choices for machine *m: cs_fw_motion_cfg_default, port_ticks_now at port_tick_hz as
- * the link clock, CS_FW_RTO_MS / CS_FW_NAK_MS, 20 retries, STATUS every 50 ms while moving. */
+ * the link clock, the link timing of a CS_FW_LINE_BPS line (cs_linktime_link), STATUS every
+ * 50 ms while moving. */
 void cs_fw_app_cfg_default(cs_fw_app_cfg_t *c, const cs_machine_t *m);
 /* Sets up the application for machine *m (kept; must outlive app) with boot id boot_id (random
  * per boot, != 0 preferred) and the defaults: executor, planner, link (CONNECTING), the step timer

@@ -24,23 +24,9 @@ G2 X2 Y5 I-4 J0
 G1 X-3 Y-2 Z-1
 G0 X7 Y-4 Z2
 EOF
-# A longer one (about 2 s) to interrupt.
-printf 'G21 G90\nG1 X150 Y100 F6000\n' >"$T/long.nc"
-cat >"$T/m.ini" <<'EOF'
-[y]
-invert_dir = true
-[gpio]
-chip = gpiochip0
-x_step = 17
-x_dir = 27
-y_step = 22
-y_dir = 23
-z_step = 5
-z_dir = 6
-enable = 4
-pulse_us = 4
-dir_setup_us = 20
-EOF
+# A longer one (about 4 s) to interrupt once it has executed a segment.
+printf 'G21 G90\nG1 X150 Y100 F3000\n' >"$T/long.nc"
+cp tests/data/gpio/wired3.ini "$T/m.ini"
 
 # check_record REC TRACE PULSE_NS SETUP_NS: the record against the simulator's trace. Prints
 # "ok <steps>" or the first problem.
@@ -110,7 +96,9 @@ timeout --foreground -k 5 60 "$CS" stream --gpio "record:$T/int.rec" --machine "
     >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
-sleep 0.6
+# the event: a progress line (once a second) that counts an executed segment
+moving() { grep -qE '^stream: [1-9][0-9]*/' "$T/int.err"; }
+expect "ctrl-c: the job is moving" wait_until 30 moving
 kill -INT "$spid"
 wait "$spid"; rc=$?
 expect "ctrl-c: exit 8" [ $rc -eq 8 ]

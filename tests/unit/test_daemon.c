@@ -80,7 +80,8 @@ static void test_protocol(void **state)
     assert_true(pid >= 0);
     if (pid == 0) {
         alarm(300); /* bounded whatever happens (generous: ASan on a loaded machine) */
-        cs_daemon_cfg_t cfg = {.port = pty, .baud = 115200, .socket_path = sock, .log = NULL};
+        cs_daemon_cfg_t cfg = {
+            .link = {.port = pty, .baud = 115200}, .socket_path = sock, .log = NULL};
         _exit(cs_daemon_serve(&cfg));
     }
     struct stat st;
@@ -219,8 +220,10 @@ static void test_pen_machine(void **state)
     assert_true(pid >= 0);
     if (pid == 0) {
         alarm(300);
-        cs_daemon_cfg_t cfg = {
-            .port = pty, .baud = 115200, .socket_path = sock, .machine_file = ini, .log = NULL};
+        cs_daemon_cfg_t cfg = {.link = {.port = pty, .baud = 115200},
+                               .socket_path = sock,
+                               .machine_file = ini,
+                               .log = NULL};
         _exit(cs_daemon_serve(&cfg));
     }
     struct stat st;

@@ -403,6 +403,81 @@ static void test_resume(void **state)
     cs_motion_free(&mo);
 }
 
+/* Waits (bounded, 30 s) until cond(r) holds; false at the deadline. */
+static bool wait_for(cs_gpio_run_t *r, bool (*cond)(const cs_gpio_run_t *))
+{
+    int64_t t_start = cs_gpio_io_now_ns();
+    while (!cond(r) && cs_gpio_io_now_ns() - t_start < 30000000000LL) {
+        struct timespec ts = {0, 5000000};
+        nanosleep(&ts, NULL);
+    }
+    return cond(r);
+}
+
+static bool moved(const cs_gpio_run_t *r)
+{
+    return cs_gpio_run_executed(r) > 0 || cs_gpio_run_finished(r);
+}
+
+/* Pause (the daemon's): the thread decelerates with the core's ramp, waits at rest with the job
+ * kept, and on resume ramps back up and runs the rest: every step of the plan on the lines, in
+ * order, never early, pulses and DIR set-up kept across the pause. */
+static void test_pause_and_resume(void **state)
+{
+    (void)state;
+    cs_machine_t m;
+    cs_machine_ini_default(&m);
+    cs_gpio_cfg_t cfg;
+    cs_gpio_cfg_default(&cfg, &m);
+    static const double pts[][4] = {{60, 40, 0, 0}, {20, 60, 0, 0}}; /* ~1.5 s at 80 mm/s */
+    cs_motion_t mo;
+    plan(&m, pts, 2, 80, &mo);
+    cs_gpio_lines_t l;
+    cs_gpio_run_opts_t o;
+    lines_for(&m, &cfg, &l, &o);
+    cs_gpio_io_t io;
+    assert_int_equal(
+        cs_gpio_io_open_recorder(&io, &l, cs_gpio_run_record_capacity(mo.segs.v, mo.segs.n)), 0);
+    o.m = &m;
+    o.cfg = &cfg;
+    o.io = &io;
+    o.segs = mo.segs.v;
+    o.nsegs = mo.segs.n;
+    o.first = 0;
+    o.realtime = false;
+    cs_gpio_run_t r;
+    assert_int_equal(cs_gpio_run_start(&r, &o), 0);
+    assert_true(wait_for(&r, moved)); /* the event: a segment executed */
+    cs_gpio_run_pause(&r, true);
+    assert_true(wait_for(&r, cs_gpio_run_paused)); /* at rest, the hold confirmed */
+    size_t k = cs_gpio_run_executed(&r);
+    assert_false(cs_gpio_run_finished(&r));
+    assert_true(k > 0 && k < mo.segs.n);
+    int64_t at_rest[CS_AXES];
+    seg_sum(mo.segs.v, 0, k, at_rest); /* at rest at a segment end */
+    for (unsigned i = 0; i < m.n_axes; i++)
+        assert_int_equal(cs_stepper_position(&r.st, i), at_rest[i]);
+    cs_gpio_run_pause(&r, false);
+    assert_true(wait_for(&r, cs_gpio_run_finished));
+    cs_gpio_run_join(&r);
+    cs_gpio_io_close(&io);
+    assert_int_equal(r.outcome, CS_GPIO_RUN_DONE);
+    assert_int_equal(cs_gpio_run_executed(&r), mo.segs.n);
+    decoded_t d;
+    decode(&io, &r, &m, &cfg, NULL, 0, &d);
+    for (unsigned i = 0; i < m.n_axes; i++) {
+        assert_int_equal(d.pos[i], mo.pos[i]); /* every step of the plan, none twice */
+        assert_int_equal(r.pos[i], mo.pos[i]);
+    }
+    assert_true(d.min_pulse >= (int64_t)cfg.pulse_ns);
+    assert_true(d.min_setup >= (int64_t)cfg.dir_setup_ns);
+    print_message("  pause: at rest after segment %zu of %zu, then resumed to the end\n", k,
+                  mo.segs.n);
+    free(d.late);
+    cs_gpio_io_free(&io);
+    cs_motion_free(&mo);
+}
+
 /* A segment the executor refuses (more steps than ticks) stops the run there, named, with
  * every step before it on the lines and the lines safe. */
 static void test_bad_segment(void **state)
@@ -530,6 +605,7 @@ int main(void)
         cmocka_unit_test(test_hold_stops_at_a_segment_end),
         cmocka_unit_test(test_stop_at_once),
         cmocka_unit_test(test_resume),
+        cmocka_unit_test(test_pause_and_resume),
         cmocka_unit_test(test_bad_segment),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -9,8 +9,9 @@
 #                       stderr in $T/serve.err), waits for the socket;
 #   dmn_progress        job 1's executed count from `status` ("" when it is not running);
 #   dmn_quarter         succeeds once job 1 has executed a quarter of N (for wait_until);
-#   dmn_still           succeeds when job 1's count stands still across the once-a-second
-#                       status line (a held job, for wait_until);
+#   dmn_still           succeeds once the link confirmed job 1's hold: status shows "(held)"
+#                       (the device reported HELD, or the GPIO step thread is at rest; before
+#                       that it shows "(holding)"), for wait_until;
 #   dmn_finished        succeeds once job 1 is done, failed or cancelled.
 C() { timeout -k 5 30 "$CS" "$@" --socket "$S"; }
 dmn_start() {
@@ -25,13 +26,7 @@ dmn_quarter() {
     p=$(dmn_progress)
     [ "${p:-0}" -ge $((N / 4)) ]
 }
-dmn_still() {
-    local a b
-    a=$(dmn_progress)
-    sleep 1.2
-    b=$(dmn_progress)
-    [ -n "$a" ] && [ "$a" = "$b" ]
-}
+dmn_still() { C status 2>/dev/null | grep -qE "^job 1 running: .*: [0-9]+/$N segments executed \(held\)$"; }
 dmn_finished() { C status 2>/dev/null | grep -qE "^job 1 (done|failed|cancelled)"; }
 dmn_job() {
     JOB=$T/line.nc

@@ -1,0 +1,42 @@
+/* cs_linktime: the timing of a byte line, computed once for every end of it (the host's serial
+ * and Modbus RTU links, the device application, the simulator): how long characters take on the
+ * wire, and the reliable link's retransmission timeout and NAK hold-off derived from it
+ * (docs/protocol.md 3.6). Integer arithmetic in the caller's ticks, rounded up (a timeout is
+ * never shorter than the wire time it covers). Owns no state; every function is ISR-safe. */
+#ifndef CS_LINKTIME_H
+#define CS_LINKTIME_H
+
+#include <stdint.h>
+
+#include "cs_err.h"
+#include "cs_link.h"
+
+/* Bits of one character: 8N1 (start, 8 data, stop) for the framed serial protocol; Modbus RTU
+ * sends 11 (start, 8 data, parity or a second stop, stop: Modbus over serial line V1.02, 2.5.1). */
+#define CS_LINKTIME_BITS_8N1 10u
+#define CS_LINKTIME_BITS_RTU 11u
+/* The reliable link's margin for a round trip's latencies (USB-serial, scheduling): 40 ms. */
+#define CS_LINKTIME_RTT_MS 40u
+/* At memory speed (a pty): 5 ms timeouts, 200 of them in a row (1 s of silence) close the link. */
+#define CS_LINKTIME_MEM_RTO_MS  5u
+#define CS_LINKTIME_MEM_RETRIES 200u
+/* On a real line: timeouts in a row before the link is closed (docs/protocol.md 3.6: 4e-9 with
+ * 1 % of bytes corrupted). */
+#define CS_LINKTIME_RETRIES 20u
+
+/* Ticks of tick_hz that n characters of bits_per_char bits take on a line of bits_per_s:
+ * ceil(n * bits_per_char * tick_hz / bits_per_s), UINT32_MAX when that does not fit 32 bits,
+ * 0 when bits_per_s is 0 (memory speed). ISR-safe. */
+uint32_t cs_linktime_chars(uint32_t n, uint32_t bits_per_char, uint32_t bits_per_s,
+                           uint32_t tick_hz);
+
+/* The reliable link's timing for a line of bits_per_s (8N1; 0: a pty at memory speed) in ticks
+ * of tick_hz (>= 1000): rto = 40 ms + three windows of the largest frame
+ * (3 * CS_LINK_WINDOW * CS_FRAME_WIRE_MAX characters), nak_holdoff = two largest frames,
+ * max_retries 20; at memory speed rto = 5 ms, nak_holdoff 0 (every NAK rewinds: a round trip is
+ * shorter than any useful hold-off), max_retries 200. keepalive is left as it is (each end's own
+ * choice). CS_ERR_ARG for a NULL c or tick_hz < 1000, CS_ERR_RANGE when rto does not fit 32 bits
+ * (c untouched then). ISR-safe. */
+cs_err_t cs_linktime_link(cs_link_cfg_t *c, uint32_t bits_per_s, uint32_t tick_hz);
+
+#endif
