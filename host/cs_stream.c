@@ -691,6 +691,7 @@ static void resume_point(run_t *s)
                  "the device reset since it ran this job (it knows no job since its boot): the "
                  "machine's position is unknown. Home it and run the job again, or state where "
                  "it is: --resume-from N --position X,Y,Z");
+        r->refused = true;
         finish(s, CS_STREAM_RESET);
     }
 }

@@ -98,6 +98,7 @@ typedef struct {
     size_t resume_from;   /* the run started after this message (o->resume_from, or the
                            * device's answer to --resume) */
     size_t resume_done;   /* --resume: the last message the device had finished then */
+    bool refused;         /* a resume refused at the start (why says what to do), nothing sent */
     bool numbered;        /* the device numbers this job's messages: executed is its word */
     size_t dev_recv;      /* last STATUS: the last message of the job the device received */
     uint32_t job_id;      /* cs_stream_job_id of the job */
