@@ -536,6 +536,7 @@ static void device_usage(FILE *f)
           "                     [--speed X | --instant] [--line-rate BPS] [--faults SPEC]\n"
           "                     [--tol MM] [--idle-exit S] [--reference JOB] [--check]\n"
           "                     [--svg OUT.svg] [--png OUT.png] [--trace OUT.csv]\n"
+          "                     [--exlog FILE]\n"
           "Runs the simulator as the device at the far end of a serial line, speaking the wire\n"
           "protocol (docs/protocol.md): `curvestep stream --port ...` streams to it.\n"
           "  --pty             create a pseudo-terminal pair, print the slave's path on the first\n"
