@@ -34,6 +34,7 @@
 #include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
+#include "cs_stream_pen.h"
 #include "cs_trace.h"
 
 #define MAX_CLIENTS 16
@@ -248,10 +249,11 @@ static void diag_text(const cs_jobplan_t *jp, const char *file, cs_err_t e, char
 /* Reads the job file once (a regular file only: a FIFO or a device would block the daemon) into
  * jp->path, laid out, ordered and pen-lifted by in (the SUBMIT words) with merge distance tol_mm;
  * on error a "file:line:col: reason" in err. */
-static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, double tol_mm,
-                     cs_jobplan_t *jp, char *err, size_t errcap)
+static bool read_job(daemon_t *d, const char *file, const cs_jobopts_t *in, const char *font,
+                     double tol_mm, cs_jobplan_t *jp, char *err, size_t errcap)
 {
     cs_jobplan_init(jp);
+    jp->font_file = font; /* NULL: the shipped font */
     jp->regular_only = true;
     jp->max_bytes = d->cfg->max_input_bytes;
     cs_pos_t tol;
@@ -304,8 +306,9 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     if (e == CS_OK)
         e = cs_jobplan_linkable(jp, file, d->link.ops->pens, curves);
     if (e == CS_OK)
-        e = curves ? cs_stream_job_add_path(job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed,
-                                            tol, &jp->diag)
+        e = curves ? cs_stream_job_add_path_pen(
+                         job, &jp->path, feed_q > 0 ? feed_q : d->m.default_feed, tol, &jp->pen,
+                         d->m.tick_hz, &(cs_vec3_t){start[0], start[1], start[2]}, &jp->diag)
                    : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (jp->have_mo) { /* the job holds its own copy of the segments */
         cs_motion_free(&jp->mo);
@@ -318,12 +321,14 @@ static bool plan_job(daemon_t *d, cs_jobplan_t *jp, const char *file, bool curve
     return false;
 }
 
-/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [shared option words] /ABS/PATH"
+/* "SUBMIT [mode=segments|curves] [tol=MM] [feed=MM/S] [font=/ABS/FONT] [shared option words]
+ * /ABS/PATH"
  * (the shared words: cs_jobopts_word, e.g. lenient, dialect=grbl, fit, rotate=90) */
 static void req_submit(daemon_t *d, char *args, FILE *out)
 {
     bool curves = false;
     double tol = 0, feed = 0;
+    const char *font = NULL;
     cs_jobopts_t in;
     cs_jobopts_init(&in);
     while (*args == ' ')
@@ -346,6 +351,8 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
         else if (strncmp(args, "feed=", 5) == 0 &&
                  ((feed = strtod(args + 5, &end)), *end == '\0' && feed > 0 && feed < 32768))
             ;
+        else if (strncmp(args, "font=/", 6) == 0)
+            font = args + 5; /* within args, which outlives the read */
         else if (cs_jobopts_word(args, &in))
             ;
         else {
@@ -363,7 +370,7 @@ static void req_submit(daemon_t *d, char *args, FILE *out)
     char err[600];
     cs_stream_job_t job;
     cs_jobplan_t jp;
-    if (!read_job(d, args, &in, tol, &jp, err, sizeof err)) {
+    if (!read_job(d, args, &in, font, tol, &jp, err, sizeof err)) {
         fprintf(out, "ERR %s\n", err);
         dlog(d, "refused %s: %s", args, err);
         return;
@@ -519,8 +526,8 @@ static void child_run(daemon_t *d, djob_t *j, int wfd)
         _exit(3);
     cs_stream_result_t r;
     memset(&r, 0, sizeof r);
-    cs_joblink_job_t jj = {&d->m, &j->job, NULL, 0, 0, d->have_pos ? d->dev_pos : NULL, false,
-                           NULL};
+    cs_joblink_job_t jj = {
+        .m = &d->m, .job = &j->job, .start_pos = d->have_pos ? d->dev_pos : NULL};
     cs_joblink_ctl_t c = {&child_interrupt, &child_pause, f, false};
     cs_err_t e = CS_OK;
     int orc = d->link.ops->keep_open ? CS_EXIT_OK : cs_joblink_open(&d->link, &jj);
@@ -855,9 +862,11 @@ static int serve_setup(daemon_t *d)
         return CS_EXIT_USAGE;
     }
     d->link.cfg.machine_file = cfg->machine_file;
-    int orc = d->link.ops->keep_open ? cs_joblink_open(&d->link, NULL) : CS_EXIT_OK;
-    if (orc != CS_EXIT_OK) {
-        fprintf(stderr, "curvestep serve: %s\n", d->link.why);
+    int orc = d->link.ops->check ? d->link.ops->check(&d->link, &d->m) : CS_EXIT_OK;
+    if (orc == CS_EXIT_OK && d->link.ops->keep_open)
+        orc = cs_joblink_open(&d->link, NULL);
+    if (orc != CS_EXIT_OK) { /* "file:line: reason" as it is */
+        fprintf(stderr, "%s%s\n", orc == CS_EXIT_INPUT ? "" : "curvestep serve: ", d->link.why);
         return orc;
     }
     d->listen_fd = open_socket(cfg->socket_path);

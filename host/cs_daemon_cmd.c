@@ -122,10 +122,13 @@ static void client_usage(FILE *f, const char *name)
     cs_daemon_default_socket(sock, sizeof sock);
     if (strcmp(name, "submit") == 0)
         fprintf(f, "usage: curvestep submit [--socket PATH] [--mode segments|curves] [--tol MM]\n"
-                   "                        [--feed MM/S] [input and layout options] FILE\n"
+                   "                        [--feed MM/S] [--font FILE.jhf] [input and layout\n"
+                   "                        options] FILE\n"
                    "Queues the job FILE (SVG, G-code or HPGL) on the daemon (`curvestep serve`).\n"
                    "The daemon reads and plans it whole now: a bad file is refused at once with\n"
-                   "file:line:col: reason. Prints the job's number. Options as for `stream`.\n");
+                   "file:line:col: reason. Prints the job's number. Options as for `stream`;\n"
+                   "--font FILE.jhf: the stroke font for SVG <text> and HP-GL LB (read by the\n"
+                   "daemon at submit; a file that is not a font is refused, file:line:col).\n");
     else if (strcmp(name, "status") == 0)
         fprintf(f, "usage: curvestep status [--socket PATH]\n"
                    "Prints the daemon's device and whether its queue is paused, then one line per\n"
@@ -157,12 +160,12 @@ static void client_usage(FILE *f, const char *name)
 typedef struct {
     const char *name; /* submit, status, ... */
     const char *socket_path;
-    const char *file, *mode, *tol, *feed, *job;
+    const char *file, *mode, *tol, *feed, *job, *font;
     bool submit, cancel;
     cs_jobopts_t in; /* sent as SUBMIT words; the daemon reads and lays out the job */
 } client_args_t;
 
-/* submit's --mode / --tol / --feed: 1 taken, 0 not one, -1 a bad value (said). */
+/* submit's --mode / --tol / --feed / --font: 1 taken, 0 not one, -1 a bad value (said). */
 static int submit_option(int argc, char **argv, int *i, client_args_t *c)
 {
     const char *a = argv[*i];
@@ -189,6 +192,8 @@ static int submit_option(int argc, char **argv, int *i, client_args_t *c)
             return -1;
         }
         c->feed = v;
+    } else if (strcmp(a, "--font") == 0) {
+        c->font = v;
     } else {
         return 0;
     }
@@ -270,9 +275,20 @@ static int client_request(const client_args_t *c, const char *verb, char *req, s
     }
     if (cs_jobopts_check(c->name, &c->in) != 0)
         return CS_EXIT_USAGE;
-    int k = snprintf(req, cap, "SUBMIT%s%s%s%s%s%s%s %s", c->mode ? " mode=" : "",
+    /* the font goes by its absolute path, one word: the daemon reads it at submit */
+    char fabs[PATH_MAX] = "";
+    if (c->font != NULL && realpath(c->font, fabs) == NULL) {
+        fprintf(stderr, "%s:0:0: cannot open the font (%s)\n", c->font, strerror(errno));
+        return CS_EXIT_INPUT;
+    }
+    if (strpbrk(fabs, " \t\n") != NULL) {
+        fprintf(stderr, "%s:0:0: a font path with blanks cannot be sent to the daemon\n", c->font);
+        return CS_EXIT_INPUT;
+    }
+    int k = snprintf(req, cap, "SUBMIT%s%s%s%s%s%s%s%s%s %s", c->mode ? " mode=" : "",
                      c->mode ? c->mode : "", c->tol ? " tol=" : "", c->tol ? c->tol : "",
-                     c->feed ? " feed=" : "", c->feed ? c->feed : "", c->in.words, abs);
+                     c->feed ? " feed=" : "", c->feed ? c->feed : "", c->font ? " font=" : "", fabs,
+                     c->in.words, abs);
     if (k < 0 || (size_t)k >= cap || strchr(abs, '\n')) {
         fprintf(stderr, "%s:0:0: path too long or not on one line\n", c->file);
         return CS_EXIT_INPUT;

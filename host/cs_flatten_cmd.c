@@ -148,7 +148,107 @@ static int take_jobopts(int *argc, char **argv, cs_jobopts_t *in)
     return cs_jobopts_check("flatten", in) != 0 ? CS_EXIT_USAGE : 0;
 }
 
-int cs_cmd_flatten(int argc, char **argv)
+/* The command line, parsed. */
+typedef struct {
+    double tol_mm;
+    size_t method;
+    bool stats;
+    const char *svg_out;
+    const char *font;
+    cs_jobopts_t in;
+    double seg_len_mm;
+    bool horner, eval_given;
+    size_t max_bytes;
+    const char *file;
+} flatten_opts_t;
+
+/* One option (getopt's code c, its value optarg): 0 to go on, or the exit status (--help: 0
+ * after the usage, as -1 would be ambiguous it returns CS_EXIT_OK). */
+static int parse_opt(int c, char **argv, flatten_opts_t *o)
+{
+    char *end = NULL;
+    cs_pos_t t = 0;
+    switch (c) {
+    case 't':
+        o->tol_mm = strtod(optarg, &end);
+        /* The tracers accept CS_TRACE_TOL_MIN LSB and up (their rounding budget is charged
+         * against the tolerance); the host refuses more than the coordinate range. */
+        if (!end || end == optarg || *end != '\0' || cs_conv_tol_to_pos(o->tol_mm, &t) != CS_OK ||
+            t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
+            fprintf(stderr,
+                    "curvestep flatten: --tol '%s': expected a tolerance in mm, from %.7f "
+                    "(%d LSB) to %d\n",
+                    optarg, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_TRACE_TOL_MIN,
+                    CS_POS_LIMIT_MM);
+            return CS_EXIT_USAGE;
+        }
+        return -1;
+    case 'm': {
+        size_t k = 0;
+        while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
+            k++;
+        if (k == sizeof methods / sizeof methods[0]) {
+            fprintf(stderr,
+                    "curvestep flatten: --method '%s': expected fd, afd, subdiv, predict or length\n",
+                    optarg);
+            return CS_EXIT_USAGE;
+        }
+        o->method = k;
+        return -1;
+    }
+    case 's':
+        o->stats = true;
+        return -1;
+    case 'o':
+        o->svg_out = optarg;
+        return -1;
+    case 'f':
+        o->font = optarg;
+        return -1;
+    case 'L':
+        o->seg_len_mm = strtod(optarg, &end);
+        if (!end || end == optarg || *end != '\0' || cs_conv_tol_to_pos(o->seg_len_mm, &t) != CS_OK) {
+            fprintf(stderr,
+                    "curvestep flatten: --seg-len '%s': expected a length in mm, "
+                    "from 1 LSB (0.0000153) to 4096\n",
+                    optarg);
+            return CS_EXIT_USAGE;
+        }
+        return -1;
+    case 'E':
+        o->eval_given = true;
+        o->horner = strcmp(optarg, "horner") == 0;
+        if (!o->horner && strcmp(optarg, "decasteljau") != 0) {
+            fprintf(stderr, "curvestep flatten: --eval '%s': expected decasteljau or horner\n",
+                    optarg);
+            return CS_EXIT_USAGE;
+        }
+        return -1;
+    case 'M':
+        if (!cs_readall_parse_mb(optarg, &o->max_bytes)) {
+            fprintf(stderr,
+                    "curvestep flatten: --max-input-mb '%s': expected a whole number of MiB, "
+                    "1 to %u\n",
+                    optarg, CS_READALL_MAX_MB);
+            return CS_EXIT_USAGE;
+        }
+        return -1;
+    case 'h':
+        flatten_usage(stdout);
+        return CS_EXIT_OK;
+    case ':':
+        fprintf(stderr, "curvestep flatten: option '%s' needs a value\n", argv[optind - 1]);
+        fprintf(stderr, "Try 'curvestep flatten --help'.\n");
+        return CS_EXIT_USAGE;
+    default:
+        fprintf(stderr, "curvestep flatten: unknown option '%s'\n", argv[optind - 1]);
+        fprintf(stderr, "Try 'curvestep flatten --help'.\n");
+        return CS_EXIT_USAGE;
+    }
+}
+
+/* Parses argv into *o: -1 to run, or the exit status (usage errors, --help). */
+static int parse_args(int argc, char **argv, flatten_opts_t *o)
 {
     static const struct option longopts[] = {
         {"tol", required_argument, NULL, 't'},
@@ -162,270 +262,217 @@ int cs_cmd_flatten(int argc, char **argv)
         {"max-input-mb", required_argument, NULL, 'M'},
         {NULL, 0, NULL, 0},
     };
-    double tol_mm = FLATTEN_DEFAULT_TOL_MM;
-    size_t method = FLATTEN_DEFAULT_METHOD;
-    bool stats = false;
-    const char *svg_out = NULL;
-    const char *font = NULL;
-    cs_jobopts_t in;
-    cs_jobopts_init(&in);
-    int r = take_jobopts(&argc, argv, &in);
+    memset(o, 0, sizeof *o);
+    o->tol_mm = FLATTEN_DEFAULT_TOL_MM;
+    o->method = FLATTEN_DEFAULT_METHOD;
+    o->seg_len_mm = FLATTEN_DEFAULT_SEG_LEN_MM;
+    cs_jobopts_init(&o->in);
+    int r = take_jobopts(&argc, argv, &o->in);
     if (r != 0)
         return r;
-    double seg_len_mm = FLATTEN_DEFAULT_SEG_LEN_MM;
-    bool horner = false, eval_given = false;
-    size_t max_bytes = 0;
     int c;
     optind = 1;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
-        switch (c) {
-        case 't': {
-            char *end = NULL;
-            tol_mm = strtod(optarg, &end);
-            cs_pos_t t = 0;
-            /* The tracers accept CS_TRACE_TOL_MIN LSB and up (their rounding budget is charged
-             * against the tolerance); the host refuses more than the coordinate range. */
-            if (!end || end == optarg || *end != '\0' || cs_conv_tol_to_pos(tol_mm, &t) != CS_OK ||
-                t < CS_TRACE_TOL_MIN || t > CS_TRACE_TOL_MAX) {
-                fprintf(stderr,
-                        "curvestep flatten: --tol '%s': expected a tolerance in mm, from %.7f "
-                        "(%d LSB) to %d\n",
-                        optarg, (double)CS_TRACE_TOL_MIN / CS_POS_ONE_MM, CS_TRACE_TOL_MIN,
-                        CS_POS_LIMIT_MM);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        }
-        case 'm': {
-            size_t k = 0;
-            while (k < sizeof methods / sizeof methods[0] && strcmp(methods[k].name, optarg) != 0)
-                k++;
-            if (k == sizeof methods / sizeof methods[0]) {
-                fprintf(stderr,
-                        "curvestep flatten: --method '%s': expected fd, afd, subdiv, predict or length\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            method = k;
-            break;
-        }
-        case 's':
-            stats = true;
-            break;
-        case 'o':
-            svg_out = optarg;
-            break;
-        case 'f':
-            font = optarg;
-            break;
-        case 'L': {
-            char *end = NULL;
-            cs_pos_t t = 0;
-            seg_len_mm = strtod(optarg, &end);
-            if (!end || end == optarg || *end != '\0' ||
-                cs_conv_tol_to_pos(seg_len_mm, &t) != CS_OK) {
-                fprintf(stderr,
-                        "curvestep flatten: --seg-len '%s': expected a length in mm, "
-                        "from 1 LSB (0.0000153) to 4096\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        }
-        case 'E':
-            eval_given = true;
-            horner = strcmp(optarg, "horner") == 0;
-            if (!horner && strcmp(optarg, "decasteljau") != 0) {
-                fprintf(stderr, "curvestep flatten: --eval '%s': expected decasteljau or horner\n",
-                        optarg);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        case 'M':
-            if (!cs_readall_parse_mb(optarg, &max_bytes)) {
-                fprintf(stderr,
-                        "curvestep flatten: --max-input-mb '%s': expected a whole number of MiB, "
-                        "1 to %u\n",
-                        optarg, CS_READALL_MAX_MB);
-                return CS_EXIT_USAGE;
-            }
-            break;
-        case 'h':
-            flatten_usage(stdout);
-            return CS_EXIT_OK;
-        case ':':
-            fprintf(stderr, "curvestep flatten: option '%s' needs a value\n", argv[optind - 1]);
-            fprintf(stderr, "Try 'curvestep flatten --help'.\n");
-            return CS_EXIT_USAGE;
-        default:
-            fprintf(stderr, "curvestep flatten: unknown option '%s'\n", argv[optind - 1]);
-            fprintf(stderr, "Try 'curvestep flatten --help'.\n");
-            return CS_EXIT_USAGE;
-        }
-    }
+    while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1)
+        if ((r = parse_opt(c, argv, o)) >= 0)
+            return r;
     if (optind != argc - 1) {
         fprintf(stderr, "curvestep flatten: %s\n",
                 optind >= argc ? "missing FILE" : "expected exactly one FILE");
         fprintf(stderr, "Try 'curvestep flatten --help'.\n");
         return CS_EXIT_USAGE;
     }
-    if (eval_given && method != FLATTEN_METHOD_LENGTH) {
+    if (o->eval_given && o->method != FLATTEN_METHOD_LENGTH) {
         fprintf(stderr, "curvestep flatten: --eval applies to --method length (the other "
                         "tracers step their own differences)\n");
         return CS_EXIT_USAGE;
     }
-    const char *file = argv[optind];
-    const char *shown = strcmp(file, "-") == 0 ? "<stdin>" : file;
-    cs_pos_t seg_len;
-    cs_conv_tol_to_pos(seg_len_mm, &seg_len); /* validated above */
-    cs_pos_t tol;
-    cs_conv_tol_to_pos(tol_mm, &tol); /* validated above */
+    o->file = argv[optind];
+    return -1;
+}
 
-    cs_path_t path;
-    cs_path_init(&path);
-    cs_path_diag_t diag;
+/* What a run made: the polyline, the chords counted, the worst deviation (--stats). */
+typedef struct {
+    cs_path_poly_t poly;
+    vbuf_t vb;
+    size_t nchords;
+    double maxdev;
+    size_t maxdev_elem;
+} flatten_run_t;
+
+/* Starts element el's polyline where it starts (a new subpath, or a jump). 0 or an exit status. */
+static int start_elem(const cs_path_t *path, size_t i, flatten_run_t *fr)
+{
+    const cs_bezier_t *cv = &path->elems[i].curve;
+    bool new_sub = i == 0 || path->elems[i].subpath != path->elems[i - 1].subpath;
+    const cs_vec3_t *prev_end =
+        i > 0 ? &path->elems[i - 1].curve.p[path->elems[i - 1].curve.degree] : NULL;
+    if (new_sub || prev_end->x != cv->p[0].x || prev_end->y != cv->p[0].y) {
+        if (i > 0 && new_sub)
+            putchar('\n');
+        double x = cs_conv_pos_to_mm(cv->p[0].x), y = cs_conv_pos_to_mm(cv->p[0].y);
+        printf("%.6f %.6f\n", x, y);
+        if ((new_sub ? cs_path_poly_move(&fr->poly, x, y) : cs_path_poly_line(&fr->poly, x, y)) !=
+            CS_OK) {
+            fprintf(stderr, "curvestep flatten: out of memory\n");
+            return CS_EXIT_INTERNAL;
+        }
+    }
+    fr->vb.n = 0;
+    if (!vbuf_push(&fr->vb, cv->p[0])) {
+        fprintf(stderr, "curvestep flatten: out of memory\n");
+        return CS_EXIT_INTERNAL;
+    }
+    return CS_EXIT_OK;
+}
+
+/* Traces element i of path, printing its chords. An exit status (CS_EXIT_OK). */
+static int trace_elem(const flatten_opts_t *o, const cs_path_t *path, size_t i, cs_pos_t tol,
+                      cs_pos_t seg_len, flatten_run_t *fr, cs_path_diag_t *diag)
+{
+    const cs_path_elem_t *el = &path->elems[i];
+    const cs_bezier_t *cv = &el->curve;
+    int status = start_elem(path, i, fr);
+    if (status != CS_EXIT_OK)
+        return status;
+    cs_trace_t tr;
+    cs_lensub_t ls;
+    bool by_length = o->method == FLATTEN_METHOD_LENGTH;
+    cs_err_t e = by_length ? cs_lensub_begin(&ls, cv, seg_len, o->horner && !cv->rational)
+                           : cs_trace_begin(&tr, cv, tol, methods[o->method].method);
+    if (e == CS_ERR_TOLERANCE) {
+        fprintf(stderr, "curvestep flatten: --tol %g: %s (method %s)\n", o->tol_mm,
+                cs_err_text(e), methods[o->method].name);
+        return CS_EXIT_USAGE;
+    }
+    cs_vec3_t pt;
+    while (e == CS_OK &&
+           (e = by_length ? cs_lensub_next(&ls, &pt) : cs_trace_next(&tr, &pt)) == CS_OK) {
+        if (++fr->nchords > CS_MOTION_MAX_SEGS) { /* bounded memory: the plan's own limit */
+            e = CS_ERR_RANGE;
+            break;
+        }
+        printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
+        if (cs_path_poly_line(&fr->poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
+                CS_OK ||
+            !vbuf_push(&fr->vb, pt)) {
+            e = CS_ERR_FULL;
+            break;
+        }
+    }
+    if (e == CS_ERR_RANGE) {
+        cs_path_diag_set(diag, e, el->loc,
+                         "more than %zu chords: too large to flatten (docs/inputs.md, Limits)",
+                         CS_MOTION_MAX_SEGS);
+        cs_path_diag_print(stderr, diag);
+        return CS_EXIT_INPUT;
+    }
+    if (e != CS_END) {
+        cs_path_diag_set(diag, e, el->loc, "cannot trace this curve: %s", cs_err_text(e));
+        cs_path_diag_print(stderr, diag);
+        return CS_EXIT_INTERNAL;
+    }
+    if (o->stats) {
+        double d = cs_path_deviation_mm(cv, fr->vb.v, fr->vb.n);
+        if (d > fr->maxdev || i == 0) {
+            fr->maxdev = d;
+            fr->maxdev_elem = i;
+        }
+    }
+    return CS_EXIT_OK;
+}
+
+/* --stats: the counts and the worst deviation on stderr. An exit status. */
+static int report_stats(const flatten_opts_t *o, const char *shown, const cs_path_t *path,
+                        const flatten_run_t *fr)
+{
+    fprintf(stderr, "flatten: %s: %zu elements in %u subpaths, %zu chords (%zu vertices)\n", shown,
+            path->n, path->nsubpaths, fr->nchords, fr->poly.n);
+    if (o->method == FLATTEN_METHOD_LENGTH)
+        fprintf(stderr, "flatten: method length (%s), chords at most %.6g mm\n",
+                o->horner ? "horner" : "decasteljau", o->seg_len_mm);
+    else
+        fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[o->method].name,
+                o->tol_mm);
+    if (path->n == 0) {
+        fprintf(stderr, "flatten: max deviation 0.000000 mm (nothing to trace)\n");
+        return CS_EXIT_OK;
+    }
+    const cs_path_loc_t *l = &path->elems[fr->maxdev_elem].loc;
+    if (isinf(fr->maxdev)) {
+        fprintf(stderr, "%s:%u:%u: internal error: the tracer returned a vertex off this curve\n",
+                l->file, l->line, l->col);
+        return CS_EXIT_INTERNAL;
+    }
+    fprintf(stderr,
+            "flatten: max deviation %.6f mm (measured in double on the host against "
+            "the exact curves; element at %s:%u:%u)\n",
+            fr->maxdev, l->file, l->line, l->col);
+    return CS_EXIT_OK;
+}
+
+/* Reads and lays out the job. CS_EXIT_OK, or the exit status after the located error. */
+static int load(const flatten_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
+{
     cs_input_opts_t iopts;
     cs_input_opts_init(&iopts);
-    cs_jobopts_input(&in, &iopts);
-    iopts.font_file = font;
-    iopts.max_bytes = max_bytes;
-    cs_err_t e = cs_input_load(file, &iopts, &path, &diag);
+    cs_jobopts_input(&o->in, &iopts);
+    iopts.font_file = o->font;
+    iopts.max_bytes = o->max_bytes;
+    cs_err_t e = cs_input_load(o->file, &iopts, path, diag);
     cs_machine_t m;
     cs_machine_ini_default(&m); /* --fit: the built-in machine's travel */
     if (e == CS_OK)
-        e = cs_jobopts_prepare(&in, "flatten", &m, false, tol_mm, &path, &diag, stderr);
-    if (e != CS_OK) {
-        cs_path_diag_print(stderr, &diag);
-        cs_path_free(&path);
-        return input_status(e);
-    }
+        e = cs_jobopts_prepare(&o->in, "flatten", &m, false, o->tol_mm, path, diag, stderr);
+    if (e == CS_OK)
+        return CS_EXIT_OK;
+    cs_path_diag_print(stderr, diag);
+    return input_status(e);
+}
 
-    int status = CS_EXIT_OK;
-    cs_path_poly_t poly;
-    cs_path_poly_init(&poly);
-    vbuf_t vb = {NULL, 0, 0};
-    size_t nchords = 0;
-    double maxdev = 0.0;
-    size_t maxdev_elem = 0;
-    cs_trace_t tr;
-    cs_lensub_t ls;
-    bool by_length = method == FLATTEN_METHOD_LENGTH;
-    for (size_t i = 0; i < path.n && status == CS_EXIT_OK; i++) {
-        const cs_path_elem_t *el = &path.elems[i];
-        const cs_bezier_t *cv = &el->curve;
-        bool new_sub = i == 0 || el->subpath != path.elems[i - 1].subpath;
-        const cs_vec3_t *prev_end =
-            i > 0 ? &path.elems[i - 1].curve.p[path.elems[i - 1].curve.degree] : NULL;
-        if (new_sub || prev_end->x != cv->p[0].x || prev_end->y != cv->p[0].y) {
-            if (i > 0 && new_sub)
-                putchar('\n');
-            printf("%.6f %.6f\n", cs_conv_pos_to_mm(cv->p[0].x), cs_conv_pos_to_mm(cv->p[0].y));
-            if ((new_sub ? cs_path_poly_move(&poly, cs_conv_pos_to_mm(cv->p[0].x),
-                                             cs_conv_pos_to_mm(cv->p[0].y))
-                         : cs_path_poly_line(&poly, cs_conv_pos_to_mm(cv->p[0].x),
-                                             cs_conv_pos_to_mm(cv->p[0].y))) != CS_OK) {
-                status = CS_EXIT_INTERNAL;
-                fprintf(stderr, "curvestep flatten: out of memory\n");
-                break;
-            }
-        }
-        vb.n = 0;
-        if (!vbuf_push(&vb, cv->p[0])) {
-            status = CS_EXIT_INTERNAL;
-            fprintf(stderr, "curvestep flatten: out of memory\n");
-            break;
-        }
-        e = by_length ? cs_lensub_begin(&ls, cv, seg_len, horner && !cv->rational)
-                      : cs_trace_begin(&tr, cv, tol, methods[method].method);
-        if (e == CS_ERR_TOLERANCE) {
-            fprintf(stderr, "curvestep flatten: --tol %g: %s (method %s)\n", tol_mm, cs_err_text(e),
-                    methods[method].name);
-            status = CS_EXIT_USAGE;
-            break;
-        }
-        cs_vec3_t pt;
-        while (e == CS_OK &&
-               (e = by_length ? cs_lensub_next(&ls, &pt) : cs_trace_next(&tr, &pt)) == CS_OK) {
-            if (++nchords > CS_MOTION_MAX_SEGS) { /* bounded memory: the plan's own limit */
-                e = CS_ERR_RANGE;
-                break;
-            }
-            printf("%.6f %.6f\n", cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y));
-            if (cs_path_poly_line(&poly, cs_conv_pos_to_mm(pt.x), cs_conv_pos_to_mm(pt.y)) !=
-                    CS_OK ||
-                !vbuf_push(&vb, pt)) {
-                e = CS_ERR_FULL;
-                break;
-            }
-        }
-        if (e == CS_ERR_RANGE) {
-            cs_path_diag_set(&diag, e, el->loc,
-                             "more than %zu chords: too large to flatten (docs/inputs.md, Limits)",
-                             CS_MOTION_MAX_SEGS);
-            cs_path_diag_print(stderr, &diag);
-            status = CS_EXIT_INPUT;
-            break;
-        }
-        if (e != CS_END) {
-            cs_path_diag_set(&diag, e, el->loc, "cannot trace this curve: %s", cs_err_text(e));
-            cs_path_diag_print(stderr, &diag);
-            status = CS_EXIT_INTERNAL;
-            break;
-        }
-        if (stats) {
-            double d = cs_path_deviation_mm(cv, vb.v, vb.n);
-            if (d > maxdev || i == 0) {
-                maxdev = d;
-                maxdev_elem = i;
-            }
-        }
+int cs_cmd_flatten(int argc, char **argv)
+{
+    flatten_opts_t o;
+    int status = parse_args(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    const char *shown = strcmp(o.file, "-") == 0 ? "<stdin>" : o.file;
+    cs_pos_t seg_len, tol;
+    cs_conv_tol_to_pos(o.seg_len_mm, &seg_len); /* validated above */
+    cs_conv_tol_to_pos(o.tol_mm, &tol);         /* validated above */
+    cs_path_t path;
+    cs_path_init(&path);
+    cs_path_diag_t diag;
+    if ((status = load(&o, &path, &diag)) != CS_EXIT_OK) {
+        cs_path_free(&path);
+        return status;
     }
+    flatten_run_t fr;
+    memset(&fr, 0, sizeof fr);
+    cs_path_poly_init(&fr.poly);
+    for (size_t i = 0; i < path.n && status == CS_EXIT_OK; i++)
+        status = trace_elem(&o, &path, i, tol, seg_len, &fr, &diag);
     if (fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, "curvestep flatten: error writing the output\n");
         if (status == CS_EXIT_OK)
             status = CS_EXIT_INTERNAL;
     }
-    if (stats && status == CS_EXIT_OK) {
-        fprintf(stderr, "flatten: %s: %zu elements in %u subpaths, %zu chords (%zu vertices)\n",
-                shown, path.n, path.nsubpaths, nchords, poly.n);
-        if (method == FLATTEN_METHOD_LENGTH)
-            fprintf(stderr, "flatten: method length (%s), chords at most %.6g mm\n",
-                    horner ? "horner" : "decasteljau", seg_len_mm);
-        else
-            fprintf(stderr, "flatten: method %s, tolerance %.6g mm\n", methods[method].name,
-                    tol_mm);
-        if (path.n > 0) {
-            const cs_path_loc_t *l = &path.elems[maxdev_elem].loc;
-            if (isinf(maxdev)) {
-                fprintf(stderr,
-                        "%s:%u:%u: internal error: the tracer returned a vertex off this curve\n",
-                        l->file, l->line, l->col);
-                status = CS_EXIT_INTERNAL;
-            } else
-                fprintf(stderr,
-                        "flatten: max deviation %.6f mm (measured in double on the host against "
-                        "the exact curves; element at %s:%u:%u)\n",
-                        maxdev, l->file, l->line, l->col);
-        } else {
-            fprintf(stderr, "flatten: max deviation 0.000000 mm (nothing to trace)\n");
-        }
-    }
-    if (svg_out && status == CS_EXIT_OK) {
+    if (o.stats && status == CS_EXIT_OK)
+        status = report_stats(&o, shown, &path, &fr);
+    if (o.svg_out && status == CS_EXIT_OK) {
         cs_svgout_opts_t so;
         cs_svgout_opts_init(&so);
         so.title = shown;
-        so.method = methods[method].name;
-        so.tol_mm = tol_mm;
-        so.max_dev_mm = stats && !isinf(maxdev) ? maxdev : -1.0;
-        e = cs_svgout_write(svg_out, &path, &poly, &so, &diag);
-        if (e == CS_ERR_IO) {
+        so.method = methods[o.method].name;
+        so.tol_mm = o.tol_mm;
+        so.max_dev_mm = o.stats && !isinf(fr.maxdev) ? fr.maxdev : -1.0;
+        if (cs_svgout_write(o.svg_out, &path, &fr.poly, &so, &diag) == CS_ERR_IO) {
             cs_path_diag_print(stderr, &diag);
             status = CS_EXIT_INTERNAL;
         }
     }
-    free(vb.v);
-    cs_path_poly_free(&poly);
+    free(fr.vb.v);
+    cs_path_poly_free(&fr.poly);
     cs_path_free(&path);
     return status;
 }

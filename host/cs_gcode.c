@@ -250,6 +250,20 @@ static void code_name(char *out, size_t cap, char letter, int v)
         snprintf(out, cap, "%c%d", letter, v / 10);
 }
 
+/* The pen's Z move of M3/M4/M5 (opts->pen_z) to t: at opts->pen_z_feed_mm_s when it is given
+ * (the [pen] z_feed, as cs_pen moves the pen for SVG and HP-GL), else rapid. The program's own F
+ * is kept for the moves after it. */
+static cs_err_t pen_z_move(gc_t *g, const double t[3], unsigned col)
+{
+    if (!(g->o->pen_z_feed_mm_s > 0))
+        return cs_gcode_add_line(g, g->pos, t, col, true);
+    double f = g->feed;
+    g->feed = g->o->pen_z_feed_mm_s * 60.0 / g->unit; /* cs_gcode_add: feed * unit / 60 mm/s */
+    cs_err_t e = cs_gcode_add_line(g, g->pos, t, col, false);
+    g->feed = f;
+    return e;
+}
+
 /* M words: pen / spindle before the motion; *end for M2 / M30. */
 static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
 {
@@ -267,12 +281,12 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
                                     m / 10);
         } else if (m == 30 || m == 40 || m == 50) {
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
-             * with opts->pen_z a rapid Z move to the pen height. */
+             * with opts->pen_z a Z move to the pen height. */
             cs_path_new_subpath(g->path);
             if (g->o->pen_z) {
                 double t[3] = {g->pos[0], g->pos[1],
                                m == 50 ? g->o->pen_up_z_mm : g->o->pen_down_z_mm};
-                if ((e = cs_gcode_add_line(g, g->pos, t, b->mcol[i], true)) != CS_OK)
+                if ((e = pen_z_move(g, t, b->mcol[i])) != CS_OK)
                     return e;
                 memcpy(g->pos, t, sizeof g->pos);
                 cs_path_new_subpath(g->path);
@@ -882,9 +896,16 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
     g.plane = 17;
     /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
     g.motion = o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
-    if (o->pen_z) /* the pen starts up: moves before the first M3 are travel (cs_pen, z mode) */
-        g.pos[2] = o->pen_up_z_mm;
     cs_path_new_subpath(path);
+    if (o->pen_z) { /* the pen starts up: moves before the first M3 are travel (cs_pen, z mode) */
+        double up[3] = {0, 0, o->pen_up_z_mm};
+        /* with a z_feed the raise from the origin is a pen move too, at that speed (else the
+         * planner's rapid to the path's start makes it) */
+        cs_err_t e0 = o->pen_z_feed_mm_s > 0 ? pen_z_move(&g, up, 0) : CS_OK;
+        if (e0 != CS_OK)
+            return e0;
+        g.pos[2] = o->pen_up_z_mm;
+    }
     if (cs_gexpr_init(&g.st) != CS_OK)
         return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
     cs_gflow_t fl;

@@ -33,9 +33,10 @@ typedef struct {
                            * drawn in the plane, T = ignored. Checksums stay errors. */
     double helix_tol_mm;  /* > 0: bound on the helix approximation (see docs/inputs.md) */
     size_t max_elements;  /* > 0: refuse (CS_ERR_FULL) a job that needs more path elements */
-    bool pen_z;           /* M3/M4 (pen down) and M5 (pen up) also move Z, as rapid moves: */
+    bool pen_z;           /* M3/M4 (pen down) and M5 (pen up) also move Z: */
     double pen_down_z_mm; /* to this machine Z on M3/M4 */
     double pen_up_z_mm;   /* to this machine Z on M5, and where the program starts */
+    double pen_z_feed_mm_s; /* at this speed, mm/s ([pen] z_feed); 0: rapid */
     cs_gcode_dialect_t dialect;
     bool start_inch;         /* the program starts in G20 (inches) instead of G21 (mm) */
     unsigned long max_loops; /* O-word loop passes allowed in one program; 0: the default

@@ -25,6 +25,7 @@ void cs_gpio_cfg_default(cs_gpio_cfg_t *c, const cs_machine_t *m)
     for (unsigned i = 0; i < CS_AXES; i++)
         c->step[i] = c->dir[i] = -1;
     c->enable = -1;
+    c->pen = -1;
     c->step_active_low = false;
     c->enable_active_low = true;
     /* The executor's own pulse (what the simulator and a firmware port give): the longest of
@@ -114,6 +115,8 @@ static const char *offset_owner(const cs_gpio_cfg_t *c, int off, const int *self
     }
     if (&c->enable != self && c->enable == off)
         return "enable";
+    if (&c->pen != self && c->pen == off)
+        return "pen";
     return NULL;
 }
 
@@ -143,6 +146,8 @@ static int handler(void *user, const char *section, const char *name, const char
     int *slot = NULL;
     if (strcasecmp(name, "enable") == 0)
         slot = &c->enable;
+    else if (strcasecmp(name, "pen") == 0)
+        slot = &c->pen;
     for (unsigned i = 0; i < CS_AXES && slot == NULL; i++) {
         size_t n = strlen(axis_names[i]);
         if (strncasecmp(name, axis_names[i], n) == 0 && name[n] == '_') {
@@ -200,7 +205,7 @@ static int handler(void *user, const char *section, const char *name, const char
     } else {
         return fail(x,
                     "[gpio] %s: unknown key (expected chip, x_step, x_dir, y_step, y_dir, z_step, "
-                    "z_dir, a_step, a_dir, enable, step_active_low, enable_active_low, pulse_us, "
+                    "z_dir, a_step, a_dir, enable, pen, step_active_low, enable_active_low, pulse_us, "
                     "dir_setup_us, enable_ms, spin_us or rt_priority)",
                     name);
     }

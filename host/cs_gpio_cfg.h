@@ -20,6 +20,7 @@ typedef struct {
     int step[CS_AXES];      /* STEP line offset of each axis, -1 = not wired */
     int dir[CS_AXES];       /* DIR line offset of each axis, -1 = not wired */
     int enable;             /* ENABLE line offset (shared by every driver), -1 = not wired */
+    int pen;                /* the pen servo's line ([pen] mode = servo: cs_gpio_pwm), -1 = none */
     bool step_active_low;   /* STEP pulses low (default false: pulses high) */
     bool enable_active_low; /* ENABLE asserted low (default true: the /EN of most drivers) */
     uint32_t pulse_ns;      /* STEP pulse width, ns (default: the longest [axis] pulse) */

@@ -14,6 +14,7 @@
 #include "cs_cmd.h"
 #include "cs_gpio_cfg.h"
 #include "cs_gpio_io.h"
+#include "cs_gpio_pwm.h"
 #include "cs_gpio_run.h"
 #include "cs_joblink.h"
 #include "cs_stream_cmd.h"
@@ -119,7 +120,13 @@ typedef struct {
     cs_gpio_run_opts_t ro;
     cs_gpio_io_t io;
     bool io_open;
-    cs_segment_t *own; /* segments taken from the job's messages (the daemon) */
+    cs_segment_t *own;           /* segments taken from the job's messages (the daemon) */
+    cs_motion_pen_t *own_pens;   /* and their pen events */
+    const cs_motion_pen_t *pens; /* servo pen events ([pen] mode = servo): cs_gpio_pwm */
+    size_t npens;
+    cs_gpio_io_t pio; /* the pen's line, its own request */
+    bool pio_open;
+    cs_gpio_pwm_t pw;
     const cs_segment_t *segs;
     size_t nsegs, first;
     uint64_t ticks; /* the job's planned time from segment `first` on, executor ticks */
@@ -211,7 +218,7 @@ static int gpio_config(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t *
         snprintf(l->why, sizeof l->why, "--gpio record:FILE needs a file name");
         return CS_EXIT_USAGE;
     }
-    if (j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
+    if (j != NULL && j->job != NULL && j->job->mode == CS_STREAM_CURVES) {
         snprintf(l->why, sizeof l->why,
                  "--gpio runs the step segments planned here: "
                  "--mode curves does not apply");
@@ -241,11 +248,15 @@ static int gpio_segments(cs_joblink_t *l, gpio_link_t *g, const cs_joblink_job_t
     g->segs = j->segs;
     g->nsegs = j->nsegs;
     if (g->segs == NULL) {
-        if (cs_joblink_segments(j->job, &g->own, &g->nsegs) != CS_OK) {
+        if (cs_joblink_segments(j->job, &g->own, &g->nsegs, &g->own_pens, &g->npens) != CS_OK) {
             snprintf(l->why, sizeof l->why, "out of memory");
             return CS_EXIT_INTERNAL;
         }
         g->segs = g->own;
+        g->pens = g->own_pens;
+    } else {
+        g->pens = j->pens;
+        g->npens = j->npens;
     }
     g->first = j->resume_from < g->nsegs ? j->resume_from : g->nsegs;
     g->ticks = 0;
@@ -269,15 +280,50 @@ static void say_lines(const cs_joblink_t *l, const gpio_link_t *g)
             g->cfg.dir_setup_ns / 1000.0);
 }
 
-static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
+/* A new link state for machine m, or NULL with the reason in l->why. */
+static gpio_link_t *gpio_new(cs_joblink_t *l, const cs_machine_t *m)
 {
     gpio_link_t *g = calloc(1, sizeof *g);
-    if (g == NULL) {
+    if (g == NULL)
         snprintf(l->why, sizeof l->why, "out of memory");
-        return CS_EXIT_INTERNAL;
+    else
+        g->m = m;
+    return g;
+}
+
+/* The [gpio] section against the option and machine m, before any job (the daemon's start). */
+static int gpio_check(cs_joblink_t *l, const cs_machine_t *m)
+{
+    gpio_link_t *g = gpio_new(l, m);
+    int rc = g != NULL ? gpio_config(l, g, NULL) : CS_EXIT_INTERNAL;
+    free(g);
+    return rc;
+}
+
+/* The pen servo's line for a job with pen events: [gpio] pen on the chip, or a recorder with
+ * room for the job (no pen line wired: exit 1; the chip refused it: 4). */
+static int open_pen(cs_joblink_t *l, gpio_link_t *g)
+{
+    if (g->cfg.pen < 0 && !g->record) {
+        snprintf(l->why, sizeof l->why,
+                 "%s:0: [pen] mode = servo, but [gpio] wires no pen line (pen = OFFSET, "
+                 "docs/gpio.md)",
+                 l->cfg.machine_file ? l->cfg.machine_file : "the built-in machine");
+        return CS_EXIT_INPUT;
     }
+    if (cs_gpio_pwm_open(&g->pio, l->cfg.gpio, g->record != NULL, g->cfg.pen,
+                         (double)g->ticks / g->m->tick_hz + 2.0, l->why, sizeof l->why) != 0)
+        return g->record ? CS_EXIT_INTERNAL : CS_EXIT_NO_DEVICE;
+    g->pio_open = true;
+    return CS_EXIT_OK;
+}
+
+static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
+{
+    gpio_link_t *g = gpio_new(l, j->m);
+    if (g == NULL)
+        return CS_EXIT_INTERNAL;
     l->gpio = g;
-    g->m = j->m;
     int rc = gpio_config(l, g, j);
     if (rc == CS_EXIT_OK)
         rc = gpio_segments(l, g, j);
@@ -297,6 +343,8 @@ static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
     } else {
         g->io_open = true;
     }
+    if (rc == CS_EXIT_OK && g->npens > 0) /* the pen servo: its own line and thread */
+        rc = open_pen(l, g);
     if (rc == CS_EXIT_OK)
         say_lines(l, g);
     return rc;
@@ -347,6 +395,10 @@ static void gpio_result(const gpio_link_t *g, const cs_joblink_job_t *j, cs_stre
     switch (run->outcome) {
     case CS_GPIO_RUN_DONE:
         r->outcome = CS_STREAM_DONE;
+        if (g->npens > 0 && !(g->pw.started && g->pw.io_errno == 0)) {
+            r->outcome = CS_STREAM_CLOSED; /* the servo may not have followed: say so */
+            r->what = "job executed, but the pen servo's pulse train failed";
+        }
         break;
     case CS_GPIO_RUN_HELD:
         r->outcome = CS_STREAM_INTERRUPTED;
@@ -392,6 +444,9 @@ static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_jo
         return CS_ERR_IO;
     }
     warn_rt(&g->run, &g->cfg);
+    if (g->npens > 0 &&
+        (rc = cs_gpio_pwm_start(&g->pw, &g->pio, &g->run, g->pens, g->npens, g->cfg.spin_ns)) != 0)
+        fprintf(stderr, "curvestep: cannot start the pen's thread: %s\n", strerror(rc));
     progress_t pg;
     memset(&pg, 0, sizeof pg);
     pg.f = c->progress;
@@ -402,6 +457,8 @@ static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_jo
     pg.first = g->first;
     gpio_watch(g, c, &pg);
     cs_gpio_run_join(&g->run);
+    if (g->npens > 0)
+        cs_gpio_pwm_stop(&g->pw); /* the last width out a few times, the line low */
     progress(&pg, g->segs, g->nsegs, g->ticks, g->m->tick_hz, &g->run, true);
     g->wall = now_s() - t_start;
     gpio_result(g, j, r);
@@ -424,6 +481,8 @@ static void gpio_counters(cs_joblink_t *l, FILE *out, const cs_stream_result_t *
             g->wall, (double)r->ticks / g->m->tick_hz,
             (double)cs_gpio_run_late_quantile(r, 0.5) / 1000.0,
             (double)cs_gpio_run_late_quantile(r, 0.99) / 1000.0, (double)r->late_max_ns / 1000.0);
+    if (g->npens > 0)
+        (void)cs_gpio_pwm_report(out, &g->pw); /* a failure is the outcome already */
     if (res->mid_message)
         fprintf(out,
                 "stream: (stopped mid-segment: the machine is past segment no. %zu, re-home it "
@@ -439,6 +498,8 @@ static int write_record(const gpio_link_t *g)
     snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
              (unsigned)g->m->tick_hz, (unsigned)g->cfg.pulse_ns, (unsigned)g->cfg.dir_setup_ns);
     int wr = f ? cs_gpio_io_write_record(&g->io, f, g->run.t0_ns, hdr) : -1;
+    if (wr == 0 && g->pio_open) /* the pen's line after the others, its own header line */
+        wr = cs_gpio_io_write_record(&g->pio, f, g->run.t0_ns, "pen servo: software PWM, 50 Hz");
     if (f && fclose(f) != 0)
         wr = -1;
     if (wr != 0) {
@@ -458,6 +519,8 @@ static int gpio_close(cs_joblink_t *l, int rc)
     gpio_link_t *g = l->gpio;
     if (g == NULL)
         return rc;
+    if (g->pio_open)
+        cs_gpio_io_close(&g->pio);
     if (g->io_open) {
         cs_gpio_io_close(&g->io);
         if (g->record && g->run.t0_ns != 0) {
@@ -467,7 +530,9 @@ static int gpio_close(cs_joblink_t *l, int rc)
         }
     }
     cs_gpio_io_free(&g->io);
+    cs_gpio_io_free(&g->pio);
     free(g->own);
+    free(g->own_pens);
     free(g);
     l->gpio = NULL;
     return rc;
@@ -477,7 +542,8 @@ const cs_joblink_ops_t cs_joblink_gpio_ops = {
     .kind = "GPIO",
     .keep_open = false,
     .curves = false,
-    .pens = false,
+    .pens = true,
+    .check = gpio_check,
     .open = gpio_open,
     .run = gpio_run,
     .counters = gpio_counters,

@@ -1145,24 +1145,100 @@ static cs_err_t escape(hp_t *h)
                 what_at(h, h->pos - 1, b));
 }
 
-static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
+/* IN[n]: initialise: absolute, pen up, at the origin; default label terminator. */
+static cs_err_t instr_in(hp_t *h, const char *mn, size_t off)
 {
     double v[2];
     size_t vo[2];
     unsigned n;
-    cs_err_t e;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 1, &n, "IN[n]");
+    if (e != CS_OK)
+        return e;
+    h->relative = false;
+    h->pen_down = false;
+    h->label_term = HP_ETX;
+    reset_scaling(h);
+    return move_to(h, 0.0, 0.0, off);
+}
+
+/* SP[pen]: select a pen (SP0, SP: put it away). */
+static cs_err_t instr_sp(hp_t *h, const char *mn, size_t off)
+{
+    double v[2];
+    size_t vo[2];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 1, &n, "SP[pen]");
+    if (e == CS_OK)
+        select_pen(h, n ? v[0] : 0.0);
+    return e;
+}
+
+/* SI w,h: character size in cm; SI; the default. */
+static cs_err_t instr_si(hp_t *h, const char *mn, size_t off)
+{
+    double v[2];
+    size_t vo[2];
+    unsigned n;
+    cs_err_t e = get_params(h, mn, off, v, vo, 0, 2, &n, "SI[width,height]");
+    if (e != CS_OK)
+        return e;
+    if (n == 1)
+        return fail(h, off, CS_ERR_PARSE, "SI: width and height, or none");
+    h->si_w = n == 2 ? v[0] : 0;
+    h->si_h = n == 2 ? v[1] : 0;
+    return CS_OK;
+}
+
+/* DF: scaling off and the window gone, as IN does; P1, P2 and RO stay (HP-GL/2 reference, DF's
+ * default-values table). */
+static cs_err_t instr_df(hp_t *h, const char *mn, size_t off)
+{
+    warn_mnemonic(h, mn, off, NULL);
+    h->sc_on = false;
+    h->win_on = false;
+    update_map(h);
+    return skip_params(h, mn);
+}
+
+/* DT t[,mode]: the label terminator is the next character ("DT;" = ETX again). */
+static cs_err_t instr_dt(hp_t *h, const char *mn)
+{
+    if (h->pos < h->len && h->buf[h->pos] != ';')
+        h->label_term = h->buf[h->pos++];
+    else
+        h->label_term = HP_ETX;
+    return skip_params(h, mn);
+}
+
+/* SM c: symbol mode with the next character as the symbol; "SM;" ends it. */
+static cs_err_t instr_sm(hp_t *h, const char *mn, size_t off)
+{
+    warn_mnemonic(h, mn, off, "symbol mode ignored: no symbol is drawn at the points");
+    if (h->pos < h->len && h->buf[h->pos] != ';' && !is_blank(h->buf[h->pos]))
+        h->pos++;
+    return end_instr(h, mn);
+}
+
+/* HP-GL/2 comment: CO "text". */
+static cs_err_t instr_co(hp_t *h, const char *mn)
+{
+    skip_sep(h);
+    if (h->pos < h->len && h->buf[h->pos] == '"') {
+        size_t q = h->pos++;
+        while (h->pos < h->len && h->buf[h->pos] != '"')
+            h->pos++;
+        if (h->pos >= h->len)
+            return fail(h, q, CS_ERR_PARSE, "CO: comment string not closed");
+        h->pos++;
+    }
+    return end_instr(h, mn);
+}
+
+static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
+{
     switch ((mn[0] << 8) | mn[1]) {
     case ('I' << 8) | 'N':
-        if ((e = get_params(h, mn, off, v, vo, 0, 1, &n, "IN[n]")) != CS_OK)
-            return e;
-        /* Initialise: absolute, pen up, at the origin; default label terminator. */
-        h->relative = false;
-        h->pen_down = false;
-        h->label_term = HP_ETX;
-        reset_scaling(h);
-        if ((e = move_to(h, 0.0, 0.0, off)) != CS_OK)
-            return e;
-        return CS_OK;
+        return instr_in(h, mn, off);
     case ('P' << 8) | 'U':
         h->pen_down = false;
         cs_path_new_subpath(h->path);
@@ -1177,10 +1253,7 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
         h->relative = true;
         return pen_moves(h, mn);
     case ('S' << 8) | 'P':
-        if ((e = get_params(h, mn, off, v, vo, 0, 1, &n, "SP[pen]")) != CS_OK)
-            return e;
-        select_pen(h, n ? v[0] : 0.0);
-        return CS_OK;
+        return instr_sp(h, mn, off);
     case ('C' << 8) | 'I':
         return circle(h, off);
     case ('A' << 8) | 'A':
@@ -1208,52 +1281,20 @@ static cs_err_t instruction(hp_t *h, const char *mn, size_t off)
     case ('L' << 8) | 'B':
         return label(h, mn, off);
     case ('S' << 8) | 'I':
-        /* SI w,h: character size in cm; SI; the default */
-        if ((e = get_params(h, mn, off, v, vo, 0, 2, &n, "SI[width,height]")) != CS_OK)
-            return e;
-        if (n == 1)
-            return fail(h, off, CS_ERR_PARSE, "SI: width and height, or none");
-        h->si_w = n == 2 ? v[0] : 0;
-        h->si_h = n == 2 ? v[1] : 0;
-        return CS_OK;
+        return instr_si(h, mn, off);
     case ('B' << 8) | 'L':
     case ('W' << 8) | 'D':
         warn_mnemonic(h, mn, off, "text instruction skipped (text is not drawn)");
         skip_label(h);
         return CS_OK;
     case ('D' << 8) | 'F':
-        /* DF: scaling off and the window gone, as IN does; P1, P2 and RO stay (HP-GL/2
-         * reference, DF's default-values table) */
-        warn_mnemonic(h, mn, off, NULL);
-        h->sc_on = false;
-        h->win_on = false;
-        update_map(h);
-        return skip_params(h, mn);
+        return instr_df(h, mn, off);
     case ('D' << 8) | 'T':
-        /* DT t[,mode]: the label terminator is the next character ("DT;" = ETX again). */
-        if (h->pos < h->len && h->buf[h->pos] != ';')
-            h->label_term = h->buf[h->pos++];
-        else
-            h->label_term = HP_ETX;
-        return skip_params(h, mn);
+        return instr_dt(h, mn);
     case ('S' << 8) | 'M':
-        /* SM c: symbol mode with the next character as the symbol; "SM;" ends it. */
-        warn_mnemonic(h, mn, off, "symbol mode ignored: no symbol is drawn at the points");
-        if (h->pos < h->len && h->buf[h->pos] != ';' && !is_blank(h->buf[h->pos]))
-            h->pos++;
-        return end_instr(h, mn);
+        return instr_sm(h, mn, off);
     case ('C' << 8) | 'O':
-        /* HP-GL/2 comment: CO "text". */
-        skip_sep(h);
-        if (h->pos < h->len && h->buf[h->pos] == '"') {
-            size_t q = h->pos++;
-            while (h->pos < h->len && h->buf[h->pos] != '"')
-                h->pos++;
-            if (h->pos >= h->len)
-                return fail(h, q, CS_ERR_PARSE, "CO: comment string not closed");
-            h->pos++;
-        }
-        return end_instr(h, mn);
+        return instr_co(h, mn);
     default:
         warn_mnemonic(h, mn, off, NULL);
         return skip_params(h, mn);

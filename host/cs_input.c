@@ -192,6 +192,7 @@ static cs_err_t parse_format(const char *name, const char *buf, size_t len,
         go.pen_z = o->pen_z;
         go.pen_down_z_mm = o->pen_down_z_mm;
         go.pen_up_z_mm = o->pen_up_z_mm;
+        go.pen_z_feed_mm_s = o->pen_z_feed_mm_s;
         go.dialect = o->dialect == CS_DIALECT_GRBL ? CS_GCODE_GRBL : CS_GCODE_LINUXCNC;
         go.start_inch = o->units == CS_UNITS_INCH;
         go.warn = o->warn;

@@ -41,6 +41,7 @@ typedef struct {
     double helix_tol_mm;      /* G-code helices (default CS_GCODE_HELIX_TOL_MM) */
     bool pen_z; /* G-code M3/M4/M5 also move Z (cs_gcode_opts_t); plan/stream: [pen] mode = z */
     double pen_down_z_mm, pen_up_z_mm;
+    double pen_z_feed_mm_s; /* the pen's Z moves' speed ([pen] z_feed), mm/s; 0: rapid */
     cs_dialect_t dialect;  /* --dialect (G-code) */
     cs_units_t units;      /* --units (G-code) */
     const char *font_file; /* --font: stroke font for SVG <text> and HP-GL LB; NULL: default */

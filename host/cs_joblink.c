@@ -135,17 +135,26 @@ uint32_t cs_joblink_line_bps(const char *dev, uint32_t baud, uint32_t line_rate)
     return strncmp(dev, "/dev/pts/", 9) == 0 ? 0 : baud;
 }
 
-cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n)
+cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n,
+                             cs_motion_pen_t **pens, size_t *npens)
 {
-    size_t k = 0;
-    cs_segment_t *v = malloc((job->n ? job->n : 1) * sizeof *v);
-    if (v == NULL)
+    size_t k = 0, p = 0, cap = job->n ? job->n : 1;
+    cs_segment_t *v = malloc(cap * sizeof *v);
+    cs_motion_pen_t *pv = malloc(cap * sizeof *pv);
+    if (v == NULL || pv == NULL) {
+        free(v);
+        free(pv);
         return CS_ERR_FULL;
+    }
     for (size_t i = 0; i < job->n; i++)
         if (job->v[i].type == CS_PROTO_SEGMENT)
             v[k++] = job->v[i].u.segment;
+        else if (job->v[i].type == CS_PROTO_PEN)
+            pv[p++] = (cs_motion_pen_t){k, job->v[i].u.pen.pulse_us};
     *segs = v;
     *n = k;
+    *pens = pv;
+    *npens = p;
     return CS_OK;
 }
 

@@ -1,11 +1,12 @@
 /* cs_joblink: the host's links behind one interface. A job planned whole on the host runs over
  * one link, picked by option: the framed serial protocol (--port: cs_stream), Modbus TCP or RTU
  * (--modbus-tcp, --modbus-rtu: cs_modbus_stream) or the GPIO step thread here (--gpio:
- * cs_gpio_run). Each link implements the same four calls (cs_joblink_ops_t): open, run the job
- * with progress, report its own counters, close; `curvestep stream` and the daemon (`serve`)
- * call only these. Owns: the link's open state (port, Modbus client, GPIO lines), the choice of
- * the link from the options, the one report of an outcome (cs_joblink_report: exit status and
- * summary lines, cs_stream_report), and the link timing of a serial line (cs_linktime).
+ * cs_gpio_run). Each link implements the same calls (cs_joblink_ops_t): open, run the job with
+ * progress, report its own counters, close (and an optional check of its configuration before
+ * any job); `curvestep stream` and the daemon (`serve`) call only these. Owns: the link's open
+ * state (port, Modbus client, GPIO lines), the choice of the link from the options (one parser
+ * for both commands), the one report of an outcome (cs_joblink_report: exit status and summary
+ * lines, cs_stream_report), and the rate a serial line really moves (its timing: cs_linktime).
  *
  * Hold, resume and cancel are not calls but the two flags of cs_joblink_ctl_t, polled by run:
  * they are set from signal handlers (Ctrl-C; the daemon's SIGUSR1/SIGUSR2/SIGTERM to the job's
@@ -21,6 +22,7 @@
 
 #include "cs_machine.h"
 #include "cs_modbus_stream.h"
+#include "cs_motion.h"
 #include "cs_segment.h"
 #include "cs_serial.h"
 #include "cs_stream.h"
@@ -44,6 +46,8 @@ typedef struct {
     const cs_stream_job_t *job; /* wire messages (serial, Modbus) */
     const cs_segment_t *segs;   /* the step segments (GPIO; NULL: taken from job's SEGMENTs) */
     size_t nsegs;
+    const cs_motion_pen_t *pens; /* their servo pen events (GPIO: cs_gpio_pwm; with segs) */
+    size_t npens;
     size_t resume_from;       /* in the link's numbering: messages (GPIO: segments) done */
     const int32_t *start_pos; /* steps where the machine stands (GPIO reports its end
                                * position from it); NULL: the origin */
@@ -69,6 +73,9 @@ typedef struct {
     bool keep_open;   /* the daemon opens it once and keeps it (serial); else once per job */
     bool curves;      /* carries CURVE messages (--mode curves) */
     bool pens;        /* carries servo pen events (PEN messages) */
+    /* Checks the link's configuration for machine m before any job (NULL: nothing to check):
+     * the daemon refuses to start on a bad one. CS_EXIT_OK, or an exit status with l->why. */
+    int (*check)(cs_joblink_t *l, const cs_machine_t *m);
     /* Opens the link for job j (j may be NULL for a keep_open link). CS_EXIT_OK, or an exit
      * status (CS_EXIT_NO_DEVICE, _USAGE, _INPUT, _INTERNAL) with one sentence in l->why. */
     int (*open)(cs_joblink_t *l, const cs_joblink_job_t *j);
@@ -125,8 +132,11 @@ int cs_joblink_report(cs_joblink_t *l, FILE *out, size_t n, const cs_stream_resu
  * 0 (memory speed) for a pseudo-terminal (/dev/pts/N: bytes move at memory speed whatever its
  * baud), else baud. */
 uint32_t cs_joblink_line_bps(const char *dev, uint32_t baud, uint32_t line_rate);
-/* The step segments of a segments-mode job (its SEGMENT messages, in order; PEN messages are
- * skipped): a new array in *segs (free it), its length in *n. CS_ERR_FULL out of memory. */
-cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n);
+/* The step segments of a segments-mode job (its SEGMENT messages, in order) and its servo pen
+ * events (a PEN message before segment k: {k, pulse_us}, as cs_stream_job_add_motion laid them
+ * out): new arrays in *segs and *pens (free both), their lengths in *n and *npens. CS_ERR_FULL
+ * out of memory. */
+cs_err_t cs_joblink_segments(const cs_stream_job_t *job, cs_segment_t **segs, size_t *n,
+                             cs_motion_pen_t **pens, size_t *npens);
 
 #endif

@@ -126,10 +126,11 @@ cs_err_t cs_jobplan_read_opts(cs_jobplan_t *jp, const char *file, const cs_machi
     iopts.regular_only = jp->regular_only;
     if (pen != NULL) {
         jp->pen = *pen;
-        /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become rapid Z moves. */
+        /* [pen] mode = z: G-code M3/M4 (pen down) and M5 (pen up) become Z moves at z_feed. */
         iopts.pen_z = pen->mode == CS_MACHINE_PEN_Z;
         iopts.pen_up_z_mm = pen->up_z_mm;
         iopts.pen_down_z_mm = pen->down_z_mm;
+        iopts.pen_z_feed_mm_s = pen->z_feed_mm_s;
     }
     cs_err_t e = cs_input_load(file, &iopts, &jp->path, &jp->diag);
     jp->gcode = fmt == CS_INPUT_GCODE;
@@ -215,15 +216,12 @@ cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t 
 
 cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool curves)
 {
-    if (jp->mo.segs.npens == 0 || (pens && !curves))
+    (void)curves; /* curves mode carries them too (cs_stream_pen) */
+    if (jp->mo.segs.npens == 0 || pens)
         return CS_OK;
-    if (curves)
-        return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                          "[pen] mode = servo: --mode curves does not carry pen events (the device "
-                          "plans the strokes itself); stream it in segments mode");
     return fail_whole(jp, file, CS_ERR_UNSUPPORTED,
-                      "[pen] mode = servo: the Modbus and GPIO links do not carry pen events yet "
-                      "(the serial link, --port, does); use mode = z or a G-code M3/M5 spindle pen");
+                      "[pen] mode = servo: this link does not carry pen events (the serial, Modbus "
+                      "and GPIO links do); use mode = z or a G-code M3/M5 spindle pen");
 }
 
 int cs_jobplan_exit(const cs_jobplan_t *jp, cs_err_t e)

@@ -92,10 +92,10 @@ cs_err_t cs_jobplan_reference(cs_jobplan_t *jp, const char *file, const cs_jobop
 cs_err_t cs_jobplan_plan(cs_jobplan_t *jp, const char *file, const cs_machine_t *m,
                          const cs_pos_t *start, cs_pos_t tol, int method, int32_t feed);
 /* The planned job can go down a device link: CS_OK, or CS_ERR_UNSUPPORTED with jp->diag
- * "file: ..." when it holds servo pen events and the link does not carry them (pens false:
- * Modbus, GPIO) or the job goes as CURVE messages (curves: the device plans the strokes itself
- * and has no place for a pen event). The serial link (stream --port, the daemon) carries them
- * in segments mode as PEN messages (docs/protocol.md). */
+ * "file: ..." when it holds servo pen events and the link does not carry them (pens false).
+ * Every link carries them now: the serial and Modbus links as PEN messages (docs/protocol.md),
+ * in segments mode in their place among the segments, in curves mode between the curves
+ * (cs_stream_pen); the GPIO link by software PWM (cs_gpio_pwm). curves no longer refuses. */
 cs_err_t cs_jobplan_linkable(cs_jobplan_t *jp, const char *file, bool pens, bool curves);
 /* The exit status for error e of cs_jobplan_read / _plan: a file that cannot be read as a job
  * (anything but running out of memory, CS_ERR_FULL) and a job the machine cannot do (outside the

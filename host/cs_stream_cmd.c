@@ -16,6 +16,7 @@
 #include "cs_serial.h"
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
+#include "cs_stream_pen.h"
 #include "cs_stream_resume.h"
 #include "cs_trace.h"
 
@@ -267,9 +268,11 @@ static int plan(const stream_args_t *a, const cs_joblink_t *l, const cs_machine_
     if (e == CS_OK)
         e = cs_jobplan_linkable(jp, a->job_file, l->ops->pens, a->curves);
     if (e == CS_OK)
-        e = a->curves ? cs_stream_job_add_path(
-                            job, &jp->path, feed_q > 0 ? feed_q : m->default_feed, tol, &jp->diag)
-                      : cs_stream_job_add_motion(job, &jp->mo.segs);
+        e = a->curves
+                ? cs_stream_job_add_path_pen(job, &jp->path, feed_q > 0 ? feed_q : m->default_feed,
+                                             tol, &jp->pen, m->tick_hz, &(cs_vec3_t){0, 0, 0},
+                                             &jp->diag)
+                : cs_stream_job_add_motion(job, &jp->mo.segs);
     if (e != CS_OK) {
         cs_path_diag_print(stderr, &jp->diag);
         return cs_jobplan_exit(jp, e);
@@ -361,9 +364,15 @@ int cs_cmd_stream(int argc, char **argv)
     if (rc == CS_EXIT_OK) {
         /* GPIO runs the segments planned here (numbered as segments), the others the messages */
         bool segs = l.ops == &cs_joblink_gpio_ops;
-        cs_joblink_job_t j = {&m,   &job,         jp.mo.segs.v,
-                              jp.mo.segs.n, a.resume_from, NULL,
-                              a.resume_ask, a.position != NULL ? a.pos : NULL};
+        cs_joblink_job_t j = {.m = &m,
+                              .job = &job,
+                              .segs = jp.mo.segs.v,
+                              .nsegs = jp.mo.segs.n,
+                              .pens = jp.mo.segs.pens,
+                              .npens = jp.mo.segs.npens,
+                              .resume_from = a.resume_from,
+                              .resume_ask = a.resume_ask,
+                              .stated_pos = a.position != NULL ? a.pos : NULL};
         if (a.position != NULL && check_position(a.position, &m, &job, a.resume_from, a.pos) != 0)
             rc = CS_EXIT_USAGE;
         else

@@ -236,6 +236,113 @@ static bool is_alpha(char c)
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
 }
 
+/* The transform functions of SVG 1.1 7.6 with their argument counts (rotate: 1 or 3). */
+static const struct {
+    const char *name;
+    unsigned minargs, maxargs;
+} xform_kinds[] = {
+    {"matrix", 6, 6}, {"translate", 1, 2}, {"scale", 1, 2},
+    {"rotate", 1, 3}, {"skewX", 1, 1},     {"skewY", 1, 1},
+};
+enum { XF_MATRIX, XF_TRANSLATE, XF_SCALE, XF_ROTATE, XF_SKEWX, XF_SKEWY, XF_KINDS };
+
+/* The index of the transform name s[0..nl) in xform_kinds, or -1. */
+static int xform_kind(const char *s, size_t nl)
+{
+    for (int k = 0; k < XF_KINDS; k++)
+        if (strlen(xform_kinds[k].name) == nl && memcmp(s, xform_kinds[k].name, nl) == 0)
+            return k;
+    return -1;
+}
+
+/* The arguments of a transform from s[*i] (just after its '('), up to and past the ')': *n of
+ * them into v. CS_OK, or CS_ERR_PARSE with *bad and *why. */
+static cs_err_t xform_args(const char *s, size_t len, size_t *i, int kind, double v[6],
+                           unsigned *n, size_t *bad, const char **why)
+{
+    *n = 0;
+    for (;;) {
+        while (*i < len && is_xml_space(s[*i]))
+            (*i)++;
+        if (*i < len && s[*i] == ')' && *n > 0)
+            break;
+        if (*n > 0 && *i < len && s[*i] == ',') {
+            (*i)++;
+            while (*i < len && is_xml_space(s[*i]))
+                (*i)++;
+        }
+        if (*n >= xform_kinds[kind].maxargs) {
+            *bad = *i;
+            *why = "too many arguments for this transform";
+            return CS_ERR_PARSE;
+        }
+        size_t b = 0;
+        size_t k = cs_svgpath_scan_number(s + *i, len - *i, &v[*n], &b);
+        if (k == 0) {
+            *bad = *i + b;
+            *why = "expected a number in the transform";
+            return CS_ERR_PARSE;
+        }
+        if (!isfinite(v[*n])) {
+            *bad = *i;
+            *why = "number too large";
+            return CS_ERR_PARSE;
+        }
+        *i += k;
+        (*n)++;
+    }
+    if (*n < xform_kinds[kind].minargs || (kind == XF_ROTATE && *n == 2)) {
+        *bad = *i;
+        *why = "too few arguments for this transform";
+        return CS_ERR_PARSE;
+    }
+    (*i)++; /* ')' */
+    return CS_OK;
+}
+
+/* The matrix of one transform function (SVG 1.1 7.4, 7.6). */
+static cs_path_affine_t xform_matrix(int kind, const double *v, unsigned n)
+{
+    cs_path_affine_t t = cs_path_affine_identity();
+    switch (kind) {
+    case XF_MATRIX:
+        t.a = v[0];
+        t.b = v[1];
+        t.c = v[2];
+        t.d = v[3];
+        t.e = v[4];
+        t.f = v[5];
+        break;
+    case XF_TRANSLATE:
+        t.e = v[0];
+        t.f = n > 1 ? v[1] : 0.0;
+        break;
+    case XF_SCALE:
+        t.a = v[0];
+        t.d = n > 1 ? v[1] : v[0];
+        break;
+    case XF_ROTATE: {
+        double r = v[0] * (M_PI / 180.0);
+        t.a = cos(r);
+        t.b = sin(r);
+        t.c = -sin(r);
+        t.d = cos(r);
+        if (n == 3) { /* rotate about (cx, cy): translate(c) rotate translate(-c) */
+            t.e = v[1] - t.a * v[1] - t.c * v[2];
+            t.f = v[2] - t.b * v[1] - t.d * v[2];
+        }
+        break;
+    }
+    case XF_SKEWX:
+        t.c = tan(v[0] * (M_PI / 180.0));
+        break;
+    default:
+        t.b = tan(v[0] * (M_PI / 180.0));
+        break;
+    }
+    return t;
+}
+
 cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *out, size_t *bad,
                                    const char **why)
 {
@@ -258,32 +365,8 @@ cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *
         size_t ns = i;
         while (i < len && is_alpha(s[i]))
             i++;
-        size_t nl = i - ns;
-        const char *name = s + ns;
-        int kind;
-        unsigned minargs, maxargs;
-        if (nl == 6 && memcmp(name, "matrix", 6) == 0) {
-            kind = 0;
-            minargs = maxargs = 6;
-        } else if (nl == 9 && memcmp(name, "translate", 9) == 0) {
-            kind = 1;
-            minargs = 1;
-            maxargs = 2;
-        } else if (nl == 5 && memcmp(name, "scale", 5) == 0) {
-            kind = 2;
-            minargs = 1;
-            maxargs = 2;
-        } else if (nl == 6 && memcmp(name, "rotate", 6) == 0) {
-            kind = 3;
-            minargs = 1;
-            maxargs = 3;
-        } else if (nl == 5 && memcmp(name, "skewX", 5) == 0) {
-            kind = 4;
-            minargs = maxargs = 1;
-        } else if (nl == 5 && memcmp(name, "skewY", 5) == 0) {
-            kind = 5;
-            minargs = maxargs = 1;
-        } else {
+        int kind = xform_kind(s + ns, i - ns);
+        if (kind < 0) {
             *bad = ns;
             *why = "unknown transform (expected matrix, translate, scale, rotate, skewX or skewY)";
             return CS_ERR_PARSE;
@@ -297,81 +380,11 @@ cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *
         }
         i++;
         double v[6];
-        unsigned n = 0;
-        for (;;) {
-            while (i < len && is_xml_space(s[i]))
-                i++;
-            if (i < len && s[i] == ')' && n > 0)
-                break;
-            if (n > 0 && i < len && s[i] == ',') {
-                i++;
-                while (i < len && is_xml_space(s[i]))
-                    i++;
-            }
-            if (n >= maxargs) {
-                *bad = i;
-                *why = "too many arguments for this transform";
-                return CS_ERR_PARSE;
-            }
-            size_t b = 0;
-            size_t k = cs_svgpath_scan_number(s + i, len - i, &v[n], &b);
-            if (k == 0) {
-                *bad = i + b;
-                *why = "expected a number in the transform";
-                return CS_ERR_PARSE;
-            }
-            if (!isfinite(v[n])) {
-                *bad = i;
-                *why = "number too large";
-                return CS_ERR_PARSE;
-            }
-            i += k;
-            n++;
-        }
-        if (n < minargs || (kind == 3 && n == 2)) {
-            *bad = i;
-            *why = "too few arguments for this transform";
-            return CS_ERR_PARSE;
-        }
-        i++; /* ')' */
-        cs_path_affine_t t = cs_path_affine_identity();
-        switch (kind) {
-        case 0:
-            t.a = v[0];
-            t.b = v[1];
-            t.c = v[2];
-            t.d = v[3];
-            t.e = v[4];
-            t.f = v[5];
-            break;
-        case 1:
-            t.e = v[0];
-            t.f = n > 1 ? v[1] : 0.0;
-            break;
-        case 2:
-            t.a = v[0];
-            t.d = n > 1 ? v[1] : v[0];
-            break;
-        case 3: {
-            double r = v[0] * (M_PI / 180.0);
-            t.a = cos(r);
-            t.b = sin(r);
-            t.c = -sin(r);
-            t.d = cos(r);
-            if (n == 3) { /* rotate about (cx, cy): translate(c) rotate translate(-c) */
-                t.e = v[1] - t.a * v[1] - t.c * v[2];
-                t.f = v[2] - t.b * v[1] - t.d * v[2];
-            }
-            break;
-        }
-        case 4:
-            t.c = tan(v[0] * (M_PI / 180.0));
-            break;
-        default:
-            t.b = tan(v[0] * (M_PI / 180.0));
-            break;
-        }
-        m = cs_path_affine_mul(m, t);
+        unsigned n;
+        cs_err_t e = xform_args(s, len, &i, kind, v, &n, bad, why);
+        if (e != CS_OK)
+            return e;
+        m = cs_path_affine_mul(m, xform_matrix(kind, v, n));
         need_sep = true;
     }
     *out = m;

@@ -108,57 +108,33 @@ static void curve_data(FILE *f, const cs_path_t *c)
     }
 }
 
-cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t *chords,
-                          const cs_svgout_opts_t *o)
+/* Extent of what is drawn: the curves themselves (sampled, tighter than the control polygon)
+ * and every chord vertex. false when there is nothing (box: 0..10 mm then). */
+static bool extent(const cs_path_t *curves, const cs_path_poly_t *chords, double box[4])
 {
-    cs_svgout_opts_t defaults;
-    if (!o) {
-        cs_svgout_opts_init(&defaults);
-        o = &defaults;
-    }
-    /* Extent of what is drawn: the curves themselves (sampled, tighter than the control
-     * polygon) and every chord vertex. */
-    double box[4] = {0, 0, 0, 0};
     bool any = false;
-    size_t nelem = curves ? curves->n : 0;
-    for (size_t i = 0; i < nelem; i++) {
+    box[0] = box[1] = box[2] = box[3] = 0;
+    for (size_t i = 0; curves && i < curves->n; i++) {
         for (int k = 0; k <= 32; k++) {
             double q[3];
             cs_path_eval_mm(&curves->elems[i].curve, k / 32.0, q);
             grow_box(box, &any, q[0], q[1]);
         }
     }
-    size_t nv = chords ? chords->n : 0;
-    for (size_t i = 0; i < nv; i++)
+    for (size_t i = 0; chords && i < chords->n; i++)
         grow_box(box, &any, chords->pts[i].x, chords->pts[i].y);
-    bool empty = !any;
-    if (empty) {
+    if (!any) {
         box[0] = box[1] = 0.0;
         box[2] = box[3] = 10.0;
     }
-    double w = box[2] - box[0], h = box[3] - box[1];
-    double span = fmax(fmax(w, h), 1e-3);
-    double u = span / SVGOUT_PX; /* one nominal pixel, in mm */
-    double margin = 24.0 * u, line = 17.0 * u;
-    int nlines = 3 + (o->title ? 1 : 0);
-    double legend = nlines * line + 40.0 * u;
-    double vx = box[0] - margin, vy = box[1] - margin;
-    double vw = fmax(w + 2.0 * margin, 520.0 * u), vh = h + 2.0 * margin + legend;
+    return any;
+}
 
-    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    fprintf(f,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%.0f\" "
-            "height=\"%.0f\" viewBox=\"%.6f %.6f %.6f %.6f\">\n",
-            vw / u, vh / u, vx, vy, vw, vh);
-    fprintf(f, "<title>curvestep flatten");
-    if (o->title) {
-        fputs(": ", f);
-        put_text(f, o->title);
-    }
-    fprintf(f, "</title>\n");
-    fprintf(f, "<rect x=\"%.6f\" y=\"%.6f\" width=\"%.6f\" height=\"%.6f\" fill=\"white\"/>\n", vx,
-            vy, vw, vh);
-    if (nelem > 0) {
+/* The exact curves (wide, pale) and the chords with their vertices; u: one pixel in mm. */
+static void draw_body(FILE *f, const cs_path_t *curves, const cs_path_poly_t *chords, double u)
+{
+    size_t nv = chords ? chords->n : 0;
+    if (curves && curves->n > 0) {
         fprintf(f,
                 "<path id=\"curves\" fill=\"none\" stroke=\"" COLOR_CURVE
                 "\" stroke-width=\"%.6g\" "
@@ -167,28 +143,53 @@ cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t
         curve_data(f, curves);
         fprintf(f, "/>\n");
     }
-    if (nv > 0) {
-        fprintf(f,
-                "<g id=\"chords\" fill=\"none\" stroke=\"" COLOR_CHORD "\" stroke-width=\"%.6g\" "
-                "stroke-linejoin=\"round\">\n",
-                1.0 * u);
-        for (size_t l = 0; l < chords->nlines; l++) {
-            size_t s = chords->starts[l], n = cs_path_poly_len(chords, l);
-            fprintf(f, "<polyline points=\"");
-            for (size_t k = 0; k < n; k++)
-                fprintf(f, "%s%.6f,%.6f", k ? " " : "", chords->pts[s + k].x, chords->pts[s + k].y);
-            fprintf(f, "\"/>\n");
-        }
-        fprintf(f, "</g>\n<g id=\"vertices\" fill=\"" COLOR_CHORD "\">\n");
-        double r = (nv > 20000 ? 1.0 : 1.6) * u;
-        for (size_t k = 0; k < nv; k++)
-            fprintf(f, "<circle cx=\"%.6f\" cy=\"%.6f\" r=\"%.6g\"/>\n", chords->pts[k].x,
-                    chords->pts[k].y, r);
-        fprintf(f, "</g>\n");
+    if (nv == 0)
+        return;
+    fprintf(f,
+            "<g id=\"chords\" fill=\"none\" stroke=\"" COLOR_CHORD "\" stroke-width=\"%.6g\" "
+            "stroke-linejoin=\"round\">\n",
+            1.0 * u);
+    for (size_t l = 0; l < chords->nlines; l++) {
+        size_t s = chords->starts[l], n = cs_path_poly_len(chords, l);
+        fprintf(f, "<polyline points=\"");
+        for (size_t k = 0; k < n; k++)
+            fprintf(f, "%s%.6f,%.6f", k ? " " : "", chords->pts[s + k].x, chords->pts[s + k].y);
+        fprintf(f, "\"/>\n");
     }
+    fprintf(f, "</g>\n<g id=\"vertices\" fill=\"" COLOR_CHORD "\">\n");
+    double r = (nv > 20000 ? 1.0 : 1.6) * u;
+    for (size_t k = 0; k < nv; k++)
+        fprintf(f, "<circle cx=\"%.6f\" cy=\"%.6f\" r=\"%.6g\"/>\n", chords->pts[k].x,
+                chords->pts[k].y, r);
+    fprintf(f, "</g>\n");
+}
 
-    /* Legend, under the drawing. */
-    double lx = box[0], ly = box[3] + margin + line;
+/* The legend's settings line: tolerance, method, measured deviation. */
+static void legend_settings(FILE *f, const cs_svgout_opts_t *o, double lx, double ly)
+{
+    fprintf(f, "<text x=\"%.6f\" y=\"%.6f\">", lx, ly);
+    const char *sep = "";
+    if (o->tol_mm > 0.0) {
+        fprintf(f, "tolerance %.6g mm", o->tol_mm);
+        sep = ", ";
+    }
+    if (o->method) {
+        fprintf(f, "%smethod ", sep);
+        put_text(f, o->method);
+        sep = ", ";
+    }
+    if (o->max_dev_mm >= 0.0)
+        fprintf(f, "%smax deviation %.5g mm (measured)", sep, o->max_dev_mm);
+    fprintf(f, "</text>\n");
+}
+
+/* Legend under the drawing from (lx, ly): title, the two samples with their counts, the
+ * settings, a scale bar (a round length about a quarter of span, with end ticks). */
+static void draw_legend(FILE *f, const cs_svgout_opts_t *o, const cs_path_t *curves,
+                        const cs_path_poly_t *chords, double lx, double ly, double line,
+                        double span, double u)
+{
+    size_t nelem = curves ? curves->n : 0, nv = chords ? chords->n : 0;
     fprintf(f, "<g id=\"legend\" font-family=\"sans-serif\" font-size=\"%.6g\" fill=\"#222\">\n",
             13.0 * u);
     if (o->title) {
@@ -216,23 +217,8 @@ cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t
             lx + 32.0 * u, ly, nchords, nv, chords ? chords->nlines : 0,
             chords && chords->nlines == 1 ? "" : "s");
     ly += line;
-    fprintf(f, "<text x=\"%.6f\" y=\"%.6f\">", lx, ly);
-    const char *sep = "";
-    if (o->tol_mm > 0.0) {
-        fprintf(f, "tolerance %.6g mm", o->tol_mm);
-        sep = ", ";
-    }
-    if (o->method) {
-        fprintf(f, "%smethod ", sep);
-        put_text(f, o->method);
-        sep = ", ";
-    }
-    if (o->max_dev_mm >= 0.0)
-        fprintf(f, "%smax deviation %.5g mm (measured)", sep, o->max_dev_mm);
-    fprintf(f, "</text>\n");
+    legend_settings(f, o, lx, ly);
     ly += line;
-
-    /* Scale bar: a round length about a quarter of the drawing, with end ticks. */
     double bar = nice_length(span / 4.0);
     double by = ly + 10.0 * u, tick = 5.0 * u;
     fprintf(f,
@@ -240,7 +226,44 @@ cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t
             "stroke-width=\"%.6g\"/>\n",
             lx, by - tick, tick, bar, -tick, 1.5 * u);
     fprintf(f, "<text x=\"%.6f\" y=\"%.6f\">%g mm</text>\n", lx + bar + 8.0 * u, by, bar);
-    fprintf(f, "</g>\n</svg>\n");
+    fprintf(f, "</g>\n");
+}
+
+cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t *chords,
+                          const cs_svgout_opts_t *o)
+{
+    cs_svgout_opts_t defaults;
+    if (!o) {
+        cs_svgout_opts_init(&defaults);
+        o = &defaults;
+    }
+    double box[4];
+    bool empty = !extent(curves, chords, box);
+    double w = box[2] - box[0], h = box[3] - box[1];
+    double span = fmax(fmax(w, h), 1e-3);
+    double u = span / SVGOUT_PX; /* one nominal pixel, in mm */
+    double margin = 24.0 * u, line = 17.0 * u;
+    int nlines = 3 + (o->title ? 1 : 0);
+    double legend = nlines * line + 40.0 * u;
+    double vx = box[0] - margin, vy = box[1] - margin;
+    double vw = fmax(w + 2.0 * margin, 520.0 * u), vh = h + 2.0 * margin + legend;
+
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    fprintf(f,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%.0f\" "
+            "height=\"%.0f\" viewBox=\"%.6f %.6f %.6f %.6f\">\n",
+            vw / u, vh / u, vx, vy, vw, vh);
+    fprintf(f, "<title>curvestep flatten");
+    if (o->title) {
+        fputs(": ", f);
+        put_text(f, o->title);
+    }
+    fprintf(f, "</title>\n");
+    fprintf(f, "<rect x=\"%.6f\" y=\"%.6f\" width=\"%.6f\" height=\"%.6f\" fill=\"white\"/>\n", vx,
+            vy, vw, vh);
+    draw_body(f, curves, chords, u);
+    draw_legend(f, o, curves, chords, box[0], box[3] + margin + line, line, span, u);
+    fprintf(f, "</svg>\n");
     if (ferror(f))
         return CS_ERR_IO;
     return empty ? CS_ERR_EMPTY : CS_OK;

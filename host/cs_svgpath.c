@@ -350,21 +350,20 @@ static cs_err_t arc_pieces_double(parser_t *p, double Cx, double Cy, double Ux, 
  * out-of-range radii), then cs_arc_build on the transformed centre and conjugate semi-axes: an
  * affine image of X = C + U cos(theta) + V sin(theta) is C' + U' cos(theta) + V' sin(theta), so
  * the unit-circle directions carry over unchanged. */
-static cs_err_t arc_to(parser_t *p, double rx, double ry, double phi_deg, bool fa, bool fs,
-                       double x2, double y2, size_t end_off, size_t elem_off)
-{
-    double x1 = p->cx, y1 = p->cy;
-    cs_vec3_t endf;
-    cs_err_t e = point(p, x2, y2, end_off, &endf);
-    if (e != CS_OK)
-        return e;
-    if (x1 == x2 && y1 == y2)
-        return CS_OK; /* F.6.2: identical end points, the arc is omitted */
-    rx = fabs(rx);
-    ry = fabs(ry);
-    if (rx == 0.0 || ry == 0.0)
-        return line_to(p, x2, y2, end_off, elem_off); /* F.6.2: zero radius = straight line */
+/* An arc's centre parameterisation (SVG 1.1 F.6.5): centre (ccx, ccy) and radii (rx, ry,
+ * scaled up when too small, F.6.6.2) in user units, the x axis' direction (cp, sp), the unit
+ * start and end directions (u0, u1), the start angle th0 and the signed sweep dth. */
+typedef struct {
+    double ccx, ccy, rx, ry, cp, sp;
+    double u0x, u0y, u1x, u1y;
+    double th0, dth;
+} arc_geo_t;
 
+/* From (x1, y1) to (x2, y2) with radii rx, ry > 0, rotation phi_deg, the flags fa, fs. false
+ * when the directions degenerate (the caller draws a line). */
+static bool arc_centre(double x1, double y1, double x2, double y2, double rx, double ry,
+                       double phi_deg, bool fa, bool fs, arc_geo_t *g)
+{
     double phi = fmod(phi_deg, 360.0) * (M_PI / 180.0);
     double cp = cos(phi), sp = sin(phi);
     double dx2 = (x1 - x2) / 2.0, dy2 = (y1 - y2) / 2.0;
@@ -382,80 +381,66 @@ static cs_err_t arc_to(parser_t *p, double rx, double ry, double phi_deg, bool f
     if (fa == fs)
         coef = -coef;
     double cxp = coef * rx * y1p / ry, cyp = -coef * ry * x1p / rx;
-    double ccx = cp * cxp - sp * cyp + (x1 + x2) / 2.0; /* F.6.5.3 */
-    double ccy = sp * cxp + cp * cyp + (y1 + y2) / 2.0;
+    g->ccx = cp * cxp - sp * cyp + (x1 + x2) / 2.0; /* F.6.5.3 */
+    g->ccy = sp * cxp + cp * cyp + (y1 + y2) / 2.0;
+    g->rx = rx;
+    g->ry = ry;
+    g->cp = cp;
+    g->sp = sp;
     /* Start and end directions on the unit circle (the vectors of F.6.5.5 and F.6.5.6). */
     double u0x = (x1p - cxp) / rx, u0y = (y1p - cyp) / ry;
     double u1x = (-x1p - cxp) / rx, u1y = (-y1p - cyp) / ry;
     double n0 = hypot(u0x, u0y), n1 = hypot(u1x, u1y);
     if (!(n0 > 0.0) || !(n1 > 0.0))
-        return line_to(p, x2, y2, end_off, elem_off);
-    u0x /= n0;
-    u0y /= n0;
-    u1x /= n1;
-    u1y /= n1;
-    double th0 = atan2(u0y, u0x);
-    double dth = atan2(u0x * u1y - u0y * u1x, u0x * u1x + u0y * u1y); /* F.6.5.6 */
-    if (fs && dth < 0.0)
-        dth += 2.0 * M_PI;
-    else if (!fs && dth > 0.0)
-        dth -= 2.0 * M_PI;
+        return false;
+    g->u0x = u0x / n0;
+    g->u0y = u0y / n0;
+    g->u1x = u1x / n1;
+    g->u1y = u1y / n1;
+    g->th0 = atan2(g->u0y, g->u0x);
+    g->dth = atan2(g->u0x * g->u1y - g->u0y * g->u1x, g->u0x * g->u1x + g->u0y * g->u1y);
+    if (fs && g->dth < 0.0) /* F.6.5.6 */
+        g->dth += 2.0 * M_PI;
+    else if (!fs && g->dth > 0.0)
+        g->dth -= 2.0 * M_PI;
+    return true;
+}
 
-    /* Centre and conjugate semi-axes in mm. */
-    double Cx, Cy, Ux, Uy, Vx, Vy;
-    cs_path_affine_point(&p->o->xform, ccx, ccy, &Cx, &Cy);
-    cs_path_affine_vector(&p->o->xform, rx * cp, rx * sp, &Ux, &Uy);
-    cs_path_affine_vector(&p->o->xform, -ry * sp, ry * cp, &Vx, &Vy);
-
-    /* A nearly flat arc (tiny sweep of a huge ellipse) is its chord to within half an LSB;
-     * drawing it as a line also spares a centre far outside the coordinate range. */
-    double ax = cs_conv_pos_to_mm(p->cur.x), ay = cs_conv_pos_to_mm(p->cur.y);
-    double bx = cs_conv_pos_to_mm(endf.x), by = cs_conv_pos_to_mm(endf.y);
+/* Largest distance (mm) of the arc with centre C and conjugate semi-axes U, V (mm) from the chord
+ * a-b, sampled: a nearly flat arc is drawn as its chord. */
+static double arc_sag(const arc_geo_t *g, const double C[2], const double U[2], const double V[2],
+                      double ax, double ay, double bx, double by)
+{
     double sag = 0.0;
     for (int k = 1; k < ARC_FLAT_SAMPLES; k++) {
-        double th = th0 + dth * k / ARC_FLAT_SAMPLES;
-        double px = Cx + Ux * cos(th) + Vx * sin(th), py = Cy + Uy * cos(th) + Vy * sin(th);
+        double th = g->th0 + g->dth * k / ARC_FLAT_SAMPLES;
+        double px = C[0] + U[0] * cos(th) + V[0] * sin(th);
+        double py = C[1] + U[1] * cos(th) + V[1] * sin(th);
         double dd = seg_dist(px, py, ax, ay, bx, by);
         if (dd > sag)
             sag = dd;
     }
-    if (!isfinite(sag))
-        return fail(p, elem_off, CS_ERR_RANGE, "arc is too large for the coordinate range");
-    if (sag < ARC_FLAT_MM)
-        return line_to(p, x2, y2, end_off, elem_off);
+    return sag;
+}
 
-    cs_vec3_t C, U, V;
-    bool centre_ok = cs_conv_mm_to_vec(Cx, Cy, 0.0, &C) == CS_OK;
-    bool axes_ok =
-        cs_conv_mm_to_vec(Ux, Uy, 0.0, &U) == CS_OK && cs_conv_mm_to_vec(Vx, Vy, 0.0, &V) == CS_OK;
-    if (!centre_ok || !axes_ok) {
-        /* cs_arc_build needs the centre and semi-axes inside the coordinate range; a flat arc
-         * of a large ellipse lies in range while they do not. Build the same pieces here. */
-        e = arc_pieces_double(p, Cx, Cy, Ux, Uy, Vx, Vy, th0, dth, &endf, elem_off);
-        if (e == CS_OK) {
-            p->cx = x2;
-            p->cy = y2;
-            p->cur = endf;
-        } else if (e == CS_ERR_RANGE && !centre_ok) {
-            fail(p, elem_off, CS_ERR_RANGE,
-                 "arc leaves the accepted range of +/-%d mm (its centre is at (%.6g, %.6g) mm)",
-                 CS_POS_LIMIT_MM, Cx, Cy);
-        }
-        return e;
-    }
+/* The arc's rational pieces from the core's builder (cs_arc_build), snapped to the path's end
+ * points, added to the path; the parser's position moves to (x2, y2) / endf. */
+static cs_err_t arc_emit(parser_t *p, const arc_geo_t *g, const cs_vec3_t *C, const cs_vec3_t *U,
+                         const cs_vec3_t *V, bool fs, const cs_vec3_t *endf, double x2, double y2,
+                         size_t end_off, size_t elem_off)
+{
     cs_param_t c0, s0, c1, s1;
-    if (cs_conv_to_param(u0x, &c0) != CS_OK || cs_conv_to_param(u0y, &s0) != CS_OK ||
-        cs_conv_to_param(u1x, &c1) != CS_OK || cs_conv_to_param(u1y, &s1) != CS_OK)
+    if (cs_conv_to_param(g->u0x, &c0) != CS_OK || cs_conv_to_param(g->u0y, &s0) != CS_OK ||
+        cs_conv_to_param(g->u1x, &c1) != CS_OK || cs_conv_to_param(g->u1y, &s1) != CS_OK)
         return fail(p, elem_off, CS_ERR_RANGE, "arc direction not representable");
-    if (c0 == c1 && s0 == s1 && fabs(dth) < M_PI) {
+    if (c0 == c1 && s0 == s1 && fabs(g->dth) < M_PI) {
         /* Distinct small-sweep directions that round together would read as a full turn. */
         return line_to(p, x2, y2, end_off, elem_off);
     }
-
     cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
     memset(seg, 0, sizeof seg); /* unused points of each piece stay defined (zero) */
     unsigned n = 0;
-    e = cs_arc_build(&C, &U, &V, c0, s0, c1, s1, fs, seg, &n);
+    cs_err_t e = cs_arc_build(C, U, V, c0, s0, c1, s1, fs, seg, &n);
     if (e != CS_OK)
         return fail(p, elem_off, e == CS_ERR_OVERFLOW ? CS_ERR_RANGE : e, "arc cannot be built: %s",
                     cs_err_text(e));
@@ -463,21 +448,75 @@ static cs_err_t arc_to(parser_t *p, double rx, double ry, double phi_deg, bool f
         return fail(p, elem_off, CS_ERR_ARG, "arc builder returned %u pieces", n);
     unsigned last = seg[n - 1].degree;
     if (lsb_dist(&seg[0].p[0], &p->cur) > ARC_SNAP_MAX_LSB ||
-        lsb_dist(&seg[n - 1].p[last], &endf) > ARC_SNAP_MAX_LSB)
+        lsb_dist(&seg[n - 1].p[last], endf) > ARC_SNAP_MAX_LSB)
         return fail(p, elem_off, CS_ERR_ARG,
                     "arc builder's end points are %lld and %lld LSB away from the arc's ends",
                     (long long)lsb_dist(&seg[0].p[0], &p->cur),
-                    (long long)lsb_dist(&seg[n - 1].p[last], &endf));
+                    (long long)lsb_dist(&seg[n - 1].p[last], endf));
     /* Make the path continuous to the LSB: the neighbours' end points are the exact ones. */
     seg[0].p[0] = p->cur;
-    seg[n - 1].p[last] = endf;
+    seg[n - 1].p[last] = *endf;
     for (unsigned i = 0; i < n; i++)
         if (cs_path_add(p->path, &seg[i], CS_PATH_ARC, loc_at(p, elem_off)) != CS_OK)
             return fail(p, elem_off, CS_ERR_FULL, "out of memory");
     p->cx = x2;
     p->cy = y2;
-    p->cur = endf;
+    p->cur = *endf;
     return CS_OK;
+}
+
+static cs_err_t arc_to(parser_t *p, double rx, double ry, double phi_deg, bool fa, bool fs,
+                       double x2, double y2, size_t end_off, size_t elem_off)
+{
+    double x1 = p->cx, y1 = p->cy;
+    cs_vec3_t endf;
+    cs_err_t e = point(p, x2, y2, end_off, &endf);
+    if (e != CS_OK)
+        return e;
+    if (x1 == x2 && y1 == y2)
+        return CS_OK; /* F.6.2: identical end points, the arc is omitted */
+    rx = fabs(rx);
+    ry = fabs(ry);
+    arc_geo_t g;
+    if (rx == 0.0 || ry == 0.0 || /* F.6.2: zero radius = straight line */
+        !arc_centre(x1, y1, x2, y2, rx, ry, phi_deg, fa, fs, &g))
+        return line_to(p, x2, y2, end_off, elem_off);
+
+    /* Centre and conjugate semi-axes in mm. */
+    double Cm[2], Um[2], Vm[2];
+    cs_path_affine_point(&p->o->xform, g.ccx, g.ccy, &Cm[0], &Cm[1]);
+    cs_path_affine_vector(&p->o->xform, g.rx * g.cp, g.rx * g.sp, &Um[0], &Um[1]);
+    cs_path_affine_vector(&p->o->xform, -g.ry * g.sp, g.ry * g.cp, &Vm[0], &Vm[1]);
+
+    /* A nearly flat arc (tiny sweep of a huge ellipse) is its chord to within half an LSB;
+     * drawing it as a line also spares a centre far outside the coordinate range. */
+    double sag = arc_sag(&g, Cm, Um, Vm, cs_conv_pos_to_mm(p->cur.x), cs_conv_pos_to_mm(p->cur.y),
+                         cs_conv_pos_to_mm(endf.x), cs_conv_pos_to_mm(endf.y));
+    if (!isfinite(sag))
+        return fail(p, elem_off, CS_ERR_RANGE, "arc is too large for the coordinate range");
+    if (sag < ARC_FLAT_MM)
+        return line_to(p, x2, y2, end_off, elem_off);
+
+    cs_vec3_t C, U, V;
+    bool centre_ok = cs_conv_mm_to_vec(Cm[0], Cm[1], 0.0, &C) == CS_OK;
+    bool axes_ok = cs_conv_mm_to_vec(Um[0], Um[1], 0.0, &U) == CS_OK &&
+                   cs_conv_mm_to_vec(Vm[0], Vm[1], 0.0, &V) == CS_OK;
+    if (centre_ok && axes_ok)
+        return arc_emit(p, &g, &C, &U, &V, fs, &endf, x2, y2, end_off, elem_off);
+    /* cs_arc_build needs the centre and semi-axes inside the coordinate range; a flat arc of a
+     * large ellipse lies in range while they do not. Build the same pieces here. */
+    e = arc_pieces_double(p, Cm[0], Cm[1], Um[0], Um[1], Vm[0], Vm[1], g.th0, g.dth, &endf,
+                          elem_off);
+    if (e == CS_OK) {
+        p->cx = x2;
+        p->cy = y2;
+        p->cur = endf;
+    } else if (e == CS_ERR_RANGE && !centre_ok) {
+        fail(p, elem_off, CS_ERR_RANGE,
+             "arc leaves the accepted range of +/-%d mm (its centre is at (%.6g, %.6g) mm)",
+             CS_POS_LIMIT_MM, Cm[0], Cm[1]);
+    }
+    return e;
 }
 
 static unsigned nargs_of(char up)
@@ -517,26 +556,108 @@ static const char *arg_name(char up, unsigned i)
 
 /* Executes one argument set of command cmd (upper case up); a[] are the arguments, aoff[] their
  * offsets; elem_off is where the element is said to come from. */
+/* M: a new subpath at (ox + a0, oy + a1). */
+static cs_err_t move_set(parser_t *p, double ox, double oy, const double *a, const size_t *aoff)
+{
+    double x = ox + a[0], y = oy + a[1];
+    cs_vec3_t q;
+    cs_err_t e = point(p, x, y, aoff[0], &q);
+    if (e != CS_OK)
+        return e;
+    p->cx = p->sx = x;
+    p->cy = p->sy = y;
+    p->cur = p->start = q;
+    p->have_cur = true;
+    cs_path_new_subpath(p->path);
+    return CS_OK;
+}
+
+/* C or S (up): one cubic from the current point. */
+static cs_err_t cubic_set(parser_t *p, char up, double ox, double oy, const double *a,
+                          const size_t *aoff, size_t elem_off)
+{
+    double c1x, c1y, c2x, c2y, x, y;
+    size_t o2;
+    if (up == 'C') {
+        c1x = ox + a[0];
+        c1y = oy + a[1];
+        c2x = ox + a[2];
+        c2y = oy + a[3];
+        x = ox + a[4];
+        y = oy + a[5];
+        o2 = 2;
+    } else {
+        /* S: the first control point is the reflection of the previous C/S's second control
+         * point about the current point, or the current point itself (§8.3.6). */
+        c1x = p->have_k ? 2.0 * p->cx - p->kx : p->cx;
+        c1y = p->have_k ? 2.0 * p->cy - p->ky : p->cy;
+        c2x = ox + a[0];
+        c2y = oy + a[1];
+        x = ox + a[2];
+        y = oy + a[3];
+        o2 = 0;
+    }
+    cs_vec3_t q[4];
+    q[0] = p->cur;
+    cs_err_t e;
+    if ((e = point(p, c1x, c1y, up == 'C' ? aoff[0] : elem_off, &q[1])) != CS_OK ||
+        (e = point(p, c2x, c2y, aoff[o2], &q[2])) != CS_OK ||
+        (e = point(p, x, y, aoff[o2 + 2], &q[3])) != CS_OK ||
+        (e = emit(p, CS_PATH_CUBIC, 3, q, elem_off)) != CS_OK)
+        return e;
+    p->kx = c2x;
+    p->ky = c2y;
+    p->cx = x;
+    p->cy = y;
+    p->cur = q[3];
+    return CS_OK;
+}
+
+/* Q or T (up): one quadratic from the current point. */
+static cs_err_t quad_set(parser_t *p, char up, double ox, double oy, const double *a,
+                         const size_t *aoff, size_t elem_off)
+{
+    double c1x, c1y, x, y;
+    size_t o1;
+    if (up == 'Q') {
+        c1x = ox + a[0];
+        c1y = oy + a[1];
+        x = ox + a[2];
+        y = oy + a[3];
+        o1 = 2;
+    } else {
+        /* T: reflection of the previous Q/T's control point, else the current point. */
+        c1x = p->have_q ? 2.0 * p->cx - p->qx : p->cx;
+        c1y = p->have_q ? 2.0 * p->cy - p->qy : p->cy;
+        x = ox + a[0];
+        y = oy + a[1];
+        o1 = 0;
+    }
+    cs_vec3_t q[3];
+    q[0] = p->cur;
+    cs_err_t e;
+    if ((e = point(p, c1x, c1y, up == 'Q' ? aoff[0] : elem_off, &q[1])) != CS_OK ||
+        (e = point(p, x, y, aoff[o1], &q[2])) != CS_OK ||
+        (e = emit(p, CS_PATH_QUAD, 2, q, elem_off)) != CS_OK)
+        return e;
+    p->qx = c1x;
+    p->qy = c1y;
+    p->cx = x;
+    p->cy = y;
+    p->cur = q[2];
+    return CS_OK;
+}
+
 static cs_err_t exec_set(parser_t *p, char cmd, char up, const double *a, const size_t *aoff,
                          size_t elem_off)
 {
     bool rel = cmd != up;
     double ox = rel ? p->cx : 0.0, oy = rel ? p->cy : 0.0;
     cs_err_t e = CS_OK;
-    bool cubic = false, quad = false;
     switch (up) {
-    case 'M': {
-        double x = ox + a[0], y = oy + a[1];
-        cs_vec3_t q;
-        if ((e = point(p, x, y, aoff[0], &q)) != CS_OK)
-            return e;
-        p->cx = p->sx = x;
-        p->cy = p->sy = y;
-        p->cur = p->start = q;
-        p->have_cur = true;
-        cs_path_new_subpath(p->path);
+    case 'M':
+        e = move_set(p, ox, oy, a, aoff);
         break;
-    }
     case 'L':
         e = line_to(p, ox + a[0], oy + a[1], aoff[0], elem_off);
         break;
@@ -547,75 +668,13 @@ static cs_err_t exec_set(parser_t *p, char cmd, char up, const double *a, const 
         e = line_to(p, p->cx, oy + a[0], aoff[0], elem_off);
         break;
     case 'C':
-    case 'S': {
-        double c1x, c1y, c2x, c2y, x, y;
-        size_t o2;
-        if (up == 'C') {
-            c1x = ox + a[0];
-            c1y = oy + a[1];
-            c2x = ox + a[2];
-            c2y = oy + a[3];
-            x = ox + a[4];
-            y = oy + a[5];
-            o2 = 2;
-        } else {
-            /* S: the first control point is the reflection of the previous C/S's second control
-             * point about the current point, or the current point itself (§8.3.6). */
-            c1x = p->have_k ? 2.0 * p->cx - p->kx : p->cx;
-            c1y = p->have_k ? 2.0 * p->cy - p->ky : p->cy;
-            c2x = ox + a[0];
-            c2y = oy + a[1];
-            x = ox + a[2];
-            y = oy + a[3];
-            o2 = 0;
-        }
-        cs_vec3_t q[4];
-        q[0] = p->cur;
-        if ((e = point(p, c1x, c1y, up == 'C' ? aoff[0] : elem_off, &q[1])) != CS_OK ||
-            (e = point(p, c2x, c2y, aoff[o2], &q[2])) != CS_OK ||
-            (e = point(p, x, y, aoff[o2 + 2], &q[3])) != CS_OK ||
-            (e = emit(p, CS_PATH_CUBIC, 3, q, elem_off)) != CS_OK)
-            return e;
-        p->kx = c2x;
-        p->ky = c2y;
-        p->cx = x;
-        p->cy = y;
-        p->cur = q[3];
-        cubic = true;
+    case 'S':
+        e = cubic_set(p, up, ox, oy, a, aoff, elem_off);
         break;
-    }
     case 'Q':
-    case 'T': {
-        double c1x, c1y, x, y;
-        size_t o1;
-        if (up == 'Q') {
-            c1x = ox + a[0];
-            c1y = oy + a[1];
-            x = ox + a[2];
-            y = oy + a[3];
-            o1 = 2;
-        } else {
-            /* T: reflection of the previous Q/T's control point, else the current point. */
-            c1x = p->have_q ? 2.0 * p->cx - p->qx : p->cx;
-            c1y = p->have_q ? 2.0 * p->cy - p->qy : p->cy;
-            x = ox + a[0];
-            y = oy + a[1];
-            o1 = 0;
-        }
-        cs_vec3_t q[3];
-        q[0] = p->cur;
-        if ((e = point(p, c1x, c1y, up == 'Q' ? aoff[0] : elem_off, &q[1])) != CS_OK ||
-            (e = point(p, x, y, aoff[o1], &q[2])) != CS_OK ||
-            (e = emit(p, CS_PATH_QUAD, 2, q, elem_off)) != CS_OK)
-            return e;
-        p->qx = c1x;
-        p->qy = c1y;
-        p->cx = x;
-        p->cy = y;
-        p->cur = q[2];
-        quad = true;
+    case 'T':
+        e = quad_set(p, up, ox, oy, a, aoff, elem_off);
         break;
-    }
     case 'A':
         e = arc_to(p, a[0], a[1], a[2], a[3] != 0.0, a[4] != 0.0, ox + a[5], oy + a[6], aoff[5],
                    elem_off);
@@ -623,8 +682,10 @@ static cs_err_t exec_set(parser_t *p, char cmd, char up, const double *a, const 
     default:
         break;
     }
-    p->have_k = cubic;
-    p->have_q = quad;
+    if (e != CS_OK && (up == 'M' || up == 'C' || up == 'S' || up == 'Q' || up == 'T'))
+        return e; /* as before: the reflection state is left as it was on these errors */
+    p->have_k = e == CS_OK && (up == 'C' || up == 'S');
+    p->have_q = e == CS_OK && (up == 'Q' || up == 'T');
     return e;
 }
 

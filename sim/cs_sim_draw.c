@@ -47,7 +47,9 @@ void cs_sim_view_project(const cs_sim_view_t *v, const double p[3], double out[2
 typedef struct {
     double x, y, v; /* picture coordinates (mm), and speed over the sample before it (mm/s) */
     double p[3];    /* machine position, mm */
-    bool travel;    /* the reference piece it lies on is a travel */
+    bool travel;    /* the reference piece it lies on is a travel (or the run's pen is up) */
+    uint64_t t;     /* its tick */
+    int mark;       /* a servo setting at this sample: 1 pen down, -1 pen up, 0 none */
 } sample_t;
 
 /* The executed path sampled every dt ticks (about 20000 samples at most, >= 1 ms apart). */
@@ -81,6 +83,8 @@ static sample_t *exec_samples(const cs_machine_t *m, const cs_sim_exec_t *ex,
         s[k].y = q[1];
         s[k].v = 0;
         s[k].travel = false;
+        s[k].t = t;
+        s[k].mark = 0;
         if (k > 0) {
             double d2 = 0;
             /* The legacy xy picture ignores z in the speed (pen up/down); a view uses 3D speed. */
@@ -190,6 +194,55 @@ static double top_speed(const sample_t *s, size_t n)
         if (!s[k].travel && s[k].v > vmax)
             vmax = s[k].v;
     return vmax;
+}
+
+/* The servo pen's state over the samples (cs_sim_draw_pen_t): segment i starts at the sum of the
+ * ticks before it (the run has no idle gaps, cs_sim_execute); an event applies before its
+ * segment. Marks the sample at or after each event. */
+static void pen_servo(sample_t *s, size_t n, const cs_machine_pen_t *pen,
+                      const cs_motion_segs_t *segs)
+{
+    size_t i = 0, ev = 0;
+    uint64_t start = 0;
+    bool down = false;
+    for (size_t k = 0; k < n; k++) {
+        while (i < segs->n && start + segs->v[i].ticks <= s[k].t)
+            start += segs->v[i++].ticks;
+        for (; ev < segs->npens && segs->pens[ev].seg <= i; ev++) {
+            down = segs->pens[ev].pulse_us == pen->down_us;
+            s[k].mark = down ? 1 : -1;
+        }
+        s[k].travel = !down;
+    }
+}
+
+/* Classifies the samples by the run's own pen (pp NULL or mode none: unchanged, returns
+ * travel_known). Returns whether any sample is pen-up. */
+static bool pen_classify(sample_t *s, size_t n, const cs_sim_draw_pen_t *pp, bool travel_known)
+{
+    if (pp == NULL || pp->pen == NULL || pp->pen->mode == CS_MACHINE_PEN_NONE)
+        return travel_known;
+    const cs_machine_pen_t *pen = pp->pen;
+    if (pen->mode == CS_MACHINE_PEN_SERVO && pp->segs != NULL)
+        pen_servo(s, n, pen, pp->segs);
+    else /* z: as the check (cs_sim_check.c, pen_is_down) */
+        for (size_t k = 0; k < n; k++)
+            s[k].travel = !(fabs(s[k].p[2] - pen->down_z_mm) < fabs(s[k].p[2] - pen->up_z_mm));
+    bool any = false;
+    for (size_t k = 0; k < n && !any; k++)
+        any = s[k].travel;
+    return any;
+}
+
+/* The end (exclusive) of the travel run that starts at sample k, and whether it moves in the
+ * picture (a pen-up stretch without motion, as the raise at the job's end, draws nothing). */
+static size_t travel_run(const sample_t *s, size_t n, size_t k, bool *moves)
+{
+    *moves = false;
+    size_t j = k;
+    for (; j < n && s[j].travel; j++)
+        *moves = *moves || s[j].x != s[k - 1].x || s[j].y != s[k - 1].y;
+    return j;
 }
 
 /* The page outline: the machine's x y travel as drawn in the picture, for the default and top
@@ -362,15 +415,60 @@ static void svg_ref_run(void *ctx, const cs_sim_ref_t *ref, size_t b, size_t n,
     fprintf(f, "\"/>\n");
 }
 
+/* The servo settings as circles (cs_sim_draw_pen_t), radius r. */
+static void svg_marks(FILE *f, const sample_t *s, size_t n, double r, double lw)
+{
+    fprintf(f, "<g class=\"pen-marks\">\n");
+    for (size_t k = 0; k < n; k++)
+        if (s[k].mark > 0)
+            fprintf(f, "<circle class=\"pen-down\" cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" "
+                       "fill=\"#1a9641\"/>\n", s[k].x, s[k].y, r);
+        else if (s[k].mark < 0)
+            fprintf(f, "<circle class=\"pen-up\" cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" "
+                       "fill=\"none\" stroke=\"#d7191c\" stroke-width=\"%.4f\"/>\n",
+                    s[k].x, s[k].y, r, lw);
+    fprintf(f, "</g>\n");
+}
+
+/* Travel first (underneath): runs of travel samples that move, as dashed grey polylines. */
+static void svg_travel(FILE *f, const sample_t *s, size_t n, double lw)
+{
+    for (size_t k = 1; k < n;) {
+        if (!s[k].travel) {
+            k++;
+            continue;
+        }
+        bool moves;
+        size_t end = travel_run(s, n, k, &moves);
+        if (moves) {
+            fprintf(f,
+                    "<polyline class=\"travel\" fill=\"none\" stroke=\"#999999\" "
+                    "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" points=\"%.4f,%.4f",
+                    lw, 6 * lw, 4 * lw, s[k - 1].x, s[k - 1].y);
+            for (; k < end; k++)
+                fprintf(f, " %.4f,%.4f", s[k].x, s[k].y);
+            fprintf(f, "\"/>\n");
+        }
+        k = end;
+    }
+}
+
 int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                          const cs_sim_ref_t *ref, const cs_sim_view_t *view)
+{
+    return cs_sim_draw_svg_pen(file, m, ex, ref, view, NULL);
+}
+
+int cs_sim_draw_svg_pen(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                        const cs_sim_ref_t *ref, const cs_sim_view_t *view,
+                        const cs_sim_draw_pen_t *pen)
 {
     size_t n;
     double lo[2], hi[2];
     sample_t *s = exec_samples(m, ex, view, &n);
     if (s == NULL)
         return -1;
-    bool travel = classify(s, n, ref);
+    bool travel = pen_classify(s, n, pen, classify(s, n, ref));
     double vmax = top_speed(s, n);
     FILE *f = fopen(file, "w");
     if (f == NULL) {
@@ -396,20 +494,7 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
                 "fill=\"none\" stroke=\"#bbbbbb\" stroke-width=\"%.4f\"/>\n",
                 blo[0], blo[1], bhi[0] - blo[0], bhi[1] - blo[1], 2 * lw);
     svg_legend(f, &lg, vmax, 2 * lw, travel, m, view);
-    /* Travel first (underneath): runs of travel samples as dashed grey polylines. */
-    for (size_t k = 1; k < n;) {
-        if (!s[k].travel) {
-            k++;
-            continue;
-        }
-        fprintf(f,
-                "<polyline class=\"travel\" fill=\"none\" stroke=\"#999999\" "
-                "stroke-width=\"%.4f\" stroke-dasharray=\"%.4f %.4f\" points=\"%.4f,%.4f",
-                lw, 6 * lw, 4 * lw, s[k - 1].x, s[k - 1].y);
-        for (; k < n && s[k].travel; k++)
-            fprintf(f, " %.4f,%.4f", s[k].x, s[k].y);
-        fprintf(f, "\"/>\n");
-    }
+    svg_travel(f, s, n, lw);
     for (size_t k = 1; k < n; k++) {
         if (s[k].travel || (s[k].x == s[k - 1].x && s[k].y == s[k - 1].y))
             continue;
@@ -427,6 +512,7 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
         ref_runs(ref, svg_ref_run, f, view);
         fprintf(f, "</g>\n");
     }
+    svg_marks(f, s, n, 5 * lw, lw);
     fprintf(f, "</svg>\n");
     free(s);
     return fclose(f) == 0 ? 0 : -1;
@@ -494,15 +580,41 @@ static void png_bed_legend(cairo_t *cr, const legend_t *lg, double vmax, double 
     }
 }
 
+/* The servo settings as circles, as svg_marks. */
+static void png_marks(cairo_t *cr, const sample_t *s, size_t n, double r, double lw)
+{
+    cairo_set_line_width(cr, lw);
+    for (size_t k = 0; k < n; k++) {
+        if (s[k].mark == 0)
+            continue;
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, s[k].x, s[k].y, r, 0, 2 * M_PI);
+        if (s[k].mark > 0) {
+            cairo_set_source_rgb(cr, 0.10, 0.59, 0.25);
+            cairo_fill(cr);
+        } else {
+            cairo_set_source_rgb(cr, 0.84, 0.10, 0.11);
+            cairo_stroke(cr);
+        }
+    }
+}
+
 int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                          const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px)
+{
+    return cs_sim_draw_png_pen(file, m, ex, ref, view, width_px, NULL);
+}
+
+int cs_sim_draw_png_pen(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                        const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px,
+                        const cs_sim_draw_pen_t *pen)
 {
     size_t n;
     double lo[2], hi[2];
     sample_t *s = exec_samples(m, ex, view, &n);
     if (s == NULL)
         return -1;
-    bool travel = classify(s, n, ref);
+    bool travel = pen_classify(s, n, pen, classify(s, n, ref));
     double vmax = top_speed(s, n);
     legend_t lg;
     bounds(m, s, n, ref, view, lo, hi, &lg);
@@ -531,10 +643,15 @@ int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_e
             k++;
             continue;
         }
+        bool moves;
+        size_t end = travel_run(s, n, k, &moves);
         cairo_move_to(cr, s[k - 1].x, s[k - 1].y);
-        for (; k < n && s[k].travel; k++)
+        for (; k < end; k++)
             cairo_line_to(cr, s[k].x, s[k].y);
-        cairo_stroke(cr);
+        if (moves)
+            cairo_stroke(cr);
+        else
+            cairo_new_path(cr);
     }
     cairo_set_dash(cr, NULL, 0, 0);
     cairo_set_line_width(cr, (view->y_down ? 3.0 : 2.0) / scale);
@@ -551,6 +668,7 @@ int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_e
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_set_line_width(cr, 0.8 / scale);
     ref_runs(ref, png_ref_run, cr, view);
+    png_marks(cr, s, n, 5.0 / scale, 1.5 / scale);
     cairo_destroy(cr);
     cairo_status_t st = cairo_surface_write_to_png(sf, file);
     cairo_surface_destroy(sf);

@@ -8,6 +8,8 @@
 
 #include <stdbool.h>
 
+#include "cs_machine_ini.h"
+#include "cs_motion.h"
 #include "cs_sim.h"
 
 /* A projection to the picture: picture x, y = rows of m applied to (x y z 1), mm. */
@@ -31,6 +33,23 @@ int cs_sim_draw_svg_view(const char *file, const cs_machine_t *m, const cs_sim_e
                          const cs_sim_ref_t *ref, const cs_sim_view_t *view);
 int cs_sim_draw_png_view(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                          const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px);
+
+/* The run's own pen, for the pictures: with a pen (mode z: down while z is nearer down_z than
+ * up_z; mode servo: by the segments' pen events, up before the first) every pen-up sample is
+ * drawn as travel (dashed grey, SVG class "travel", one polyline per pen-up stretch that moves
+ * in x y) and every pen-down one as drawing, whatever the reference says; each servo setting is
+ * marked where the run stood (SVG circles of class "pen-down", filled green, and "pen-up", open
+ * red). pen NULL or mode none: as the _view functions. */
+typedef struct {
+    const cs_machine_pen_t *pen;  /* the machine's [pen] */
+    const cs_motion_segs_t *segs; /* the segments run: their ticks and pen events */
+} cs_sim_draw_pen_t;
+int cs_sim_draw_svg_pen(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                        const cs_sim_ref_t *ref, const cs_sim_view_t *view,
+                        const cs_sim_draw_pen_t *pen);
+int cs_sim_draw_png_pen(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
+                        const cs_sim_ref_t *ref, const cs_sim_view_t *view, int width_px,
+                        const cs_sim_draw_pen_t *pen);
 
 /* The default view. ref may be NULL. Return 0, or -1 (I/O or cairo error; errno / message on
  * stderr). */

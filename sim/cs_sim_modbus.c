@@ -589,9 +589,11 @@ int cs_sim_modbus_main(int argc, char **argv)
         return USAGE;
     }
     cs_machine_t m;
+    cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
+    cs_machine_ini_pen_default(&pen);
     char err[512];
     if (machine_file) {
-        if (cs_machine_ini_load(machine_file, &m, err, sizeof err) != 0) {
+        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return INPUT;
         }
@@ -610,6 +612,8 @@ int cs_sim_modbus_main(int argc, char **argv)
     cs_sim_ref_t ref;
     cs_sim_ref_init(&ref);
     out.ref = &ref;
+    if (pen.mode == CS_MACHINE_PEN_SERVO)
+        out.pen = &pen;
     if (out.reference) { /* a bad job is reported before anything is served */
         cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
         cs_jobplan_init(&jp);

@@ -48,7 +48,8 @@ static void usage(FILE *f)
         "  --trace OUT.csv   every step edge: t_s,axis,dir,x_mm,y_mm,z_mm\n"
         "  --svg OUT.svg     drawing: exact geometry (black), executed path coloured by speed;\n"
         "                    with --reference, executed travel moves (the job's G0 moves and\n"
-        "                    the jumps between its elements) thin dashed grey\n"
+        "                    the jumps between its elements) thin dashed grey; with a [pen],\n"
+        "                    pen-up motion dashed grey and each servo setting marked\n"
         "  --png OUT.png     the same drawing through cairo (1600 px wide)\n"
         "  --png-width PX    width of that picture, 100..8000 px (default 1600)\n"
         "  --view V          project the drawing: top (x y), front (x z), side (y z) or iso\n"
@@ -246,12 +247,13 @@ static int replay_outputs(const replay_args_t *a, const cs_machine_t *m,
         perror(a->trace);
         rc = EXIT_INTERNAL;
     }
-    if (rc == EXIT_OK && a->svg && cs_sim_draw_svg_view(a->svg, m, ex, r, &a->view) != 0) {
+    cs_sim_draw_pen_t dp = {pen, segs}; /* pen-up travel and servo settings in the pictures */
+    if (rc == EXIT_OK && a->svg && cs_sim_draw_svg_pen(a->svg, m, ex, r, &a->view, &dp) != 0) {
         perror(a->svg);
         rc = EXIT_INTERNAL;
     }
     if (rc == EXIT_OK && a->png &&
-        cs_sim_draw_png_view(a->png, m, ex, r, &a->view, (int)a->png_width) != 0)
+        cs_sim_draw_png_pen(a->png, m, ex, r, &a->view, (int)a->png_width, &dp) != 0)
         rc = EXIT_INTERNAL;
     if (rc == EXIT_OK && a->check) {
         printf("check: %s\n", ok ? "ok" : "FAILED");

@@ -56,6 +56,8 @@ cs_err_t cs_modbus_mailbox_encode(const cs_proto_msg_t *m, uint16_t seq, uint16_
         need = CS_MODBUS_MAILBOX_SEGMENT_REGS;
     else if (m->type == CS_PROTO_CURVE)
         need = CS_MODBUS_MAILBOX_CURVE_REGS;
+    else if (m->type == CS_PROTO_PEN)
+        need = CS_MODBUS_MAILBOX_PEN_REGS;
     else
         return CS_ERR_UNSUPPORTED;
     if (cap < need)
@@ -68,6 +70,8 @@ cs_err_t cs_modbus_mailbox_encode(const cs_proto_msg_t *m, uint16_t seq, uint16_
         put32(regs + 1, m->u.segment.ticks);
         for (unsigned i = 0; i < CS_AXES; i++)
             put32(regs + 3 + 2 * i, (uint32_t)m->u.segment.steps[i]);
+    } else if (m->type == CS_PROTO_PEN) {
+        regs[1] = m->u.pen.pulse_us;
     } else {
         for (unsigned k = 0; k < 4; k++) {
             put32(regs + 1 + 6 * k, (uint32_t)m->u.curve.p[k].x);
@@ -104,6 +108,11 @@ cs_err_t cs_modbus_mailbox_decode(const uint16_t *regs, size_t n, cs_proto_msg_t
             m->u.curve.p[k].z = get32(regs + 5 + 6 * k);
         }
         m->u.curve.feed = get32(regs + 25);
+    } else if (regs[0] == CS_PROTO_PEN) {
+        if (n != CS_MODBUS_MAILBOX_PEN_REGS)
+            return CS_ERR_FRAME;
+        m->type = CS_PROTO_PEN;
+        m->u.pen.pulse_us = regs[1];
     } else {
         return CS_ERR_UNSUPPORTED;
     }

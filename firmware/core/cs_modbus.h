@@ -39,6 +39,7 @@
  * registers, high word first, then the sequence number in the last register written. */
 #define CS_MODBUS_MAILBOX_SEGMENT_REGS (1 + 2 + 2 * CS_AXES + 1) /* 12 */
 #define CS_MODBUS_MAILBOX_CURVE_REGS   (1 + 2 * 12 + 2 + 1)      /* 28 */
+#define CS_MODBUS_MAILBOX_PEN_REGS     (1 + 1 + 1) /* 3: type, pulse width (us), sequence */
 #define CS_MODBUS_MAILBOX_REGS         CS_MODBUS_MAILBOX_CURVE_REGS
 
 /* Commands (holding register COMMAND). */
@@ -123,7 +124,7 @@ cs_err_t cs_modbus_map_init(cs_modbus_map_t *mp, const cs_modbus_app_t *app, uin
 cs_err_t cs_modbus_pdu(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_t *rsp, size_t cap,
                        size_t *rn);
 
-/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT or CURVE and its sequence
+/* Mailbox codec, shared by the host and the device. Encodes a SEGMENT, CURVE or PEN and its sequence
  * into regs[0..cap), *n = registers: CS_ERR_UNSUPPORTED for another type, CS_ERR_RANGE for a
  * field outside its cs_proto range, CS_ERR_FULL when cap is too small. Pure. */
 cs_err_t cs_modbus_mailbox_encode(const cs_proto_msg_t *m, uint16_t seq, uint16_t *regs, size_t cap,

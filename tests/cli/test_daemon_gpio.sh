@@ -7,7 +7,9 @@
 # executed, the recorded steps on each axis those of the plan, no STEP edge before its planned
 # time, the lines safe at the end. A second job, planned from where the first left the machine
 # (the position the GPIO link reports), brings it back to the origin: its steps are the first's
-# negated. A third is cancelled while it runs. Curves mode is refused at submit. Every process
+# negated. A third is cancelled while it runs. Curves mode is refused at submit. A servo pen job
+# runs the pen's pulse train beside the step thread. A bad [gpio] section stops serve at its
+# start. Every process
 # is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -93,6 +95,42 @@ kill -TERM "$DPID"
 wait "$DPID"
 expect "serve: exit 0" [ $? -eq 0 ]
 expect "serve: log names the link" grep -q "^serve: serving record:$REC on " "$T/serve.err"
+
+# 5. a servo pen job through the daemon: the pen's pulse train beside the step thread, its widths
+# the plan's pen events in turn (taken back out of the job's PEN messages)
+{
+    printf '[pen]\nmode = servo\nup_us = 1900\ndown_us = 1100\nsettle_ms = 100\n'
+    grep -v '^#' tests/data/gpio/wired3.ini | grep -v '^\[y\]\|^invert_dir'
+    printf 'pen = 18\n'
+} >"$T/pen.ini"
+printf '<svg xmlns="http://www.w3.org/2000/svg" width="40mm" height="40mm" viewBox="0 0 40 40">\n<path d="M5 5 L20 5" fill="none" stroke="black"/>\n<path d="M25 30 L35 35" fill="none" stroke="black"/>\n</svg>\n' >"$T/pen.svg"
+"$CS" plan --machine "$T/pen.ini" -o "$T/pen.seg" "$T/pen.svg" 2>/dev/null
+pw=$(awk '/^pen / { if ($2 != last) printf " %d", $2; last = $2 }' "$T/pen.seg")
+S=$T/sock/pen.sock
+PREC=$T/pen.rec
+dmn_start --gpio "record:$PREC" --machine "$T/pen.ini"
+C submit "$T/pen.svg" >"$T/psub" 2>&1
+expect "pen job queued" grep -q "^OK job 1 queued: " "$T/psub"
+expect "pen job ended" wait_until 60 dmn_finished
+C status >"$T/pst" 2>&1
+expect "pen job done" grep -q "^job 1 done: .*(job executed)$" "$T/pst"
+got=$(awk -F, '$3 == "pen" && $4 == 1 { r = $2 } $3 == "pen" && $4 == 0 && r != "" { w = ($2 - r) / 1000; if (w != last) s = s " " w; last = w } END { print s }' "$PREC")
+expect "pen job: widths in turn =$pw (got $got)" [ -n "$pw" ] && [ " $got" = "$pw" ]
+kill -TERM "$DPID"
+wait "$DPID"
+expect "pen daemon: exit 0" [ $? -eq 0 ]
+
+# a bad [gpio] section stops serve at its start, with file:line (exit 1); a chip the file does
+# not name is a usage error (exit 2)
+printf '[gpio]\nx_step = 17\nx_dir = 17\n' >"$T/dup.ini"
+timeout -k 5 30 "$CS" serve --gpio "record:$T/x.rec" --machine "$T/dup.ini" --socket "$T/sock/b.sock" \
+    >/dev/null 2>"$T/dup.err"
+expect "bad [gpio]: exit 1" [ $? -eq 1 ]
+expect "bad [gpio]: file:line" grep -q "^$T/dup.ini:3: \[gpio\] x_dir: line 17 is already x_step" "$T/dup.err"
+timeout -k 5 30 "$CS" serve --gpio gpiochip1 --machine "$T/m.ini" --socket "$T/sock/b.sock" \
+    >/dev/null 2>"$T/mis.err"
+expect "chip mismatch: exit 2" [ $? -eq 2 ]
+expect "chip mismatch: said" grep -q "chip = gpiochip0" "$T/mis.err"
 
 # usage: --gpio and another link
 "$CS" serve --gpio gpiochip0 --port /dev/null >/dev/null 2>"$T/two.err"

@@ -55,6 +55,21 @@ for kind in svg plt nc; do
     expect "$kind: simulator check passes" grep -q '^check: ok$' "$T/$kind.sim"
     expect "$kind: check reports pen-down motion" grep -q '^deviation of pen-down motion' "$T/$kind.sim"
 done
+# The pen moves at [pen] z_feed (20 mm/s) for every input, G-code's M3/M5 included: the fastest
+# z-only segment, |dz| steps / 80 steps/mm over its ticks / tick_hz, is at most z_feed plus one
+# step's worth of that segment (rounding), and the pen does move at speed (above 10 mm/s).
+zpeak() {
+    awk '/^# curvestep segments/ { for (i = 1; i <= NF; i++) if ($i ~ /^tick_hz=/) hz = substr($i, 9) }
+         !/^#/ && !/^pen/ && $2 == 0 && $3 == 0 && $4 != 0 && $1 > 0 {
+             dz = $4 < 0 ? -$4 : $4; v = (dz - 1) / 80 / ($1 / hz); if (v > m) m = v }
+         END { printf "%.3f\n", m }' "$1"
+}
+for kind in svg plt nc; do
+    v=$(zpeak "$T/$kind.seg")
+    expect "$kind: z peak velocity $v mm/s within (10, 20] (z_feed)" \
+        awk -v v="$v" 'BEGIN { exit !(v > 10 && v <= 20) }'
+done
+
 # The SVG job lies at z = 0 in the file: every drawn element is at down_z, so the plan ends up.
 expect "svg ends pen up" grep -q 'rounded to steps: exact' "$T/svg.sim"
 
@@ -110,14 +125,8 @@ done
     >"$T/svbad.sim" 2>/dev/null; rc=$?
 expect "servo: a plan without pen events fails the check" [ $rc -eq 4 ]
 expect "servo: names the segment" grep -qE '^pen: segment [0-9]+ moves pen up over a stroke' "$T/svbad.sim"
-# The serial link carries pen events (PEN messages: test_servo_stream.sh); curves mode and the
-# Modbus and GPIO links do not: stream refuses before opening anything, saying why.
-run "servo stream curves refused" 1 stream --machine "$T/servo.ini" --port /dev/null \
-    --mode curves "$T/job.svg"
-expect_err "servo curves says why" 'mode = servo: --mode curves does not carry pen events'
-run "servo stream modbus refused" 1 stream --machine "$T/servo.ini" --modbus-tcp 127.0.0.1:9 \
-    "$T/job.svg"
-expect_err "servo modbus says why" 'mode = servo: the Modbus and GPIO links do not carry pen events'
+# Every link carries pen events, in segments and curves mode: test_servo_stream.sh (serial,
+# daemon), test_servo_links.sh (Modbus, curves), test_gpio_pen.sh (GPIO, software PWM).
 printf '[pen]\nmode = servo\nup_us = 1900\n' >"$T/bad2.ini"
 run "servo needs both widths" 1 plan --machine "$T/bad2.ini" "$T/job.svg"
 expect_err "servo needs both widths: says so" 'mode = servo needs up_us and down_us'

@@ -38,6 +38,10 @@ enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
 #define DIR_BIT0     5 /* PD5 */
 #define VEC_T1_COMPA 11
 #define HIST_MAX     8192 /* interrupt lengths histogrammed exactly below this many cycles */
+#define VEC_T1_COMPB 12   /* Timer1 compare B: the pen servo's edges (port_avr.c) */
+#define SERVO_WRAP_CYC 524288u /* one Timer1 wrap: 65536 counts of 8 cycles */
+#define TCCR1A_ADDR  0x80 /* data-space address of TCCR1A (ATmega328P register summary) */
+#define SERVO_WIDTHS 256 /* distinct successive servo pulse widths kept for the report */
 #define SLICE        1024 /* cycles run between two services of the pty and the clocks */
 
 typedef struct {
@@ -76,6 +80,12 @@ static struct {
     bool active;
     uint64_t last_activity; /* cycle */
     uint64_t min_sp;
+    /* the servo pin (OC1B = PB2): rises, the period between them, the distinct widths in turn */
+    bool servo_high;
+    uint64_t servo_rise, servo_periods, servo_pmin, servo_pmax;
+    uint64_t servo_dropped; /* compare matches simavr did not deliver (whole wraps late) */
+    uint64_t servo_w[SERVO_WIDTHS];
+    size_t servo_nw;
     FILE *csv;
     FILE *isr_csv;  /* --isr-csv: every step interrupt, "entry-cycle,cycles" */
     uint64_t *prof; /* --profile: cycles spent at each flash word inside the step interrupt */
@@ -152,6 +162,59 @@ static void on_dir(struct avr_irq_t *irq, uint32_t value, void *param)
         uint64_t hold = now - a->rise_at;
         if (hold < a->min_hold)
             a->min_hold = hold;
+    }
+}
+
+/* The servo output OC1B (PB2), as the data sheet defines it (ATmega328P 16.7.1, normal mode):
+ * at each Timer1 compare-B match the pin goes to the level its COM1B1:0 bits in TCCR1A say
+ * (3: set, 2: clear). The match is seen here as the compare-B interrupt becoming pending, at its
+ * exact cycle, and the bits are read from the chip's registers at that cycle. (simavr 1.6 also
+ * drives the pin, but models normal mode like PWM mode, forcing the opposite level at every
+ * overflow and on every OCR1A write, which the real chip does not: the pin itself is not read.)
+ * Each rise closes a period (rise to rise); each fall closes a pulse, whose width is kept when it
+ * differs from the one before. Not activity: the train runs while idle.
+ * simavr 1.6 now and then drops a compare match (its normal-mode compare timers are cancelled and
+ * re-armed on every OCR1x write, and the step interrupt writes OCR1A all the time): the edge
+ * then comes a whole Timer1 wrap (65536 counts) late. Such an interval is counted as a drop and
+ * measured less the wraps, so the period and width figures stay those the firmware programmed;
+ * any other error still shows. */
+static void on_servo(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+    (void)irq;
+    (void)param;
+    if (value == 0)
+        return;
+    uint8_t com = (uint8_t)((g.avr->data[TCCR1A_ADDR] >> 4) & 3u);
+    if (com < 2)
+        return;
+    bool high = com == 3;
+    if (high == g.servo_high)
+        return;
+    g.servo_high = high;
+    uint64_t now = g.avr->cycle;
+    if (high) {
+        if (g.servo_rise != 0) {
+            uint64_t p = now - g.servo_rise;
+            while (p > SERVO_WRAP_CYC + SERVO_WRAP_CYC / 2u) { /* a match simavr did not deliver */
+                p -= SERVO_WRAP_CYC;
+                g.servo_dropped++;
+            }
+            g.servo_pmin = p < g.servo_pmin ? p : g.servo_pmin;
+            g.servo_pmax = p > g.servo_pmax ? p : g.servo_pmax;
+            g.servo_periods++;
+        }
+        g.servo_rise = now;
+    } else if (g.servo_rise != 0) {
+        /* in Timer1 counts (8 cycles): simavr stamps events at instruction boundaries, a few
+         * cycles after the match; the pin itself switches on the count */
+        uint64_t w = now - g.servo_rise;
+        while (w > SERVO_WRAP_CYC / 2u) { /* as above: no servo pulse is 32 ms long */
+            w -= SERVO_WRAP_CYC;
+            g.servo_dropped++;
+        }
+        w = (w + 4u) / 8u;
+        if ((g.servo_nw == 0 || g.servo_w[g.servo_nw - 1] != w) && g.servo_nw < SERVO_WIDTHS)
+            g.servo_w[g.servo_nw++] = w;
     }
 }
 
@@ -428,6 +491,13 @@ int main(int argc, char **argv)
             avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('D'), (int)(DIR_BIT0 + i)), on_dir,
             (void *)i);
     }
+    avr_irq_t *vecb = avr_get_interrupt_irq(avr, VEC_T1_COMPB);
+    if (vecb == NULL) {
+        fprintf(stderr, "avr_harness: no vector %d\n", VEC_T1_COMPB);
+        return EX_EMU;
+    }
+    avr_irq_register_notify(vecb + AVR_INT_IRQ_PENDING, on_servo, NULL);
+    g.servo_pmin = UINT64_MAX;
     avr_irq_t *vec = avr_get_interrupt_irq(avr, VEC_T1_COMPA);
     if (vec == NULL) {
         fprintf(stderr, "avr_harness: no vector %d\n", VEC_T1_COMPA);
@@ -588,6 +658,18 @@ int main(int argc, char **argv)
                 (unsigned long long)g.isr_max, (double)g.isr_sum / (double)g.isr_n);
     else
         fprintf(out, "isr: vector %d (TIMER1_COMPA): no calls\n", VEC_T1_COMPA);
+    if (g.servo_periods > 0) {
+        fprintf(out, "servo: OC1B %llu periods, rise to rise min %llu max %llu cycles (%.3f..%.3f "
+                     "us), %llu dropped matches, widths (us):",
+                (unsigned long long)g.servo_periods, (unsigned long long)g.servo_pmin,
+                (unsigned long long)g.servo_pmax, (double)g.servo_pmin / 16.0,
+                (double)g.servo_pmax / 16.0, (unsigned long long)g.servo_dropped);
+        for (size_t k = 0; k < g.servo_nw; k++)
+            fprintf(out, " %.1f", (double)g.servo_w[k] / 2.0);
+        fprintf(out, "\n");
+    } else {
+        fprintf(out, "servo: OC1B no period\n");
+    }
     if (g.min_sp != UINT64_MAX)
         fprintf(out, "stack: lowest SP 0x%04llx (%llu bytes below the top of RAM 0x08ff)%s\n",
                 (unsigned long long)g.min_sp, (unsigned long long)(0x8ffu - g.min_sp),

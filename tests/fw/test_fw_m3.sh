@@ -38,11 +38,11 @@ QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none 
 # value NAME FILE SED-EXPR: the last match of a report line (for messages).
 value() { sed -n "$2" "$1" | tail -n1; }
 
-# start_fw NAME: qemu in the background (90 s at most), PTY = the guest UART's pty.
+# start_fw NAME: qemu in the background (600 s at most: the hold case alone may wait 480 s on a loaded machine), PTY = the guest UART's pty.
 start_fw() {
     local name=$1
     # qemu prints the pty on stdout, the semihosting console goes to stderr: one file
-    timeout -k 5 300 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
+    timeout -k 5 600 "${QEMU[@]}" >"$T/$name.fw" 2>&1 &
     QPID=$!
     pids+=("$QPID")
     PTY=

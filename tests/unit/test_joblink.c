@@ -1,9 +1,10 @@
 /* Tests of cs_joblink, the links behind one interface: the link the options pick (exactly one;
  * none or two refused), the option parser `stream` and `serve` share (values checked, bad ones
  * refused), the line rate a serial device really moves (pty: memory speed), the step segments
- * of a job's messages (PEN messages skipped), and the one report: the exit status of every
- * outcome (README's table, written out here) and the summary lines, with the link's own
- * counters line in place of the byte counters and no resume hint after a stop mid-message.
+ * and pen events of a job's messages (each PEN where it stood), and the one report: the exit
+ * status of every outcome (README's table, written out here) and the summary lines, with the
+ * link's own counters line in place of the byte counters and no resume hint after a stop
+ * mid-message.
  * The links themselves run in tests/cli (test_stream, test_modbus, test_gpio, test_daemon*). */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -48,9 +49,11 @@ static void test_select(void **state)
     assert_int_equal(cs_joblink_select(&l, &c), CS_EXIT_OK);
     assert_ptr_equal(l.ops, &cs_joblink_modbus_ops);
     /* what each link carries */
-    assert_true(cs_joblink_serial_ops.keep_open && cs_joblink_serial_ops.pens);
-    assert_false(cs_joblink_modbus_ops.keep_open || cs_joblink_modbus_ops.pens);
-    assert_false(cs_joblink_gpio_ops.keep_open || cs_joblink_gpio_ops.pens);
+    assert_true(cs_joblink_serial_ops.keep_open); /* the port stays open between jobs */
+    assert_false(cs_joblink_modbus_ops.keep_open || cs_joblink_gpio_ops.keep_open);
+    /* every link carries servo pen events (PEN messages; GPIO: cs_gpio_pwm) */
+    assert_true(cs_joblink_serial_ops.pens && cs_joblink_modbus_ops.pens &&
+                cs_joblink_gpio_ops.pens);
 }
 
 /* Runs cs_joblink_option over words; returns its last result and the index reached. */
@@ -131,9 +134,16 @@ static void test_segments_of_a_job(void **state)
     assert_int_equal(cs_stream_job_add_motion(&job, &ms), CS_OK);
     assert_int_equal(job.n, 5);
     cs_segment_t *out;
-    size_t n;
-    assert_int_equal(cs_joblink_segments(&job, &out, &n), CS_OK);
+    cs_motion_pen_t *pout;
+    size_t n, np;
+    assert_int_equal(cs_joblink_segments(&job, &out, &n, &pout, &np), CS_OK);
     assert_int_equal(n, 3);
+    assert_int_equal(np, 2); /* where they were: before segments 0 and 2 */
+    assert_int_equal(pout[0].seg, 0);
+    assert_int_equal(pout[0].pulse_us, 1000);
+    assert_int_equal(pout[1].seg, 2);
+    assert_int_equal(pout[1].pulse_us, 2000);
+    free(pout);
     for (size_t k = 0; k < 3; k++) {
         assert_int_equal(out[k].ticks, s[k].ticks);
         for (unsigned i = 0; i < CS_AXES; i++)

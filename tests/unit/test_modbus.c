@@ -256,6 +256,30 @@ static void test_mailbox_codec(void **state)
 
 /* --- the map: sequence rule, commands, status, exceptions ----------------------------------- */
 
+/* The PEN layout (docs/modbus.md): type 0x25, the width in us, the sequence; its range is the
+ * wire protocol's (400..2600 us), a wrong length is a frame error. Values by hand. */
+static void test_mailbox_pen(void **state)
+{
+    (void)state;
+    cs_proto_msg_t p = {.type = CS_PROTO_PEN}, d;
+    p.u.pen.pulse_us = 1500;
+    uint16_t regs[CS_MODBUS_MAILBOX_REGS], seq;
+    size_t n;
+    assert_int_equal(cs_modbus_mailbox_encode(&p, 0x1234, regs, 28, &n), CS_OK);
+    assert_int_equal(n, 3);
+    const uint16_t want[3] = {0x0025, 1500, 0x1234};
+    assert_memory_equal(regs, want, sizeof want);
+    assert_int_equal(cs_modbus_mailbox_decode(regs, n, &d, &seq), CS_OK);
+    assert_int_equal(d.type, CS_PROTO_PEN);
+    assert_int_equal(d.u.pen.pulse_us, 1500);
+    assert_int_equal(seq, 0x1234);
+    assert_int_equal(cs_modbus_mailbox_decode(regs, 4, &d, &seq), CS_ERR_FRAME);
+    regs[1] = 300; /* below 400 us */
+    assert_int_equal(cs_modbus_mailbox_decode(regs, 3, &d, &seq), CS_ERR_RANGE);
+    p.u.pen.pulse_us = 2700;
+    assert_int_equal(cs_modbus_mailbox_encode(&p, 1, regs, 28, &n), CS_ERR_RANGE);
+}
+
 static void test_sequence_rule(void **state)
 {
     (void)state;
@@ -723,6 +747,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_crc),
         cmocka_unit_test(test_mailbox_codec),
+        cmocka_unit_test(test_mailbox_pen),
         cmocka_unit_test(test_sequence_rule),
         cmocka_unit_test(test_commands_status_exceptions),
         cmocka_unit_test(test_rtu_framing),

@@ -237,13 +237,55 @@ void port_step_pulse(uint8_t mask)
     SREG = s;
 }
 
-/* The pen servo is not wired on this port yet (Timer1 is the step timer; a servo wants a 50 Hz
- * 16-bit PWM): the width is kept where a debugger reads it (docs/firmware.md, "Pen servo"). */
-static volatile uint16_t pen_pulse_us;
+/* The pen servo: a 50 Hz RC-servo pulse train on OC1B (PB2, the Uno's D10), made by Timer1's
+ * compare unit B while Timer1 keeps counting freely for the step timer (fast PWM with an ICR1
+ * top would take Timer1 from the steps). The pin is switched by the hardware at the compare
+ * match ("set / clear OC1B on compare match", ATmega328P data sheet 16.7.1, COM1B1:0 in normal
+ * mode), so its edges are exact to the count (0.5 us); the compare B interrupt only programs the
+ * next edge, at any time before it (at least PORT_PEN_MIN_US later): a step interrupt running
+ * meanwhile delays nothing. Period SERVO_PERIOD counts = 20 ms; a new width takes effect at the
+ * next rising edge. */
+#define SERVO_PERIOD ((uint16_t)(F_CPU / 8u / 50u)) /* counts of 0.5 us in 20 ms: 40000 */
+#define SERVO_PIN    ((uint8_t)(1u << PB2))
+#define COM1B_SET    ((uint8_t)((1u << COM1B1) | (1u << COM1B0)))
+#define COM1B_CLEAR  ((uint8_t)(1u << COM1B1))
+CS_STATIC_ASSERT(F_CPU / 8u / 50u < 65536u && F_CPU / 8u / 1000000u * 2600u < F_CPU / 8u / 50u,
+                 avr_servo_period_fits);
+static volatile uint16_t servo_counts; /* the width in counts, 0: no pulse train yet */
+static uint16_t servo_cur;             /* the width of the pulse under way (fixed at its rise) */
+static uint8_t servo_high;             /* the last edge programmed was the rise */
 
 void port_pen_set(uint16_t pulse_us)
 {
-    pen_pulse_us = pulse_us;
+    uint16_t c = (uint16_t)(pulse_us * (uint16_t)(F_CPU / 8000000u));
+    uint8_t s = SREG;
+    cli();
+    if (servo_counts == 0 && c != 0) { /* first setting: start the train, rising soon */
+        PORTB = (uint8_t)(PORTB & (uint8_t)~SERVO_PIN);
+        DDRB = (uint8_t)(DDRB | SERVO_PIN);
+        OCR1B = (uint16_t)(TCNT1 + 64u);
+        TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1B_SET) | COM1B_SET);
+        servo_high = 0;
+        TIFR1 = (uint8_t)(1u << OCF1B);
+        TIMSK1 = (uint8_t)(TIMSK1 | (1u << OCIE1B));
+    }
+    servo_counts = c;
+    SREG = s;
+}
+
+/* Compare B matched: the pin has just risen or fallen; program the other edge. */
+ISR(TIMER1_COMPB_vect)
+{
+    if (!servo_high) { /* it rose at OCR1B: fall after the width */
+        servo_cur = servo_counts;
+        OCR1B = (uint16_t)(OCR1B + servo_cur);
+        TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1B_SET) | COM1B_CLEAR);
+        servo_high = 1;
+    } else { /* it fell: rise one period after the last rise */
+        OCR1B = (uint16_t)(OCR1B + (uint16_t)(SERVO_PERIOD - servo_cur));
+        TCCR1A = (uint8_t)(TCCR1A | COM1B_SET);
+        servo_high = 0;
+    }
 }
 
 void port_dir_set(uint8_t mask)

@@ -24,6 +24,8 @@
 #define SYSCTL_RCC_OSCSRC_M  (0x3u << 4)
 #define SYSCTL_RCGC1_TIMER0  (1u << 16)
 #define SYSCTL_RCGC1_UART0   (1u << 0)
+#define SYSCTL_RCGC1_TIMER1  (1u << 17)
+#define SYSCTL_RCGC1_TIMER2  (1u << 18)
 #define SYSCTL_RCGC2_GPIOA   (1u << 0)
 #define SYSCTL_RCGC2_GPIOD   (1u << 3)
 #define SYSCTL_RCGC2_GPIOG   (1u << 6)
@@ -73,6 +75,20 @@
 #define TIMER_CTL_TAEN     (1u << 0)
 #define TIMER_INT_TATO     (1u << 0)
 #define TIMER0A_IRQ        19
+
+/* The same registers on any GPTM (Timer1 at 0x40031000, Timer2 at 0x40032000; data sheet 9.5):
+ * the pen servo's period (Timer1A, 32-bit periodic, IRQ 21) and width (Timer2A, one-shot, IRQ 23). */
+#define TIMER1              0x40031000u
+#define TIMER2              0x40032000u
+#define GPTM_CFG(t)         REG32((t) + 0x00u)
+#define GPTM_TAMR(t)        REG32((t) + 0x04u)
+#define GPTM_CTL(t)         REG32((t) + 0x0Cu)
+#define GPTM_IMR(t)         REG32((t) + 0x18u)
+#define GPTM_ICR(t)         REG32((t) + 0x24u)
+#define GPTM_TAILR(t)       REG32((t) + 0x28u)
+#define TIMER_TAMR_PERIODIC 2u
+#define TIMER1A_IRQ         21
+#define TIMER2A_IRQ         23
 
 /* Cortex-M3 core peripherals (ARMv7-M ARM B3.3, B3.4). */
 #define SYST_CSR           REG32(0xE000E010u)

@@ -52,6 +52,33 @@ static void line_axes(const char *label, const int32_t *v, bool is_signed)
 }
 
 /* The report a test compares with the simulator; one fact per line, "key: values". */
+/* The pen servo's train as the port measured it (port_m3_servo.c), in core cycles (50 per us). */
+static void report_servo(void)
+{
+    port_m3_servo_t sv;
+    port_m3_servo(&sv);
+    char b[240];
+    size_t n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: servo: PG1 ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.periods);
+    semihost_fmt_str(b, sizeof b, &n, " periods, mean ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.periods ? (uint32_t)(sv.span_cyc / sv.periods) : 0);
+    semihost_fmt_str(b, sizeof b, &n, " cycles (min ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.min_cyc);
+    semihost_fmt_str(b, sizeof b, &n, " max ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.max_cyc);
+    semihost_fmt_str(b, sizeof b, &n, "), last width ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.high_n);
+    semihost_fmt_str(b, sizeof b, &n, " pulses of ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.high_sum);
+    semihost_fmt_str(b, sizeof b, &n, " cycles; registers: period ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.period_reg);
+    semihost_fmt_str(b, sizeof b, &n, " width ");
+    semihost_fmt_uint(b, sizeof b, &n, sv.width_reg);
+    semihost_fmt_str(b, sizeof b, &n, " cycles\n");
+    semihost_write0(b);
+}
+
 static void report(void)
 {
     cs_fw_report_t r;
@@ -82,6 +109,7 @@ static void report(void)
     semihost_fmt_uint(b, sizeof b, &n, r.stats.pen_us);
     semihost_fmt_str(b, sizeof b, &n, " us\n");
     semihost_write0(b);
+    report_servo();
     line_axes("fw: position (executor):", r.pos, true);
     line_axes("fw: position (STEP/DIR pins):", pins, true);
     line_axes("fw: step pulses:", (const int32_t *)pulses, false);

@@ -223,16 +223,6 @@ void port_step_pulse(uint8_t mask)
     GPIO_DATA(GPIO_PORTD, STEP_PINS) = 0;
 }
 
-/* The pen servo is not wired on this board yet (no PWM timer set up): the width is kept where a
- * debugger reads it, and the job report (main_m3.c) prints the count and the last width from
- * the application's counters (docs/firmware.md, "Pen servo"). */
-static volatile uint16_t pen_pulse_us;
-
-void port_pen_set(uint16_t pulse_us)
-{
-    pen_pulse_us = pulse_us;
-}
-
 void port_dir_set(uint8_t mask)
 {
     mask &= 0x0Fu;

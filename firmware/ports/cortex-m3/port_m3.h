@@ -2,7 +2,7 @@
  * beyond port.h: the core clock and its cycle counter, the STEP/DIR lines as the pins saw them
  * (for the report a test compares with the simulator), sleeping until the next interrupt, and a
  * fault flag. Pin map: STEP x/y/z/a on PD0..PD3, DIR x/y/z/a on PD4..PD7 (high = positive),
- * driver ENABLE on PG0 (low = enabled), UART0 on PA0 (RX) / PA1 (TX) at 115200 8N1. */
+ * driver ENABLE on PG0 (low = enabled), pen servo on PG1 (50 Hz, high = the pulse), UART0 on PA0 (RX) / PA1 (TX) at 115200 8N1. */
 #ifndef PORT_M3_H
 #define PORT_M3_H
 
@@ -40,6 +40,20 @@ void port_m3_spin(void);
 uint32_t port_m3_step_irqs(void);
 /* Bytes the UART received while its ring was full (lost). */
 uint32_t port_m3_rx_overruns(void);
+/* The pen servo's pulse train as the port measured it (SysTick cycles stamped in the edge
+ * interrupts) and as its timers are programmed (registers read back): port_m3_servo.c. */
+typedef struct {
+    uint32_t periods;    /* rise-to-rise intervals measured */
+    uint64_t span_cyc;   /* the periods summed, core cycles (mean = span / periods) */
+    uint32_t min_cyc;    /* shortest period, core cycles (0 when none) */
+    uint32_t max_cyc;    /* longest period, core cycles */
+    uint32_t high_n;     /* pulses measured since the width last changed */
+    uint32_t high_sum;   /* their widths summed, core cycles */
+    uint32_t period_reg; /* Timer1A's period as programmed: TAILR + 1, cycles */
+    uint32_t width_reg;  /* Timer2A's load (the last pulse's width) as programmed, cycles */
+} port_m3_servo_t;
+/* Snapshot of the servo measurements and registers. ISR-safe. */
+void port_m3_servo(port_m3_servo_t *out);
 /* Code passed to port_fault (CS_OK when none). */
 cs_err_t port_m3_fault_code(void);
 /* Called by port_fault after the machine is made safe (main_m3.c: report and exit under qemu). */

@@ -21,8 +21,11 @@ void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void UART0_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void Timer0A_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void Timer1A_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void Timer2A_Handler(void) __attribute__((weak, alias("Default_Handler")));
 
-/* 16 system exceptions, then the LM3S6965's interrupts 0..47 (UART0 = 5, Timer0A = 19). */
+/* 16 system exceptions, then the LM3S6965's interrupts 0..47 (UART0 = 5, Timer0A = 19,
+ * Timer1A = 21, Timer2A = 23). */
 typedef void (*vector_t)(void);
 __attribute__((section(".isr_vector"), used)) const vector_t vectors[16 + 48] = {
     [0] = (vector_t)(uintptr_t)&_estack,
@@ -38,6 +41,8 @@ __attribute__((section(".isr_vector"), used)) const vector_t vectors[16 + 48] = 
     [15] = SysTick_Handler,
     [16 + 5] = UART0_Handler,
     [16 + 19] = Timer0A_Handler,
+    [16 + 21] = Timer1A_Handler,
+    [16 + 23] = Timer2A_Handler,
 };
 
 void Reset_Handler(void)

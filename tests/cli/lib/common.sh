@@ -19,6 +19,7 @@
 #   gone PID              succeeds when process PID has ended;
 #   wait_pty FILE SECS    sets PTY to the first line of FILE (where `curvestep-sim --pty` prints
 #                         its terminal) once there is one, or to "" after SECS seconds;
+#   (a script that failed leaves its temp files in $B/failed/<script>.<pid>/ for diagnosis)
 #   finish                prints "cli: N passed, M failed" and returns non-zero on a failure
 #                         (the last command of a script, so it is the script's exit status).
 
@@ -34,6 +35,14 @@ cs_cli_cleanup() {
     local p
     for p in ${pids[@]+"${pids[@]}"}; do kill "$p" 2>/dev/null; done
     wait 2>/dev/null
+    # A failed script leaves its files (device reports, logs, plans) for diagnosis: a failure
+    # seen only on a loaded machine cannot be rerun at will.
+    if [ "$fail" -gt 0 ] && [ -d "$T" ]; then
+        local keep
+        keep="$B/failed/$(basename "$0" .sh).$$"
+        mkdir -p "$keep" && cp -a "$T/." "$keep/" 2>/dev/null &&
+            echo "note: $(basename "$0"): its files are kept in $keep"
+    fi
     rm -rf "$T"
 }
 trap cs_cli_cleanup EXIT
