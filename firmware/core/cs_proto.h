@@ -33,8 +33,8 @@ typedef enum {
     CS_PROTO_RESUME = 0x23,  /* resume after hold */
     CS_PROTO_ABORT = 0x24,   /* stop now and flush the queue */
     CS_PROTO_PEN = 0x25,     /* servo pen pulse width, set between the queued neighbours */
-    CS_PROTO_QUERY = 0x26,   /* asks for a STATUS now (a host that reconnected) */
-    CS_PROTO_SETPOS = 0x27,  /* job id and numbering, and optionally the position in steps */
+    CS_PROTO_QUERY = 0x2C,   /* asks for a STATUS now (a host that reconnected) */
+    CS_PROTO_SETPOS = 0x2D,  /* job id and numbering, and optionally the position in steps */
 } cs_proto_type_t;
 
 /* Payload sizes in bytes (n = number of axes a status carries, 1..CS_PROTO_AXES_MAX). */

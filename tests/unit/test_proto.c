@@ -190,7 +190,7 @@ static void test_unknown_types_and_empty_payload(void **state)
 {
     (void)state;
     const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x20, 0x21,
-                             0x22, 0x23, 0x24, 0x25, 0x26, 0x27};
+                             0x22, 0x23, 0x24, 0x25, 0x2C, 0x2D};
     uint8_t buf[CS_PROTO_LEN_MAX] = {0};
     cs_proto_msg_t m;
     unsigned unknown = 0;
@@ -461,7 +461,7 @@ static void test_classification_and_boot_peek(void **state)
     (void)state;
     assert_false(cs_proto_sequenced(CS_PROTO_ACK));
     assert_false(cs_proto_sequenced(CS_PROTO_PING));
-    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26, 0x27};
+    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x2C, 0x2D};
     for (size_t i = 0; i < sizeof seqd; i++) {
         assert_true(cs_proto_sequenced(seqd[i]));
         assert_int_equal(cs_proto_uses_slot(seqd[i]),
@@ -510,18 +510,18 @@ static void test_pen_layout_and_range(void **state)
     }
 }
 
-/* QUERY (0x26) is its type byte; SETPOS (0x27): flags, job id, base (u32 each but flags), four
+/* QUERY (0x2C) is its type byte; SETPOS (0x2D): flags, job id, base (u32 each but flags), four
  * i32 positions in steps, written out by hand; an unknown flag bit is refused both ways. */
 static void test_query_and_setpos_layout(void **state)
 {
     (void)state;
     cs_proto_msg_t m = {0};
     m.type = CS_PROTO_QUERY;
-    const uint8_t q[1] = {0x26};
+    const uint8_t q[1] = {0x2C};
     expect_encoding(&m, q, sizeof q);
     m.type = CS_PROTO_SETPOS;
     m.u.setpos = (cs_proto_setpos_t){CS_PROTO_SETPOS_POS, 0x01020304u, 54081u, {-1, 800, 0, 7}};
-    uint8_t w[CS_PROTO_LEN_SETPOS] = {0x27, 0x01, 0x04, 0x03, 0x02, 0x01, 0x41, 0xD3, 0x00, 0x00,
+    uint8_t w[CS_PROTO_LEN_SETPOS] = {0x2D, 0x01, 0x04, 0x03, 0x02, 0x01, 0x41, 0xD3, 0x00, 0x00,
                                       0xFF, 0xFF, 0xFF, 0xFF, 0x20, 0x03, 0x00, 0x00, 0x00, 0x00,
                                       0x00, 0x00, 0x07, 0x00, 0x00, 0x00};
     assert_int_equal(sizeof w, 26);
