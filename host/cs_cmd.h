@@ -52,4 +52,12 @@ int cs_cmd_pause(int argc, char **argv);
 int cs_cmd_resume(int argc, char **argv);
 int cs_cmd_cancel(int argc, char **argv);
 
+/* curvestep home | jog | probe | unlock --port DEV [--baud N] [--machine FILE.ini] ...: the
+ * machine-control commands (host/cs_ctl_cmd.c) */
+int cs_cmd_home(int argc, char **argv);
+int cs_cmd_jog(int argc, char **argv);
+int cs_cmd_probe(int argc, char **argv);
+int cs_cmd_unlock(int argc, char **argv);
+int cs_cmd_spindle(int argc, char **argv);
+
 #endif

@@ -113,7 +113,9 @@ void cs_gcode_target(gc_t *g, block_t *b, double t[3])
             continue;
         }
         b->used |= BIT('X' + a);
-        t[a] = g->incr ? g->pos[a] + w->v * g->unit : w->v * g->unit + g->off[a];
+        /* G53: machine coordinates for this line (LinuxCNC "G53 Move in Machine Coordinates") */
+        double off = b->machine ? 0.0 : cs_gcode_offset(g, a);
+        t[a] = g->incr ? g->pos[a] + w->v * g->unit : w->v * g->unit + off;
     }
 }
 
@@ -237,18 +239,18 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
         if (b->w['S' - 'A'].v < 0)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->w['S' - 'A'].col),
                                     "S (spindle speed) must not be negative");
+        double was = g->speed;
+        g->speed = b->w['S' - 'A'].v;
+        if (g->o->spindle && g->spindle != GC_M5 && g->speed != was) {
+            cs_err_t e = g->o->spindle(g->o->spindle_ctx, g->spindle, g->speed);
+            if (e != CS_OK)
+                return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, b->w['S' - 'A'].col),
+                                        "S: the spindle could not be set");
+        }
     }
     return CS_OK;
 }
 
-/* A G or M code's name ("G5.2", "M30"). */
-static void code_name(char *out, size_t cap, char letter, int v)
-{
-    if (v % 10)
-        snprintf(out, cap, "%c%d.%d", letter, v / 10, v % 10);
-    else
-        snprintf(out, cap, "%c%d", letter, v / 10);
-}
 
 /* The pen's Z move of M3/M4/M5 (opts->pen_z) to t: at opts->pen_z_feed_mm_s when it is given
  * (the [pen] z_feed, as cs_pen moves the pen for SVG and HP-GL), else rapid. The program's own F
@@ -270,32 +272,37 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
     cs_err_t e;
     for (unsigned i = 0; i < b->nm; i++) {
         int m = b->m[i];
-        if (m == 20 || m == 300) {
+        cs_gcode_group_t grp = cs_gcode_group_m(m);
+        if (grp == GC_GROUP_M_STOP) {
             *end = true;
-        } else if ((m == 30 || m == 40 || m == 50) && g->nurbs) {
+        } else if (grp == GC_GROUP_M_SPINDLE && g->nurbs) {
             /* The block's curve starts where it opened: a pen or spindle change (and its Z
              * move) cannot come between its control points. */
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->mcol[i]),
                                     "M%d inside a NURBS block: start or stop the spindle (pen) "
                                     "before the G5.2 or after its G5.3",
                                     m / 10);
-        } else if (m == 30 || m == 40 || m == 50) {
+        } else if (grp == GC_GROUP_M_SPINDLE) {
+            g->spindle = m;
+            if (g->o->spindle && (e = g->o->spindle(g->o->spindle_ctx, m, g->speed)) != CS_OK)
+                return cs_path_diag_set(g->diag, e, cs_gcode_loc(g, b->mcol[i]),
+                                        "M%d: the spindle could not be set", m / 10);
             /* Pen down / spindle on, or pen up / spindle off: a new subpath either way, and
              * with opts->pen_z a Z move to the pen height. */
             cs_path_new_subpath(g->path);
             if (g->o->pen_z) {
                 double t[3] = {g->pos[0], g->pos[1],
-                               m == 50 ? g->o->pen_up_z_mm : g->o->pen_down_z_mm};
+                               m == GC_M5 ? g->o->pen_up_z_mm : g->o->pen_down_z_mm};
                 if ((e = pen_z_move(g, t, b->mcol[i])) != CS_OK)
                     return e;
                 memcpy(g->pos, t, sizeof g->pos);
                 cs_path_new_subpath(g->path);
             }
-        } else if (m == 70 || m == 80 || m == 90) {
+        } else if (grp == GC_GROUP_M_COOLANT) {
             /* Coolant mist / flood / off (LinuxCNC and Grbl): nothing to draw or move. */
         } else {
             char what[32];
-            code_name(what, sizeof what, 'M', m);
+            cs_gcode_code_name(what, sizeof what, 'M', m);
             if ((e = unsupported(g, b->mcol[i], what)) != CS_OK)
                 return e;
         }
@@ -305,17 +312,20 @@ static cs_err_t run_m(gc_t *g, block_t *b, bool *end)
 
 /* What the G words of one line ask for. */
 typedef struct {
-    int motion; /* MOT_*, 53 (G5.3), or -2: no motion word on the line */
+    int motion; /* MOT_*, GC_G5_3, or MOT_LINE_NONE: no motion word on the line */
     unsigned mcol;
-    bool g92, g64, drop;
+    bool g64, drop;
     int drop_code;
-    unsigned g92col, g64col, dropcol;
+    int axes_code; /* G10, G28, G30, G92: a non-modal code that takes the axis words; -1: none */
+    unsigned axes_col, g64col, dropcol;
 } gline_t;
 
 /* G codes this reader carries out in LinuxCNC's dialect that Grbl 1.1 does not have. */
 static bool grbl_lacks(int v)
 {
-    return v == 50 || v == 51 || v == 52 || v == 53 || v == 62 || v == 640 || v == 611 || v == 901;
+    return v == GC_G5 || v == GC_G5_1 || v == GC_G5_2 || v == GC_G5_3 || v == GC_G6_2 ||
+           v == GC_G64 || v == GC_G61_1 || v == GC_G90_1 || v == GC_G59_1 || v == GC_G59_2 ||
+           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3;
 }
 
 /* Codes that move (threading, probing, canned cycles...) or read the line's axis words for
@@ -323,15 +333,13 @@ static bool grbl_lacks(int v)
  * whole block goes with it; moving to its axis words as an ordinary move could plunge the tool. */
 static bool moves_or_takes_axes(int v, bool *motion)
 {
-    *motion = v == 330 || v == 331 || (v >= 382 && v <= 385) || v == 730 || v == 740 || v == 760 ||
-              (v >= 810 && v <= 890) || (v >= 50 && v <= 53) || v == 62;
-    return *motion || v == 40 || v == 100 || v == 280 || v == 281 || v == 300 || v == 301 ||
-           v == 520 || v == 530 || v == 922 || v == 923;
+    *motion = cs_gcode_group_g(v) == GC_GROUP_MOTION;
+    return *motion || cs_gcode_group_g(v) == GC_GROUP_NONMODAL;
 }
 
 static cs_err_t set_motion(gc_t *g, gline_t *l, int v, unsigned c)
 {
-    if (l->motion != -2)
+    if (l->motion != MOT_LINE_NONE)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, c),
                                 "two motion words on one line");
     l->motion = v;
@@ -343,7 +351,7 @@ static cs_err_t set_motion(gc_t *g, gline_t *l, int v, unsigned c)
 static cs_err_t drop_g(gc_t *g, gline_t *l, int v, unsigned c)
 {
     char what[48];
-    code_name(what, sizeof what, 'G', v);
+    cs_gcode_code_name(what, sizeof what, 'G', v);
     if (g->o->dialect == CS_GCODE_GRBL && grbl_lacks(v))
         strcat(what, " (not in Grbl 1.1)");
     if (!g->o->lenient)
@@ -378,74 +386,95 @@ static cs_err_t run_g64(gc_t *g, block_t *b, unsigned col)
     return CS_OK;
 }
 
+/* Two G words of one modal group on a line (LinuxCNC G-code reference, "Modal Groups": "It is an
+ * error to put a G-code from group 1 and a G-code from group 0 on the same line if both of them
+ * use axis words" and two of one group are an error). Two motion words: set_motion says so. */
+static cs_err_t check_groups(gc_t *g, const block_t *b)
+{
+    for (unsigned i = 0; i < b->ng; i++) {
+        cs_gcode_group_t gi = cs_gcode_group_g(b->g[i]);
+        for (unsigned j = 0; j < i && gi != GC_GROUP_NONE && gi != GC_GROUP_MOTION; j++) {
+            if (cs_gcode_group_g(b->g[j]) != gi)
+                continue;
+            char a[16], c[16];
+            cs_gcode_code_name(a, sizeof a, 'G', b->g[j]);
+            cs_gcode_code_name(c, sizeof c, 'G', b->g[i]);
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->gcol[i]),
+                                    "%s and %s on one line: two words of one modal group", a, c);
+        }
+    }
+    return CS_OK;
+}
+
+/* Modes that set state and nothing else: plane, units, distance modes, path mode. */
+static bool run_g_mode(gc_t *g, int v)
+{
+    switch (v) {
+    case GC_G17:
+        g->plane = 17;
+        return true;
+    case GC_G18:
+        g->plane = 18;
+        return true;
+    case GC_G19:
+        g->plane = 19;
+        return true;
+    case GC_G20:
+        g->unit = MM_PER_INCH;
+        return true;
+    case GC_G21:
+        g->unit = 1.0;
+        return true;
+    case GC_G90:
+    case GC_G91:
+        g->incr = v == GC_G91;
+        return true;
+    case GC_G90_1:
+    case GC_G91_1:
+        g->ijk_abs = v == GC_G90_1;
+        return true;
+    case GC_G61:   /* exact path, */
+    case GC_G61_1: /* exact stop: curvestep never rounds a corner off, so the path is the same */
+    case GC_G94:   /* feed in units per minute: the only feed mode */
+    case GC_G40:   /* cutter radius compensation off */
+    case GC_G49:   /* tool length offset off */
+        return true;
+    default:
+        return false;
+    }
+}
+
 /* The modal G words of a line into the state, the motion word and the specials into *l. */
 static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
 {
-    cs_err_t e = CS_OK;
+    cs_err_t e = check_groups(g, b);
     for (unsigned i = 0; i < b->ng && e == CS_OK; i++) {
         int v = b->g[i];
         unsigned c = b->gcol[i];
-        if (g->o->dialect == CS_GCODE_GRBL && grbl_lacks(v)) {
+        if ((g->o->dialect == CS_GCODE_GRBL && grbl_lacks(v)) ||
+            (v >= GC_G38_2 && v <= GC_G38_5 && !g->o->probe)) {
             e = drop_g(g, l, v, c);
             continue;
         }
-        switch (v) {
-        case 0:
-        case 10:
-        case 20:
-        case 30:
-        case 50:
-        case 51:
-        case 52:
-        case 53:
-        case 62:
-            e = set_motion(g, l, v, c);
-            break;
-        case 800:
+        if (run_g_mode(g, v))
+            continue;
+        if (cs_gcode_coord_system(v) != 0 || v == GC_G28_1 || v == GC_G30_1 || v == GC_G92_1 ||
+            v == GC_G92_2 || v == GC_G92_3) {
+            cs_gcode_wcs_set(g, v);
+        } else if (v == GC_G10 || v == GC_G28 || v == GC_G30 || v == GC_G92) {
+            l->axes_code = v;
+            l->axes_col = c;
+        } else if (v == GC_G53) {
+            b->machine = true;
+        } else if (v == GC_G80) {
             e = set_motion(g, l, MOT_NONE, c);
-            break;
-        case 170:
-        case 180:
-        case 190:
-            g->plane = v / 10;
-            break;
-        case 200:
-            g->unit = MM_PER_INCH;
-            break;
-        case 210:
-            g->unit = 1.0;
-            break;
-        case 900:
-            g->incr = false;
-            break;
-        case 910:
-            g->incr = true;
-            break;
-        case 901:
-            g->ijk_abs = true;
-            break;
-        case 911:
-            g->ijk_abs = false;
-            break;
-        case 920:
-            l->g92 = true;
-            l->g92col = c;
-            break;
-        case 921:
-            memset(g->off, 0, sizeof g->off);
-            break;
-        case 640:
+        } else if (v == GC_G64) {
             l->g64 = true;
             l->g64col = c;
-            break;
-        case 610: /* exact path, */
-        case 611: /* exact stop: curvestep never rounds a corner off, so the path is the same */
-        case 940: /* feed in units per minute: the only feed mode */
-        case 540: /* the first work coordinate system: the only one */
-        case 400: /* cutter radius compensation off */
-        case 490: /* tool length offset off */
-            break;
-        default:
+        } else if (cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
+                   v != GC_G73 && v != GC_G74 && v != GC_G76 && v < GC_G81) {
+            e = set_motion(g, l, v, c); /* G0 .. G6.2 and (with a probe) G38.2 .. G38.5 */
+        } else {
             e = drop_g(g, l, v, c);
         }
     }
@@ -457,7 +486,7 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
 {
     char what[32], words[160] = "";
     size_t k = 0;
-    code_name(what, sizeof what, 'G', code);
+    cs_gcode_code_name(what, sizeof what, 'G', code);
     for (const char *q = "XYZIJKRPQL"; *q; q++) {
         word_t *w = &b->w[*q - 'A'];
         if (w->has && k < sizeof words - 24)
@@ -475,43 +504,29 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
                       k ? words : " (none)");
 }
 
-/* G92: the current position gets the coordinates of the axis words. */
-static cs_err_t run_g92(gc_t *g, block_t *b, const gline_t *l)
+/* G10, G28, G30, G92: the line's axis words are theirs, so no motion word may share it. */
+static cs_err_t run_axes_code(gc_t *g, block_t *b, const gline_t *l)
 {
-    if (l->motion != -2)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->g92col),
-                                "G92 and a motion word on one line");
-    if (!cs_gcode_any_axis(b)) {
-        /* LinuxCNC refuses a bare G92; so do we unless lenient (RepRap's "G92 E0" is bare
-         * once its E word was dropped as unsupported). */
-        if (!g->o->lenient)
-            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->g92col),
-                                    "G92 needs axis words (the coordinates to give the "
-                                    "current position)");
-        cs_gcode_warn(g, l->g92col,
-                      "G92 without X, Y or Z: ignored, offsets unchanged (--lenient)");
+    if (l->motion != MOT_LINE_NONE) {
+        char what[16];
+        cs_gcode_code_name(what, sizeof what, 'G', l->axes_code);
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->axes_col),
+                                "%s and a motion word on one line", what);
     }
-    for (int a = 0; a < 3; a++) {
-        const word_t *w = &b->w['X' - 'A' + a];
-        if (w->has) {
-            g->off[a] = g->pos[a] - w->v * g->unit;
-            b->used |= BIT('X' + a);
-        }
-    }
-    return CS_OK;
+    return cs_gcode_wcs_axes(g, b, l->axes_code, l->axes_col);
 }
 
 /* NURBS lines: G5.3, G5.2, G6.2 and the lines of an open block. *done when the line was one. */
 static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_col, bool *done)
 {
     *done = true;
-    if (g->nurbs && l->motion != -2 && l->motion != MOT_G52 && l->motion != 53)
+    if (g->nurbs && l->motion != MOT_LINE_NONE && l->motion != MOT_G52 && l->motion != GC_G5_3)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->mcol),
                                 g->nurbs == MOT_G62
                                     ? "motion word inside a G6.2 block (it ends with its last "
                                       "K-only line)"
                                     : "motion word inside a G5.2 block (close it with G5.3 first)");
-    if (l->motion == 53) {
+    if (l->motion == GC_G5_3) {
         if (g->nurbs != MOT_G52)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, l->mcol),
                                     "G5.3 without an open G5.2 block");
@@ -539,8 +554,12 @@ static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_
 /* The motion of a line (modal: the mode in effect when the line has none). */
 static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first_col)
 {
-    if (l->motion != -2)
+    if (l->motion != MOT_LINE_NONE)
         g->motion = l->motion;
+    if (b->machine && g->motion != MOT_G0 && g->motion != MOT_G1)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, first_col),
+                                "G53 needs G0 or G1 in effect (LinuxCNC: a move in machine "
+                                "coordinates)");
     /* A move happens when the line has axis words or arc / spline words; a motion word alone
      * ("G2" on its own line) only sets the mode. */
     bool go = cs_gcode_any_axis(b);
@@ -575,6 +594,13 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
         e = do_spline(g, b, g->motion == MOT_G51, l->mcol);
         g->g5_prev = g->motion == MOT_G5;
         break;
+    case GC_G38_2:
+    case GC_G38_3:
+    case GC_G38_4:
+    case GC_G38_5:
+        e = cs_gcode_probe(g, b, g->motion, l->mcol);
+        g->g5_prev = false;
+        break;
     default: /* G5.2 / G6.2 mode after its block: axis words alone start nothing */
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, first_col),
                                 "axis words after a closed NURBS block: give G0, G1... first");
@@ -585,7 +611,7 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
 static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
 {
     bool end = false, done;
-    gline_t l = {-2, first_col, false, false, false, 0, 0, 0, 0};
+    gline_t l = {.motion = MOT_LINE_NONE, .mcol = first_col, .axes_code = -1};
     cs_err_t e = run_letters(g, b);
     /* A line without K ends a G6.2 block before anything on it runs. */
     if (e == CS_OK && g->nurbs == MOT_G62 && !b->w['K' - 'A'].has)
@@ -605,7 +631,8 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
         return e;
     if ((e = run_nurbs(g, b, &l, first_col, &done)) != CS_OK)
         return e;
-    if (!done && (e = l.g92 ? run_g92(g, b, &l) : run_motion(g, b, &l, first_col)) != CS_OK)
+    if (!done && (e = l.axes_code >= 0 ? run_axes_code(g, b, &l)
+                                        : run_motion(g, b, &l, first_col)) != CS_OK)
         return e;
     /* Words given but not used by anything on the line. */
     for (int i = 0; i < 26; i++) {
@@ -842,8 +869,19 @@ void cs_gcode_opts_init(cs_gcode_opts_t *o)
     o->helix_tol_mm = CS_GCODE_HELIX_TOL_MM;
 }
 
-/* Runs the program line by line in the order its O-words decide (cs_gflow). */
-static cs_err_t run_program(gc_t *g, cs_gflow_t *fl, const char *buf)
+cs_err_t cs_gcode_line(gc_t *g, const char *s, size_t n)
+{
+    cs_err_t e = do_line(g, s, n);
+    if (e != CS_OK) {
+        cs_gexpr_discard(&g->st);
+        return e;
+    }
+    if (cs_gexpr_commit(&g->st) != CS_OK)
+        return cs_path_diag_set(g->diag, CS_ERR_FULL, cs_gcode_loc(g, 1), "out of memory");
+    return CS_OK;
+}
+
+cs_err_t cs_gcode_run_lines(gc_t *g, cs_gflow_t *fl, const char *buf)
 {
     cs_err_t e = CS_OK;
     size_t k = 0;
@@ -852,20 +890,62 @@ static cs_err_t run_program(gc_t *g, cs_gflow_t *fl, const char *buf)
         g->line = (unsigned)(k + 1);
         if (g->stats)
             g->stats->lines++;
-        if (fl->lines[k].kind != CS_GFLOW_NONE) {
+        if (fl->lines[k].kind != CS_GFLOW_NONE)
             e = cs_gflow_exec(fl, g->name, buf, k, &g->st, &next, g->diag);
-        } else if ((e = do_line(g, buf + fl->lines[k].start, fl->lines[k].len)) == CS_OK &&
-                   cs_gexpr_commit(&g->st) != CS_OK) {
-            e = cs_path_diag_set(g->diag, CS_ERR_FULL, cs_gcode_loc(g, 1), "out of memory");
-        }
+        else
+            e = cs_gcode_line(g, buf + fl->lines[k].start, fl->lines[k].len);
         k = next;
     }
+    return e;
+}
+
+/* Runs the program line by line in the order its O-words decide (cs_gflow). */
+static cs_err_t run_program(gc_t *g, cs_gflow_t *fl, const char *buf)
+{
+    cs_err_t e = cs_gcode_run_lines(g, fl, buf);
     if (e == CS_OK && g->nurbs == MOT_G62)
         e = cs_gcode_nurbs_close(g); /* a G6.2 block at the end of the program */
     if (e == CS_OK && g->nurbs)
         e = cs_path_diag_set(g->diag, CS_ERR_PARSE, g->nurbs_loc,
                              "G5.2 block not closed by G5.3 before the end of the program");
     return e;
+}
+
+void cs_gcode_start_modes(gc_t *g)
+{
+    g->unit = g->o->start_inch ? MM_PER_INCH : 1.0;
+    g->plane = 17;
+    g->incr = false;
+    g->ijk_abs = false;
+    g->feed = 0;
+    g->g5_prev = false;
+    g->spindle = GC_M5;
+    /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
+    g->motion = g->o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
+}
+
+cs_err_t cs_gcode_begin(gc_t *g, const char *name, const cs_gcode_opts_t *o, cs_path_t *path,
+                        cs_path_diag_t *diag)
+{
+    memset(g, 0, sizeof *g);
+    cs_path_loc_t l0 = {"<input>", 0, 0};
+    g->name = cs_path_intern(path, name ? name : "<input>");
+    if (!g->name)
+        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
+    l0.file = g->name;
+    if (!(o->helix_tol_mm > 0) || o->helix_tol_mm > CS_POS_LIMIT_MM)
+        return cs_path_diag_set(diag, CS_ERR_TOLERANCE, l0, "helix tolerance %g mm not accepted",
+                                o->helix_tol_mm);
+    g->o = o;
+    g->path = path;
+    g->diag = diag;
+    cs_gcode_start_modes(g);
+    if (o->pen_z) /* the pen starts up: moves before the first M3 are travel (cs_pen, z mode) */
+        g->pos[2] = o->pen_up_z_mm;
+    if (cs_gexpr_init(&g->st) != CS_OK)
+        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
+    cs_gcode_wcs_init(g);
+    return CS_OK;
 }
 
 cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_gcode_opts_t *o,
@@ -877,40 +957,28 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
         o = &dflt;
     }
     gc_t g;
-    memset(&g, 0, sizeof g);
-    cs_path_loc_t l0 = {"<input>", 0, 0};
-    g.name = cs_path_intern(path, name ? name : "<input>");
-    if (!g.name)
-        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
-    l0.file = g.name;
-    if (!(o->helix_tol_mm > 0) || o->helix_tol_mm > CS_POS_LIMIT_MM)
-        return cs_path_diag_set(diag, CS_ERR_TOLERANCE, l0, "helix tolerance %g mm not accepted",
-                                o->helix_tol_mm);
-    g.o = o;
-    g.path = path;
-    g.diag = diag;
+    cs_err_t e = cs_gcode_begin(&g, name, o, path, diag);
+    if (e != CS_OK) {
+        cs_gexpr_free(&g.st);
+        return e;
+    }
     g.stats = stats;
     if (stats)
         memset(stats, 0, sizeof *stats);
-    g.unit = o->start_inch ? MM_PER_INCH : 1.0;
-    g.plane = 17;
-    /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
-    g.motion = o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
     cs_path_new_subpath(path);
-    if (o->pen_z) { /* the pen starts up: moves before the first M3 are travel (cs_pen, z mode) */
-        double up[3] = {0, 0, o->pen_up_z_mm};
-        /* with a z_feed the raise from the origin is a pen move too, at that speed (else the
-         * planner's rapid to the path's start makes it) */
-        cs_err_t e0 = o->pen_z_feed_mm_s > 0 ? pen_z_move(&g, up, 0) : CS_OK;
-        if (e0 != CS_OK)
-            return e0;
+    if (o->pen_z && o->pen_z_feed_mm_s > 0) {
+        /* the pen starts up: with a z_feed the raise from the origin is a pen move too, at
+         * that speed (else the planner's rapid to the path's start makes it) */
+        double up[3] = {g.pos[0], g.pos[1], o->pen_up_z_mm};
+        g.pos[2] = 0;
+        if ((e = pen_z_move(&g, up, 0)) != CS_OK) {
+            cs_gexpr_free(&g.st);
+            return e;
+        }
         g.pos[2] = o->pen_up_z_mm;
     }
-    if (cs_gexpr_init(&g.st) != CS_OK)
-        return cs_path_diag_set(diag, CS_ERR_FULL, l0, "out of memory");
     cs_gflow_t fl;
-    cs_err_t e =
-        cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops, diag);
+    e = cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops, diag);
     if (e == CS_OK)
         e = run_program(&g, &fl, buf);
     cs_gflow_free(&fl);

@@ -15,6 +15,18 @@
 /* Receives each warning (code CS_OK, loc and reason filled). */
 typedef void (*cs_gcode_warn_fn)(void *ctx, const cs_path_diag_t *w);
 
+/* Carries out a probing move (G38.2 .. G38.5, code in tenths) from `from` toward `to` (machine
+ * mm) at feed_mm_s: *contact says whether the probe touched (G38.4 / G38.5: lost contact), hit
+ * where the machine stopped (mm). Anything but CS_OK ends the read with that error. */
+typedef cs_err_t (*cs_gcode_probe_fn)(void *ctx, int code, const double from[3],
+                                      const double to[3], double feed_mm_s, bool *contact,
+                                      double hit[3]);
+
+/* The spindle (or laser, or pen) changed: code GC_M3, GC_M4 or GC_M5 (tenths), s the S in force.
+ * Called at M3/M4/M5 and at an S that changes the speed of a running spindle, before the line's
+ * motion. Anything but CS_OK ends the read with that error. */
+typedef cs_err_t (*cs_gcode_spindle_fn)(void *ctx, int code, double s);
+
 /* Default largest distance (mm) between a helix (G2/G3 with a third-axis move) and the rational
  * quadratic pieces that carry it. */
 #define CS_GCODE_HELIX_TOL_MM 0.001
@@ -43,6 +55,10 @@ typedef struct {
                               * CS_GFLOW_MAX_LOOPS (a runaway loop is a located error) */
     cs_gcode_warn_fn warn;   /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
+    cs_gcode_probe_fn probe; /* NULL: G38.2 .. G38.5 are unsupported (a file has no probe) */
+    void *probe_ctx;
+    cs_gcode_spindle_fn spindle; /* NULL: none (M3/M4/M5 only split subpaths) */
+    void *spindle_ctx;
 } cs_gcode_opts_t;
 
 /* What a read found (for tests and --stats). */
@@ -69,5 +85,49 @@ void cs_gcode_opts_init(cs_gcode_opts_t *o);
  * CS_ERR_KNOTS (NURBS blocks), CS_ERR_FULL (out of memory), each with *diag. stats may be NULL. */
 cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_gcode_opts_t *o,
                        cs_path_t *path, cs_path_diag_t *diag, cs_gcode_stats_t *stats);
+
+/* ---- line at a time (a sender's stream: `curvestep grbl`) ---- */
+
+/* A reader that keeps its state across lines: position, modal state, parameters (work offsets
+ * among them), O-word subroutines defined so far, an open NURBS block. */
+typedef struct cs_gcode_session cs_gcode_session_t;
+
+/* What a sender may ask about (Grbl's $G, $#, status WCO). */
+typedef struct {
+    double pos[3];    /* machine position after the last line, mm */
+    double off[3];    /* program coordinate = machine - off (coordinate system + G92), mm */
+    int wcs;          /* coordinate system in use, 1 (G54) .. 9 (G59.3) */
+    bool inch, incr, ijk_abs;
+    int plane;        /* 17, 18, 19 */
+    int motion;       /* G code of the motion mode in tenths (cs_gcode_words.h), -1: none */
+    double feed;      /* F in program units per minute, 0: none given */
+    int spindle;      /* M3, M4 or M5 in tenths (cs_gcode_words.h) */
+    double speed;     /* S */
+    bool holding;     /* lines are held: an O-word block or G5.2 block is open */
+} cs_gcode_state_t;
+
+/* A session named name (in locations) with options o (copied; NULL: defaults). NULL without
+ * memory. The machine starts as cs_gcode_read starts it. */
+cs_gcode_session_t *cs_gcode_session_new(const char *name, const cs_gcode_opts_t *o);
+void cs_gcode_session_free(cs_gcode_session_t *s);
+/* Reads one line (line[0..len), no end of line) numbered lineno (for locations) and appends its
+ * moves to *out (loc file: the session's name). Lines of an O-word block (sub ... endsub, if,
+ * while, do, repeat) are held and run when the block closes; a sub definition is kept for later
+ * calls. *ended is set by M2 / M30 (the modal state is then back at the start, position, offsets
+ * and parameters kept). Errors as cs_gcode_read; on an error the state is as before the line
+ * and the held block (if any) is dropped. */
+cs_err_t cs_gcode_feed(cs_gcode_session_t *s, const char *line, size_t len, unsigned lineno,
+                       cs_path_t *out, cs_path_diag_t *diag, bool *ended);
+/* Puts the state back to what it was before the last successful cs_gcode_feed (once). False
+ * when there is nothing to undo. */
+bool cs_gcode_undo(cs_gcode_session_t *s);
+void cs_gcode_state(const cs_gcode_session_t *s, cs_gcode_state_t *st);
+/* Numbered parameter #index (1..5399), 0 outside. */
+double cs_gcode_param(const cs_gcode_session_t *s, int index);
+/* The machine is at mm (after a cancelled move, a probe, homing). */
+void cs_gcode_set_pos(cs_gcode_session_t *s, const double mm[3]);
+/* Modal state back to the start; held lines dropped; with clear_g92 the G92 offsets too (a soft
+ * reset). Position, coordinate systems and parameters are kept. */
+void cs_gcode_reset(cs_gcode_session_t *s, bool clear_g92);
 
 #endif

@@ -317,7 +317,7 @@ cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
             double v = w->has ? w->v * g->unit : 0.0;
             if (w->has)
                 b->used |= BIT('I' + ax[k]);
-            c[ax[k]] = g->ijk_abs ? v + g->off[ax[k]] : s[ax[k]] + v;
+            c[ax[k]] = g->ijk_abs ? v + cs_gcode_offset(g, ax[k]) : s[ax[k]] + v;
         }
         r0 = hypot(s0 - c[ax[0]], s1 - c[ax[1]]);
         r1 = hypot(e0 - c[ax[0]], e1 - c[ax[1]]);

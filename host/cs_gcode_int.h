@@ -10,6 +10,8 @@
 
 #include "cs_gcode.h"
 #include "cs_gexpr.h"
+#include "cs_gflow.h"
+#include "cs_gcode_words.h"
 #include "cs_gnurbs.h"
 
 #define MM_PER_INCH 25.4
@@ -17,18 +19,33 @@
 #define GC_PI  3.14159265358979323846
 #define BIT(c) (1u << ((c) - 'A'))
 
-/* Motion modes: the G number times ten. */
+/* Motion modes: the motion group's G code (cs_gcode_words.h), or one of these. */
 enum {
-    MOT_DROPPED = -3, /* an unsupported motion mode dropped by --lenient (G81, G38.2...) */
+    MOT_LINE_NONE = -2, /* gline_t: no motion word on the line */
+    MOT_DROPPED = -3,   /* an unsupported motion mode dropped by --lenient (G81, G38.2...) */
     MOT_NONE = -1,
-    MOT_G0 = 0,
-    MOT_G1 = 10,
-    MOT_G2 = 20,
-    MOT_G3 = 30,
-    MOT_G5 = 50,
-    MOT_G51 = 51,
-    MOT_G52 = 52,
-    MOT_G62 = 62
+    MOT_G0 = GC_G0,
+    MOT_G1 = GC_G1,
+    MOT_G2 = GC_G2,
+    MOT_G3 = GC_G3,
+    MOT_G5 = GC_G5,
+    MOT_G51 = GC_G5_1,
+    MOT_G52 = GC_G5_2,
+    MOT_G62 = GC_G6_2
+};
+
+/* Numbered parameters the reader keeps (LinuxCNC G-code reference, "Numbered Parameters"); the
+ * offsets are stored in millimetres, the machine's unit. */
+enum {
+    GC_P_PROBE = 5061,    /* #5061..#5063: the last probe's contact (program coordinates) */
+    GC_P_PROBE_OK = 5070, /* 1: the last probe made contact */
+    GC_P_G28 = 5161,      /* #5161..#5163: G28 home (machine coordinates) */
+    GC_P_G30 = 5181,      /* #5181..#5183: G30 home */
+    GC_P_G92_ON = 5210,   /* 1: the G92 offsets apply */
+    GC_P_G92 = 5211,      /* #5211..#5213: the G92 offsets */
+    GC_P_WCS = 5220,      /* the coordinate system in use, 1 (G54) .. 9 (G59.3) */
+    GC_P_WCS1 = 5221,     /* #5221..#5223: G54's offsets; system n at GC_P_WCS1 + 20 (n - 1) */
+    GC_P_WCS_STRIDE = 20
 };
 
 typedef struct {
@@ -46,7 +63,6 @@ typedef struct {
     unsigned line;
     /* modal state */
     double pos[3];    /* machine position, mm */
-    double off[3];    /* G92: program coordinate = machine - off */
     double unit;      /* mm per program unit */
     bool incr;        /* G91 */
     bool ijk_abs;     /* G90.1 */
@@ -54,6 +70,8 @@ typedef struct {
     int motion;       /* MOT_* */
     int dropped_code; /* --lenient: the unsupported motion code MOT_DROPPED stands for */
     double feed;      /* F in program units per minute; 0 = none given */
+    int spindle;      /* GC_M3, GC_M4 or GC_M5 (the spindle / laser / pen state) */
+    double speed;     /* S (spindle speed, laser power), 0 until given */
     bool g5_prev;     /* the last move was a G5: its P, Q continue */
     double g5_pq[2];
     bool last_rapid;
@@ -70,6 +88,7 @@ typedef struct {
 
 /* One line's words. */
 typedef struct {
+    bool machine; /* G53 on the line: its axis words are machine coordinates */
     word_t w[26]; /* by letter; G and M are kept apart */
     int g[8];
     unsigned gcol[8];
@@ -97,6 +116,16 @@ cs_err_t cs_gcode_add_line(gc_t *g, const double a[3], const double b[3], unsign
 /* The line's X Y Z (absolute or G91, units, G92 offsets) -> target t in machine mm. */
 void cs_gcode_target(gc_t *g, block_t *b, double t[3]);
 bool cs_gcode_any_axis(const block_t *b);
+/* Program coordinate = machine - offset: axis a's offset (coordinate system + G92), mm. */
+double cs_gcode_offset(const gc_t *g, int a);
+/* G10, G28, G30, G92 (the non-modal codes that take the line's axis words, cs_gcode_wcs.c). */
+cs_err_t cs_gcode_wcs_axes(gc_t *g, block_t *b, int code, unsigned col);
+/* G28.1, G30.1, G92.1, G92.2, G92.3 and G54..G59.3 (no axis words). */
+void cs_gcode_wcs_set(gc_t *g, int code);
+/* Parameters at program start: G54 in use, no offsets. */
+void cs_gcode_wcs_init(gc_t *g);
+/* G38.2 .. G38.5 to the line's target, through opts->probe (cs_gcode_wcs.c). */
+cs_err_t cs_gcode_probe(gc_t *g, block_t *b, int code, unsigned col);
 /* The plane's axes: first, second (counter-clockwise from first to second), normal. */
 void cs_gcode_plane_axes(int plane, int ax[3]);
 
@@ -108,5 +137,18 @@ cs_err_t cs_gcode_nurbs_close(gc_t *g);
 cs_err_t cs_gcode_nurbs_line(gc_t *g, block_t *b, bool first, unsigned col);
 /* A G6.2 line (first) or a line of its block. */
 cs_err_t cs_gcode_g62_line(gc_t *g, block_t *b, bool first, unsigned col);
+
+/* ---- the reader's steps, shared with the line-at-a-time session (cs_gcode_feed.c) ---- */
+
+/* *g at program start for a read named name with options o into path (diag for errors).
+ * CS_ERR_FULL, CS_ERR_TOLERANCE with diag. The caller frees g->st and g->nb. */
+cs_err_t cs_gcode_begin(gc_t *g, const char *name, const cs_gcode_opts_t *o, cs_path_t *path,
+                        cs_path_diag_t *diag);
+/* Units, plane, distance modes, motion mode and feed as at program start. */
+void cs_gcode_start_modes(gc_t *g);
+/* One ordinary (not O-word) line s[0..n): its words run, its parameter settings committed. */
+cs_err_t cs_gcode_line(gc_t *g, const char *s, size_t n);
+/* Runs fl's lines of buf from the first in the order the O-words decide, up to M2 / M30. */
+cs_err_t cs_gcode_run_lines(gc_t *g, cs_gflow_t *fl, const char *buf);
 
 #endif

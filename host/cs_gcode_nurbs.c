@@ -164,7 +164,7 @@ cs_err_t cs_gcode_g62_line(gc_t *g, block_t *b, bool first, unsigned col)
         const word_t *w = &b->w['X' - 'A' + a];
         if (w->has) {
             b->used |= BIT('X' + a);
-            t[a] = w->v * g->unit + g->off[a];
+            t[a] = w->v * g->unit + cs_gcode_offset(g, a);
         }
     }
     cs_vec3_t v0, v1;

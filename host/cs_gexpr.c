@@ -74,6 +74,21 @@ cs_err_t cs_gexpr_init(cs_gexpr_store_t *st)
     return st->num ? CS_OK : CS_ERR_FULL;
 }
 
+cs_err_t cs_gexpr_copy(cs_gexpr_store_t *dst, const cs_gexpr_store_t *src)
+{
+    *dst = *src;
+    dst->num = malloc(CS_GEXPR_NUM_PARAMS * sizeof *dst->num);
+    dst->named = src->capnamed ? malloc(src->capnamed * sizeof *dst->named) : NULL;
+    if (!dst->num || (src->capnamed && !dst->named)) {
+        cs_gexpr_free(dst);
+        return CS_ERR_FULL;
+    }
+    memcpy(dst->num, src->num, CS_GEXPR_NUM_PARAMS * sizeof *dst->num);
+    if (src->nnamed)
+        memcpy(dst->named, src->named, src->nnamed * sizeof *dst->named);
+    return CS_OK;
+}
+
 void cs_gexpr_free(cs_gexpr_store_t *st)
 {
     free(st->num);
@@ -235,6 +250,97 @@ static size_t gx_word(const gx_t *x, size_t i, char w[GX_WORD_MAX + 1])
 
 static cs_err_t gx_bracket(gx_t *x, size_t *i, double *out);
 
+/* EXISTS[#<name>] at s[*i] == '[': 1 if the named parameter is defined here. */
+static cs_err_t gx_exists(gx_t *x, size_t *i, double *out)
+{
+    size_t j = *i + 1;
+    gx_blanks(x->s, x->n, &j);
+    char name[CS_GEXPR_NAME_MAX];
+    double v;
+    if (j + 1 >= x->n || x->s[j] != '#' || x->s[j + 1] != '<')
+        return gx_fail(x->f, CS_ERR_PARSE, j, "EXISTS takes a named parameter: EXISTS[#<name>]");
+    j++;
+    cs_err_t e = gx_name(x, &j, name);
+    if (e != CS_OK)
+        return e;
+    gx_blanks(x->s, x->n, &j);
+    if (j >= x->n || x->s[j] != ']')
+        return gx_fail(x->f, CS_ERR_PARSE, j, "expected ']' after EXISTS[#<%s>", name);
+    *i = j + 1;
+    *out = cs_gexpr_get_named(x->st, name, &v) ? 1.0 : 0.0;
+    return CS_OK;
+}
+
+/* The functions, in the order of gx_func's names. */
+enum { GXF_ABS, GXF_ACOS, GXF_ASIN, GXF_ATAN, GXF_COS, GXF_EXP, GXF_FIX, GXF_FUP, GXF_LN,
+       GXF_ROUND, GXF_SIN, GXF_SQRT, GXF_TAN, GXF_EXISTS };
+
+/* Function fn (named w, at column at) of a into *r; ATAN reads its "/[x]" at s[*i]. */
+static cs_err_t gx_call_fn(gx_t *x, int fn, const char *w, size_t at, size_t *i, double a,
+                           double *r)
+{
+    const double deg = GX_PI / 180.0; /* LinuxCNC: angles in degrees, in and out */
+    cs_err_t e;
+    switch (fn) {
+    case GXF_ABS:
+        *r = fabs(a);
+        return CS_OK;
+    case GXF_ACOS:
+    case GXF_ASIN:
+        if (a < -1.0 || a > 1.0)
+            return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g]: the argument must be from -1 to 1", w,
+                           a);
+        *r = (fn == GXF_ACOS ? acos(a) : asin(a)) / deg;
+        return CS_OK;
+    case GXF_ATAN: { /* ATAN[y]/[x] */
+        gx_blanks(x->s, x->n, i);
+        if (*i >= x->n || x->s[*i] != '/')
+            return gx_fail(x->f, CS_ERR_PARSE, *i, "ATAN takes two arguments: ATAN[y]/[x]");
+        (*i)++;
+        gx_blanks(x->s, x->n, i);
+        double b;
+        if (*i >= x->n || x->s[*i] != '[')
+            return gx_fail(x->f, CS_ERR_PARSE, *i, "ATAN takes two arguments: ATAN[y]/[x]");
+        if ((e = gx_bracket(x, i, &b)) != CS_OK)
+            return e;
+        *r = atan2(a, b) / deg;
+        return CS_OK;
+    }
+    case GXF_COS:
+        *r = cos(a * deg);
+        return CS_OK;
+    case GXF_EXP:
+        *r = exp(a);
+        return CS_OK;
+    case GXF_FIX:
+        *r = floor(a);
+        return CS_OK;
+    case GXF_FUP:
+        *r = ceil(a);
+        return CS_OK;
+    case GXF_LN:
+        if (!(a > 0))
+            return gx_fail(x->f, CS_ERR_RANGE, at, "LN[%g]: the argument must be positive", a);
+        *r = log(a);
+        return CS_OK;
+    case GXF_ROUND:
+        *r = a < 0 ? -floor(-a + 0.5) : floor(a + 0.5); /* halves away from zero */
+        return CS_OK;
+    case GXF_SIN:
+        *r = sin(a * deg);
+        return CS_OK;
+    case GXF_SQRT:
+        if (a < 0)
+            return gx_fail(x->f, CS_ERR_RANGE, at, "SQRT[%g]: the argument must not be negative",
+                           a);
+        *r = sqrt(a);
+        return CS_OK;
+    default:
+        *r = tan(a * deg);
+        return CS_OK;
+    }
+}
+
 /* A unary function at s[*i] (letters). */
 static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
 {
@@ -252,89 +358,14 @@ static cs_err_t gx_func(gx_t *x, size_t *i, double *out)
     gx_blanks(x->s, x->n, i);
     if (*i >= x->n || x->s[*i] != '[')
         return gx_fail(x->f, CS_ERR_PARSE, *i, "%s must be followed by [argument]", w);
-    if (fn == 13) { /* EXISTS[#<name>]: 1 if the named parameter is defined here */
-        size_t j = *i + 1;
-        gx_blanks(x->s, x->n, &j);
-        char name[CS_GEXPR_NAME_MAX];
-        double v;
-        if (j + 1 >= x->n || x->s[j] != '#' || x->s[j + 1] != '<')
-            return gx_fail(x->f, CS_ERR_PARSE, j,
-                           "EXISTS takes a named parameter: EXISTS[#<name>]");
-        j++;
-        cs_err_t e = gx_name(x, &j, name);
-        if (e != CS_OK)
-            return e;
-        gx_blanks(x->s, x->n, &j);
-        if (j >= x->n || x->s[j] != ']')
-            return gx_fail(x->f, CS_ERR_PARSE, j, "expected ']' after EXISTS[#<%s>", name);
-        *i = j + 1;
-        *out = cs_gexpr_get_named(x->st, name, &v) ? 1.0 : 0.0;
-        return CS_OK;
-    }
-    double a;
+    if (fn == GXF_EXISTS)
+        return gx_exists(x, i, out);
+    double a, r = 0;
     cs_err_t e = gx_bracket(x, i, &a);
+    if (e == CS_OK)
+        e = gx_call_fn(x, fn, w, at, i, a, &r);
     if (e != CS_OK)
         return e;
-    double r = 0;
-    const double deg = GX_PI / 180.0; /* LinuxCNC: angles in degrees, in and out */
-    switch (fn) {
-    case 0:
-        r = fabs(a);
-        break;
-    case 1:
-    case 2:
-        if (a < -1.0 || a > 1.0)
-            return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g]: the argument must be from -1 to 1", w,
-                           a);
-        r = (fn == 1 ? acos(a) : asin(a)) / deg;
-        break;
-    case 3: { /* ATAN[y]/[x] */
-        gx_blanks(x->s, x->n, i);
-        if (*i >= x->n || x->s[*i] != '/')
-            return gx_fail(x->f, CS_ERR_PARSE, *i, "ATAN takes two arguments: ATAN[y]/[x]");
-        (*i)++;
-        gx_blanks(x->s, x->n, i);
-        double b;
-        if (*i >= x->n || x->s[*i] != '[')
-            return gx_fail(x->f, CS_ERR_PARSE, *i, "ATAN takes two arguments: ATAN[y]/[x]");
-        if ((e = gx_bracket(x, i, &b)) != CS_OK)
-            return e;
-        r = atan2(a, b) / deg;
-        break;
-    }
-    case 4:
-        r = cos(a * deg);
-        break;
-    case 5:
-        r = exp(a);
-        break;
-    case 6:
-        r = floor(a);
-        break;
-    case 7:
-        r = ceil(a);
-        break;
-    case 8:
-        if (!(a > 0))
-            return gx_fail(x->f, CS_ERR_RANGE, at, "LN[%g]: the argument must be positive", a);
-        r = log(a);
-        break;
-    case 9:
-        r = a < 0 ? -floor(-a + 0.5) : floor(a + 0.5);
-        break; /* halves away from zero */
-    case 10:
-        r = sin(a * deg);
-        break;
-    case 11:
-        if (a < 0)
-            return gx_fail(x->f, CS_ERR_RANGE, at, "SQRT[%g]: the argument must not be negative",
-                           a);
-        r = sqrt(a);
-        break;
-    default:
-        r = tan(a * deg);
-        break;
-    }
     if (!isfinite(r))
         return gx_fail(x->f, CS_ERR_RANGE, at, "%s[%g] is not a finite number", w, a);
     *out = r;

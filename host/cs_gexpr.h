@@ -52,6 +52,9 @@ typedef struct {
 /* Empty store (every numbered parameter 0, no named ones). CS_ERR_FULL without memory. */
 cs_err_t cs_gexpr_init(cs_gexpr_store_t *st);
 void cs_gexpr_free(cs_gexpr_store_t *st);
+/* *dst becomes an independent copy of *src (a session's undo). CS_ERR_FULL without memory (dst
+ * is then empty). */
+cs_err_t cs_gexpr_copy(cs_gexpr_store_t *dst, const cs_gexpr_store_t *src);
 
 /* An explicit number at s[*i] (line s[0..n)): [+-] digits [. digits], no blanks inside. A number
  * followed by e/E and a digit is refused (LinuxCNC has no exponent form). On success *i moves

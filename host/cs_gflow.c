@@ -127,6 +127,14 @@ static cs_err_t gf_parse(cs_gflow_line_t *l, const char *s, const char *name, si
     return CS_OK;
 }
 
+cs_err_t cs_gflow_line_parse(const char *s, size_t n, cs_gflow_line_t *l)
+{
+    cs_path_diag_t d;
+    memset(l, 0, sizeof *l);
+    l->len = n;
+    return gf_parse(l, s, "", 0, &d);
+}
+
 /* The innermost open construct with line's label, of one of kinds, not past a sub. */
 static gf_open_t *gf_find(cs_gflow_t *f, gf_open_t *st, size_t nst, const char *label,
                           const cs_gflow_kind_t *kinds, size_t nk)

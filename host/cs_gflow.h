@@ -79,6 +79,11 @@ cs_err_t cs_gflow_init(cs_gflow_t *f, const char *name, const char *buf, size_t 
                        unsigned long max_iterations, cs_path_diag_t *diag);
 void cs_gflow_free(cs_gflow_t *f);
 
+/* Reads the O-word of line s[0..n) into *l (kind CS_GFLOW_NONE when the line has none): what a
+ * line-at-a-time reader needs to know whether a block opens or closes. CS_ERR_PARSE when it is
+ * malformed (cs_gflow_init then says where and why). */
+cs_err_t cs_gflow_line_parse(const char *s, size_t n, cs_gflow_line_t *l);
+
 /* The line of sub o<label> ("100", "<name>"), or f->n when the file has none. */
 size_t cs_gflow_find_sub(const cs_gflow_t *f, const char *label);
 

@@ -172,6 +172,24 @@ cs_err_t cs_gnurbs_build(const cs_gnurbs_t *nb, cs_gnurbs_emit_fn emit, void *ct
     return e;
 }
 
+cs_err_t cs_gnurbs_copy(cs_gnurbs_t *dst, const cs_gnurbs_t *src)
+{
+    *dst = *src;
+    dst->cps = src->n ? malloc(src->n * sizeof *dst->cps) : NULL;
+    dst->knots = src->nknots ? malloc(src->nknots * sizeof *dst->knots) : NULL;
+    dst->cap = src->n;
+    dst->capknots = src->nknots;
+    if ((src->n && !dst->cps) || (src->nknots && !dst->knots)) {
+        cs_gnurbs_free(dst);
+        return CS_ERR_FULL;
+    }
+    if (src->n)
+        memcpy(dst->cps, src->cps, src->n * sizeof *dst->cps);
+    if (src->nknots)
+        memcpy(dst->knots, src->knots, src->nknots * sizeof *dst->knots);
+    return CS_OK;
+}
+
 void cs_gnurbs_free(cs_gnurbs_t *nb)
 {
     free(nb->cps);

@@ -44,5 +44,7 @@ cs_err_t cs_gnurbs_knot(cs_gnurbs_t *nb, double k);
 cs_err_t cs_gnurbs_build(const cs_gnurbs_t *nb, cs_gnurbs_emit_fn emit, void *ctx, char *why,
                          size_t whylen);
 void cs_gnurbs_free(cs_gnurbs_t *nb);
+/* *dst becomes an independent copy of *src. CS_ERR_FULL without memory (dst then empty). */
+cs_err_t cs_gnurbs_copy(cs_gnurbs_t *dst, const cs_gnurbs_t *src);
 
 #endif

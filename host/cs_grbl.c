@@ -3,7 +3,7 @@
  * messages in brackets, status reports <State|MPos:...|FS:...>, real-time bytes picked out of the
  * stream as they arrive, a 128-byte receive buffer that character-counting senders fill. */
 #define _GNU_SOURCE
-#include "cs_grbl.h"
+#include "cs_grbl_int.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -23,7 +23,9 @@
 #include "cs_cmd.h"
 #include "cs_conv.h"
 #include "cs_grbl_dev.h"
+#include "cs_gcode_words.h"
 #include "cs_grbl_gc.h"
+#include "cs_grbl_ov.h"
 #include "cs_serial.h"
 #include "cs_stream_cmd.h"
 #include "cs_trace.h"
@@ -33,50 +35,6 @@
 /* a whole receive buffer is one line for the line reader (and is_dwell's copy) */
 CS_STATIC_ASSERT(CS_GRBL_RX_SIZE < CS_GRBL_GC_LINE_MAX, rx_line_fits_reader);
 
-/* Grbl 1.1 error codes we answer (grbl wiki, "Interface", error codes). */
-enum {
-    ERR_LETTER = 1,       /* expected command letter */
-    ERR_NUMBER = 2,       /* bad number format */
-    ERR_DOLLAR = 3,       /* '$' statement not recognized or supported */
-    ERR_HOMING = 5,       /* homing not enabled */
-    ERR_NOT_IDLE = 8,     /* '$' command only when idle */
-    ERR_LOCKED = 9,       /* G-code locked out during alarm */
-    ERR_OVERFLOW = 11,    /* line overflow */
-    ERR_JOG_TRAVEL = 15,  /* jog target exceeds machine travel */
-    ERR_JOG = 16,         /* invalid jog command */
-    ERR_UNSUPPORTED = 20, /* unsupported or invalid g-code command */
-    ERR_MODAL = 21,       /* modal group violation */
-    ERR_NO_FEED = 22,     /* undefined feed rate */
-    ERR_NO_AXIS = 26,     /* no axis words */
-    ERR_NO_COMMAND = 31,  /* axis words with no command that uses them */
-    ERR_TARGET = 33,      /* invalid target */
-    ERR_UNUSED = 36,      /* unused value words */
-};
-
-typedef struct {
-    const cs_grbl_cfg_t *cfg;
-    cs_machine_t m;
-    cs_pos_t tol;
-    int32_t feed; /* --feed (Q15.16 mm/s), 0: the machine's */
-    cs_serial_t ser;
-    cs_grbl_dev_t dev;
-    cs_grbl_gc_t gc;
-    cs_path_t pending;           /* read, not yet planned */
-    cs_pos_t plan_pos[CS_AXES];  /* where the last planned chunk ends */
-    bool last_push_jog;          /* the last item queued was a jog */
-    int fd;                      /* the client (-1: none) */
-    char rx[CS_GRBL_RX_SIZE];    /* Grbl's receive buffer */
-    size_t rxn;
-    bool rx_overflow;            /* a line longer than the buffer: dropped up to its newline */
-    bool after_cr;               /* the last line ended with '\r' */
-    unsigned lineno;             /* lines received since the start */
-    double t_last_line;
-    bool held, check_mode, alarm; /* alarm: a soft limit, cleared by $X */
-    int report_mask;              /* $10 */
-    unsigned reports;
-    double wco_sent[3];
-    unsigned cancelled_seen; /* device runs ended by cancel that were synced */
-} grbl_t;
 
 static volatile sig_atomic_t stop_flag;
 static void on_stop(int sig)
@@ -87,9 +45,7 @@ static void on_stop(int sig)
 
 /* ---- output ---- */
 
-/* Writes a line + "\r\n" to the client; a client that does not read loses it (never blocks). */
-static void say(grbl_t *g, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void say(grbl_t *g, const char *fmt, ...)
+void cs_grbl_say(grbl_t *g, const char *fmt, ...)
 {
     if (g->fd < 0)
         return;
@@ -118,7 +74,7 @@ static void say(grbl_t *g, const char *fmt, ...)
     }
 }
 
-static double steps_mm(const grbl_t *g, int a, int32_t steps)
+double cs_grbl_steps_mm(const grbl_t *g, int a, int32_t steps)
 {
     return (double)steps * 65536.0 / g->m.axis[a].steps_per_mm;
 }
@@ -126,17 +82,20 @@ static double steps_mm(const grbl_t *g, int a, int32_t steps)
 /* ---- the device's position back into the reader and the planner ---- */
 
 /* After a cancel: the reader and the next chunk start where the device stopped. */
-static void sync_from_device(grbl_t *g)
+void cs_grbl_sync(grbl_t *g)
 {
     cs_grbl_dev_snap_t s;
     cs_grbl_dev_snap(&g->dev, &s);
     if (!s.have_pos)
         return;
+    double mm[3];
+    memcpy(mm, g->gc.pos, sizeof mm);
     for (int a = 0; a < 3 && a < g->m.n_axes; a++) {
-        g->gc.pos[a] = steps_mm(g, a, s.pos[a]);
+        mm[a] = cs_grbl_steps_mm(g, a, s.pos[a]);
         g->plan_pos[a] = (cs_pos_t)llround((double)s.pos[a] * 65536.0 * 65536.0 /
                                            (double)g->m.axis[a].steps_per_mm);
     }
+    cs_grbl_gc_set_pos(&g->gc, mm);
     g->cancelled_seen = s.cancelled;
 }
 
@@ -146,8 +105,7 @@ static void drop_all(grbl_t *g)
     cs_grbl_dev_cancel(&g->dev, false);
     g->held = false;
     cs_path_free(&g->pending);
-    cs_grbl_gc_free(&g->gc);
-    sync_from_device(g);
+    cs_grbl_sync(g);
 }
 
 /* ---- chunks ---- */
@@ -178,31 +136,95 @@ static cs_err_t plan_chunk(grbl_t *g, cs_path_t *path, cs_grbl_item_t *it, cs_pa
 /* A soft-limit style stop (Grbl ALARM:2): the planner refused what was already answered ok. */
 static void alarm_planner(grbl_t *g, const cs_path_diag_t *d)
 {
-    say(g, "[MSG:line %u: %s]", d->loc.line, d->reason[0] ? d->reason : "cannot plan");
-    say(g, "ALARM:2");
+    cs_grbl_say(g, "[MSG:line %u: %s]", d->loc.line, d->reason[0] ? d->reason : "cannot plan");
+    cs_grbl_say(g, "ALARM:2");
     g->alarm = true;
     drop_all(g);
 }
 
-/* Plans the pending lines and queues them (there is room: lines are read only then). */
-static void flush_chunk(grbl_t *g)
+/* The overrides in force now, on moves not planned yet (Grbl applies them to what is not yet
+ * executed; curvestep to what is not yet planned: a chunk already on the device keeps its feed). */
+static void apply_overrides(grbl_t *g, cs_path_t *path)
 {
-    if (g->pending.n == 0)
+    double rapid = INFINITY;
+    for (int a = 0; a < 3 && a < g->m.n_axes; a++)
+        rapid = fmin(rapid, g->m.axis[a].max_rate / 65536.0);
+    double dflt = (g->feed > 0 ? g->feed : g->m.default_feed) / 65536.0;
+    cs_grbl_ov_apply(&g->ov, path, 0, dflt, rapid);
+}
+
+static void take_bytes(grbl_t *g, const unsigned char *b, size_t n);
+
+/* Reads the client's bytes for up to 5 ms while a step waits on the device: real-time bytes act
+ * (? is answered, ! holds), the rest waits in the receive buffer. */
+static void pump(grbl_t *g)
+{
+    struct pollfd p = {g->fd, POLLIN, 0};
+    if (g->fd < 0 || poll(&p, 1, 5) <= 0) {
+        if (g->fd < 0)
+            poll(NULL, 0, 5);
         return;
+    }
+    unsigned char buf[256];
+    ssize_t n = read(g->fd, buf, sizeof buf);
+    if (n > 0)
+        take_bytes(g, buf, (size_t)n);
+}
+
+/* Waits until the queue has room for one more item (or the device failed). */
+static bool wait_room(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    for (;;) {
+        cs_grbl_dev_snap(&g->dev, &s);
+        if (s.failed || stop_flag)
+            return false;
+        if (cs_grbl_dev_room(&g->dev, 1))
+            return true;
+        pump(g);
+    }
+}
+
+bool cs_grbl_queue_path(grbl_t *g, cs_path_t *path)
+{
+    if (path->n == 0)
+        return true;
+    apply_overrides(g, path);
     cs_grbl_item_t it = {0};
     cs_path_diag_t d;
-    if (plan_chunk(g, &g->pending, &it, &d) != CS_OK) {
+    if (plan_chunk(g, path, &it, &d) != CS_OK) {
         alarm_planner(g, &d);
-        return;
+        return false;
     }
-    if (!cs_grbl_dev_push(&g->dev, &it)) { /* not reached: called only with room */
-        cs_path_diag_t full = {.code = CS_ERR_FULL, .loc = {"grbl", g->lineno, 1}};
-        snprintf(full.reason, sizeof full.reason, "internal: the chunk queue is full");
+    if (!wait_room(g) || !cs_grbl_dev_push(&g->dev, &it)) {
         cs_stream_job_free(&it.job);
-        alarm_planner(g, &full);
-        return;
+        return false;
     }
     g->last_push_jog = false;
+    return true;
+}
+
+bool cs_grbl_run_msgs(grbl_t *g, const cs_proto_msg_t *m, size_t n, bool wait)
+{
+    cs_grbl_item_t it = {0};
+    cs_stream_job_init(&it.job, CS_STREAM_SEGMENTS);
+    cs_err_t e = CS_OK;
+    for (size_t k = 0; k < n && e == CS_OK; k++)
+        e = cs_stream_job_add_msg(&it.job, &m[k]);
+    if (e != CS_OK || !wait_room(g) || !cs_grbl_dev_push(&g->dev, &it)) {
+        cs_stream_job_free(&it.job);
+        return false;
+    }
+    g->last_push_jog = false;
+    cs_grbl_dev_snap_t s;
+    for (;;) {
+        cs_grbl_dev_snap(&g->dev, &s);
+        if (s.failed || stop_flag)
+            return false;
+        if (!wait || cs_grbl_dev_idle(&g->dev))
+            return true;
+        pump(g);
+    }
 }
 
 /* True when elements n0.. of path stay inside the machine's travel (32 samples each). */
@@ -242,8 +264,8 @@ static int gcode_error(const cs_path_diag_t *d)
 
 static void reply_error(grbl_t *g, const cs_path_diag_t *d)
 {
-    say(g, "[MSG:line %u col %u: %s]", d->loc.line, d->loc.col, d->reason);
-    say(g, "error:%d", gcode_error(d));
+    cs_grbl_say(g, "[MSG:line %u col %u: %s]", d->loc.line, d->loc.col, d->reason);
+    cs_grbl_say(g, "error:%d", gcode_error(d));
 }
 
 /* "G4 P<seconds>" alone on a line (Grbl: P in seconds): true with *s. */
@@ -262,56 +284,80 @@ static bool is_dwell(const char *line, double *s)
     return false;
 }
 
+/* Appends the moves of from to to (their locations named in to). False without memory. */
+static bool append_moves(cs_path_t *to, const cs_path_t *from)
+{
+    if (from->n == 0)
+        return true;
+    const char *name = cs_path_intern(to, "grbl");
+    if (name == NULL || !cs_path_grow((void **)&to->elems, &to->cap, to->n + from->n,
+                                      sizeof *to->elems))
+        return false;
+    for (size_t k = 0; k < from->n; k++) {
+        to->elems[to->n] = from->elems[k];
+        to->elems[to->n].loc.file = name;
+        to->n++;
+    }
+    if (from->blend_tol_mm > 0 && (to->blend_tol_mm == 0 || from->blend_tol_mm < to->blend_tol_mm))
+        to->blend_tol_mm = from->blend_tol_mm; /* G64 P: the smallest asked for */
+    return true;
+}
+
 static void gcode_line(grbl_t *g, const char *line)
 {
     double dwell;
     if (g->alarm) {
-        say(g, "error:%d", ERR_LOCKED);
+        cs_grbl_say(g, "error:%d", ERR_LOCKED);
         return;
     }
     if (!g->check_mode && is_dwell(line, &dwell)) {
-        flush_chunk(g);
+        cs_grbl_flush(g);
         cs_grbl_item_t it = {.dwell = true, .dwell_s = dwell};
         cs_grbl_dev_push(&g->dev, &it);
         g->last_push_jog = false;
-        say(g, "ok");
+        cs_grbl_say(g, "ok");
         return;
     }
-    cs_grbl_gc_t before = g->gc;
-    before.block = NULL; /* the line consumes (or keeps) the held block itself */
-    before.block_len = before.block_lines = 0;
-    size_t n0 = g->pending.n;
+    /* the line's moves go to a path of their own: a probe or a spindle change inside the line
+     * queues the lines before it (pending) while the reader appends to this one */
+    cs_path_t lp;
+    cs_path_init(&lp);
     cs_path_diag_t d;
     bool end;
-    if (cs_grbl_gc_line(&g->gc, line, g->lineno, &g->pending, &d, &end) != CS_OK) {
+    g->in_reader = true; /* a G38.x waits on the device inside the reader */
+    cs_err_t e = cs_grbl_gc_line(&g->gc, line, g->lineno, &lp, &d, &end);
+    g->in_reader = false;
+    bool ok = e == CS_OK;
+    if (!ok) {
         reply_error(g, &d);
-        return;
+    } else if (!inside_travel(g, &lp, 0)) {
+        ok = false;
+        cs_grbl_gc_undo(&g->gc);
+        cs_grbl_say(g, "[MSG:line %u: the move leaves the machine's travel]", g->lineno);
+        cs_grbl_say(g, "error:%d", ERR_TARGET);
+    } else if (!g->check_mode && !append_moves(&g->pending, &lp)) { /* $C: never run */
+        ok = false;
+        cs_grbl_gc_undo(&g->gc);
+        cs_grbl_say(g, "[MSG:line %u: out of memory]", g->lineno);
+        cs_grbl_say(g, "error:%d", ERR_UNSUPPORTED);
     }
-    if (!inside_travel(g, &g->pending, n0)) {
-        g->pending.n = n0;
-        g->gc = before;
-        say(g, "[MSG:line %u: the move leaves the machine's travel]", g->lineno);
-        say(g, "error:%d", ERR_TARGET);
+    cs_path_free(&lp);
+    if (!ok)
         return;
-    }
-    if (g->check_mode)
-        g->pending.n = n0; /* $C: read and checked, never run */
     if (end) {
-        flush_chunk(g);
-        cs_grbl_gc_reset_modal(&g->gc);
+        cs_grbl_flush(g); /* the reader is back in its start modes (M2 / M30) */
     } else if (g->pending.n >= CS_GRBL_CHUNK_ELEMS) {
-        flush_chunk(g);
+        cs_grbl_flush(g);
     }
-    say(g, "ok");
+    cs_grbl_say(g, "ok");
 }
 
 /* ---- jogging ($J=) ---- */
 
 /* Checks a jog line's words (Grbl: G20 G21 G90 G91 G53, X Y Z, F; F required). */
-static int jog_words(const char *s, bool *g53)
+static int jog_words(const char *s)
 {
     bool f = false, axis = false;
-    *g53 = false;
     while (*s) {
         char c = (char)(*s >= 'a' && *s <= 'z' ? *s - 32 : *s);
         if (c == ' ') {
@@ -324,15 +370,12 @@ static int jog_words(const char *s, bool *g53)
             return c >= 'A' && c <= 'Z' ? ERR_NUMBER : ERR_LETTER;
         s = e;
         long gx = lround(v * 10);
-        if (c == 'G' && (gx == 200 || gx == 210 || gx == 900 || gx == 910 || gx == 530)) {
-            *g53 = *g53 || gx == 530;
-        } else if (c == 'X' || c == 'Y' || c == 'Z') {
-            axis = true;
-        } else if (c == 'F') {
-            f = true;
-        } else {
+        bool mode = c == 'G' && (gx == GC_G20 || gx == GC_G21 || gx == GC_G90 || gx == GC_G91 ||
+                                 gx == GC_G53);
+        axis = axis || c == 'X' || c == 'Y' || c == 'Z';
+        f = f || c == 'F';
+        if (!mode && c != 'X' && c != 'Y' && c != 'Z' && c != 'F')
             return ERR_JOG;
-        }
     }
     return !f ? ERR_NO_FEED : !axis ? ERR_NO_AXIS : 0;
 }
@@ -342,51 +385,61 @@ static void jog_line(grbl_t *g, const char *words)
     cs_grbl_dev_snap_t s;
     cs_grbl_dev_snap(&g->dev, &s);
     if (g->alarm || s.failed) {
-        say(g, "error:%d", ERR_LOCKED);
+        cs_grbl_say(g, "error:%d", ERR_LOCKED);
         return;
     }
     if (g->pending.n > 0 || (s.busy && !s.busy_jog) || (s.queued > 0 && !g->last_push_jog)) {
-        say(g, "error:%d", ERR_NOT_IDLE);
+        cs_grbl_say(g, "error:%d", ERR_NOT_IDLE);
         return;
     }
-    bool g53;
-    int bad = jog_words(words, &g53);
+    int bad = jog_words(words);
     if (bad) {
-        say(g, "error:%d", bad);
+        cs_grbl_say(g, "error:%d", bad);
         return;
     }
-    /* a jog leaves the parser's modes alone: it is read with a copy of them */
-    cs_grbl_gc_t j = g->gc;
-    j.block = NULL;
-    if (g53)
-        memset(j.off, 0, sizeof j.off);
+    /* a jog leaves the parser's modes alone: read, then taken back (its end position kept);
+     * G53 is the reader's own (machine coordinates for the line) */
     char line[CS_GRBL_GC_LINE_MAX + 8];
     snprintf(line, sizeof line, "G1 %s", words);
-    if (g53) { /* G53: machine coordinates (cs_gcode has no G53: offsets cleared above) */
-        char *p = strstr(line, "G53");
-        p = p ? p : strstr(line, "g53");
-        if (p)
-            memcpy(p, "   ", 3);
-    }
     cs_path_t path;
     cs_path_init(&path);
     cs_path_diag_t d;
     bool end;
-    cs_err_t e = cs_grbl_gc_line(&j, line, g->lineno, &path, &d, &end);
+    cs_err_t e = cs_grbl_gc_line(&g->gc, line, g->lineno, &path, &d, &end);
+    double jog_end[3];
+    memcpy(jog_end, g->gc.pos, sizeof jog_end);
+    if (e == CS_OK)
+        cs_grbl_gc_undo(&g->gc);
     if (e != CS_OK || !inside_travel(g, &path, 0)) {
         cs_path_free(&path);
-        say(g, "error:%d", e != CS_OK ? ERR_JOG : ERR_JOG_TRAVEL);
+        cs_grbl_say(g, "error:%d", e != CS_OK ? ERR_JOG : ERR_JOG_TRAVEL);
+        return;
+    }
+    /* the device plans the jog itself (JOG: a straight move at F with its acceleration,
+     * docs/protocol.md); 0x85 then stops it decelerating, like any item (HOLD, ABORT) */
+    double feed_mm_s = path.n > 0 ? path.elems[path.n - 1].feed_mm_s : 0;
+    size_t moves = path.n;
+    cs_path_free(&path);
+    if (moves == 0) { /* a jog to where the machine is: nothing to do */
+        cs_grbl_say(g, "ok");
         return;
     }
     cs_grbl_item_t it = {.jog = true};
-    if (plan_chunk(g, &path, &it, &d) != CS_OK) {
-        say(g, "error:%d", ERR_JOG_TRAVEL);
+    cs_proto_msg_t m = {.type = CS_PROTO_JOG};
+    m.u.jog.feed = cs_motion_speed(feed_mm_s);
+    cs_stream_job_init(&it.job, CS_STREAM_SEGMENTS);
+    if (cs_conv_mm_to_vec(jog_end[0], jog_end[1], jog_end[2], &m.u.jog.target) != CS_OK ||
+        cs_stream_job_add_msg(&it.job, &m) != CS_OK || !cs_grbl_dev_push(&g->dev, &it)) {
+        cs_stream_job_free(&it.job);
+        cs_grbl_say(g, "error:%d", ERR_JOG_TRAVEL);
         return;
     }
-    cs_grbl_dev_push(&g->dev, &it);
     g->last_push_jog = true;
-    memcpy(g->gc.pos, j.pos, sizeof g->gc.pos);
-    say(g, "ok");
+    g->plan_pos[0] = m.u.jog.target.x; /* the next chunk starts where the jog ends */
+    g->plan_pos[1] = m.u.jog.target.y;
+    g->plan_pos[2] = m.u.jog.target.z;
+    cs_grbl_gc_set_pos(&g->gc, jog_end);
+    cs_grbl_say(g, "ok");
 }
 
 /* ---- status report ('?') ---- */
@@ -397,6 +450,8 @@ static const char *state_name(const grbl_t *g, const cs_grbl_dev_snap_t *s)
         return "Alarm";
     if (g->check_mode)
         return "Check";
+    if (g->homing)
+        return "Home";
     if (g->held)
         return s->busy && s->dev_state != CS_PROTO_STATE_HELD ? "Hold:1" : "Hold:0";
     if (s->busy_jog)
@@ -412,7 +467,7 @@ static void status_report(grbl_t *g)
     cs_grbl_dev_snap(&g->dev, &s);
     double mpos[3] = {0, 0, 0};
     for (int a = 0; a < 3 && a < g->m.n_axes; a++)
-        mpos[a] = s.have_pos ? steps_mm(g, a, s.pos[a]) : 0;
+        mpos[a] = s.have_pos ? cs_grbl_steps_mm(g, a, s.pos[a]) : 0;
     bool wpos = (g->report_mask & 1) == 0;
     char buf[320];
     int n = snprintf(buf, sizeof buf, "<%s|%s:%.3f,%.3f,%.3f", state_name(g, &s),
@@ -421,17 +476,25 @@ static void status_report(grbl_t *g)
     if (g->report_mask & 2)
         n += snprintf(buf + n, sizeof buf - (size_t)n, "|Bf:%zu,%zu", CS_GRBL_DEV_QUEUE - s.queued,
                       CS_GRBL_RX_SIZE - g->rxn);
-    n += snprintf(buf + n, sizeof buf - (size_t)n, "|FS:%.0f,0",
-                  s.busy && !g->held ? s.speed_mm_min : 0.0);
+    n += snprintf(buf + n, sizeof buf - (size_t)n, "|FS:%.0f,%.0f",
+                  s.busy && !g->held ? s.speed_mm_min : 0.0,
+                  g->sp_code == GC_M5 ? 0.0 : g->sp_s * g->ov.spindle / 100.0);
+    char pins[24];
+    cs_grbl_pins(g, &s, pins, sizeof pins);
+    n += snprintf(buf + n, sizeof buf - (size_t)n, "%s", pins);
     /* Grbl sends WCO every 10 to 30 reports and when it changes, Ov now and then */
     bool wco = g->reports % 10 == 0 || memcmp(g->wco_sent, g->gc.off, sizeof g->wco_sent) != 0;
     if (wco) {
-        n += snprintf(buf + n, sizeof buf - (size_t)n, "|WCO:%.3f,%.3f,%.3f|Ov:100,100,100",
-                      g->gc.off[0], g->gc.off[1], g->gc.off[2]);
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|WCO:%.3f,%.3f,%.3f", g->gc.off[0],
+                      g->gc.off[1], g->gc.off[2]);
         memcpy(g->wco_sent, g->gc.off, sizeof g->wco_sent);
     }
+    if (wco || g->ov_changed)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, "|Ov:%d,%d,%d", g->ov.feed, g->ov.rapid,
+                      g->ov.spindle);
+    g->ov_changed = false;
     g->reports++;
-    say(g, "%s>", buf);
+    cs_grbl_say(g, "%s>", buf);
 }
 
 /* ---- $ commands ---- */
@@ -447,65 +510,87 @@ static void dollar_settings(grbl_t *g)
     int dirmask = 0;
     for (int a = 0; a < 3 && a < m->n_axes; a++)
         dirmask |= m->axis[a].invert_dir ? 1 << a : 0;
-    say(g, "$0=%.0f", m->axis[0].pulse_ticks * 1e6 / m->tick_hz);
-    say(g, "$1=25");
-    say(g, "$2=0");
-    say(g, "$3=%d", dirmask);
-    say(g, "$4=0");
-    say(g, "$5=0");
-    say(g, "$6=0");
-    say(g, "$10=%d", g->report_mask);
-    say(g, "$11=%.3f", cs_conv_pos_to_mm(m->junction_deviation));
-    say(g, "$12=%.3f", cs_conv_pos_to_mm(g->tol));
-    say(g, "$13=0");
-    say(g, "$20=1"); /* the planner always refuses moves outside the travel */
-    say(g, "$21=0");
-    say(g, "$22=0");
-    say(g, "$23=0");
-    say(g, "$24=25.000");
-    say(g, "$25=500.000");
-    say(g, "$26=250");
-    say(g, "$27=1.000");
-    say(g, "$30=1000");
-    say(g, "$31=0");
-    say(g, "$32=0");
+    cs_grbl_say(g, "$0=%.0f", m->axis[0].pulse_ticks * 1e6 / m->tick_hz);
+    cs_grbl_say(g, "$1=25");
+    cs_grbl_say(g, "$2=0");
+    cs_grbl_say(g, "$3=%d", dirmask);
+    cs_grbl_say(g, "$4=0");
+    cs_grbl_say(g, "$5=0");
+    cs_grbl_say(g, "$6=0");
+    cs_grbl_say(g, "$10=%d", g->report_mask);
+    cs_grbl_say(g, "$11=%.3f", cs_conv_pos_to_mm(m->junction_deviation));
+    cs_grbl_say(g, "$12=%.3f", cs_conv_pos_to_mm(g->tol));
+    cs_grbl_say(g, "$13=0");
+    cs_grbl_say(g, "$20=1"); /* the planner always refuses moves outside the travel */
+    const cs_ctlcfg_t *c = &g->ctl; /* [homing], [spindle] */
+    int homedir = 0; /* Grbl $23: a set bit homes that axis towards its minimum */
     for (int a = 0; a < 3; a++)
-        say(g, "$%d=%.3f", 100 + a, m->axis[a].steps_per_mm / 65536.0);
+        homedir |= c->at_max[a] ? 0 : 1 << a;
+    cs_grbl_say(g, "$21=1"); /* the device stops on any limit switch that trips (ALARM:1) */
+    cs_grbl_say(g, "$22=%d", c->n_order > 0);
+    cs_grbl_say(g, "$23=%d", homedir);
+    cs_grbl_say(g, "$24=%.3f", c->latch * 60.0);
+    cs_grbl_say(g, "$25=%.3f", c->seek * 60.0);
+    cs_grbl_say(g, "$26=0");
+    cs_grbl_say(g, "$27=%.3f", c->pulloff);
+    cs_grbl_say(g, "$30=%.0f", c->s_max);
+    cs_grbl_say(g, "$31=0");
+    cs_grbl_say(g, "$32=%d", c->laser);
     for (int a = 0; a < 3; a++)
-        say(g, "$%d=%.3f", 110 + a, mm_min(m->axis[a].max_rate));
+        cs_grbl_say(g, "$%d=%.3f", 100 + a, m->axis[a].steps_per_mm / 65536.0);
     for (int a = 0; a < 3; a++)
-        say(g, "$%d=%.3f", 120 + a, m->axis[a].max_accel / 65536.0);
+        cs_grbl_say(g, "$%d=%.3f", 110 + a, mm_min(m->axis[a].max_rate));
     for (int a = 0; a < 3; a++)
-        say(g, "$%d=%.3f", 130 + a,
+        cs_grbl_say(g, "$%d=%.3f", 120 + a, m->axis[a].max_accel / 65536.0);
+    for (int a = 0; a < 3; a++)
+        cs_grbl_say(g, "$%d=%.3f", 130 + a,
             cs_conv_pos_to_mm(m->axis[a].travel_max) - cs_conv_pos_to_mm(m->axis[a].travel_min));
-    say(g, "ok");
+    cs_grbl_say(g, "ok");
 }
 
+/* "[NAME:x,y,z]" from parameters #first.. (mm). */
+static void say_param3(grbl_t *g, const char *name, int first)
+{
+    cs_grbl_say(g, "[%s:%.3f,%.3f,%.3f]", name, cs_grbl_gc_param(&g->gc, first),
+        cs_grbl_gc_param(&g->gc, first + 1), cs_grbl_gc_param(&g->gc, first + 2));
+}
+
+/* $#: the reader's parameters, where LinuxCNC keeps them (G54 #5221.., 20 apart; G28 #5161..;
+ * G30 #5181..; G92 #5211.. when #5210 says they apply); PRB in machine coordinates. */
 static void dollar_params(grbl_t *g)
 {
-    for (int k = 54; k <= 59; k++)
-        say(g, "[G%d:0.000,0.000,0.000]", k);
-    say(g, "[G28:0.000,0.000,0.000]");
-    say(g, "[G30:0.000,0.000,0.000]");
-    say(g, "[G92:%.3f,%.3f,%.3f]", g->gc.off[0], g->gc.off[1], g->gc.off[2]);
-    say(g, "[TLO:0.000]");
-    say(g, "[PRB:0.000,0.000,0.000:0]");
-    say(g, "ok");
+    for (int k = 0; k < 6; k++) {
+        char name[16];
+        snprintf(name, sizeof name, "G%d", 54 + k);
+        say_param3(g, name, 5221 + 20 * k);
+    }
+    say_param3(g, "G28", 5161);
+    say_param3(g, "G30", 5181);
+    if (cs_grbl_gc_param(&g->gc, 5210) != 0)
+        say_param3(g, "G92", 5211);
+    else
+        cs_grbl_say(g, "[G92:0.000,0.000,0.000]");
+    cs_grbl_say(g, "[TLO:0.000]");
+    cs_grbl_say(g, "[PRB:%.3f,%.3f,%.3f:%d]", g->prb[0], g->prb[1], g->prb[2], g->prb_ok ? 1 : 0);
+    cs_grbl_say(g, "ok");
 }
 
 static void dollar_modes(grbl_t *g)
 {
     const cs_grbl_gc_t *c = &g->gc;
-    char motion[24];
+    char motion[24], wcs[16];
     if (c->motion < 0)
         snprintf(motion, sizeof motion, "G80");
-    else if (c->motion % 10)
-        snprintf(motion, sizeof motion, "G%d.%d", c->motion / 10, c->motion % 10);
     else
-        snprintf(motion, sizeof motion, "G%d", c->motion / 10);
-    say(g, "[GC:%s G54 G%d %s %s G94 M5 M9 T0 F%g S0]", motion, c->plane, c->inch ? "G20" : "G21",
-        c->incr ? "G91" : "G90", c->feed);
-    say(g, "ok");
+        cs_gcode_code_name(motion, sizeof motion, 'G', c->motion);
+    static const int systems[] = {GC_G54, GC_G55,   GC_G56,   GC_G57,  GC_G58,
+                                  GC_G59, GC_G59_1, GC_G59_2, GC_G59_3};
+    cs_gcode_code_name(wcs, sizeof wcs, 'G', systems[c->wcs >= 1 && c->wcs <= 9 ? c->wcs - 1 : 0]);
+    char spindle[8];
+    cs_gcode_code_name(spindle, sizeof spindle, 'M', c->spindle);
+    cs_grbl_say(g, "[GC:%s %s G%d %s %s G94 %s M9 T0 F%g S%g]", motion, wcs, c->plane,
+        c->inch ? "G20" : "G21", c->incr ? "G91" : "G90", spindle, c->feed, c->speed);
+    cs_grbl_say(g, "ok");
 }
 
 /* $N=value: $10 (status report mask) is ours, in memory; the machine's settings are not. */
@@ -514,38 +599,38 @@ static void dollar_set(grbl_t *g, const char *s)
     char *e;
     long n = strtol(s, &e, 10);
     if (e == s || *e != '=') {
-        say(g, "error:%d", ERR_DOLLAR);
+        cs_grbl_say(g, "error:%d", ERR_DOLLAR);
         return;
     }
     char *e2;
     double v = strtod(e + 1, &e2);
     if (e2 == e + 1 || *e2 != '\0') {
-        say(g, "error:%d", ERR_NUMBER);
+        cs_grbl_say(g, "error:%d", ERR_NUMBER);
         return;
     }
     if (n == 10 && v >= 0 && v <= 3 && v == floor(v)) {
         g->report_mask = (int)v;
-        say(g, "ok");
+        cs_grbl_say(g, "ok");
         return;
     }
-    say(g, "[MSG:$%ld is read-only here: the machine file (%s) owns the machine's settings; edit "
+    cs_grbl_say(g, "[MSG:$%ld is read-only here: the machine file (%s) owns the machine's settings; edit "
            "it and restart curvestep grbl]",
         n, g->cfg->job.machine_file ? g->cfg->job.machine_file : "built-in machine");
-    say(g, "error:%d", ERR_DOLLAR);
+    cs_grbl_say(g, "error:%d", ERR_DOLLAR);
 }
 
 static void dollar_check(grbl_t *g)
 {
     g->check_mode = !g->check_mode;
-    say(g, "[MSG:%s]", g->check_mode ? "Enabled" : "Disabled");
+    cs_grbl_say(g, "[MSG:%s]", g->check_mode ? "Enabled" : "Disabled");
     if (!g->check_mode) { /* Grbl soft-resets when check mode ends */
-        cs_grbl_gc_init(&g->gc);
-        sync_from_device(g);
-        say(g, "ok");
-        say(g, "%s", GRBL_WELCOME);
+        cs_grbl_gc_reset_modal(&g->gc, true);
+        cs_grbl_sync(g);
+        cs_grbl_say(g, "ok");
+        cs_grbl_say(g, "%s", GRBL_WELCOME);
         return;
     }
-    say(g, "ok");
+    cs_grbl_say(g, "ok");
 }
 
 static void dollar(grbl_t *g, const char *s)
@@ -553,8 +638,8 @@ static void dollar(grbl_t *g, const char *s)
     cs_grbl_dev_snap_t st;
     cs_grbl_dev_snap(&g->dev, &st);
     if (strcmp(s, "$") == 0) {
-        say(g, "[HLP:$$ $# $G $I $N $x=val $J=line $C $X $H ~ ! ? ctrl-x]");
-        say(g, "ok");
+        cs_grbl_say(g, "[HLP:$$ $# $G $I $N $x=val $J=line $C $X $H ~ ! ? ctrl-x]");
+        cs_grbl_say(g, "ok");
     } else if (strcmp(s, "$$") == 0) {
         dollar_settings(g);
     } else if (strcmp(s, "$#") == 0) {
@@ -562,35 +647,34 @@ static void dollar(grbl_t *g, const char *s)
     } else if (strcmp(s, "$G") == 0) {
         dollar_modes(g);
     } else if (strcmp(s, "$I") == 0) {
-        say(g, "[VER:1.1h.20190825:curvestep %s]", CS_VERSION);
-        say(g, "[OPT:,%d,%d]", CS_GRBL_DEV_QUEUE, CS_GRBL_RX_SIZE);
-        say(g, "ok");
+        cs_grbl_say(g, "[VER:1.1h.20190825:curvestep %s]", CS_VERSION);
+        cs_grbl_say(g, "[OPT:,%d,%d]", CS_GRBL_DEV_QUEUE, CS_GRBL_RX_SIZE);
+        cs_grbl_say(g, "ok");
     } else if (strcmp(s, "$N") == 0) {
-        say(g, "$N0=");
-        say(g, "$N1=");
-        say(g, "ok");
+        cs_grbl_say(g, "$N0=");
+        cs_grbl_say(g, "$N1=");
+        cs_grbl_say(g, "ok");
     } else if (strcmp(s, "$X") == 0) {
-        if (g->alarm || st.failed)
-            say(g, "[MSG:Caution: Unlocked]");
-        g->alarm = false;
-        cs_grbl_dev_clear(&g->dev);
-        sync_from_device(g);
-        say(g, "ok");
+        cs_grbl_unlock(g);
     } else if (strcmp(s, "$C") == 0) {
         dollar_check(g);
     } else if (strcmp(s, "$H") == 0) {
-        say(g, "[MSG:no homing yet: curvestep has no limit switch inputs (docs/controller.md)]");
-        say(g, "error:%d", ERR_HOMING);
+        if (g->pending.n > 0 || !cs_grbl_dev_idle(&g->dev))
+            cs_grbl_say(g, "error:%d", ERR_NOT_IDLE);
+        else
+            cs_grbl_home(g);
     } else if (strncmp(s, "$J=", 3) == 0) {
         jog_line(g, s + 3);
     } else if (s[1] >= '0' && s[1] <= '9') {
         dollar_set(g, s + 1);
     } else {
-        say(g, "error:%d", ERR_DOLLAR);
+        cs_grbl_say(g, "error:%d", ERR_DOLLAR);
     }
 }
 
 /* ---- input ---- */
+
+static void soft_reset(grbl_t *g);
 
 /* One complete line from the receive buffer (no newline). Grbl drops spaces and upper-cases
  * outside comments; cs_gcode takes either, so the line goes as it came. */
@@ -604,13 +688,17 @@ static void do_line(grbl_t *g, char *line)
     g->lineno++;
     g->t_last_line = cs_serial_now_s();
     if (*line == '\0') {
-        say(g, "ok");
+        cs_grbl_say(g, "ok");
     } else if (*line == '$') {
         for (char *p = line; *p && *p != '='; p++) /* "$j=" as "$J=", "$x" as "$X" */
             *p = (char)(*p >= 'a' && *p <= 'z' ? *p - 32 : *p);
         dollar(g, line);
     } else {
         gcode_line(g, line);
+    }
+    if (g->reset_pending) {
+        g->reset_pending = false;
+        soft_reset(g);
     }
 }
 
@@ -621,15 +709,16 @@ static void soft_reset(grbl_t *g)
     g->rx_overflow = false;
     g->held = false;
     g->check_mode = false;
-    cs_grbl_gc_reset_modal(&g->gc);
-    memset(g->gc.off, 0, sizeof g->gc.off);
-    say(g, "%s", "");
-    say(g, "%s", GRBL_WELCOME);
+    cs_grbl_gc_reset_modal(&g->gc, true);
+    cs_grbl_ov_init(&g->ov); /* Grbl's reset puts the overrides back at 100 % */
+    g->ov_changed = true;
+    cs_grbl_say(g, "%s", "");
+    cs_grbl_say(g, "%s", GRBL_WELCOME);
 }
 
 /* A real-time byte (grbl wiki "Interface": picked out of the stream wherever it comes). True
- * when b was one. Overrides 0x90..0x9D, safety door 0x84 and the toggles 0x9E..0xA1 are
- * accepted and ignored: curvestep has no overrides yet (docs/controller.md). */
+ * when b was one. The overrides 0x90..0x9D change what is planned next (cs_grbl_ov); safety
+ * door 0x84 and the toggles 0x9E..0xA1 are accepted and ignored (docs/controller.md). */
 static bool realtime(grbl_t *g, unsigned char b)
 {
     cs_grbl_dev_snap_t s;
@@ -651,15 +740,24 @@ static bool realtime(grbl_t *g, unsigned char b)
         }
         return true;
     case 0x18:
-        soft_reset(g);
+        if (g->in_reader) { /* the reader is mid-line (a probe): reset once it is out */
+            g->reset_pending = true;
+            cs_grbl_dev_cancel(&g->dev, false);
+        } else {
+            soft_reset(g);
+        }
         return true;
     case 0x85: /* jog cancel: hold, then flush the jogs (nothing when not jogging) */
         if (cs_grbl_dev_cancel(&g->dev, true)) {
             g->held = false;
-            sync_from_device(g);
+            cs_grbl_sync(g);
         }
         return true;
     default:
+        if (cs_grbl_ov_byte(&g->ov, b)) {
+            g->ov_changed = true;
+            return true;
+        }
         return b >= 0x80;
     }
 }
@@ -674,7 +772,7 @@ static void take_bytes(grbl_t *g, const unsigned char *b, size_t n)
             if (b[k] == '\n') {
                 g->rx_overflow = false;
                 g->lineno++;
-                say(g, "error:%d", ERR_OVERFLOW);
+                cs_grbl_say(g, "error:%d", ERR_OVERFLOW);
             }
             continue;
         }
@@ -718,9 +816,13 @@ static void take_lines(grbl_t *g)
 static void watch_device(grbl_t *g)
 {
     cs_grbl_dev_snap_t s;
+    bool was = g->alarm;
+    cs_grbl_watch_alarm(g); /* a device alarm: ALARM:N */
     cs_grbl_dev_snap(&g->dev, &s);
-    if (s.failed && !g->alarm) {
-        say(g, "[MSG:device: %s]", s.why);
+    if (g->alarm && !was) {
+        drop_all(g);
+    } else if (s.failed && !g->alarm) {
+        cs_grbl_say(g, "[MSG:device: %s]", s.why);
         g->alarm = true;
         drop_all(g);
     }
@@ -780,8 +882,8 @@ static void accept_client(grbl_t *g, int lfd)
         return;
     g->fd = c;
     g->rxn = 0;
-    say(g, "%s", "");
-    say(g, "%s", GRBL_WELCOME);
+    cs_grbl_say(g, "%s", "");
+    cs_grbl_say(g, "%s", GRBL_WELCOME);
 }
 
 /* The loop: client bytes, lines while there is room, chunks when the sender pauses. */
@@ -805,7 +907,7 @@ static void serve_loop(grbl_t *g, int lfd)
         take_lines(g);
         if (g->pending.n > 0 && cs_serial_now_s() - g->t_last_line > CS_GRBL_CHUNK_IDLE_MS / 1e3 &&
             cs_grbl_dev_room(&g->dev, 1))
-            flush_chunk(g);
+            cs_grbl_flush(g);
         watch_device(g);
     }
 }
@@ -838,7 +940,7 @@ static int open_front(grbl_t *g, int *lfd, int *slave)
                     strerror(errno));
             return CS_EXIT_INTERNAL;
         }
-        say(g, "%s", GRBL_WELCOME);
+        cs_grbl_say(g, "%s", GRBL_WELCOME);
     }
     printf("%s\n", shown);
     fflush(stdout);
@@ -852,6 +954,27 @@ static int start(grbl_t *g)
     if (rc != CS_EXIT_OK)
         return rc;
     g->feed = cs_motion_speed(g->cfg->job.feed_mm_s);
+    char err[512];
+    if (cs_ctlcfg_load(g->cfg->job.machine_file, &g->m, &g->ctl, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return CS_EXIT_INPUT;
+    }
+    cs_gcode_opts_t o;
+    cs_gcode_opts_init(&o);
+    o.probe = cs_grbl_probe; /* G38.x on the device (PROBE) */
+    o.probe_ctx = g;
+    o.spindle = cs_grbl_spindle; /* M3/M4/M5 S on the device (SPINDLE) */
+    o.spindle_ctx = g;
+    if (cs_grbl_gc_init(&g->gc, &o) != CS_OK) {
+        fprintf(stderr, "curvestep grbl: out of memory\n");
+        return CS_EXIT_INTERNAL;
+    }
+    cs_path_diag_t d;
+    if (g->cfg->state != NULL && cs_grbl_gc_load(&g->gc, g->cfg->state, &d) != CS_OK) {
+        fprintf(stderr, "%s:%u:%u: %s (curvestep grbl --state)\n", d.loc.file, d.loc.line,
+                d.loc.col, d.reason);
+        return CS_EXIT_INPUT;
+    }
     if (cs_serial_open(&g->ser, g->cfg->port, g->cfg->baud) != 0) {
         fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", g->cfg->port, strerror(errno));
         return CS_EXIT_NO_DEVICE;
@@ -881,10 +1004,12 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     g->cfg = cfg;
     g->fd = -1;
     g->report_mask = 1; /* Grbl's default $10=1: MPos */
-    cs_grbl_gc_init(&g->gc);
+    cs_grbl_ov_init(&g->ov);
+    g->sp_code = GC_M5;
     cs_path_init(&g->pending);
     int rc = start(g);
     if (rc != CS_EXIT_OK) {
+        cs_grbl_gc_free(&g->gc);
         free(g);
         return rc;
     }
@@ -903,6 +1028,8 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     }
     cs_grbl_dev_stop(&g->dev);
     cs_serial_close(&g->ser);
+    if (rc == CS_EXIT_OK && cfg->state != NULL && cs_grbl_gc_save(&g->gc, cfg->state) != CS_OK)
+        fprintf(stderr, "curvestep grbl: cannot write %s: %s\n", cfg->state, strerror(errno));
     if (cfg->link != NULL && cfg->listen == NULL)
         unlink(cfg->link);
     if (g->fd >= 0)

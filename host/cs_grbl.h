@@ -25,6 +25,7 @@ typedef struct {
     cs_jobplan_opts_t job; /* --machine, --tol, --feed */
     const char *listen;    /* --listen [ADDR:]PORT; NULL: a pseudo-terminal */
     const char *link;      /* --link PATH: a symlink to the pty; NULL: none */
+    const char *state;     /* --state FILE: work offsets kept across runs; NULL: none */
 } cs_grbl_cfg_t;
 
 /* --listen's value: [ADDR:]PORT, ADDR an IPv4 address (default 127.0.0.1), PORT 0..65535. False

@@ -11,6 +11,7 @@ static void usage(FILE *f)
 {
     fputs("usage: curvestep grbl --port DEV [--baud N] [--machine FILE.ini] [--tol MM]\n"
           "                      [--feed MM/S] [--pty [--link PATH] | --listen [ADDR:]PORT]\n"
+          "                      [--state FILE]\n"
           "Speaks Grbl 1.1's serial protocol to a G-code sender (Universal G-code Sender,\n"
           "cncjs, bCNC, a streaming script) and drives the curvestep device on DEV (a serial\n"
           "line, or the pty printed by `curvestep-sim --pty`) with its wire protocol.\n"
@@ -24,15 +25,23 @@ static void usage(FILE *f)
           "  --port DEV         the device's serial line; --baud N its speed (default 115200)\n"
           "  --machine FILE     machine description (default: the built-in plotter); $$ shows\n"
           "                     it as Grbl settings, read-only ($10 alone can be set)\n"
+          "  --state FILE       keep the work offsets (G54..G59.3, set by G10) and the G28/G30\n"
+          "                     homes in FILE: read at start, written on exit (as G-code)\n"
           "  --tol MM           chord tolerance (default: the machine's); --feed MM/S the feed\n"
           "                     where the program gives no F (default: the machine's)\n"
           "Each line is answered ok when it is read into the queue (error:N, with a [MSG:...]\n"
           "saying why, when it is refused: the stream goes on). Lines are planned in chunks:\n"
           "a chunk ends when the sender pauses 30 ms, after 400 moves, at a G4 dwell or at\n"
           "M2/M30, and each chunk ends at rest (no look-ahead across chunks).\n"
-          "Real-time bytes: ? status, ! feed hold, ~ resume, Ctrl-X reset, 0x85 jog cancel;\n"
-          "the override bytes 0x90-0x9D are accepted and ignored. $$ $# $G $I $N $C $X $J=\n"
-          "work; $H answers error:5 (no homing switches yet). See docs/controller.md.\n"
+          "Lines are LinuxCNC G-code read a line at a time: parameters, work offsets (G10,\n"
+          "G54-G59.3, G92, G28/G30, G53) and O-word subroutines carry from line to line.\n"
+          "Real-time bytes: ? status, ! feed hold, ~ resume, Ctrl-X reset, 0x85 jog cancel,\n"
+          "0x90-0x9D feed/rapid/spindle overrides (on moves not yet planned; Ov: in the\n"
+          "status). $$ $# $G $I $N $C $X $J= $H work. On the device: $H homes the axes of\n"
+          "the machine file's [homing], $X unlocks, G38.2-G38.5 probe ([PRB:] reported),\n"
+          "M3/M4/M5 S drive the spindle ([spindle] laser = true: Grbl's laser mode); its\n"
+          "alarms come as ALARM:N, its switches as Pn: in the status.\n"
+          "See docs/controller.md.\n"
           "SIGINT or SIGTERM: the running chunk is held, aborted, and the command ends.\n"
           "Exit status: 0 stopped by a signal, 1 bad machine file, 2 bad command line,\n"
           "3 internal error (pty, socket), 4 the port cannot be opened.\n",
@@ -72,6 +81,8 @@ int cs_cmd_grbl(int argc, char **argv)
             c.listen = argv[++i];
         } else if (strcmp(a, "--link") == 0 && has) {
             c.link = argv[++i];
+        } else if (strcmp(a, "--state") == 0 && has) {
+            c.state = argv[++i];
         } else {
             fprintf(stderr, "curvestep grbl: unknown or incomplete option '%s'\n", a);
             usage(stderr);

@@ -50,6 +50,25 @@ static ssize_t progress_write(void *cookie, const char *buf, size_t len)
     return (ssize_t)len;
 }
 
+/* cs_stream's on_event (worker thread): what the device said about alarms, probes, inputs. */
+static void on_event(void *ctx, const cs_proto_event_t *ev)
+{
+    cs_grbl_dev_t *d = ctx;
+    pthread_mutex_lock(&d->mu);
+    d->s.have_inputs = true;
+    d->s.inputs = ev->inputs;
+    if (ev->kind == CS_PROTO_EVENT_ALARM) {
+        d->s.alarms++;
+        d->s.alarm_code = ev->code;
+    } else if (ev->kind == CS_PROTO_EVENT_PROBE) {
+        d->s.probes++;
+        d->s.probe_contact = ev->code != 0;
+        for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
+            d->s.probe_pos[i] = i < ev->axes ? ev->pos[i] : 0;
+    }
+    pthread_mutex_unlock(&d->mu);
+}
+
 static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
 {
     cs_stream_opts_t o;
@@ -58,6 +77,9 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     o.interrupt = &d->run_interrupt;
     o.pause = &d->run_pause;
     o.quiet_hello = true;
+    o.on_event = on_event;
+    o.jog_cancel = it->jog; /* Grbl's 0x85 on the device's JOG: JOG_CANCEL */
+    o.event_ctx = d;
     cookie_io_functions_t io = {.write = progress_write};
     o.progress = fopencookie(d, "w", io);
     o.progress_tty = true; /* ten updates a second */
@@ -210,6 +232,14 @@ void cs_grbl_dev_clear(cs_grbl_dev_t *d)
     d->s.why[0] = '\0';
     pthread_cond_broadcast(&d->cv);
     pthread_mutex_unlock(&d->mu);
+}
+
+bool cs_grbl_dev_idle(cs_grbl_dev_t *d)
+{
+    pthread_mutex_lock(&d->mu);
+    bool idle = d->n == 0 && !d->s.busy;
+    pthread_mutex_unlock(&d->mu);
+    return idle;
 }
 
 void cs_grbl_dev_snap(cs_grbl_dev_t *d, cs_grbl_dev_snap_t *s)

@@ -40,6 +40,14 @@ typedef struct {
     bool failed;                    /* a chunk ended other than done or cancelled */
     char why[200];                  /* ... why */
     unsigned cancelled;             /* runs ended by cancel (interrupt) so far */
+    /* from the device's EVENTs (docs/protocol.md, EVENT) */
+    bool have_inputs;
+    uint16_t inputs;                      /* CS_PROTO_IN_* bits of the last EVENT */
+    unsigned alarms;                      /* ALARM events so far */
+    uint8_t alarm_code;                   /* the last one's (Grbl's ALARM:N numbering) */
+    unsigned probes;                      /* PROBE events so far */
+    bool probe_contact;                   /* the last one touched */
+    int32_t probe_pos[CS_PROTO_AXES_MAX]; /* ... there (steps) */
 } cs_grbl_dev_snap_t;
 
 typedef struct {
@@ -80,6 +88,8 @@ bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on);
 /* Clears the failure (Grbl's $X). */
 void cs_grbl_dev_clear(cs_grbl_dev_t *d);
+/* True when nothing is queued or running. */
+bool cs_grbl_dev_idle(cs_grbl_dev_t *d);
 /* Copies the state. */
 void cs_grbl_dev_snap(cs_grbl_dev_t *d, cs_grbl_dev_snap_t *s);
 /* Cancels everything, ends the worker and frees the queue. */

@@ -1,6 +1,8 @@
 /* cs_machine_ini: INI machine file -> cs_machine_t, every value range-checked. */
 #include "cs_machine_ini.h"
 
+#include "cs_ctlcfg.h"
+
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -77,6 +79,20 @@ static bool parse_num(const char *v, double *out)
         return false;
     *out = d;
     return true;
+}
+
+bool cs_machine_ini_number(const char *v, double *out)
+{
+    return parse_num(v, out);
+}
+
+int cs_machine_ini_bool(const char *v)
+{
+    if (strcasecmp(v, "true") == 0 || strcmp(v, "1") == 0 || strcasecmp(v, "yes") == 0)
+        return 1;
+    if (strcasecmp(v, "false") == 0 || strcmp(v, "0") == 0 || strcasecmp(v, "no") == 0)
+        return 0;
+    return -1;
 }
 
 /* Positive Q15.16 value in (0, 32768). */
@@ -202,72 +218,60 @@ static int pen_key(ini_ctx_t *c, const char *section, const char *name, const ch
     return 1;
 }
 
-static int handler(void *user, const char *section, const char *name, const char *value)
+/* A key of [machine]. */
+static int machine_key(ini_ctx_t *c, const char *section, const char *name, const char *value)
 {
-    ini_ctx_t *c = user;
     cs_machine_t *m = c->m;
     double d;
-    if (strcasecmp(section, "pen") == 0)
-        return pen_key(c, section, name, value);
-    /* [gpio] (pins of the GPIO link) is read and checked by cs_gpio_cfg in a second pass over
-     * the file; the machine itself does not depend on it. */
-    if (strcasecmp(section, "gpio") == 0)
-        return 1;
-    if (strcasecmp(section, "machine") == 0) {
-        if (strcasecmp(name, "profile") == 0) {
-            if (strcasecmp(value, "trapezoid") == 0)
-                m->profile = CS_PROFILE_TRAPEZOID;
-            else if (strcasecmp(value, "scurve") == 0)
-                m->profile = CS_PROFILE_SCURVE;
-            else
-                return fail(c, "[%s] %s: expected trapezoid or scurve", section, name);
-            return 1;
-        }
-        if (!parse_num(value, &d))
-            return fail(c, "[%s] %s: not a number", section, name);
-        if (strcasecmp(name, "axes") == 0) {
-            if (d != 3 && d != 4)
-                return fail(c, "[%s] %s: must be 3 or 4", section, name);
-            m->n_axes = (uint8_t)d;
-            c->has_a = d == 4;
-        } else if (strcasecmp(name, "tick_hz") == 0) {
-            if (d < 1000 || d > 16e6 || d != floor(d))
-                return fail(c, "[%s] %s: must be an integer in 1000..16000000", section, name);
-            m->tick_hz = (uint32_t)d;
-        } else if (strcasecmp(name, "segment_ms") == 0) {
-            if (!(d > 0) || d > 1000)
-                return fail(c, "[%s] %s: must be in (0, 1000] ms", section, name);
-            c->segment_ms = d;
-        } else if (strcasecmp(name, "tolerance") == 0) {
-            if (cs_conv_tol_to_pos(d, &m->tolerance) != CS_OK)
-                return fail(c, "[%s] %s: must be in [1/65536, 4096] mm", section, name);
-        } else if (strcasecmp(name, "junction_deviation") == 0) {
-            if (!(d >= 0) || cs_conv_mm_to_pos(d, &m->junction_deviation) != CS_OK)
-                return fail(c, "[%s] %s: must be in [0, 4096] mm", section, name);
-        } else if (strcasecmp(name, "default_feed") == 0) {
-            if (!to_q16_pos(d, &m->default_feed))
-                return fail(c, "[%s] %s: must be in (0, 32768) mm/s", section, name);
-        } else if (strcasecmp(name, "max_jerk") == 0) {
-            if (!(d >= 1) || d > 2e9)
-                return fail(c, "[%s] %s: must be in [1, 2e9] mm/s^3", section, name);
-            m->max_jerk = (int32_t)d;
-        } else {
-            return fail(c, "[%s] %s: unknown key", section, name);
-        }
+    if (strcasecmp(name, "profile") == 0) {
+        if (strcasecmp(value, "trapezoid") == 0)
+            m->profile = CS_PROFILE_TRAPEZOID;
+        else if (strcasecmp(value, "scurve") == 0)
+            m->profile = CS_PROFILE_SCURVE;
+        else
+            return fail(c, "[%s] %s: expected trapezoid or scurve", section, name);
         return 1;
     }
-    int ax = -1;
-    for (int i = 0; i < CS_AXES; i++)
-        if (strcasecmp(section, axis_names[i]) == 0)
-            ax = i;
-    if (ax < 0)
-        return fail(c, "[%s]%s: unknown section (expected machine, x, y, z, a, pen or gpio)",
-                    section, "");
-    if (ax == CS_AXIS_A) {
-        c->has_a = true;
-        m->n_axes = 4;
+    if (!parse_num(value, &d))
+        return fail(c, "[%s] %s: not a number", section, name);
+    if (strcasecmp(name, "axes") == 0) {
+        if (d != 3 && d != 4)
+            return fail(c, "[%s] %s: must be 3 or 4", section, name);
+        m->n_axes = (uint8_t)d;
+        c->has_a = d == 4;
+    } else if (strcasecmp(name, "tick_hz") == 0) {
+        if (d < 1000 || d > 16e6 || d != floor(d))
+            return fail(c, "[%s] %s: must be an integer in 1000..16000000", section, name);
+        m->tick_hz = (uint32_t)d;
+    } else if (strcasecmp(name, "segment_ms") == 0) {
+        if (!(d > 0) || d > 1000)
+            return fail(c, "[%s] %s: must be in (0, 1000] ms", section, name);
+        c->segment_ms = d;
+    } else if (strcasecmp(name, "tolerance") == 0) {
+        if (cs_conv_tol_to_pos(d, &m->tolerance) != CS_OK)
+            return fail(c, "[%s] %s: must be in [1/65536, 4096] mm", section, name);
+    } else if (strcasecmp(name, "junction_deviation") == 0) {
+        if (!(d >= 0) || cs_conv_mm_to_pos(d, &m->junction_deviation) != CS_OK)
+            return fail(c, "[%s] %s: must be in [0, 4096] mm", section, name);
+    } else if (strcasecmp(name, "default_feed") == 0) {
+        if (!to_q16_pos(d, &m->default_feed))
+            return fail(c, "[%s] %s: must be in (0, 32768) mm/s", section, name);
+    } else if (strcasecmp(name, "max_jerk") == 0) {
+        if (!(d >= 1) || d > 2e9)
+            return fail(c, "[%s] %s: must be in [1, 2e9] mm/s^3", section, name);
+        m->max_jerk = (int32_t)d;
+    } else {
+        return fail(c, "[%s] %s: unknown key", section, name);
     }
-    cs_axis_cfg_t *a = &m->axis[ax];
+    return 1;
+}
+
+/* A key of axis section ax ([x], [y], [z], [a]). */
+static int axis_key(ini_ctx_t *c, int ax, const char *section, const char *name,
+                    const char *value)
+{
+    double d;
+    cs_axis_cfg_t *a = &c->m->axis[ax];
     if (strcasecmp(name, "invert_dir") == 0) {
         if (strcasecmp(value, "true") == 0 || strcmp(value, "1") == 0 ||
             strcasecmp(value, "yes") == 0)
@@ -304,6 +308,37 @@ static int handler(void *user, const char *section, const char *name, const char
         return fail(c, "[%s] %s: unknown key", section, name);
     }
     return 1;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    ini_ctx_t *c = user;
+    cs_machine_t *m = c->m;
+    if (strcasecmp(section, "pen") == 0)
+        return pen_key(c, section, name, value);
+    /* [gpio] (pins of the GPIO link) is read and checked by cs_gpio_cfg in a second pass over
+     * the file; the machine itself does not depend on it. */
+    if (strcasecmp(section, "gpio") == 0)
+        return 1;
+    /* [homing], [limits], [probe], [spindle]: machine control, read by cs_ctlcfg likewise */
+    if (cs_ctlcfg_section(section))
+        return 1;
+    if (strcasecmp(section, "machine") == 0)
+        return machine_key(c, section, name, value);
+    int ax = -1;
+    for (int i = 0; i < CS_AXES; i++)
+        if (strcasecmp(section, axis_names[i]) == 0)
+            ax = i;
+    if (ax < 0)
+        return fail(c,
+                    "[%s]%s: unknown section (expected machine, x, y, z, a, pen, gpio, homing, "
+                    "limits, probe or spindle)",
+                    section, "");
+    if (ax == CS_AXIS_A) {
+        c->has_a = true;
+        m->n_axes = 4;
+    }
+    return axis_key(c, ax, section, name, value);
 }
 
 static int finish(ini_ctx_t *c, int rc, const char *name, char *err, size_t errlen)

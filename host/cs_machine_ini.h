@@ -69,6 +69,10 @@ bool cs_machine_ini_find(char *out, size_t outlen);
  * Returns 0, or -1 with "file:line: reason" in err (as cs_machine_ini_load_pen). */
 int cs_machine_ini_open(const char *who, const char *given, cs_machine_t *m, cs_machine_pen_t *pen,
                         char *err, size_t errlen);
+/* A decimal number of the machine file (no hex, inf or nan; blanks after it allowed): true and
+ * *out. A boolean: 1 for true / 1 / yes, 0 for false / 0 / no, -1 otherwise. */
+bool cs_machine_ini_number(const char *v, double *out);
+int cs_machine_ini_bool(const char *v);
 /* mm/s (double) <-> the core's Q15.16 motion format. */
 double cs_machine_ini_to_double(int32_t q16);
 

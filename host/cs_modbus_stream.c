@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "cs_linktime.h"
 #include "cs_serial.h"
@@ -219,12 +220,24 @@ cs_mb_rc_t cs_mb_read_status(cs_mb_client_t *c, cs_mb_status_t *st)
     st->refused_seq = ir[CS_MODBUS_IR_REFUSED_SEQ];
     for (unsigned i = 0; i < CS_AXES; i++)
         st->pos[i] = s32(ir + CS_MODBUS_IR_POS + 2 * i);
+    st->lease = ir[CS_MODBUS_IR_LEASE];
+    st->lease_left_ms = ir[CS_MODBUS_IR_LEASE_LEFT];
     return CS_MB_OK;
 }
 
 cs_mb_rc_t cs_mb_write_mailbox(cs_mb_client_t *c, const uint16_t *regs, size_t n)
 {
-    return request(c, 1, CS_MODBUS_HR_MAILBOX, (int)n, regs, NULL);
+    if (c->token == 0 || n > CS_MODBUS_MAILBOX_REGS)
+        return request(c, 1, CS_MODBUS_HR_MAILBOX, (int)n, regs, NULL);
+    uint16_t with[1 + CS_MODBUS_MAILBOX_REGS]; /* the token just before the mailbox */
+    with[0] = c->token;
+    memcpy(with + 1, regs, n * sizeof *regs);
+    return request(c, 1, CS_MODBUS_HR_TOKEN, (int)n + 1, with, NULL);
+}
+
+cs_mb_rc_t cs_mb_lease(cs_mb_client_t *c, bool claim)
+{
+    return request(c, 2, claim ? CS_MODBUS_HR_LEASE : CS_MODBUS_HR_RELEASE, 1, &c->token, NULL);
 }
 
 cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd)
@@ -280,6 +293,7 @@ typedef struct {
     uint32_t resent, refused;
     bool held;         /* HOLD sent for o->pause, RESUME not yet */
     double t_progress; /* last write taken, message executed or axis moved (stall_ms) */
+    double t_lease;    /* last claim or mailbox write that renewed the lease (0: none held) */
 } mrun_t;
 
 static void finish(mrun_t *s, cs_stream_outcome_t oc)
@@ -326,6 +340,91 @@ static bool stalled(mrun_t *s, double now)
              now - s->t_progress, (unsigned)s->st.state);
     finish(s, CS_STREAM_CLOSED);
     return true;
+}
+
+/* A token for this job's lease: the clock's nanoseconds and the process id, folded to 16 bits,
+ * never 0 (0 means "no token"). Two hosts picking the same one: 1 in 65535. */
+static uint16_t new_token(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    uint32_t h =
+        (uint32_t)ts.tv_nsec * 2654435761u ^ (uint32_t)getpid() * 40503u ^ (uint32_t)ts.tv_sec;
+    uint16_t t = (uint16_t)(h ^ (h >> 16));
+    return t != 0 ? t : 1u;
+}
+
+static void lease_refused(mrun_t *s, const char *doing)
+{
+    s->r->dev_error.code = CS_ERR_LEASED;
+    s->r->dev_error_msg = s->next + 1;
+    snprintf(s->r->why, sizeof s->r->why,
+             "%s: another Modbus client holds the writer lease (it ends %u ms after that "
+             "client's last write unless renewed)",
+             doing, (unsigned)s->st.lease_left_ms);
+    finish(s, CS_STREAM_DEVICE_ERROR);
+}
+
+/* Claims the writer lease before the first write. A lease another client holds (a host that
+ * just died, a panel) is waited out once, for the time the device says is left plus a second;
+ * then the stream stops (exit 7) rather than wait on. A map without a lease (exception 2 to
+ * LEASE) is written without a token. */
+static void claim_lease(mrun_t *s)
+{
+    s->c->token = new_token();
+    double deadline = 0;
+    for (;;) {
+        cs_mb_rc_t rc = cs_mb_lease(s->c, true);
+        if (rc == CS_MB_OK) {
+            s->t_lease = cs_serial_now_s();
+            return;
+        }
+        if (rc != CS_MB_EXCEPTION) {
+            lost(s, rc, "claiming the writer lease");
+            return;
+        }
+        if (s->c->exception == CS_MODBUS_EX_ILLEGAL_ADDRESS) {
+            s->c->token = 0; /* a map without a lease (its application has none): write as is */
+            return;
+        }
+        rc = cs_mb_read_status(s->c, &s->st);
+        if (rc != CS_MB_OK) {
+            lost(s, rc, "reading the status");
+            return;
+        }
+        double now = cs_serial_now_s();
+        if (deadline == 0)
+            deadline = now + s->st.lease_left_ms / 1000.0 + 1.0;
+        if (s->o->interrupt != NULL && *s->o->interrupt) {
+            finish(s, CS_STREAM_INTERRUPTED); /* nothing was sent: nothing to stop */
+            return;
+        }
+        if (now >= deadline) {
+            lease_refused(s, "claiming the writer lease");
+            return;
+        }
+        sleep_ms(100);
+    }
+}
+
+/* Renews the lease when nothing renewed it for CS_MB_LEASE_RENEW_MS (the queue draining, a
+ * pause): false (and the outcome set) when it was lost or the device stopped answering. */
+static bool renew_lease(mrun_t *s, double now)
+{
+    if (s->t_lease == 0 || now - s->t_lease < CS_MB_LEASE_RENEW_MS / 1000.0)
+        return true;
+    cs_mb_rc_t rc = cs_mb_lease(s->c, true);
+    if (rc == CS_MB_OK) {
+        s->t_lease = now;
+        return true;
+    }
+    if (rc == CS_MB_EXCEPTION) {
+        (void)cs_mb_read_status(s->c, &s->st);
+        lease_refused(s, "renewing the writer lease");
+    } else {
+        lost(s, rc, "renewing the writer lease");
+    }
+    return false;
 }
 
 /* Reads the status and follows it: executed count, credits, the device's next sequence (going
@@ -453,6 +552,7 @@ static bool write_next(mrun_t *s)
     cs_mb_rc_t rc = cs_mb_write_mailbox(s->c, regs, n);
     if (rc == CS_MB_OK) {
         s->t_progress = cs_serial_now_s();
+        s->t_lease = s->t_progress; /* a write carrying the token renews the lease */
         s->next++;
         if (s->next > r->sent)
             r->sent = s->next;
@@ -549,6 +649,8 @@ static void mb_prepare(mrun_t *s)
             lost(s, CS_MB_NO_ANSWER, "resetting an earlier error");
         }
     }
+    if (!s->stop)
+        claim_lease(s);
     s->base = st->next_seq;
     s->exec_seq = (uint16_t)(st->next_seq - 1u);
     s->credits = st->free_slots;
@@ -617,7 +719,7 @@ static void mb_stream(mrun_t *s)
         if (mb_controls(s, &t_all_sent))
             break;
         double now = cs_serial_now_s();
-        if (stalled(s, now))
+        if (stalled(s, now) || !renew_lease(s, now))
             break;
         bool wrote = false;
         if (s->next < job->n && s->credits > 0) {
@@ -644,6 +746,8 @@ static void mb_finish(mrun_t *s, double t0)
     cs_stream_result_t *r = s->r;
     if (r->outcome == CS_STREAM_DEVICE_ERROR)
         control(s, CS_MODBUS_CMD_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
+    if (s->t_lease != 0 && r->outcome != CS_STREAM_CLOSED && r->outcome != CS_STREAM_RESET)
+        (void)cs_mb_lease(s->c, false); /* the next job, or another client, may write now */
     double t_end = cs_serial_now_s();
     cs_stream_progress(&s->prog, o->progress, o->progress_tty, true, s->job->n, r->executed,
                        r->sent, o->resume_from, s->c->retries + s->resent, what(s));

@@ -29,6 +29,7 @@ typedef struct {
     bool tcp;
     char where[160]; /* HOST:PORT or the device path, for messages */
     int unit;
+    uint16_t token;      /* writer-lease token: mailbox writes carry it (0: none) */
     uint32_t timeout_ms; /* response timeout of one try */
     unsigned tries;      /* tries of one request before CS_MB_NO_ANSWER, >= 1 */
     int exception;       /* code of the last exception answer */
@@ -69,11 +70,19 @@ typedef struct {
     uint32_t tick_hz, boot_id;
     uint16_t state, free_slots, last_exec, next_seq, error, error_seq, refused, refused_seq;
     int32_t pos[CS_AXES];
+    uint16_t lease, lease_left_ms; /* 1: the mailbox is leased; ms until it expires */
 } cs_mb_status_t;
 
 cs_mb_rc_t cs_mb_read_status(cs_mb_client_t *c, cs_mb_status_t *st);
-/* One mailbox write (FC16 of n registers at CS_MODBUS_HR_MAILBOX). */
+/* One mailbox write: FC16 of n registers at CS_MODBUS_HR_MAILBOX, or with c->token != 0 the
+ * token and the n registers at CS_MODBUS_HR_TOKEN. */
 cs_mb_rc_t cs_mb_write_mailbox(cs_mb_client_t *c, const uint16_t *regs, size_t n);
+/* Claims or renews (claim) the writer lease with c->token, or gives it back (FC06 to LEASE or
+ * RELEASE). CS_MB_EXCEPTION with exception 1: another client holds it. */
+cs_mb_rc_t cs_mb_lease(cs_mb_client_t *c, bool claim);
+/* How often the stream renews its lease when it has written nothing (the device keeps it
+ * CS_FW_MODBUS_LEASE_MS, 5 s, after the last claim or write). */
+#define CS_MB_LEASE_RENEW_MS 1000u
 /* One command (FC06 to CS_MODBUS_HR_COMMAND). */
 cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd);
 /* "illegal data value", ... for an exception code. */
@@ -97,7 +106,10 @@ typedef struct {
 /* Defaults: hello 2 s, status every 50 ms, idle 3 s, stall 30 s. */
 void cs_mb_stream_opts_default(cs_mb_stream_opts_t *o, cs_mb_client_t *c, uint8_t axes,
                                uint32_t tick_hz);
-/* Streams job messages resume_from+1..n; fills *r like cs_stream_run. Never waits without a
+/* Streams job messages resume_from+1..n; fills *r like cs_stream_run. It first claims the
+ * writer lease with a fresh token (a lease another client holds is waited out once, for the
+ * time the device says it has left, then CS_STREAM_DEVICE_ERROR with dev_error.code
+ * CS_ERR_LEASED), renews it while it streams and gives it back at the end. Never waits without a
  * deadline: a device whose next sequence runs ahead of what this host wrote (another Modbus
  * client wrote to the mailbox) ends it at once as CS_STREAM_DEVICE_ERROR (dev_error.code
  * CS_ERR_SEQ); no progress for stall_ms ends it as CS_STREAM_CLOSED, with the reason in r->why

@@ -48,6 +48,11 @@ static cs_err_t job_push(cs_stream_job_t *j, const cs_proto_msg_t *m)
     return CS_OK;
 }
 
+cs_err_t cs_stream_job_add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m)
+{
+    return job_push(j, m);
+}
+
 cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n)
 {
     for (size_t k = 0; k < n; k++) {
@@ -327,6 +332,9 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
         s->have_hello = true;
     } else if (m.type == CS_PROTO_STATUS) {
         on_status(s, &m.u.status);
+    } else if (m.type == CS_PROTO_EVENT) {
+        if (s->o->on_event != NULL)
+            s->o->on_event(s->o->event_ctx, &m.u.event);
     } else if (m.type == CS_PROTO_ERROR) {
         s->r->dev_error = m.u.error;
         /* counted back from the last sequence queued, never forward from the session's first
@@ -576,7 +584,9 @@ static bool run_controls(run_t *s, double *t_last_ack)
 {
     const cs_stream_opts_t *o = s->o;
     if (o->interrupt != NULL && *o->interrupt) {
-        if (*o->interrupt < 2) {
+        if (*o->interrupt < 2 && o->jog_cancel) {
+            control(s, CS_PROTO_JOG_CANCEL, CS_PROTO_STATE_IDLE, CS_PROTO_STATE_ALARM, 5000);
+        } else if (*o->interrupt < 2) {
             control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
             control(s, CS_PROTO_ABORT, CS_PROTO_STATE_ABORTED, CS_PROTO_STATE_IDLE, 2000);
         }

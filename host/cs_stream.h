@@ -38,6 +38,10 @@ void cs_stream_job_free(cs_stream_job_t *j);
 /* Appends step segments as SEGMENT messages. CS_ERR_FULL out of memory, CS_ERR_RANGE for a
  * segment the protocol cannot carry. */
 cs_err_t cs_stream_job_add_segments(cs_stream_job_t *j, const cs_segment_t *s, size_t n);
+/* Appends one message as it is (HOME, JOG, PROBE, SPINDLE, UNLOCK: docs/protocol.md).
+ * CS_ERR_RANGE (or the encoder's error) for a message the protocol cannot carry, CS_ERR_FULL out
+ * of memory. */
+cs_err_t cs_stream_job_add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m);
 /* Appends a plan's segments with its servo pen events as PEN messages in their place (a pen
  * event before segment k goes right before that segment's SEGMENT; docs/protocol.md, PEN).
  * Errors as cs_stream_job_add_segments (CS_ERR_RANGE: a pulse width outside 400..2600 us). */
@@ -81,6 +85,13 @@ typedef struct {
     uint32_t hello_ms;  /* wait this long for the connection and HELLO */
     uint32_t status_ms; /* after the last ACK, wait this long for the final STATUS */
     bool quiet_hello;
+    /* NULL: none; else called with every EVENT the device sends (alarm, probe contact, axis
+     * homed, inputs: docs/protocol.md), before the ERROR an alarm is followed by */
+    void (*on_event)(void *ctx, const cs_proto_event_t *ev);
+    void *event_ctx;
+    /* interrupt < 2: send JOG_CANCEL (decelerate to rest, drop the rest, back to IDLE) instead
+     * of HOLD then ABORT (a job of jogs) */
+    bool jog_cancel;
 } cs_stream_opts_t;
 
 typedef struct {

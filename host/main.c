@@ -25,6 +25,11 @@ static const struct {
     {"pause", cs_cmd_pause, "hold the daemon's running job and its queue"},
     {"resume", cs_cmd_resume, "resume the daemon's held job and queue"},
     {"cancel", cs_cmd_cancel, "cancel a queued job, or the running one (hold, then abort)"},
+    {"home", cs_cmd_home, "home the machine on its switches ([homing] of the machine file)"},
+    {"jog", cs_cmd_jog, "move the device to a machine position (Ctrl-C decelerates, stops)"},
+    {"probe", cs_cmd_probe, "probe towards a position, print the contact (G38.2..G38.5)"},
+    {"unlock", cs_cmd_unlock, "leave the device's alarm state (Grbl's $X)"},
+    {"spindle", cs_cmd_spindle, "set the spindle or laser output (M3/M4/M5 S; laser mode)"},
     {"help", cmd_help, "show this help, or a command's help: curvestep help COMMAND"},
 };
 

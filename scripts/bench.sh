@@ -116,8 +116,13 @@ fw_section() {
     echo
     curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
-        firmware/core/cs_predict.c firmware/core/cs_trace.c
+        firmware/core/cs_predict.c firmware/core/cs_trace.c firmware/core/cs_fd3.c
     local trace=$CORE_BYTES
+    echo "**The planar polynomial FD path alone** (cs_fd3 + what it takes from cs_fd: pieces of"
+    echo "a cubic with an exact step count each, the block loop cs_fd3_fill):"
+    echo
+    curve_core fd3 "-DCURVE_CORE_FD3" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
+        firmware/core/cs_fd.c firmware/core/cs_fd3.c
     echo "**The default tracer alone** (cs_predict: planar polynomial curves of degree <= 3, what"
     echo "curves mode gets from SVG and G5; cs_subdiv contributes its distance test only):"
     echo
@@ -157,6 +162,10 @@ fw_section() {
                 w = $2
                 if (w == "fd_begin") w = "cs_fd_begin (Wang bound, initial differences)"
                 else if (w == "fd_point") w = "**cs_fd_next: one FD point**"
+                else if (w == "fd3_begin") w = "cs_fd3_begin (planar polynomial FD: piece plan, first piece)"
+                else if (w == "fd3_point") w = "cs_fd3_next: one point (piece starts included)"
+                else if (w == "fd3_fill_point") w = "cs_fd3_fill: one point (block loop, piece starts included)"
+                else if (w == "fd3_loop_point") w = "**cs_fd3_fill inside a piece: one point (the loop)**"
                 else if (w == "trace_fd_chord") w = "cs_trace, FD: one chord (begin included)"
                 else if (w == "trace_afd_chord") w = "cs_trace, AFD: one chord (begin included)"
                 else if (w == "trace_subdiv_chord") w = "cs_trace, subdivision: one chord (begin included)"
@@ -168,6 +177,17 @@ fw_section() {
         echo
         echo "Per chord of a CURVE message the M3 device thus spends the tracer's share plus the"
         echo "planner's; at 50 MHz that bounds how many chords per second curves mode can plan."
+        echo
+        local pc fl
+        pc=$(printf '%s\n' "$out" | awk '$2 == "trace_predict_chord" {printf "%.0f", $6 * 20 / $4}')
+        fl=$(printf '%s\n' "$out" | awk '$2 == "fd3_loop_point" {printf "%.0f", $6 * 20 / $4}')
+        echo "Goals (issue 18) on the chip:"
+        echo
+        echo "| goal | measured | verdict |"
+        echo "|---|---|---|"
+        echo "| default tracer <= 1,500 M3 instructions a chord | $pc | $([ "${pc:-99999}" -le 1500 ] && echo met || echo "MISSED: 1.2-2.4 flatness tests a chord, each Q30 product a call of ~40 instructions (docs/fixed-point.md)") |"
+        echo "| uniform FD of a planar polynomial cubic <= 40 M3 instructions a point | $fl (cs_fd3_fill inside a piece) | $([ "${fl:-99999}" -le 40 ] && echo met || echo MISSED) |"
+        echo "| curve core with the default tracer <= 3 KB on the M0+ | $predict bytes | $([ "$predict" -le 3072 ] && echo met || echo "MISSED: cs_predict alone is most of it (polynomial and conic tests, predictor), plus libgcc's 64-bit multiply and division") |"
         echo
     fi
     local b

@@ -57,6 +57,12 @@ void cs_sim_exec_free(cs_sim_exec_t *ex)
     free(ex->edges);
     ex->edges = NULL;
     ex->n = 0;
+    free(ex->marks);
+    ex->marks = NULL;
+    ex->nmarks = 0;
+    free(ex->spins);
+    ex->spins = NULL;
+    ex->nspins = 0;
 }
 
 void cs_sim_dynamics(const cs_machine_t *m, const cs_sim_exec_t *ex, double window_s,

@@ -15,9 +15,21 @@
 #include "cs_segment.h"
 #include "port_posix.h"
 
+/* A machine-control event of a simulated device run (cs_fw_ctl), where the machine was. */
+typedef enum { CS_SIM_MARK_ALARM = 1, CS_SIM_MARK_PROBE = 2, CS_SIM_MARK_HOMED = 3 } cs_sim_mark_kind_t;
+typedef struct {
+    uint64_t t;    /* tick */
+    uint8_t kind;  /* cs_sim_mark_kind_t */
+    double p[3];   /* physical position, mm (the STEP/DIR lines) */
+} cs_sim_mark_t;
+
 typedef struct {
     port_posix_edge_t *edges; /* every step, time order (owned) */
     size_t n;
+    cs_sim_mark_t *marks;         /* switch trips, probe contacts, axes homed (owned; may be 0) */
+    size_t nmarks;
+    port_posix_spindle_t *spins;  /* spindle / laser settings, time order (owned; may be 0) */
+    size_t nspins;
     uint64_t end_tick;         /* when the executor went idle */
     int64_t pos[CS_AXES];      /* final position, steps (from the STEP/DIR lines) */
     int32_t exec_pos[CS_AXES]; /* the executor's own count */

@@ -15,6 +15,7 @@
 
 #include "cs_fw_app.h"
 #include "cs_jobplan.h"
+#include "cs_path.h"
 #include "cs_sim_exlog.h"
 #include "cs_stream.h"
 #include "port_posix.h"
@@ -46,8 +47,11 @@ struct cs_sim_motion {
     double dry_since;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
     cs_sim_exlog_t xl; /* cfg->exlog: the executed log on disk (xl.fd < 0: none) */
+    uint32_t seen[3]; /* alarms, probe cycles, homings already marked (note_marks) */
 };
 typedef struct cs_sim_motion sim_dev_t;
+
+static void note_marks(sim_dev_t *d);
 
 void cs_sim_device_cfg_default(cs_sim_device_cfg_t *cfg, const cs_machine_t *m)
 {
@@ -106,6 +110,12 @@ static void sync_res(sim_dev_t *d)
 {
     const cs_fw_stats_t *s = &d->app.mo.stats;
     cs_sim_device_result_t *r = d->res;
+    const cs_fw_ctl_t *c = &d->app.mo.ctl;
+    r->homings = c->homings;
+    r->alarms = c->alarms;
+    r->probes = c->probes;
+    if (c->alarm != 0)
+        r->last_alarm = c->alarm;
     r->executed = s->executed;
     r->segments = s->segments;
     r->curves = s->curves;
@@ -148,6 +158,7 @@ static void advance(sim_dev_t *d, double wall)
             break;
     }
     cs_fw_motion_poll(mo);
+    note_marks(d);
     if (mo->stats.segments != seg0 && d->dry) {
         d->res->exec_gaps++;
         d->res->gap_wall_s += wall - d->dry_since;
@@ -238,9 +249,58 @@ static int read_line(sim_dev_t *d, int wait_ms)
 }
 
 /* One pass of the device: the line read, the application run over it, time advanced. */
+/* A machine-control event happened (a counter moved): note where the machine is. */
+static void note_marks(sim_dev_t *d)
+{
+    const cs_fw_ctl_t *c = &d->app.mo.ctl;
+    if (!d->cfg->keep_edges) /* the marks go with the edges (cs_sim_exec_free) */
+        return;
+    uint32_t now[3] = {c->alarms, c->probes, c->homings};
+    cs_sim_exec_t *ex = &d->res->ex;
+    for (unsigned k = 0; k < 3; k++) {
+        for (; d->seen[k] < now[k]; d->seen[k]++) {
+            void *b = ex->marks;
+            size_t cap = ex->nmarks;
+            if (!cs_path_grow(&b, &cap, ex->nmarks + 1, sizeof *ex->marks))
+                return;
+            ex->marks = b;
+            cs_sim_mark_t *mk = &ex->marks[ex->nmarks++];
+            mk->t = port_posix_now();
+            mk->kind = (uint8_t)(k == 0 ? CS_SIM_MARK_ALARM : k == 1 ? CS_SIM_MARK_PROBE
+                                                                      : CS_SIM_MARK_HOMED);
+            for (unsigned i = 0; i < 3; i++)
+                mk->p[i] = i < d->m->n_axes ? (double)port_posix_position(i) * CS_MOTION_ONE /
+                                                  (double)d->m->axis[i].steps_per_mm
+                                            : 0;
+        }
+    }
+}
+
+static volatile sig_atomic_t g_estop, g_estop_seen;
+
+void cs_sim_device_estop(bool pressed)
+{
+    g_estop = pressed ? 1 : 0;
+}
+
+/* The simulated machine's inputs: [limits] and [probe] at the physical position (the steps on
+ * the STEP/DIR lines since start, in mm). */
+static uint16_t sim_inputs(void *ctx, const int64_t *pos)
+{
+    const sim_dev_t *d = ctx;
+    double mm[CS_AXES] = {0};
+    for (unsigned i = 0; i < d->m->n_axes; i++)
+        mm[i] = (double)pos[i] * CS_MOTION_ONE / (double)d->m->axis[i].steps_per_mm;
+    return cs_ctlcfg_inputs(d->cfg->ctl, mm);
+}
+
 static cs_err_t serve_pass(sim_dev_t *d, double *last_rx_s)
 {
     cs_fw_motion_t *mo = &d->app.mo;
+    if (g_estop != g_estop_seen) { /* the pin interrupt of the e-stop */
+        g_estop_seen = g_estop;
+        port_posix_inputs_force(CS_PROTO_IN_ESTOP, g_estop ? CS_PROTO_IN_ESTOP : 0);
+    }
     bool busy = !cs_fw_motion_done(mo) && !mo->hold.hold;
     if (read_line(d, busy ? 1 : 5) != 0)
         return CS_ERR_IO;
@@ -325,6 +385,10 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
             d->inv = (uint8_t)(d->inv | (1u << i));
     port_posix_reset(d->m->tick_hz, d->inv);
     port_posix_record(true);
+    port_posix_inputs_force(0, 0);
+    g_estop = g_estop_seen = 0;
+    bool model = cfg->ctl != NULL && cs_ctlcfg_has_inputs(cfg->ctl);
+    port_posix_inputs_model(model ? sim_inputs : NULL, d);
     /* the application on the POSIX port, its link on the wall clock in microseconds with the
      * timing of the simulated line (cs_linktime_link, as the host computes it) */
     cs_fw_app_cfg_t ac;
@@ -473,6 +537,16 @@ static cs_err_t keep_edges(sim_dev_t *d)
     if (res->ex.edges != NULL || ne == 0)
         res->ex.n = ne;
     res->ex.end_tick = port_posix_now();
+    size_t ns;
+    const port_posix_spindle_t *sp = port_posix_spindles(&ns);
+    if (rc == CS_OK && ns > 0) {
+        res->ex.spins = malloc(ns * sizeof *sp);
+        if (res->ex.spins == NULL)
+            rc = CS_ERR_FULL;
+        else
+            memcpy(res->ex.spins, sp, ns * sizeof *sp);
+        res->ex.nspins = res->ex.spins != NULL ? ns : 0;
+    }
     for (unsigned i = 0; i < CS_AXES; i++) {
         res->ex.pos[i] = port_posix_position(i);
         res->ex.exec_pos[i] = cs_stepper_position(&d->app.mo.st, i);
@@ -504,6 +578,11 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     (void)port_posix_pens(&res->pens);
     if (rc == CS_OK && d->cfg->keep_edges)
         rc = keep_pens(res);
+    const port_posix_spindle_t *sp = port_posix_spindles(&res->spindles);
+    for (size_t i = 0; i < res->spindles; i++)
+        if (sp[i].duty > res->max_duty)
+            res->max_duty = sp[i].duty;
+    port_posix_inputs_model(NULL, NULL);
     port_posix_reset(d->m->tick_hz, d->inv); /* frees the port's copy of the edges */
     port_stepper_attach(NULL);
     free(d);
@@ -528,6 +607,11 @@ static void on_signal(int sig)
 {
     (void)sig;
     g_stop = 1;
+}
+
+static void on_estop(int sig)
+{
+    cs_sim_device_estop(sig == SIGUSR1);
 }
 
 static void device_usage(FILE *f)
@@ -685,6 +769,7 @@ typedef struct {
     cs_sim_ref_t ref;
     double end_mm[3];
     int fd, keep;
+    cs_ctlcfg_t ctl; /* [limits], [probe]: the switches and the probe surface */
 } device_run_t;
 
 /* Parses argv into d: -1 to go on, else the exit status (--help, a usage error). */
@@ -751,8 +836,13 @@ static int device_setup(device_run_t *d)
     } else {
         cs_machine_ini_default(&d->m);
     }
+    if (cs_ctlcfg_load(o->machine_file, &d->m, &d->ctl, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return DEV_INPUT;
+    }
     cs_sim_device_cfg_t *cfg = &d->cfg;
     cs_sim_device_cfg_default(cfg, &d->m);
+    cfg->ctl = &d->ctl;
     cfg->queue_size = (uint16_t)o->queue;
     cfg->speed = o->instant ? 0 : o->speed;
     cfg->line_rate = (uint32_t)d->line_rate;
@@ -821,6 +911,9 @@ static int device_serve(device_run_t *d)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sa.sa_handler = on_estop;
+    sigaction(SIGUSR1, &sa, NULL);
+    sigaction(SIGUSR2, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     cs_sim_device_result_t res;
     cs_err_t e = cs_sim_device_serve(d->fd, &d->cfg, &g_stop, &res);
@@ -844,6 +937,15 @@ static int device_serve(device_run_t *d)
            (unsigned)res.frames.frames, (unsigned)res.frames.crc_errs, (unsigned)res.frames.bad,
            (unsigned)res.link.duplicates, (unsigned)res.link.out_of_order,
            (unsigned)res.link.retransmits);
+    if (res.homings || res.alarms || res.probes || res.spindles) {
+        char last[32] = "";
+        if (res.alarms)
+            snprintf(last, sizeof last, " (last ALARM:%u)", (unsigned)res.last_alarm);
+        printf("control: %u axes homed, %u alarms%s, %u probe cycles; spindle: %zu settings, "
+               "largest duty %u/1000\n",
+               (unsigned)res.homings, (unsigned)res.alarms, last, (unsigned)res.probes,
+               res.spindles, (unsigned)res.max_duty);
+    }
     const cs_sim_device_opts_t *o = &d->o;
     cs_sim_device_out_t out = {o->out.reference, o->out.trace, o->out.svg, o->out.png,
                                o->out.check,     &d->ref,      {0, 0, 0},  NULL};

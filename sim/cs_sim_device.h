@@ -17,6 +17,7 @@
 #include "cs_fw_motion.h"
 #include "cs_link.h"
 #include "cs_machine.h"
+#include "cs_ctlcfg.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
 #include "cs_serial.h"
@@ -47,6 +48,8 @@ typedef struct {
     bool keep_edges;      /* copy the recorded STEP edges into the result (for checks) */
     const char *exlog;    /* append every finished segment to this file (cs_sim_exlog); NULL:
                            * none */
+    const cs_ctlcfg_t *ctl; /* [limits] and [probe]: the simulated switches and probe surface
+                             * (physical machine coordinates, 0 at start); NULL: none */
 } cs_sim_device_cfg_t;
 
 typedef struct {
@@ -75,6 +78,12 @@ typedef struct {
      * k+1 starts at the tick of pen setting k), the settings as their pen events: what
      * cs_sim_check reads from a segments file's "pen US" lines (free: cs_motion_segs_free) */
     cs_motion_segs_t pen_segs;
+    /* machine control (cs_fw_ctl): axes homed, alarms (the last one's code), probe cycles,
+     * spindle / laser output settings recorded (port_spindle_set) and the largest duty */
+    uint32_t homings, alarms, probes;
+    uint8_t last_alarm;
+    size_t spindles;
+    uint16_t max_duty;
 } cs_sim_device_result_t;
 
 /* Defaults: queue 32, real time, no faults, subdivision at the machine's tolerance. */
@@ -149,6 +158,10 @@ void cs_sim_device_opts_default(cs_sim_device_opts_t *o);
 /* Takes argv[*i] (and its value, advancing *i) when it is one of those options: 1 taken, 0 not
  * one of them, -1 a bad value (the sentence printed on stderr). */
 int cs_sim_device_opt(int argc, char **argv, int *i, cs_sim_device_opts_t *o);
+
+/* The e-stop of the simulated machine: pressed (true) or released, reported to the device at
+ * its next pass (curvestep-sim: SIGUSR1 presses, SIGUSR2 releases). ISR-safe (a flag). */
+void cs_sim_device_estop(bool pressed);
 
 /* The `curvestep-sim --pty | --port DEV ...` command line (sim/main.c hands these over). */
 int cs_sim_device_main(int argc, char **argv);

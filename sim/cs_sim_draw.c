@@ -415,6 +415,80 @@ static void svg_ref_run(void *ctx, const cs_sim_ref_t *ref, size_t b, size_t n,
     fprintf(f, "\"/>\n");
 }
 
+/* --- machine control: spindle / laser power along the path, switch trips, probe contacts -- */
+
+/* The spindle duty (1/1000) in force at tick t, 0 before the first setting. */
+static unsigned duty_at(const cs_sim_exec_t *ex, uint64_t t, size_t *cur)
+{
+    while (*cur < ex->nspins && ex->spins[*cur].t <= t)
+        (*cur)++;
+    if (*cur == 0)
+        return 0;
+    const port_posix_spindle_t *sp = &ex->spins[*cur - 1];
+    return sp->mode != 0 ? sp->duty : 0;
+}
+
+/* Mark colours: alarm (switch trip, e-stop) red, probe contact green, axis homed blue. */
+static void mark_rgb(uint8_t kind, double rgb[3])
+{
+    rgb[0] = kind == CS_SIM_MARK_ALARM ? 0.85 : 0.1;
+    rgb[1] = kind == CS_SIM_MARK_PROBE ? 0.65 : 0.1;
+    rgb[2] = kind == CS_SIM_MARK_HOMED ? 0.85 : 0.1;
+}
+
+/* Under the path: where the output is on, a translucent orange band as wide as the duty (up to
+ * 12 line widths at full power); over it: a ring at each mark. */
+static void svg_control(FILE *f, const cs_sim_exec_t *ex, const sample_t *s, size_t n,
+                        const cs_sim_view_t *view, double lw)
+{
+    size_t cur = 0;
+    for (size_t k = 1; k < n && ex->nspins > 0; k++) {
+        unsigned d = duty_at(ex, s[k].t, &cur);
+        if (d == 0)
+            continue;
+        fprintf(f,
+                "<line class=\"power\" x1=\"%.4f\" y1=\"%.4f\" x2=\"%.4f\" y2=\"%.4f\" "
+                "stroke=\"#ff8c00\" stroke-opacity=\"0.45\" stroke-width=\"%.4f\"/>\n",
+                s[k - 1].x, s[k - 1].y, s[k].x, s[k].y, 12 * lw * d / 1000.0);
+    }
+    for (size_t i = 0; i < ex->nmarks; i++) {
+        double q[2], rgb[3];
+        cs_sim_view_project(view, ex->marks[i].p, q);
+        mark_rgb(ex->marks[i].kind, rgb);
+        fprintf(f,
+                "<circle class=\"mark\" cx=\"%.4f\" cy=\"%.4f\" r=\"%.4f\" fill=\"none\" "
+                "stroke=\"#%02x%02x%02x\" stroke-width=\"%.4f\"/>\n",
+                q[0], q[1], 8 * lw, (int)(rgb[0] * 255), (int)(rgb[1] * 255), (int)(rgb[2] * 255),
+                2 * lw);
+    }
+}
+
+static void png_control(cairo_t *cr, const cs_sim_exec_t *ex, const sample_t *s, size_t n,
+                        const cs_sim_view_t *view, double scale)
+{
+    size_t cur = 0;
+    for (size_t k = 1; k < n && ex->nspins > 0; k++) {
+        unsigned d = duty_at(ex, s[k].t, &cur);
+        if (d == 0)
+            continue;
+        cairo_set_source_rgba(cr, 1.0, 0.55, 0.0, 0.45);
+        cairo_set_line_width(cr, 12.0 * d / 1000.0 / scale);
+        cairo_move_to(cr, s[k - 1].x, s[k - 1].y);
+        cairo_line_to(cr, s[k].x, s[k].y);
+        cairo_stroke(cr);
+    }
+    cairo_set_line_width(cr, 2.0 / scale);
+    for (size_t i = 0; i < ex->nmarks; i++) {
+        double q[2], rgb[3];
+        cs_sim_view_project(view, ex->marks[i].p, q);
+        mark_rgb(ex->marks[i].kind, rgb);
+        cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, q[0], q[1], 8.0 / scale, 0, 2 * M_PI);
+        cairo_stroke(cr);
+    }
+}
+
 /* The servo settings as circles (cs_sim_draw_pen_t), radius r. */
 static void svg_marks(FILE *f, const sample_t *s, size_t n, double r, double lw)
 {
@@ -513,6 +587,7 @@ int cs_sim_draw_svg_pen(const char *file, const cs_machine_t *m, const cs_sim_ex
         fprintf(f, "</g>\n");
     }
     svg_marks(f, s, n, 5 * lw, lw);
+    svg_control(f, ex, s, n, view, lw);
     fprintf(f, "</svg>\n");
     free(s);
     return fclose(f) == 0 ? 0 : -1;
@@ -669,6 +744,7 @@ int cs_sim_draw_png_pen(const char *file, const cs_machine_t *m, const cs_sim_ex
     cairo_set_line_width(cr, 0.8 / scale);
     ref_runs(ref, png_ref_run, cr, view);
     png_marks(cr, s, n, 5.0 / scale, 1.5 / scale);
+    png_control(cr, ex, s, n, view, scale);
     cairo_destroy(cr);
     cairo_status_t st = cairo_surface_write_to_png(sf, file);
     cairo_surface_destroy(sf);

@@ -1,13 +1,12 @@
 /* cs_sim_modbus: the simulated device behind Modbus (docs/modbus.md). The register map and its
  * sequence rule are the core's (firmware/core/cs_modbus); the motion side is the serial
- * device's (cs_sim_motion_*). Modbus TCP: libmodbus listens, accepts and receives; each request
- * PDU goes to the core's handler, and libmodbus sends the answer it decided. Modbus RTU: the
- * core's own RTU server, fed byte by byte from a pty or a tty. */
+ * device's (cs_sim_motion_*). Modbus TCP: the simulator's own server (cs_sim_mbtcp: several
+ * clients, served in turn, MBAP checked) hands each request PDU to the core's handler. Modbus
+ * RTU: the core's own RTU server, fed byte by byte from a pty or a tty. */
 #include "cs_sim_modbus.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
-#include <modbus/modbus.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
@@ -29,6 +28,7 @@
 #include "cs_motion.h"
 #include "cs_serial.h"
 #include "cs_sim_device.h"
+#include "cs_sim_mbtcp.h"
 
 #define DELAYED_MAX 8
 
@@ -41,11 +41,8 @@ typedef struct {
     uint64_t seed;
 } mb_faults_t;
 
-typedef struct {
+typedef struct { /* an RTU answer held back by the delay fault (TCP: cs_sim_mbtcp's own) */
     double due;
-    int fd; /* TCP client socket the answer belongs to (-1: RTU) */
-    uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-    int qlen;
     uint8_t rsp[CS_MODBUS_RTU_MAX];
     size_t rlen;
 } delayed_t;
@@ -64,6 +61,8 @@ typedef struct {
     delayed_t dl[DELAYED_MAX];
     unsigned ndl;
     double last_rx_s;
+    double idle_exit;         /* --idle-exit, 0: none */
+    cs_sim_mbtcp_stats_t tcp; /* the TCP server's counters */
 } mbdev_t;
 
 static double rnd(mbdev_t *d)
@@ -107,11 +106,27 @@ static void app_status(void *ctx, cs_modbus_status_t *st)
     cs_fw_modbus_status(&d->fm, st);
 }
 
-/* Runs the motion paced to the wall clock and latches its errors (cs_fw_modbus). */
+static cs_err_t app_lease(void *ctx, uint8_t op, uint16_t token)
+{
+    mbdev_t *d = ctx;
+    return cs_fw_modbus_lease(&d->fm, op, token);
+}
+
+/* Runs the motion paced to the wall clock, latches its errors (cs_fw_modbus) and sets the
+ * lease's clock: a request sees the device as of now. */
 static void step_motion(mbdev_t *d)
 {
-    cs_sim_motion_advance(d->mo, cs_serial_now_s());
+    double now = cs_serial_now_s();
+    cs_sim_motion_advance(d->mo, now);
     cs_fw_modbus_collect(&d->fm);
+    cs_fw_modbus_clock(&d->fm, (uint32_t)(uint64_t)(now * 1000.0));
+}
+
+/* True once the job ran and --idle-exit seconds passed since the last request. */
+static bool idle_done(const mbdev_t *d)
+{
+    return d->idle_exit > 0 && cs_sim_motion_started(d->mo) && cs_sim_motion_done(d->mo) &&
+           cs_serial_now_s() - d->last_rx_s > d->idle_exit;
 }
 
 /* What to do with an answer: 0 send now, 1 drop, 2 delay. */
@@ -134,164 +149,44 @@ static void sleep_us(long us)
     nanosleep(&ts, NULL);
 }
 
-/* --- Modbus TCP (libmodbus) ----------------------------------------------------------------- */
+/* --- Modbus TCP (cs_sim_mbtcp) -------------------------------------------------------------- */
 
-/* Sends the answer the core decided, through libmodbus: an exception as such, a normal answer
- * by modbus_reply from a mapping that holds the values the core put in it. */
-static void tcp_send(modbus_t *ctx, modbus_mapping_t *map, int fd, const uint8_t *query, int qlen,
-                     const uint8_t *rsp, size_t rlen)
+/* One request from any client: another unit's is not answered (0 and 255, which some TCP
+ * clients send, included); ours goes to the core's handler with the motion as of now, and the
+ * answer faults decide when (or whether) it goes out. */
+static double tcp_handle(void *ctx, uint8_t unit, const uint8_t *pdu, size_t n, uint8_t *rsp,
+                         size_t *rn)
 {
-    modbus_set_socket(ctx, fd);
-    int hl = modbus_get_header_length(ctx);
-    if (rsp[0] & 0x80u) {
-        modbus_reply_exception(ctx, query, rsp[1]);
-        return;
+    mbdev_t *d = ctx;
+    d->last_rx_s = cs_serial_now_s();
+    d->requests++;
+    if (unit != d->unit) {
+        d->wrong_unit++;
+        return -1;
     }
-    uint8_t fc = rsp[0];
-    if (fc == CS_MODBUS_FC_READ_HOLDING || fc == CS_MODBUS_FC_READ_INPUT) {
-        unsigned addr = ((unsigned)query[hl + 1] << 8) | query[hl + 2];
-        uint16_t *tab =
-            fc == CS_MODBUS_FC_READ_INPUT ? map->tab_input_registers : map->tab_registers;
-        for (size_t k = 0; 2 + 2 * k + 1 < rlen; k++)
-            tab[addr + k] = (uint16_t)((rsp[2 + 2 * k] << 8) | rsp[3 + 2 * k]);
-    }
-    modbus_reply(ctx, query, qlen, map);
+    step_motion(d);
+    cs_modbus_pdu(&d->map, pdu, n, rsp, CS_MODBUS_PDU_MAX, rn);
+    int fate = answer_fate(d);
+    return fate == 0 ? 0.0 : fate == 1 ? -1.0 : d->f.delay_ms / 1000.0;
 }
 
-static int parse_hostport(const char *s, char *host, size_t cap, int *port)
+static bool tcp_tick(void *ctx)
 {
-    const char *colon = strrchr(s, ':');
-    if (colon == NULL || (size_t)(colon - s) >= cap || colon == s)
-        return -1;
-    memcpy(host, s, (size_t)(colon - s));
-    host[colon - s] = '\0';
-    char *end;
-    long p = strtol(colon + 1, &end, 10);
-    if (*end != '\0' || p < 0 || p > 65535 || colon[1] == '\0')
-        return -1;
-    struct in_addr a;
-    if (inet_pton(AF_INET, host, &a) != 1)
-        return -1;
-    *port = (int)p;
-    return 0;
+    mbdev_t *d = ctx;
+    step_motion(d);
+    return idle_done(d);
 }
 
-static int serve_tcp(mbdev_t *d, const char *addr, double idle_exit, volatile sig_atomic_t *stop)
+static bool tcp_busy(void *ctx)
 {
-    char host[64];
-    int port;
-    if (parse_hostport(addr, host, sizeof host, &port) != 0) {
-        fprintf(stderr, "curvestep-sim: --modbus-tcp wants ADDR:PORT with an IPv4 address, "
-                        "e.g. 127.0.0.1:1502 (port 0: any free port)\n");
-        return 2;
-    }
-    modbus_t *ctx = modbus_new_tcp(host, port);
-    if (ctx == NULL) {
-        fprintf(stderr, "curvestep-sim: modbus_new_tcp: %s\n", modbus_strerror(errno));
-        return 3;
-    }
-    int ls = modbus_tcp_listen(ctx, 4);
-    if (ls < 0) {
-        fprintf(stderr, "curvestep-sim: cannot listen on %s: %s\n", addr, modbus_strerror(errno));
-        modbus_free(ctx);
-        return 3;
-    }
-    struct sockaddr_in sa;
-    socklen_t sl = sizeof sa;
-    if (getsockname(ls, (struct sockaddr *)&sa, &sl) != 0) {
-        perror("curvestep-sim: getsockname");
-        close(ls);
-        modbus_free(ctx);
-        return 3;
-    }
-    printf("%s:%u\n", host, (unsigned)ntohs(sa.sin_port));
-    fflush(stdout);
-    modbus_mapping_t *map = modbus_mapping_new_start_address(
-        0, 0, 0, 0, 0, CS_MODBUS_HR_MAILBOX + CS_MODBUS_MAILBOX_REGS, 0, CS_MODBUS_IR_COUNT);
-    if (map == NULL) {
-        close(ls);
-        modbus_free(ctx);
-        return 3;
-    }
-    /* a request's bytes arrive together on loopback; a peer that stalls mid-request is cut */
-    modbus_set_byte_timeout(ctx, 0, 500000);
-    int client = -1;
-    uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-    while (!*stop) {
-        double now = cs_serial_now_s();
-        /* answers held back by the delay fault */
-        for (unsigned k = 0; k < d->ndl;) {
-            if (d->dl[k].due <= now) {
-                if (d->dl[k].fd == client && client >= 0)
-                    tcp_send(ctx, map, client, d->dl[k].query, d->dl[k].qlen, d->dl[k].rsp,
-                             d->dl[k].rlen);
-                d->dl[k] = d->dl[--d->ndl];
-            } else {
-                k++;
-            }
-        }
-        struct pollfd pf[2] = {{ls, POLLIN, 0}, {client, POLLIN, 0}};
-        int busy = cs_sim_motion_busy(d->mo);
-        int pr = poll(pf, client >= 0 ? 2 : 1, busy || d->ndl ? 1 : 5);
-        if (pr < 0 && errno != EINTR)
-            break;
-        if (pr > 0 && (pf[0].revents & POLLIN)) {
-            int s = ls;
-            int c = modbus_tcp_accept(ctx, &s); /* sets ctx's socket to the new client */
-            if (c >= 0) {
-                if (client >= 0) /* one host at a time: a new connection replaces the old */
-                    close(client);
-                client = c;
-                /* answers go out at once: with Nagle's algorithm an answer written while the
-                 * previous one waits for the host's delayed ACK is held up to 40 ms */
-                int one = 1;
-                setsockopt(c, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-            }
-        }
-        if (client >= 0 && pr > 0 && (pf[1].revents & (POLLIN | POLLHUP | POLLERR))) {
-            modbus_set_socket(ctx, client);
-            int rc = modbus_receive(ctx, query);
-            if (rc < 0) { /* the host closed the connection (or sent garbage): drop it */
-                close(client);
-                client = -1;
-            } else if (rc > 0) {
-                d->last_rx_s = cs_serial_now_s();
-                int hl = modbus_get_header_length(ctx);
-                uint8_t unit = query[hl - 1];
-                d->requests++;
-                if (unit != d->unit) {
-                    d->wrong_unit++; /* another unit's request: not ours to answer */
-                } else {
-                    uint8_t rsp[CS_MODBUS_PDU_MAX];
-                    size_t rn;
-                    step_motion(d); /* the status read sees the motion as of now */
-                    cs_modbus_pdu(&d->map, query + hl, (size_t)(rc - hl), rsp, sizeof rsp, &rn);
-                    int fate = answer_fate(d);
-                    if (fate == 0) {
-                        tcp_send(ctx, map, client, query, rc, rsp, rn);
-                    } else if (fate == 2) {
-                        delayed_t *q = &d->dl[d->ndl++];
-                        q->due = cs_serial_now_s() + d->f.delay_ms / 1000.0;
-                        q->fd = client;
-                        memcpy(q->query, query, (size_t)rc);
-                        q->qlen = rc;
-                        memcpy(q->rsp, rsp, rn);
-                        q->rlen = rn;
-                    }
-                }
-            }
-        }
-        step_motion(d);
-        if (idle_exit > 0 && cs_sim_motion_started(d->mo) && cs_sim_motion_done(d->mo) &&
-            cs_serial_now_s() - d->last_rx_s > idle_exit)
-            break;
-    }
-    if (client >= 0)
-        close(client);
-    close(ls);
-    modbus_mapping_free(map);
-    modbus_free(ctx);
-    return 0;
+    mbdev_t *d = ctx;
+    return cs_sim_motion_busy(d->mo) != 0;
+}
+
+static int serve_tcp(mbdev_t *d, const char *addr, volatile sig_atomic_t *stop)
+{
+    cs_sim_mbtcp_app_t app = {tcp_handle, tcp_tick, tcp_busy, d};
+    return cs_sim_mbtcp_serve(addr, &app, stop, &d->tcp);
 }
 
 /* --- Modbus RTU (the core's server) ---------------------------------------------------------- */
@@ -322,32 +217,44 @@ static int set_parity(int fd, char parity)
     return tcsetattr(fd, TCSANOW, &t);
 }
 
-static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity, double idle_exit,
-                     volatile sig_atomic_t *stop, cs_modbus_rtu_stats_t *rs)
+/* Opens the line: a new pty (its path printed) or the serial device dev at baud and parity.
+ * 0, or the exit status (1: the device, 3: the pty) with the reason on stderr. */
+static int rtu_open(const char *dev, uint32_t baud, char parity, cs_serial_t *ser, int *keep)
 {
-    int fd = -1, keep = -1;
-    cs_serial_t ser;
+    *keep = -1;
     if (strcmp(dev, "pty") == 0) {
+        int fd;
         char name[256];
-        if (cs_serial_openpty(&fd, &keep, name, sizeof name) != 0) {
+        if (cs_serial_openpty(&fd, keep, name, sizeof name) != 0) {
             perror("curvestep-sim: openpty");
             return 3;
         }
         printf("%s\n", name);
         fflush(stdout);
-        cs_serial_attach(&ser, fd);
-    } else {
-        if (cs_serial_open(&ser, dev, baud) != 0) {
-            fprintf(stderr, "curvestep-sim: %s: %s\n", dev, strerror(errno));
-            return 1;
-        }
-        fd = ser.fd;
-        if (set_parity(fd, parity) != 0) {
-            fprintf(stderr, "curvestep-sim: %s: parity: %s\n", dev, strerror(errno));
-            close(fd);
-            return 1;
-        }
+        cs_serial_attach(ser, fd);
+        return 0;
     }
+    if (cs_serial_open(ser, dev, baud) != 0) {
+        fprintf(stderr, "curvestep-sim: %s: %s\n", dev, strerror(errno));
+        return 1;
+    }
+    if (set_parity(ser->fd, parity) != 0) {
+        fprintf(stderr, "curvestep-sim: %s: parity: %s\n", dev, strerror(errno));
+        close(ser->fd);
+        return 1;
+    }
+    return 0;
+}
+
+static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity,
+                     volatile sig_atomic_t *stop, cs_modbus_rtu_stats_t *rs)
+{
+    int keep;
+    cs_serial_t ser;
+    int orc = rtu_open(dev, baud, parity, &ser, &keep);
+    if (orc != 0)
+        return orc;
+    int fd = ser.fd;
     cs_serial_set_lossy(&ser, true);
     cs_modbus_rtu_t *r = calloc(1, sizeof *r);
     if (r == NULL || cs_modbus_rtu_init(r, &d->map, d->unit, baud) != CS_OK) {
@@ -402,14 +309,12 @@ static int serve_rtu(mbdev_t *d, const char *dev, uint32_t baud, char parity, do
             } else if (fate == 2) {
                 delayed_t *q = &d->dl[d->ndl++];
                 q->due = cs_serial_now_s() + d->f.delay_ms / 1000.0;
-                q->fd = -1;
                 memcpy(q->rsp, reply, len);
                 q->rlen = len;
             }
         }
         step_motion(d);
-        if (idle_exit > 0 && cs_sim_motion_started(d->mo) && cs_sim_motion_done(d->mo) &&
-            cs_serial_now_s() - d->last_rx_s > idle_exit)
+        if (idle_done(d))
             break;
     }
     d->wrong_unit += r->stats.other_unit;
@@ -440,7 +345,8 @@ static void usage(FILE *f)
           "                     [--svg OUT.svg] [--png OUT.png] [--trace OUT.csv]\n"
           "Runs the simulator as a Modbus device with the register map of docs/modbus.md:\n"
           "`curvestep stream --modbus-tcp ...` or `--modbus-rtu ...` streams to it.\n"
-          "  --modbus-tcp A:P  serve Modbus TCP (libmodbus) on IPv4 address A, port P; use\n"
+          "  --modbus-tcp A:P  serve Modbus TCP on IPv4 address A, port P, to up to 8 clients\n"
+          "                    at once, in turn (docs/modbus.md); use\n"
           "                    127.0.0.1 (loopback) unless the device must be reachable from\n"
           "                    elsewhere. Port 0 picks a free port. The first line of standard\n"
           "                    output is the address and port bound, e.g. 127.0.0.1:40123\n"
@@ -509,144 +415,151 @@ static int parse_faults(const char *spec, mb_faults_t *f)
     return 0;
 }
 
-int cs_sim_modbus_main(int argc, char **argv)
-{
-    enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3 };
-    const char *tcp = NULL, *rtu = NULL;
-    long unit = 1;
-    char parity = 0;        /* 0: not given (even) */
+enum { OK = 0, INPUT = 1, USAGE = 2, INTERNAL = 3 };
+
+/* The command line, parsed. */
+typedef struct {
+    const char *tcp, *rtu;
+    long unit;
+    char parity;            /* 0: not given (even) */
     cs_sim_device_opts_t o; /* the options the serial device takes too */
-    cs_sim_device_opts_default(&o);
+    mb_faults_t f;
+} mb_args_t;
+
+/* Parses argv into *a: -1 to go on, else the exit status (--help: OK, a bad option: USAGE). */
+static int parse_args(int argc, char **argv, mb_args_t *a)
+{
+    *a = (mb_args_t){.unit = 1, .f = {.delay_ms = 300}};
+    cs_sim_device_opts_default(&a->o);
     for (int i = 1; i < argc; i++) /* `--modbus-tcp --help` too */
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
             return OK;
         }
     for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
+        const char *arg = argv[i];
         bool has = i + 1 < argc;
         char *end = NULL;
-        int took = cs_sim_device_opt(argc, argv, &i, &o);
+        int took = cs_sim_device_opt(argc, argv, &i, &a->o);
         if (took < 0)
             return USAGE;
         if (took > 0)
             continue;
-        if (strcmp(a, "--modbus-tcp") == 0 && has) {
-            tcp = argv[++i];
-        } else if (strcmp(a, "--modbus-rtu") == 0 && has) {
-            rtu = argv[++i];
-        } else if (strcmp(a, "--parity") == 0 && has) {
+        if (strcmp(arg, "--modbus-tcp") == 0 && has) {
+            a->tcp = argv[++i];
+        } else if (strcmp(arg, "--modbus-rtu") == 0 && has) {
+            a->rtu = argv[++i];
+        } else if (strcmp(arg, "--parity") == 0 && has) {
             const char *v = argv[++i];
-            parity = strcmp(v, "none") == 0   ? 'N'
-                     : strcmp(v, "even") == 0 ? 'E'
-                     : strcmp(v, "odd") == 0  ? 'O'
-                                              : 0;
-            if (parity == 0) {
+            a->parity = strcmp(v, "none") == 0   ? 'N'
+                        : strcmp(v, "even") == 0 ? 'E'
+                        : strcmp(v, "odd") == 0  ? 'O'
+                                                 : 0;
+            if (a->parity == 0) {
                 fprintf(stderr, "curvestep-sim: --parity wants none, even or odd\n");
                 return USAGE;
             }
-        } else if (strcmp(a, "--unit") == 0 && has) {
-            unit = strtol(argv[++i], &end, 10);
-            if (*end != '\0' || unit < 0) {
-                fprintf(stderr, "curvestep-sim: %s wants a number\n", a);
+        } else if (strcmp(arg, "--unit") == 0 && has) {
+            a->unit = strtol(argv[++i], &end, 10);
+            if (*end != '\0' || a->unit < 0) {
+                fprintf(stderr, "curvestep-sim: %s wants a number\n", arg);
                 return USAGE;
             }
         } else {
-            fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", a);
+            fprintf(stderr, "curvestep-sim: unknown or incomplete option %s\n", arg);
             usage(stderr);
             return USAGE;
         }
     }
-    const char *machine_file = o.machine_file, *faults = o.faults;
-    cs_sim_device_out_t out = o.out;
-    bool instant = o.instant;
-    double speed = o.speed, idle_exit = o.idle_exit, tol_mm = o.tol_mm;
-    long queue = o.queue, baud = o.baud;
-    if ((tcp != NULL) == (rtu != NULL)) {
-        fprintf(stderr, "curvestep-sim: give exactly one of --modbus-tcp and --modbus-rtu\n");
+    return -1;
+}
+
+/* The combinations and ranges parse_args cannot see one option at a time: OK or USAGE. */
+static int check_args(mb_args_t *a)
+{
+    const char *why = NULL;
+    if ((a->tcp != NULL) == (a->rtu != NULL))
+        why = "give exactly one of --modbus-tcp and --modbus-rtu";
+    else if (a->parity != 0 && a->rtu == NULL)
+        why = "--parity applies to --modbus-rtu only";
+    else if (a->o.queue < 1 || a->o.queue > CS_SIM_DEVICE_QUEUE_MAX)
+        why = "--queue wants 1..256";
+    else if (a->unit < 1 || a->unit > 247)
+        why = "--unit wants a Modbus unit id, 1..247";
+    else if (!cs_serial_baud_ok((uint32_t)a->o.baud) || a->o.baud == 0)
+        why = "--baud is not a termios rate";
+    else if (a->o.faults != NULL && parse_faults(a->o.faults, &a->f) != 0)
+        why = "--faults: bad list (see --modbus-tcp --help)";
+    if (why != NULL) {
+        fprintf(stderr, "curvestep-sim: %s\n", why);
         return USAGE;
     }
-    if (parity != 0 && rtu == NULL) {
-        fprintf(stderr, "curvestep-sim: --parity applies to --modbus-rtu only\n");
-        return USAGE;
-    }
-    if (queue < 1 || queue > CS_SIM_DEVICE_QUEUE_MAX) {
-        fprintf(stderr, "curvestep-sim: --queue wants 1..%d\n", CS_SIM_DEVICE_QUEUE_MAX);
-        return USAGE;
-    }
-    if (unit < 1 || unit > 247) {
-        fprintf(stderr, "curvestep-sim: --unit wants a Modbus unit id, 1..247\n");
-        return USAGE;
-    }
-    if (!cs_serial_baud_ok((uint32_t)baud) || baud == 0) {
-        fprintf(stderr, "curvestep-sim: --baud %ld is not a termios rate\n", baud);
-        return USAGE;
-    }
-    mb_faults_t f = {.delay_ms = 300};
-    if (faults != NULL && parse_faults(faults, &f) != 0) {
-        fprintf(stderr, "curvestep-sim: --faults: bad list '%s' (see --modbus-tcp --help)\n",
-                faults);
-        return USAGE;
-    }
-    cs_machine_t m;
-    cs_machine_pen_t pen; /* mode servo: the check follows the device's pen settings */
-    cs_machine_ini_pen_default(&pen);
+    return OK;
+}
+
+/* The machine (and its pen settings: with a servo pen the check follows them), the device's
+ * configuration and the reference job: OK, INPUT or USAGE. */
+static int prepare(const mb_args_t *a, cs_machine_t *m, cs_machine_pen_t *pen,
+                   cs_sim_device_cfg_t *cfg, cs_sim_ref_t *ref, cs_sim_device_out_t *out)
+{
     char err[512];
-    if (machine_file) {
-        if (cs_machine_ini_load_pen(machine_file, &m, &pen, err, sizeof err) != 0) {
+    cs_machine_ini_pen_default(pen);
+    if (a->o.machine_file) {
+        if (cs_machine_ini_load_pen(a->o.machine_file, m, pen, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return INPUT;
         }
     } else {
-        cs_machine_ini_default(&m);
+        cs_machine_ini_default(m);
     }
-    cs_sim_device_cfg_t cfg;
-    cs_sim_device_cfg_default(&cfg, &m);
-    cfg.queue_size = (uint16_t)queue;
-    cfg.speed = instant ? 0 : speed;
-    cfg.keep_edges = true;
-    if (tol_mm > 0 && cs_conv_tol_to_pos(tol_mm, &cfg.tol) != CS_OK) {
-        fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", tol_mm);
+    cs_sim_device_cfg_default(cfg, m);
+    cfg->queue_size = (uint16_t)a->o.queue;
+    cfg->speed = a->o.instant ? 0 : a->o.speed;
+    cfg->keep_edges = true;
+    if (a->o.tol_mm > 0 && cs_conv_tol_to_pos(a->o.tol_mm, &cfg->tol) != CS_OK) {
+        fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", a->o.tol_mm);
         return USAGE;
     }
-    cs_sim_ref_t ref;
-    cs_sim_ref_init(&ref);
-    out.ref = &ref;
-    if (pen.mode == CS_MACHINE_PEN_SERVO)
-        out.pen = &pen;
-    if (out.reference) { /* a bad job is reported before anything is served */
-        cs_jobplan_t jp; /* read and laid out as plan / stream do (cs_jobopts) */
+    *out = a->o.out;
+    out->ref = ref;
+    if (pen->mode == CS_MACHINE_PEN_SERVO)
+        out->pen = pen;
+    if (out->reference) { /* a bad job is reported before anything is served */
+        cs_jobplan_t jp;  /* read and laid out as plan / stream do (cs_jobopts) */
         cs_jobplan_init(&jp);
-        cs_err_t e = cs_jobplan_reference(&jp, out.reference, &o.in, machine_file, &m);
+        cs_err_t e = cs_jobplan_reference(&jp, out->reference, &a->o.in, a->o.machine_file, m);
         if (e == CS_OK)
-            e = cs_sim_ref_from_path(&ref, &jp.path, out.end_mm);
+            e = cs_sim_ref_from_path(ref, &jp.path, out->end_mm);
         else
             cs_path_diag_print(stderr, &jp.diag);
         cs_jobplan_free(&jp);
-        if (e != CS_OK) {
-            cs_sim_ref_free(&ref);
+        if (e != CS_OK)
             return INPUT;
-        }
     }
+    return OK;
+}
+
+/* The device: the motion side and the firmware's Modbus front end behind the core's map, the
+ * injected refusals in front (one ctx for the hooks). NULL (said on stderr) when it fails. */
+static mbdev_t *open_device(const mb_args_t *a, const cs_machine_t *m,
+                            const cs_sim_device_cfg_t *cfg, cs_sim_device_result_t *res,
+                            double start)
+{
     mbdev_t *d = calloc(1, sizeof *d);
-    if (d == NULL) {
-        cs_sim_ref_free(&ref);
-        return INTERNAL;
-    }
-    d->m = &m;
-    d->unit = (uint8_t)unit;
-    d->f = f;
-    d->rng = f.seed ? f.seed : 0x9E3779B97F4A7C15ull;
-    double start = cs_serial_now_s();
+    if (d == NULL)
+        return NULL;
+    d->m = m;
+    d->unit = (uint8_t)a->unit;
+    d->f = a->f;
+    d->rng = a->f.seed ? a->f.seed : 0x9E3779B97F4A7C15ull;
     d->last_rx_s = start;
-    cs_sim_device_result_t res;
-    cs_err_t e = cs_sim_motion_open(&d->mo, &cfg, &res);
+    d->idle_exit = a->o.idle_exit;
+    cs_err_t e = cs_sim_motion_open(&d->mo, cfg, res);
     if (e == CS_OK) {
         cs_modbus_app_t app;
         cs_fw_modbus_init(&d->fm, cs_sim_motion_fw(d->mo),
                           (uint32_t)getpid() * 2654435761u ^ (uint32_t)(start * 1e6), &app);
-        /* the injected refusals in front of the device's; one ctx for the three hooks */
-        app = (cs_modbus_app_t){app_submit, app_command, app_status, d};
+        app = (cs_modbus_app_t){app_submit, app_command, app_status, app_lease, d};
         e = cs_modbus_map_init(&d->map, &app, 0);
     }
     if (e != CS_OK) {
@@ -654,49 +567,91 @@ int cs_sim_modbus_main(int argc, char **argv)
         if (d->mo)
             cs_sim_motion_close(d->mo);
         free(d);
-        cs_sim_ref_free(&ref);
-        return INTERNAL;
+        return NULL;
     }
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
-    cs_modbus_rtu_stats_t rs = {0};
-    int rc = tcp ? serve_tcp(d, tcp, idle_exit, &g_stop)
-                 : serve_rtu(d, rtu, (uint32_t)baud, parity != 0 ? parity : 'E', idle_exit, &g_stop,
-                             &rs);
-    res.wall_s = cs_serial_now_s() - start;
+    return d;
+}
+
+/* The Modbus lines of the report (the rest is the serial device's). */
+static void report_modbus(const mbdev_t *d, const cs_sim_device_result_t *res, bool tcp,
+                          const cs_modbus_rtu_stats_t *rs)
+{
     cs_modbus_stats_t ms = d->map.stats;
-    e = cs_sim_motion_close(d->mo);
-    if (e != CS_OK && rc == OK) {
-        fprintf(stderr, "curvestep-sim: device failed: %s\n", cs_err_text(e));
-        rc = INTERNAL;
-    }
-    if (rc == USAGE) {
-        cs_sim_exec_free(&res.ex);
-        cs_sim_ref_free(&ref);
-        free(d);
-        return rc;
-    }
     printf("device: served %.2f s; %llu messages executed (%llu step segments, %llu curves); "
            "%u holds, %u aborts, error %u (%s)\n",
-           res.wall_s, (unsigned long long)res.executed, (unsigned long long)res.segments,
-           (unsigned long long)res.curves, (unsigned)res.holds, (unsigned)res.aborts,
+           res->wall_s, (unsigned long long)res->executed, (unsigned long long)res->segments,
+           (unsigned long long)res->curves, (unsigned)res->holds, (unsigned)res->aborts,
            (unsigned)d->fm.error, d->fm.error ? cs_err_text((cs_err_t)d->fm.error) : "none");
     printf("modbus %s unit %u: %llu requests (%llu for other units, not answered); %u mailbox "
            "writes accepted, %u repeats answered without executing, %u refused; %u exceptions\n",
            tcp ? "tcp" : "rtu", (unsigned)d->unit, (unsigned long long)d->requests,
            (unsigned long long)d->wrong_unit, (unsigned)ms.accepted, (unsigned)ms.repeats,
            (unsigned)ms.refused, (unsigned)ms.exceptions);
-    if (rtu)
-        printf("rtu: %u frames answered, %u CRC errors, %u overruns\n", (unsigned)rs.frames,
-               (unsigned)rs.crc_errs, (unsigned)rs.overruns);
+    if (tcp)
+        printf("tcp: %llu connections (at most %u at once, %llu closed to make room), %llu "
+               "closed for a bad MBAP length, %llu frames with another protocol id dropped, "
+               "%llu closed for not reading their answers\n",
+               (unsigned long long)d->tcp.connections, d->tcp.most,
+               (unsigned long long)d->tcp.evicted, (unsigned long long)d->tcp.bad_length,
+               (unsigned long long)d->tcp.bad_proto, (unsigned long long)d->tcp.slow);
+    else
+        printf("rtu: %u frames answered, %u CRC errors, %u overruns\n", (unsigned)rs->frames,
+               (unsigned)rs->crc_errs, (unsigned)rs->overruns);
     printf("faults: %llu answers dropped, %llu delayed, %llu busy refusals, %llu failures\n",
            (unsigned long long)d->dropped, (unsigned long long)d->delayed,
            (unsigned long long)d->busy, (unsigned long long)d->failed);
-    rc = cs_sim_device_report(&m, &cfg, &res, &out, true, rc);
+}
+
+/* Serves until a signal (or --idle-exit), then reports: the exit status. */
+static int serve(const mb_args_t *a, mbdev_t *d, cs_sim_device_result_t *res, double start,
+                 cs_modbus_rtu_stats_t *rs)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    int rc = a->tcp ? serve_tcp(d, a->tcp, &g_stop)
+                    : serve_rtu(d, a->rtu, (uint32_t)a->o.baud, a->parity != 0 ? a->parity : 'E',
+                                &g_stop, rs);
+    res->wall_s = cs_serial_now_s() - start;
+    cs_err_t e = cs_sim_motion_close(d->mo);
+    if (e != CS_OK && rc == OK) {
+        fprintf(stderr, "curvestep-sim: device failed: %s\n", cs_err_text(e));
+        rc = INTERNAL;
+    }
+    return rc;
+}
+
+int cs_sim_modbus_main(int argc, char **argv)
+{
+    mb_args_t a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0)
+        return rc;
+    if (check_args(&a) != OK)
+        return USAGE;
+    cs_machine_t m;
+    cs_machine_pen_t pen;
+    cs_sim_device_cfg_t cfg;
+    cs_sim_device_out_t out;
+    cs_sim_ref_t ref;
+    cs_sim_ref_init(&ref);
+    rc = prepare(&a, &m, &pen, &cfg, &ref, &out);
+    double start = cs_serial_now_s();
+    cs_sim_device_result_t res;
+    mbdev_t *d = rc == OK ? open_device(&a, &m, &cfg, &res, start) : NULL;
+    if (d == NULL) {
+        cs_sim_ref_free(&ref);
+        return rc != OK ? rc : INTERNAL;
+    }
+    cs_modbus_rtu_stats_t rs = {0};
+    rc = serve(&a, d, &res, start, &rs);
+    if (rc != USAGE) {
+        report_modbus(d, &res, a.tcp != NULL, &rs);
+        rc = cs_sim_device_report(&m, &cfg, &res, &out, true, rc);
+    }
     cs_sim_exec_free(&res.ex);
     cs_sim_ref_free(&ref);
     free(d);

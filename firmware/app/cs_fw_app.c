@@ -64,7 +64,11 @@ static void send_hello(cs_fw_app_t *a)
     h.u.hello.axes = a->m->n_axes;
     h.u.hello.queue_size = a->cfg.motion.queue_size;
     h.u.hello.tick_hz = a->m->tick_hz;
-    h.u.hello.caps = CS_FW_CURVES ? CS_PROTO_CAP_ALL : CS_PROTO_CAP_SEGMENTS;
+    uint16_t ctl = CS_FW_CTL ? (uint16_t)(CS_PROTO_CAP_SPINDLE |
+                                          (CS_FW_CURVES ? CS_PROTO_CAP_CONTROL : 0u))
+                             : 0u;
+    h.u.hello.caps =
+        (uint16_t)(CS_PROTO_CAP_SEGMENTS | (CS_FW_CURVES ? CS_PROTO_CAP_CURVES : 0u) | ctl);
     /* the first message of a freshly opened sender: the window has room */
     (void)cs_link_send_msg(&a->link, &h, NULL);
     a->status_due = true;
@@ -154,11 +158,30 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
             cs_fw_motion_error(&a->mo, e, ev->seq);
         a->status_due = true;
         break;
+    case CS_PROTO_JOG_CANCEL:
+        cs_fw_ctl_jog_cancel(&a->mo);
+        break;
+    case CS_PROTO_UNLOCK:
+        e = cs_fw_ctl_unlock(&a->mo);
+        if (e != CS_OK)
+            cs_fw_motion_error(&a->mo, e, ev->seq);
+        break;
     default: /* SEGMENT, CURVE; CURVE without curves or a device-to-host type is refused */
         e = cs_fw_motion_queue(&a->mo, &m, ev->seq);
         if (e != CS_OK) /* CS_ERR_FULL: cs_link refuses it first; belt and braces */
             cs_fw_motion_error(&a->mo, e, ev->seq);
         break;
+    }
+}
+
+static void send_events(cs_fw_app_t *a)
+{
+    cs_proto_msg_t em;
+    em.type = CS_PROTO_EVENT;
+    while (cs_link_can_send(&a->link, CS_PROTO_EVENT) && cs_fw_ctl_peek_event(&a->mo, &em.u.event)) {
+        if (cs_link_send_msg(&a->link, &em, NULL) != CS_OK)
+            break;
+        cs_fw_ctl_drop_event(&a->mo);
     }
 }
 
@@ -252,11 +275,14 @@ void cs_fw_app_poll(cs_fw_app_t *a)
     cs_fw_motion_poll(&a->mo);
     if (cs_fw_motion_news(&a->mo))
         a->status_due = true;
+    /* an alarm's EVENT before its ERROR: a host that stops on the error has seen why */
+    if (cs_link_state(&a->link) == CS_LINK_OPEN)
+        send_events(a);
     send_errors(a);
     now = a->cfg.clock();
     uint8_t st = a->mo.state;
     uint32_t period = ms_ticks(
-        a, (st == CS_PROTO_STATE_RUNNING || st == CS_PROTO_STATE_HELD) ? a->cfg.status_ms : 250u);
+        a, (cs_proto_state_busy(st) || st == CS_PROTO_STATE_HELD) ? a->cfg.status_ms : 250u);
     if (cs_link_state(&a->link) == CS_LINK_OPEN &&
         (a->status_due || (uint32_t)(now - a->status_at) >= period))
         (void)cs_fw_app_send_status(a);
@@ -267,7 +293,8 @@ bool cs_fw_app_can_sleep(const cs_fw_app_t *app)
 {
     bool open = cs_link_state(&app->link) == CS_LINK_OPEN;
     return !app->mo.more && app->txp_off >= app->txp_len &&
-           !(open && (app->status_due || app->mo.nerr));
+           !(open && (app->status_due || app->mo.nerr || app->mo.ctl.nev)) &&
+           app->mo.ctl.trip == CS_FW_TRIP_NONE;
 }
 
 bool cs_fw_app_idle(const cs_fw_app_t *app)

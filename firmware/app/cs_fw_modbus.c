@@ -2,19 +2,51 @@
  * cs_fw_modbus.h and docs/modbus.md. */
 #include "cs_fw_modbus.h"
 
+#include <stdbool.h>
 #include <stddef.h>
 
 void cs_fw_modbus_init(cs_fw_modbus_t *fm, cs_fw_motion_t *mo, uint32_t boot_id,
                        cs_modbus_app_t *app)
 {
-    fm->mo = mo;
-    fm->boot = boot_id != 0 ? boot_id : 1u;
-    fm->error = 0;
-    fm->error_seq = 0;
+    /* no error latched, no lease, the clock at 0 until the caller sets it */
+    *fm = (cs_fw_modbus_t){.mo = mo, .boot = boot_id != 0 ? boot_id : 1u};
     app->submit = cs_fw_modbus_submit;
     app->command = cs_fw_modbus_command;
     app->status = cs_fw_modbus_status;
+    app->lease = cs_fw_modbus_lease;
     app->ctx = fm;
+}
+
+void cs_fw_modbus_clock(cs_fw_modbus_t *fm, uint32_t now_ms)
+{
+    fm->now_ms = now_ms;
+}
+
+/* ms left of the lease, 0 when there is none or it expired (wrap-safe: the difference of two
+ * wrapping counters, read as signed). */
+static uint32_t lease_left(const cs_fw_modbus_t *fm)
+{
+    uint32_t d = fm->lease_until_ms - fm->now_ms;
+    return fm->lease_token != 0 && d - 1u < CS_FW_MODBUS_LEASE_MS ? d : 0u;
+}
+
+cs_err_t cs_fw_modbus_lease(void *ctx, uint8_t op, uint16_t token)
+{
+    cs_fw_modbus_t *fm = ctx;
+    if (lease_left(fm) == 0)
+        fm->lease_token = 0; /* expired: its holder went silent */
+    bool mine = fm->lease_token == token;
+    if (fm->lease_token != 0 && !mine)
+        return CS_ERR_LEASED;
+    if (op == CS_MODBUS_LEASE_RELEASE) {
+        fm->lease_token = 0;
+        return CS_OK;
+    }
+    if (op == CS_MODBUS_LEASE_CLAIM || (op == CS_MODBUS_LEASE_WRITE && fm->lease_token != 0)) {
+        fm->lease_token = token; /* taken, or renewed by its holder's claim or write */
+        fm->lease_until_ms = fm->now_ms + CS_FW_MODBUS_LEASE_MS;
+    }
+    return CS_OK; /* a write with no lease held: as before leases existed */
 }
 
 cs_err_t cs_fw_modbus_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
@@ -65,6 +97,9 @@ void cs_fw_modbus_status(void *ctx, cs_modbus_status_t *st)
     st->error_seq = fm->error_seq;
     for (unsigned i = 0; i < CS_AXES; i++)
         st->pos[i] = i < CS_PROTO_AXES_MAX ? ps.pos[i] : 0;
+    uint32_t left = lease_left(fm);
+    st->lease = left != 0;
+    st->lease_left_ms = (uint16_t)left;
 }
 
 void cs_fw_modbus_collect(cs_fw_modbus_t *fm)

@@ -30,13 +30,21 @@ int32_t cs_fw_motion_position(const cs_fw_motion_t *a, unsigned axis)
     return p;
 }
 
-bool cs_fw_motion_drained(const cs_fw_motion_t *a)
+bool cs_fw_motion_still(const cs_fw_motion_t *a)
 {
 #if CS_FW_CURVES
     if (a->tracing || a->gen_busy || cs_planner_count(&a->pl) != 0)
         return false;
 #endif
-    return !a->has_pend && !a->pen_wait && cs_stepper_idle(&a->st);
+    uint32_t s = port_irq_save();
+    bool idle = cs_stepper_idle(&a->st);
+    port_irq_restore(s);
+    return !a->has_pend && idle;
+}
+
+bool cs_fw_motion_drained(const cs_fw_motion_t *a)
+{
+    return !a->pen_wait && !cs_fw_ctl_blocking(a) && cs_fw_motion_still(a);
 }
 
 bool cs_fw_motion_done(const cs_fw_motion_t *a)
@@ -57,7 +65,19 @@ static uint32_t tag_item(const cs_fw_motion_t *a, uint8_t tag)
     return d < 0x80u ? a->exec_item + d : a->exec_item - (uint32_t)(0x100u - d);
 }
 
-static void mark_executed(cs_fw_motion_t *a, uint32_t item)
+bool cs_fw_motion_executed(const cs_fw_motion_t *a, uint32_t n)
+{
+    return !item_after(n, a->exec_item);
+}
+
+uint16_t cs_fw_motion_current_seq(const cs_fw_motion_t *a)
+{
+    if (item_after(a->popped, a->exec_item))
+        return a->item_seq[(a->exec_item + 1u) & SEQ_MASK];
+    return a->exec_seq;
+}
+
+void cs_fw_motion_mark(cs_fw_motion_t *a, uint32_t item)
 {
     if (item_after(item, a->exec_item)) {
         a->stats.executed += item - a->exec_item;
@@ -75,11 +95,24 @@ static void note_completed(cs_fw_motion_t *a)
     port_irq_restore(s);
     uint8_t done = (uint8_t)(a->pushed - inring - running);
     while (a->completed != done) {
-        mark_executed(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
+        cs_fw_motion_mark(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
         a->completed++;
     }
     if (cs_fw_motion_drained(a))
-        mark_executed(a, a->popped); /* items that made no segment (zero moves, errors) */
+        cs_fw_motion_mark(a, a->popped); /* items that made no segment (zero moves, errors) */
+}
+
+uint16_t cs_fw_motion_halted(cs_fw_motion_t *a, uint8_t done)
+{
+    while (a->completed != done) {
+        cs_fw_motion_mark(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
+        a->completed++;
+    }
+    /* (the low 8 bits of a tag index the sequence map: CS_FW_SEQMAP <= 128) */
+    uint16_t seq = a->pushed != done ? a->item_seq[a->tag[done & TAG_MASK] & SEQ_MASK]
+                                     : cs_fw_motion_current_seq(a);
+    a->completed = a->pushed;
+    return seq;
 }
 
 static void pop_item(cs_fw_motion_t *a, cs_fw_item_t *out)
@@ -93,18 +126,11 @@ static void pop_item(cs_fw_motion_t *a, cs_fw_item_t *out)
 
 static bool may_take_item(const cs_fw_motion_t *a)
 {
-    return a->qcount > 0 && (a->take_max == 0 || item_after(a->take_max, a->popped));
+    return a->qcount > 0 && !cs_fw_ctl_blocking(a) &&
+           (a->take_max == 0 || item_after(a->take_max, a->popped));
 }
 
 #if CS_FW_CURVES
-static cs_pos_t steps_to_pos(int32_t steps, int32_t spm)
-{
-    /* mm Q16 = steps * 2^32 / spm(Q16), rounded to nearest */
-    int64_t num = (int64_t)steps * ((int64_t)1 << 32);
-    int64_t q = num >= 0 ? (num + spm / 2) / spm : -((-num + spm / 2) / spm);
-    return (cs_pos_t)q;
-}
-
 /* SEGMENT messages moved the machine behind the planner's back: start it from there. */
 static void refresh_planner(cs_fw_motion_t *a)
 {
@@ -112,9 +138,17 @@ static void refresh_planner(cs_fw_motion_t *a)
         return;
     cs_pos_t p[CS_AXES] = {0};
     for (unsigned i = 0; i < a->m->n_axes; i++)
-        p[i] = steps_to_pos(a->steps_pos[i], a->m->axis[i].steps_per_mm);
+        p[i] = cs_fw_ctl_steps_to_pos(a->steps_pos[i], a->m->axis[i].steps_per_mm);
     (void)cs_planner_set_position(&a->pl, p);
     a->pl_stale = false;
+}
+
+void cs_fw_motion_plan_line(cs_fw_motion_t *a, const cs_vec3_t *target, int32_t feed, uint32_t n)
+{
+    refresh_planner(a);
+    cs_err_t e = cs_planner_line3(&a->pl, target, feed, n);
+    if (e != CS_OK)
+        cs_fw_motion_error(a, e, a->item_seq[n & SEQ_MASK]);
 }
 
 static void start_curve(cs_fw_motion_t *a, const cs_fw_item_t *it)
@@ -191,7 +225,9 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
 {
     for (unsigned guard = 0; guard < NEXT_GUARD; guard++) {
 #if CS_FW_CURVES
-        bool feeding = a->tracing || (may_take_item(a) && a->q[a->qhead].type == CS_PROTO_CURVE);
+        uint8_t head = a->q[a->qhead].type;
+        bool feeding = a->tracing || (may_take_item(a) && (head == CS_PROTO_CURVE ||
+                                                           head == CS_PROTO_JOG));
         /* Cut when the look-ahead is full or nothing more can be added now (the planner always
          * plans its last block to end at rest, so cutting early is safe). */
         if (a->gen_busy ||
@@ -218,6 +254,11 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
             a->pen_item = a->popped;
             return false;
         }
+        if (it.type != CS_PROTO_SEGMENT && it.type != CS_PROTO_CURVE) {
+            if (!cs_fw_ctl_take(a, &it, a->popped))
+                return false; /* HOME, PROBE, a synchronous SPINDLE: cs_fw_ctl starts them */
+            continue;
+        }
 #if CS_FW_CURVES
         if (it.type == CS_PROTO_CURVE) {
             start_curve(a, &it);
@@ -240,9 +281,14 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
 static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segment_t *orig,
                          uint32_t done)
 {
+    uint16_t aux = cs_fw_ctl_aux(a, s);
     uint32_t irq = port_irq_save();
+    if (a->ctl.trip != CS_FW_TRIP_NONE) { /* halted by an input: cs_fw_ctl drops the rest */
+        port_irq_restore(irq);
+        return;
+    }
     bool was_idle = cs_stepper_idle(&a->st);
-    cs_err_t e = cs_stepper_push(&a->st, s);
+    cs_err_t e = cs_stepper_push_aux(&a->st, s, aux);
     if (e == CS_OK) {
         a->tag[a->pushed & TAG_MASK] = (uint8_t)done;
         a->pushed++;
@@ -279,7 +325,7 @@ static bool apply_pen(cs_fw_motion_t *a)
     a->pen_wait = false;
     a->stats.pens++;
     a->stats.pen_us = a->pen_us;
-    mark_executed(a, a->pen_item);
+    cs_fw_motion_mark(a, a->pen_item);
     return true;
 }
 
@@ -306,7 +352,10 @@ static void feed(cs_fw_motion_t *a)
 
 static void update_state(cs_fw_motion_t *a)
 {
-    uint8_t st = a->hold.hold            ? CS_PROTO_STATE_HELD
+    uint8_t ctl = cs_fw_ctl_state(a);
+    uint8_t st = ctl == CS_PROTO_STATE_ALARM ? ctl
+                 : a->hold.hold && !a->ctl.cancel ? CS_PROTO_STATE_HELD
+                 : ctl != 0xFFu                   ? ctl
                  : !cs_fw_motion_done(a) ? CS_PROTO_STATE_RUNNING
                  : a->aborted            ? CS_PROTO_STATE_ABORTED
                                          : CS_PROTO_STATE_IDLE;
@@ -363,17 +412,17 @@ cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_f
     mo->state = CS_PROTO_STATE_IDLE;
     mo->news = true;
     port_stepper_attach(&mo->st);
+    cs_fw_ctl_init(mo);
     return CS_OK;
 }
 
 cs_err_t cs_fw_motion_queue(cs_fw_motion_t *a, const cs_proto_msg_t *msg, uint16_t seq)
 {
-    bool curve = false;
-#if CS_FW_CURVES
-    curve = msg->type == CS_PROTO_CURVE;
-#endif
-    if (msg->type != CS_PROTO_SEGMENT && msg->type != CS_PROTO_PEN && !curve)
+    if (!cs_proto_uses_slot(msg->type) || (!CS_FW_CURVES && msg->type == CS_PROTO_CURVE))
         return CS_ERR_UNSUPPORTED;
+    cs_err_t e = cs_fw_ctl_admit(a, msg->type);
+    if (e != CS_OK)
+        return e;
     if (a->qcount >= a->cfg.queue_size)
         return CS_ERR_FULL;
     cs_fw_item_t *it = &a->q[(a->qhead + a->qcount) % CS_FW_QUEUE];
@@ -383,9 +432,17 @@ cs_err_t cs_fw_motion_queue(cs_fw_motion_t *a, const cs_proto_msg_t *msg, uint16
         it->u.pen_us = msg->u.pen.pulse_us;
     else if (msg->type == CS_PROTO_SEGMENT)
         it->u.seg = msg->u.segment;
+    else if (msg->type == CS_PROTO_SPINDLE)
+        it->u.spindle = msg->u.spindle;
 #if CS_FW_CURVES
-    else
+    else if (msg->type == CS_PROTO_CURVE)
         it->u.curve = msg->u.curve;
+    else if (msg->type == CS_PROTO_HOME)
+        it->u.home = msg->u.home;
+    else if (msg->type == CS_PROTO_JOG)
+        it->u.jog = msg->u.jog;
+    else
+        it->u.probe = msg->u.probe;
 #endif
     a->qcount++;
     a->aborted = false;
@@ -400,7 +457,7 @@ void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
     a->news = true;
 }
 
-void cs_fw_motion_abort(cs_fw_motion_t *a)
+void cs_fw_motion_flush(cs_fw_motion_t *a)
 {
     /* Items taken from the queue but not wholly handed to the executor (the segment held back,
      * a PEN waiting, a curve being traced or planned) are dropped unexecuted: they are given
@@ -412,8 +469,6 @@ void cs_fw_motion_abort(cs_fw_motion_t *a)
                         : a->exec_item;
     if (item_after(a->popped, keep))
         a->popped = keep;
-    a->qcount = 0;
-    a->qhead = 0;
     a->has_pend = false;
     a->pen_wait = false;
 #if CS_FW_CURVES
@@ -427,14 +482,28 @@ void cs_fw_motion_abort(cs_fw_motion_t *a)
     }
     a->pl_stale = true;
 #endif
+}
+
+void cs_fw_motion_drop(cs_fw_motion_t *a)
+{
+    a->qcount = 0;
+    a->qhead = 0;
+    cs_fw_motion_flush(a);
     cs_hold_reset(&a->hold);
+    a->news = true;
+}
+
+void cs_fw_motion_abort(cs_fw_motion_t *a)
+{
+    cs_fw_ctl_abort(a);
+    cs_fw_motion_drop(a);
     a->aborted = true;
     a->stats.aborts++;
-    a->news = true;
 }
 
 void cs_fw_motion_poll(cs_fw_motion_t *a)
 {
+    cs_fw_ctl_poll(a);
     feed(a);
     note_completed(a);
     update_state(a);
@@ -468,12 +537,10 @@ cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
     if (sp->flags & CS_PROTO_SETPOS_POS) {
         if (!cs_fw_motion_done(a))
             return CS_ERR_STATE;
-        uint32_t irq = port_irq_save();
-        cs_err_t e = cs_stepper_set_position(&a->st, sp->pos);
-        port_irq_restore(irq);
-        if (e != CS_OK)
-            return e;
-        for (unsigned i = 0; i < CS_AXES; i++) {
+        for (unsigned i = 0; i < CS_AXES; i++) { /* idle: cannot fail (done above) */
+            uint32_t irq = port_irq_save();
+            (void)cs_stepper_set_position(&a->st, i, sp->pos[i]);
+            port_irq_restore(irq);
 #if CS_FW_SIM_HOOKS
             a->set_delta[i] += sp->pos[i] - a->steps_pos[i];
 #endif

@@ -36,6 +36,8 @@
 #define CS_FW_SIM_HOOKS 0
 #endif
 
+#include "cs_fw_ctl.h"
+
 #if CS_FW_CURVES
 #include "cs_planner.h"
 #include "cs_trace.h"
@@ -61,15 +63,20 @@ CS_STATIC_ASSERT(CS_FW_SEQMAP <= 128, fw_tags_8_bits);
 CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
 CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
 
-/* One motion-queue slot: a SEGMENT, a PEN or (with curves) a CURVE, and its link sequence. */
+/* One motion-queue slot: a SEGMENT, a PEN, a SPINDLE or (with curves) a CURVE, HOME, JOG or
+ * PROBE, and its link sequence. */
 typedef struct {
-    uint8_t type; /* CS_PROTO_SEGMENT, CS_PROTO_PEN or CS_PROTO_CURVE */
+    uint8_t type; /* CS_PROTO_SEGMENT, CS_PROTO_PEN, ... */
     uint16_t seq;
     union {
         cs_segment_t seg;
         uint16_t pen_us;
+        cs_proto_spindle_t spindle;
 #if CS_FW_CURVES
         cs_proto_curve_t curve;
+        cs_proto_home_t home;
+        cs_proto_jog_t jog;
+        cs_proto_probe_t probe;
 #endif
     } u;
 } cs_fw_item_t;
@@ -94,7 +101,7 @@ typedef struct {
     uint8_t method;      /* cs_trace_method_t for CURVE messages */
 } cs_fw_motion_cfg_t;
 
-typedef struct {
+typedef struct cs_fw_motion_s {
     const cs_machine_t *m;
     cs_fw_motion_cfg_t cfg;
     /* motion queue: slots free = link credits */
@@ -151,6 +158,7 @@ typedef struct {
     uint8_t nerr;
     cs_exlog_segs_t log; /* every segment handed to the executor */
     cs_fw_stats_t stats;
+    cs_fw_ctl_t ctl; /* limits, alarm, homing, jog, probe, spindle (cs_fw_ctl) */
 } cs_fw_motion_t;
 
 /* Zeroes n bytes at p without memset (freestanding: no libc; the application's structs are
@@ -161,7 +169,9 @@ void cs_fw_motion_cfg_default(cs_fw_motion_cfg_t *c, const cs_machine_t *m);
 /* Empty queue, executor at 0, attached to the port's step timer (port_stepper_attach); the last
  * executed sequence reads 0xFFFF. CS_ERR_ARG for a bad machine or cfg. Not ISR-safe. */
 cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_fw_motion_cfg_t *c);
-/* Queues a SEGMENT, PEN or CURVE with its sequence (a PEN is applied with port_pen_set once the
+/* Queues a SEGMENT, PEN, SPINDLE, CURVE, HOME, JOG or PROBE with its sequence (the last four
+ * with curves only; HOME, PROBE and a non-laser SPINDLE start like a PEN, cs_fw_ctl; every one
+ * refused with CS_ERR_STATE in alarm) (a PEN is applied with port_pen_set once the
  * executor has run everything queued before it and stopped, never while held, and nothing after
  * it starts before): CS_ERR_FULL when no slot is free,
  * CS_ERR_UNSUPPORTED for another type (or CURVE without curves). Main loop. */
@@ -198,6 +208,27 @@ bool cs_fw_motion_news(cs_fw_motion_t *mo);
 void cs_fw_motion_status(const cs_fw_motion_t *mo, cs_proto_status_t *st);
 /* Executor position of axis, steps (interrupt masked while read). Main loop. */
 int32_t cs_fw_motion_position(const cs_fw_motion_t *mo, unsigned axis);
+/* Control side (cs_fw_ctl) helpers. Main loop. Drop: the queue and everything not yet in the
+ * executor's ring are forgotten, the hold released (ABORT without the ABORTED state). Flush:
+ * only what was taken from the queue and not yet pushed (planner, tracer, held-back segment,
+ * waiting PEN), the planner restarted from steps_pos. Mark: item n (numbered from 1 as taken)
+ * counts as executed. Still: nothing taken waits to run and the executor is idle. Executed: item n
+ * has been executed. Current seq: the sequence of the item executing (the last executed when
+ * none). Plan line: a straight move to target (mm) at feed for item n into the planner (an
+ * error is reported about n). */
+void cs_fw_motion_drop(cs_fw_motion_t *mo);
+void cs_fw_motion_flush(cs_fw_motion_t *mo);
+void cs_fw_motion_mark(cs_fw_motion_t *mo, uint32_t n);
+bool cs_fw_motion_still(const cs_fw_motion_t *mo);
+bool cs_fw_motion_executed(const cs_fw_motion_t *mo, uint32_t n);
+uint16_t cs_fw_motion_current_seq(const cs_fw_motion_t *mo);
+/* The executor was halted after `done` segments (mod 256, counted as cs_fw_motion pushes them):
+ * those count as executed, the rest of the ring as gone; returns the sequence of the item whose
+ * segment was cut (the current one when none was). */
+uint16_t cs_fw_motion_halted(cs_fw_motion_t *mo, uint8_t done);
+#if CS_FW_CURVES
+void cs_fw_motion_plan_line(cs_fw_motion_t *mo, const cs_vec3_t *target, int32_t feed, uint32_t n);
+#endif
 /* Raises an error about the message with sequence seq (reported in an ERROR; the first
  * CS_FW_ERRQ waiting are kept, the rest only counted). */
 void cs_fw_motion_error(cs_fw_motion_t *mo, cs_err_t code, uint16_t seq);

@@ -30,7 +30,8 @@
     X(CS_ERR_TIMEOUT, 19, "timed out")                                                         \
     X(CS_ERR_UNSUPPORTED, 20, "unsupported operation or message")                              \
     X(CS_ERR_IO, 21, "input/output error")                                                     \
-    X(CS_ERR_PARSE, 22, "input could not be parsed")
+    X(CS_ERR_PARSE, 22, "input could not be parsed")                                          \
+    X(CS_ERR_LEASED, 23, "the mailbox is leased by another client")
 
 #define CS_ERR_ENUM_(name, value, text) name = value,
 typedef enum { CS_ERR_TABLE(CS_ERR_ENUM_) CS_ERR_COUNT_ } cs_err_t;

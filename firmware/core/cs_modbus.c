@@ -125,7 +125,7 @@ cs_err_t cs_modbus_mailbox_decode(const uint16_t *regs, size_t n, cs_proto_msg_t
 cs_err_t cs_modbus_map_init(cs_modbus_map_t *mp, const cs_modbus_app_t *app, uint16_t first_seq)
 {
     if (mp == NULL || app == NULL || app->submit == NULL || app->command == NULL ||
-        app->status == NULL)
+        app->status == NULL) /* app->lease is optional */
         return CS_ERR_ARG;
     *mp = (cs_modbus_map_t){0};
     mp->app = *app;
@@ -172,6 +172,8 @@ static void input_regs(cs_modbus_map_t *mp, uint16_t *ir)
     ir[CS_MODBUS_IR_REFUSED_SEQ] = mp->refused_seq;
     for (unsigned i = 0; i < CS_AXES; i++)
         put32(ir + CS_MODBUS_IR_POS + 2 * i, (uint32_t)st.pos[i]);
+    ir[CS_MODBUS_IR_LEASE] = st.lease ? 1u : 0u;
+    ir[CS_MODBUS_IR_LEASE_LEFT] = st.lease ? st.lease_left_ms : 0u;
 }
 
 /* Holding register value; false when addr is not in the map. */
@@ -179,6 +181,11 @@ static bool holding(const cs_modbus_map_t *mp, uint16_t addr, uint16_t *v)
 {
     if (addr == CS_MODBUS_HR_COMMAND) {
         *v = mp->last_cmd;
+        return true;
+    }
+    if (mp->app.lease != NULL && (addr == CS_MODBUS_HR_LEASE || addr == CS_MODBUS_HR_RELEASE ||
+                                  addr == CS_MODBUS_HR_TOKEN)) {
+        *v = 0; /* the token is never shown: input register LEASE says whether one is held */
         return true;
     }
     if (addr >= CS_MODBUS_HR_MAILBOX && addr < CS_MODBUS_HR_MAILBOX + CS_MODBUS_MAILBOX_REGS) {
@@ -197,12 +204,19 @@ static uint8_t refuse(cs_modbus_map_t *mp, cs_err_t why, uint16_t seq, uint8_t e
     return ex;
 }
 
-/* The mailbox rule (docs/modbus.md, "Sequence numbers"): returns 0 (accepted or a repeat of the
- * last accepted write) or the exception code. */
-static uint8_t mailbox_write(cs_modbus_map_t *mp, const uint16_t *regs, size_t n)
+/* The mailbox rule (docs/modbus.md, "The writer lease" then "Sequence numbers"): returns 0
+ * (accepted or a repeat of the last accepted write) or the exception code. token: the writer's
+ * (0: the write carried none). The lease comes first: a write from another client is refused
+ * whatever its sequence, so it can neither queue a message nor take the holder's number. */
+static uint8_t mailbox_write(cs_modbus_map_t *mp, uint16_t token, const uint16_t *regs, size_t n)
 {
     cs_proto_msg_t m;
     uint16_t seq = n > 0 ? regs[n - 1] : 0;
+    if (mp->app.lease != NULL) {
+        cs_err_t le = mp->app.lease(mp->app.ctx, CS_MODBUS_LEASE_WRITE, token);
+        if (le != CS_OK)
+            return refuse(mp, le, seq, CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    }
     if (seq == (uint16_t)(mp->next_seq - 1u) && mp->last_n != 0) {
         /* the retry of a write whose answer was lost: same registers = the same message,
          * already queued: answer OK, do not queue it again */
@@ -233,6 +247,20 @@ static uint8_t mailbox_write(cs_modbus_map_t *mp, const uint16_t *regs, size_t n
     return 0;
 }
 
+/* A write to LEASE (claim or renew) or RELEASE: 0 or the exception code. */
+static uint8_t lease_op(cs_modbus_map_t *mp, uint8_t op, uint16_t token)
+{
+    if (mp->app.lease == NULL)
+        return CS_MODBUS_EX_ILLEGAL_ADDRESS; /* a map without a lease */
+    if (token == 0)
+        return CS_MODBUS_EX_ILLEGAL_VALUE;
+    cs_err_t e = mp->app.lease(mp->app.ctx, op, token);
+    return e == CS_OK ? 0 : refuse(mp, e, 0, CS_MODBUS_EX_ILLEGAL_FUNCTION);
+}
+
+/* A one-register write (FC06, or FC16 of one register): COMMAND, LEASE or RELEASE. */
+static uint8_t write_one(cs_modbus_map_t *mp, uint16_t addr, uint16_t val);
+
 static uint8_t command(cs_modbus_map_t *mp, uint16_t cmd)
 {
     if (cmd < CS_MODBUS_CMD_HOLD || cmd > CS_MODBUS_CMD_RESET)
@@ -246,6 +274,78 @@ static uint8_t command(cs_modbus_map_t *mp, uint16_t cmd)
     return 0;
 }
 
+static uint8_t write_one(cs_modbus_map_t *mp, uint16_t addr, uint16_t val)
+{
+    if (addr == CS_MODBUS_HR_COMMAND)
+        return command(mp, val);
+    if (addr == CS_MODBUS_HR_LEASE)
+        return lease_op(mp, CS_MODBUS_LEASE_CLAIM, val);
+    if (addr == CS_MODBUS_HR_RELEASE)
+        return lease_op(mp, CS_MODBUS_LEASE_RELEASE, val);
+    /* a one-register mailbox write cannot carry a message: outside the writable map */
+    return CS_MODBUS_EX_ILLEGAL_ADDRESS;
+}
+
+/* FC03 / FC04 (spec 6.3, 6.4): the values go straight into the answer (no second buffer:
+ * small stacks). Returns the answer's length or 0 with *ex set. */
+static size_t read_regs(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_t *rsp,
+                        uint8_t *ex)
+{
+    uint8_t fc = req[0];
+    uint16_t addr = n == 5 ? rd16(req + 1) : 0, qty = n == 5 ? rd16(req + 3) : 0;
+    if (n != 5 || qty < 1 || qty > 125) { /* spec 6.3 / 6.4: exception 03 */
+        *ex = CS_MODBUS_EX_ILLEGAL_VALUE;
+        return 0;
+    }
+    bool ok;
+    if (fc == CS_MODBUS_FC_READ_INPUT) {
+        uint16_t ir[CS_MODBUS_IR_COUNT];
+        ok = (uint32_t)addr + qty <= CS_MODBUS_IR_COUNT;
+        if (ok) {
+            input_regs(mp, ir);
+            for (unsigned k = 0; k < qty; k++)
+                wr16(rsp + 2 + 2 * k, ir[addr + k]);
+        }
+    } else {
+        ok = true;
+        for (unsigned k = 0; ok && k < qty; k++) {
+            uint16_t v = 0;
+            ok = (uint32_t)addr + k <= 0xFFFFu && holding(mp, (uint16_t)(addr + k), &v);
+            wr16(rsp + 2 + 2 * k, v);
+        }
+    }
+    if (!ok) {
+        *ex = CS_MODBUS_EX_ILLEGAL_ADDRESS;
+        return 0;
+    }
+    rsp[0] = fc;
+    rsp[1] = (uint8_t)(2 * qty);
+    return 2 + 2 * (size_t)qty;
+}
+
+/* FC16 (spec 6.12): one register to COMMAND, LEASE or RELEASE; a message to the mailbox, from
+ * 0x0100 (no token) or from 0x00FF (the writer's token first). 0 or the exception code. */
+static uint8_t write_multi(cs_modbus_map_t *mp, const uint8_t *req, size_t n)
+{
+    if (n < 6)
+        return CS_MODBUS_EX_ILLEGAL_VALUE;
+    uint16_t addr = rd16(req + 1), qty = rd16(req + 3);
+    uint8_t bytes = req[5];
+    if (qty < 1 || qty > 123 || bytes != 2 * qty || n != 6 + (size_t)bytes)
+        return CS_MODBUS_EX_ILLEGAL_VALUE;
+    uint16_t regs[1 + CS_MODBUS_MAILBOX_REGS];
+    for (unsigned k = 0; k < qty && k < 1 + CS_MODBUS_MAILBOX_REGS; k++)
+        regs[k] = rd16(req + 6 + 2 * k);
+    if (qty == 1 && addr != CS_MODBUS_HR_MAILBOX && addr != CS_MODBUS_HR_TOKEN)
+        return write_one(mp, addr, regs[0]);
+    if (addr == CS_MODBUS_HR_MAILBOX && qty <= CS_MODBUS_MAILBOX_REGS)
+        return mailbox_write(mp, 0, regs, qty);
+    if (addr == CS_MODBUS_HR_TOKEN && mp->app.lease != NULL && qty >= 2 &&
+        qty <= 1 + CS_MODBUS_MAILBOX_REGS)
+        return mailbox_write(mp, regs[0], regs + 1, (size_t)qty - 1u);
+    return CS_MODBUS_EX_ILLEGAL_ADDRESS;
+}
+
 cs_err_t cs_modbus_pdu(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_t *rsp, size_t cap,
                        size_t *rn)
 {
@@ -253,101 +353,66 @@ cs_err_t cs_modbus_pdu(cs_modbus_map_t *mp, const uint8_t *req, size_t n, uint8_
         return CS_ERR_ARG;
     mp->stats.requests++;
     uint8_t fc = n > 0 ? req[0] : 0;
+    uint8_t ex = CS_MODBUS_EX_ILLEGAL_FUNCTION;
     if (n == 0 || n > CS_MODBUS_PDU_MAX) {
-        *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_FUNCTION, rsp);
-        return CS_OK;
-    }
-    switch (fc) {
-    case CS_MODBUS_FC_READ_HOLDING:
-    case CS_MODBUS_FC_READ_INPUT: {
-        if (n != 5) {
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_VALUE, rsp);
+        /* no function code to answer to (or more than a PDU holds): exception 1 */
+    } else if (fc == CS_MODBUS_FC_READ_HOLDING || fc == CS_MODBUS_FC_READ_INPUT) {
+        *rn = read_regs(mp, req, n, rsp, &ex);
+        if (*rn > 0)
             return CS_OK;
-        }
-        uint16_t addr = rd16(req + 1), qty = rd16(req + 3);
-        if (qty < 1 || qty > 125) { /* spec 6.3 / 6.4: exception 03 */
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_VALUE, rsp);
-            return CS_OK;
-        }
-        /* values go straight into the answer (no second buffer: small stacks) */
-        bool ok;
-        if (fc == CS_MODBUS_FC_READ_INPUT) {
-            uint16_t ir[CS_MODBUS_IR_COUNT];
-            ok = (uint32_t)addr + qty <= CS_MODBUS_IR_COUNT;
-            if (ok) {
-                input_regs(mp, ir);
-                for (unsigned k = 0; k < qty; k++)
-                    wr16(rsp + 2 + 2 * k, ir[addr + k]);
-            }
-        } else {
-            ok = true;
-            for (unsigned k = 0; ok && k < qty; k++) {
-                uint16_t v = 0;
-                ok = (uint32_t)addr + k <= 0xFFFFu && holding(mp, (uint16_t)(addr + k), &v);
-                wr16(rsp + 2 + 2 * k, v);
-            }
-        }
-        if (!ok) {
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_ADDRESS, rsp);
-            return CS_OK;
-        }
-        rsp[0] = fc;
-        rsp[1] = (uint8_t)(2 * qty);
-        *rn = 2 + 2 * (size_t)qty;
-        return CS_OK;
-    }
-    case CS_MODBUS_FC_WRITE_SINGLE: {
-        if (n != 5) {
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_VALUE, rsp);
-            return CS_OK;
-        }
-        uint16_t addr = rd16(req + 1), val = rd16(req + 3);
-        /* only COMMAND takes a single write: a one-register mailbox write cannot carry a
-         * message, so it is outside the writable map */
-        uint8_t ex = addr != CS_MODBUS_HR_COMMAND ? CS_MODBUS_EX_ILLEGAL_ADDRESS : command(mp, val);
-        if (ex != 0) {
-            *rn = exception(mp, fc, ex, rsp);
-            return CS_OK;
-        }
-        for (unsigned k = 0; k < 5; k++) /* the answer echoes the request */
-            rsp[k] = req[k];
-        *rn = 5;
-        return CS_OK;
-    }
-    case CS_MODBUS_FC_WRITE_MULTI: {
-        if (n < 6) {
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_VALUE, rsp);
-            return CS_OK;
-        }
-        uint16_t addr = rd16(req + 1), qty = rd16(req + 3);
-        uint8_t bytes = req[5];
-        if (qty < 1 || qty > 123 || bytes != 2 * qty || n != 6 + (size_t)bytes) {
-            *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_VALUE, rsp);
-            return CS_OK;
-        }
-        uint16_t regs[CS_MODBUS_MAILBOX_REGS];
-        for (unsigned k = 0; k < qty && k < CS_MODBUS_MAILBOX_REGS; k++)
-            regs[k] = rd16(req + 6 + 2 * k);
-        uint8_t ex;
-        if (addr == CS_MODBUS_HR_COMMAND && qty == 1)
-            ex = command(mp, regs[0]);
-        else if (addr == CS_MODBUS_HR_MAILBOX && qty <= CS_MODBUS_MAILBOX_REGS)
-            ex = mailbox_write(mp, regs, qty);
+    } else if (fc == CS_MODBUS_FC_WRITE_SINGLE || fc == CS_MODBUS_FC_WRITE_MULTI) {
+        if (fc == CS_MODBUS_FC_WRITE_SINGLE)
+            ex = n != 5 ? CS_MODBUS_EX_ILLEGAL_VALUE : write_one(mp, rd16(req + 1), rd16(req + 3));
         else
-            ex = CS_MODBUS_EX_ILLEGAL_ADDRESS;
-        if (ex != 0) {
-            *rn = exception(mp, fc, ex, rsp);
+            ex = write_multi(mp, req, n);
+        if (ex == 0) {
+            /* FC06 echoes the request; FC16 answers function, address, quantity */
+            for (unsigned k = 0; k < 5; k++)
+                rsp[k] = req[k];
+            *rn = 5;
             return CS_OK;
         }
-        for (unsigned k = 0; k < 5; k++) /* function, address, quantity */
-            rsp[k] = req[k];
-        *rn = 5;
-        return CS_OK;
     }
-    default:
-        *rn = exception(mp, fc, CS_MODBUS_EX_ILLEGAL_FUNCTION, rsp);
-        return CS_OK;
-    }
+    /* an unknown function code: fc | 0x80 with exception 1 (spec 7), as for every exception */
+    *rn = exception(mp, fc, ex, rsp);
+    return CS_OK;
+}
+
+/* --- Modbus TCP ----------------------------------------------------------------------------- */
+
+cs_err_t cs_modbus_mbap_parse(const uint8_t *b, size_t n, cs_modbus_mbap_t *h)
+{
+    if (b == NULL || h == NULL)
+        return CS_ERR_ARG;
+    if (n < CS_MODBUS_MBAP_LEN)
+        return CS_ERR_EMPTY;
+    uint16_t len = rd16(b + 4); /* unit id + PDU */
+    if (len < 2 || len > 1 + CS_MODBUS_PDU_MAX)
+        return CS_ERR_FRAME;
+    h->tid = rd16(b);
+    h->proto = rd16(b + 2);
+    h->unit = b[6];
+    h->pdu_len = (size_t)len - 1u;
+    if (n < CS_MODBUS_MBAP_LEN + h->pdu_len)
+        return CS_ERR_EMPTY;
+    return h->proto == 0 ? CS_OK : CS_ERR_UNSUPPORTED;
+}
+
+cs_err_t cs_modbus_mbap_frame(const cs_modbus_mbap_t *h, const uint8_t *pdu, size_t n, uint8_t *out,
+                              size_t cap, size_t *len)
+{
+    if (h == NULL || pdu == NULL || out == NULL || len == NULL)
+        return CS_ERR_ARG;
+    if (n == 0 || n > CS_MODBUS_PDU_MAX || CS_MODBUS_MBAP_LEN + n > cap)
+        return CS_ERR_FULL;
+    wr16(out, h->tid);
+    wr16(out + 2, 0);
+    wr16(out + 4, (uint16_t)(n + 1u));
+    out[6] = h->unit;
+    for (size_t k = 0; k < n; k++)
+        out[CS_MODBUS_MBAP_LEN + k] = pdu[k];
+    *len = CS_MODBUS_MBAP_LEN + n;
+    return CS_OK;
 }
 
 /* --- RTU ------------------------------------------------------------------------------------ */

@@ -11,7 +11,10 @@
 #define F16_ONE         ((uint32_t)1 << 16)
 #define F16_CAP         (16u * F16_ONE) /* at most 4x growth of the step per test */
 /* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
- * then within about 2.5 % of the largest that passes). */
+ * then within about 2.5 % of the largest that passes). 1.10 would save 7 % of the instructions
+ * for 0.25 % more chords, but moves a vertex of test_predict's cusp where the reference's
+ * vertex placement (first parameter within 2 LSB) picks the wrong branch (true error 0.54 LSB,
+ * reported 1.79). */
 #define F16_ACCEPT ((F16_ONE * 105u) / 100u)
 
 /* Piecewise-linear majorant of m(a, b) = max_{t in [0,1]} |3t(1-t)((1-t) a + t b)|, in 1/1024,
@@ -37,16 +40,10 @@ static uint64_t uabs64(int64_t v)
     return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
 }
 
-/* Smallest k with v >> k < 2^bits, from the bit length of v (found by halving: 6 steps). */
+/* Smallest k with v >> k < 2^bits. */
 static unsigned shift_below(uint64_t v, unsigned bits)
 {
-    unsigned n = 0;
-    for (unsigned step = 32; step != 0; step >>= 1)
-        if ((v >> step) != 0) {
-            v >>= step;
-            n += step;
-        }
-    n += (unsigned)v; /* bit length: v is now 0 or 1 */
+    unsigned n = cs_fixed_bitlen64(v);
     return n > bits ? n - bits : 0;
 }
 
@@ -120,30 +117,92 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     return CS_OK;
 }
 
+/* x t / 2^30 rounded half away from zero: bit for bit cs_fixed_mul64_q30, inlined with one
+ * 128-bit multiply where the compiler has the type (64-bit hosts), the out-of-line 64x32
+ * product in two halves elsewhere. Every Horner step of the tracer goes through it. */
+static int64_t mul_t(int64_t x, cs_param_t t)
+{
+#if defined(__SIZEOF_INT128__)
+    __extension__ typedef unsigned __int128 u128_t;
+    uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
+    uint64_t at = t < 0 ? (uint64_t)0 - (uint64_t)(int64_t)t : (uint64_t)t;
+    uint64_t r = (uint64_t)(((u128_t)m * at + ((uint64_t)1 << 29)) >> 30);
+    return ((x < 0) != (t < 0)) ? -(int64_t)r : (int64_t)r;
+#else
+    return cs_fixed_mul64_q30(x, t);
+#endif
+}
+
 /* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
  * rounded once: <= 1 unit in d1, 1/2 in d2). */
 static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
 {
     for (unsigned k = 0; k < 2; k++) {
-        int64_t a3x3 = 3 * p->a[3][k];
-        d[1][k] = p->a[2][k] + cs_fixed_mul64_q30(a3x3, t);
-        d[0][k] = p->a[1][k] + cs_fixed_mul64_q30(2 * p->a[2][k] + cs_fixed_mul64_q30(a3x3, t), t);
+        int64_t a3t = mul_t(3 * p->a[3][k], t);
+        d[1][k] = p->a[2][k] + a3t;
+        d[0][k] = p->a[1][k] + mul_t(2 * p->a[2][k] + a3t, t);
     }
+}
+
+/* v / 2^s rounded half up, for |v| < 2^61 and 0 < s < 62, on v + 2^62 (non-negative, so no
+ * >> of a negative value, implementation-defined in C99): branch-free, one shift. */
+#define RSH_BIAS ((uint64_t)1 << 62)
+static int64_t rsh_round(int64_t v, unsigned s)
+{
+    uint64_t u = (uint64_t)v + RSH_BIAS + ((uint64_t)1 << (s - 1));
+    return (int64_t)(u >> s) - (int64_t)(RSH_BIAS >> s);
+}
+
+/* A trial step h = m 2^-s (Q30 when s = 30). Predicted steps are cut to SHORT_BITS significant
+ * bits (a relative change below 2^-15, nothing to the chord count), so each product x h is one
+ * native 64-bit multiply and a rounding shift (|x| < 2^45, m < 2^16: below 2^61) instead of a
+ * 64x32 product in two halves; a step with more bits (the rest of the curve, rem) takes
+ * cs_fixed_mul64_q30. Both round once: <= 1/2 unit. */
+#define SHORT_BITS 16
+typedef struct {
+    int64_t m;
+    unsigned s;
+    bool short_step;
+} step_t;
+
+static step_t step_of(cs_param_t h)
+{
+    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
+    step_t st = {h, CS_PARAM_FRAC_BITS, false};
+    if (((uint32_t)h & (((uint32_t)1 << e) - 1u)) == 0) {
+        st.m = h >> e;
+        st.s = CS_PARAM_FRAC_BITS - e;
+        st.short_step = true;
+    }
+    return st;
+}
+
+static int64_t mul_step(int64_t x, step_t h)
+{
+    if (!h.short_step)
+        return mul_t(x, (cs_param_t)h.m);
+    return rsh_round(x * h.m, h.s);
+}
+
+/* h cut to its SHORT_BITS leading bits (rounded down). */
+static int64_t short_of(int64_t h)
+{
+    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
+    return h & ~(((int64_t)1 << e) - 1);
 }
 
 /* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, int64_t d[2][2], step_t h, int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
-        int64_t c1 = cs_fixed_mul64_q30(d[0][k], h);
-        int64_t c2 = cs_fixed_mul64_q30(cs_fixed_mul64_q30(d[1][k], h), h);
-        int64_t c3 =
-            cs_fixed_mul64_q30(cs_fixed_mul64_q30(cs_fixed_mul64_q30(p->a[3][k], h), h), h);
+        int64_t c1 = mul_step(d[0][k], h);
+        int64_t c2 = mul_step(mul_step(d[1][k], h), h);
+        int64_t c3 = mul_step(mul_step(mul_step(p->a[3][k], h), h), h);
         v[0][k] = c1;
         v[1][k] = 2 * c1 + c2;
         v[2][k] = 3 * (c1 + c2 + c3);
@@ -170,9 +229,10 @@ static uint32_t room_q16(uint64_t allowed, uint64_t found)
 static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
 {
     uint64_t ax = uabs64(x), ay = uabs64(y);
-    unsigned k = 11; /* components < 2^26: >> 11 leaves < 2^15; keep more bits if they are small */
-    while (k > 0 && ((ax | ay) >> (k - 1)) < ((uint64_t)1 << 15))
-        k--;
+    /* components < 2^26: >> 11 leaves < 2^15; keep more bits if they are small */
+    unsigned k = shift_below(ax | ay, 15);
+    if (k > 11)
+        k = 11;
     uint32_t bx = (uint32_t)(ax >> k), by = (uint32_t)(ay >> k);
     uint32_t dd = bx * bx + by * by; /* < 2^31 */
     uint32_t l = bx > by ? bx + 3 * by / 8 : by + 3 * bx / 8;
@@ -197,23 +257,24 @@ static bool hull_flat(int64_t v[3][2], int64_t T)
 static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
 {
     int64_t v[3][2];
-    sub_curve(p, d, h, v);
+    sub_curve(p, d, step_of(h), v);
     uint64_t m = 0;
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
             m |= uabs64(v[i][k]);
     int64_t thr_f = (int64_t)p->thr << F;
-    unsigned s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
-    while ((m >> s) >= ((uint64_t)1 << UNIT_BITS))
-        s++;
+    unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
+    if (s < p->thr_shift)
+        s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
     int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
     if (T <= 0) {
         *room = F16_ONE / 4;
         return false;
     }
-    for (unsigned i = 0; i < 3 && s > 0; i++)
-        for (unsigned k = 0; k < 2; k++)
-            v[i][k] = cs_fixed_round_shift64(v[i][k], s);
+    if (s > 0) /* rounded (half up: <= 1/2 unit), inline: this is the hot path */
+        for (unsigned i = 0; i < 3; i++)
+            for (unsigned k = 0; k < 2; k++)
+                v[i][k] = rsh_round(v[i][k], s);
     int64_t dd = v[2][0] * v[2][0] + v[2][1] * v[2][1];
     int64_t dot1 = v[0][0] * v[2][0] + v[0][1] * v[2][1];
     int64_t dot2 = v[1][0] * v[2][0] + v[1][1] * v[2][1];
@@ -225,14 +286,21 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
     int64_t c1 = v[2][0] * v[0][1] - v[2][1] * v[0][0];
     int64_t c2 = v[2][0] * v[1][1] - v[2][1] * v[1][0];
     uint64_t found = majorant(c1, c2);
-    /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, decided exactly on squares (128 bits):
-     * found^2 <= (3072 T)^2 dd. */
+    /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
-    bool ok = cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
     unsigned sh;
     uint32_t len = approx_len(v[2][0], v[2][1], &sh);
-    *room = room_q16(k * len, found >> sh); /* both scaled by 2^-sh */
-    return ok;
+    uint64_t allowed = k * len, f1 = (found >> sh) + 1; /* f1 > found / 2^sh */
+    *room = room_q16(allowed, f1 - 1); /* both scaled by 2^-sh */
+    /* Clear cases decided on the estimate: len <= 1.0022 |D| / 2^sh, so f1 (1 + 1/32) <=
+     * allowed + 1 proves found <= 3072 T |D| (docs/fixed-point.md); a bound 1/16 above the
+     * estimate fails when len has 10 bits or more (then len >= 0.998 |D| / 2^sh). The rest
+     * exactly on squares (128 bits): found^2 <= (3072 T)^2 dd. */
+    if (f1 + (f1 >> 5) <= allowed)
+        return true;
+    if (len >= 1024u && f1 - 1 >= allowed + (allowed >> 4))
+        return false;
+    return cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
 }
 
 /* sqrt(x) in Q16 for x in Q16 (0 < x <= F16_CAP), within 0.2 %: x = m 4^e with m in [1/2, 2),
@@ -265,7 +333,7 @@ static int64_t predict(cs_param_t h, uint32_t room)
 /* a + (b - a) u, u in Q30 (|b - a| < 2^60: one rounding of 1/2 unit). */
 static int64_t lerp(int64_t a, int64_t b, cs_param_t u)
 {
-    return a + cs_fixed_mul64_q30(b - a, u);
+    return a + mul_t(b - a, u);
 }
 
 /* Homogeneous blossom b(u, v) of the conic (x, y, w), by two levels of lerps. */
@@ -286,19 +354,38 @@ static void project(const int64_t hp[3], unsigned frac, int64_t q[2])
     }
 }
 
+/* What every trial piece of a conic from t shares: the blossom's first level at t (lerps of
+ * the homogeneous points), Q0 = b(t, t), its projection and its weight W0. */
+typedef struct {
+    int64_t l01[3], l12[3], q0[2], w0;
+} conic_start_t;
+
+static void conic_start(const cs_predict_t *p, conic_start_t *c0)
+{
+    int64_t b0[3];
+    for (unsigned k = 0; k < 3; k++) {
+        c0->l01[k] = lerp(p->h[0][k], p->h[1][k], p->t);
+        c0->l12[k] = lerp(p->h[1][k], p->h[2][k], p->t);
+        b0[k] = lerp(c0->l01[k], c0->l12[k], p->t); /* = blossom(p, t, t) */
+    }
+    project(b0, F, c0->q0);
+    c0->w0 = b0[2];
+}
+
 /* Flatness test of the conic piece [t, t + h] with control points Q0, Q1, Q2 and weights W0,
  * W1, W2: its farthest point from the chord is the shoulder, at omega/(1 + omega) of Q1's
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
+static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_t h,
+                       uint32_t *room)
 {
-    int64_t b0[3], b1[3], b2[3], q0[2], q1[2], q2[2], v[2], d[2];
+    int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
+    const int64_t *q0 = c0->q0;
     cs_param_t t1 = p->t + h;
-    blossom(p, p->t, p->t, b0);
-    blossom(p, p->t, t1, b1);
+    for (unsigned k = 0; k < 3; k++) /* b(t, t + h): the first level at t is shared */
+        b1[k] = lerp(c0->l01[k], c0->l12[k], t1);
     blossom(p, t1, t1, b2);
-    project(b0, F, q0);
     project(b1, F, q1);
     project(b2, F, q2);
     uint64_t m = 0;
@@ -307,9 +394,9 @@ static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
         d[k] = q2[k] - q0[k];
         m |= uabs64(v[k]) | uabs64(d[k]);
     }
-    unsigned s = p->thr_shift;
-    while ((m >> s) >= ((uint64_t)1 << CONIC_UNIT_BITS))
-        s++;
+    unsigned s = shift_below(m, CONIC_UNIT_BITS);
+    if (s < p->thr_shift)
+        s = p->thr_shift;
     int64_t T = (((int64_t)p->thr << F) >> s) - 2;
     if (T <= 0) {
         *room = F16_ONE / 4;
@@ -320,7 +407,7 @@ static bool test_conic(const cs_predict_t *p, cs_param_t h, uint32_t *room)
         d[k] = cs_fixed_round_shift64(d[k], s);
     }
     /* phi = W1 / (W1 + sqrt(W0 W2)) rounded up to 1/256 (sqrt rounded down). */
-    uint64_t sq = cs_fixed_isqrt64((uint64_t)b0[2] * (uint64_t)b2[2]);
+    uint64_t sq = cs_fixed_isqrt64((uint64_t)c0->w0 * (uint64_t)b2[2]);
     uint64_t w1 = (uint64_t)b1[2], phi = ((w1 << 8) + w1 + sq - 1) / (w1 + sq);
     uint64_t lim = (uint64_t)T << 8, lim2 = lim * lim; /* T < 2^20: lim^2 < 2^56 */
     int64_t dd = d[0] * d[0] + d[1] * d[1], dot = v[0] * d[0] + v[1] * d[1];
@@ -351,9 +438,9 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
     }
     int64_t r[2];
     for (unsigned k = 0; k < 2; k++) {
-        int64_t acc = p->a[2][k] + cs_fixed_mul64_q30(p->a[3][k], t);
-        acc = p->a[1][k] + cs_fixed_mul64_q30(acc, t);
-        r[k] = cs_fixed_round_shift64(p->a[0][k] + cs_fixed_mul64_q30(acc, t), F);
+        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], t);
+        acc = p->a[1][k] + mul_t(acc, t);
+        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F);
     }
     /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
     pt->x = (cs_pos_t)r[0];
@@ -365,13 +452,18 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
  * between the largest passing and the smallest failing step. 0 when none passes. */
 static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
 {
-    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? short_of(p->h_next) : rem;
+    /* What every trial step from t shares: B'(t), B''(t)/2, or the conic's start (Q0 of each
+     * trial piece and the blossom's first level at t, computed once). */
     int64_t d[2][2] = {{0, 0}, {0, 0}};
+    conic_start_t c0; /* set and read only for a conic */
     if (!p->conic)
         derivs(p, p->t, d);
+    else
+        conic_start(p, &c0);
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
                      : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
@@ -385,7 +477,9 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
             nh = rem;
         if (nh <= lo || nh >= hi)
             nh = lo + (hi - lo) / 2;
-        if (nh == h || hi - lo <= 1)
+        if (nh != rem)
+            nh = short_of(nh);
+        if (nh <= lo || nh == h || hi - lo <= 1)
             break;
         h = nh;
     }
@@ -394,7 +488,7 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (p->conic ? test_conic(p, (cs_param_t)h, &room)
+        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
                      : test_step(p, d, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;

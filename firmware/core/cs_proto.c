@@ -62,6 +62,52 @@ static bool axes_ok(uint8_t n)
     return n >= 1 && n <= CS_PROTO_AXES_MAX;
 }
 
+static bool speed_ok(int32_t v)
+{
+    return v > 0;
+}
+
+/* The machine-control messages (docs/protocol.md, "Machine control"). */
+static cs_err_t check_ctl(const cs_proto_msg_t *m)
+{
+    switch (m->type) {
+    case CS_PROTO_EVENT: {
+        const cs_proto_event_t *e = &m->u.event;
+        bool ok = e->kind >= CS_PROTO_EVENT_ALARM && e->kind < CS_PROTO_EVENT_COUNT_ &&
+                  !(e->inputs & (uint16_t)~CS_PROTO_IN_ALL) && axes_ok(e->axes);
+        return ok ? CS_OK : CS_ERR_RANGE;
+    }
+    case CS_PROTO_HOME: {
+        const cs_proto_home_t *h = &m->u.home;
+        bool ok = h->axis < CS_PROTO_AXES_MAX && !(h->flags & (uint8_t)~CS_PROTO_HOME_MAX) &&
+                  speed_ok(h->seek) && speed_ok(h->latch) && h->pulloff >= 0 &&
+                  h->pulloff <= CS_POS_LIMIT && h->search > 0 && h->search <= CS_POS_LIMIT &&
+                  cs_fixed_pos_ok(h->home_pos);
+        return ok ? CS_OK : CS_ERR_RANGE;
+    }
+    case CS_PROTO_JOG:
+        return cs_fixed_vec_ok(&m->u.jog.target) && speed_ok(m->u.jog.feed) ? CS_OK : CS_ERR_RANGE;
+    case CS_PROTO_PROBE:
+        return cs_fixed_vec_ok(&m->u.probe.target) && speed_ok(m->u.probe.feed) &&
+                       !(m->u.probe.flags &
+                         (uint8_t) ~(CS_PROTO_PROBE_AWAY | CS_PROTO_PROBE_NO_ERROR))
+                   ? CS_OK
+                   : CS_ERR_RANGE;
+    case CS_PROTO_SPINDLE: {
+        const cs_proto_spindle_t *p = &m->u.spindle;
+        bool ok = p->mode < CS_PROTO_SPINDLE_MODE_COUNT_ &&
+                  !(p->flags & (uint8_t)~CS_PROTO_SPINDLE_LASER) &&
+                  p->power <= CS_PROTO_SPINDLE_FULL && p->feed >= 0;
+        return ok ? CS_OK : CS_ERR_RANGE;
+    }
+    case CS_PROTO_JOG_CANCEL:
+    case CS_PROTO_UNLOCK:
+        return CS_OK;
+    default:
+        return CS_ERR_UNSUPPORTED;
+    }
+}
+
 static cs_err_t check(const cs_proto_msg_t *m)
 {
     switch (m->type) {
@@ -112,7 +158,7 @@ static cs_err_t check(const cs_proto_msg_t *m)
     case CS_PROTO_QUERY:
         return CS_OK;
     default:
-        return CS_ERR_UNSUPPORTED;
+        return check_ctl(m);
     }
 }
 
@@ -142,7 +188,19 @@ static size_t msg_len(uint8_t type, uint8_t axes)
     case CS_PROTO_RESUME:
     case CS_PROTO_ABORT:
     case CS_PROTO_QUERY:
+    case CS_PROTO_JOG_CANCEL:
+    case CS_PROTO_UNLOCK:
         return CS_PROTO_LEN_CONTROL;
+    case CS_PROTO_EVENT:
+        return (size_t)CS_PROTO_LEN_EVENT(axes);
+    case CS_PROTO_HOME:
+        return CS_PROTO_LEN_HOME;
+    case CS_PROTO_JOG:
+        return CS_PROTO_LEN_JOG;
+    case CS_PROTO_PROBE:
+        return CS_PROTO_LEN_PROBE;
+    case CS_PROTO_SPINDLE:
+        return CS_PROTO_LEN_SPINDLE;
     default:
         return 0;
     }
@@ -155,7 +213,119 @@ bool cs_proto_sequenced(uint8_t type)
 
 bool cs_proto_uses_slot(uint8_t type)
 {
-    return type == CS_PROTO_SEGMENT || type == CS_PROTO_CURVE || type == CS_PROTO_PEN;
+    switch (type) {
+    case CS_PROTO_SEGMENT:
+    case CS_PROTO_CURVE:
+    case CS_PROTO_PEN:
+    case CS_PROTO_HOME:
+    case CS_PROTO_JOG:
+    case CS_PROTO_PROBE:
+    case CS_PROTO_SPINDLE:
+        return true;
+    default:
+        return false;
+    }
+}
+
+bool cs_proto_state_busy(uint8_t state)
+{
+    return state == CS_PROTO_STATE_RUNNING || state == CS_PROTO_STATE_HOMING ||
+           state == CS_PROTO_STATE_JOG;
+}
+
+static void put_vec(uint8_t *p, const cs_vec3_t *v)
+{
+    puti32(p, v->x);
+    puti32(p + 4, v->y);
+    puti32(p + 8, v->z);
+}
+
+static void get_vec(const uint8_t *p, cs_vec3_t *v)
+{
+    v->x = geti32(p);
+    v->y = geti32(p + 4);
+    v->z = geti32(p + 8);
+}
+
+/* The machine-control messages' bytes (docs/protocol.md); the type byte is written already. */
+static void encode_ctl(const cs_proto_msg_t *m, uint8_t *buf)
+{
+    switch (m->type) {
+    case CS_PROTO_EVENT:
+        buf[1] = m->u.event.kind;
+        buf[2] = m->u.event.code;
+        put16(buf + 3, m->u.event.inputs);
+        buf[5] = m->u.event.axes;
+        for (unsigned i = 0; i < m->u.event.axes; i++)
+            puti32(buf + 6 + 4 * i, m->u.event.pos[i]);
+        break;
+    case CS_PROTO_HOME:
+        buf[1] = m->u.home.axis;
+        buf[2] = m->u.home.flags;
+        puti32(buf + 3, m->u.home.seek);
+        puti32(buf + 7, m->u.home.latch);
+        puti32(buf + 11, m->u.home.pulloff);
+        puti32(buf + 15, m->u.home.search);
+        puti32(buf + 19, m->u.home.home_pos);
+        break;
+    case CS_PROTO_JOG:
+        put_vec(buf + 1, &m->u.jog.target);
+        puti32(buf + 13, m->u.jog.feed);
+        break;
+    case CS_PROTO_PROBE:
+        put_vec(buf + 1, &m->u.probe.target);
+        puti32(buf + 13, m->u.probe.feed);
+        buf[17] = m->u.probe.flags;
+        break;
+    case CS_PROTO_SPINDLE:
+        buf[1] = m->u.spindle.mode;
+        buf[2] = m->u.spindle.flags;
+        put16(buf + 3, m->u.spindle.power);
+        puti32(buf + 5, m->u.spindle.feed);
+        break;
+    default: /* JOG_CANCEL, UNLOCK: the type byte is the whole message */
+        break;
+    }
+}
+
+static void decode_ctl(const uint8_t *buf, cs_proto_msg_t *m)
+{
+    switch (m->type) {
+    case CS_PROTO_EVENT:
+        m->u.event.kind = buf[1];
+        m->u.event.code = buf[2];
+        m->u.event.inputs = get16(buf + 3);
+        m->u.event.axes = buf[5];
+        for (unsigned i = 0; i < m->u.event.axes; i++)
+            m->u.event.pos[i] = geti32(buf + 6 + 4 * i);
+        break;
+    case CS_PROTO_HOME:
+        m->u.home.axis = buf[1];
+        m->u.home.flags = buf[2];
+        m->u.home.seek = geti32(buf + 3);
+        m->u.home.latch = geti32(buf + 7);
+        m->u.home.pulloff = geti32(buf + 11);
+        m->u.home.search = geti32(buf + 15);
+        m->u.home.home_pos = geti32(buf + 19);
+        break;
+    case CS_PROTO_JOG:
+        get_vec(buf + 1, &m->u.jog.target);
+        m->u.jog.feed = geti32(buf + 13);
+        break;
+    case CS_PROTO_PROBE:
+        get_vec(buf + 1, &m->u.probe.target);
+        m->u.probe.feed = geti32(buf + 13);
+        m->u.probe.flags = buf[17];
+        break;
+    case CS_PROTO_SPINDLE:
+        m->u.spindle.mode = buf[1];
+        m->u.spindle.flags = buf[2];
+        m->u.spindle.power = get16(buf + 3);
+        m->u.spindle.feed = geti32(buf + 5);
+        break;
+    default:
+        break;
+    }
 }
 
 cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size_t *len)
@@ -165,7 +335,9 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
     cs_err_t e = check(m);
     if (e != CS_OK)
         return e;
-    uint8_t axes = m->type == CS_PROTO_STATUS ? m->u.status.axes : 0;
+    uint8_t axes = m->type == CS_PROTO_STATUS  ? m->u.status.axes
+                   : m->type == CS_PROTO_EVENT ? m->u.event.axes
+                                               : 0;
     size_t n = msg_len(m->type, axes);
     if (cap < n)
         return CS_ERR_FULL;
@@ -229,7 +401,8 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
     case CS_PROTO_PEN:
         put16(buf + 1, m->u.pen.pulse_us);
         break;
-    default: /* HOLD, RESUME, ABORT, QUERY: the type byte is the whole message */
+    default: /* HOLD, RESUME, ABORT, QUERY: the type byte is the whole message; the rest */
+        encode_ctl(m, buf);
         break;
     }
     *len = n;
@@ -244,10 +417,11 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
         return CS_ERR_FRAME;
     uint8_t type = buf[0];
     uint8_t axes = 0;
-    if (type == CS_PROTO_STATUS) {
-        if (len <= 10)
+    if (type == CS_PROTO_STATUS || type == CS_PROTO_EVENT) {
+        size_t at = type == CS_PROTO_STATUS ? 10u : 5u; /* the axes byte */
+        if (len <= at)
             return CS_ERR_FRAME;
-        axes = buf[10];
+        axes = buf[at];
         if (!axes_ok(axes))
             return CS_ERR_RANGE;
     }
@@ -318,6 +492,7 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
         m->u.pen.pulse_us = get16(buf + 1);
         break;
     default:
+        decode_ctl(buf, m);
         break;
     }
     return check(m);

@@ -27,6 +27,7 @@ typedef enum {
     CS_PROTO_HELLO = 0x10,   /* device identity and capacity, first message after boot */
     CS_PROTO_STATUS = 0x11,  /* state, queue fill, position in steps, last executed sequence */
     CS_PROTO_ERROR = 0x12,   /* a cs_err_t code about a message */
+    CS_PROTO_EVENT = 0x13,   /* alarm, probe contact, axis homed, inputs changed (+ position) */
     CS_PROTO_SEGMENT = 0x20, /* step segment (cs_segment_t): ticks + signed steps per axis */
     CS_PROTO_CURVE = 0x21,   /* cubic Bezier, 4 control points + feed, traced on the device */
     CS_PROTO_HOLD = 0x22,    /* feed hold: decelerate and stop, keep the queue */
@@ -35,6 +36,12 @@ typedef enum {
     CS_PROTO_PEN = 0x25,     /* servo pen pulse width, set between the queued neighbours */
     CS_PROTO_QUERY = 0x2C,   /* asks for a STATUS now (a host that reconnected) */
     CS_PROTO_SETPOS = 0x2D,  /* job id and numbering, and optionally the position in steps */
+    CS_PROTO_HOME = 0x26,    /* home one axis on its switch (seek, back off, latch, pull off) */
+    CS_PROTO_JOG = 0x27,     /* straight move planned on the device, cancellable */
+    CS_PROTO_JOG_CANCEL = 0x28, /* decelerate a jog to rest and drop the queue */
+    CS_PROTO_PROBE = 0x29,      /* straight move that stops when the probe input changes */
+    CS_PROTO_SPINDLE = 0x2A,    /* spindle / laser output, in queue order */
+    CS_PROTO_UNLOCK = 0x2B,     /* leave the alarm state */
 } cs_proto_type_t;
 
 /* Payload sizes in bytes (n = number of axes a status carries, 1..CS_PROTO_AXES_MAX). */
@@ -48,6 +55,11 @@ typedef enum {
 #define CS_PROTO_LEN_CONTROL   1 /* hold, resume, abort, query */
 #define CS_PROTO_LEN_PEN       3
 #define CS_PROTO_LEN_SETPOS    (10 + 4 * CS_AXES)
+#define CS_PROTO_LEN_EVENT(n)  (6 + 4 * (n))
+#define CS_PROTO_LEN_HOME      23
+#define CS_PROTO_LEN_JOG       17
+#define CS_PROTO_LEN_PROBE     18
+#define CS_PROTO_LEN_SPINDLE   9
 #define CS_PROTO_LEN_MAX       CS_PROTO_LEN_CURVE
 
 /* ACK flags. */
@@ -55,7 +67,10 @@ typedef enum {
 /* HELLO capability bits. */
 #define CS_PROTO_CAP_SEGMENTS 0x0001u
 #define CS_PROTO_CAP_CURVES   0x0002u
-#define CS_PROTO_CAP_ALL      (CS_PROTO_CAP_SEGMENTS | CS_PROTO_CAP_CURVES)
+#define CS_PROTO_CAP_CONTROL  0x0004u /* HOME, JOG, PROBE (planned on the device) */
+#define CS_PROTO_CAP_SPINDLE  0x0008u /* SPINDLE */
+#define CS_PROTO_CAP_ALL                                                                           \
+    (CS_PROTO_CAP_SEGMENTS | CS_PROTO_CAP_CURVES | CS_PROTO_CAP_CONTROL | CS_PROTO_CAP_SPINDLE)
 
 /* STATUS flags: what the device knows since its boot. */
 #define CS_PROTO_STATUS_JOB 0x01u /* a SETPOS numbered the job: job_id, done, recv are valid */
@@ -71,6 +86,9 @@ typedef enum {
     CS_PROTO_STATE_HELD = 2,    /* stopped by HOLD, queue kept */
     CS_PROTO_STATE_ABORTED = 3, /* stopped by ABORT, queue flushed */
     CS_PROTO_STATE_FAULT = 4,   /* stopped on an error (see the ERROR messages) */
+    CS_PROTO_STATE_ALARM = 5,   /* hard limit, e-stop, homing or probe failure: UNLOCK first */
+    CS_PROTO_STATE_HOMING = 6,  /* a HOME is running */
+    CS_PROTO_STATE_JOG = 7,     /* a JOG is running */
     CS_PROTO_STATE_COUNT_
 } cs_proto_state_t;
 
@@ -144,6 +162,84 @@ typedef struct {
     uint16_t pulse_us; /* CS_PROTO_PEN_MIN_US..CS_PROTO_PEN_MAX_US */
 } cs_proto_pen_t;
 
+/* Input bits (EVENT.inputs, port_inputs_read): set = active, whatever the wiring's polarity. */
+#define CS_PROTO_IN_MIN(i)  ((uint16_t)(1u << (i)))        /* switch at axis i's minimum end */
+#define CS_PROTO_IN_MAX(i)  ((uint16_t)(1u << (4u + (i)))) /* switch at axis i's maximum end */
+#define CS_PROTO_IN_LIMITS  0x00FFu
+#define CS_PROTO_IN_PROBE   0x0100u
+#define CS_PROTO_IN_ESTOP   0x0200u
+#define CS_PROTO_IN_ALL     0x03FFu
+
+typedef enum {
+    CS_PROTO_EVENT_ALARM = 1,  /* code: cs_proto_alarm_t; pos: where the machine stopped */
+    CS_PROTO_EVENT_PROBE = 2,  /* code: 1 contact, 0 none; pos: the contact position */
+    CS_PROTO_EVENT_HOMED = 3,  /* code: the axis; pos: the position set */
+    CS_PROTO_EVENT_INPUTS = 4, /* code 0; the inputs changed while idle */
+    CS_PROTO_EVENT_COUNT_
+} cs_proto_event_kind_t;
+
+/* Alarm codes, numbered as Grbl 1.1's ALARM:N where Grbl has one. */
+typedef enum {
+    CS_PROTO_ALARM_HARD_LIMIT = 1,
+    CS_PROTO_ALARM_SOFT_LIMIT = 2,
+    CS_PROTO_ALARM_ABORT_CYCLE = 3,
+    CS_PROTO_ALARM_PROBE_INITIAL = 4,
+    CS_PROTO_ALARM_PROBE_CONTACT = 5,
+    CS_PROTO_ALARM_HOMING_RESET = 6,
+    CS_PROTO_ALARM_HOMING_DOOR = 7,
+    CS_PROTO_ALARM_HOMING_PULLOFF = 8,
+    CS_PROTO_ALARM_HOMING_APPROACH = 9,
+    CS_PROTO_ALARM_ESTOP = 10,
+    CS_PROTO_ALARM_COUNT_
+} cs_proto_alarm_t;
+
+typedef struct {
+    uint8_t kind;                   /* cs_proto_event_kind_t */
+    uint8_t code;                   /* per kind (docs/protocol.md EVENT) */
+    uint16_t inputs;                /* CS_PROTO_IN_* bits, within CS_PROTO_IN_ALL */
+    uint8_t axes;                   /* 1..CS_PROTO_AXES_MAX */
+    int32_t pos[CS_PROTO_AXES_MAX]; /* steps */
+} cs_proto_event_t;
+
+#define CS_PROTO_HOME_MAX 0x01u /* HOME flags: the switch is at the maximum end */
+typedef struct {
+    uint8_t axis;     /* 0..CS_PROTO_AXES_MAX-1 */
+    uint8_t flags;    /* CS_PROTO_HOME_MAX */
+    int32_t seek;     /* mm/s Q15.16, > 0 */
+    int32_t latch;    /* mm/s Q15.16, > 0 */
+    cs_pos_t pulloff; /* mm, 0..CS_POS_LIMIT */
+    cs_pos_t search;  /* mm, 1 LSB..CS_POS_LIMIT: the longest seek */
+    cs_pos_t home_pos; /* mm, |x| <= CS_POS_LIMIT: position set after the pull-off */
+} cs_proto_home_t;
+
+typedef struct {
+    cs_vec3_t target; /* machine coordinates, mm, inside CS_POS_LIMIT */
+    int32_t feed;     /* mm/s Q15.16, > 0 */
+} cs_proto_jog_t;
+
+#define CS_PROTO_PROBE_AWAY     0x01u /* stop when contact is lost (G38.4/.5) */
+#define CS_PROTO_PROBE_NO_ERROR 0x02u /* no alarm without contact (G38.3/.5) */
+typedef struct {
+    cs_vec3_t target;
+    int32_t feed;  /* mm/s Q15.16, > 0 */
+    uint8_t flags; /* CS_PROTO_PROBE_* */
+} cs_proto_probe_t;
+
+typedef enum {
+    CS_PROTO_SPINDLE_OFF = 0,
+    CS_PROTO_SPINDLE_CW = 1,  /* M3 */
+    CS_PROTO_SPINDLE_CCW = 2, /* M4 */
+    CS_PROTO_SPINDLE_MODE_COUNT_
+} cs_proto_spindle_mode_t;
+#define CS_PROTO_SPINDLE_LASER 0x01u /* power scaled by speed, set per segment without a stop */
+#define CS_PROTO_SPINDLE_FULL  1000u /* power: duty in 1/1000 */
+typedef struct {
+    uint8_t mode;   /* cs_proto_spindle_mode_t */
+    uint8_t flags;  /* CS_PROTO_SPINDLE_LASER */
+    uint16_t power; /* 0..CS_PROTO_SPINDLE_FULL */
+    int32_t feed;   /* mm/s Q15.16, >= 0: laser mode's speed of full power (0: constant) */
+} cs_proto_spindle_t;
+
 typedef struct {
     uint8_t type; /* cs_proto_type_t */
     union {
@@ -156,7 +252,12 @@ typedef struct {
         cs_proto_curve_t curve;
         cs_proto_pen_t pen;
         cs_proto_setpos_t setpos;
-    } u; /* none for HOLD, RESUME, ABORT, QUERY */
+        cs_proto_event_t event;
+        cs_proto_home_t home;
+        cs_proto_jog_t jog;
+        cs_proto_probe_t probe;
+        cs_proto_spindle_t spindle;
+    } u; /* none for HOLD, RESUME, ABORT, JOG_CANCEL, UNLOCK, QUERY */
 } cs_proto_msg_t;
 
 /* Encode *m into buf[0..cap), *len = bytes written. CS_ERR_UNSUPPORTED for an unknown type,
@@ -169,9 +270,11 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
 cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m);
 /* True for the types cs_link delivers reliably (everything but ACK and PING). */
 bool cs_proto_sequenced(uint8_t type);
-/* True for the types that take a slot of the device's motion queue (SEGMENT, CURVE, PEN): only
- * these spend flow-control credits. */
+/* True for the types that take a slot of the device's motion queue (SEGMENT, CURVE, PEN, HOME,
+ * JOG, PROBE, SPINDLE): only these spend flow-control credits. */
 bool cs_proto_uses_slot(uint8_t type);
+/* True for the states in which the device is moving or about to (RUNNING, HOMING, JOG). */
+bool cs_proto_state_busy(uint8_t state);
 /* Boot id carried by a well-formed ACK, HELLO or STATUS payload (true), else false. */
 bool cs_proto_peek_boot(const uint8_t *buf, size_t len, uint32_t *boot_id);
 

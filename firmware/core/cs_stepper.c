@@ -57,6 +57,8 @@ cs_err_t cs_stepper_init(cs_stepper_t *st, const cs_machine_t *m)
     st->steps_done = 0;
     for (unsigned i = 0; i < CS_AXES; i++)
         st->pos[i] = 0;
+    st->on_load = NULL;
+    st->load_ctx = NULL;
     return CS_OK;
 }
 
@@ -104,6 +106,33 @@ static uint32_t div_period(uint32_t t, uint32_t c, uint32_t *q)
 }
 
 cs_err_t cs_stepper_push(cs_stepper_t *st, const cs_segment_t *seg)
+{
+    return cs_stepper_push_aux(st, seg, 0);
+}
+
+void cs_stepper_on_load(cs_stepper_t *st, cs_stepper_load_fn fn, void *ctx)
+{
+    st->on_load = fn;
+    st->load_ctx = ctx;
+}
+
+void cs_stepper_halt(cs_stepper_t *st)
+{
+    st->running = false;
+    st->head = st->tail;
+}
+
+cs_err_t cs_stepper_set_position(cs_stepper_t *st, unsigned axis, int32_t steps)
+{
+    if (axis >= CS_AXES)
+        return CS_ERR_ARG;
+    if (!cs_stepper_idle(st))
+        return CS_ERR_STATE;
+    st->pos[axis] = steps;
+    return CS_OK;
+}
+
+cs_err_t cs_stepper_push_aux(cs_stepper_t *st, const cs_segment_t *seg, uint16_t aux)
 {
     uint32_t ticks = seg->ticks;
     if (ticks == 0 || ticks > SEG_MAX_TICKS)
@@ -159,6 +188,7 @@ cs_err_t cs_stepper_push(cs_stepper_t *st, const cs_segment_t *seg)
     p->neg = neg;
     p->dir = (uint8_t)(((uint8_t)~neg) ^ st->invert_mask);
     p->move = move;
+    p->aux = aux;
     /* The slot is written before the index that publishes it (both volatile accesses are
      * ordered; one core, so no hardware barrier is needed). */
     st->tail = (uint8_t)(t + 1u);
@@ -168,15 +198,6 @@ cs_err_t cs_stepper_push(cs_stepper_t *st, const cs_segment_t *seg)
 int32_t cs_stepper_position(const cs_stepper_t *st, unsigned axis)
 {
     return axis < CS_AXES ? st->pos[axis] : 0;
-}
-
-cs_err_t cs_stepper_set_position(cs_stepper_t *st, const int32_t pos[CS_AXES])
-{
-    if (!cs_stepper_idle(st))
-        return CS_ERR_STATE;
-    for (unsigned i = 0; i < CS_AXES; i++)
-        st->pos[i] = pos[i];
-    return CS_OK;
 }
 
 /* Makes *p the current segment. Starting the period error at C - 1 makes call j end at
@@ -251,9 +272,13 @@ static CS_STEPPER_NOINLINE void next_segment(cs_stepper_t *st, cs_stepper_out_t 
     if (h == st->tail) {
         out->dir_mask = st->dir_mask;
         out->next_ticks = 0;
+        if (st->on_load != NULL)
+            st->on_load(st->load_ctx, 0);
         return;
     }
     load_segment(st, &st->ring[h & RING_MASK]);
+    if (st->on_load != NULL)
+        st->on_load(st->load_ctx, st->ring[h & RING_MASK].aux);
     st->head = (uint8_t)(h + 1u);
     out->dir_mask = (uint8_t)(st->dir_mask & AXES_MASK);
     out->next_ticks = st->wide ? period_wide(st) : period_narrow(st);

@@ -46,7 +46,12 @@ typedef struct {
     uint8_t dir;  /* DIR levels (invert_dir applied) */
     uint8_t move; /* axes with steps (bit i = axis i) */
     uint8_t wide; /* needs the 32-bit DDA */
+    uint16_t aux; /* the producer's word for this segment, handed to the load hook */
 } cs_stepper_seg_t;
+
+/* Called from the step interrupt when a segment is loaded (its aux word) and when the ring has
+ * run dry (aux 0): how the application makes an output follow the segments (laser power). */
+typedef void (*cs_stepper_load_fn)(void *ctx, uint16_t aux);
 
 /* A segment runs on the 16-bit DDA when C <= this and its base period < 0xFFFF: then every
  * accumulator, count and period of the segment fits 16 bits (8-bit targets do half the work). */
@@ -76,6 +81,8 @@ typedef struct {
     int32_t w_e[CS_AXES];
     uint32_t w_mag[CS_AXES];
     cs_stepper_seg_t ring[CS_STEPPER_RING];
+    cs_stepper_load_fn on_load; /* NULL: none */
+    void *load_ctx;
 } cs_stepper_t;
 
 /* Empty executor at position 0 for machine *m (axes, DIR inversion). Not ISR-safe. */
@@ -86,6 +93,19 @@ cs_err_t cs_stepper_init(cs_stepper_t *st, const cs_machine_t *m);
  * |steps| > ticks). Main loop only; ISR-safe against cs_stepper_tick (single producer, single
  * consumer). */
 cs_err_t cs_stepper_push(cs_stepper_t *st, const cs_segment_t *seg);
+/* The same with the aux word the load hook gets when the segment starts. */
+cs_err_t cs_stepper_push_aux(cs_stepper_t *st, const cs_segment_t *seg, uint16_t aux);
+/* Sets the load hook (NULL: none). Not ISR-safe: call with the step interrupt masked. */
+void cs_stepper_on_load(cs_stepper_t *st, cs_stepper_load_fn fn, void *ctx);
+/* Stops at once: the running segment ends where it is and the ring is emptied (a hard limit, a
+ * probe contact); the position stays exact (every step issued was counted). Call from the step
+ * interrupt, from an interrupt that cannot preempt it or with it masked; the producer must push
+ * nothing more until it has seen the halt (it pushes with the interrupt masked). The port's
+ * timer is the caller's business (port_timer_stop). */
+void cs_stepper_halt(cs_stepper_t *st);
+/* Sets axis's position to steps (homing). Only while idle; not ISR-safe. CS_ERR_STATE when not
+ * idle, CS_ERR_ARG for an axis out of range. */
+cs_err_t cs_stepper_set_position(cs_stepper_t *st, unsigned axis, int32_t steps);
 /* Free slots in the ring. ISR-safe. */
 unsigned cs_stepper_free(const cs_stepper_t *st);
 /* True when nothing is queued or executing. ISR-safe. */
@@ -97,8 +117,5 @@ void cs_stepper_tick(cs_stepper_t *st, cs_stepper_out_t *out);
 /* Position in steps of axis (0 when out of range). Read it with the timer interrupt masked on
  * targets where a 32-bit read is not atomic. */
 int32_t cs_stepper_position(const cs_stepper_t *st, unsigned axis);
-/* Sets the position counters to pos[0..CS_AXES) steps (a position the user or a homing stated).
- * CS_ERR_STATE unless the executor is idle. Call with the timer interrupt masked. */
-cs_err_t cs_stepper_set_position(cs_stepper_t *st, const int32_t pos[CS_AXES]);
 
 #endif

@@ -9,6 +9,63 @@ CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_SUBDIV_TOL_MIN, trace_tol_min_covers_sub
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_SUBDIV_TOL_MAX, trace_tol_max_within_subdiv);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MIN >= CS_PREDICT_TOL_MIN, trace_tol_min_covers_predict);
 CS_STATIC_ASSERT(CS_TRACE_TOL_MAX <= CS_PREDICT_TOL_MAX, trace_tol_max_within_predict);
+CS_STATIC_ASSERT(CS_TRACE_TOL_MIN > CS_FD3_SLACK_LSB, trace_tol_min_covers_fd3);
+
+/* One begin per configured engine (CS_TRACE_METHODS); an engine left out answers
+ * CS_ERR_UNSUPPORTED. Each sets tr->impl to what runs. */
+static cs_err_t begin_reach(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
+{
+#if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV
+    tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
+    return cs_subdiv_reach_begin(&tr->u.reach, c, tol);
+#else
+    (void)tr, (void)c, (void)tol;
+    return CS_ERR_UNSUPPORTED;
+#endif
+}
+
+static cs_err_t begin_predict(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
+{
+#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
+    if (cs_predict_accepts(c)) {
+        tr->impl = CS_TRACE_IMPL_PREDICT;
+        return cs_predict_begin(&tr->u.pr, c, tol);
+    }
+#endif
+    return begin_reach(tr, c, tol);
+}
+
+static cs_err_t begin_fd(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
+{
+#if CS_TRACE_METHODS & CS_TRACE_WITH_FD
+    cs_err_t e;
+    if (cs_fd3_accepts(c) && (e = cs_fd3_begin(&tr->u.fd3, c, tol)) != CS_ERR_UNSUPPORTED) {
+        tr->impl = CS_TRACE_IMPL_FD3; /* planar polynomial: the specialised loop */
+        return e;
+    }
+    tr->impl = CS_TRACE_IMPL_FD;
+    e = cs_fd_begin(&tr->u.fd, c, tol);
+    /* a rational curve needing more than 2^(60/n) steps goes to the reach subdivision */
+    return e == CS_ERR_UNSUPPORTED ? begin_reach(tr, c, tol) : e;
+#else
+    (void)tr, (void)c, (void)tol;
+    return CS_ERR_UNSUPPORTED;
+#endif
+}
+
+static cs_err_t begin_afd(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
+{
+#if CS_TRACE_METHODS & CS_TRACE_WITH_AFD
+    if (!c->rational) {
+        tr->impl = CS_TRACE_IMPL_AFD;
+        return cs_afd_begin(&tr->u.afd, c, tol);
+    }
+    return begin_reach(tr, c, tol);
+#else
+    (void)tr, (void)c, (void)tol;
+    return CS_ERR_UNSUPPORTED;
+#endif
+}
 
 cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
                         cs_trace_method_t method)
@@ -21,27 +78,10 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
         return CS_ERR_ARG;
     if (tol < CS_TRACE_TOL_MIN || tol > CS_TRACE_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    cs_err_t e;
-    if (method == CS_TRACE_PREDICT && cs_predict_accepts(c)) {
-        tr->impl = CS_TRACE_IMPL_PREDICT;
-        e = cs_predict_begin(&tr->u.pr, c, tol);
-    } else if (method == CS_TRACE_SUBDIV || method == CS_TRACE_PREDICT) {
-        tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
-        e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
-    } else if (method == CS_TRACE_FD) {
-        tr->impl = CS_TRACE_IMPL_FD;
-        e = cs_fd_begin(&tr->u.fd, c, tol);
-        if (e == CS_ERR_UNSUPPORTED) { /* rational curve needing more than 2^(60/n) steps */
-            tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
-            e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
-        }
-    } else if (c->rational) {
-        tr->impl = CS_TRACE_IMPL_SUBDIV_REACH;
-        e = cs_subdiv_reach_begin(&tr->u.reach, c, tol);
-    } else {
-        tr->impl = CS_TRACE_IMPL_AFD;
-        e = cs_afd_begin(&tr->u.afd, c, tol);
-    }
+    cs_err_t e = method == CS_TRACE_PREDICT ? begin_predict(tr, c, tol)
+                 : method == CS_TRACE_SUBDIV ? begin_reach(tr, c, tol)
+                 : method == CS_TRACE_FD     ? begin_fd(tr, c, tol)
+                                             : begin_afd(tr, c, tol);
     if (e == CS_OK)
         tr->done = false;
     return e;
@@ -56,18 +96,33 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
         return CS_ERR_DEPTH;
     }
     cs_err_t e;
+    (void)pt; /* unused only when no engine is configured */
     switch (tr->impl) {
+#if CS_TRACE_METHODS & CS_TRACE_WITH_FD
     case CS_TRACE_IMPL_FD:
         e = cs_fd_next(&tr->u.fd, pt);
         break;
+    case CS_TRACE_IMPL_FD3:
+        e = cs_fd3_next(&tr->u.fd3, pt);
+        break;
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_AFD
     case CS_TRACE_IMPL_AFD:
         e = cs_afd_next(&tr->u.afd, pt);
         break;
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
     case CS_TRACE_IMPL_PREDICT:
         e = cs_predict_next(&tr->u.pr, pt);
         break;
-    default:
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV
+    case CS_TRACE_IMPL_SUBDIV_REACH:
         e = cs_subdiv_reach_next(&tr->u.reach, pt);
+        break;
+#endif
+    default: /* no engine started (cannot happen after a successful begin) */
+        e = CS_ERR_ARG;
         break;
     }
     if (e == CS_OK)

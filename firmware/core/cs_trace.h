@@ -8,6 +8,7 @@
 #include "cs_afd.h"
 #include "cs_bezier.h"
 #include "cs_fd.h"
+#include "cs_fd3.h"
 #include "cs_predict.h"
 #include "cs_subdiv.h"
 
@@ -46,19 +47,43 @@ typedef enum {
     CS_TRACE_IMPL_SUBDIV_DYADIC = 2, /* not run by cs_trace any more (cs_subdiv_t directly) */
     CS_TRACE_IMPL_SUBDIV_REACH = 3,
     CS_TRACE_IMPL_PREDICT = 4,
+    CS_TRACE_IMPL_FD3 = 5, /* CS_TRACE_FD on a planar polynomial curve of degree <= 3 (cs_fd3) */
 } cs_trace_impl_t;
 
-/* The tracing state: caller-owned, fixed size (one of the engine states; no dyadic stack). */
+/* Which tracers an image carries (compile-time, e.g. -DCS_TRACE_METHODS=CS_TRACE_WITH_PREDICT):
+ * cs_trace_t holds the state of those only, and cs_trace_begin answers CS_ERR_UNSUPPORTED for
+ * the others (and for curves whose fallback, the reach subdivision, is left out). Default: all.
+ * Sizes on a 64-bit host: FD 872 bytes (its rational part; 216 for the planar path alone), AFD
+ * 352, reach subdivision 288, predicted step 176. */
+#define CS_TRACE_WITH_FD      1u /* cs_fd and cs_fd3 */
+#define CS_TRACE_WITH_AFD     2u
+#define CS_TRACE_WITH_SUBDIV  4u /* the reach subdivision: also the others' fallback */
+#define CS_TRACE_WITH_PREDICT 8u
+#ifndef CS_TRACE_METHODS
+#define CS_TRACE_METHODS 15u
+#endif
+
+/* The tracing state: caller-owned, fixed size (the configured engine states; no dyadic stack). */
 typedef struct {
     uint8_t method; /* cs_trace_method_t asked for */
     uint8_t impl;   /* cs_trace_impl_t running */
     bool done;
     uint32_t count; /* vertices returned so far */
     union {
+#if CS_TRACE_METHODS & CS_TRACE_WITH_FD
         cs_fd_t fd;
+        cs_fd3_t fd3;
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_AFD
         cs_afd_t afd;
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV
         cs_subdiv_reach_t reach;
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
         cs_predict_t pr;
+#endif
+        uint8_t none; /* keeps the union valid when nothing is configured */
     } u;
 } cs_trace_t;
 

@@ -41,6 +41,17 @@ size_t port_uart_write(const uint8_t *buf, size_t len);
  * keeps it (a 50 Hz RC-servo pulse train, or a recorded value: docs/firmware.md says which
  * port does what). Called from the main loop with the executor stopped; not ISR-safe. */
 void port_pen_set(uint16_t pulse_us);
+/* The machine's inputs now: CS_PROTO_IN_* bits (cs_proto.h: min / max limit switch per axis,
+ * probe, e-stop), set = active whatever the wiring's polarity (the port inverts). ISR-safe. */
+uint16_t port_inputs_read(void);
+/* The port calls fn(ctx, bits) whenever the input bits change, from an interrupt that cannot
+ * preempt the step interrupt (same priority, or the step interrupt itself where the port samples
+ * the inputs there), and at once when any is active already; fn may halt the executor. NULL fn:
+ * none. Not ISR-safe. */
+void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx);
+/* The spindle / laser output: PWM duty in 1/1000 of the period (0..1000), mode 0 off (enable
+ * low, duty 0), 1 clockwise, 2 counter-clockwise (direction line high). ISR-safe. */
+void port_spindle_set(uint16_t duty, uint8_t mode);
 /* Unrecoverable error: stop the timer, drop STEP lines, report code, stay safe. */
 void port_fault(cs_err_t code);
 

@@ -1,6 +1,6 @@
 /* bench_modbus: step segments per second over each link on this machine: the serial protocol
  * through a pty (cs_stream against cs_sim_device), Modbus TCP on loopback (cs_mb_stream_run with
- * libmodbus's client against the simulator's libmodbus server) and Modbus RTU through a pty
+ * libmodbus's client against the simulator's own server, cs_sim_mbtcp) and Modbus RTU through a pty
  * (libmodbus's RTU client against the core's RTU server in the simulator). The devices execute
  * instantly, so the figure is what the link carries. Each link streams the same random job; the
  * device's count and hash of the executed segments are checked against the job. Also the bytes
@@ -198,12 +198,16 @@ int main(int argc, char **argv)
     fprintf(stderr, "bench_modbus: modbus rtu\n");
     rows[2] = run_modbus(&job, want, false);
 
-    /* a real RTU line: request of 12 registers = 9 + 24 + 2 bytes, answer 8 bytes, and one
-     * status read (8 + 53 bytes) per queue's worth of writes, at 11 bits a character, plus the
-     * 3.5-character gap after each frame (1750 us above 19200 baud) */
+    /* a real RTU line: an FC16 request of R registers is 9 + 2 R bytes (unit, function,
+     * address, quantity, byte count, data, CRC), R = the token + a SEGMENT's 12; its answer 8
+     * bytes; one status read (8 bytes, answer 5 + 2 x 26) per queue's worth of writes; at 11
+     * bits a character, plus the 3.5-character gap after each frame (1750 us above 19200) */
     const double baud = 115200, qsize = 32;
-    double wr = (35.0 + 8.0) * 11.0 / baud + 2 * 1750e-6;
-    double st = (8.0 + 53.0) * 11.0 / baud + 2 * 1750e-6;
+    const double seg_req = 9.0 + 2.0 * (1 + CS_MODBUS_MAILBOX_SEGMENT_REGS);
+    const double cur_req = 9.0 + 2.0 * (1 + CS_MODBUS_MAILBOX_CURVE_REGS);
+    const double st_bytes = 8.0 + 5.0 + 2.0 * CS_MODBUS_IR_COUNT;
+    double wr = (seg_req + 8.0) * 11.0 / baud + 2 * 1750e-6;
+    double st = st_bytes * 11.0 / baud + 2 * 1750e-6;
     double line_rate = 1.0 / (wr + st / qsize);
 
     printf("## Links: serial, Modbus TCP, Modbus RTU (bench_modbus)\n\n");
@@ -211,9 +215,10 @@ int main(int argc, char **argv)
            "by the host engine of each link to the simulator executing instantly in a child "
            "process, so the figure is what the link carries. Serial: `cs_stream` over a pty, "
            "window of 8 frames. Modbus: `cs_mb_stream_run`, libmodbus 3.1.6 client, one FC16 "
-           "mailbox write (12 registers) per segment, waiting for its answer, plus one FC04 "
-           "status read (24 registers) whenever the %d queue slots it knows of are used; TCP "
-           "through the simulator's libmodbus server on 127.0.0.1, RTU through the core's RTU "
+           "mailbox write (the lease's token and 12 registers) per segment, waiting for its "
+           "answer, plus one FC04 status read (26 registers) whenever the %d queue slots it "
+           "knows of are used; TCP through the simulator's own server (`cs_sim_mbtcp`) on "
+           "127.0.0.1, RTU through the core's RTU "
            "server on a pty (no baud-rate pacing). Every run is checked: the device executed "
            "exactly the job (count and FNV-1a hash of the executed segments).\n\n",
            n, (int)qsize);
@@ -226,8 +231,8 @@ int main(int argc, char **argv)
         fprintf(csv, "%s,%zu,%.4f,%.1f,%.2f,%u,%d\n", rows[k].name, n, rows[k].seconds,
                 rows[k].rate, rows[k].bytes_per_seg, rows[k].retx, rows[k].ok);
     }
-    /* a CURVE: 28 registers = 9 + 56 + 2 bytes, same answer */
-    double wr_c = (67.0 + 8.0) * 11.0 / baud + 2 * 1750e-6;
+    /* a CURVE: the token and 28 registers, same answer */
+    double wr_c = (cur_req + 8.0) * 11.0 / baud + 2 * 1750e-6;
     double curve_rate = 1.0 / (wr_c + st / qsize);
     printf("\nModbus waits for each answer before the next write (one request in flight, as "
            "the protocol has it), so its rate is one round trip per segment; the serial link "
@@ -239,13 +244,13 @@ int main(int argc, char **argv)
            "Over a real RTU line stream curves (`--mode curves`: one %d-register write a cubic, "
            "about **%.0f curves/s** on the same line, each curve many segments of motion) or "
            "plan longer segments.\n",
-           line_rate, 35.0 + 8.0, (int)qsize, line_rate * 0.005,
+           line_rate, seg_req + 8.0, (int)qsize, line_rate * 0.005,
            (double)machine.tick_hz / machine.segment_ticks, CS_MODBUS_MAILBOX_CURVE_REGS,
            curve_rate);
     fprintf(csv, "Modbus RTU 115200 baud (computed),0,0,%.1f,%.1f,0,1\n", line_rate,
-            35.0 + 8.0 + (8.0 + 53.0) / qsize);
+            seg_req + 8.0 + st_bytes / qsize);
     fprintf(csv, "Modbus RTU 115200 baud curves (computed),0,0,%.1f,%.1f,0,1\n", curve_rate,
-            67.0 + 8.0 + (8.0 + 53.0) / qsize);
+            cur_req + 8.0 + st_bytes / qsize);
     fclose(csv);
     cs_stream_job_free(&job);
     return 0;

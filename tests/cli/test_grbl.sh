@@ -78,6 +78,28 @@ expect "long: 2502 ok, 0 errors" grep -q '^acks: 2502 0$' "$T/long.out"
 expect "long: ends Idle at (1, 1)" grep -q '^final: <Idle|MPos:1.000,1.000,0.000|' "$T/long.out"
 expect "long: same final position as plan + replay" grep -qxF "$LONG_POS" "$T/long.sim"
 
+# 1c. work offsets (G10 L20, G10 L2, G54/G55, G92, G92.1) and an O-word sub defined and called
+#     over several lines, by character counting: the final position is the hand-computed machine
+#     17, 18 (G54 zero at 10, 10 plus X7 Y8), the same as plan + replay; then $# shows the offsets
+#     kept (G92 cleared by the client's soft reset) and $G a coordinate system and spindle.
+WCS=tests/data/gcode/grbl-wcs-sub.ngc
+"$CS" plan "$WCS" -o "$T/wcs.seg" 2>/dev/null
+WCS_POS=$("$SIM" --replay "$T/wcs.seg" 2>/dev/null | grep '^final position:')
+expect "wcs: plan + replay at machine 17, 18" grep -q 'x=1360 steps (17.0000 mm) y=1440 steps (18.0000 mm)' <<<"$WCS_POS"
+start_sim wcs
+start_grbl wcs
+client "$GPTY" stream "$WCS" --method counting >"$T/wcs.out"; rc=$?
+client "$GPTY" cmd '$#' 'G55 G20 M3 S1000' '$G' >"$T/wcs2.out"
+stop_all
+expect "wcs: client exit 0" [ $rc -eq 0 ]
+expect "wcs: 20 ok, 0 errors" grep -q '^acks: 20 0$' "$T/wcs.out"
+expect "wcs: ends Idle at machine 17, 18" grep -q '^final: <Idle|MPos:17.000,18.000,0.000|' "$T/wcs.out"
+expect "wcs: same final position as plan + replay" grep -qxF "$WCS_POS" "$T/wcs.sim"
+expect "wcs: \$# G54 from G10 L20" grep -qx '\[G54:10.000,10.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$# G55 from G10 L2" grep -qx '\[G55:40.000,5.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$# G92 cleared" grep -qx '\[G92:0.000,0.000,0.000\]' "$T/wcs2.out"
+expect "wcs: \$G" grep -qx '\[GC:G80 G55 G17 G20 G90 G94 M3 M9 T0 F0 S1000\]' "$T/wcs2.out"
+
 # 2. send-response, ? every 2 lines, and a hold (!) mid-job then resume (~), in real time x20.
 start_sim sr --speed 20 --reference "$PROG" --check
 start_grbl sr
@@ -123,8 +145,8 @@ expect "\$H: error:5 (no homing)" grep -qx 'error:5' "$T/dolh.out"
 expect "errors: beyond the travel error:33, said why" grep -q '^\[MSG:line [0-9]*: the move leaves the machine.s travel\]$' "$T/dolerr.out"
 expect "errors: in order 33, 22 (jog without F), 16 (bad jog word), 15 (jog beyond travel)" \
     [ "$(grep '^error:' "$T/dolerr.out" | tr '\n' ' ')" = "error:33 error:22 error:16 error:15 " ]
-expect "override bytes ignored: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
-expect "override bytes ignored: the status" grep -q '^<Idle|' "$T/dolov.out"
+expect "override bytes: nothing but the status back" [ "$(grep -c . "$T/dolov.out")" -eq 2 ]
+expect "override bytes: feed +10 %, spindle +10 -1 % in Ov (0x91 0x9A 0x9D)" grep -qE '^<Idle\|.*\|Ov:110,100,109>$' "$T/dolov.out"
 expect "\$10=3: Bf in the status" grep -qE '^<Idle\|MPos:0\.000,0\.000,0\.000\|Bf:[0-9]+,128\|FS:0,0' "$T/dolq.out"
 
 # 4. a bad line mid-program: error:N for it alone, the rest runs (final position exact against
@@ -140,8 +162,9 @@ expect "bad: 11 ok, 1 error" grep -q '^acks: 11 1$' "$T/bad.out"
 expect "bad: device check ok" grep -q '^check: ok$' "$T/bad.sim"
 expect "bad: final position exact" grep -qxF "$REF_POS" "$T/bad.sim"
 
-# 5. a jog (10 s long in real time) cancelled with 0x85: stops short of its end; then the
-#    program's G-code goes on from where the jog stopped.
+# 5. a jog (10 s long in real time; the device's JOG) cancelled with 0x85 (the device's
+#    JOG_CANCEL, decelerating within the machine's acceleration): stops short of its end; then
+#    the program's G-code goes on from where the jog stopped.
 start_sim jog --speed 1
 start_grbl jog
 client "$GPTY" jogcancel '$J=G91 X100 F600' >"$T/jog.out"; rc=$?
@@ -153,7 +176,8 @@ expect "jog: accepted" grep -qx 'reply: ok' "$T/jog.out"
 expect "jog: Jog state while moving" grep -q '^jogging: <Jog|MPos:' "$T/jog.out"
 x=$(sed -n 's/^final: <Idle|MPos:\([0-9.-]*\),.*/\1/p' "$T/jog.out")
 expect "jog: cancelled between 0 and 100 mm" awk -v x="${x:-0}" 'BEGIN {exit !(x > 0 && x < 100)}'
-expect "jog: device held and aborted" grep -q ' 1 holds, 1 aborts' "$T/jog.sim"
+expect "jog: the device's JOG_CANCEL stopped it (counted as its one hold), no ABORT" grep -q ' 1 holds, 0 aborts' "$T/jog.sim"
+expect "jog: the cancel decelerated (x within its acceleration)" grep -qE '^axis x: .*peak acceleration [0-9.]+ mm/s\^2 \(limit [0-9.]+ \+ [0-9.]+\) ok$' "$T/jog.sim"
 expect "jog: G-code after the cancel ok" grep -qx ok "$T/jog2.out"
 expect "jog: then Idle at the origin" grep -q '^final: <Idle|MPos:0.000,0.000,0.000|' "$T/jog3.out"
 expect "jog: device back at the origin" grep -q '^final position: x=0 steps (0.0000 mm) y=0 steps' "$T/jog.sim"
@@ -175,6 +199,68 @@ client "$T/ttyCURVESTEP" cmd '$G' >"$T/lnk.out"
 expect "link: answers" grep -q '^\[GC:' "$T/lnk.out"
 stop_all
 expect "link: removed on exit" [ ! -e "$T/ttyCURVESTEP" ]
+
+# 6b. --state FILE: G10 offsets and a G28.1 home written on exit, read back by the next run.
+start_sim st1
+start_grbl st1 --state "$T/state.ngc"
+client "$GPTY" cmd 'G10 L2 P3 X1.5 Y-2' 'G0 X4 Y5' 'G28.1' >"$T/st1.out"
+stop_all
+expect "state: written on exit" grep -qx 'G10 L2 P3 X1.5 Y-2 Z0' "$T/state.ngc"
+start_sim st2
+start_grbl st2 --state "$T/state.ngc"
+client "$GPTY" cmd '$#' >"$T/st2.out"
+stop_all
+expect "state: G56 read back" grep -qx '\[G56:1.500,-2.000,0.000\]' "$T/st2.out"
+expect "state: G28 home read back" grep -qx '\[G28:4.000,5.000,0.000\]' "$T/st2.out"
+printf 'G10 L2 P1 X1\nG10 L7 P1 X1\n' >"$T/badstate.ngc"
+run "state: a bad state file is exit 1" 1 grbl --port /dev/null --state "$T/badstate.ngc"
+expect "state: located error" grep -q "badstate.ngc:2:5: G10 sets work offsets with L2 or L20 only" "$T/err"
+
+# 8. machine control on the device (the simulator's switches and probe from the machine file):
+#    by hand, with the switches at x -5, y -5 (min) and z 3 (max), pull-off 1 and every axis
+#    set to 0 where it ends, the machine's 0 is the simulator's (-4, -4, 2); its probe surface at
+#    z -2.5 is machine z -4.5. $H homes (ok, at 0 0 0); G38.2 from 10 10 0 touches at
+#    [PRB:10.000,10.000,-4.500:1]; a G38.2 that touches nothing is ALARM:5, G-code is then
+#    locked (error:9) until $X; a G0 X-20 trips the x switch at machine -1 (ALARM:1, Pn:X);
+#    $H clears that alarm and homes again.
+printf '%s\n' '[homing]' 'order = zxy' 'x = min' 'y = min' 'z = max' 'x_pos = 0' 'y_pos = 0' \
+    'z_pos = 0' 'pulloff = 1' '[limits]' 'x_min = -5' 'y_min = -5' 'z_max = 3' '[probe]' \
+    'z = -2.5' >"$T/ctl.ini"
+start_sim ctl --speed 20 --machine "$T/ctl.ini"
+start_grbl ctl --machine "$T/ctl.ini"
+client "$GPTY" cmd '$H' '?' 'G0 X10 Y10' 'G38.2 Z-20 F100' '$#' 'G0 Z0' 'G38.2 Z-1 F100' '?' \
+    'G0 X1' '$X' 'G0 X-20' '@waitfor Alarm' '$H' '?' >"$T/ctl.out"; rc=$?
+stop_all
+expect "ctl: client exit 0" [ $rc -eq 0 ]
+expect "ctl: \$H ok, then at 0 0 0" grep -q '^<Idle|MPos:0.000,0.000,0.000|' "$T/ctl.out"
+expect "ctl: probe contact" grep -qx '\[PRB:10.000,10.000,-4.500:1\]' "$T/ctl.out"
+expect "ctl: \$# PRB" [ "$(grep -c '^\[PRB:10.000,10.000,-4.500:1\]$' "$T/ctl.out")" -eq 2 ]
+expect "ctl: probe without contact: PRB :0" grep -qx '\[PRB:10.000,10.000,-1.000:0\]' "$T/ctl.out"
+expect "ctl: ALARM:5" grep -qx 'ALARM:5' "$T/ctl.out"
+expect "ctl: Alarm state where it stopped" grep -q '^<Alarm|MPos:10.000,10.000,-1.000|' "$T/ctl.out"
+expect "ctl: locked until \$X (error:9)" grep -qx 'error:9' "$T/ctl.out"
+expect "ctl: \$X unlocks" grep -qx '\[MSG:Caution: Unlocked\]' "$T/ctl.out"
+expect "ctl: hard limit ALARM:1" grep -qx 'ALARM:1' "$T/ctl.out"
+expect "ctl: stopped on the x switch (machine -1), Pn:X" grep -q '^state: <Alarm|MPos:-1.000,10.000,-1.000|FS:0,0|Pn:X' "$T/ctl.out"
+expect "ctl: \$H again: ok at 0 0 0" [ "$(grep -c '^<Idle|MPos:0.000,0.000,0.000|' "$T/ctl.out")" -eq 2 ]
+expect "ctl: the device homed 6 axes, 2 alarms, 2 probes" grep -q '^control: 6 axes homed, 2 alarms (last ALARM:1), 2 probe cycles' "$T/ctl.sim"
+
+# 9. a laser job (Grbl's laser mode: [spindle] laser = true): M4 S600 with rapids between the
+#    cuts; the device's largest duty is 600/1000 (full power at the programmed speed) and the
+#    final position is the one plan + replay gives.
+printf '%s\n' '[spindle]' 'laser = true' 's_max = 1000' >"$T/laser.ini"
+printf '%s\n' 'G21 G90' 'M4 S600' 'G0 X5' 'G1 X25 F600' 'G0 X30 Y5' 'G1 Y25 F300' 'M5' \
+    'G0 X0 Y1' >"$T/laser.nc"
+"$CS" plan --machine "$T/laser.ini" "$T/laser.nc" -o "$T/laser.seg" 2>/dev/null
+LASER_POS=$("$SIM" --replay "$T/laser.seg" --machine "$T/laser.ini" 2>/dev/null | grep '^final position:')
+start_sim laser --machine "$T/laser.ini"
+start_grbl laser --machine "$T/laser.ini"
+client "$GPTY" stream "$T/laser.nc" --method counting >"$T/laser.out"; rc=$?
+stop_all
+expect "laser: client exit 0" [ $rc -eq 0 ]
+expect "laser: 8 ok" grep -q '^acks: 8 0$' "$T/laser.out"
+expect "laser: largest duty 600/1000" grep -q 'largest duty 600/1000' "$T/laser.sim"
+expect "laser: final position as plan + replay" grep -qxF "$LASER_POS" "$T/laser.sim"
 
 # 7. usage.
 run "help: exit 0" 0 grbl --help

@@ -57,12 +57,12 @@ same_opts "$T/simhelp" "$T/sim.txt" "curvestep-sim's help" man/curvestep-sim.1
 
 # The machine file: keys the code compares against (strcasecmp(name, "key")), every one a .B.
 unman <"$M/curvestep-machine.5" >"$T/m5.txt"
-for k in $(grep -ohE 'strcasecmp\((name|name \+ n \+ 1), "[a-z_]+"\)' host/cs_machine_ini.c host/cs_gpio_cfg.c |
+for k in $(grep -ohE 'strcasecmp\((name|name \+ n \+ 1), "[a-z_]+"\)' host/cs_machine_ini.c host/cs_gpio_cfg.c host/cs_ctlcfg.c |
     sed -E 's/.*"([a-z_]+)"\)/\1/' | sort -u); do
     grep -qE "^\.B ([a-z_]+_)?$k( |\$)|_$k|(^|[ ,])$k(,| |\$)" <(grep '^\.B' "$T/m5.txt") && ok ||
         ko "man/curvestep-machine.5 does not document the key '$k'"
 done
-for s in $(grep -ohE 'strcasecmp\(section, "[a-z]+"\)' host/cs_machine_ini.c host/cs_gpio_cfg.c |
+for s in $(grep -ohE 'strcasecmp\(section, "[a-z]+"\)' host/cs_machine_ini.c host/cs_gpio_cfg.c host/cs_ctlcfg.c |
     sed -E 's/.*"([a-z]+)"\)/\1/' | sort -u) x y z a; do
     grep -qE "^\.SH .*\[$s\]" "$T/m5.txt" && ok || ko "man/curvestep-machine.5 has no section [$s]"
 done

@@ -22,6 +22,8 @@
 #include "../../host/cs_gcode.c"
 #include "../../host/cs_gcode_arc.c"
 #include "../../host/cs_gcode_nurbs.c"
+#include "../../host/cs_gcode_wcs.c"
+#include "../../host/cs_gcode_words.c"
 #include "../../host/cs_gexpr.c"
 #include "../../host/cs_gflow.c"
 #include "../../host/cs_gnurbs.c"

@@ -9,16 +9,21 @@
  * message queued carries first_seq + k, so no sequence is queued twice (a bitmap of the
  * sequences queued is checked too), a normal FC16 answer to the mailbox means queued once or a
  * repeat, an exception means nothing queued; a full queue is exception 6; the registers read
- * back equal the message queued (re-encoded); the status block is consistent (VERSION 1, FREE
+ * back equal the message queued (re-encoded); the status block is consistent (VERSION, FREE
  * <= QUEUE_SIZE, NEXT_SEQ = first_seq + writes accepted, REFUSED a documented code and 0 after a
- * RESET with no refusal since).
+ * RESET with no refusal since, LEASE = a lease held). With the writer lease (configuration bit
+ * 0x80): while a token holds it, no mailbox write that does not carry that token is taken, and
+ * every refusal by the lease is exception 1 with REFUSED = CS_ERR_LEASED.
  * Input: byte 0 = configuration (baud, queue size, first sequence, start time), then records:
  *   00gggggg L b[L]  L bytes on the RTU line, gggggg x 64 us between bytes (the first byte
  *                    after the previous record's last byte by the same gap)
  *   01...... S       S x 32 us of silence, then cs_modbus_rtu_idle
  *   10...... L b[L]  L bytes as one PDU to cs_modbus_pdu
  *   11xxxxxx         application: x&3 = 0 execute (x>>2)+1 queued messages, 1 fail the next
- *                    submit with CS_ERR_LIMIT, 2 queue stays full until the next execute
+ *                    submit with CS_ERR_LIMIT, 2 queue stays full until the next execute,
+ *                    3 the lease expires (its holder went silent)
+ * Configuration bit 0x80: the application has the writer lease hook (a holder without a clock:
+ * it ends by release or by record 11xxxx11).
  * Built and run by scripts/fuzz.sh; -DCS_FUZZ_SEED_MAIN builds the seed writer instead. */
 #include <stdbool.h>
 #include <stdint.h>
@@ -47,12 +52,33 @@ typedef struct {
     uint32_t refused_at_reset; /* map refusals counted at the last RESET */
     bool reset_seen;           /* a RESET was obeyed since the start */
     bool reset_now;            /* ... during the current request */
+    bool lease_hook;           /* the map has the lease (configuration bit 0x80) */
+    uint16_t refused_now;      /* the map's REFUSED after the current request */
+    uint16_t holder;           /* the lease's token, 0: free */
+    uint16_t holder_before;    /* ... when the current request began */
+    uint32_t lease_refusals;   /* in the current request */
 } app_t;
+
+/* The writer lease without a clock (cs_fw_modbus's expiry is unit-tested): one token at a time. */
+static cs_err_t app_lease(void *ctx, uint8_t op, uint16_t token)
+{
+    app_t *a = ctx;
+    FUZZ_CHECK(op == CS_MODBUS_LEASE_WRITE || token != 0); /* the map refuses token 0 itself */
+    if (a->holder != 0 && token != a->holder) {
+        a->lease_refusals++;
+        return CS_ERR_LEASED;
+    }
+    if (op == CS_MODBUS_LEASE_CLAIM)
+        a->holder = token;
+    else if (op == CS_MODBUS_LEASE_RELEASE)
+        a->holder = 0;
+    return CS_OK;
+}
 
 static cs_err_t app_submit(void *ctx, const cs_proto_msg_t *m, uint16_t seq)
 {
     app_t *a = ctx;
-    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE);
+    FUZZ_CHECK(m->type == CS_PROTO_SEGMENT || m->type == CS_PROTO_CURVE || m->type == CS_PROTO_PEN);
     if (a->fail_next) {
         a->fail_next = false;
         a->submits_failed++;
@@ -102,6 +128,8 @@ static void app_status(void *ctx, cs_modbus_status_t *st)
     st->last_exec = (uint16_t)(a->first_seq + a->queued - a->pending - 1u);
     st->pos[0] = -7;
     st->pos[3] = INT32_MIN;
+    st->lease = a->holder != 0;
+    st->lease_left_ms = a->holder != 0 ? 5000 : 0;
 }
 
 /* --- checks --------------------------------------------------------------------------------- */
@@ -114,7 +142,7 @@ static uint16_t rd16(const uint8_t *p)
 static bool refused_code_ok(uint16_t c)
 {
     return c == 0 || c == CS_ERR_SEQ || c == CS_ERR_RANGE || c == CS_ERR_FRAME ||
-           c == CS_ERR_UNSUPPORTED || c == CS_ERR_FULL || c == CS_ERR_LIMIT;
+           c == CS_ERR_UNSUPPORTED || c == CS_ERR_FULL || c == CS_ERR_LIMIT || c == CS_ERR_LEASED;
 }
 
 /* The state of the map and the application agree; a full FC04 read shows it consistently. */
@@ -123,7 +151,8 @@ static void check_state(cs_modbus_map_t *mp, app_t *a)
     FUZZ_CHECK(mp->next_seq == (uint16_t)(a->first_seq + a->queued));
     FUZZ_CHECK(mp->stats.accepted == a->queued);
     FUZZ_CHECK(mp->last_n == 0 || mp->last_n == CS_MODBUS_MAILBOX_SEGMENT_REGS ||
-               mp->last_n == CS_MODBUS_MAILBOX_CURVE_REGS);
+               mp->last_n == CS_MODBUS_MAILBOX_CURVE_REGS ||
+               mp->last_n == CS_MODBUS_MAILBOX_PEN_REGS);
     FUZZ_CHECK(refused_code_ok(mp->refused));
     if (a->reset_seen && mp->stats.refused == a->refused_at_reset)
         FUZZ_CHECK(mp->refused == 0 && mp->refused_seq == 0);
@@ -156,10 +185,25 @@ static void check_state(cs_modbus_map_t *mp, app_t *a)
     FUZZ_CHECK(IR(CS_MODBUS_IR_REFUSED) == mp->refused);
     FUZZ_CHECK(IR(CS_MODBUS_IR_REFUSED_SEQ) == mp->refused_seq);
     FUZZ_CHECK(IR(CS_MODBUS_IR_POS + 6) == 0x8000 && IR(CS_MODBUS_IR_POS + 7) == 0);
+    FUZZ_CHECK(IR(CS_MODBUS_IR_LEASE) == (a->holder != 0));
 #undef IR
     uint8_t hreq[5] = {CS_MODBUS_FC_READ_HOLDING, 0, 0, 0, 1};
     FUZZ_CHECK(cs_modbus_pdu(mp, hreq, 5, rsp, sizeof rsp, &rn) == CS_OK);
     FUZZ_CHECK(rn == 4 && rd16(rsp + 2) == a->last_cmd);
+}
+
+/* A one-register write answered normally: a command obeyed, or the lease claimed (then held
+ * by that token) or released (then free). */
+static void check_one_write(uint16_t addr, uint16_t v, const app_t *a)
+{
+    if (addr == CS_MODBUS_HR_COMMAND) {
+        FUZZ_CHECK(a->last_cmd == v);
+        return;
+    }
+    FUZZ_CHECK(a->lease_hook && v != 0);
+    FUZZ_CHECK(addr == CS_MODBUS_HR_LEASE || addr == CS_MODBUS_HR_RELEASE);
+    FUZZ_CHECK(a->holder == (addr == CS_MODBUS_HR_LEASE ? v : 0));
+    FUZZ_CHECK(a->holder_before == 0 || a->holder_before == v);
 }
 
 static bool exception_code_ok(uint8_t c)
@@ -182,8 +226,12 @@ static void check_reply(const uint8_t *q, size_t qn, const uint8_t *p, size_t n,
         FUZZ_CHECK(a->submits_ok == 0); /* an exception: nothing queued */
         FUZZ_CHECK(a->submits_full == 0 || p[1] == CS_MODBUS_EX_DEVICE_BUSY);
         FUZZ_CHECK(a->submits_failed == 0 || p[1] == CS_MODBUS_EX_DEVICE_FAILURE);
+        /* the lease refused it: exception 1, and REFUSED says why */
+        FUZZ_CHECK(a->lease_refusals == 0 ||
+                   (p[1] == CS_MODBUS_EX_ILLEGAL_FUNCTION && a->refused_now == CS_ERR_LEASED));
         return;
     }
+    FUZZ_CHECK(a->lease_refusals == 0);
     FUZZ_CHECK(p[0] == fc && qn >= 5);
     FUZZ_CHECK(after->exceptions == before->exceptions);
     FUZZ_CHECK(a->submits_full == 0 && a->submits_failed == 0);
@@ -196,12 +244,17 @@ static void check_reply(const uint8_t *q, size_t qn, const uint8_t *p, size_t n,
         FUZZ_CHECK(a->submits_ok == 0);
         break;
     case CS_MODBUS_FC_WRITE_SINGLE:
-        FUZZ_CHECK(qn == 5 && n == 5 && memcmp(p, q, 5) == 0 && addr == CS_MODBUS_HR_COMMAND);
-        FUZZ_CHECK(a->submits_ok == 0 && a->last_cmd == qty);
+        FUZZ_CHECK(qn == 5 && n == 5 && memcmp(p, q, 5) == 0 && a->submits_ok == 0);
+        check_one_write(addr, qty, a);
         break;
     case CS_MODBUS_FC_WRITE_MULTI:
         FUZZ_CHECK(n == 5 && memcmp(p, q, 5) == 0 && qn == 6 + 2 * (size_t)qty && q[5] == 2 * qty);
-        if (addr == CS_MODBUS_HR_MAILBOX) {
+        if (addr == CS_MODBUS_HR_MAILBOX || addr == CS_MODBUS_HR_TOKEN) {
+            /* with a lease held, only its holder's token is taken */
+            bool token = addr == CS_MODBUS_HR_TOKEN;
+            FUZZ_CHECK(!token || a->lease_hook);
+            FUZZ_CHECK(a->holder_before == 0 || (token && rd16(q + 6) == a->holder_before));
+            qty = (uint16_t)(qty - token);
             /* queued once, or the repeat of the last write answered without queueing */
             bool queued = a->submits_ok == 1 && after->accepted == before->accepted + 1 &&
                           after->repeats == before->repeats;
@@ -209,11 +262,12 @@ static void check_reply(const uint8_t *q, size_t qn, const uint8_t *p, size_t n,
                           after->repeats == before->repeats + 1;
             FUZZ_CHECK(queued || repeat);
             FUZZ_CHECK(qty == CS_MODBUS_MAILBOX_SEGMENT_REGS ||
-                       qty == CS_MODBUS_MAILBOX_CURVE_REGS);
-            FUZZ_CHECK(rd16(q + 4 + 2 * qty) == (uint16_t)(a->first_seq + a->queued - 1u));
+                       qty == CS_MODBUS_MAILBOX_CURVE_REGS || qty == CS_MODBUS_MAILBOX_PEN_REGS);
+            FUZZ_CHECK(rd16(q + 4 + 2 * (qty + token)) ==
+                       (uint16_t)(a->first_seq + a->queued - 1u));
         } else {
-            FUZZ_CHECK(addr == CS_MODBUS_HR_COMMAND && qty == 1 && a->submits_ok == 0);
-            FUZZ_CHECK(a->last_cmd == rd16(q + 6));
+            FUZZ_CHECK(qty == 1 && a->submits_ok == 0);
+            check_one_write(addr, rd16(q + 6), a);
         }
         break;
     default:
@@ -237,6 +291,8 @@ static bool any_byte;
 static void before_request(cs_modbus_stats_t *s)
 {
     app.submits_ok = app.submits_full = app.submits_failed = 0;
+    app.lease_refusals = 0;
+    app.holder_before = app.holder;
     app.reset_now = false;
     *s = map.stats;
 }
@@ -264,6 +320,7 @@ static void check_rtu_reply(size_t end, const uint8_t *reply, size_t len,
     FUZZ_CHECK(cs_modbus_crc(CS_MODBUS_CRC_INIT, q, qn) == 0);
     FUZZ_CHECK(len >= 5 && len <= CS_MODBUS_RTU_MAX && reply[0] == UNIT);
     FUZZ_CHECK(cs_modbus_crc(CS_MODBUS_CRC_INIT, reply, len) == 0);
+    app.refused_now = map.refused;
     check_reply(q + 1, qn - 3, reply + 1, len - 3, &app, before, &map.stats);
 }
 
@@ -374,6 +431,7 @@ static void pdu(const uint8_t *q, size_t qn)
     FUZZ_CHECK(rn >= 2 && rn <= CS_MODBUS_PDU_MAX);
     for (size_t k = CS_MODBUS_PDU_MAX; k < sizeof rsp; k++)
         FUZZ_CHECK(rsp[k] == 0xA5); /* nothing written past cap */
+    app.refused_now = map.refused;
     check_reply(q, qn, rsp, rn, &app, &before, &map.stats);
     after_command_reset(&before);
 }
@@ -387,7 +445,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&app, 0, sizeof app);
     app.queue_size = (uint16_t)(1 + (cfg & 7));
     app.first_seq = firsts[(cfg >> 3) & 3];
-    cs_modbus_app_t hooks = {app_submit, app_command, app_status, &app};
+    app.lease_hook = (cfg & 0x80) != 0;
+    cs_modbus_app_t hooks = {app_submit, app_command, app_status, app.lease_hook ? app_lease : NULL,
+                             &app};
     FUZZ_CHECK(cs_modbus_map_init(&map, &hooks, app.first_seq) == CS_OK);
     uint32_t baud = (cfg & 0x20) ? 9600 : 115200;
     FUZZ_CHECK(cs_modbus_rtu_init(&rtu, &map, UNIT, baud) == CS_OK);
@@ -443,6 +503,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 app.stuck_full = true;
                 break;
             default:
+                app.holder = 0; /* the lease expired */
                 break;
             }
         }
@@ -566,7 +627,7 @@ int main(int argc, char **argv)
     put(&s, cfg);
     rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_INPUT, 0, CS_MODBUS_IR_COUNT), 1, false);
     rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_INPUT, 8, 4), 1, false);
-    rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_INPUT, 20, 5), 1, false); /* past the end */
+    rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_INPUT, 22, 5), 1, false); /* past the end */
     rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_HOLDING, 0, 1), 1, false);
     rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_HOLDING, 0x100, 28), 1, false);
     rtu_rec(&s, UNIT, p, rd(p, CS_MODBUS_FC_READ_HOLDING, 0x1, 1), 1, false);
@@ -653,6 +714,30 @@ int main(int argc, char **argv)
     pdu_rec(&s, p, 4);
     pdu_rec(&s, p, 0);
     emit(d, "seed-pdu", &s);
+
+    /* the writer lease: a claim, the holder's write with its token, a foreign write with the
+     * next sequence (refused), a foreign claim, the lease expiring, a release */
+    put(&s, cfg | 0x80);
+    pdu_rec(&s, p, rd(p, CS_MODBUS_FC_WRITE_SINGLE, CS_MODBUS_HR_LEASE, 0x1234));
+    {
+        uint16_t r[1 + CS_MODBUS_MAILBOX_REGS];
+        n = segment(p, 0);
+        r[0] = 0x1234;
+        for (size_t k = 0; k < CS_MODBUS_MAILBOX_SEGMENT_REGS; k++)
+            r[1 + k] = (uint16_t)((p[6 + 2 * k] << 8) | p[7 + 2 * k]);
+        pdu_rec(&s, p, wr_regs(p, CS_MODBUS_HR_TOKEN, r, 1 + CS_MODBUS_MAILBOX_SEGMENT_REGS));
+        pdu_rec(&s, p, segment(p, 1)); /* no token: refused */
+        r[0] = 0x9999;
+        r[CS_MODBUS_MAILBOX_SEGMENT_REGS] = 1;
+        pdu_rec(&s, p, wr_regs(p, CS_MODBUS_HR_TOKEN, r, 1 + CS_MODBUS_MAILBOX_SEGMENT_REGS));
+    }
+    pdu_rec(&s, p, rd(p, CS_MODBUS_FC_WRITE_SINGLE, CS_MODBUS_HR_LEASE, 0x9999));
+    pdu_rec(&s, p, rd(p, CS_MODBUS_FC_READ_HOLDING, CS_MODBUS_HR_TOKEN, 29));
+    put(&s, 0xC3); /* expires */
+    pdu_rec(&s, p, rd(p, CS_MODBUS_FC_WRITE_SINGLE, CS_MODBUS_HR_LEASE, 0x9999));
+    pdu_rec(&s, p, rd(p, CS_MODBUS_FC_WRITE_SINGLE, CS_MODBUS_HR_RELEASE, 0x9999));
+    rtu_rec(&s, UNIT, p, segment(p, 1), 0, false);
+    emit(d, "seed-lease", &s);
     return 0;
 }
 #endif

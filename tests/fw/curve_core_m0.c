@@ -3,7 +3,8 @@
  * CURVE_CORE_FD: a cubic Bezier traced by uniform forward differences (cs_bezier_init,
  * cs_fd_begin, cs_fd_next), the equivalent of Marlin's G5; CURVE_CORE_TRACE: any Bezier by any of
  * the tracers (cs_trace); CURVE_CORE_PREDICT: a planar cubic by the default tracer alone
- * (cs_predict_begin, cs_predict_next). Not run: the volatile sink keeps every call. */
+ * (cs_predict_begin, cs_predict_next); CURVE_CORE_FD3: a planar polynomial cubic by the specialised
+ * FD path (cs_fd3_begin, cs_fd3_fill). Not run: the volatile sink keeps every call. */
 #include <stddef.h>
 #include <stdint.h>
 
@@ -11,6 +12,8 @@
 #include "cs_trace.h"
 #elif defined(CURVE_CORE_PREDICT)
 #include "cs_predict.h"
+#elif defined(CURVE_CORE_FD3)
+#include "cs_fd3.h"
 #else
 #include "cs_fd.h"
 #endif
@@ -76,6 +79,16 @@ int main(void)
         return 1;
     while (cs_predict_next(&pr, &v) == CS_OK)
         sink = v.x + v.y + v.z;
+#elif defined(CURVE_CORE_FD3)
+    static cs_fd3_t f3;
+    static cs_vec3_t blk[16];
+    size_t got;
+    if (cs_fd3_begin(&f3, &c, 655) != CS_OK)
+        return 1;
+    while ((got = cs_fd3_fill(&f3, blk, 16)) != 0) {
+        v = blk[got - 1];
+        sink = v.x + v.y + v.z;
+    }
 #else
     static cs_fd_t f;
     if (cs_fd_begin(&f, &c, 655) != CS_OK)

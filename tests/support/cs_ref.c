@@ -317,3 +317,33 @@ size_t cs_ref_greedy_count(const cs_bezier_t *c, double tol)
     }
     return count;
 }
+
+/* Largest distance (mm) of a vertex from a curve lying on the line y = P0.y (a collinear
+ * fold): exact, the curve covers the x range between its extreme x on [0, 1] (sampled finely
+ * enough for its own extremes, as cs_ref_eval is exact in double). cs_ref_measure places a
+ * vertex on the first piece of curve within 2 LSB after the previous one, which on a curve
+ * that retraces itself may be the outgoing branch for a vertex of the returning one. */
+double cs_ref_fold_vertex_error(const cs_bezier_t *c, const cs_vec3_t *verts, size_t n)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k <= 100000; k++) {
+        double x = cs_ref_eval(c, k / 100000.0).x / CS_REF_LSB_MM;
+        lo = fmin(lo, x);
+        hi = fmax(hi, x);
+    }
+    double worst = 0;
+    for (size_t i = 0; i < n; i++) {
+        double x = verts[i].x, dy = fabs((double)verts[i].y - c->p[0].y);
+        double dx = x < lo ? lo - x : x > hi ? x - hi : 0;
+        worst = fmax(worst, hypot(dx, dy));
+    }
+    return worst * CS_REF_LSB_MM;
+}
+
+bool cs_ref_collinear_x(const cs_bezier_t *c)
+{
+    for (unsigned i = 1; i <= c->degree; i++)
+        if (c->p[i].y != c->p[0].y)
+            return false;
+    return true;
+}

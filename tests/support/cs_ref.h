@@ -45,5 +45,11 @@ void cs_ref_measure(const cs_bezier_t *c, const cs_vec3_t *v, size_t n, double *
 /* Greedy reference chord count for tolerance tol (mm): from each vertex, the longest chord (largest
  * t found by bisection on t, 40 steps) whose deviation stays within tol, in double. */
 size_t cs_ref_greedy_count(const cs_bezier_t *c, double tol);
+/* True when every control point of c lies on the line y = P0.y (a collinear fold). */
+bool cs_ref_collinear_x(const cs_bezier_t *c);
+/* Largest distance (mm) of v[0..n-1] from such a curve, exact: the curve covers the x range
+ * between its extremes, so it is the distance to that segment (cs_ref_measure's placement may
+ * put a vertex of the returning branch on the outgoing one). */
+double cs_ref_fold_vertex_error(const cs_bezier_t *c, const cs_vec3_t *verts, size_t n);
 
 #endif

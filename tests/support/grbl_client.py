@@ -12,10 +12,13 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
         seen while running ("running: <...>"), with --hold-after N sends ! after N lines,
         reports "held: <...>" once the state is Hold:0 and the position has stopped, then ~;
         at the end waits for Idle and prints "final: <...>" and "acks: OK ERR".
-  cmd LINE...     sends each line (send-response) and prints every reply line
+  cmd LINE...     sends each line (send-response) and prints every reply line; a LINE
+                  "@waitfor STATE" is not sent: it waits as waitfor does
   jogcancel LINE  sends the $J= LINE, waits for the Jog state, sends 0x85 and prints
                   "jogging: <...>" and "final: <...>" once Idle
   idle            (no soft reset first) waits for Idle, prints "final: <...>"
+  waitfor STATE   (no soft reset first) waits for the state STATE (Alarm, Idle...), prints
+                  the pushed lines seen meanwhile (ALARM:N...) and "state: <...>"
   raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
 Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
 Every wait has a deadline (--deadline S, default 60); a missed one exits 3.
@@ -31,7 +34,7 @@ import tty
 
 RX_SIZE = 128
 STATUS_RE = re.compile(r"^<([A-Za-z]+(?::\d)?)\|(MPos|WPos):(-?\d+\.\d{3}),(-?\d+\.\d{3}),(-?\d+\.\d{3})"
-                       r"(\|Bf:\d+,\d+)?\|FS:\d+,\d+(\|WCO:-?\d+\.\d{3},-?\d+\.\d{3},-?\d+\.\d{3})?"
+                       r"(\|Bf:\d+,\d+)?\|FS:\d+,\d+(\|Pn:[XYZPDHRS]+)?(\|WCO:-?\d+\.\d{3},-?\d+\.\d{3},-?\d+\.\d{3})?"
                        r"(\|Ov:\d+,\d+,\d+)?>$")
 
 
@@ -126,6 +129,23 @@ def wait_idle(g):
     sys.exit(3)
 
 
+def wait_for(g, state):
+    """Polls ? until the state is state; prints the pushed lines seen meanwhile (ALARM:N...) and
+    "state: <...>". 0, or 3 at the deadline."""
+    end = time.monotonic() + g.deadline
+    while time.monotonic() < end:
+        st = g.status()
+        for line in g.pushed:
+            print(line, flush=True)
+        g.pushed.clear()
+        if st.startswith("<" + state):
+            print("state: " + st, flush=True)
+            return 0
+        time.sleep(0.05)
+    print("deadline: never " + state, flush=True)
+    return 3
+
+
 def hold_and_resume(g):
     end = time.monotonic() + g.deadline
     last = None
@@ -210,6 +230,8 @@ def main(argv):
     if cmd == "idle":  # no reset: waits for what runs to end
         print("final: " + wait_idle(g), flush=True)
         return 0
+    if cmd == "waitfor":  # no reset: waits for a state, prints the pushed lines seen meanwhile
+        return wait_for(g, argv[3])
     wait_welcome(g)
     if cmd == "stream":
         method, hold_after, every = "simple", 0, 0
@@ -224,6 +246,10 @@ def main(argv):
         stream(g, program(argv[3]), method, hold_after, every)
     elif cmd == "cmd":
         for line in argv[3:]:
+            if line.startswith("@waitfor "):  # not sent: waits for a state (as waitfor)
+                if wait_for(g, line.split(" ", 1)[1]) != 0:
+                    return 3
+                continue
             g.write((line + "\n").encode())
             while True:
                 reply = g.need()

@@ -2,7 +2,9 @@
  * the POSIX port: the identity and status registers' source (queue size, axes, tick rate, boot
  * id, free slots, last executed, position: compared with what was queued), a mailbox write that
  * finds no slot (CS_ERR_FULL: exception DEVICE_BUSY), HOLD/RESUME/ABORT through the command
- * hook, and the execution error latch (FAULT until RESET, the motion aborted). */
+ * hook, the execution error latch (FAULT until RESET, the motion aborted), and the writer
+ * lease's clock: it ends CS_FW_MODBUS_LEASE_MS after the holder's last claim or write, not a
+ * millisecond before, across the wrap of the millisecond counter. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -118,11 +120,55 @@ static void test_commands_and_error_latch(void **state)
     assert_int_equal(st.state, CS_PROTO_STATE_ABORTED);
 }
 
+/* At start ms: the holder 0xA1 claims; another token (0xB2) is refused until the lease ends,
+ * 5000 ms after the holder's last claim or write, when it may take it. */
+static void lease_run(uint32_t start)
+{
+    cs_modbus_status_t st;
+    cs_fw_modbus_clock(&fm, start);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.lease, 0);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_CLAIM, 0xA1), CS_OK);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.lease, 1);
+    assert_int_equal(st.lease_left_ms, CS_FW_MODBUS_LEASE_MS);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_CLAIM, 0xB2), CS_ERR_LEASED);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_WRITE, 0xB2), CS_ERR_LEASED);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_WRITE, 0), CS_ERR_LEASED);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_RELEASE, 0xB2), CS_ERR_LEASED);
+    /* the holder's write at +3000 renews it: +7999 still held, +8000 over */
+    cs_fw_modbus_clock(&fm, start + 3000u);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_WRITE, 0xA1), CS_OK);
+    cs_fw_modbus_clock(&fm, start + 7999u);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.lease_left_ms, 1);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_CLAIM, 0xB2), CS_ERR_LEASED);
+    cs_fw_modbus_clock(&fm, start + 8000u);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.lease, 0);
+    assert_int_equal(st.lease_left_ms, 0);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_CLAIM, 0xB2), CS_OK);
+    /* now the old holder is the other client; the new one releases and anyone may write */
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_WRITE, 0xA1), CS_ERR_LEASED);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_RELEASE, 0xB2), CS_OK);
+    assert_int_equal(app.lease(app.ctx, CS_MODBUS_LEASE_WRITE, 0), CS_OK);
+    app.status(app.ctx, &st);
+    assert_int_equal(st.lease, 0); /* a write with no lease held claims nothing */
+}
+
+static void test_lease_expiry(void **state)
+{
+    (void)state;
+    lease_run(1000u);
+    lease_run(0xFFFFFFFFu - 4000u); /* the clock wraps between the claim and the end */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_status_and_queue, setup, teardown),
         cmocka_unit_test_setup_teardown(test_commands_and_error_latch, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_lease_expiry, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

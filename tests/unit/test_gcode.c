@@ -325,12 +325,12 @@ static void test_unsupported_strict_and_lenient(void **state)
     assert_true(nwarn >= 2);
 }
 
-/* --lenient drops a canned cycle with its moves, and G28/G53 with their axis words: executing
+/* --lenient drops a canned cycle with its moves, and G52/G33 with their axis words: executing
  * those words as ordinary moves could drive the tool into the work. */
 static void test_lenient_drops_words_of_dropped_codes(void **state)
 {
     (void)state;
-    const char *t = "G0 Z5\nG81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG0 X3\nG28 X0 Y0\nG53 G0 Z0\n"
+    const char *t = "G0 Z5\nG81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
                     "G1 X4 F60\n";
     expect_diag(parse(t), CS_ERR_UNSUPPORTED, 2, 1);
     assert_int_equal(parse_opts(t, true), CS_OK);
@@ -340,10 +340,10 @@ static void test_lenient_drops_words_of_dropped_codes(void **state)
     expect_pt(2, 1, 4, 0, 5, PT_TOL);
     expect_continuous();
     /* One warning per skipped block, naming the code and every word skipped with it: the G81
-     * line, its modal repeat "X2 Y2", G28, G53. */
+     * line, its modal repeat "X2 Y2", G52, G33. */
     assert_int_equal(nwarn, 4);
-    assert_non_null(strstr(last_warn, "t.nc:7:1: G53 is not supported: its block skipped, with "
-                                      "its words Z0"));
+    assert_non_null(strstr(last_warn, "t.nc:7:1: G33 is not supported: its block skipped, with "
+                                      "its words Z0 K1"));
 }
 
 static void test_syntax_errors(void **state)
@@ -934,7 +934,7 @@ static void test_cncjs_motion_lenient(void **state)
 }
 
 /* --lenient reads special-fields.gcode up to its corrupted line 8: T0 ignored (no tool changer),
- * "G92 E0" ignored (E dropped, then a bare G92), G28 dropped. */
+ * "G92 E0" ignored (E dropped, then a bare G92); G28 is carried out (to the G28 home, 0 0 0). */
 static void test_cncjs_special_fields_lenient(void **state)
 {
     (void)state;
@@ -944,9 +944,9 @@ static void test_cncjs_special_fields_lenient(void **state)
     assert_non_null(strstr(last_warn, "t.nc:1:4: T (tool select): ignored"));
     assert_int_equal(P.n, 0);
     expect_diag(parse(txt), CS_ERR_UNSUPPORTED, 1, 4);
-    /* The file itself, lenient: T0, E, bare G92, G28 warned once each before the line-8 error. */
+    /* The file itself, lenient: T0, E, bare G92 warned once each before the line-8 error. */
     expect_diag(parse_file(DATA "special-fields.gcode", true), CS_ERR_PARSE, 8, 16);
-    assert_int_equal(nwarn, 4);
+    assert_int_equal(nwarn, 3);
 }
 
 /* ---- LinuxCNC parameters, expressions and O-words (cs_gexpr, cs_gflow) ----------------------- */

@@ -24,7 +24,7 @@
  * number of refused lines. */
 static int feed_lines(const char *text, cs_grbl_gc_t *g, cs_path_t *out)
 {
-    cs_grbl_gc_init(g);
+    assert_int_equal(cs_grbl_gc_init(g, NULL), CS_OK);
     cs_path_init(out);
     int bad = 0;
     unsigned no = 0;
@@ -162,7 +162,7 @@ static void test_end_and_diag(void **state)
     cs_path_t p;
     cs_path_diag_t d;
     bool end;
-    cs_grbl_gc_init(&g);
+    assert_int_equal(cs_grbl_gc_init(&g, NULL), CS_OK);
     cs_path_init(&p);
     assert_int_equal(cs_grbl_gc_line(&g, "G1 X1 F60 M2", 7, &p, &d, &end), CS_OK);
     assert_true(end);

@@ -88,7 +88,41 @@ static void fake_map(cs_modbus_map_t *mp, fake_t *f)
 {
     memset(f, 0, sizeof *f);
     f->hash = FW_TEST_HASH0;
-    cs_modbus_app_t app = {fake_submit, fake_command, fake_status, f};
+    cs_modbus_app_t app = {fake_submit, fake_command, fake_status, NULL, f};
+    assert_int_equal(cs_modbus_map_init(mp, &app, 0), CS_OK);
+}
+
+/* A lease without a clock (cs_fw_modbus's expiry is tested in test_fw_modbus): one holder at a
+ * time, every call recorded. */
+typedef struct {
+    fake_t f;
+    uint16_t holder;
+    uint8_t ops[16];
+    uint16_t tokens[16];
+    unsigned nops;
+} fake_lease_t;
+
+static cs_err_t fake_lease(void *ctx, uint8_t op, uint16_t token)
+{
+    fake_lease_t *l = (fake_lease_t *)ctx; /* f first: the other hooks see the fake_t */
+    if (l->nops < 16) {
+        l->ops[l->nops] = op;
+        l->tokens[l->nops++] = token;
+    }
+    if (l->holder != 0 && token != l->holder)
+        return CS_ERR_LEASED;
+    if (op == CS_MODBUS_LEASE_CLAIM)
+        l->holder = token;
+    else if (op == CS_MODBUS_LEASE_RELEASE)
+        l->holder = 0;
+    return CS_OK;
+}
+
+static void fake_lease_map(cs_modbus_map_t *mp, fake_lease_t *l)
+{
+    memset(l, 0, sizeof *l);
+    l->f.hash = FW_TEST_HASH0;
+    cs_modbus_app_t app = {fake_submit, fake_command, fake_status, fake_lease, l};
     assert_int_equal(cs_modbus_map_init(mp, &app, 0), CS_OK);
 }
 
@@ -387,7 +421,7 @@ static void test_commands_status_exceptions(void **state)
     assert_int_equal((int32_t)(((uint32_t)v[20] << 16) | v[21]), 0x7FFFFFFF);
     assert_int_equal((int32_t)(((uint32_t)v[22] << 16) | v[23]), -1);
     /* exceptions: outside the map, bad quantities, unknown function, malformed writes */
-    assert_int_equal(call(&mp, req, pdu_read(req, 0x04, 20, 5), rsp, &rn),
+    assert_int_equal(call(&mp, req, pdu_read(req, 0x04, CS_MODBUS_IR_COUNT - 4, 5), rsp, &rn),
                      CS_MODBUS_EX_ILLEGAL_ADDRESS);
     assert_int_equal(call(&mp, req, pdu_read(req, 0x04, 0, 0), rsp, &rn),
                      CS_MODBUS_EX_ILLEGAL_VALUE);
@@ -414,6 +448,171 @@ static void test_commands_status_exceptions(void **state)
     const uint8_t reset[] = {0x06, 0x00, 0x00, 0x00, CS_MODBUS_CMD_RESET};
     assert_int_equal(call(&mp, reset, 5, rsp, &rn), 0);
     assert_int_equal(ir(&mp, CS_MODBUS_IR_REFUSED), 0);
+}
+
+/* --- the writer lease ----------------------------------------------------------------------- */
+
+/* FC16 of a SEGMENT with a token first, at CS_MODBUS_HR_TOKEN: the exception (0: taken). */
+static int write_with_token(cs_modbus_map_t *mp, uint16_t token, const cs_proto_msg_t *m,
+                            uint16_t seq)
+{
+    uint16_t regs[1 + CS_MODBUS_MAILBOX_REGS];
+    size_t n;
+    regs[0] = token;
+    assert_int_equal(cs_modbus_mailbox_encode(m, seq, regs + 1, CS_MODBUS_MAILBOX_REGS, &n), CS_OK);
+    uint8_t req[260], rsp[260];
+    size_t rn;
+    return call(mp, req, pdu_write_multi(req, CS_MODBUS_HR_TOKEN, regs, n + 1), rsp, &rn);
+}
+
+static int write_reg(cs_modbus_map_t *mp, uint16_t addr, uint16_t v)
+{
+    uint8_t req[5] = {0x06, (uint8_t)(addr >> 8), (uint8_t)addr, (uint8_t)(v >> 8), (uint8_t)v};
+    uint8_t rsp[260];
+    size_t rn;
+    return call(mp, req, 5, rsp, &rn);
+}
+
+/* docs/modbus.md "The writer lease": the holder's writes (with its token) are taken; a write
+ * from anyone else, with the right sequence or as a repeat of the holder's last write, is
+ * refused with exception 1 and REFUSED = 23, and queues nothing nor moves NEXT_SEQ. */
+static void test_lease(void **state)
+{
+    (void)state;
+    cs_modbus_map_t mp;
+    fake_lease_t l;
+    fake_lease_map(&mp, &l);
+    cs_proto_msg_t s = segment(100, 3, -4, 5);
+    /* no lease held: a write without a token is taken, as before leases */
+    assert_int_equal(write_msg(&mp, &s, 0), 0);
+    assert_int_equal(l.nops, 1);
+    assert_int_equal(l.ops[0], CS_MODBUS_LEASE_WRITE);
+    assert_int_equal(l.tokens[0], 0);
+    /* claim with token 0x1234 (FC06 to LEASE); token 0 is not a token */
+    assert_int_equal(write_reg(&mp, CS_MODBUS_HR_LEASE, 0), CS_MODBUS_EX_ILLEGAL_VALUE);
+    assert_int_equal(write_reg(&mp, CS_MODBUS_HR_LEASE, 0x1234), 0);
+    assert_int_equal(l.holder, 0x1234);
+    /* another client claims: exception 1, REFUSED says leased */
+    assert_int_equal(write_reg(&mp, CS_MODBUS_HR_LEASE, 0x9999), CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    assert_int_equal(ir(&mp, CS_MODBUS_IR_REFUSED), CS_ERR_LEASED);
+    /* another client writes the mailbox with the current sequence, without a token or with a
+     * wrong one, or repeats the holder's last write: refused, nothing queued */
+    assert_int_equal(write_msg(&mp, &s, 1), CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    assert_int_equal(ir(&mp, CS_MODBUS_IR_REFUSED), CS_ERR_LEASED);
+    assert_int_equal(ir(&mp, CS_MODBUS_IR_REFUSED_SEQ), 1);
+    assert_int_equal(write_with_token(&mp, 0x4321, &s, 1), CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    assert_int_equal(write_msg(&mp, &s, 0), CS_MODBUS_EX_ILLEGAL_FUNCTION); /* the repeat */
+    assert_int_equal(l.f.submitted, 1);
+    assert_int_equal(ir(&mp, CS_MODBUS_IR_NEXT_SEQ), 1);
+    assert_int_equal(mp.stats.repeats, 0);
+    /* the holder's write (token first) is taken, its repeat answered without queueing */
+    assert_int_equal(write_with_token(&mp, 0x1234, &s, 1), 0);
+    assert_int_equal(write_with_token(&mp, 0x1234, &s, 1), 0);
+    assert_int_equal(l.f.submitted, 2);
+    assert_int_equal(mp.stats.repeats, 1);
+    assert_int_equal(ir(&mp, CS_MODBUS_IR_NEXT_SEQ), 2);
+    /* the token is never read back */
+    uint8_t req[260], rsp[260];
+    size_t rn;
+    assert_int_equal(call(&mp, req, pdu_read(req, 0x03, CS_MODBUS_HR_TOKEN, 1), rsp, &rn), 0);
+    assert_int_equal((rsp[2] << 8) | rsp[3], 0);
+    assert_int_equal(call(&mp, req, pdu_read(req, 0x03, CS_MODBUS_HR_LEASE, 2), rsp, &rn), 0);
+    assert_int_equal(rsp[2] | rsp[3] | rsp[4] | rsp[5], 0);
+    /* release by another: refused; by the holder (FC16 of one register): done */
+    assert_int_equal(write_reg(&mp, CS_MODBUS_HR_RELEASE, 0x9999), CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    uint16_t tok = 0x1234;
+    assert_int_equal(call(&mp, req, pdu_write_multi(req, CS_MODBUS_HR_RELEASE, &tok, 1), rsp, &rn),
+                     0);
+    assert_int_equal(l.holder, 0);
+    /* a token write to anything but the mailbox, or too long for it: illegal address */
+    uint16_t big[2 + CS_MODBUS_MAILBOX_REGS] = {0x1234, 0x20};
+    assert_int_equal(call(&mp, req, pdu_write_multi(req, CS_MODBUS_HR_TOKEN, big, 30), rsp, &rn),
+                     CS_MODBUS_EX_ILLEGAL_ADDRESS);
+    assert_int_equal(call(&mp, req, pdu_write_multi(req, CS_MODBUS_HR_TOKEN, big, 1), rsp, &rn),
+                     CS_MODBUS_EX_ILLEGAL_ADDRESS);
+    /* a map whose application has no lease: LEASE, RELEASE and TOKEN are outside it */
+    cs_modbus_map_t plain;
+    fake_t f;
+    fake_map(&plain, &f);
+    assert_int_equal(write_reg(&plain, CS_MODBUS_HR_LEASE, 7), CS_MODBUS_EX_ILLEGAL_ADDRESS);
+    assert_int_equal(write_with_token(&plain, 7, &s, 0), CS_MODBUS_EX_ILLEGAL_ADDRESS);
+    assert_int_equal(call(&plain, req, pdu_read(req, 0x03, CS_MODBUS_HR_LEASE, 1), rsp, &rn),
+                     CS_MODBUS_EX_ILLEGAL_ADDRESS);
+}
+
+/* Function codes the map does not serve, and PDUs with no function code at all: fc | 0x80 and
+ * exception 1 (MODBUS Application Protocol V1.1b3, section 7), never a normal answer. */
+static void test_unknown_functions(void **state)
+{
+    (void)state;
+    cs_modbus_map_t mp;
+    fake_t f;
+    fake_map(&mp, &f);
+    const uint8_t fcs[] = {0x01, 0x02, 0x05, 0x07, 0x0F, 0x11, 0x14, 0x16, 0x17, 0x2B, 0x41, 0x7F};
+    for (size_t k = 0; k < sizeof fcs; k++) {
+        uint8_t req[5] = {fcs[k], 0, 0, 0, 1}, rsp[260];
+        size_t rn = 0;
+        assert_int_equal(cs_modbus_pdu(&mp, req, 5, rsp, CS_MODBUS_PDU_MAX, &rn), CS_OK);
+        assert_int_equal(rn, 2);
+        assert_int_equal(rsp[0], fcs[k] | 0x80);
+        assert_int_equal(rsp[1], CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    }
+    uint8_t req[1] = {0}, rsp[260];
+    size_t rn = 0;
+    assert_int_equal(cs_modbus_pdu(&mp, req, 0, rsp, CS_MODBUS_PDU_MAX, &rn), CS_OK);
+    assert_int_equal(rn, 2);
+    assert_int_equal(rsp[0], 0x80);
+    assert_int_equal(rsp[1], CS_MODBUS_EX_ILLEGAL_FUNCTION);
+    assert_int_equal(f.submitted + f.ncmd, 0);
+}
+
+/* The MBAP header (Modbus Messaging on TCP/IP Implementation Guide V1.0b, 3.1.3), bytes
+ * written out by hand. */
+static void test_mbap(void **state)
+{
+    (void)state;
+    cs_modbus_mbap_t h;
+    /* transaction 0x0102, protocol 0, length 6, unit 7, FC04 0x0000 x 24 */
+    const uint8_t ok[] = {0x01, 0x02, 0x00, 0x00, 0x00, 0x06, 0x07, 0x04, 0x00, 0x00, 0x00, 0x18};
+    for (size_t n = 0; n < sizeof ok; n++) /* incomplete: wait for more */
+        assert_int_equal(cs_modbus_mbap_parse(ok, n, &h), CS_ERR_EMPTY);
+    assert_int_equal(cs_modbus_mbap_parse(ok, sizeof ok, &h), CS_OK);
+    assert_int_equal(h.tid, 0x0102);
+    assert_int_equal(h.unit, 7);
+    assert_int_equal(h.pdu_len, 5);
+    uint8_t two[2 * sizeof ok]; /* two frames back to back: the first one's length only */
+    memcpy(two, ok, sizeof ok);
+    memcpy(two + sizeof ok, ok, sizeof ok);
+    assert_int_equal(cs_modbus_mbap_parse(two, sizeof two, &h), CS_OK);
+    assert_int_equal(h.pdu_len, 5);
+    /* protocol id 1: a whole frame, not Modbus */
+    uint8_t b[300];
+    memcpy(b, ok, sizeof ok);
+    b[3] = 1;
+    assert_int_equal(cs_modbus_mbap_parse(b, sizeof ok, &h), CS_ERR_UNSUPPORTED);
+    assert_int_equal(h.pdu_len, 5);
+    /* lengths 0, 1 (no function code) and 255 (longer than any PDU): the stream is lost */
+    const uint16_t bad[] = {0, 1, 255, 0xFFFF};
+    for (size_t k = 0; k < 4; k++) {
+        memcpy(b, ok, sizeof ok);
+        b[4] = (uint8_t)(bad[k] >> 8);
+        b[5] = (uint8_t)bad[k];
+        assert_int_equal(cs_modbus_mbap_parse(b, 7, &h), CS_ERR_FRAME);
+    }
+    /* length 254: the largest PDU (253 bytes), complete only with all of it */
+    memset(b, 0, sizeof b);
+    b[5] = 254;
+    assert_int_equal(cs_modbus_mbap_parse(b, 7 + 252, &h), CS_ERR_EMPTY);
+    assert_int_equal(cs_modbus_mbap_parse(b, 7 + 253, &h), CS_OK);
+    /* the answer's header: same transaction and unit, protocol 0, length = 1 + PDU */
+    const uint8_t pdu[] = {0x84, 0x02};
+    size_t len = 0;
+    h = (cs_modbus_mbap_t){.tid = 0xBEEF, .proto = 5, .unit = 9};
+    assert_int_equal(cs_modbus_mbap_frame(&h, pdu, 2, b, sizeof b, &len), CS_OK);
+    const uint8_t want[] = {0xBE, 0xEF, 0x00, 0x00, 0x00, 0x03, 0x09, 0x84, 0x02};
+    assert_int_equal(len, sizeof want);
+    assert_memory_equal(b, want, sizeof want);
+    assert_int_equal(cs_modbus_mbap_frame(&h, pdu, 2, b, 8, &len), CS_ERR_FULL);
 }
 
 /* --- RTU framing ------------------------------------------------------------------------------ */
@@ -562,7 +761,7 @@ static pid_t start_server(int *slave_fd, char *path, size_t cap, int *result_fd,
         memset(&f, 0, sizeof f);
         f.hash = FW_TEST_HASH0;
         f.instant = true;
-        cs_modbus_app_t app = {fake_submit, fake_command, fake_status, &f};
+        cs_modbus_app_t app = {fake_submit, fake_command, fake_status, NULL, &f};
         cs_modbus_map_init(&mp, &app, 0);
         cs_modbus_rtu_t r;
         cs_modbus_rtu_init(&r, &mp, 3, 115200);
@@ -750,6 +949,9 @@ int main(void)
         cmocka_unit_test(test_mailbox_pen),
         cmocka_unit_test(test_sequence_rule),
         cmocka_unit_test(test_commands_status_exceptions),
+        cmocka_unit_test(test_lease),
+        cmocka_unit_test(test_unknown_functions),
+        cmocka_unit_test(test_mbap),
         cmocka_unit_test(test_rtu_framing),
         cmocka_unit_test(test_libmodbus_client),
         cmocka_unit_test(test_stream_lost_answers),

@@ -21,6 +21,7 @@
 #include "cs_arc.h"
 #include "cs_predict.h"
 #include "cs_ref.h"
+#include "curve_cases.h"
 #include "cs_trace.h"
 
 #define MM(v)     ((cs_pos_t)lround((v)*65536.0))
@@ -32,25 +33,7 @@ static const double tols_mm[N_TOLS] = {0.1, 0.01, 0.001};
 static cs_vec3_t verts[MAX_VERTS];
 
 static uint64_t rng = 0x2545F4914F6CDD1Dull;
-static double unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
 
-static cs_bezier_t make(unsigned degree, const double (*p)[2], double z)
-{
-    cs_bezier_t c;
-    memset(&c, 0, sizeof c);
-    c.degree = (uint8_t)degree;
-    for (unsigned i = 0; i <= degree; i++) {
-        c.p[i] = cs_fixed_vec(MM(p[i][0]), MM(p[i][1]), MM(z));
-        c.w[i] = CS_WEIGHT_ONE;
-    }
-    return c;
-}
 
 /* Traces c with cs_predict directly; returns the final code, *n vertices. */
 static cs_err_t run(const cs_bezier_t *c, cs_pos_t tol, size_t *n)
@@ -69,36 +52,6 @@ static cs_err_t run(const cs_bezier_t *c, cs_pos_t tol, size_t *n)
     return e;
 }
 
-/* Largest distance (LSB) of a vertex from a curve lying on the line y = P0.y (a collinear
- * fold): exact, the curve covers the x range between its extreme x on [0, 1] (sampled finely
- * enough for its own extremes, as cs_ref_eval is exact in double). cs_ref_measure places a
- * vertex on the first piece of curve within 2 LSB after the previous one, which on a curve
- * that retraces itself may be the outgoing branch for a vertex of the returning one. */
-static double fold_vertex_error(const cs_bezier_t *c, size_t n)
-{
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k <= 100000; k++) {
-        double x = cs_ref_eval(c, k / 100000.0).x / LSB;
-        lo = fmin(lo, x);
-        hi = fmax(hi, x);
-    }
-    double worst = 0;
-    for (size_t i = 0; i < n; i++) {
-        double x = verts[i].x, dy = fabs((double)verts[i].y - c->p[0].y);
-        double dx = x < lo ? lo - x : x > hi ? x - hi : 0;
-        worst = fmax(worst, hypot(dx, dy));
-    }
-    return worst * LSB;
-}
-
-static bool collinear_x(const cs_bezier_t *c)
-{
-    for (unsigned i = 1; i <= c->degree; i++)
-        if (c->p[i].y != c->p[0].y)
-            return false;
-    return true;
-}
-
 /* The promise for one curve at one tolerance; returns the chord count. */
 static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
 {
@@ -108,8 +61,8 @@ static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
     assert_memory_equal(&verts[n - 1], &c->p[c->degree], sizeof(cs_vec3_t));
     double dev, verr;
     cs_ref_measure(c, verts, n, &dev, &verr);
-    if (collinear_x(c))
-        verr = fold_vertex_error(c, n);
+    if (cs_ref_collinear_x(c))
+        verr = cs_ref_fold_vertex_error(c, verts, n);
     double tol_mm = tol * LSB;
     if (!(dev <= tol_mm) || !(verr <= LSB)) {
         print_error("%s: tol %g mm: deviation %.9g mm, vertex error %.3g LSB (%zu chords)\n", what,
@@ -117,15 +70,6 @@ static size_t check(const cs_bezier_t *c, cs_pos_t tol, const char *what)
         fail();
     }
     return n;
-}
-
-static cs_bezier_t random_curve(unsigned degree, double box)
-{
-    double p[4][2];
-    for (unsigned i = 0; i <= degree; i++)
-        for (unsigned a = 0; a < 2; a++)
-            p[i][a] = (unit() * 2 - 1) * box;
-    return make(degree, (const double(*)[2])p, (unit() * 2 - 1) * 10);
 }
 
 /* Random cubics and quadratics: the promise, and chords within 1.05x greedy over the set. */
@@ -137,7 +81,7 @@ static void test_random(void **state)
         for (int ti = 0; ti < N_TOLS; ti++) {
             size_t chords = 0, greedy = 0;
             for (size_t k = 0; k < nc; k++) {
-                cs_bezier_t c = random_curve(degree, 100);
+                cs_bezier_t c = curve_cases_random(&rng, degree, 100);
                 chords += check(&c, MM(tols_mm[ti]), degree == 3 ? "random cubic" : "quadratic");
                 greedy += cs_ref_greedy_count(&c, tols_mm[ti]);
             }
@@ -151,37 +95,14 @@ static void test_random(void **state)
     }
 }
 
-static const struct {
-    const char *name;
-    unsigned degree;
-    double p[4][2];
-} hard[] = {
-    {"coincident", 3, {{0, 0}, {0, 0}, {50, 20}, {50, 20}}},
-    {"all points equal", 3, {{7, 7}, {7, 7}, {7, 7}, {7, 7}}},
-    {"cusp", 3, {{0, 0}, {100, 100}, {0, 100}, {100, 0}}},
-    {"loop", 3, {{0, 0}, {150, 100}, {-50, 100}, {100, 0}}},
-    {"inflection", 3, {{0, 0}, {33, 50}, {66, -50}, {100, 0}}},
-    {"collinear fold", 3, {{0, 0}, {100, 0}, {20, 0}, {60, 0}}},
-    {"collinear fold back", 3, {{0, 0}, {100, 0}, {-50, 0}, {0, 0}}},
-    {"closed loop (equal ends)", 3, {{0, 0}, {80, 60}, {-80, 60}, {0, 0}}},
-    {"near-equal ends", 3, {{0, 0}, {80, 60}, {-80, 60}, {0.00002, 0}}},
-    {"2 m S", 3, {{-1000, -500}, {-300, 900}, {400, -900}, {1000, 500}}},
-    {"2 m loop", 3, {{-1000, 0}, {1500, 1500}, {-1500, 1500}, {1000, 0}}},
-    {"worst-case coordinates", 3, {{-4096, -4096}, {4096, 4096}, {-4096, 4096}, {4096, -4096}}},
-    {"1 um", 3, {{0, 0}, {0.001, 0.001}, {0.002, -0.001}, {0.003, 0}}},
-    {"straight 8 m", 3, {{-4000, -4000}, {-1000, -1000}, {1000, 1000}, {4000, 4000}}},
-    {"line", 1, {{-30, 5}, {70, -12}}},
-    {"quadratic U turn", 2, {{0, 0}, {100, 1000}, {0.5, 0}}},
-};
-
 static void test_hard(void **state)
 {
     (void)state;
-    for (size_t i = 0; i < sizeof hard / sizeof hard[0]; i++) {
-        cs_bezier_t c = make(hard[i].degree, hard[i].p, 3);
+    for (size_t i = 0; i < curve_cases_hard_n; i++) {
+        cs_bezier_t c = curve_cases_planar(curve_cases_hard[i].degree, curve_cases_hard[i].p, 3);
         for (int ti = 0; ti < N_TOLS; ti++)
-            check(&c, MM(tols_mm[ti]), hard[i].name);
-        check(&c, CS_PREDICT_TOL_MIN, hard[i].name);
+            check(&c, MM(tols_mm[ti]), curve_cases_hard[i].name);
+        check(&c, CS_PREDICT_TOL_MIN, curve_cases_hard[i].name);
     }
 }
 
@@ -190,7 +111,7 @@ static void test_small_tol(void **state)
 {
     (void)state;
     for (int k = 0; k < 200; k++) {
-        cs_bezier_t c = random_curve(3, k < 100 ? 0.05 : 5);
+        cs_bezier_t c = curve_cases_random(&rng, 3, k < 100 ? 0.05 : 5);
         check(&c, CS_PREDICT_TOL_MIN + (cs_pos_t)(k % 3), "small tolerance");
     }
 }
@@ -224,7 +145,7 @@ static void test_arcs(void **state)
                 }
                 const double kap = 0.5522847498;
                 double p[4][2] = {{r, 0}, {r, kap * r * q}, {kap * r, r * q}, {0, r * q}};
-                cs_bezier_t c = make(3, (const double(*)[2])p, 0);
+                cs_bezier_t c = curve_cases_planar(3, (const double(*)[2])p, 0);
                 check(&c, MM(tols_mm[ti]), "cubic quarter ellipse");
             }
         if ((double)chords > 1.05 * (double)greedy) {
@@ -239,7 +160,7 @@ static void test_refuse(void **state)
 {
     (void)state;
     cs_predict_t p;
-    cs_bezier_t c = make(3, hard[4].p, 0);
+    cs_bezier_t c = curve_cases_planar(3, curve_cases_hard[4].p, 0);
     assert_int_equal(cs_predict_begin(&p, &c, CS_PREDICT_TOL_MIN - 1), CS_ERR_TOLERANCE);
     assert_int_equal(cs_predict_begin(&p, &c, CS_PREDICT_TOL_MAX + 1), CS_ERR_TOLERANCE);
     cs_bezier_t d = c;
@@ -250,7 +171,7 @@ static void test_refuse(void **state)
     r.rational = true; /* a rational cubic */
     assert_false(cs_predict_accepts(&r));
     static const double hyp[3][2] = {{0, 0}, {10, 10}, {20, 0}};
-    cs_bezier_t h = make(2, hyp, 0);
+    cs_bezier_t h = curve_cases_planar(2, hyp, 0);
     h.rational = true;
     h.w[0] = h.w[2] = CS_WEIGHT_ONE / 2; /* w1^2 > w0 w2: a hyperbola arc */
     assert_false(cs_predict_accepts(&h));

@@ -288,6 +288,30 @@ ISR(TIMER1_COMPB_vect)
     }
 }
 
+/* The machine's inputs: none wired in this port (its build leaves machine control out,
+ * CS_FW_CTL=0: the ATmega328P's 2 KB of RAM are full; docs/firmware.md, "Machine control"):
+ * every input reads inactive, no edge is reported. */
+uint16_t port_inputs_read(void)
+{
+    return 0;
+}
+
+void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+{
+    (void)fn;
+    (void)ctx;
+}
+
+/* The spindle / laser output: kept for a debugger, no PWM pin driven yet. */
+static volatile uint16_t spindle_duty;
+static volatile uint8_t spindle_mode;
+
+void port_spindle_set(uint16_t duty, uint8_t mode)
+{
+    spindle_duty = duty;
+    spindle_mode = mode;
+}
+
 void port_dir_set(uint8_t mask)
 {
     uint8_t s = SREG;

@@ -3,6 +3,7 @@
  * advances exactly 1 ns per guest instruction, so SysTick cycles (20 ns each at 50 MHz) count
  * instructions: instructions = cycles * 20 / 2^shift. Measures, on one cubic Bezier:
  *   fd      cs_fd_next per point (uniform forward differences, the inner loop)
+ *   fd3     cs_fd3_next per point (the planar polynomial FD path: 3 adds per coordinate)
  *   trace   cs_trace_next per chord for each tracer (FD, AFD, subdivision)
  *   planner cs_planner_line3 + cs_segment_next per chord: what the device does with each chord
  *           of a CURVE message (the look-ahead plan and its step segments)
@@ -11,6 +12,7 @@
 #include <stdint.h>
 
 #include "cs_fd.h"
+#include "cs_fd3.h"
 #include "cs_planner.h"
 #include "cs_segment.h"
 #include "cs_trace.h"
@@ -88,6 +90,40 @@ static void bench_trace(const cs_bezier_t *c, cs_trace_method_t m, const char *n
     if (e != CS_END)
         failed = true;
     print(name, n, t1 - t0);
+}
+
+static void bench_fd3(const cs_bezier_t *c, cs_pos_t tol)
+{
+    static cs_fd3_t f;
+    cs_vec3_t p;
+    uint32_t t0 = cycles();
+    if (cs_fd3_begin(&f, c, tol) != CS_OK)
+        failed = true;
+    uint32_t t1 = cycles();
+    uint32_t n = 0;
+    while (cs_fd3_next(&f, &p) == CS_OK)
+        n++;
+    uint32_t t2 = cycles();
+    print("fd3_begin", 1, t1 - t0);
+    print("fd3_point", n, t2 - t1);
+    /* The block loop (cs_fd3_fill, 64 vertices a call) */
+    static cs_vec3_t buf[64];
+    if (cs_fd3_begin(&f, c, tol) != CS_OK)
+        failed = true;
+    uint32_t t3 = cycles();
+    uint32_t m = 0, k;
+    while ((k = (uint32_t)cs_fd3_fill(&f, buf, 64)) != 0)
+        m += k;
+    uint32_t t4 = cycles();
+    print("fd3_fill_point", m, t4 - t3);
+    /* The loop alone: the first piece's steps but its last (no piece start in the timing) */
+    if (cs_fd3_begin(&f, c, tol) != CS_OK)
+        failed = true;
+    size_t inner = f.left - 1u < 64u ? f.left - 1u : 64u;
+    uint32_t t5 = cycles();
+    k = (uint32_t)cs_fd3_fill(&f, buf, inner);
+    uint32_t t6 = cycles();
+    print("fd3_loop_point", k, t6 - t5);
 }
 
 /* The device's work per chord of a CURVE: plan it, cut the plan into step segments. */
@@ -170,6 +206,7 @@ int main(void)
     uint32_t t1 = cycles();
     print("overhead", 1, t1 - t0);
     bench_fd(&c, CS_POS_ONE_MM / 1000, "fd_point"); /* 1 um: many points */
+    bench_fd3(&c, CS_POS_ONE_MM / 1000);
     bench_trace(&c, CS_TRACE_FD, "trace_fd_chord");
     bench_trace(&c, CS_TRACE_AFD, "trace_afd_chord");
     bench_trace(&c, CS_TRACE_SUBDIV, "trace_subdiv_chord");

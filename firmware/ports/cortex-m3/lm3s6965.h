@@ -39,6 +39,36 @@
 #define GPIO_AFSEL(port)      REG32((port) + 0x420u)
 #define GPIO_DEN(port)        REG32((port) + 0x51Cu)
 
+/* Machine control (port_m3_ctl.c): GPIO ports B, C, E, F, their interrupt and pull-up
+ * registers (data sheet 8.5), the PWM module's generator 0 (data sheet 20.6) and its clock gate. */
+#define SYSCTL_RCGC0         REG32(0x400FE100u)
+#define SYSCTL_RCGC0_PWM     (1u << 20)
+#define SYSCTL_RCGC2_GPIOB   (1u << 1)
+#define SYSCTL_RCGC2_GPIOC   (1u << 2)
+#define SYSCTL_RCGC2_GPIOE   (1u << 4)
+#define SYSCTL_RCGC2_GPIOF   (1u << 5)
+#define GPIO_PORTB           0x40005000u
+#define GPIO_PORTC           0x40006000u
+#define GPIO_PORTE           0x40024000u
+#define GPIO_PORTF           0x40025000u
+#define GPIO_IS(port)        REG32((port) + 0x404u)
+#define GPIO_IBE(port)       REG32((port) + 0x408u)
+#define GPIO_IM(port)        REG32((port) + 0x410u)
+#define GPIO_ICR(port)       REG32((port) + 0x41Cu)
+#define GPIO_PUR(port)       REG32((port) + 0x510u)
+#define GPIO_PDR(port)       REG32((port) + 0x514u)
+#define GPIOB_IRQ            1
+#define GPIOE_IRQ            4
+#define PWM_BASE             0x40028000u
+#define PWM_ENABLE           REG32(PWM_BASE + 0x008u)
+#define PWM0_CTL             REG32(PWM_BASE + 0x040u)
+#define PWM0_LOAD            REG32(PWM_BASE + 0x050u)
+#define PWM0_CMPA            REG32(PWM_BASE + 0x058u)
+#define PWM0_GENA            REG32(PWM_BASE + 0x060u)
+#define PWM_GEN_ENABLE       (1u << 0)
+#define PWM_GENA_LOAD_HIGH   (3u << 2) /* ACTLOAD: drive high at the load (count-down mode) */
+#define PWM_GENA_CMPAD_LOW   (2u << 6) /* ACTCMPAD: drive low at compare A counting down */
+
 /* UART0 (ARM PrimeCell PL011), IRQ 5. */
 #define UART0           0x4000C000u
 #define UART_DR         REG32(UART0 + 0x000u)

@@ -16,22 +16,47 @@ __attribute__((section(".noinit"))) static uint32_t noise[32];
 
 static const char axis_name[4] = {'x', 'y', 'z', 'a'};
 
-/* "exit-idle=MS" anywhere on the command line. */
-static uint32_t parse_exit_idle(const char *s)
+/* "KEY=N" (N signed decimal) anywhere on the command line: true and *v. */
+static bool parse_int(const char *cmd, const char *key, int32_t *v)
 {
-    static const char key[] = "exit-idle=";
-    for (; *s != '\0'; s++) {
+    for (const char *s = cmd; *s != '\0'; s++) {
         unsigned k = 0;
         while (key[k] != '\0' && s[k] == key[k])
             k++;
-        if (key[k] != '\0')
+        if (key[k] != '\0' || (s != cmd && s[-1] != ' ')) /* a whole word only */
             continue;
-        uint32_t v = 0;
-        for (s += k; *s >= '0' && *s <= '9' && v < 100000000u; s++)
-            v = v * 10u + (uint32_t)(*s - '0');
-        return v;
+        s += k;
+        bool neg = *s == '-';
+        if (neg)
+            s++;
+        int32_t n = 0;
+        for (; *s >= '0' && *s <= '9' && n < 100000000; s++)
+            n = n * 10 + (int32_t)(*s - '0');
+        *v = neg ? -n : n;
+        return true;
     }
-    return 0;
+    return false;
+}
+
+/* "exit-idle=MS" on the command line (0: none). */
+static uint32_t parse_exit_idle(const char *cmd)
+{
+    int32_t v;
+    return parse_int(cmd, "exit-idle=", &v) && v > 0 ? (uint32_t)v : 0u;
+}
+
+/* Simulated switches and probe for qemu (its board has none to press): "x_min=STEPS" ...
+ * "a_max=STEPS", "probe_z=STEPS" in STEP/DIR pin positions (port_m3_sim_switch). */
+static void sim_switches(const char *cmd)
+{
+    static const char *const keys[8] = {"x_min=", "y_min=", "z_min=", "a_min=",
+                                        "x_max=", "y_max=", "z_max=", "a_max="};
+    int32_t v;
+    for (unsigned i = 0; i < 8u; i++)
+        if (parse_int(cmd, keys[i], &v))
+            port_m3_sim_switch((uint16_t)(1u << i), (uint8_t)(i & 3u), v, i >= 4u);
+    if (parse_int(cmd, "probe_z=", &v))
+        port_m3_sim_switch(CS_PROTO_IN_PROBE, 2, v, false);
 }
 
 static void line_axes(const char *label, const int32_t *v, bool is_signed)
@@ -109,6 +134,28 @@ static void report(void)
     semihost_fmt_uint(b, sizeof b, &n, r.stats.pen_us);
     semihost_fmt_str(b, sizeof b, &n, " us\n");
     semihost_write0(b);
+    uint32_t sp_n;
+    uint16_t sp_duty;
+    uint8_t sp_mode;
+    port_m3_spindle(&sp_n, &sp_duty, &sp_mode);
+    const cs_fw_ctl_t *c = &app.mo.ctl;
+    n = 0;
+    semihost_fmt_str(b, sizeof b, &n, "fw: control: ");
+    semihost_fmt_uint(b, sizeof b, &n, c->homings);
+    semihost_fmt_str(b, sizeof b, &n, " axes homed, ");
+    semihost_fmt_uint(b, sizeof b, &n, c->alarms);
+    semihost_fmt_str(b, sizeof b, &n, " alarms (now ");
+    semihost_fmt_uint(b, sizeof b, &n, c->alarm);
+    semihost_fmt_str(b, sizeof b, &n, "), ");
+    semihost_fmt_uint(b, sizeof b, &n, c->probes);
+    semihost_fmt_str(b, sizeof b, &n, " probe cycles; spindle: ");
+    semihost_fmt_uint(b, sizeof b, &n, sp_n);
+    semihost_fmt_str(b, sizeof b, &n, " settings, last duty ");
+    semihost_fmt_uint(b, sizeof b, &n, sp_duty);
+    semihost_fmt_str(b, sizeof b, &n, " mode ");
+    semihost_fmt_uint(b, sizeof b, &n, sp_mode);
+    semihost_fmt_str(b, sizeof b, &n, "\n");
+    semihost_write0(b);
     report_servo();
     line_axes("fw: position (executor):", r.pos, true);
     line_axes("fw: position (STEP/DIR pins):", pins, true);
@@ -169,8 +216,10 @@ int main(void)
 {
     port_init();
     char cmd[96];
-    if (semihost_cmdline(cmd, sizeof cmd))
+    if (semihost_cmdline(cmd, sizeof cmd)) {
         exit_idle_ms = parse_exit_idle(cmd);
+        sim_switches(cmd);
+    }
     /* boot id: the host's clock (semihosting), the power-up noise of SRAM, the cycle counter */
     uint32_t boot = semihost_time() * 2654435761u;
     for (unsigned i = 0; i < sizeof noise / sizeof noise[0]; i++)

@@ -161,6 +161,7 @@ void port_init(void)
     NVIC_IPR(UART0_IRQ) = 0x40u;   /* the UART may interrupt the step interrupt: its FIFO */
     NVIC_IPR(TIMER0A_IRQ) = 0x80u; /* holds 16 bytes, the step interrupt runs for microseconds */
     NVIC_ISER(0) = (1u << UART0_IRQ) | (1u << TIMER0A_IRQ);
+    port_m3_ctl_init(); /* switch, probe and e-stop pins, the spindle PWM (port_m3_ctl.c) */
     __asm volatile("cpsie i" ::: "memory");
 }
 
@@ -251,6 +252,8 @@ void Timer0A_Handler(void)
         port_timer_arm(o.next_ticks);
     else
         port_timer_stop();
+    if (o.step_mask != 0)
+        port_m3_ctl_stepped(); /* simulated switches move with the pins (port_m3_ctl.c) */
 }
 
 void port_m3_edges(cs_exlog_edges_t *l)

@@ -56,6 +56,23 @@ typedef struct {
 void port_m3_servo(port_m3_servo_t *out);
 /* Code passed to port_fault (CS_OK when none). */
 cs_err_t port_m3_fault_code(void);
+/* Machine control (port_m3_ctl.c). Pins: limit switches min x/y/z/a on PB0..PB3, max on
+ * PB4..PB7, probe on PE0, e-stop on PE1: active high with the internal pull-downs (switches to
+ * 3.3 V), or active low with the pull-ups when built with -DPORT_M3_INPUTS_ACTIVE_LOW=1; an
+ * interrupt on both edges at the step timer's priority; spindle / laser PWM on PF0 (the PWM
+ * module's generator 0, PORT_M3_SPINDLE_HZ), enable on PC4 (high = on), direction on PC5 (high =
+ * counter-clockwise). Init: called by port_init. Stepped: the step interrupt calls it after
+ * pulses (simulated switches). Sim switch: input bit `bit` (CS_PROTO_IN_*) reads active while
+ * axis's STEP/DIR position is >= at (above) or <= at: qemu's board has no switch to press
+ * (main_m3.c sets them from its command line). Spindle: the settings so far, the last duty and
+ * mode. */
+#ifndef PORT_M3_SPINDLE_HZ
+#define PORT_M3_SPINDLE_HZ 5000u
+#endif
+void port_m3_ctl_init(void);
+void port_m3_ctl_stepped(void);
+void port_m3_sim_switch(uint16_t bit, uint8_t axis, int32_t at, bool above);
+void port_m3_spindle(uint32_t *settings, uint16_t *duty, uint8_t *mode);
 /* Called by port_fault after the machine is made safe (main_m3.c: report and exit under qemu). */
 void port_m3_on_fault(cs_err_t code);
 

@@ -20,6 +20,8 @@ void DebugMon_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void UART0_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void GPIOB_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void GPIOE_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void Timer0A_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void Timer1A_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void Timer2A_Handler(void) __attribute__((weak, alias("Default_Handler")));
@@ -39,6 +41,8 @@ __attribute__((section(".isr_vector"), used)) const vector_t vectors[16 + 48] = 
     [12] = DebugMon_Handler,
     [14] = PendSV_Handler,
     [15] = SysTick_Handler,
+    [16 + 1] = GPIOB_Handler,
+    [16 + 4] = GPIOE_Handler,
     [16 + 5] = UART0_Handler,
     [16 + 19] = Timer0A_Handler,
     [16 + 21] = Timer1A_Handler,

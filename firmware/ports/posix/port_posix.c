@@ -25,6 +25,13 @@ struct posix_state {
     size_t (*wr)(void *, const uint8_t *, size_t);
     void *io_ctx;
     cs_exlog_edges_t elog;
+    port_posix_spindle_t *spins;
+    size_t nspins, capspins;
+    uint16_t inputs, force_mask, force_val;
+    void (*in_fn)(void *, uint16_t);
+    void *in_ctx;
+    uint16_t (*model)(void *, const int64_t *);
+    void *model_ctx;
 };
 static struct posix_state g = {.hz = 100000,
                                .record = true,
@@ -37,12 +44,21 @@ void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
 {
     free(g.edges);
     free(g.pens);
+    free(g.spins);
     cs_stepper_t *st = g.st;
+    void (*in_fn)(void *, uint16_t) = g.in_fn;
+    void *in_ctx = g.in_ctx;
+    uint16_t (*model)(void *, const int64_t *) = g.model;
+    void *model_ctx = g.model_ctx;
     int in = g.fd_in, out = g.fd_out;
     size_t (*rd)(void *, uint8_t *, size_t) = g.rd;
     size_t (*wr)(void *, const uint8_t *, size_t) = g.wr;
     void *ctx = g.io_ctx;
     g = (struct posix_state){0};
+    g.in_fn = in_fn;
+    g.in_ctx = in_ctx;
+    g.model = model;
+    g.model_ctx = model_ctx;
     g.rd = rd;
     g.wr = wr;
     g.io_ctx = ctx;
@@ -153,6 +169,62 @@ void port_pen_set(uint16_t pulse_us)
     g.pens[g.npens++] = (port_posix_pen_t){g.now, pulse_us};
 }
 
+void port_spindle_set(uint16_t duty, uint8_t mode)
+{
+    void *b = g.spins;
+    bool ok = grow(&b, &g.capspins, g.nspins, sizeof *g.spins, 256);
+    g.spins = b;
+    if (!ok) {
+        g.record_ok = false;
+        return;
+    }
+    g.spins[g.nspins++] = (port_posix_spindle_t){g.now, duty, mode};
+}
+
+const port_posix_spindle_t *port_posix_spindles(size_t *n)
+{
+    *n = g.nspins;
+    return g.spins;
+}
+
+/* The bits from the model and the forced ones; the hook hears of a change (the pin interrupt). */
+static void inputs_update(void)
+{
+    uint16_t b = g.model != NULL ? g.model(g.model_ctx, g.pos) : 0;
+    b = (uint16_t)((b & (uint16_t)~g.force_mask) | (g.force_val & g.force_mask));
+    if (b == g.inputs)
+        return;
+    g.inputs = b;
+    if (g.in_fn != NULL)
+        g.in_fn(g.in_ctx, b);
+}
+
+uint16_t port_inputs_read(void)
+{
+    return g.inputs;
+}
+
+void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+{
+    g.in_fn = fn;
+    g.in_ctx = ctx;
+    inputs_update();
+}
+
+void port_posix_inputs_model(uint16_t (*model)(void *ctx, const int64_t *pos), void *ctx)
+{
+    g.model = model;
+    g.model_ctx = ctx;
+    inputs_update();
+}
+
+void port_posix_inputs_force(uint16_t mask, uint16_t value)
+{
+    g.force_mask = mask;
+    g.force_val = value;
+    inputs_update();
+}
+
 const port_posix_pen_t *port_posix_pens(size_t *n)
 {
     *n = g.npens;
@@ -202,6 +274,9 @@ static void step_isr(void)
         port_timer_arm(o.next_ticks);
     else
         port_timer_stop();
+    /* the switches move with the machine: sampled after each step (the hook may halt) */
+    if (o.step_mask != 0)
+        inputs_update();
 }
 
 bool port_posix_run(uint64_t until)

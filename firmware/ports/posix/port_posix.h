@@ -26,6 +26,23 @@ typedef struct {
     uint16_t pulse_us;
 } port_posix_pen_t;
 
+/* One spindle / laser output setting (port_spindle_set): from tick t on, duty (1/1000), mode. */
+typedef struct {
+    uint64_t t;
+    uint16_t duty;
+    uint8_t mode;
+} port_posix_spindle_t;
+
+/* The simulated inputs: model(ctx, pos) gives the input bits for the positions pos[0..8) in
+ * steps seen on the STEP/DIR lines (the physical machine); evaluated after every step interrupt
+ * that stepped, and the attached hook (port_inputs_attach) is called there when the bits change,
+ * as a real board's pin interrupt would. NULL: every input inactive. Kept across resets. */
+void port_posix_inputs_model(uint16_t (*model)(void *ctx, const int64_t *pos), void *ctx);
+/* Forces the bits in mask to the levels in value (an e-stop pressed by a test) and reports the
+ * change to the hook at once; mask 0 releases them. */
+void port_posix_inputs_force(uint16_t mask, uint16_t value);
+/* The spindle settings since reset, in time order; *n gets their count. */
+const port_posix_spindle_t *port_posix_spindles(size_t *n);
 /* Forgets everything (time 0, timer stopped, no edges) and sets the tick rate and which axes have
  * an inverted DIR line (bit i = axis i). */
 void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask);

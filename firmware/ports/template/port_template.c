@@ -62,6 +62,30 @@ void port_pen_set(uint16_t pulse_us)
     (void)pulse_us;
 }
 
+uint16_t port_inputs_read(void)
+{
+    /* Read the switch, probe and e-stop pins, invert the active-low ones and pack them as
+     * CS_PROTO_IN_* bits (min switch of axis i = bit i, max = bit 4 + i, probe 8, e-stop 9). */
+    return 0;
+}
+
+void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+{
+    /* Keep fn and ctx; enable a pin-change / edge interrupt on every input pin at the step
+     * timer's priority (so fn never preempts the step interrupt). Its handler calls
+     * fn(ctx, port_inputs_read()) when the bits differ from the last ones it reported. */
+    (void)fn;
+    (void)ctx;
+}
+
+void port_spindle_set(uint16_t duty, uint8_t mode)
+{
+    /* A hardware PWM timer's compare = duty x period / 1000; enable pin = mode != 0; direction
+     * pin = mode == 2. Must be safe to call from the step interrupt (laser power per segment). */
+    (void)duty;
+    (void)mode;
+}
+
 void port_timer_stop(void)
 {
     /* Disable the step timer interrupt. */

@@ -1,0 +1,202 @@
+/* cs_grbl_ctl: the Grbl front end's machine control through the device's messages
+ * (docs/protocol.md, "Machine control"): $H as one HOME per axis of the machine file's [homing]
+ * order, $X as UNLOCK, G38.x as PROBE with the contact from the device's EVENT, M3/M4/M5 and S
+ * as SPINDLE in queue order (laser mode: off in rapids, M4's power scaled by speed on the
+ * device, as Grbl's $32=1), ALARM:N from the device's alarm EVENT and Pn: from its inputs.
+ * Grbl 1.1 semantics from the grbl wiki ("Interface": alarm codes, Pn; "Laser Mode"). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cs_conv.h"
+#include "cs_gcode_words.h"
+#include "cs_grbl_int.h"
+#include "cs_motion.h"
+
+
+void cs_grbl_watch_alarm(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    if (s.alarms == g->alarms_seen)
+        return;
+    g->alarms_seen = s.alarms;
+    /* the device's alarm codes are Grbl's ALARM:N (cs_proto_alarm_t) */
+    cs_grbl_say(g, "ALARM:%u", (unsigned)s.alarm_code);
+    g->alarm = true;
+}
+
+void cs_grbl_home(grbl_t *g)
+{
+    if (g->ctl.n_order == 0) {
+        cs_grbl_say(g, "[MSG:homing is not configured: no [homing] order in the machine file]");
+        cs_grbl_say(g, "error:%d", ERR_HOMING);
+        return;
+    }
+    cs_proto_msg_t m[CS_AXES];
+    for (unsigned k = 0; k < g->ctl.n_order; k++)
+        if (cs_ctlcfg_home_msg(&g->ctl, &g->m, k, &m[k]) != CS_OK) {
+            cs_grbl_say(g, "[MSG:[homing] of the machine file does not fit a HOME message]");
+            cs_grbl_say(g, "error:%d", ERR_HOMING);
+            return;
+        }
+    /* Grbl: $H is how an alarm is left after a limit trip; the device's HOME unlocks too */
+    g->alarm = false;
+    cs_grbl_dev_clear(&g->dev);
+    g->homing = true;
+    bool ok = cs_grbl_run_msgs(g, m, g->ctl.n_order, true);
+    g->homing = false;
+    cs_grbl_watch_alarm(g);
+    cs_grbl_sync(g);
+    if (!ok || g->alarm) {
+        g->alarm = true;
+        cs_grbl_say(g, "error:%d", ERR_LOCKED);
+        return;
+    }
+    cs_grbl_say(g, "ok");
+}
+
+void cs_grbl_unlock(grbl_t *g)
+{
+    cs_grbl_dev_snap_t s;
+    cs_grbl_dev_snap(&g->dev, &s);
+    if (g->alarm || s.failed)
+        cs_grbl_say(g, "[MSG:Caution: Unlocked]");
+    bool dev_alarm = s.alarms > 0 && g->alarm;
+    g->alarm = false;
+    cs_grbl_dev_clear(&g->dev);
+    if (dev_alarm) {
+        /* UNLOCK takes no queue slot, so nothing would report it executed: the spindle off
+         * behind it (what the alarm left anyway) does */
+        cs_proto_msg_t m[2] = {{.type = CS_PROTO_UNLOCK}, {.type = CS_PROTO_SPINDLE}};
+        if (!cs_grbl_run_msgs(g, m, 2, true)) {
+            cs_grbl_dev_snap(&g->dev, &s);
+            cs_grbl_say(g, "[MSG:the device stays locked: %s]", s.why);
+            g->alarm = true;
+            cs_grbl_dev_clear(&g->dev);
+        }
+        g->sp_code = GC_M5;
+    }
+    cs_grbl_sync(g);
+    cs_grbl_say(g, "ok");
+}
+
+cs_err_t cs_grbl_probe(void *ctx, int code, const double from[3], const double to[3],
+                       double feed_mm_s, bool *contact, double hit[3])
+{
+    grbl_t *g = ctx;
+    (void)from;
+    memcpy(hit, to, 3 * sizeof *hit);
+    *contact = true;
+    if (g->check_mode) /* $C: checked, nothing moves; the contact is taken at the target */
+        return CS_OK;
+    cs_grbl_flush(g); /* the moves before the probe run first */
+    cs_proto_msg_t m = {.type = CS_PROTO_PROBE};
+    if (cs_conv_mm_to_vec(to[0], to[1], to[2], &m.u.probe.target) != CS_OK)
+        return CS_ERR_RANGE;
+    m.u.probe.feed = cs_motion_speed(feed_mm_s);
+    m.u.probe.flags = (uint8_t)((code == GC_G38_4 || code == GC_G38_5 ? CS_PROTO_PROBE_AWAY : 0) |
+                                (code == GC_G38_3 || code == GC_G38_5 ? CS_PROTO_PROBE_NO_ERROR
+                                                                       : 0));
+    cs_grbl_dev_snap_t s0, s;
+    cs_grbl_dev_snap(&g->dev, &s0);
+    cs_grbl_run_msgs(g, &m, 1, true);
+    cs_grbl_dev_snap(&g->dev, &s);
+    cs_grbl_sync(g);
+    *contact = s.probes > s0.probes && s.probe_contact;
+    for (int a = 0; a < 3 && a < g->m.n_axes; a++)
+        hit[a] = cs_grbl_steps_mm(g, a, s.probes > s0.probes ? s.probe_pos[a] : s.pos[a]);
+    /* Grbl reports every probe cycle: [PRB:x,y,z:ok], machine coordinates */
+    memcpy(g->prb, hit, sizeof g->prb);
+    g->prb_ok = *contact;
+    cs_grbl_say(g, "[PRB:%.3f,%.3f,%.3f:%d]", hit[0], hit[1], hit[2], *contact ? 1 : 0);
+    return CS_OK;
+}
+
+/* The SPINDLE message for code (M3/M4/M5) at s; in a laser's rapid run (rapid) the power is 0,
+ * and M4's full power is at feed_mm_s (the run's F: the device scales by speed). */
+static cs_proto_msg_t spindle_msg(const grbl_t *g, int code, double s, bool rapid,
+                                  double feed_mm_s)
+{
+    cs_proto_msg_t m = {.type = CS_PROTO_SPINDLE};
+    m.u.spindle.mode = code == GC_M3   ? CS_PROTO_SPINDLE_CW
+                       : code == GC_M4 ? CS_PROTO_SPINDLE_CCW
+                                       : CS_PROTO_SPINDLE_OFF;
+    double duty = g->ctl.s_max > 0 ? s / g->ctl.s_max * g->ov.spindle / 100.0 : 0;
+    duty = fmin(fmax(duty, 0.0), 1.0) * CS_PROTO_SPINDLE_FULL;
+    m.u.spindle.power = code == GC_M5 || rapid ? 0 : (uint16_t)lround(duty);
+    if (g->ctl.laser) {
+        m.u.spindle.flags = CS_PROTO_SPINDLE_LASER;
+        /* Grbl's laser mode: M4 dynamic (power x speed / F), M3 constant */
+        m.u.spindle.feed = code == GC_M4 ? cs_motion_speed(feed_mm_s) : 0;
+    }
+    return m;
+}
+
+cs_err_t cs_grbl_spindle(void *ctx, int code, double s)
+{
+    grbl_t *g = ctx;
+    if (g->check_mode)
+        return CS_OK;
+    cs_grbl_flush(g); /* the moves before the change run with the state before it */
+    g->sp_code = code;
+    g->sp_s = s;
+    if (g->ctl.laser && code != GC_M5)
+        return CS_OK; /* the power goes with each run of moves (cs_grbl_flush) */
+    cs_proto_msg_t m = spindle_msg(g, code, s, false, 0);
+    return cs_grbl_run_msgs(g, &m, 1, false) ? CS_OK : CS_ERR_STATE;
+}
+
+void cs_grbl_flush(grbl_t *g)
+{
+    cs_path_t *p = &g->pending;
+    if (!g->ctl.laser || g->sp_code == GC_M5 || p->n == 0) {
+        cs_grbl_queue_path(g, p);
+        return;
+    }
+    /* laser on: a run of moves with one rapid flag and one feed gets its own power */
+    size_t k0 = 0;
+    bool ok = true;
+    while (k0 < p->n && ok) {
+        size_t k1 = k0 + 1;
+        while (k1 < p->n && p->elems[k1].rapid == p->elems[k0].rapid &&
+               p->elems[k1].feed_mm_s == p->elems[k0].feed_mm_s)
+            k1++;
+        cs_path_t run;
+        cs_path_init(&run);
+        ok = cs_path_grow((void **)&run.elems, &run.cap, k1 - k0, sizeof *run.elems);
+        if (ok) {
+            memcpy(run.elems, p->elems + k0, (k1 - k0) * sizeof *run.elems);
+            run.n = k1 - k0;
+            run.blend_tol_mm = p->blend_tol_mm;
+            double feed = p->elems[k0].feed_mm_s > 0 ? p->elems[k0].feed_mm_s
+                                                     : (g->feed > 0 ? g->feed : g->m.default_feed) /
+                                                           65536.0;
+            cs_proto_msg_t m = spindle_msg(g, g->sp_code, g->sp_s, p->elems[k0].rapid, feed);
+            ok = cs_grbl_run_msgs(g, &m, 1, false) && cs_grbl_queue_path(g, &run);
+        }
+        cs_path_free(&run);
+        k0 = k1;
+    }
+    p->n = 0;
+}
+
+void cs_grbl_pins(const grbl_t *g, const cs_grbl_dev_snap_t *s, char *out, size_t cap)
+{
+    (void)g;
+    out[0] = '\0';
+    if (!s->have_inputs || s->inputs == 0 || cap < 16)
+        return;
+    /* Grbl 1.1 "Pn:": X Y Z limit pins, P probe; R (reset/abort) stands for the e-stop */
+    size_t n = (size_t)snprintf(out, cap, "|Pn:");
+    for (unsigned a = 0; a < 3; a++)
+        if (s->inputs & (CS_PROTO_IN_MIN(a) | CS_PROTO_IN_MAX(a)))
+            out[n++] = (char)('X' + a);
+    if (s->inputs & CS_PROTO_IN_PROBE)
+        out[n++] = 'P';
+    if (s->inputs & CS_PROTO_IN_ESTOP)
+        out[n++] = 'R';
+    out[n] = '\0';
+    if (n == 4)
+        out[0] = '\0';
+}

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Machine control on the Cortex-M3 image under qemu (as tests/fw/test_fw_m3.sh runs it). qemu's
+# board has no switch to press, so the image's command line places simulated ones
+# (main_m3.c, port_m3_sim_switch) in STEP/DIR pin steps, 80 steps/mm: x min at -400 (-5 mm),
+# x max at 4000 (50 mm), z max at 160 (2 mm), the probe surface at z -240 (-3 mm). Expected
+# values by hand, as in tests/cli/test_control.sh:
+#  - `curvestep home` (order zx, pull-off 1 mm): the pins end at x -400 + 80 = -320 and
+#    z 160 - 80 = 80 steps; the device reads x -99 mm, z 0 (x_pos, z_pos): device = pins - (95
+#    mm, 0, 1 mm) from then on;
+#  - `curvestep probe` down to z = -10: contact at pin z -240, device z -4 mm;
+#  - a jog into the x max switch: ALARM:1 with the x max bit (0x010), stopped at pin x 4000
+#    (device -45 mm); `unlock`; a jog back to -60 mm (pins 2800);
+#  - `curvestep spindle --ccw 250`: the port's PWM last set to duty 250/1000, mode 2 (the alarm
+#    and `unlock` set it off before).
+# Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
+set -u
+B=${CS_BUILD:-build}
+FW=${FW_M3_DIR:-${B%/asan}/fw/cortex-m3}
+ELF=$FW/curvestep.elf
+QEMU=(qemu-system-arm -M lm3s6965evb -kernel "$ELF" -display none -monitor none -serial pty
+    -icount shift=4
+    -semihosting-config
+    enable=on,target=native,arg=curvestep,arg=x_min=-400,arg=x_max=4000,arg=z_max=160,arg=probe_z=-240)
+. "$(dirname "${BASH_SOURCE[0]}")/../cli/lib/common.sh"
+
+if ! command -v qemu-system-arm >/dev/null; then
+    echo "FAIL: qemu-system-arm missing (scripts/deps.sh installs it)"
+    echo "cli: 0 passed, 1 failed"
+    exit 1
+fi
+expect "image built" [ -f "$ELF" ]
+MC=$T/m3.ini
+cat firmware/ports/cortex-m3/machine.ini tests/data/ctl-homing.ini >"$MC"
+near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
+
+timeout -k 5 400 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
+QPID=$!
+pids+=("$QPID")
+wait_until 20 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
+FPTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/fw.out")
+expect "qemu: pty" [ -n "$FPTY" ]
+ctl() { c=$1; shift; timeout -k 5 180 "$CS" "$c" --port "$FPTY" --machine "$MC" "$@"; }
+
+ctl home >"$T/home.out" 2>&1; rc=$?
+expect "home: exit 0 (got $rc)" [ $rc -eq 0 ]
+expect "home: final position" grep -q '^home: machine position -99.0000 0.0000 0.0000 mm$' \
+    "$T/home.out"
+ctl probe --feed 2 -- -99 0 -10 >"$T/probe.out" 2>&1; rc=$?
+expect "probe: exit 0 (got $rc)" [ $rc -eq 0 ]
+pz=$(grep '^probe: contact at' "$T/probe.out" | awk '{ print $6 }')
+expect "probe: contact at z = -4 mm within a step (got $pz)" near "${pz:-x}" -4 0.0125
+ctl jog --feed 50 -- -40 0 -1 >"$T/hl.out" 2>&1; rc=$?
+expect "hard limit: exit 7 (got $rc)" [ $rc -eq 7 ]
+expect "hard limit: ALARM:1 with the x max switch" grep -q '^jog: ALARM:1 (hard limit.*inputs 0x010' \
+    "$T/hl.out"
+hx=$(grep '^jog: ALARM:1' "$T/hl.out" | awk '{ print $13 }')
+expect "hard limit: stopped at x = -45 mm (got $hx)" near "${hx:-x}" -45 0.0001
+ctl unlock >"$T/u.out" 2>&1; rc=$?
+expect "unlock: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl jog --feed 50 -- -60 0 -1 >"$T/back.out" 2>&1; rc=$?
+expect "jog back: exit 0 (got $rc)" [ $rc -eq 0 ]
+ctl spindle --ccw 250 >"$T/sp.out" 2>&1; rc=$?
+expect "spindle M4 S250: exit 0 (got $rc)" [ $rc -eq 0 ]
+kill -TERM "$QPID" 2>/dev/null
+wait_until 30 gone "$QPID"
+expect "image: control line" grep -q '^fw: control: 2 axes homed, [1-9] alarms (now 0), 1 probe cycles' \
+    "$T/fw.out"
+expect "image: spindle last set to duty 250/1000, counter-clockwise" \
+    grep -qE '; spindle: [0-9]+ settings, last duty 250 mode 2$' "$T/fw.out"
+expect "image: STEP/DIR pins at (2800, 0, 0)" \
+    grep -q '^fw: position (STEP/DIR pins): x=2800 y=0 z=0$' "$T/fw.out"
+finish
