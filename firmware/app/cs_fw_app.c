@@ -147,6 +147,7 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
         cs_fw_motion_hold(&a->mo, m.type == CS_PROTO_HOLD);
         break;
     case CS_PROTO_ABORT:
+        cs_fw_motion_give_back(&a->mo);
         cs_fw_motion_abort(&a->mo);
         break;
     case CS_PROTO_QUERY: /* a host that (re)connected asks where the job stands */

@@ -459,16 +459,6 @@ void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
 
 void cs_fw_motion_flush(cs_fw_motion_t *a)
 {
-    /* Items taken from the queue but not wholly handed to the executor (the segment held back,
-     * a PEN waiting, a curve being traced or planned) are dropped unexecuted: they are given
-     * back their numbers, so "executed" and the job's numbers (STATUS done/recv) stay the truth
-     * and a resume sends them again. The ring's segments finish; the last one's tag is the
-     * last item they complete. */
-    uint32_t keep = a->pushed != a->completed
-                        ? tag_item(a, a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK])
-                        : a->exec_item;
-    if (item_after(a->popped, keep))
-        a->popped = keep;
     a->has_pend = false;
     a->pen_wait = false;
 #if CS_FW_CURVES
@@ -491,6 +481,21 @@ void cs_fw_motion_drop(cs_fw_motion_t *a)
     cs_fw_motion_flush(a);
     cs_hold_reset(&a->hold);
     a->news = true;
+}
+
+void cs_fw_motion_give_back(cs_fw_motion_t *a)
+{
+    /* ABORT: items taken from the queue but not wholly handed to the executor (the segment held
+     * back, a PEN waiting, a curve being traced or planned) are dropped unexecuted: they are
+     * given back their numbers, so "executed" and the job's numbers (STATUS done/recv) stay the
+     * truth and a resume sends them again. The ring's segments finish; the last one's tag is
+     * the last item they complete. (Only here: the machine-control paths that flush mid-item,
+     * homing and probing, keep their item taken.) */
+    uint32_t keep = a->pushed != a->completed
+                        ? tag_item(a, a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK])
+                        : a->exec_item;
+    if (item_after(a->popped, keep))
+        a->popped = keep;
 }
 
 void cs_fw_motion_abort(cs_fw_motion_t *a)

@@ -187,6 +187,9 @@ void cs_fw_motion_poll(cs_fw_motion_t *mo);
 /* A new boot of the link (a reset that keeps the machine where it is): the queue, the errors and
  * the sequences are forgotten; the executor, its position and what it holds are kept. */
 void cs_fw_motion_reboot(cs_fw_motion_t *mo);
+/* Before an ABORT message: the items taken from the queue but not handed to the executor get
+ * their numbers back (they will not run; STATUS done/recv stay the truth). Main loop. */
+void cs_fw_motion_give_back(cs_fw_motion_t *mo);
 /* SETPOS: numbers the items received from now on base+1, ... in job job_id; with
  * CS_PROTO_SETPOS_POS sets the position counters to pos[] (steps), which needs the queue empty
  * and the executor idle: CS_ERR_STATE otherwise (nothing changed). Main loop. */

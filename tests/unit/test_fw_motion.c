@@ -316,6 +316,7 @@ static void test_setpos_numbers_the_job(void **state)
     cs_fw_motion_hold(&mo, true);
     run_until(UINT64_MAX);
     assert_true(mo.has_pend);
+    cs_fw_motion_give_back(&mo); /* as the ABORT message does (cs_fw_app) */
     cs_fw_motion_abort(&mo);
     run_until(UINT64_MAX);
     cs_fw_motion_status(&mo, &st);
