@@ -77,7 +77,7 @@ SIM_INC   := $(PORT_INC) -Ihost -Isim
 # tests, benchmarks and fuzz targets may look at every layer
 INCLUDES  := $(SIM_INC) -Itests/support
 # The host's build of the application offers the simulator's largest queue (--queue 1..256).
-FW_HOST_DEFS := -DCS_FW_QUEUE=256
+FW_HOST_DEFS := -DCS_FW_QUEUE=256 -DCS_FW_SIM_HOOKS=1
 WARN      := -Wall -Wextra -Werror
 CORE_BASE   := -std=c99 $(WARN) -Wconversion $(OPT) $(SANFLAGS)
 CORE_CFLAGS := $(CORE_BASE) $(CORE_INC)

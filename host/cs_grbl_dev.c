@@ -98,7 +98,7 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     take_status(d, &r);
     if (e != CS_OK || (r.outcome != CS_STREAM_DONE && r.outcome != CS_STREAM_INTERRUPTED)) {
         d->s.failed = true;
-        snprintf(d->s.why, sizeof d->s.why, "%s%s%s", cs_stream_outcome_text(r.outcome),
+        snprintf(d->s.why, sizeof d->s.why, "%s%s%.150s", cs_stream_outcome_text(r.outcome),
                  r.why[0] ? ": " : "", r.why);
     }
     if (r.outcome == CS_STREAM_INTERRUPTED)

@@ -183,11 +183,17 @@ static cs_err_t serial_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_
     /* the link's timing for the rate the line really moves, in cs_serial_now_us microseconds */
     cs_stream_link_timing(&o.link, cs_joblink_line_bps(l->cfg.port, l->cfg.baud, l->cfg.line_rate));
     o.resume_from = j->resume_from;
+    o.resume_ask = j->resume_ask;
+    o.set_pos = j->stated_pos != NULL;
+    for (unsigned i = 0; o.set_pos && i < CS_PROTO_AXES_MAX; i++)
+        o.pos[i] = j->stated_pos[i];
     o.interrupt = c->interrupt;
     o.pause = c->pause;
     o.progress = c->progress;
     o.progress_tty = c->progress_tty;
-    return cs_stream_run(j->job, &o, r);
+    cs_err_t e = cs_stream_run(j->job, &o, r);
+    l->resume_from = r->resume_from; /* --resume: where the device's word put the start */
+    return e;
 }
 
 static int serial_close(cs_joblink_t *l, int rc)

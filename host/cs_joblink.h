@@ -51,6 +51,11 @@ typedef struct {
     size_t resume_from;       /* in the link's numbering: messages (GPIO: segments) done */
     const int32_t *start_pos; /* steps where the machine stands (GPIO reports its end
                                * position from it); NULL: the origin */
+    /* serial: --resume (ask the device where the job stands; resume_from is then ignored) and
+     * --position (steps the user stated, sent before any motion: SETPOS), docs/streaming.md
+     * "Resume"; false / NULL elsewhere */
+    bool resume_ask;
+    const int32_t *stated_pos;
 } cs_joblink_job_t;
 
 /* How the caller steers a run (all polled by run; any may be NULL / false). */

@@ -10,6 +10,7 @@
 
 #include "cs_conv.h"
 #include "cs_err_text.h"
+#include "cs_exlog.h"
 #include "cs_linktime.h"
 #include "cs_motion.h"
 
@@ -276,23 +277,19 @@ void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s)
     (void)cs_linktime_link(c, bits_per_s, 1000000u); /* CS_ERR_RANGE below 5 bits/s: c kept */
 }
 
-#define CS_STREAM_CTL_MAX 16
-
 typedef struct {
     const cs_stream_job_t *job;
     const cs_stream_opts_t *o;
     cs_stream_result_t *r;
     cs_link_t link;
     bool open, have_hello;
-    uint16_t first_seq; /* sequence of message resume_from + 1 */
-    uint16_t exec_seq;  /* last executed sequence seen */
     size_t next;        /* job index of the next message to send (0-based) */
     bool stop;          /* outcome decided */
     bool held;          /* HOLD sent for o->pause, RESUME not yet */
-    /* sequences of the HOLD/RESUME sent for o->pause that the device's last executed sequence
-     * has not passed yet: they are not job messages, so they do not count as executed */
-    uint16_t ctl_seq[CS_STREAM_CTL_MAX];
-    size_t nctl;
+    /* STATUS messages received with nothing of ours unacknowledged: the device sent them after
+     * it had taken everything we sent (its ACK goes out before them), so they answer it */
+    unsigned fresh;
+    cs_proto_status_t last; /* the last STATUS */
     double t0, t_first;
     cs_stream_progress_t prog;
 } run_t;
@@ -305,34 +302,24 @@ static void finish(run_t *s, cs_stream_outcome_t oc)
     }
 }
 
+/* The device's STATUS: state and position; once the device numbers this job (SETPOS, or
+ * found on --resume), its last finished message is what counts as executed: no guess from link
+ * sequences, so HOLD / RESUME / QUERY never count and a reconnect loses nothing. */
 static void on_status(run_t *s, const cs_proto_status_t *st)
 {
+    s->last = *st;
     s->r->dev_state = st->state;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         s->r->dev_pos[i] = i < st->axes ? st->pos[i] : 0;
     if (!s->open)
         return;
-    size_t base = s->o->resume_from;
-    size_t in_flight = s->r->sent - s->r->executed;
-    uint16_t d = (uint16_t)(st->last_seq - s->exec_seq);
-    size_t skipped = 0; /* control messages among the newly executed sequences */
-    for (size_t i = 0; i < s->nctl; i++) {
-        uint16_t k = (uint16_t)(s->ctl_seq[i] - s->exec_seq);
-        skipped += k != 0 && k <= d;
+    if (cs_link_unacked(&s->link) == 0)
+        s->fresh++;
+    if (s->r->numbered && (st->flags & CS_PROTO_STATUS_JOB) && st->job_id == s->r->job_id &&
+        st->done <= s->r->sent && st->recv <= s->r->sent) {
+        s->r->executed = st->done;
+        s->r->dev_recv = st->recv;
     }
-    if (d != 0 && d >= skipped && d - skipped <= in_flight) {
-        size_t keep = 0;
-        for (size_t i = 0; i < s->nctl; i++) {
-            uint16_t k = (uint16_t)(s->ctl_seq[i] - s->exec_seq);
-            if (!(k != 0 && k <= d))
-                s->ctl_seq[keep++] = s->ctl_seq[i];
-        }
-        s->nctl = keep;
-        d = (uint16_t)(d - skipped);
-        s->r->executed += d;
-        s->exec_seq = st->last_seq;
-    }
-    (void)base;
 }
 
 static void on_deliver(run_t *s, const cs_link_event_t *ev)
@@ -355,7 +342,7 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
         uint16_t last = (uint16_t)(cs_link_last_acked(&s->link) + cs_link_unacked(&s->link));
         uint16_t back = (uint16_t)(last - m.u.error.seq);
         s->r->dev_error_msg =
-            s->open && back < s->r->sent - s->o->resume_from ? s->r->sent - back : 0;
+            s->open && back < s->r->sent - s->r->resume_from ? s->r->sent - back : 0;
         finish(s, CS_STREAM_DEVICE_ERROR);
     }
 }
@@ -399,11 +386,8 @@ static void pump_in(run_t *s, int wait_ms)
         cs_link_event_t ev;
         if (cs_link_feed(&s->link, buf[k], now, 0, &ev) != CS_OK)
             continue;
-        if (ev.what & CS_LINK_EV_OPEN) {
+        if (ev.what & CS_LINK_EV_OPEN)
             s->open = true;
-            s->first_seq = (uint16_t)(ev.last_acked + 1u);
-            s->exec_seq = ev.last_acked;
-        }
         if (ev.what & CS_LINK_EV_RESET) {
             s->r->old_boot = ev.old_boot;
             s->r->new_boot = ev.new_boot;
@@ -416,7 +400,7 @@ static void pump_in(run_t *s, int wait_ms)
     if (s->open) {
         /* sent minus what the link still holds unacknowledged (a window, far below 65,536):
          * no 16-bit sequence arithmetic, so no wrap on long jobs */
-        size_t in_session = s->r->sent - s->o->resume_from;
+        size_t in_session = s->r->sent - s->r->resume_from;
         size_t unacked = cs_link_unacked(&s->link);
         s->r->delivered = s->r->sent - (unacked < in_session ? unacked : in_session);
     }
@@ -478,45 +462,47 @@ static void progress(run_t *s, bool final)
 {
     s->prog.t_first = s->t_first;
     cs_stream_progress(&s->prog, s->o->progress, s->o->progress_tty, final, s->job->n,
-                       s->r->executed, s->r->sent, s->o->resume_from, s->link.stats.retransmits,
+                       s->r->executed, s->r->sent, s->r->resume_from, s->link.stats.retransmits,
                        s->job->mode == CS_STREAM_CURVES ? "curves" : "segments");
 }
 
-/* Sends one control message (HOLD or ABORT) and waits until the device says it obeyed (state in
- * want_a or want_b) or wait_ms passed. */
-static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint32_t wait_ms)
+#define ANY_STATE 0xFFu
+
+/* Sends m and waits until the device took it and answered with a STATUS whose state is want_a
+ * or want_b (ANY_STATE: any), or wait_ms passed: true when it answered so. */
+static bool exchange(run_t *s, const cs_proto_msg_t *m, uint8_t want_a, uint8_t want_b,
+                     uint32_t wait_ms)
 {
-    uint16_t seq = 0;
-    bool track = type == CS_PROTO_HOLD || type == CS_PROTO_RESUME;
-    cs_proto_msg_t m = {.type = type};
     double t_end = cs_serial_now_s() + wait_ms / 1000.0;
     bool sent = false;
-    uint8_t before = s->r->dev_state;
-    (void)before;
-    s->r->dev_state = 0xFF; /* wait for a STATUS sent after the message */
+    unsigned mark = 0;
     while (cs_serial_now_s() < t_end) {
-        uint32_t now = cs_serial_now_us();
-        if (!sent && cs_link_can_send(&s->link, type))
-            sent = cs_link_send_msg(&s->link, &m, &seq) == CS_OK;
-        if (sent && track && s->nctl < CS_STREAM_CTL_MAX) {
-            s->ctl_seq[s->nctl++] = seq; /* not a job message (see run_t.ctl_seq) */
-            track = false;
+        if (!sent && cs_link_can_send(&s->link, m->type)) {
+            sent = cs_link_send_msg(&s->link, m, NULL) == CS_OK;
+            mark = s->fresh;
         }
-        if (pump_out(s, now) != 0)
-            return;
+        if (pump_out(s, cs_serial_now_us()) != 0)
+            return false;
         pump_in(s, 5);
-        if (sent && cs_link_unacked(&s->link) == 0 &&
-            (s->r->dev_state == want_a || s->r->dev_state == want_b))
-            return;
+        if (sent && s->fresh != mark &&
+            (want_a == ANY_STATE || s->r->dev_state == want_a || s->r->dev_state == want_b))
+            return true;
         if (cs_link_state(&s->link) != CS_LINK_OPEN)
-            return;
+            return false;
         if (s->o->interrupt != NULL && *s->o->interrupt >= 2)
-            return;
+            return false;
     }
+    return false;
 }
 
-/* Sets up s for job (link endpoint with a fresh boot id and nonce). CS_ERR_ARG when the link
- * refuses the options. */
+/* Sends one control message (HOLD, RESUME or ABORT) and waits until the device says it obeyed
+ * (state in want_a or want_b) or wait_ms passed. */
+static void control(run_t *s, uint8_t type, uint8_t want_a, uint8_t want_b, uint32_t wait_ms)
+{
+    cs_proto_msg_t m = {.type = type};
+    (void)exchange(s, &m, want_a, want_b, wait_ms);
+}
+
 static cs_err_t run_init(run_t *s, const cs_stream_job_t *job, const cs_stream_opts_t *o,
                          cs_stream_result_t *r)
 {
@@ -526,8 +512,9 @@ static cs_err_t run_init(run_t *s, const cs_stream_job_t *job, const cs_stream_o
     /* a line that takes no more bytes (the peer stopped reading) must not block the loop: what
      * the driver refuses is lost, and the link resends it or declares the peer gone */
     cs_serial_set_lossy(o->ser, true);
-    r->sent = r->delivered = r->executed = o->resume_from;
+    r->sent = r->delivered = r->executed = r->resume_from = o->resume_from;
     s->next = o->resume_from;
+    r->job_id = cs_stream_job_id(job);
     s->t0 = cs_serial_now_s();
     uint32_t seed = (uint32_t)getpid() * 2654435761u ^ (uint32_t)(s->t0 * 1e6);
     uint32_t boot = seed ? seed : 1u;
@@ -606,7 +593,7 @@ static bool run_controls(run_t *s, double *t_last_ack)
         finish(s, CS_STREAM_INTERRUPTED);
         return true;
     }
-    if (o->pause != NULL && (*o->pause != 0) != s->held && s->nctl + 2 <= CS_STREAM_CTL_MAX) {
+    if (o->pause != NULL && (*o->pause != 0) != s->held) {
         s->held = !s->held;
         if (s->held) {
             control(s, CS_PROTO_HOLD, CS_PROTO_STATE_HELD, CS_PROTO_STATE_IDLE, 2000);
@@ -641,6 +628,104 @@ static void check_end(run_t *s, double *t_last_ack)
                  "everything was delivered but the device reports %zu executed", r->executed);
         finish(s, CS_STREAM_CLOSED);
     }
+}
+
+uint32_t cs_stream_job_id(const cs_stream_job_t *job)
+{
+    uint32_t h = CS_EXLOG_HASH0; /* FNV-1a 32 (Fowler/Noll/Vo, public domain), as cs_exlog */
+    for (size_t k = 0; k < job->n; k++) {
+        uint8_t buf[CS_PROTO_LEN_MAX];
+        size_t len = 0;
+        if (cs_proto_encode(&job->v[k], buf, sizeof buf, &len) != CS_OK)
+            len = 0; /* cannot happen: the job was encoded when it was built (job_push) */
+        for (size_t i = 0; i < len; i++)
+            h = (h ^ buf[i]) * 16777619u;
+    }
+    return h != 0 ? h : 1u;
+}
+
+/* Sends SETPOS: the device numbers the job's messages from base + 1 (and with o->set_pos takes
+ * the stated position); true when it took it (a STATUS saying so came back). */
+static bool send_setpos(run_t *s, size_t base, bool with_pos)
+{
+    cs_proto_msg_t m = {.type = CS_PROTO_SETPOS};
+    m.u.setpos.flags = with_pos ? CS_PROTO_SETPOS_POS : 0;
+    m.u.setpos.job_id = s->r->job_id;
+    m.u.setpos.base = (uint32_t)base;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        m.u.setpos.pos[i] = with_pos ? s->o->pos[i] : 0;
+    s->r->numbered = true;
+    if (!with_pos) /* a fresh job: its numbers are checked by every STATUS that follows */
+        return cs_link_send_msg(&s->link, &m, NULL) == CS_OK;
+    return exchange(s, &m, ANY_STATE, ANY_STATE, s->o->hello_ms) &&
+           (s->last.flags & CS_PROTO_STATUS_POS) && s->last.job_id == s->r->job_id;
+}
+
+/* The start of a resumed run: what the device says about the job decides where to go on from
+ * (docs/streaming.md, "Resume"). Refusals say why in r->why and what to do. */
+static void resume_point(run_t *s)
+{
+    cs_stream_result_t *r = s->r;
+    const cs_stream_opts_t *o = s->o;
+    const cs_proto_status_t *st = &s->last;
+    bool knows = (st->flags & CS_PROTO_STATUS_JOB) != 0, same = knows && st->job_id == r->job_id;
+    if (same && o->set_pos) {
+        snprintf(r->why, sizeof r->why,
+                 "the device did not reset and still numbers this job (it finished %lu, received "
+                 "%lu): --position is for a device that reset; use --resume",
+                 (unsigned long)st->done, (unsigned long)st->recv);
+        finish(s, CS_STREAM_INCOMPATIBLE);
+    } else if (same && (o->resume_ask || o->resume_from == st->recv) && st->recv <= s->job->n) {
+        r->numbered = true; /* go on after the last message it received (its queue runs on) */
+        r->resume_from = r->sent = r->delivered = s->next = st->recv;
+        r->executed = r->resume_done = st->done;
+        r->dev_recv = st->recv;
+    } else if (same) {
+        snprintf(r->why, sizeof r->why,
+                 "--resume-from %zu, but the device received messages 1..%lu of this job and "
+                 "finished %lu: use --resume",
+                 o->resume_from, (unsigned long)st->recv, (unsigned long)st->done);
+        finish(s, CS_STREAM_INCOMPATIBLE);
+    } else if (knows) {
+        snprintf(r->why, sizeof r->why,
+                 "the device's job is another one (id %08lx, this file's is %08lx): not resumed",
+                 (unsigned long)st->job_id, (unsigned long)r->job_id);
+        finish(s, CS_STREAM_INCOMPATIBLE);
+    } else if (!o->resume_ask && o->set_pos) {
+        if (!send_setpos(s, o->resume_from, true) && !s->stop) {
+            snprintf(r->why, sizeof r->why, "the device did not take the stated position");
+            finish(s, CS_STREAM_NO_DEVICE);
+        }
+    } else {
+        snprintf(r->why, sizeof r->why,
+                 "the device reset since it ran this job (it knows no job since its boot): the "
+                 "machine's position is unknown. Home it and run the job again, or state where "
+                 "it is: --resume-from N --position X,Y,Z");
+        r->refused = true;
+        finish(s, CS_STREAM_RESET);
+    }
+}
+
+/* Phase 1b: a fresh job is numbered from 1 (SETPOS); a resumed one asks the device first
+ * (QUERY) and goes on from what it says. */
+static void run_begin(run_t *s)
+{
+    const cs_stream_opts_t *o = s->o;
+    if (!o->resume_ask && o->resume_from == 0 && !o->set_pos) {
+        if (!send_setpos(s, 0, false))
+            finish(s, CS_STREAM_CLOSED);
+        return;
+    }
+    cs_proto_msg_t q = {.type = CS_PROTO_QUERY};
+    if (!exchange(s, &q, ANY_STATE, ANY_STATE, o->hello_ms)) {
+        if (!s->stop) {
+            snprintf(s->r->why, sizeof s->r->why, "no STATUS in answer to QUERY within %u ms",
+                     (unsigned)o->hello_ms);
+            finish(s, CS_STREAM_NO_DEVICE);
+        }
+        return;
+    }
+    resume_point(s);
 }
 
 /* Phase 2: keeps the window and the credits full until an outcome. */
@@ -703,6 +788,8 @@ cs_err_t cs_stream_run(const cs_stream_job_t *job, const cs_stream_opts_t *o, cs
     run_connect(s);
     if (!s->stop)
         check_hello(s);
+    if (!s->stop)
+        run_begin(s);
     run_stream(s);
     run_finish(s);
     free(s);

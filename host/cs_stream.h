@@ -73,6 +73,10 @@ typedef struct {
     uint8_t axes; /* the machine: HELLO must announce the same */
     uint32_t tick_hz;
     size_t resume_from; /* messages 1..resume_from were executed already: start after them */
+    bool resume_ask;    /* --resume: ask the device (QUERY) where this job stands, go on from
+                         * the last message it received; refused when it does not know the job */
+    bool set_pos;       /* --position: with resume_from, SETPOS the device's position first */
+    int32_t pos[CS_PROTO_AXES_MAX]; /* set_pos: the machine's position, steps */
     volatile sig_atomic_t *interrupt; /* > 0: stop (HOLD, ABORT); >= 2: give up at once */
     volatile sig_atomic_t *pause;     /* NULL: never; != 0: HOLD (queue kept), back to 0: RESUME */
     FILE *progress;                   /* NULL: none; else progress bar (tty) or lines */
@@ -102,11 +106,18 @@ typedef struct {
     size_t dev_error_msg;        /* DEVICE_ERROR: job number of the message it is about (0: ?) */
     uint8_t dev_state;           /* last STATUS */
     int32_t dev_pos[CS_PROTO_AXES_MAX];
+    size_t resume_from;   /* the run started after this message (o->resume_from, or the
+                           * device's answer to --resume) */
+    size_t resume_done;   /* --resume: the last message the device had finished then */
+    bool refused;         /* a resume refused at the start (why says what to do), nothing sent */
+    bool numbered;        /* the device numbers this job's messages: executed is its word */
+    size_t dev_recv;      /* last STATUS: the last message of the job the device received */
+    uint32_t job_id;      /* cs_stream_job_id of the job */
     cs_link_stats_t link;
     uint64_t bytes_out, bytes_in;
     double wall_s;   /* from the connection to the end */
     double stream_s; /* from the first message sent to the last one executed */
-    char why[160];   /* one sentence for NO_DEVICE / INCOMPATIBLE / CLOSED */
+    char why[320];   /* one sentence for NO_DEVICE / INCOMPATIBLE / CLOSED / RESET */
     const char *what; /* the link's own sentence for the outcome (a static string; NULL:
                        * cs_stream_outcome_text): the GPIO link's "held, then stopped ..." */
     bool mid_message; /* stopped inside message `executed` + 1: the machine is past the last
@@ -121,6 +132,9 @@ void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes,
  * do not match; the version is each link's own check. */
 bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t tick_hz,
                               cs_stream_mode_t mode, char *why, size_t cap);
+/* The job's name on the device (SETPOS, STATUS): FNV-1a 32 over every message as encoded, never
+ * 0. A different file, mode or plan gives another id, so --resume refuses it. */
+uint32_t cs_stream_job_id(const cs_stream_job_t *job);
 /* Link timing for a line of bits_per_s (0: a pty at memory speed) in cs_serial_now_us
  * microseconds: the core's cs_linktime_link (docs/protocol.md 3.6), the one every end computes
  * (below 5 bits/s the timeout does not fit 32 bits: c is left as it was). */

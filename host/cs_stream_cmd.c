@@ -17,6 +17,7 @@
 #include "cs_stream.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_pen.h"
+#include "cs_stream_resume.h"
 #include "cs_trace.h"
 
 static volatile sig_atomic_t interrupted;
@@ -32,7 +33,8 @@ static void usage(FILE *f)
 {
     fputs("usage: curvestep stream --port DEV [--baud N] [--machine FILE.ini]\n"
           "                        [--mode segments|curves] [--tol MM] [--feed MM/S]\n"
-          "                        [--resume-from N] [--line-rate BPS] [--font FILE.jhf]\n"
+          "                        [--resume | --resume-from N [--position X,Y,Z]]\n"
+          "                        [--line-rate BPS] [--font FILE.jhf]\n"
           "                        [--quiet] [input and layout options] FILE\n"
           "       curvestep stream --modbus-tcp HOST:PORT [--unit ID] [options] FILE\n"
           "       curvestep stream --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
@@ -70,16 +72,23 @@ static void usage(FILE *f)
           "  --feed MM/S        drawing feed (default: the machine's default_feed)\n"
           "  --max-input-mb N   refuse a job file larger than N MiB (default 64)\n"
           "  --max-segments N   refuse a job of more than N step segments (default 8388608)\n"
-          "  --resume-from N    messages 1..N were executed already: send from N+1 on (the\n"
-          "                     number printed after a reset or a lost link). The machine must\n"
-          "                     be where message N left it\n"
+          "  --resume           (--port) the link was lost but the device did not reset: ask\n"
+          "                     it where this job stands and go on after the last message it\n"
+          "                     received (refused, saying what to do, if it reset)\n"
+          "  --resume-from N    messages 1..N were executed already: send from N+1 on. With\n"
+          "                     --port, a device that did not reset must agree (else use\n"
+          "                     --resume); one that reset needs --position\n"
+          "  --position X,Y,Z   (--port, with --resume-from) where the machine is, mm: sent to\n"
+          "                     the device (SETPOS) before any motion. In segments mode it must\n"
+          "                     be where message N left the machine\n"
           "  --line-rate BPS    pace writes as a real line of BPS bits/s would (10 bits a byte),\n"
           "                     for measurements on a pseudo-terminal\n"
           "  --quiet            no progress\n"
           "Progress goes to standard error: a bar (percent, ETA, messages per second,\n"
           "retransmissions) on a terminal, else one line a second. Ctrl-C holds the motion,\n"
           "then aborts it (the device's queue is flushed); a second Ctrl-C leaves at once.\n"
-          "The summary line names the last executed message, to use with --resume-from.\n",
+          "When the link dies the summary names the last message the device confirmed and the\n"
+          "last one it may have executed, and how to resume (docs/streaming.md, Resume).\n",
           f);
     cs_jobopts_help(f);
     fputs("Exit status: 0 the whole job was executed; 1 bad input (file:line:col: reason);\n"
@@ -96,6 +105,9 @@ typedef struct {
     cs_jobplan_opts_t jo;
     cs_joblink_cfg_t link;
     size_t resume_from; /* --resume-from N */
+    bool resume_ask;      /* --resume */
+    const char *position; /* --position X,Y,Z (mm) */
+    int32_t pos[CS_AXES]; /* --position in steps */
     bool curves, quiet;
 } stream_args_t;
 
@@ -111,6 +123,10 @@ static int stream_option(int argc, char **argv, int *i, stream_args_t *a)
             return -1;
         }
         a->resume_from = (size_t)n;
+    } else if (strcmp(o, "--resume") == 0) {
+        a->resume_ask = true;
+    } else if (strcmp(o, "--position") == 0 && has) {
+        a->position = argv[++*i];
     } else if (strcmp(o, "--mode") == 0 && has) {
         const char *m = argv[++*i];
         if (strcmp(m, "segments") != 0 && strcmp(m, "curves") != 0) {
@@ -160,6 +176,51 @@ static int parse_args(int argc, char **argv, stream_args_t *a)
     return -1;
 }
 
+/* --resume, --resume-from and --position together: true (said on stderr) when they clash. */
+static bool resume_opts_bad(bool serial, bool ask, bool from, bool pos)
+{
+    const char *why = (ask || pos) && !serial
+                          ? "--resume and --position need --port (the serial protocol; "
+                            "docs/streaming.md, Resume)"
+                      : ask && (from || pos) ? "--resume asks the device where to go on: it takes "
+                                               "neither --resume-from nor --position"
+                      : pos && !from ? "--position needs --resume-from N"
+                                     : NULL;
+    if (why != NULL)
+        fprintf(stderr, "curvestep stream: %s\n", why);
+    return why != NULL;
+}
+
+/* --position X,Y,Z in steps; in segments mode it must be where message n left the machine
+ * (the segments are relative moves: from anywhere else the rest of the job would be offset). */
+static int check_position(const char *text, const cs_machine_t *m, const cs_stream_job_t *job,
+                          size_t n, int32_t steps[CS_AXES])
+{
+    cs_err_t e = cs_stream_resume_position(text, m, steps);
+    if (e != CS_OK) {
+        fprintf(stderr, "curvestep stream: --position %s: %s\n", text,
+                e == CS_ERR_RANGE ? "outside the coordinate range"
+                                  : "wants one number of mm per axis, comma-separated");
+        return -1;
+    }
+    if (job->mode != CS_STREAM_SEGMENTS)
+        return 0; /* curves: the device travels to the next curve's start itself */
+    int64_t want[CS_AXES];
+    cs_stream_resume_steps_after(job, n, want);
+    for (unsigned i = 0; i < m->n_axes; i++)
+        if (want[i] != steps[i]) {
+            static const char names[] = "xyza";
+            fprintf(stderr,
+                    "curvestep stream: --position %s: message %zu left the machine at %c = %.4f mm "
+                    "(%lld steps), not %.4f mm: move it there first (the segments are relative "
+                    "moves), or give the right N\n",
+                    text, n, names[i], (double)want[i] * CS_MOTION_ONE / m->axis[i].steps_per_mm,
+                    (long long)want[i], (double)steps[i] * CS_MOTION_ONE / m->axis[i].steps_per_mm);
+            return -1;
+        }
+    return 0;
+}
+
 /* The link the options pick, checked against the other options. */
 static int pick_link(stream_args_t *a, cs_joblink_t *l)
 {
@@ -169,6 +230,9 @@ static int pick_link(stream_args_t *a, cs_joblink_t *l)
         usage(stderr);
         return CS_EXIT_USAGE;
     }
+    if (resume_opts_bad(l->ops == &cs_joblink_serial_ops, a->resume_ask, a->resume_from != 0,
+                        a->position != NULL))
+        return CS_EXIT_USAGE;
     if (a->link.parity != 0 && a->link.modbus_rtu == NULL) {
         fprintf(stderr, "curvestep stream: --parity applies to --modbus-rtu only\n");
         return CS_EXIT_USAGE;
@@ -229,6 +293,20 @@ static int plan(const stream_args_t *a, const cs_joblink_t *l, const cs_machine_
     return CS_EXIT_OK;
 }
 
+/* What a serial run says beyond the one report: where --resume started, and after a lost link
+ * the device's confirmed and possibly executed numbers and how to resume. */
+static void resume_lines(const stream_args_t *a, const cs_joblink_job_t *j,
+                         const cs_stream_result_t *r)
+{
+    if (a->resume_ask && r->numbered)
+        fprintf(stdout,
+                "stream: resumed: the device had received %s 1..%zu of this job and finished "
+                "%zu of them; sent from %zu on\n",
+                a->curves ? "curves" : "segments", r->resume_from, r->resume_done,
+                r->resume_from + 1);
+    cs_stream_resume_hint(stdout, j->job, r, j->m, a->job_file);
+}
+
 /* Opens the link, runs the job with Ctrl-C as a hold, reports, closes. */
 static int run_link(const stream_args_t *a, cs_joblink_t *l, const cs_joblink_job_t *j, size_t n)
 {
@@ -255,6 +333,7 @@ static int run_link(const stream_args_t *a, cs_joblink_t *l, const cs_joblink_jo
         return cs_joblink_close(l, CS_EXIT_INTERNAL);
     }
     rc = cs_joblink_report(l, stdout, n, &r);
+    resume_lines(a, j, &r);
     fflush(stdout);
     return cs_joblink_close(l, rc);
 }
@@ -291,8 +370,13 @@ int cs_cmd_stream(int argc, char **argv)
                               .nsegs = jp.mo.segs.n,
                               .pens = jp.mo.segs.pens,
                               .npens = jp.mo.segs.npens,
-                              .resume_from = a.resume_from};
-        rc = run_link(&a, &l, &j, segs ? jp.mo.segs.n : job.n);
+                              .resume_from = a.resume_from,
+                              .resume_ask = a.resume_ask,
+                              .stated_pos = a.position != NULL ? a.pos : NULL};
+        if (a.position != NULL && check_position(a.position, &m, &job, a.resume_from, a.pos) != 0)
+            rc = CS_EXIT_USAGE;
+        else
+            rc = run_link(&a, &l, &j, segs ? jp.mo.segs.n : job.n);
     }
     cs_stream_job_free(&job);
     cs_jobplan_free(&jp);

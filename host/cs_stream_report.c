@@ -47,7 +47,7 @@ static void outcome_line(FILE *out, const char *where, const cs_stream_result_t 
     fprintf(out, "stream: %s: %s", where, cs_stream_result_text(r));
     if (r->why[0] && r->outcome != CS_STREAM_DEVICE_ERROR)
         fprintf(out, " (%s)", r->why);
-    if (r->outcome == CS_STREAM_RESET)
+    if (r->outcome == CS_STREAM_RESET && !r->refused)
         fprintf(out, " (boot id %08x -> %08x; %u messages were in flight)", (unsigned)r->old_boot,
                 (unsigned)r->new_boot, (unsigned)r->unacked);
     if (r->outcome == CS_STREAM_DEVICE_ERROR)
@@ -78,8 +78,11 @@ int cs_stream_report(FILE *out, const char *where, size_t n, const cs_stream_res
         counters(ctx, out, r);
     else
         cs_stream_report_bytes(out, r, resume_from, curves);
+    /* a device that numbers the job (serial link) gets the confirmed / in-flight lines and the
+     * resume rules from the command (cs_stream_resume_hint); a refusal at the start said why */
     if (rc != CS_EXIT_OK && r->executed < n && !r->mid_message &&
-        r->outcome != CS_STREAM_NO_DEVICE && r->outcome != CS_STREAM_INCOMPATIBLE)
+        r->outcome != CS_STREAM_NO_DEVICE && r->outcome != CS_STREAM_INCOMPATIBLE &&
+        !r->numbered && !r->refused)
         cs_stream_report_resume(out, one, r->executed);
     fflush(out);
     return rc;

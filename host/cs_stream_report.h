@@ -30,7 +30,8 @@ void cs_stream_report_bytes(FILE *out, const cs_stream_result_t *r, size_t resum
 void cs_stream_report_counts(FILE *out, size_t executed, size_t n, size_t delivered, size_t sent,
                              const char *what);
 /* "stream: to continue once the machine is where ONE no. E left it: ..." (one: "segment" or
- * "curve"). */
+ * "curve"): the hint of links whose device does not number the job (Modbus, GPIO); a serial
+ * run the device numbered gets cs_stream_resume_hint instead. */
 void cs_stream_report_resume(FILE *out, const char *one, size_t executed);
 
 #endif

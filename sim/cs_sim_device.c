@@ -16,6 +16,7 @@
 #include "cs_fw_app.h"
 #include "cs_jobplan.h"
 #include "cs_path.h"
+#include "cs_sim_exlog.h"
 #include "cs_stream.h"
 #include "port_posix.h"
 
@@ -45,6 +46,7 @@ struct cs_sim_motion {
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
+    cs_sim_exlog_t xl; /* cfg->exlog: the executed log on disk (xl.fd < 0: none) */
     uint32_t seen[3]; /* alarms, probe cycles, homings already marked (note_marks) */
 };
 typedef struct cs_sim_motion sim_dev_t;
@@ -77,6 +79,10 @@ static size_t uart_read(void *ctx, uint8_t *buf, size_t max)
 static size_t uart_write(void *ctx, const uint8_t *buf, size_t n)
 {
     sim_dev_t *d = ctx;
+    /* the executed log first: whatever a STATUS about to go out says finished is on disk, even
+     * if the process is killed right after (a log never behind what the host was told) */
+    if (d->xl.fd >= 0)
+        (void)cs_sim_exlog_flush(&d->xl, &d->app.mo);
     if (cs_serial_write(&d->ser, buf, n) != 0)
         d->ser.lost += n; /* a device UART never blocks: bytes nobody takes are gone */
     return n;
@@ -305,6 +311,8 @@ static cs_err_t serve_pass(sim_dev_t *d, double *last_rx_s)
     while (d->rx_off < d->rx_len);
     advance(d, cs_serial_now_s());
     cs_fw_app_poll(&d->app); /* STATUS, ERROR and acknowledgements after the motion moved */
+    if (d->xl.fd >= 0 && cs_sim_exlog_flush(&d->xl, &d->app.mo) != CS_OK)
+        return CS_ERR_IO;
     return CS_OK;
 }
 
@@ -404,6 +412,12 @@ cs_err_t cs_sim_motion_open(sim_dev_t **out, const cs_sim_device_cfg_t *cfg,
         return CS_ERR_ARG;
     }
     res->seg_hash = d->app.mo.log.hash;
+    d->xl.fd = -1;
+    if (cfg->exlog != NULL && cs_sim_exlog_open(&d->xl, cfg->exlog, &d->app.mo) != CS_OK) {
+        port_stepper_attach(NULL);
+        free(d);
+        return CS_ERR_IO;
+    }
     *out = d;
     return CS_OK;
 }
@@ -548,9 +562,15 @@ cs_err_t cs_sim_motion_close(sim_dev_t *d)
     port_posix_run(UINT64_MAX);
     cs_fw_motion_poll(&d->app.mo);
     sync_res(d);
+    if (d->xl.fd >= 0) {
+        if (cs_sim_exlog_flush(&d->xl, &d->app.mo) != CS_OK)
+            rc = CS_ERR_IO;
+        cs_sim_exlog_close(&d->xl, &d->app.mo);
+    }
     res->ticks = port_posix_now();
+    /* the lines' count, plus what SETPOS stated (the lines did not move for that) */
     for (unsigned i = 0; i < CS_AXES; i++)
-        res->pos[i] = port_posix_position(i);
+        res->pos[i] = port_posix_position(i) + d->app.mo.set_delta[i];
     res->log_segs = d->app.mo.log;
     res->log_edges = port_posix_edge_log();
     if (d->cfg->keep_edges)
@@ -600,6 +620,7 @@ static void device_usage(FILE *f)
           "                     [--speed X | --instant] [--line-rate BPS] [--faults SPEC]\n"
           "                     [--tol MM] [--idle-exit S] [--reference JOB] [--check]\n"
           "                     [--svg OUT.svg] [--png OUT.png] [--trace OUT.csv]\n"
+          "                     [--exlog FILE]\n"
           "Runs the simulator as the device at the far end of a serial line, speaking the wire\n"
           "protocol (docs/protocol.md): `curvestep stream --port ...` streams to it.\n"
           "  --pty             create a pseudo-terminal pair, print the slave's path on the first\n"
@@ -623,6 +644,9 @@ static void device_usage(FILE *f)
           "                    the input and layout options given to stream (--lenient,\n"
           "                    --fit, --merge ...: curvestep-sim --help lists them)\n"
           "  --check           exit 4 when a check of the report fails\n"
+          "  --exlog FILE      append a line `JOB_NO TICKS X Y Z A` for every step segment the\n"
+          "                    executor finished (written as they finish: a killed device\n"
+          "                    leaves what it did; restarts append to the same file)\n"
           "  --svg/--png/--trace  drawings and the CSV of every step edge, as with --replay\n"
           "SIGINT or SIGTERM ends the service: what the executor holds is finished, then the\n"
           "report goes to standard output: messages executed, link counters, retransmissions,\n"
@@ -736,6 +760,7 @@ enum { DEV_OK = 0, DEV_INPUT = 1, DEV_USAGE = 2, DEV_INTERNAL = 3 };
 typedef struct {
     cs_sim_device_opts_t o;
     const char *port;
+    const char *exlog; /* --exlog FILE (cs_sim_exlog) */
     bool pty;
     long line_rate;
     cs_machine_t m;
@@ -767,6 +792,8 @@ static int device_parse(int argc, char **argv, device_run_t *d)
             d->pty = true;
         } else if (strcmp(a, "--port") == 0 && has) {
             d->port = argv[++i];
+        } else if (strcmp(a, "--exlog") == 0 && has) {
+            d->exlog = argv[++i];
         } else if (strcmp(a, "--line-rate") == 0 && has) {
             d->line_rate = strtol(argv[++i], &end, 10);
             if (*end != '\0' || d->line_rate < 0) {
@@ -821,6 +848,15 @@ static int device_setup(device_run_t *d)
     cfg->line_rate = (uint32_t)d->line_rate;
     cfg->idle_exit_s = o->idle_exit;
     cfg->keep_edges = true;
+    cfg->exlog = d->exlog;
+    if (d->exlog != NULL) { /* said now when the log cannot be written, not as a closed line */
+        int xfd = open(d->exlog, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+        if (xfd < 0) {
+            fprintf(stderr, "curvestep-sim: --exlog %s: %s\n", d->exlog, strerror(errno));
+            return DEV_INPUT;
+        }
+        close(xfd);
+    }
     if (o->tol_mm > 0 && cs_conv_tol_to_pos(o->tol_mm, &cfg->tol) != CS_OK) {
         fprintf(stderr, "curvestep-sim: --tol %g mm is outside the accepted range\n", o->tol_mm);
         return DEV_USAGE;

@@ -46,6 +46,8 @@ typedef struct {
     double idle_exit_s;   /* return after this long idle with nothing received, once something
                            * was executed (0 = never) */
     bool keep_edges;      /* copy the recorded STEP edges into the result (for checks) */
+    const char *exlog;    /* append every finished segment to this file (cs_sim_exlog); NULL:
+                           * none */
     const cs_ctlcfg_t *ctl; /* [limits] and [probe]: the simulated switches and probe surface
                              * (physical machine coordinates, 0 at start); NULL: none */
 } cs_sim_device_cfg_t;

@@ -147,7 +147,17 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
         cs_fw_motion_hold(&a->mo, m.type == CS_PROTO_HOLD);
         break;
     case CS_PROTO_ABORT:
+        cs_fw_motion_give_back(&a->mo);
         cs_fw_motion_abort(&a->mo);
+        break;
+    case CS_PROTO_QUERY: /* a host that (re)connected asks where the job stands */
+        a->status_due = true;
+        break;
+    case CS_PROTO_SETPOS:
+        e = cs_fw_motion_setpos(&a->mo, &m.u.setpos);
+        if (e != CS_OK)
+            cs_fw_motion_error(&a->mo, e, ev->seq);
+        a->status_due = true;
         break;
     case CS_PROTO_JOG_CANCEL:
         cs_fw_ctl_jog_cancel(&a->mo);

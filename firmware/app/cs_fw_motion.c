@@ -7,7 +7,7 @@
 #include "port.h"
 
 #define SEQ_MASK ((uint32_t)CS_FW_SEQMAP - 1u)
-#define TAG_MASK ((uint8_t)(2 * CS_STEPPER_RING - 1))
+#define TAG_MASK ((uint8_t)(CS_FW_TAGS - 1))
 /* next_segment's work budget a pass (blocks cut, points traced, items taken) */
 #define NEXT_GUARD 64u
 
@@ -57,6 +57,14 @@ static bool item_after(uint32_t x, uint32_t y)
     return (int32_t)(x - y) > 0;
 }
 
+/* The item an 8-bit tag names: the one within 2^7 of the last executed (items in flight are
+ * fewer than CS_FW_SEQMAP <= 128). */
+static uint32_t tag_item(const cs_fw_motion_t *a, uint8_t tag)
+{
+    uint8_t d = (uint8_t)(tag - (uint8_t)a->exec_item);
+    return d < 0x80u ? a->exec_item + d : a->exec_item - (uint32_t)(0x100u - d);
+}
+
 bool cs_fw_motion_executed(const cs_fw_motion_t *a, uint32_t n)
 {
     return !item_after(n, a->exec_item);
@@ -87,7 +95,7 @@ static void note_completed(cs_fw_motion_t *a)
     port_irq_restore(s);
     uint8_t done = (uint8_t)(a->pushed - inring - running);
     while (a->completed != done) {
-        cs_fw_motion_mark(a, a->tag[a->completed & TAG_MASK]);
+        cs_fw_motion_mark(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
         a->completed++;
     }
     if (cs_fw_motion_drained(a))
@@ -97,9 +105,10 @@ static void note_completed(cs_fw_motion_t *a)
 uint16_t cs_fw_motion_halted(cs_fw_motion_t *a, uint8_t done)
 {
     while (a->completed != done) {
-        cs_fw_motion_mark(a, a->tag[a->completed & TAG_MASK]);
+        cs_fw_motion_mark(a, tag_item(a, a->tag[a->completed & TAG_MASK]));
         a->completed++;
     }
+    /* (the low 8 bits of a tag index the sequence map: CS_FW_SEQMAP <= 128) */
     uint16_t seq = a->pushed != done ? a->item_seq[a->tag[done & TAG_MASK] & SEQ_MASK]
                                      : cs_fw_motion_current_seq(a);
     a->completed = a->pushed;
@@ -281,7 +290,7 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     bool was_idle = cs_stepper_idle(&a->st);
     cs_err_t e = cs_stepper_push_aux(&a->st, s, aux);
     if (e == CS_OK) {
-        a->tag[a->pushed & TAG_MASK] = done;
+        a->tag[a->pushed & TAG_MASK] = (uint8_t)done;
         a->pushed++;
         if (was_idle)
             port_timer_arm(1);
@@ -293,6 +302,10 @@ static void push_segment(cs_fw_motion_t *a, const cs_segment_t *s, const cs_segm
     }
     a->stats.segments++;
     cs_exlog_segment(&a->log, orig);
+#if CS_FW_SIM_HOOKS
+    if (a->pushed_hook != NULL)
+        a->pushed_hook(a->hook_ctx, orig, cs_fw_motion_job_no(a, done));
+#endif
     for (unsigned i = 0; i < CS_AXES; i++)
         a->steps_pos[i] += s->steps[i];
 }
@@ -470,6 +483,21 @@ void cs_fw_motion_drop(cs_fw_motion_t *a)
     a->news = true;
 }
 
+void cs_fw_motion_give_back(cs_fw_motion_t *a)
+{
+    /* ABORT: items taken from the queue but not wholly handed to the executor (the segment held
+     * back, a PEN waiting, a curve being traced or planned) are dropped unexecuted: they are
+     * given back their numbers, so "executed" and the job's numbers (STATUS done/recv) stay the
+     * truth and a resume sends them again. The ring's segments finish; the last one's tag is
+     * the last item they complete. (Only here: the machine-control paths that flush mid-item,
+     * homing and probing, keep their item taken.) */
+    uint32_t keep = a->pushed != a->completed
+                        ? tag_item(a, a->tag[(uint8_t)(a->pushed - 1u) & TAG_MASK])
+                        : a->exec_item;
+    if (item_after(a->popped, keep))
+        a->popped = keep;
+}
+
 void cs_fw_motion_abort(cs_fw_motion_t *a)
 {
     cs_fw_ctl_abort(a);
@@ -496,6 +524,44 @@ void cs_fw_motion_reboot(cs_fw_motion_t *a)
     a->aborted = false;
     a->nerr = 0;
     a->news = true;
+    /* a rebooted device knows neither the job nor where the machine is */
+    a->job_flags = 0;
+    a->job_id = a->job_base = 0;
+}
+
+uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *a, uint32_t item)
+{
+    if (!(a->job_flags & CS_PROTO_STATUS_JOB))
+        return 0;
+    /* items before the SETPOS belong to the previous job: nothing of this one */
+    return item_after(item, a->job_item0) ? a->job_base + (item - a->job_item0) : a->job_base;
+}
+
+cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
+{
+    if (sp->flags & CS_PROTO_SETPOS_POS) {
+        if (!cs_fw_motion_done(a))
+            return CS_ERR_STATE;
+        for (unsigned i = 0; i < CS_AXES; i++) { /* idle: cannot fail (done above) */
+            uint32_t irq = port_irq_save();
+            (void)cs_stepper_set_position(&a->st, i, sp->pos[i]);
+            port_irq_restore(irq);
+#if CS_FW_SIM_HOOKS
+            a->set_delta[i] += sp->pos[i] - a->steps_pos[i];
+#endif
+            a->steps_pos[i] = sp->pos[i];
+        }
+#if CS_FW_CURVES
+        a->pl_stale = true;
+#endif
+        a->job_flags |= CS_PROTO_STATUS_POS;
+    }
+    a->job_id = sp->job_id;
+    a->job_base = sp->base;
+    a->job_item0 = a->popped + a->qcount; /* the next item received is base + 1 */
+    a->job_flags |= CS_PROTO_STATUS_JOB;
+    a->news = true;
+    return CS_OK;
 }
 
 void cs_fw_motion_take_limit(cs_fw_motion_t *a, uint32_t n)
@@ -523,6 +589,10 @@ void cs_fw_motion_status(const cs_fw_motion_t *a, cs_proto_status_t *st)
     st->axes = a->m->n_axes;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         st->pos[i] = i < a->m->n_axes ? cs_fw_motion_position(a, i) : 0;
+    st->flags = a->job_flags;
+    st->job_id = a->job_id;
+    st->done = cs_fw_motion_job_no(a, a->exec_item);
+    st->recv = cs_fw_motion_job_no(a, a->popped + a->qcount);
 }
 
 bool cs_fw_motion_peek_error(const cs_fw_motion_t *a, cs_proto_error_t *e)

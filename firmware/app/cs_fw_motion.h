@@ -31,6 +31,10 @@
 #ifndef CS_FW_ERRQ
 #define CS_FW_ERRQ 4
 #endif
+/* 1 (the host build of the simulator): the executed-log hook and SETPOS's position delta. */
+#ifndef CS_FW_SIM_HOOKS
+#define CS_FW_SIM_HOOKS 0
+#endif
 
 #include "cs_fw_ctl.h"
 
@@ -50,6 +54,12 @@ CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + CS_PLANNER_RING + 3, fw_seqma
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + 3, fw_seqmap_room);
 #endif
 CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_two);
+/* Segment tags: a power of two above the segments in flight (the ring and the running one). */
+#define CS_FW_TAGS (2 * CS_STEPPER_RING)
+CS_STATIC_ASSERT(CS_FW_TAGS >= CS_STEPPER_RING + 1 && CS_FW_TAGS <= 256, fw_tags_room);
+/* 8-bit tags name an item within 2^7 of the last executed: items in flight stay below
+ * CS_FW_SEQMAP (the sequence map relies on it too). */
+CS_STATIC_ASSERT(CS_FW_SEQMAP <= 128, fw_tags_8_bits);
 CS_STATIC_ASSERT(CS_FW_QUEUE >= 1 && CS_FW_QUEUE <= 1024, fw_queue_size);
 CS_STATIC_ASSERT(CS_FW_ERRQ >= 1 && CS_FW_ERRQ <= 255, fw_errq_size);
 
@@ -99,9 +109,10 @@ typedef struct cs_fw_motion_s {
     uint16_t qhead, qcount;
     /* executor and which item each queued segment finishes */
     cs_stepper_t st;
-    /* item executed once segment k has run: the ring's segments and the running one, so twice
-     * the ring (a slot is free for the next push while its segment still runs) */
-    uint32_t tag[2 * CS_STEPPER_RING];
+    /* item executed once segment k has run: one per segment in flight, which is the ring's
+     * CS_STEPPER_RING plus the one running (a ring of only CS_STEPPER_RING tags had the newest
+     * overwrite the running segment's, counting up to a ring of items executed early) */
+    uint8_t tag[CS_FW_TAGS]; /* low 8 bits (items in flight: fewer than CS_FW_SEQMAP <= 128) */
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
     cs_segment_t pend; /* produced, held back by a hold at rest */
@@ -117,6 +128,18 @@ typedef struct cs_fw_motion_s {
     uint32_t pen_item;
     uint16_t item_seq[CS_FW_SEQMAP];
     uint16_t exec_seq;          /* sequence of the last item executed */
+    /* the job's numbering (SETPOS): item i (counted like popped) is job number
+     * job_base + i - job_item0; flags CS_PROTO_STATUS_*, forgotten at a reboot */
+    uint32_t job_id, job_base, job_item0;
+    uint8_t job_flags;
+#if CS_FW_SIM_HOOKS
+    /* for the simulator (host builds only): its executed log's hook (NULL: none), called for
+     * every segment handed to the executor with the job number of the item it finishes; and
+     * the position changes SETPOS made (the STEP lines did not move for them) */
+    void (*pushed_hook)(void *ctx, const cs_segment_t *s, uint32_t job_no);
+    void *hook_ctx;
+    int32_t set_delta[CS_AXES];
+#endif
     int32_t steps_pos[CS_AXES]; /* position after everything pushed, steps */
 #if CS_FW_CURVES
     cs_planner_t pl;
@@ -164,6 +187,15 @@ void cs_fw_motion_poll(cs_fw_motion_t *mo);
 /* A new boot of the link (a reset that keeps the machine where it is): the queue, the errors and
  * the sequences are forgotten; the executor, its position and what it holds are kept. */
 void cs_fw_motion_reboot(cs_fw_motion_t *mo);
+/* Before an ABORT message: the items taken from the queue but not handed to the executor get
+ * their numbers back (they will not run; STATUS done/recv stay the truth). Main loop. */
+void cs_fw_motion_give_back(cs_fw_motion_t *mo);
+/* SETPOS: numbers the items received from now on base+1, ... in job job_id; with
+ * CS_PROTO_SETPOS_POS sets the position counters to pos[] (steps), which needs the queue empty
+ * and the executor idle: CS_ERR_STATE otherwise (nothing changed). Main loop. */
+cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *mo, const cs_proto_setpos_t *sp);
+/* Job number of item (counted from 1 since init like the queue's items): 0 without a job. */
+uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *mo, uint32_t item);
 /* Takes no queue item numbered past n (items count from 1 since init; 0: no limit). */
 void cs_fw_motion_take_limit(cs_fw_motion_t *mo, uint32_t n);
 /* Free queue slots (the link's credits). */
@@ -173,7 +205,8 @@ bool cs_fw_motion_drained(const cs_fw_motion_t *mo);
 bool cs_fw_motion_done(const cs_fw_motion_t *mo);
 /* True (once) when the state changed or a hold/resume/abort came since the last call. */
 bool cs_fw_motion_news(cs_fw_motion_t *mo);
-/* State, queue fill, last executed sequence, axes and position (boot_id left as it is). Masks
+/* State, queue fill, last executed sequence, axes, position and the job's progress (flags,
+ * job id, last item finished, last item received; boot_id left as it is). Masks
  * the step interrupt while it reads the executor. Main loop. */
 void cs_fw_motion_status(const cs_fw_motion_t *mo, cs_proto_status_t *st);
 /* Executor position of axis, steps (interrupt masked while read). Main loop. */

@@ -8,6 +8,7 @@
 CS_STATIC_ASSERT(CS_PROTO_AXES_MAX == CS_AXES, proto_axes_match_machine);
 CS_STATIC_ASSERT(CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX) <= CS_PROTO_LEN_MAX, status_fits);
 CS_STATIC_ASSERT(CS_PROTO_LEN_SEGMENT <= CS_PROTO_LEN_MAX, segment_fits);
+CS_STATIC_ASSERT(CS_PROTO_LEN_SETPOS <= CS_PROTO_LEN_MAX, setpos_fits);
 /* The link must at least carry its own control messages, status and segments in every build;
  * a build whose CS_FRAME_PAYLOAD_MAX is below CS_PROTO_LEN_CURVE cannot carry curves (the link
  * then refuses them with CS_ERR_ARG). */
@@ -120,9 +121,12 @@ static cs_err_t check(const cs_proto_msg_t *m)
         return CS_OK;
     }
     case CS_PROTO_STATUS:
-        return (m->u.status.state >= CS_PROTO_STATE_COUNT_ || !axes_ok(m->u.status.axes))
+        return (m->u.status.state >= CS_PROTO_STATE_COUNT_ || !axes_ok(m->u.status.axes) ||
+                (m->u.status.flags & (uint8_t)~CS_PROTO_STATUS_ALL))
                    ? CS_ERR_RANGE
                    : CS_OK;
+    case CS_PROTO_SETPOS:
+        return (m->u.setpos.flags & (uint8_t)~CS_PROTO_SETPOS_POS) ? CS_ERR_RANGE : CS_OK;
     case CS_PROTO_ERROR:
         return (m->u.error.code < CS_ERR_ARG || m->u.error.code >= CS_ERR_COUNT_) ? CS_ERR_RANGE
                                                                                   : CS_OK;
@@ -151,6 +155,7 @@ static cs_err_t check(const cs_proto_msg_t *m)
     case CS_PROTO_HOLD:
     case CS_PROTO_RESUME:
     case CS_PROTO_ABORT:
+    case CS_PROTO_QUERY:
         return CS_OK;
     default:
         return check_ctl(m);
@@ -177,9 +182,12 @@ static size_t msg_len(uint8_t type, uint8_t axes)
         return CS_PROTO_LEN_CURVE;
     case CS_PROTO_PEN:
         return CS_PROTO_LEN_PEN;
+    case CS_PROTO_SETPOS:
+        return CS_PROTO_LEN_SETPOS;
     case CS_PROTO_HOLD:
     case CS_PROTO_RESUME:
     case CS_PROTO_ABORT:
+    case CS_PROTO_QUERY:
     case CS_PROTO_JOG_CANCEL:
     case CS_PROTO_UNLOCK:
         return CS_PROTO_LEN_CONTROL;
@@ -361,6 +369,17 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
         buf[10] = axes;
         for (unsigned i = 0; i < axes; i++)
             puti32(buf + 11 + 4 * i, m->u.status.pos[i]);
+        buf[11 + 4 * axes] = m->u.status.flags;
+        put32(buf + 12 + 4 * axes, m->u.status.job_id);
+        put32(buf + 16 + 4 * axes, m->u.status.done);
+        put32(buf + 20 + 4 * axes, m->u.status.recv);
+        break;
+    case CS_PROTO_SETPOS:
+        buf[1] = m->u.setpos.flags;
+        put32(buf + 2, m->u.setpos.job_id);
+        put32(buf + 6, m->u.setpos.base);
+        for (unsigned i = 0; i < CS_AXES; i++)
+            puti32(buf + 10 + 4 * i, m->u.setpos.pos[i]);
         break;
     case CS_PROTO_ERROR:
         buf[1] = m->u.error.code;
@@ -382,7 +401,7 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
     case CS_PROTO_PEN:
         put16(buf + 1, m->u.pen.pulse_us);
         break;
-    default: /* HOLD, RESUME, ABORT: the type byte is the whole message; the rest */
+    default: /* HOLD, RESUME, ABORT, QUERY: the type byte is the whole message; the rest */
         encode_ctl(m, buf);
         break;
     }
@@ -440,6 +459,17 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
         m->u.status.axes = axes;
         for (unsigned i = 0; i < axes; i++)
             m->u.status.pos[i] = geti32(buf + 11 + 4 * i);
+        m->u.status.flags = buf[11 + 4 * axes];
+        m->u.status.job_id = get32(buf + 12 + 4 * axes);
+        m->u.status.done = get32(buf + 16 + 4 * axes);
+        m->u.status.recv = get32(buf + 20 + 4 * axes);
+        break;
+    case CS_PROTO_SETPOS:
+        m->u.setpos.flags = buf[1];
+        m->u.setpos.job_id = get32(buf + 2);
+        m->u.setpos.base = get32(buf + 6);
+        for (unsigned i = 0; i < CS_AXES; i++)
+            m->u.setpos.pos[i] = geti32(buf + 10 + 4 * i);
         break;
     case CS_PROTO_ERROR:
         m->u.error.code = buf[1];

@@ -13,7 +13,9 @@
 #include "cs_fixed.h"
 #include "cs_segment.h"
 
-#define CS_PROTO_VERSION 1
+/* 2: STATUS carries the job's confirmed progress (flags, job id, done, received); QUERY and
+ * SETPOS (issue 17: resume from what the device did). */
+#define CS_PROTO_VERSION 2
 /* Axes a hello or a status may announce (x, y, z, a: cs_machine.h's CS_AXES). */
 #define CS_PROTO_AXES_MAX 4
 
@@ -32,6 +34,8 @@ typedef enum {
     CS_PROTO_RESUME = 0x23,  /* resume after hold */
     CS_PROTO_ABORT = 0x24,   /* stop now and flush the queue */
     CS_PROTO_PEN = 0x25,     /* servo pen pulse width, set between the queued neighbours */
+    CS_PROTO_QUERY = 0x2C,   /* asks for a STATUS now (a host that reconnected) */
+    CS_PROTO_SETPOS = 0x2D,  /* job id and numbering, and optionally the position in steps */
     CS_PROTO_HOME = 0x26,    /* home one axis on its switch (seek, back off, latch, pull off) */
     CS_PROTO_JOG = 0x27,     /* straight move planned on the device, cancellable */
     CS_PROTO_JOG_CANCEL = 0x28, /* decelerate a jog to rest and drop the queue */
@@ -44,12 +48,13 @@ typedef enum {
 #define CS_PROTO_LEN_ACK       14
 #define CS_PROTO_LEN_PING      5
 #define CS_PROTO_LEN_HELLO     15
-#define CS_PROTO_LEN_STATUS(n) (11 + 4 * (n))
+#define CS_PROTO_LEN_STATUS(n) (24 + 4 * (n))
 #define CS_PROTO_LEN_ERROR     4
 #define CS_PROTO_LEN_SEGMENT   (5 + 4 * CS_AXES)
 #define CS_PROTO_LEN_CURVE     53
-#define CS_PROTO_LEN_CONTROL   1 /* hold, resume, abort */
+#define CS_PROTO_LEN_CONTROL   1 /* hold, resume, abort, query */
 #define CS_PROTO_LEN_PEN       3
+#define CS_PROTO_LEN_SETPOS    (10 + 4 * CS_AXES)
 #define CS_PROTO_LEN_EVENT(n)  (6 + 4 * (n))
 #define CS_PROTO_LEN_HOME      23
 #define CS_PROTO_LEN_JOG       17
@@ -66,6 +71,13 @@ typedef enum {
 #define CS_PROTO_CAP_SPINDLE  0x0008u /* SPINDLE */
 #define CS_PROTO_CAP_ALL                                                                           \
     (CS_PROTO_CAP_SEGMENTS | CS_PROTO_CAP_CURVES | CS_PROTO_CAP_CONTROL | CS_PROTO_CAP_SPINDLE)
+
+/* STATUS flags: what the device knows since its boot. */
+#define CS_PROTO_STATUS_JOB 0x01u /* a SETPOS numbered the job: job_id, done, recv are valid */
+#define CS_PROTO_STATUS_POS 0x02u /* a SETPOS stated the position: pos is the machine's */
+#define CS_PROTO_STATUS_ALL (CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS)
+/* SETPOS flags. */
+#define CS_PROTO_SETPOS_POS 0x01u /* set the position counters to pos[] (device idle only) */
 
 /* Device states reported by STATUS. */
 typedef enum {
@@ -108,7 +120,22 @@ typedef struct {
     uint16_t last_seq;              /* sequence of the last message executed */
     uint8_t axes;                   /* 1..CS_PROTO_AXES_MAX: entries of pos[] on the wire */
     int32_t pos[CS_PROTO_AXES_MAX]; /* position in steps per axis */
+    uint8_t flags;                  /* CS_PROTO_STATUS_* */
+    uint32_t job_id;                /* the job SETPOS named (0: none since boot) */
+    uint32_t done; /* job number of the last queue item the executor finished (0: none) */
+    uint32_t recv; /* job number of the last queue item received (done..recv: still to run) */
 } cs_proto_status_t;
+
+/* SETPOS: from the next queue item on, items are numbered base+1, base+2, ... in job job_id;
+ * with CS_PROTO_SETPOS_POS also the executor's position counters become pos[] (steps), which
+ * the device accepts only when its queue is empty and its executor idle (else ERROR
+ * CS_ERR_STATE). Takes no queue slot. */
+typedef struct {
+    uint8_t flags;         /* CS_PROTO_SETPOS_* */
+    uint32_t job_id;       /* the host's name of the job (a hash of its messages) */
+    uint32_t base;         /* job number of the last item executed before this session */
+    int32_t pos[CS_AXES];  /* steps per axis (used with CS_PROTO_SETPOS_POS) */
+} cs_proto_setpos_t;
 
 typedef struct {
     uint8_t code; /* cs_err_t, CS_ERR_ARG..CS_ERR_COUNT_-1 (never CS_OK or CS_END) */
@@ -224,12 +251,13 @@ typedef struct {
         cs_segment_t segment;
         cs_proto_curve_t curve;
         cs_proto_pen_t pen;
+        cs_proto_setpos_t setpos;
         cs_proto_event_t event;
         cs_proto_home_t home;
         cs_proto_jog_t jog;
         cs_proto_probe_t probe;
         cs_proto_spindle_t spindle;
-    } u; /* none for HOLD, RESUME, ABORT, JOG_CANCEL, UNLOCK */
+    } u; /* none for HOLD, RESUME, ABORT, JOG_CANCEL, UNLOCK, QUERY */
 } cs_proto_msg_t;
 
 /* Encode *m into buf[0..cap), *len = bytes written. CS_ERR_UNSUPPORTED for an unknown type,

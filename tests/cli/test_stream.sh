@@ -67,14 +67,23 @@ if command -v script >/dev/null 2>&1; then
     expect "tty: progress bar" grep -qE '\[#+\] 100\.0% [0-9]+/[0-9]+ segments  ETA 0:00  [0-9]+ segments/s  retx [0-9]+' "$T/tty.out"
 fi
 
-# 3. a device reset after 500 segments: exit 5, last executed 500; --resume-from 500 finishes.
+# 3. a device reset after 500 segments: exit 5, last executed 500; --resume-from 500 alone is
+# refused (the position is unknown), with --position (where segment 500 left it) it finishes.
 start_sim rst --reference "$JOB" --check --faults reset-after=500
 timeout -k 5 60 "$CS" stream --port "$PTY" "$JOB" >"$T/rst.out" 2>"$T/rst.err"; rc=$?
 expect "reset: exit 5" [ $rc -eq 5 ]
 expect "reset: reported" grep -q 'device reset mid-job (boot id' "$T/rst.out"
 expect "reset: last executed 500" grep -q 'last executed: 500$' "$T/rst.out"
-expect "reset: says how to resume" grep -q -- '--resume-from 500' "$T/rst.out"
-timeout -k 5 60 "$CS" stream --resume-from 500 --port "$PTY" "$JOB" >"$T/rst2.out" 2>"$T/rst2.err"; rc=$?
+expect "reset: confirmed 500" grep -q 'confirmed by the device: segment no. 500 finished' "$T/rst.out"
+expect "reset: says how to resume" grep -q -- '--resume-from N --position X,Y,Z' "$T/rst.out"
+expect "reset: no plain --resume after a reset" bash -c "! grep -q -- '--resume $JOB' '$T/rst.out'"
+# the machine stands where segment 500 left it (the simulator keeps it): state it
+at=$(sed -n 's/^stream: segment no. 500 leaves the machine at \([-0-9.,]*\) mm$/\1/p' "$T/rst.out")
+expect "reset: position after 500 named" [ -n "$at" ]
+timeout -k 5 60 "$CS" stream --resume-from 500 --port "$PTY" "$JOB" >"$T/rst1.out" 2>"$T/rst1.err"; rc=$?
+expect "reset: --resume-from without --position refused (exit 5)" [ $rc -eq 5 ]
+expect "reset: refusal says what to do" grep -q 'position is unknown. Home it' "$T/rst1.out"
+timeout -k 5 60 "$CS" stream --resume-from 500 --position "$at" --port "$PTY" "$JOB" >"$T/rst2.out" 2>"$T/rst2.err"; rc=$?
 wait_sim
 expect "resume: exit 0" [ $rc -eq 0 ]
 expect "resume: job executed" grep -q "job executed" "$T/rst2.out"

@@ -105,8 +105,16 @@ int main(int argc, char **argv)
     m.u.hello = (cs_proto_hello_t){1, 0xCAFEF00Du, 4, 32, 1000000u, CS_PROTO_CAP_ALL};
     write_seed(argv[1], "hello", &m, 1);
     m.type = CS_PROTO_STATUS;
-    m.u.status =
-        (cs_proto_status_t){CS_PROTO_STATE_RUNNING, 0xCAFEF00Du, 5, 99, 4, {-1, 2, -300000, 40000}};
+    m.u.status = (cs_proto_status_t){CS_PROTO_STATE_RUNNING,
+                                     0xCAFEF00Du,
+                                     5,
+                                     99,
+                                     4,
+                                     {-1, 2, -300000, 40000},
+                                     CS_PROTO_STATUS_JOB,
+                                     0x12345678u,
+                                     1000u,
+                                     1005u};
     write_seed(argv[1], "status", &m, 2);
     m.type = CS_PROTO_ERROR;
     m.u.error = (cs_proto_error_t){CS_ERR_LIMIT, 77};
@@ -127,6 +135,11 @@ int main(int argc, char **argv)
     write_seed(argv[1], "resume", &m, 6);
     m.type = CS_PROTO_ABORT;
     write_seed(argv[1], "abort", &m, 7);
+    m.type = CS_PROTO_QUERY;
+    write_seed(argv[1], "query", &m, 8);
+    m.type = CS_PROTO_SETPOS;
+    m.u.setpos = (cs_proto_setpos_t){CS_PROTO_SETPOS_POS, 0x12345678u, 1000u, {800, -80, 0, 0}};
+    write_seed(argv[1], "setpos", &m, 9);
     return 0;
 }
 #endif

@@ -4,7 +4,9 @@
  * credits and its full case; feed hold mid-job stops at rest with work left and the position of
  * the executed segments, resume finishes with the same segment log as a run without a hold;
  * abort drops what is queued; the take limit; refused message types; a PEN is set exactly
- * between the segments queued around it and the settle segment after it makes no step. */
+ * between the segments queued around it and the settle segment after it makes no step; SETPOS
+ * numbers the job (STATUS done and recv as counted here), states a position only when idle, a
+ * reboot forgets both, and an abort gives back the numbers of what it dropped unexecuted. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -281,6 +283,61 @@ static int teardown(void **state)
     return 0;
 }
 
+/* SETPOS and the job's numbers (docs/protocol.md, SETPOS; STATUS flags, done, recv). */
+static void test_setpos_numbers_the_job(void **state)
+{
+    (void)state;
+    cs_proto_status_t st;
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.flags, 0); /* after boot: no job, position not stated */
+    assert_int_equal(st.done, 0);
+    assert_int_equal(st.recv, 0);
+    /* a resumed job: messages 1..1000 ran before; the machine is at (800, -80) steps */
+    cs_proto_setpos_t sp = {CS_PROTO_SETPOS_POS, 0xABCD1234u, 1000u, {800, -80, 0, 0}};
+    assert_int_equal(cs_fw_motion_setpos(&mo, &sp), CS_OK);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.flags, CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS);
+    assert_int_equal(st.job_id, 0xABCD1234u);
+    assert_int_equal(st.done, 1000);
+    assert_int_equal(st.recv, 1000);
+    assert_int_equal(st.pos[0], 800);
+    assert_int_equal(st.pos[1], -80);
+    queue_job(40);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.recv, 1040); /* received, not executed */
+    assert_int_equal(st.done, 1000);
+    /* a position can only be stated at rest with nothing queued */
+    assert_int_equal(cs_fw_motion_setpos(&mo, &sp), CS_ERR_STATE);
+    /* Ctrl-C: hold (the next segment is kept back at rest), then abort */
+    run_until(500u * 2 + port_posix_now());
+    /* exactly what finished, at any moment (the segments in flight are one more than the
+     * ring) */
+    assert_int_equal(mo.stats.executed, mo.completed);
+    cs_fw_motion_hold(&mo, true);
+    run_until(UINT64_MAX);
+    assert_true(mo.has_pend);
+    cs_fw_motion_give_back(&mo); /* as the ABORT message does (cs_fw_app) */
+    cs_fw_motion_abort(&mo);
+    run_until(UINT64_MAX);
+    cs_fw_motion_status(&mo, &st);
+    uint32_t ran = mo.stats.executed;
+    assert_true(ran > 0 && ran < 40);
+    /* what ran, exactly: the numbers given back by the abort are sent again on a resume */
+    assert_int_equal(st.done, 1000 + ran);
+    assert_int_equal(st.recv, 1000 + ran);
+    int64_t want[2];
+    sum_steps(ran, want);
+    assert_int_equal(st.pos[0], 800 + want[0]);
+    assert_int_equal(st.pos[1], -80 + want[1]);
+    /* the lines moved only by what ran; SETPOS's change is kept apart */
+    assert_int_equal(port_posix_position(0) + mo.set_delta[0], st.pos[0]);
+    /* a reboot forgets the job and the stated position */
+    cs_fw_motion_reboot(&mo);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.flags, 0);
+    assert_int_equal(st.done, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -290,6 +347,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_refused_types, setup, teardown),
         cmocka_unit_test_setup_teardown(test_pen_between_segments, setup, teardown),
         cmocka_unit_test_setup_teardown(test_pen_hold_and_abort, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_setpos_numbers_the_job, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

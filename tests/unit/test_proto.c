@@ -32,6 +32,8 @@ static void le32(uint8_t *p, uint32_t v)
         p[i] = (uint8_t)(v >> (8 * i));
 }
 
+static void expect_range(const cs_proto_msg_t *bad, const uint8_t *raw, size_t n);
+
 static void expect_encoding(const cs_proto_msg_t *m, const uint8_t *want, size_t n)
 {
     uint8_t buf[CS_PROTO_LEN_MAX + 8];
@@ -101,8 +103,16 @@ static void test_status_layout_every_axis_count(void **state)
     for (uint8_t axes = 1; axes <= CS_PROTO_AXES_MAX; axes++) {
         cs_proto_msg_t m = {0};
         m.type = CS_PROTO_STATUS;
-        m.u.status = (cs_proto_status_t){
-            CS_PROTO_STATE_HELD, 0x89ABCDEFu, 7, 0xFFFE, axes, {INT32_MIN, -1, INT32_MAX, 123456}};
+        m.u.status = (cs_proto_status_t){CS_PROTO_STATE_HELD,
+                                         0x89ABCDEFu,
+                                         7,
+                                         0xFFFE,
+                                         axes,
+                                         {INT32_MIN, -1, INT32_MAX, 123456},
+                                         CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS,
+                                         0xCAFEF00Du,
+                                         70000u,
+                                         70016u};
         uint8_t w[CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX)] = {0x11, CS_PROTO_STATE_HELD};
         le32(w + 2, 0x89ABCDEFu);
         le16(w + 6, 7);
@@ -111,7 +121,16 @@ static void test_status_layout_every_axis_count(void **state)
         const uint32_t raw[4] = {0x80000000u, 0xFFFFFFFFu, 0x7FFFFFFFu, 123456u};
         for (unsigned i = 0; i < axes; i++)
             le32(w + 11 + 4 * i, raw[i]);
+        /* after the positions: flags, job id, last finished, last received */
+        w[11 + 4 * axes] = 0x03;
+        le32(w + 12 + 4 * axes, 0xCAFEF00Du);
+        le32(w + 16 + 4 * axes, 70000u);
+        le32(w + 20 + 4 * axes, 70016u);
         expect_encoding(&m, w, (size_t)CS_PROTO_LEN_STATUS(axes));
+        /* an unknown flag bit is refused both ways */
+        m.u.status.flags = 0x04;
+        w[11 + 4 * axes] = 0x04;
+        expect_range(&m, w, (size_t)CS_PROTO_LEN_STATUS(axes));
     }
 }
 
@@ -170,8 +189,8 @@ static void test_error_segment_curve_control_layout(void **state)
 static void test_unknown_types_and_empty_payload(void **state)
 {
     (void)state;
-    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x13, 0x20, 0x21, 0x22, 0x23,
-                             0x24, 0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B};
+    const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x13, 0x20, 0x21, 0x22, 0x23, 0x24,
+                             0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B, 0x2C, 0x2D};
     uint8_t buf[CS_PROTO_LEN_MAX] = {0};
     cs_proto_msg_t m;
     unsigned unknown = 0;
@@ -325,7 +344,8 @@ static void test_random_round_trips(void **state)
     (void)state;
     const uint8_t types[] = {CS_PROTO_ACK,    CS_PROTO_PING,    CS_PROTO_HELLO, CS_PROTO_STATUS,
                              CS_PROTO_ERROR,  CS_PROTO_SEGMENT, CS_PROTO_CURVE, CS_PROTO_HOLD,
-                             CS_PROTO_RESUME, CS_PROTO_ABORT,   CS_PROTO_PEN};
+                             CS_PROTO_RESUME, CS_PROTO_ABORT,   CS_PROTO_PEN,   CS_PROTO_QUERY,
+                             CS_PROTO_SETPOS};
     for (int t = 0; t < 20000; t++) {
         cs_proto_msg_t m;
         memset(&m, 0, sizeof m);
@@ -354,6 +374,17 @@ static void test_random_round_trips(void **state)
             m.u.status.axes = (uint8_t)(1 + rng() % 4);
             for (unsigned i = 0; i < m.u.status.axes; i++)
                 m.u.status.pos[i] = (int32_t)(uint32_t)rng();
+            m.u.status.flags = (uint8_t)(rng() % 4);
+            m.u.status.job_id = (uint32_t)rng();
+            m.u.status.done = (uint32_t)rng();
+            m.u.status.recv = (uint32_t)rng();
+            break;
+        case CS_PROTO_SETPOS:
+            m.u.setpos.flags = (uint8_t)(rng() % 2);
+            m.u.setpos.job_id = (uint32_t)rng();
+            m.u.setpos.base = (uint32_t)rng();
+            for (unsigned i = 0; i < 4; i++)
+                m.u.setpos.pos[i] = (int32_t)(uint32_t)rng();
             break;
         case CS_PROTO_ERROR:
             m.u.error.code = (uint8_t)(CS_ERR_ARG + rng() % (CS_ERR_COUNT_ - CS_ERR_ARG));
@@ -430,7 +461,7 @@ static void test_classification_and_boot_peek(void **state)
     (void)state;
     assert_false(cs_proto_sequenced(CS_PROTO_ACK));
     assert_false(cs_proto_sequenced(CS_PROTO_PING));
-    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25};
+    const uint8_t seqd[] = {0x10, 0x11, 0x12, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x2C, 0x2D};
     for (size_t i = 0; i < sizeof seqd; i++) {
         assert_true(cs_proto_sequenced(seqd[i]));
         assert_int_equal(cs_proto_uses_slot(seqd[i]),
@@ -477,6 +508,27 @@ static void test_pen_layout_and_range(void **state)
         else
             expect_range(&m, cases[i].bytes, sizeof cases[i].bytes);
     }
+}
+
+/* QUERY (0x2C) is its type byte; SETPOS (0x2D): flags, job id, base (u32 each but flags), four
+ * i32 positions in steps, written out by hand; an unknown flag bit is refused both ways. */
+static void test_query_and_setpos_layout(void **state)
+{
+    (void)state;
+    cs_proto_msg_t m = {0};
+    m.type = CS_PROTO_QUERY;
+    const uint8_t q[1] = {0x2C};
+    expect_encoding(&m, q, sizeof q);
+    m.type = CS_PROTO_SETPOS;
+    m.u.setpos = (cs_proto_setpos_t){CS_PROTO_SETPOS_POS, 0x01020304u, 54081u, {-1, 800, 0, 7}};
+    uint8_t w[CS_PROTO_LEN_SETPOS] = {0x2D, 0x01, 0x04, 0x03, 0x02, 0x01, 0x41, 0xD3, 0x00, 0x00,
+                                      0xFF, 0xFF, 0xFF, 0xFF, 0x20, 0x03, 0x00, 0x00, 0x00, 0x00,
+                                      0x00, 0x00, 0x07, 0x00, 0x00, 0x00};
+    assert_int_equal(sizeof w, 26);
+    expect_encoding(&m, w, sizeof w);
+    m.u.setpos.flags = 0x02;
+    w[1] = 0x02;
+    expect_range(&m, w, sizeof w);
 }
 
 /* The machine-control messages (docs/protocol.md, "Machine control"): every byte of EVENT,
@@ -647,6 +699,7 @@ int main(void)
         cmocka_unit_test(test_random_bytes_get_documented_answers),
         cmocka_unit_test(test_classification_and_boot_peek),
         cmocka_unit_test(test_pen_layout_and_range),
+        cmocka_unit_test(test_query_and_setpos_layout),
         cmocka_unit_test(test_event_layout),
         cmocka_unit_test(test_home_layout),
         cmocka_unit_test(test_jog_probe_layout),

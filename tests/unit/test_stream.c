@@ -153,17 +153,26 @@ static void device_cfg(cs_sim_device_cfg_t *cfg)
     cfg->idle_exit_s = 1.0;
 }
 
-static cs_stream_result_t run_host(cs_serial_t *ser, const cs_stream_job_t *job, size_t resume,
-                                   volatile sig_atomic_t *intr)
+static cs_stream_result_t run_host_at(cs_serial_t *ser, const cs_stream_job_t *job, size_t resume,
+                                      volatile sig_atomic_t *intr, const int32_t *pos)
 {
     cs_stream_opts_t o;
     cs_stream_opts_default(&o, ser, machine.n_axes, machine.tick_hz);
     o.resume_from = resume;
+    o.set_pos = pos != NULL;
+    for (unsigned a = 0; pos != NULL && a < CS_PROTO_AXES_MAX; a++)
+        o.pos[a] = pos[a];
     o.interrupt = intr;
     o.progress = getenv("TEST_STREAM_PROGRESS") ? stderr : NULL;
     cs_stream_result_t r;
     assert_int_equal(cs_stream_run(job, &o, &r), CS_OK);
     return r;
+}
+
+static cs_stream_result_t run_host(cs_serial_t *ser, const cs_stream_job_t *job, size_t resume,
+                                   volatile sig_atomic_t *intr)
+{
+    return run_host_at(ser, job, resume, intr, NULL);
 }
 
 static uint64_t hash_of(const cs_segment_t *s, size_t n)
@@ -318,8 +327,18 @@ static void test_stream_reset_and_resume(void **state)
     assert_int_equal(r.outcome, CS_STREAM_RESET);
     assert_int_equal(r.executed, at); /* the last executed segment, exactly */
     assert_true(r.new_boot != r.old_boot);
-    /* a new host session continues after segment `at` on the rebooted device */
-    cs_stream_result_t r2 = run_host(&ser, &job, r.executed, NULL);
+    /* the rebooted device knows no job: resuming without a stated position is refused */
+    cs_stream_result_t r1 = run_host(&ser, &job, r.executed, NULL);
+    assert_int_equal(r1.outcome, CS_STREAM_RESET);
+    assert_true(r1.refused); /* a refusal, not a second reset */
+    assert_int_equal(r1.new_boot, 0);
+    /* a new host session states where segment `at` left the machine (summed here) and
+     * continues after it on the rebooted device */
+    int32_t at_pos[CS_PROTO_AXES_MAX] = {0, 0, 0, 0};
+    for (size_t k = 0; k < at; k++)
+        for (int a = 0; a < 3; a++)
+            at_pos[a] += segs[k].steps[a];
+    cs_stream_result_t r2 = run_host_at(&ser, &job, r.executed, NULL, at_pos);
     assert_int_equal(r2.outcome, CS_STREAM_DONE);
     assert_int_equal(r2.executed, n);
     assert_int_equal(r2.hello.boot_id, r.new_boot);
