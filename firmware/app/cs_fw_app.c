@@ -166,6 +166,9 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
         e = cs_fw_ctl_unlock(&a->mo);
         if (e != CS_OK)
             cs_fw_motion_error(&a->mo, e, ev->seq);
+        else
+            cs_fw_motion_count_immediate(&a->mo);
+        a->status_due = true;
         break;
     default: /* SEGMENT, CURVE; CURVE without curves or a device-to-host type is refused */
         e = cs_fw_motion_queue(&a->mo, &m, ev->seq);

@@ -537,6 +537,17 @@ uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *a, uint32_t item)
     return item_after(item, a->job_item0) ? a->job_base + (item - a->job_item0) : a->job_base;
 }
 
+void cs_fw_motion_count_immediate(cs_fw_motion_t *a)
+{
+    /* numbered after everything before it: only when nothing is queued or running (an UNLOCK
+     * comes in the alarm state, whose stop emptied the queue), else it would count as done an
+     * item still waiting */
+    if ((a->job_flags & CS_PROTO_STATUS_JOB) && cs_fw_motion_done(a)) {
+        a->job_base++;
+        a->news = true;
+    }
+}
+
 cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
 {
     if (sp->flags & CS_PROTO_SETPOS_POS) {

@@ -194,6 +194,10 @@ void cs_fw_motion_give_back(cs_fw_motion_t *mo);
  * CS_PROTO_SETPOS_POS sets the position counters to pos[] (steps), which needs the queue empty
  * and the executor idle: CS_ERR_STATE otherwise (nothing changed). Main loop. */
 cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *mo, const cs_proto_setpos_t *sp);
+/* A message the host numbers as a job item but that takes no queue slot (UNLOCK) counts as
+ * received and finished at once, so the job's numbering (done, recv) stays the host's; only
+ * when the queue is empty and the executor idle. Main loop only, not ISR-safe. */
+void cs_fw_motion_count_immediate(cs_fw_motion_t *mo);
 /* Job number of item (counted from 1 since init like the queue's items): 0 without a job. */
 uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *mo, uint32_t item);
 /* Takes no queue item numbered past n (items count from 1 since init; 0: no limit). */

@@ -338,6 +338,31 @@ static void test_setpos_numbers_the_job(void **state)
     assert_int_equal(st.done, 0);
 }
 
+/* An UNLOCK the host numbers as a job item counts as received and finished at once, at rest
+ * only (never ahead of a queued item). */
+static void test_immediate_item_numbered(void **state)
+{
+    (void)state;
+    cs_proto_status_t st;
+    cs_fw_motion_count_immediate(&mo); /* no job numbered yet: nothing to count */
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.done, 0);
+    cs_proto_setpos_t sp = {0, 7u, 5u, {0, 0, 0, 0}};
+    assert_int_equal(cs_fw_motion_setpos(&mo, &sp), CS_OK);
+    cs_fw_motion_count_immediate(&mo);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.done, 6);
+    assert_int_equal(st.recv, 6);
+    queue_job(3); /* items 7..9 queued: an immediate message now is not counted */
+    cs_fw_motion_count_immediate(&mo);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.recv, 9);
+    assert_int_equal(st.done, 6);
+    run_until(UINT64_MAX);
+    cs_fw_motion_status(&mo, &st);
+    assert_int_equal(st.done, 9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -348,6 +373,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_pen_between_segments, setup, teardown),
         cmocka_unit_test_setup_teardown(test_pen_hold_and_abort, setup, teardown),
         cmocka_unit_test_setup_teardown(test_setpos_numbers_the_job, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_immediate_item_numbered, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
