@@ -44,6 +44,45 @@ static const tp_view_t views[] = {
     {"iso", {{S2, S2, 0, 0}, {-S6, S6, 2 * S6, 0}, {S3, -S3, S3, 0}}},
 };
 
+/* The drop-cutter part of the help (--cutter and the options only it takes). */
+static void tp_usage_dropcut(FILE *f)
+{
+    fputs(
+        "Drop-cutter finishing (--cutter): gouge-free from above for ball, flat and\n"
+        "bull-nose cutters. The surface is meshed within tol / 4 (a proven bound), the cutter\n"
+        "enlarged by that bound is dropped onto the mesh along a zig-zag raster (OpenCAMLib's\n"
+        "drop-cutter: facet, edge and vertex contacts), points along each pass added until\n"
+        "every chord is within tol of the drop height, and passes added between two\n"
+        "neighbours until the scallop between them (measured across the surface) is at most H\n"
+        "for every cutter; passes joined at cutting height where the straight link stays above\n"
+        "the drop surface. Sphere items are meshed too. Prints the programmed point \"x y z\"\n"
+        "(mm) per line, a blank line between polylines.\n"
+        "  --cutter K      ball:R, flat:R or bull:R:r (radius R, corner radius r, mm)\n"
+        "  --scallop H     largest material height left between passes, mm\n"
+        "  --stepover MM   a fixed step-over instead (no scallop refinement)\n"
+        "  --angle DEG     raster direction from +x (default 0: passes along x)\n"
+        "  --strategy S    raster (default: zig-zag passes) or waterline (constant-z contours\n"
+        "                  of the drop surface, levels 2 sqrt(2rH - H^2) apart, r the corner\n"
+        "                  radius, H for a flat end: for steep walls; --check then fails on\n"
+        "                  gouge only and reports the scallop of shallow ground)\n"
+        "  --output P      tip (default) or centre (of the corner radius: the ball's centre)\n"
+        "  --feed F        cutting feed in mm/min on every G1 (default 1000)\n"
+        "  --plunge F      plunge feed in mm/min (default 300)\n"
+        "  --spindle S     M3 S<S> before cutting, M5 after (default: no spindle words)\n"
+        "  --min-z Z       the lowest the tip goes (default: the surface's lowest point)\n"
+        "  --stock BOX     X0,Y0,X1,Y1: the region the cutter's axis covers (default: the\n"
+        "                  surface's extent and R beyond)\n"
+        "  --check         measure, against dense samples of the exact surface, the deepest\n"
+        "                  penetration of the cutter along the path and the scallop (distance\n"
+        "                  from the surface to the nearest cutter; what no cutter from above\n"
+        "                  reaches is reported apart as unreachable); exit 1 when over --tol\n"
+        "                  or H (--check-step MM: the sampling step, default 0.05 mm)\n"
+        "  --no-link       retract after every pass (default: link at cutting height where\n"
+        "                  the straight move stays above the drop surface)\n"
+        "\n"
+        , f);
+}
+
 static void tp_usage(FILE *f)
 {
     char kw[256];
@@ -88,38 +127,9 @@ static void tp_usage(FILE *f)
         "or faces down (undercut). n-sided patches are finished as bicubic cells fitted within\n"
         "tol / 2, one block per cell. See docs/surfaces.md.\n"
         "\n"
-        "Drop-cutter finishing (--cutter): gouge-free from above for ball, flat and\n"
-        "bull-nose cutters. The surface is meshed within tol / 4 (a proven bound), the cutter\n"
-        "enlarged by that bound is dropped onto the mesh along a zig-zag raster (OpenCAMLib's\n"
-        "drop-cutter: facet, edge and vertex contacts), points along each pass added until\n"
-        "every chord is within tol of the drop height, and passes added between two\n"
-        "neighbours until the scallop between them (measured across the surface) is at most H\n"
-        "for every cutter; passes joined at cutting height where the straight link stays above\n"
-        "the drop surface. Sphere items are meshed too. Prints the programmed point \"x y z\"\n"
-        "(mm) per line, a blank line between polylines.\n"
-        "  --cutter K      ball:R, flat:R or bull:R:r (radius R, corner radius r, mm)\n"
-        "  --scallop H     largest material height left between passes, mm\n"
-        "  --stepover MM   a fixed step-over instead (no scallop refinement)\n"
-        "  --angle DEG     raster direction from +x (default 0: passes along x)\n"
-        "  --strategy S    raster (default: zig-zag passes) or waterline (constant-z contours\n"
-        "                  of the drop surface, levels 2 sqrt(2rH - H^2) apart, r the corner\n"
-        "                  radius, H for a flat end: for steep walls; --check then fails on\n"
-        "                  gouge only and reports the scallop of shallow ground)\n"
-        "  --output P      tip (default) or centre (of the corner radius: the ball's centre)\n"
-        "  --feed F        cutting feed in mm/min on every G1 (default 1000)\n"
-        "  --plunge F      plunge feed in mm/min (default 300)\n"
-        "  --spindle S     M3 S<S> before cutting, M5 after (default: no spindle words)\n"
-        "  --min-z Z       the lowest the tip goes (default: the surface's lowest point)\n"
-        "  --stock BOX     X0,Y0,X1,Y1: the region the cutter's axis covers (default: the\n"
-        "                  surface's extent and R beyond)\n"
-        "  --check         measure, against dense samples of the exact surface, the deepest\n"
-        "                  penetration of the cutter along the path and the scallop (distance\n"
-        "                  from the surface to the nearest cutter; what no cutter from above\n"
-        "                  reaches is reported apart as unreachable); exit 1 when over --tol\n"
-        "                  or H (--check-step MM: the sampling step, default 0.05 mm)\n"
-        "  --no-link       retract after every pass (default: link at cutting height where\n"
-        "                  the straight move stays above the drop surface)\n"
-        "\n"
+        , kw);
+    tp_usage_dropcut(f);
+    fprintf(f,
         "Options:\n"
         "  --patches FILE  the surface file ('-' reads standard input)\n"
         "  --view V        top (x y), front (x z), side (y z), iso (orthographic, seen from\n"
@@ -148,7 +158,7 @@ static void tp_usage(FILE *f)
         "\n"
         "Exit status: 0 success; 1 bad input (\"file:line:col: reason\" on stderr, including\n"
         "coordinates outside +/-%d mm after scaling); 2 usage error; 3 internal error.\n",
-        kw, TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
+        TP_MAX_LINES, TP_DEFAULT_LINES, TP_DEFAULT_TOL_MM, CS_POS_LIMIT_MM);
 }
 
 static bool parse_view(const char *s, tp_view_t *v)
