@@ -21,7 +21,7 @@ static void serve_usage(FILE *f)
     fprintf(f,
             "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
             "                       | --gpio CHIP\n"
-            "                       [--baud N] [--parity none|even|odd] [--unit ID]\n"
+            "                       [--baud N] [--line-rate BPS] [--parity none|even|odd] [--unit ID]\n"
             "                       [--machine FILE.ini] [--socket PATH] [--max-input-mb N]\n"
             "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
             "came (as `curvestep stream` does: read once and planned whole at submit time, then\n"
@@ -38,6 +38,9 @@ static void serve_usage(FILE *f)
             "                  --gpio record:FILE runs on no hardware and writes each job's\n"
             "                  edges to FILE (docs/gpio.md)\n"
             "  --baud N        line speed of --port and --modbus-rtu (default 115200)\n"
+            "  --line-rate BPS --port: time the link for a line of BPS bits/s and pace writes\n"
+            "                  to it (for a pty that stands for a real UART, e.g. qemu's; a\n"
+            "                  pty is otherwise timed at memory speed)\n"
             "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
             "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
@@ -104,8 +107,8 @@ int cs_cmd_serve(int argc, char **argv)
         serve_usage(stderr);
         return CS_EXIT_USAGE;
     }
-    if (cfg.link.line_rate != 0) {
-        fprintf(stderr, "curvestep serve: --line-rate applies to `curvestep stream` only\n");
+    if (cfg.link.line_rate != 0 && cfg.link.port == NULL) {
+        fprintf(stderr, "curvestep serve: --line-rate applies to --port only\n");
         return CS_EXIT_USAGE;
     }
     if (cfg.link.parity != 0 && cfg.link.modbus_rtu == NULL) {

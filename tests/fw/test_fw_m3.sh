@@ -174,7 +174,7 @@ S=$T/sock/cs.sock
 N=$nseg
 mkdir -p "$T/sock"
 start_fw hold
-dmn_start --port "$PTY" --machine "$INI"
+dmn_start --port "$PTY" --machine "$INI" --line-rate 115200 # a UART, not a memory-speed pty
 C submit --feed $FEED "$JOB" >"$T/hsub.out" 2>&1
 expect "hold: submitted" grep -q "^OK job 1 queued: .*: $nseg segments$" "$T/hsub.out"
 expect "hold: a quarter ran" wait_until 180 dmn_quarter
