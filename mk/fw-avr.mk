@@ -18,9 +18,9 @@ AVR_MCU     := -mmcu=atmega328p -DF_CPU=16000000UL
 # 2 waiting ERRORs (a 2-frame window) and 16-byte UART reads a pass (on the stack), which pay for
 # protocol 2's longer STATUS and keep the stack clear of the static data.
 # machine.ini in $(AVR_PORT) says the same for the host.
-AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_CTL=0 -DCS_FW_QUEUE=7 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40 \
-               -DCS_STEPPER_RING=8 -DCS_FW_XY_RATE=100 -DCS_FW_XY_ACCEL=2000 \
-               -DCS_FW_ERRQ=2 -DCS_FW_RX_CHUNK=16
+AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_CTL=1 -DCS_FW_QUEUE=7 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40 \
+               -DCS_STEPPER_RING=4 -DCS_FW_XY_RATE=100 -DCS_FW_XY_ACCEL=2000 \
+               -DCS_FW_ERRQ=2 -DCS_FW_RX_CHUNK=16 -DCS_FW_EVQ=2 -DCS_FW_SEQMAP=8
 # -flto: the executor's call (cs_stepper_tick, in the core) is inlined into the step interrupt
 # at link time, so the interrupt saves only the registers it uses and passes its answer in
 # registers (about 40 cycles of the ~440 a call takes; docs/firmware-avr.md).

@@ -50,7 +50,10 @@
 #define CS_FW_SEQMAP 64
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + CS_PLANNER_RING + 3, fw_seqmap_room);
 #else
+/* Overridable for the smallest builds (the AVR's 16: its ring of 8 + 3 fits). */
+#ifndef CS_FW_SEQMAP
 #define CS_FW_SEQMAP 32
+#endif
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + 3, fw_seqmap_room);
 #endif
 CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_two);
