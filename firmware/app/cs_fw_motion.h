@@ -77,6 +77,8 @@ typedef struct {
         cs_proto_spindle_t spindle;
 #if CS_FW_CURVES
         cs_proto_curve_t curve;
+#endif
+#if CS_FW_CTL
         cs_proto_home_t home;
         cs_proto_jog_t jog;
         cs_proto_probe_t probe;
