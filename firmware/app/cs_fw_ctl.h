@@ -24,9 +24,8 @@
 #ifndef CS_FW_CURVES /* as cs_fw_motion.h: 1 = the on-board planner is there */
 #define CS_FW_CURVES 1
 #endif
-/* 1 (default): machine control built in; 0: left out (the smallest builds: the ATmega328p's
- * 2 KB are full), HELLO then offers no CONTROL or SPINDLE capability and the messages are
- * refused with CS_ERR_UNSUPPORTED. */
+/* 1 (default, the ATmega328p's too): machine control built in; 0: left out, HELLO then offers
+ * no CONTROL or SPINDLE capability and the messages are refused with CS_ERR_UNSUPPORTED. */
 #ifndef CS_FW_CTL
 #define CS_FW_CTL 1
 #endif
