@@ -266,27 +266,6 @@ void cs_fw_ctl_line_stop(cs_fw_motion_t *mo)
 }
 #endif
 
-#if CS_FW_CURVES
-bool cs_fw_ctl_line_next(cs_fw_motion_t *mo, cs_segment_t *s, uint32_t *done)
-{
-    (void)mo;
-    (void)s;
-    (void)done;
-    return false;
-}
-
-bool cs_fw_ctl_line_busy(const cs_fw_motion_t *mo)
-{
-    (void)mo;
-    return false;
-}
-
-void cs_fw_ctl_line_stop(cs_fw_motion_t *mo)
-{
-    (void)mo;
-}
-#endif
-
 static uint16_t home_bit(const cs_proto_home_t *h)
 {
     return (uint16_t)((h->flags & CS_PROTO_HOME_MAX) ? CS_PROTO_IN_MAX(h->axis)
@@ -756,7 +735,10 @@ void cs_fw_ctl_drop_event(cs_fw_motion_t *mo)
 {
     (void)mo;
 }
+#endif
 
+#if !CS_FW_CTL || CS_FW_CURVES
+/* No line generator: the planner moves the operations, or there are none. */
 bool cs_fw_ctl_line_next(cs_fw_motion_t *mo, cs_segment_t *s, uint32_t *done)
 {
     (void)mo;
