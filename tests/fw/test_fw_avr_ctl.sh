@@ -16,7 +16,8 @@
 #     (-240 - 80) / 80 = -4 mm within one step;
 #  4. `curvestep spindle S` / `--ccw S` / `--off`: Timer2 in fast PWM on OC2A (TCCR2A 0x83, clock
 #     / 8: 7.8 kHz) with (OCR2A + 1) / 256 within 1/512 of S / s_max, enable (A3) on, direction
-#     (A4) low for M3 and high for M4; all off after --off;
+#     (A4) low for M3 and high for M4; all off after --off; laser mode at power 800, full at 20
+#     mm/s, during a 10 mm/s jog: 800 x 10 / 20 = 400 of s_max, dark when the jog ends;
 #  5. the e-stop (A0) pressed by the harness: an alarm that `curvestep unlock` cannot clear.
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
@@ -132,6 +133,17 @@ rc2=$?
 ctl spindle --off >"$T/sp3.out" 2>&1
 rc3=$?
 expect "spindle: three settings, exit 0 ($rc1 $rc2 $rc3)" [ $rc1 -eq 0 -a $rc2 -eq 0 -a $rc3 -eq 0 ]
+# laser mode: power LP, full at LF mm/s; a jog at LV mm/s (x off the switch, LD mm) runs at
+# LP x LV / LF of s_max (the device's jog is at constant speed); then dark, then M5
+LP=800 LF=20 LV=10 LD=10
+ctl spindle --laser --feed $LF $LP >"$T/sp4.out" 2>&1
+rc4=$?
+ctl jog --feed $LV -- "$(awk -v h="$hx" -v d=$LD 'BEGIN { printf "%.4f", h - d }')" \
+    "$(mm $YT)" "$(mm $PZ $OZ)" >"$T/lj.out" 2>&1
+rc5=$?
+ctl spindle --off >"$T/sp5.out" 2>&1
+rc6=$?
+expect "laser: set, jog, off: exit 0 ($rc4 $rc5 $rc6)" [ $rc4 -eq 0 -a $rc5 -eq 0 -a $rc6 -eq 0 ]
 stop_harness
 expect "harness: result ok" grep -q '^result: ok$' "$T/h.out"
 expect "trips: x pressed at x $XMAX twice, the last at y $YT z $PZ" \
@@ -142,11 +154,13 @@ expect "home: z switch pressed twice (seek, latch)" \
     grep -q "^switch: PB4 limit z >= $ZMAX: 2 presses" "$T/h.out"
 expect "probe: one contact at z $PZ" grep -q "^switch: PC5 probe z <= $PZ: 1 presses, last at .* z=$PZ$" \
     "$T/h.out"
-# the pins at the end: on the x switch (the pending step at most beyond), the probe's contact
+# the pins at the end: LD mm back from the x switch (where it stopped: one step at most beyond),
+# at the probe's contact
 px=$(sed -n 's/^position: x=\(-\?[0-9]*\) .*/\1/p' "$T/h.out")
-expect "pins: x $XMAX within a step (got ${px:-?})" near "${px:-x}" $XMAX 1
+expect "pins: x $XMAX - $LD mm within a step (got ${px:-?})" near "${px:-x}" $((XMAX - LD * SPM)) 1
 expect "pins: y $YT, z $PZ" grep -q "^position: x=.* y=$YT z=$PZ$" "$T/h.out"
-pwm_ok() { # pwm_ok N S EN DIR: setting N is fast PWM at S / s_max, enable EN, direction DIR
+pwm_ok() { # pwm_ok N S EN DIR [REL]: setting N is fast PWM at S / s_max (within 1/512, and REL
+    # of it), enable EN, direction DIR
     local l
     l=$(grep "^pwm: $1: " "$T/h.out")
     [ -n "$l" ] || return 1
@@ -157,13 +171,32 @@ pwm_ok() { # pwm_ok N S EN DIR: setting N is fast PWM at S / s_max, enable EN, d
     en=$(sed -n 's/.* enable=\([01]\).*/\1/p' <<<"$l")
     dir=$(sed -n 's/.* dir=\([01]\).*/\1/p' <<<"$l")
     [ "$a" = 83 ] && [ $((16#$b & 7)) -eq 2 ] && [ "$en" = "$3" ] && [ "$dir" = "$4" ] &&
-        awk -v o="$o" -v s="$2" -v m="$S_MAX" 'BEGIN { d = (o + 1) / 256 - s / m; if (d < 0) d = -d; exit !(d <= 1 / 512) }'
+        awk -v o="$o" -v s="$2" -v m="$S_MAX" -v r="${5:-0}" \
+            'BEGIN { d = (o + 1) / 256 - s / m; if (d < 0) d = -d; exit !(d <= 1 / 512 + r * s / m) }'
 }
 expect "pwm: M3 S600 = fast PWM on OC2A, duty 600/$S_MAX, enable, cw" pwm_ok 0 600 1 0
 expect "pwm: M4 S250 = duty 250/$S_MAX, enable, ccw" pwm_ok 1 250 1 1
 expect "pwm: M5 = OC2A off, enable and direction low" \
     grep -qE '^pwm: 2: TCCR2A=0x00 TCCR2B=0x00 OCR2A=[0-9]+ enable=0 dir=0 off$' "$T/h.out"
-expect "pwm: nothing else" [ "$(grep -c '^pwm: ' "$T/h.out")" -eq 3 ]
+# the laser's jog: fast PWM at LP x LV / LF (within 1/512, and 1 % for the speed of 5 ms
+# segments of whole steps and ticks), enable on, clockwise, first; then other segments' speeds:
+# LV x SPM x 5 ms = 4 steps a segment, and a segment one step short (the rounding that keeps the
+# line's total exact) runs at 3/4 of it, so every setting while it runs lies between LP x (3/4)
+# LV / LF and LP x LV / LF; then, the ring run dry, dark but enabled; M5: all off, the last
+expect "pwm: laser at $LP x $LV / $LF of $S_MAX as the jog starts" \
+    pwm_ok 3 "$(awk -v p=$LP -v v=$LV -v f=$LF 'BEGIN { print p * v / f }')" 1 0 0.01
+awk -v p=$LP -v v=$LV -v f=$LF -v m=$S_MAX '
+    /^pwm: / { n = $2 + 0 }
+    /^pwm: / && n >= 3 && / duty / && !dark {
+        split($NF, q, "/"); d = q[1] / 256; hi = p * v / f / m; lo = hi * 3 / 4
+        if (d < lo - 1 / 512 - hi / 100 || d > hi + 1 / 512 + hi / 100) bad++
+        if (/enable=1 dir=0/) on++; else bad++
+    }
+    /^pwm: / && n >= 3 && / off$/ && !dark { dark = n; if ($0 !~ /enable=1 dir=0/) bad++ }
+    /^pwm: / { last = $0 }
+    END { exit !(on >= 1 && !bad && dark > 3 && last ~ /enable=0 dir=0 off$/ &&
+                 last ~ ("^pwm: " dark + 1 ":")) }' "$T/h.out"
+expect "pwm: laser power follows the segments' speed, then dark, then M5 (all off)" [ $? -eq 0 ]
 
 # 5. the e-stop, pressed 0.3 s after boot: an alarm unlock cannot clear
 start_harness "$T/e.out" --estop-at 0.3
