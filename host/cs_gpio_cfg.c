@@ -26,6 +26,10 @@ void cs_gpio_cfg_default(cs_gpio_cfg_t *c, const cs_machine_t *m)
         c->step[i] = c->dir[i] = -1;
     c->enable = -1;
     c->pen = -1;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        c->lim_min[i] = c->lim_max[i] = -1;
+    c->probe = c->estop = -1;
+    c->limit_active_low = c->probe_active_low = c->estop_active_low = true;
     c->step_active_low = false;
     c->enable_active_low = true;
     /* The executor's own pulse (what the simulator and a firmware port give): the longest of
@@ -40,6 +44,14 @@ void cs_gpio_cfg_default(cs_gpio_cfg_t *c, const cs_machine_t *m)
     c->enable_ns = 10000000;
     c->spin_ns = 100000;
     c->rt_priority = 50;
+}
+
+bool cs_gpio_cfg_has_inputs(const cs_gpio_cfg_t *c)
+{
+    bool any = c->probe >= 0 || c->estop >= 0;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        any = any || c->lim_min[i] >= 0 || c->lim_max[i] >= 0;
+    return any;
 }
 
 bool cs_gpio_cfg_wired(const cs_gpio_cfg_t *c, unsigned axis)
@@ -112,7 +124,19 @@ static const char *offset_owner(const cs_gpio_cfg_t *c, int off, const int *self
             snprintf(buf, len, "%s_dir", axis_names[i]);
             return buf;
         }
+        if (&c->lim_min[i] != self && c->lim_min[i] == off) {
+            snprintf(buf, len, "%s_min", axis_names[i]);
+            return buf;
+        }
+        if (&c->lim_max[i] != self && c->lim_max[i] == off) {
+            snprintf(buf, len, "%s_max", axis_names[i]);
+            return buf;
+        }
     }
+    if (&c->probe != self && c->probe == off)
+        return "probe";
+    if (&c->estop != self && c->estop == off)
+        return "estop";
     if (&c->enable != self && c->enable == off)
         return "enable";
     if (&c->pen != self && c->pen == off)
@@ -148,6 +172,10 @@ static int handler(void *user, const char *section, const char *name, const char
         slot = &c->enable;
     else if (strcasecmp(name, "pen") == 0)
         slot = &c->pen;
+    else if (strcasecmp(name, "probe") == 0)
+        slot = &c->probe;
+    else if (strcasecmp(name, "estop") == 0)
+        slot = &c->estop;
     for (unsigned i = 0; i < CS_AXES && slot == NULL; i++) {
         size_t n = strlen(axis_names[i]);
         if (strncasecmp(name, axis_names[i], n) == 0 && name[n] == '_') {
@@ -155,6 +183,10 @@ static int handler(void *user, const char *section, const char *name, const char
                 slot = &c->step[i];
             else if (strcasecmp(name + n + 1, "dir") == 0)
                 slot = &c->dir[i];
+            else if (strcasecmp(name + n + 1, "min") == 0)
+                slot = &c->lim_min[i];
+            else if (strcasecmp(name + n + 1, "max") == 0)
+                slot = &c->lim_max[i];
         }
     }
     if (slot) {
@@ -173,14 +205,23 @@ static int handler(void *user, const char *section, const char *name, const char
         *slot = (int)d;
         return 1;
     }
-    if (strcasecmp(name, "step_active_low") == 0 || strcasecmp(name, "enable_active_low") == 0) {
+    bool *flag = strcasecmp(name, "step_active_low") == 0     ? &c->step_active_low
+                 : strcasecmp(name, "enable_active_low") == 0 ? &c->enable_active_low
+                 : strcasecmp(name, "limit_active_low") == 0  ? &c->limit_active_low
+                 : strcasecmp(name, "probe_active_low") == 0  ? &c->probe_active_low
+                 : strcasecmp(name, "estop_active_low") == 0  ? &c->estop_active_low
+                                                              : NULL;
+    if (flag) {
         int b = parse_bool(value);
         if (b < 0)
             return fail(x, "[gpio] %s: expected true or false", name);
-        if (tolower((unsigned char)name[0]) == 's')
-            c->step_active_low = b == 1;
-        else
-            c->enable_active_low = b == 1;
+        *flag = b == 1;
+        return 1;
+    }
+    if (strcasecmp(name, "state") == 0) {
+        if (value[0] == '\0' || strlen(value) >= sizeof c->state)
+            return fail(x, "[gpio] state: expected a file path (< %zu chars)", sizeof c->state);
+        snprintf(c->state, sizeof c->state, "%s", value);
         return 1;
     }
     if (strcasecmp(name, "pulse_us") == 0) {
@@ -206,7 +247,9 @@ static int handler(void *user, const char *section, const char *name, const char
         return fail(x,
                     "[gpio] %s: unknown key (expected chip, x_step, x_dir, y_step, y_dir, z_step, "
                     "z_dir, a_step, a_dir, enable, pen, step_active_low, enable_active_low, pulse_us, "
-                    "dir_setup_us, enable_ms, spin_us or rt_priority)",
+                    "dir_setup_us, enable_ms, spin_us, rt_priority, x_min, x_max, y_min, y_max, "
+                    "z_min, z_max, a_min, a_max, probe, estop, limit_active_low, "
+                    "probe_active_low, estop_active_low or state)",
                     name);
     }
     return 1;
@@ -229,6 +272,11 @@ static int finish(ctx_t *x, int rc, const char *name, char *err, size_t errlen)
         if ((c->step[i] >= 0) != (c->dir[i] >= 0)) {
             snprintf(err, errlen, "%s:0: [gpio] %s_step and %s_dir go together (one is missing)",
                      name, axis_names[i], axis_names[i]);
+            return -1;
+        }
+        if ((c->lim_min[i] >= 0 || c->lim_max[i] >= 0) && i >= m->n_axes) {
+            snprintf(err, errlen, "%s:0: [gpio] %s_%s: the machine has no %s axis", name,
+                     axis_names[i], c->lim_min[i] >= 0 ? "min" : "max", axis_names[i]);
             return -1;
         }
         if (c->step[i] >= 0 && i >= m->n_axes) {
