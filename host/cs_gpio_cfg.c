@@ -111,36 +111,28 @@ static int parse_bool(const char *v)
     return -1;
 }
 
-/* The key naming line offset `off` other than `self`, or NULL. */
+/* The key naming line offset `off` other than `self`, or NULL (each line is used once, so the
+ * order the keys are looked at in does not matter). */
 static const char *offset_owner(const cs_gpio_cfg_t *c, int off, const int *self, char *buf,
                                 size_t len)
 {
-    for (unsigned i = 0; i < CS_AXES; i++) {
-        if (&c->step[i] != self && c->step[i] == off) {
-            snprintf(buf, len, "%s_step", axis_names[i]);
-            return buf;
-        }
-        if (&c->dir[i] != self && c->dir[i] == off) {
-            snprintf(buf, len, "%s_dir", axis_names[i]);
-            return buf;
-        }
-        if (&c->lim_min[i] != self && c->lim_min[i] == off) {
-            snprintf(buf, len, "%s_min", axis_names[i]);
-            return buf;
-        }
-        if (&c->lim_max[i] != self && c->lim_max[i] == off) {
-            snprintf(buf, len, "%s_max", axis_names[i]);
-            return buf;
-        }
-    }
-    if (&c->probe != self && c->probe == off)
-        return "probe";
-    if (&c->estop != self && c->estop == off)
-        return "estop";
-    if (&c->enable != self && c->enable == off)
-        return "enable";
-    if (&c->pen != self && c->pen == off)
-        return "pen";
+    const struct {
+        const int *v;
+        const char *suffix;
+    } per_axis[] = {{c->step, "step"}, {c->dir, "dir"}, {c->lim_min, "min"}, {c->lim_max, "max"}};
+    for (unsigned k = 0; k < sizeof per_axis / sizeof per_axis[0]; k++)
+        for (unsigned i = 0; i < CS_AXES; i++)
+            if (&per_axis[k].v[i] != self && per_axis[k].v[i] == off) {
+                snprintf(buf, len, "%s_%s", axis_names[i], per_axis[k].suffix);
+                return buf;
+            }
+    const struct {
+        const int *v;
+        const char *name;
+    } one[] = {{&c->enable, "enable"}, {&c->pen, "pen"}, {&c->probe, "probe"}, {&c->estop, "estop"}};
+    for (unsigned k = 0; k < sizeof one / sizeof one[0]; k++)
+        if (one[k].v != self && *one[k].v == off)
+            return one[k].name;
     return NULL;
 }
 

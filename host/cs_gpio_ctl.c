@@ -302,19 +302,15 @@ static void target_of(const sess_t *s, double to[CS_AXES])
         to[i] = s->a->xyz[i];
 }
 
-static double move_mm(const sess_t *s, const cs_gpio_ctl_args_t *a)
-{
-    (void)s;
-    return fabs(a->xyz[0]) + fabs(a->xyz[1]) + fabs(a->xyz[2]) + 8192.0;
-}
-
-int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a)
+/* probe (G38.2..G38.5: the probe input watched) or jog (nothing watched) to the target. */
+static int run_target(const cs_gpio_ctl_args_t *a, bool probe)
 {
     sess_t s;
-    int rc = sess_open(&s, a, record_cap(a->m, move_mm(NULL, a)));
+    double mm = fabs(a->xyz[0]) + fabs(a->xyz[1]) + fabs(a->xyz[2]) + 8192.0;
+    int rc = sess_open(&s, a, record_cap(a->m, mm));
     if (rc >= 0)
         return rc;
-    if (!has_input(&s, 0, false, CS_PROTO_IN_PROBE)) {
+    if (probe && !has_input(&s, 0, false, CS_PROTO_IN_PROBE)) {
         fprintf(stderr, "%s:0: [gpio] wires no probe input (probe = OFFSET)\n",
                 a->machine_file ? a->machine_file : "the built-in machine");
         return sess_close(&s, CS_EXIT_INPUT);
@@ -323,16 +319,16 @@ int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a)
     uint16_t in = rc < 0 ? inputs_now(&s) : 0;
     if (rc < 0 && (in & CS_PROTO_IN_ESTOP))
         rc = alarm(&s, CS_PROTO_ALARM_ESTOP, in);
-    if (rc < 0 && ((in & CS_PROTO_IN_PROBE) != 0) != a->away)
+    if (rc < 0 && probe && ((in & CS_PROTO_IN_PROBE) != 0) != a->away)
         rc = alarm(&s, CS_PROTO_ALARM_PROBE_INITIAL, in);
     bool hit = false;
     if (rc < 0) {
         double to[CS_AXES];
         target_of(&s, to);
-        uint16_t w = a->away ? 0 : CS_PROTO_IN_PROBE, r = a->away ? CS_PROTO_IN_PROBE : 0;
-        rc = move(&s, a->m, to, a->feed, w, r, &hit);
+        uint16_t p = probe ? CS_PROTO_IN_PROBE : 0;
+        rc = move(&s, a->m, to, a->feed, a->away ? 0 : p, a->away ? p : 0, &hit);
     }
-    if (rc < 0) {
+    if (rc < 0 && probe) {
         say_pos(&s, hit ? "contact at " : "no contact; ended at ");
         if (!hit && !a->no_error)
             rc = alarm(&s, CS_PROTO_ALARM_PROBE_CONTACT, s.g->run.inputs);
@@ -344,24 +340,14 @@ int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a)
     return sess_close(&s, rc);
 }
 
+int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a)
+{
+    return run_target(a, true);
+}
+
 int cs_gpio_ctl_jog(const cs_gpio_ctl_args_t *a)
 {
-    sess_t s;
-    int rc = sess_open(&s, a, record_cap(a->m, move_mm(NULL, a)));
-    if (rc >= 0)
-        return rc;
-    rc = refuse_alarm(&s);
-    bool hit = false;
-    if (rc < 0) {
-        double to[CS_AXES];
-        target_of(&s, to);
-        rc = move(&s, a->m, to, a->feed, 0, 0, &hit);
-    }
-    if (rc < 0) {
-        say_pos(&s, "machine position ");
-        rc = CS_EXIT_OK;
-    }
-    return sess_close(&s, rc);
+    return run_target(a, false);
 }
 
 int cs_gpio_ctl_unlock(const cs_gpio_ctl_args_t *a)

@@ -26,21 +26,8 @@ set -u
 need_bin "$CS"
 
 M=$T/m.ini
-cat >"$M" <<EOF
-[machine]
-tick_hz = 100000
-[x]
-travel_min = -100
-travel_max = 100
-[z]
-travel_min = -20
-travel_max = 0
-[limits]
-x_min = -5
-x_max = 50
-z_max = 2
-[probe]
-z = -3
+cat tests/data/ctl-switches.ini tests/data/ctl-homing.ini >"$M"
+cat >>"$M" <<EOF
 [gpio]
 x_step = 17
 x_dir = 27
@@ -53,10 +40,7 @@ limit_active_low = true
 probe_active_low = false
 state = $T/machine.state
 EOF
-cat tests/data/ctl-homing.ini >>"$M"
 
-# near A B TOL: |A - B| <= TOL
-near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
 # rises AXIS FILE: "N S": the record's STEP rises of AXIS and their signed sum (DIR level 1 = +)
 rises() {
     awk -F, -v ax="$1" '$3 == ax "_dir" { d = $4 ? 1 : -1 }
