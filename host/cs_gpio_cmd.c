@@ -374,7 +374,7 @@ static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
     return rc;
 }
 
-int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, size_t record_cap)
+int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, unsigned axes, size_t record_cap)
 {
     gpio_link_t *g = gpio_new(l, m);
     if (g == NULL)
@@ -385,7 +385,7 @@ int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, size_t record_
         return rc;
     uint64_t steps[CS_AXES];
     for (unsigned i = 0; i < CS_AXES; i++)
-        steps[i] = i < m->n_axes ? 1 : 0; /* every axis may move */
+        steps[i] = i < m->n_axes && (axes >> i & 1u) ? 1 : 0; /* the axes the command moves */
     return open_lines(l, g, steps, record_cap, true);
 }
 

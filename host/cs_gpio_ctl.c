@@ -51,8 +51,9 @@ static void say_pos(const sess_t *s, const char *what)
     fflush(stdout);
 }
 
-/* Opens the link with room for `cap` recorded set calls. -1, or an exit status (said). */
-static int sess_open(sess_t *s, const cs_gpio_ctl_args_t *a, size_t cap)
+/* Opens the link for a command moving the axes of mask `axes`, with room for `cap` recorded set
+ * calls. -1, or an exit status (said). */
+static int sess_open(sess_t *s, const cs_gpio_ctl_args_t *a, unsigned axes, size_t cap)
 {
     memset(s, 0, sizeof *s);
     s->a = a;
@@ -62,7 +63,7 @@ static int sess_open(sess_t *s, const cs_gpio_ctl_args_t *a, size_t cap)
     cfg.machine_file = a->machine_file;
     int rc = cs_joblink_select(&s->l, &cfg);
     if (rc == CS_EXIT_OK)
-        rc = cs_gpio_link_open_ctl(&s->l, a->m, cap);
+        rc = cs_gpio_link_open_ctl(&s->l, a->m, axes, cap);
     if (rc != CS_EXIT_OK) {
         fprintf(stderr, "curvestep %s: %s\n", a->who, s->l.why);
         return s->l.ops ? cs_joblink_close(&s->l, rc) : rc;
@@ -260,8 +261,11 @@ int cs_gpio_ctl_home(const cs_gpio_ctl_args_t *a)
         const cs_proto_home_t *h = &msg[k].u.home;
         total += ((double)h->search + 5.0 * h->pulloff) / CS_POS_ONE_MM + LATCH_MARGIN_MM;
     }
+    unsigned axes = 0;
+    for (unsigned k = 0; k < c->n_order; k++)
+        axes |= 1u << c->order[k];
     sess_t s;
-    int rc = sess_open(&s, a, record_cap(a->m, total));
+    int rc = sess_open(&s, a, axes, record_cap(a->m, total));
     if (rc >= 0)
         return rc;
     for (unsigned k = 0; k < c->n_order && rc < 0; k++) {
@@ -307,7 +311,7 @@ static int run_target(const cs_gpio_ctl_args_t *a, bool probe)
 {
     sess_t s;
     double mm = fabs(a->xyz[0]) + fabs(a->xyz[1]) + fabs(a->xyz[2]) + 8192.0;
-    int rc = sess_open(&s, a, record_cap(a->m, mm));
+    int rc = sess_open(&s, a, 7u, record_cap(a->m, mm)); /* x, y, z */
     if (rc >= 0)
         return rc;
     if (probe && !has_input(&s, 0, false, CS_PROTO_IN_PROBE)) {
@@ -353,7 +357,7 @@ int cs_gpio_ctl_jog(const cs_gpio_ctl_args_t *a)
 int cs_gpio_ctl_unlock(const cs_gpio_ctl_args_t *a)
 {
     sess_t s;
-    int rc = sess_open(&s, a, 16);
+    int rc = sess_open(&s, a, 0, 16);
     if (rc >= 0)
         return rc;
     uint16_t in = inputs_now(&s);

@@ -52,10 +52,11 @@ typedef struct {
 } cs_gpio_link_t;
 
 /* Opens the GPIO machine of l->cfg (--gpio CHIP or record:FILE, the machine file) for machine m
- * for a control command: every axis of m must be wired (the recorder wires them all), the
+ * for a control command: the axes in mask `axes` (bit i: axis i) must be wired (the recorder
+ * wires them all), the
  * inputs and the state are read; an alarm does not refuse (the command decides). record_cap:
  * set calls the recorder keeps for the whole command. CS_EXIT_OK, or a status with l->why. */
-int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, size_t record_cap);
+int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, unsigned axes, size_t record_cap);
 /* The open link (after cs_gpio_link_open_ctl). */
 cs_gpio_link_t *cs_gpio_link_of(cs_joblink_t *l);
 /* Runs segs on the step thread with the inputs watched (watch / release bits, hard limits),
