@@ -146,19 +146,9 @@ static bool us_to_ns(const char *v, double lo, double hi, uint32_t *ns)
     return true;
 }
 
-static int handler(void *user, const char *section, const char *name, const char *value)
+/* The line-offset field that key `name` sets, or NULL when it is not a line key. */
+static int *offset_slot(cs_gpio_cfg_t *c, const char *name)
 {
-    ctx_t *x = user;
-    cs_gpio_cfg_t *c = x->c;
-    if (strcasecmp(section, "gpio") != 0)
-        return 1; /* the machine's sections: cs_machine_ini's business */
-    if (strcasecmp(name, "chip") == 0) {
-        if (value[0] == '\0' || strlen(value) >= sizeof c->chip)
-            return fail(x, "[gpio] chip: expected a chip name, path, number or label (< %zu chars)",
-                        sizeof c->chip);
-        cs_gpio_cfg_chip_name(value, c->chip, sizeof c->chip);
-        return 1;
-    }
     int *slot = NULL;
     if (strcasecmp(name, "enable") == 0)
         slot = &c->enable;
@@ -181,6 +171,23 @@ static int handler(void *user, const char *section, const char *name, const char
                 slot = &c->lim_max[i];
         }
     }
+    return slot;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    ctx_t *x = user;
+    cs_gpio_cfg_t *c = x->c;
+    if (strcasecmp(section, "gpio") != 0)
+        return 1; /* the machine's sections: cs_machine_ini's business */
+    if (strcasecmp(name, "chip") == 0) {
+        if (value[0] == '\0' || strlen(value) >= sizeof c->chip)
+            return fail(x, "[gpio] chip: expected a chip name, path, number or label (< %zu chars)",
+                        sizeof c->chip);
+        cs_gpio_cfg_chip_name(value, c->chip, sizeof c->chip);
+        return 1;
+    }
+    int *slot = offset_slot(c, name);
     if (slot) {
         double d;
         if (strcasecmp(value, "none") == 0) {
