@@ -315,7 +315,14 @@ static int open_inputs(cs_joblink_t *l, gpio_link_t *g, bool ctl)
     g->has_in = cs_gpio_in_any(&g->in);
     if (!g->has_in)
         return CS_EXIT_OK; /* nothing can trip: no state to keep */
-    cs_gpio_state_path(g->cfg.state, g->record, l->cfg.gpio, g->state_path, sizeof g->state_path);
+    if (cs_gpio_state_path(g->cfg.state, g->record, l->cfg.gpio, g->state_path,
+                           sizeof g->state_path) != 0) {
+        snprintf(l->why, sizeof l->why,
+                 "%s:0: [gpio] state: no XDG_RUNTIME_DIR or HOME for the GPIO state file: give "
+                 "state = PATH (docs/gpio.md, \"Inputs\")",
+                 l->cfg.machine_file ? l->cfg.machine_file : "the built-in machine");
+        return CS_EXIT_INPUT;
+    }
     if (cs_gpio_state_load(g->state_path, &g->st, l->why, sizeof l->why) != 0)
         return CS_EXIT_INPUT;
     g->st_loaded = true;

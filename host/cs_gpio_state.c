@@ -2,26 +2,38 @@
 #include "cs_gpio_state.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
-void cs_gpio_state_path(const char *cfg_state, const char *record, const char *chip, char *out,
-                        size_t outlen)
+int cs_gpio_state_path(const char *cfg_state, const char *record, const char *chip, char *out,
+                       size_t outlen)
 {
     if (cfg_state != NULL && cfg_state[0] != '\0') {
         snprintf(out, outlen, "%s", cfg_state);
-    } else if (record != NULL) {
-        snprintf(out, outlen, "%s.state", record);
-    } else {
-        const char *dir = getenv("XDG_RUNTIME_DIR");
-        char name[64];
-        snprintf(name, sizeof name, "%s", chip);
-        for (char *p = name; *p; p++)
-            if (*p == '/')
-                *p = '_';
-        snprintf(out, outlen, "%s/curvestep-gpio-%s.state", dir && dir[0] ? dir : "/tmp", name);
+        return 0;
     }
+    if (record != NULL) {
+        snprintf(out, outlen, "%s.state", record);
+        return 0;
+    }
+    /* never a fixed name in a world-writable directory such as /tmp: another user could plant
+     * it (or a link in its place) and decide the alarm */
+    const char *run = getenv("XDG_RUNTIME_DIR"), *home = getenv("HOME");
+    char name[64];
+    snprintf(name, sizeof name, "%s", chip);
+    for (char *p = name; *p; p++)
+        if (*p == '/')
+            *p = '_';
+    if (run != NULL && run[0] == '/')
+        snprintf(out, outlen, "%s/curvestep-gpio-%s.state", run, name);
+    else if (home != NULL && home[0] == '/')
+        snprintf(out, outlen, "%s/.curvestep-gpio-%s.state", home, name);
+    else
+        return -1;
+    return 0;
 }
 
 int cs_gpio_state_load(const char *path, cs_gpio_state_t *s, char *err, size_t errlen)
@@ -70,9 +82,13 @@ int cs_gpio_state_save(const char *path, const cs_gpio_state_t *s)
 {
     char tmp[400];
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (f == NULL)
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW, 0644);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (f == NULL) {
+        if (fd >= 0)
+            close(fd);
         return -1;
+    }
     fprintf(f, "# curvestep gpio state: the alarm, the machine position (steps), the recorder's\n"
                "# physical offset (steps), the axes homed\n");
     fprintf(f, "alarm %u inputs 0x%03x\n", (unsigned)s->alarm, (unsigned)s->inputs);
