@@ -43,7 +43,12 @@ static int load_hold(const cs_gpio_run_t *r)
 /* True when the run is asked to stop at once (a cancel): ends a wait early. */
 static bool stop_now(const void *ctx)
 {
-    return load_hold((const cs_gpio_run_t *)ctx) >= 2;
+    const cs_gpio_run_t *r = ctx;
+    /* the e-stop ends a long wait too (a dwell, a slow axis): seen within one sleep slice */
+    const cs_gpio_in_t *in = r->o.in;
+    if (in != NULL && (__atomic_load_n(&in->bits, __ATOMIC_ACQUIRE) & CS_PROTO_IN_ESTOP))
+        return true;
+    return load_hold(r) >= 2;
 }
 
 /* Waits until CLOCK_MONOTONIC reaches t. false when asked to stop at once meanwhile. */
@@ -219,14 +224,12 @@ static bool emit_steps(stepper_run_t *s, const int32_t before[CS_AXES])
     cs_gpio_run_t *r = s->r;
     uint32_t lines = step_lines(s->o, s->out.step_mask);
     int64_t at = s->planned > s->t_dir + s->setup ? s->planned : s->t_dir + s->setup;
-    if (!wait_until(r, at, s->spin)) {
-        s->oc = CS_GPIO_RUN_STOPPED;
-        s->unsent = true;
-        for (unsigned i = 0; i < CS_AXES; i++)
-            s->unsent_pos[i] = before[i];
-        return false;
-    }
-    if (inputs_trip(s, before)) { /* an edge while waiting for the rise: this step is not made */
+    bool waited = wait_until(r, at, s->spin);
+    /* the inputs read after the wait (an edge while waiting, or the e-stop that ended it) */
+    bool tripped = inputs_trip(s, before);
+    if (!waited || tripped) { /* stopped or tripped: this call's steps are not made */
+        if (!tripped)
+            s->oc = CS_GPIO_RUN_STOPPED;
         s->unsent = true;
         for (unsigned i = 0; i < CS_AXES; i++)
             s->unsent_pos[i] = before[i];
@@ -256,7 +259,10 @@ static bool emit_dir(stepper_run_t *s)
     if (want == s->dir)
         return true;
     if (!s->out.step_mask && !wait_until(s->r, s->planned, s->spin)) {
-        s->oc = CS_GPIO_RUN_STOPPED;
+        int32_t pos[CS_AXES];
+        exec_pos(s, pos);
+        if (!inputs_trip(s, pos))
+            s->oc = CS_GPIO_RUN_STOPPED;
         return false;
     }
     int64_t at = s->out.step_mask ? s->planned + s->pulse : s->planned;
