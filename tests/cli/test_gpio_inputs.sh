@@ -19,7 +19,8 @@
 #  - probe down to z = -10: contact where physical z reaches -3 mm: machine z = -4 mm, the record
 #    holding exactly (1 - -3) x 80 = 320 z rises downwards; G38.3 above the surface: no contact,
 #    exit 0; G38.2 there: ALARM:5, exit 7.
-#  - [gpio] input keys read and checked (a line used twice, a switch of an axis the machine lacks).
+#  - [gpio] input keys read and checked (a line used twice, a switch of an axis the machine lacks);
+#    a missing chip (exit 4), --port with --gpio (exit 2), a homing switch not there (exit 1).
 # Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -152,5 +153,15 @@ bad "a switch on a STEP line" 'x_min = 17\n' 'bad.ini:4: \[gpio\] x_min: line 17
 bad "the probe on the e-stop's line" 'estop = 3\nprobe = 3\n' 'bad.ini:5: \[gpio\] probe: line 3 is already estop'
 bad "a switch of no axis" 'a_max = 4\n' 'bad.ini:0: \[gpio\] a_max: the machine has no a axis'
 bad "a bad polarity" 'limit_active_low = maybe\n' 'bad.ini:4: \[gpio\] limit_active_low: expected true or false'
+
+# 6. the command line and the machine file: a chip that is not there (exit 4, named), --port and
+# --gpio together (exit 2), a [homing] switch the recorder has no [limits] for (exit 1)
+run "home on a missing chip" 4 home --gpio gpiochip9 --machine "$M"
+expect_err "home on a missing chip: named" 'cannot open GPIO chip gpiochip9'
+run "--port and --gpio" 2 unlock --port /dev/null --gpio record:"$T/u.csv"
+expect_err "--port and --gpio: said" 'exclude each other'
+grep -v '^x_min = -5$' "$M" >"$T/nox.ini"
+run "home without the x min switch" 1 home --gpio record:"$T/nx.csv" --machine "$T/nox.ini"
+expect_err "home without the x min switch: said" 'wires no x_min'
 
 finish
