@@ -18,21 +18,23 @@ case "$JOBS" in '' | *[!0-9]* | 0) echo "run-tests.sh: CS_TEST_JOBS must be a po
 
 # The tests are independent (each script works in its own mktemp directory, takes ephemeral
 # ports and its own pseudo-terminals; build/failed/<script>.<pid> is per process), so they run
-# side by side. The scripts go first, the slow ones before the rest (the order below is by their
-# time on this machine, longest first, so that two runners end together); the unit binaries,
-# short, fill in at the end.
+# side by side. The slow ones start first, so that the runners end together (the list is by
+# their time on this machine, longest first: a script or a unit binary by its name); then the
+# other scripts; the unit binaries, mostly short, fill in at the end.
+slow_first="test_dropcut test_grbl test_predict test_resume test_plan test_modbus_clients"
+slow_first+=" test_safety_inputs test_help test_modbus test_stream test_daemon test_fw_m3_page"
+all=("${CLI_DIR:-tests/cli}"/test_*.sh "$@")
 items=()
-slow_first="test_dropcut test_resume test_modbus test_stream test_grbl test_fw_m3 test_daemon"
-cli=("${CLI_DIR:-tests/cli}"/test_*.sh)
 for s in $slow_first; do
-    for t in "${cli[@]}"; do [ "$(basename "$t" .sh)" = "$s" ] && items+=("cli:$t"); done
+    for t in "${all[@]}"; do
+        case "$t" in *.sh) k=cli ;; *) k=unit ;; esac
+        [ "$(basename "$t" .sh)" = "$s" ] && items+=("$k:$t")
+    done
 done
-for t in "${cli[@]}"; do
-    [ -f "$t" ] || continue
+for t in "${all[@]}"; do
     case " $slow_first " in *" $(basename "$t" .sh) "*) continue ;; esac
-    items+=("cli:$t")
+    case "$t" in *.sh) [ -f "$t" ] && items+=("cli:$t") ;; *) items+=("unit:$t") ;; esac
 done
-for bin in "$@"; do items+=("unit:$bin"); done
 
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
