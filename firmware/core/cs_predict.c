@@ -35,6 +35,13 @@ static uint64_t majorant(int64_t c1, int64_t c2)
     return same ? 416 * p + 352 * q : 426 * p - 130 * q;
 }
 
+/* a b for |a|, |b| < 2^31: one 32x32 -> 64 multiply (SMULL on a Cortex-M3, one call of the
+ * 32x32 product on the M0+) where int64 operands would take a 64x64 product. */
+static int64_t mul32(int32_t a, int32_t b)
+{
+    return (int64_t)a * b;
+}
+
 static uint64_t uabs64(int64_t v)
 {
     return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
@@ -117,20 +124,23 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     return CS_OK;
 }
 
-/* x t / 2^30 rounded half away from zero: bit for bit cs_fixed_mul64_q30, inlined with one
- * 128-bit multiply where the compiler has the type (64-bit hosts), the out-of-line 64x32
- * product in two halves elsewhere. Every Horner step of the tracer goes through it. */
+/* x t / 2^30 rounded half away from zero, for 0 <= t <= 2^30 (every parameter and step of the
+ * tracer) and |x| < 2^62: bit for bit cs_fixed_mul64_q30, inline. With |x| = xh 2^32 + xl the
+ * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
+ * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
+ * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
 static int64_t mul_t(int64_t x, cs_param_t t)
 {
+    uint64_t m = uabs64(x);
+    uint32_t ut = (uint32_t)t;
 #if defined(__SIZEOF_INT128__)
     __extension__ typedef unsigned __int128 u128_t;
-    uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
-    uint64_t at = t < 0 ? (uint64_t)0 - (uint64_t)(int64_t)t : (uint64_t)t;
-    uint64_t r = (uint64_t)(((u128_t)m * at + ((uint64_t)1 << 29)) >> 30);
-    return ((x < 0) != (t < 0)) ? -(int64_t)r : (int64_t)r;
+    uint64_t r = (uint64_t)(((u128_t)m * ut + ((uint64_t)1 << 29)) >> 30);
 #else
-    return cs_fixed_mul64_q30(x, t);
+    uint64_t hi = (uint64_t)(uint32_t)(m >> 32) * ut, lo = (uint64_t)(uint32_t)m * ut;
+    uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
 #endif
+    return x < 0 ? -(int64_t)r : (int64_t)r;
 }
 
 /* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
@@ -153,56 +163,18 @@ static int64_t rsh_round(int64_t v, unsigned s)
     return (int64_t)(u >> s) - (int64_t)(RSH_BIAS >> s);
 }
 
-/* A trial step h = m 2^-s (Q30 when s = 30). Predicted steps are cut to SHORT_BITS significant
- * bits (a relative change below 2^-15, nothing to the chord count), so each product x h is one
- * native 64-bit multiply and a rounding shift (|x| < 2^45, m < 2^16: below 2^61) instead of a
- * 64x32 product in two halves; a step with more bits (the rest of the curve, rem) takes
- * cs_fixed_mul64_q30. Both round once: <= 1/2 unit. */
-#define SHORT_BITS 16
-typedef struct {
-    int64_t m;
-    unsigned s;
-    bool short_step;
-} step_t;
-
-static step_t step_of(cs_param_t h)
-{
-    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
-    step_t st = {h, CS_PARAM_FRAC_BITS, false};
-    if (((uint32_t)h & (((uint32_t)1 << e) - 1u)) == 0) {
-        st.m = h >> e;
-        st.s = CS_PARAM_FRAC_BITS - e;
-        st.short_step = true;
-    }
-    return st;
-}
-
-static int64_t mul_step(int64_t x, step_t h)
-{
-    if (!h.short_step)
-        return mul_t(x, (cs_param_t)h.m);
-    return rsh_round(x * h.m, h.s);
-}
-
-/* h cut to its SHORT_BITS leading bits (rounded down). */
-static int64_t short_of(int64_t h)
-{
-    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
-    return h & ~(((int64_t)1 << e) - 1);
-}
-
 /* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, int64_t d[2][2], step_t h, int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
-        int64_t c1 = mul_step(d[0][k], h);
-        int64_t c2 = mul_step(mul_step(d[1][k], h), h);
-        int64_t c3 = mul_step(mul_step(mul_step(p->a[3][k], h), h), h);
+        int64_t c1 = mul_t(d[0][k], h);
+        int64_t c2 = mul_t(mul_t(d[1][k], h), h);
+        int64_t c3 = mul_t(mul_t(mul_t(p->a[3][k], h), h), h);
         v[0][k] = c1;
         v[1][k] = 2 * c1 + c2;
         v[2][k] = 3 * (c1 + c2 + c3);
@@ -243,11 +215,11 @@ static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
 /* Convex-hull test for short chords and pieces whose inner points project outside the chord:
  * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
  * dist(V_i, D) <= 4 T in the 3x-scaled units. */
-static bool hull_flat(int64_t v[3][2], int64_t T)
+static bool hull_flat(int32_t v[3][2], int64_t T)
 {
-    cs_vec3_t o = {0, 0, 0}, d = {(cs_pos_t)v[2][0], (cs_pos_t)v[2][1], 0};
-    cs_vec3_t q1 = {(cs_pos_t)v[0][0], (cs_pos_t)v[0][1], 0};
-    cs_vec3_t q2 = {(cs_pos_t)v[1][0], (cs_pos_t)v[1][1], 0};
+    cs_vec3_t o = {0, 0, 0}, d = {v[2][0], v[2][1], 0};
+    cs_vec3_t q1 = {v[0][0], v[0][1], 0};
+    cs_vec3_t q2 = {v[1][0], v[1][1], 0};
     return cs_subdiv_dist_ok(&q1, &o, &d, (uint32_t)(4 * T)) &&
            cs_subdiv_dist_ok(&q2, &o, &d, (uint32_t)(4 * T));
 }
@@ -257,7 +229,7 @@ static bool hull_flat(int64_t v[3][2], int64_t T)
 static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
 {
     int64_t v[3][2];
-    sub_curve(p, d, step_of(h), v);
+    sub_curve(p, d, h, v);
     uint64_t m = 0;
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
@@ -271,25 +243,28 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
         *room = F16_ONE / 4;
         return false;
     }
-    if (s > 0) /* rounded (half up: <= 1/2 unit), inline: this is the hot path */
-        for (unsigned i = 0; i < 3; i++)
-            for (unsigned k = 0; k < 2; k++)
-                v[i][k] = rsh_round(v[i][k], s);
-    int64_t dd = v[2][0] * v[2][0] + v[2][1] * v[2][1];
-    int64_t dot1 = v[0][0] * v[2][0] + v[0][1] * v[2][1];
-    int64_t dot2 = v[1][0] * v[2][0] + v[1][1] * v[2][1];
+    /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
+     * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
+     * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
+    int32_t w[3][2];
+    for (unsigned i = 0; i < 3; i++)
+        for (unsigned k = 0; k < 2; k++)
+            w[i][k] = (int32_t)(s > 0 ? rsh_round(v[i][k], s) : v[i][k]);
+    int64_t dd = mul32(w[2][0], w[2][0]) + mul32(w[2][1], w[2][1]);
+    int64_t dot1 = mul32(w[0][0], w[2][0]) + mul32(w[0][1], w[2][1]);
+    int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
     if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
-        bool ok = hull_flat(v, T);
+        bool ok = hull_flat(w, T);
         *room = ok ? F16_ONE : F16_ONE / 4;
         return ok;
     }
-    int64_t c1 = v[2][0] * v[0][1] - v[2][1] * v[0][0];
-    int64_t c2 = v[2][0] * v[1][1] - v[2][1] * v[1][0];
+    int64_t c1 = mul32(w[2][0], w[0][1]) - mul32(w[2][1], w[0][0]);
+    int64_t c2 = mul32(w[2][0], w[1][1]) - mul32(w[2][1], w[1][0]);
     uint64_t found = majorant(c1, c2);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
     unsigned sh;
-    uint32_t len = approx_len(v[2][0], v[2][1], &sh);
+    uint32_t len = approx_len(w[2][0], w[2][1], &sh);
     uint64_t allowed = k * len, f1 = (found >> sh) + 1; /* f1 > found / 2^sh */
     *room = room_q16(allowed, f1 - 1); /* both scaled by 2^-sh */
     /* Clear cases decided on the estimate: len <= 1.0022 |D| / 2^sh, so f1 (1 + 1/32) <=
@@ -452,7 +427,7 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
  * between the largest passing and the smallest failing step. 0 when none passes. */
 static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
 {
-    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? short_of(p->h_next) : rem;
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
     /* What every trial step from t shares: B'(t), B''(t)/2, or the conic's start (Q0 of each
      * trial piece and the blossom's first level at t, computed once). */
     int64_t d[2][2] = {{0, 0}, {0, 0}};
@@ -477,8 +452,6 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
             nh = rem;
         if (nh <= lo || nh >= hi)
             nh = lo + (hi - lo) / 2;
-        if (nh != rem)
-            nh = short_of(nh);
         if (nh <= lo || nh == h || hi - lo <= 1)
             break;
         h = nh;
