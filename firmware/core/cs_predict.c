@@ -76,16 +76,35 @@ bool cs_predict_accepts(const cs_bezier_t *c)
     return true;
 }
 
-cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+/* What both begins share: the checks (tolerance, then the curve, then its range; a polynomial
+ * curve for cs_predict_begin, a conic for cs_predict_begin_conic) and the tracing state. */
+static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol, bool conic)
 {
     p->done = true;
     if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    if (!cs_predict_accepts(c))
+    if (!cs_predict_accepts(c) || c->rational != conic)
         return CS_ERR_UNSUPPORTED;
     for (unsigned i = 0; i <= c->degree; i++)
         if (!cs_fixed_vec_ok(&c->p[i]))
             return CS_ERR_RANGE;
+    p->t = 0;
+    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->thr = tol - CS_PREDICT_SLACK_LSB;
+    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
+    p->z = c->p[0].z;
+    p->end = c->p[c->degree];
+    return CS_OK;
+}
+
+static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
+static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
+
+cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_err_t e = begin_common(p, c, tol, false);
+    if (e != CS_OK)
+        return e;
     for (unsigned k = 0; k < 2; k++) {
         /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
         int64_t q[4] = {0, 0, 0, 0};
@@ -107,19 +126,23 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
         p->a[2][k] = a2 * ((int64_t)1 << F);
         p->a[3][k] = a3 * ((int64_t)1 << F);
     }
-    p->conic = c->rational;
-    for (unsigned i = 0; i <= 2 && p->conic; i++) {
+    p->next = next_poly;
+    p->done = false;
+    return CS_OK;
+}
+
+cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_err_t e = begin_common(p, c, tol, true);
+    if (e != CS_OK)
+        return e;
+    for (unsigned i = 0; i <= 2; i++) {
         int64_t w = c->w[i]; /* exact products: |w x| < 2^58 */
         p->h[i][0] = w * c->p[i].x;
         p->h[i][1] = w * c->p[i].y;
         p->h[i][2] = w;
     }
-    p->t = 0;
-    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
-    p->thr = tol - CS_PREDICT_SLACK_LSB;
-    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
-    p->z = c->p[0].z;
-    p->end = c->p[c->degree];
+    p->next = next_conic;
     p->done = false;
     return CS_OK;
 }
@@ -167,7 +190,8 @@ static int64_t rsh_round(int64_t v, unsigned s)
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
+                      int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
@@ -226,8 +250,9 @@ static bool hull_flat(int32_t v[3][2], int64_t T)
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
-static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
+static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
 {
+    const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
     sub_curve(p, d, h, v);
     uint64_t m = 0;
@@ -352,9 +377,9 @@ static void conic_start(const cs_predict_t *p, conic_start_t *c0)
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_t h,
-                       uint32_t *room)
+static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
 {
+    const conic_start_t *c0 = ctx;
     int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
     const int64_t *q0 = c0->q0;
     cs_param_t t1 = p->t + h;
@@ -399,23 +424,26 @@ static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_
     return cs_fixed_cmp_prod_u64(found, found, lim2, (uint64_t)dd) <= 0;
 }
 
-static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
+/* The vertex at p->t: the conic's blossom b(t, t) divided once, rounded to the nearest LSB. */
+static void eval_conic(const cs_predict_t *p, cs_vec3_t *pt)
 {
-    if (p->conic) {
-        int64_t b[3], q[2];
-        blossom(p, t, t, b);
-        for (unsigned k = 0; k < 2; k++) /* rounded to the nearest LSB */
-            q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
-        pt->x = (cs_pos_t)q[0];
-        pt->y = (cs_pos_t)q[1];
-        pt->z = p->z;
-        return;
-    }
+    int64_t b[3], q[2];
+    blossom(p, p->t, p->t, b);
+    for (unsigned k = 0; k < 2; k++)
+        q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
+    pt->x = (cs_pos_t)q[0];
+    pt->y = (cs_pos_t)q[1];
+    pt->z = p->z;
+}
+
+/* The vertex at p->t: B(t) by Horner, rounded to the LSB. */
+static void eval_poly(const cs_predict_t *p, cs_vec3_t *pt)
+{
     int64_t r[2];
     for (unsigned k = 0; k < 2; k++) {
-        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], t);
-        acc = p->a[1][k] + mul_t(acc, t);
-        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F);
+        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], p->t);
+        acc = p->a[1][k] + mul_t(acc, p->t);
+        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, p->t), F);
     }
     /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
     pt->x = (cs_pos_t)r[0];
@@ -423,23 +451,20 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
     pt->z = p->z;
 }
 
+/* One flatness test of the piece [t, t + h]; ctx is what every trial piece from t shares
+ * (B'(t) and B''(t)/2, or the conic's start). */
+typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room);
+
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
+static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
+                            uint32_t *lo_room)
 {
+    cs_param_t rem = CS_PARAM_ONE - p->t;
     int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
-    /* What every trial step from t shares: B'(t), B''(t)/2, or the conic's start (Q0 of each
-     * trial piece and the blossom's first level at t, computed once). */
-    int64_t d[2][2] = {{0, 0}, {0, 0}};
-    conic_start_t c0; /* set and read only for a conic */
-    if (!p->conic)
-        derivs(p, p->t, d);
-    else
-        conic_start(p, &c0);
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
-                     : test_step(p, d, (cs_param_t)h, &room)) {
+        if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
             if (h == rem || room <= F16_ACCEPT)
@@ -461,8 +486,7 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
-                     : test_step(p, d, (cs_param_t)h, &room)) {
+        if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
         }
@@ -471,26 +495,54 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
     return (cs_param_t)lo;
 }
 
-cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+/* Moves to the next vertex by the step find_step gave: CS_OK and *eval when the caller
+ * computes the vertex at p->t, CS_OK and *pt = P_n at the end, CS_ERR_DEPTH for no step. */
+static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t *pt, bool *eval)
 {
-    if (p->done)
-        return CS_END;
-    cs_param_t rem = CS_PARAM_ONE - p->t;
-    uint32_t room = F16_ONE;
-    cs_param_t h = find_step(p, rem, &room);
-    if (h == 0) {
-        p->done = true;
+    *eval = false;
+    p->done = true;
+    if (h == 0)
         return CS_ERR_DEPTH;
-    }
     p->t += h;
     if (p->t == CS_PARAM_ONE) {
         *pt = p->end;
-        p->done = true;
         return CS_OK;
     }
     /* Next chord: about as long in t as this one, corrected by the room this one left. */
     int64_t nh = predict(h, room);
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
-    eval_at(p, p->t, pt);
+    p->done = false;
+    *eval = true;
     return CS_OK;
+}
+
+static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt)
+{
+    int64_t d[2][2];
+    derivs(p, p->t, d);
+    uint32_t room = F16_ONE;
+    bool eval;
+    cs_param_t h = find_step(p, test_step, d, &room); /* sets room: before step_to reads it */
+    cs_err_t e = step_to(p, h, room, pt, &eval);
+    if (eval)
+        eval_poly(p, pt);
+    return e;
+}
+
+static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt)
+{
+    conic_start_t c0;
+    conic_start(p, &c0);
+    uint32_t room = F16_ONE;
+    bool eval;
+    cs_param_t h = find_step(p, test_conic, &c0, &room); /* sets room: before step_to reads it */
+    cs_err_t e = step_to(p, h, room, pt, &eval);
+    if (eval)
+        eval_conic(p, pt);
+    return e;
+}
+
+cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+{
+    return p->done ? CS_END : p->next(p, pt);
 }
