@@ -152,7 +152,16 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
  * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
  * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
  * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
-static int64_t mul_t(int64_t x, cs_param_t t)
+/* Inline on cores with a 32x32 -> 64 multiply instruction (about 8 instructions a call saved on
+ * the M3, 32 calls a chord); out of line where it would be two libgcc calls (M0+, AVR): there the
+ * flash matters more. */
+#if defined(__GNUC__) && (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && \
+                                                        __ARM_ARCH_ISA_THUMB >= 2))
+#define MUL_T_INLINE __attribute__((always_inline)) inline
+#else
+#define MUL_T_INLINE
+#endif
+static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
     uint64_t m = uabs64(x);
     uint32_t ut = (uint32_t)t;
@@ -177,14 +186,29 @@ static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
     }
 }
 
-/* v / 2^s rounded half up, for |v| < 2^61 and 0 < s < 62, on v + 2^62 (non-negative, so no
- * >> of a negative value, implementation-defined in C99): branch-free, one shift. */
-#define RSH_BIAS ((uint64_t)1 << 62)
-static int64_t rsh_round(int64_t v, unsigned s)
+/* v / 2^s rounded half up, for 0 < s < 32 and a result that fits int32: the result's bits are
+ * bits s..s+31 of v + 2^(s-1) in two's complement (a logical and an arithmetic shift differ only
+ * in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by two
+ * constant-width shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and
+ * no negative value is shifted (implementation-defined in C99). */
+static int32_t rsh_round32(int64_t v, unsigned s)
 {
-    uint64_t u = (uint64_t)v + RSH_BIAS + ((uint64_t)1 << (s - 1));
-    return (int64_t)(u >> s) - (int64_t)(RSH_BIAS >> s);
+    uint64_t u = (uint64_t)v + ((uint64_t)1 << (s - 1));
+#if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
+    uint32_t r = (uint32_t)(u >> s);
+#else
+    uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
+    uint32_t r = (lo >> s) | (hi << (32 - s));
+#endif
+    return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
 }
+/* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
+ * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
+ * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
+CS_STATIC_ASSERT(((int64_t)8 * CS_POS_LIMIT << F) < ((int64_t)1 << (UNIT_BITS + 31)),
+                 predict_unit_shift_below_32);
+CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS + 31)),
+                 predict_thr_shift_below_32);
 
 /* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
@@ -274,7 +298,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint
     int32_t w[3][2];
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
-            w[i][k] = (int32_t)(s > 0 ? rsh_round(v[i][k], s) : v[i][k]);
+            w[i][k] = s > 0 ? rsh_round32(v[i][k], s) : (int32_t)v[i][k];
     int64_t dd = mul32(w[2][0], w[2][0]) + mul32(w[2][1], w[2][1]);
     int64_t dot1 = mul32(w[0][0], w[2][0]) + mul32(w[0][1], w[2][1]);
     int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
