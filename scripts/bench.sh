@@ -124,10 +124,11 @@ fw_section() {
     curve_core fd3 "-DCURVE_CORE_FD3" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_fd3.c
     echo "**The default tracer alone** (cs_predict: planar polynomial curves of degree <= 3, what"
-    echo "curves mode gets from SVG and G5; cs_subdiv contributes its distance test only):"
+    echo "curves mode gets from SVG and G5; the conic path, entered by cs_predict_begin_conic only,"
+    echo "is not linked):"
     echo
     curve_core predict "-DCURVE_CORE_PREDICT" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
-        firmware/core/cs_subdiv.c firmware/core/cs_predict.c
+        firmware/core/cs_predict.c
     local predict=$CORE_BYTES
     local verdict="met"
     [ "$fd_poly" -lt 3072 ] || verdict="NOT met"

@@ -2,7 +2,6 @@
  * docs/fixed-point.md, "Predicted-step tracer"). */
 #include "cs_predict.h"
 
-#include "cs_subdiv.h"
 
 #define F               CS_PREDICT_FRAC
 #define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
@@ -260,16 +259,29 @@ static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
     return l == 0 ? 0 : (l + dd / l) / 2;
 }
 
+/* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
+ * test's 32-bit components (below 2^27: products below 2^54, |V - D|^2 below 2^57), with
+ * dot = V . D and dd = |D|^2 already computed; r2 = r^2. */
+static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t dot, int64_t dd,
+                        uint64_t r2)
+{
+    if (dd == 0 || dot <= 0) /* nearest point is 0 (also a zero-length chord) */
+        return (uint64_t)(mul32(v[0], v[0]) + mul32(v[1], v[1])) <= r2;
+    if (dot >= dd) { /* nearest point is D */
+        int32_t ex = v[0] - d[0], ey = v[1] - d[1];
+        return (uint64_t)(mul32(ex, ex) + mul32(ey, ey)) <= r2;
+    }
+    uint64_t c = uabs64(mul32(d[0], v[1]) - mul32(d[1], v[0])); /* |D x V| <= r |D| */
+    return cs_fixed_cmp_prod_u64(c, c, r2, (uint64_t)dd) <= 0;
+}
+
 /* Convex-hull test for short chords and pieces whose inner points project outside the chord:
  * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
  * dist(V_i, D) <= 4 T in the 3x-scaled units. */
-static bool hull_flat(int32_t v[3][2], int64_t T)
+static bool hull_flat(int32_t v[3][2], int64_t dot1, int64_t dot2, int64_t dd, int64_t T)
 {
-    cs_vec3_t o = {0, 0, 0}, d = {v[2][0], v[2][1], 0};
-    cs_vec3_t q1 = {v[0][0], v[0][1], 0};
-    cs_vec3_t q2 = {v[1][0], v[1][1], 0};
-    return cs_subdiv_dist_ok(&q1, &o, &d, (uint32_t)(4 * T)) &&
-           cs_subdiv_dist_ok(&q2, &o, &d, (uint32_t)(4 * T));
+    uint64_t r2 = (uint64_t)(16 * T * T); /* T < 2^20 */
+    return seg_dist_ok(v[0], v[2], dot1, dd, r2) && seg_dist_ok(v[1], v[2], dot2, dd, r2);
 }
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
@@ -303,7 +315,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint
     int64_t dot1 = mul32(w[0][0], w[2][0]) + mul32(w[0][1], w[2][1]);
     int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
     if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
-        bool ok = hull_flat(w, T);
+        bool ok = hull_flat(w, dot1, dot2, dd, T);
         *room = ok ? F16_ONE : F16_ONE / 4;
         return ok;
     }
