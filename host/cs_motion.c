@@ -197,17 +197,43 @@ int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_
     return ferror(f) ? -1 : 0;
 }
 
+bool cs_motion_spindle_used(const cs_motion_segs_t *s)
+{
+    for (size_t q = 0; q < s->npowers; q++)
+        if (s->powers[q].spindle == 3 || s->powers[q].spindle == 4)
+            return true;
+    return false;
+}
+
+/* The power marks before segment k (all: every one left) as comment lines. */
+static void write_powers(FILE *f, const cs_motion_segs_t *s, size_t *q, size_t k, bool all)
+{
+    for (; *q < s->npowers && (all || s->powers[*q].seg == k); (*q)++) {
+        const cs_motion_power_t *p = &s->powers[*q];
+        if (p->spindle == 5)
+            fprintf(f, "# spindle M5\n");
+        else if (p->rapid)
+            fprintf(f, "# spindle M%u S%g rapid\n", (unsigned)p->spindle, p->s);
+        else
+            fprintf(f, "# spindle M%u S%g F%.3f\n", (unsigned)p->spindle, p->s, p->feed_mm_s);
+    }
+}
+
 int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s)
 {
     cs_motion_write(f, m, s->v, 0); /* the header */
-    size_t p = 0;
+    size_t p = 0, q = s->npowers;
+    if (cs_motion_spindle_used(s))
+        q = 0; /* a job that never turns a spindle on says nothing about it */
     for (size_t k = 0; k < s->n; k++) {
         for (; p < s->npens && s->pens[p].seg == k; p++)
             fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
+        write_powers(f, s, &q, k, false);
         write_seg(f, m, &s->v[k]);
     }
     for (; p < s->npens; p++)
         fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
+    write_powers(f, s, &q, s->n, true);
     return ferror(f) ? -1 : 0;
 }
 

@@ -72,7 +72,11 @@ void cs_motion_segs_free(cs_motion_segs_t *s);
 /* Appends a servo pen event: an exact stop (cs_motion_finish), then settle_ms of rest (one or
  * more segments without steps) that begins with the pulse pulse_us. CS_ERR_FULL on OOM. */
 cs_err_t cs_motion_pen(cs_motion_t *mo, uint16_t pulse_us, double settle_ms);
-/* As cs_motion_write, with the "pen PULSE_US" line before each pen event's segment. */
+/* True when a power mark turns a spindle or laser on (M3 or M4). */
+bool cs_motion_spindle_used(const cs_motion_segs_t *s);
+/* As cs_motion_write, with the "pen PULSE_US" line before each pen event's segment and, when
+ * cs_motion_spindle_used, a comment line before the first segment of each power mark:
+ * "# spindle M3|M4 S<S> F<mm/s>" (feed moves), "# spindle M3|M4 S<S> rapid", "# spindle M5". */
 int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s);
 /* Queues a straight move to target (mm) at feed (mm/s Q15.16, <= 0 rapid); cuts segments first
  * when the ring is full. Planner errors pass through (CS_ERR_LIMIT: nothing was queued). */

@@ -47,6 +47,18 @@ static void usage(FILE *f)
           f);
 }
 
+
+/* The spindle / laser line of the summary: how many power changes, the largest S. */
+static void spindle_summary(const cs_motion_segs_t *s)
+{
+    double smax = 0;
+    for (size_t q = 0; q < s->npowers; q++)
+        if (s->powers[q].spindle != 5 && s->powers[q].s > smax)
+            smax = s->powers[q].s;
+    fprintf(stderr, "plan: spindle: %zu changes (\"# spindle\" lines), largest S %g\n",
+            s->npowers, smax);
+}
+
 int cs_cmd_plan(int argc, char **argv)
 {
     const char *out_file = NULL, *job = NULL;
@@ -135,6 +147,8 @@ int cs_cmd_plan(int argc, char **argv)
                     jp.path.n, jp.mo.blocks, jp.mo.segs.n, (long long)jp.mo.steps,
                     (double)jp.mo.ticks / m.tick_hz, (unsigned long long)jp.mo.ticks,
                     (unsigned)m.tick_hz);
+        if (rc == CS_EXIT_OK && cs_motion_spindle_used(&jp.mo.segs))
+            spindle_summary(&jp.mo.segs);
     }
     cs_jobplan_free(&jp);
     return rc;
