@@ -283,7 +283,7 @@ printf '%s\n' '[x]' 'steps_per_mm = 400' 'max_rate = 100' 'max_accel = 200' '[y]
     's_max = 1000' >"$T/blend.ini"
 printf '%s\n' 'G21 G90' 'M4 S1000' 'G1 X10 F1200' 'G1 X20 S500' 'G1 X20 Y10 S1000' 'G0 X0 Y0' \
     'M5' >"$T/blend.nc"
-start_sim blend --machine "$T/blend.ini" --trace "$T/blend.csv"
+start_sim blend --machine "$T/blend.ini" --trace "$T/blend.csv" --svg "$T/blend.svg"
 start_grbl blend --machine "$T/blend.ini"
 client "$GPTY" stream "$T/blend.nc" --method burst >"$T/blend.out"; rc=$?
 stop_all
@@ -329,6 +329,10 @@ expect "blend: the corner's S change keeps moving (>= 1 mm/s)" \
 expect "blend: M4 power / S = v / F within 1 % on every segment of the cuts" \
     grep -Eq '^power [1-9][0-9]+ segments, 0 off' "$T/blend.chk"
 expect "blend: the rapid runs with the laser off" grep -qx 'rapid lit 0' "$T/blend.chk"
+# the drawing shows the power along the path: a band per lit stretch, as wide as the duty, so
+# the M4 ramps at the start and at the corner give many widths
+expect "blend: the picture draws the laser power, its width following the duty" \
+    [ "$(grep -o 'class="power"[^>]*stroke-width="[0-9.]*"' "$T/blend.svg" | sed 's/.*stroke-width=//' | sort -u | wc -l)" -ge 10 ]
 
 # 7. usage.
 run "help: exit 0" 0 grbl --help
