@@ -357,8 +357,10 @@ static int pump_out(run_t *s, uint32_t now)
             return 0;
         if (e == CS_ERR_TIMEOUT) {
             snprintf(s->r->why, sizeof s->r->why,
-                     "the device stopped answering (%u retransmission timeouts of %u ms)",
-                     (unsigned)s->o->link.max_retries + 1u, (unsigned)s->o->link.rto / 1000u);
+                     "the device stopped answering (silent for %u s: %u retransmission timeouts, "
+                     "%u ms doubling up to %u ms)",
+                     (unsigned)(s->o->link.give_up / 1000000u), (unsigned)s->link.retries + 1u,
+                     (unsigned)s->o->link.rto / 1000u, (unsigned)s->o->link.rto_max / 1000u);
             finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
             return 0;
         }
