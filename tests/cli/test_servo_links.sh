@@ -21,13 +21,14 @@ expect "plan: pen events ($pens, $lowers down)" [ "$pens" -gt 2 -a "$lowers" -gt
 one() {
     local name=$1 dev=$2 host=$3
     shift 3
-    timeout -k 5 120 "$SIM" $dev --instant --idle-exit 1 --machine "$MC" --reference "$JOB" \
+    timeout -k 5 300 "$SIM" $dev --instant --machine "$MC" --reference "$JOB" \
         --check >"$T/$name.sim" 2>"$T/$name.simerr" &
     local sp=$!
     pids+=($sp)
     wait_pty "$T/$name.sim" 60
     timeout -k 5 90 "$CS" stream $host "$PTY" --machine "$MC" "$@" "$JOB" >"$T/$name.out" 2>&1
     expect "$name: stream exit 0" [ $? -eq 0 ]
+    kill "$sp" # the host has exited: SIGTERM ends the device with its report
     wait_until 60 gone "$sp"
     wait "$sp"
     expect "$name: device exit 0" [ $? -eq 0 ]
