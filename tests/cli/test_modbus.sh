@@ -17,6 +17,10 @@ JOB=tests/data/svg/resvg/M-L-Z-A.svg
 SMALL=$T/small.nc
 printf 'G21 G90\nG1 X10 Y0 F3000\nG2 X10 Y10 I0 J5\nG1 X0 Y10\nG3 X0 Y0 I0 J-5\n' >"$SMALL"
 
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
 # start_dev NAME ser|tcp|rtu ARGS...: the device in the background (--instant unless ARGS start
 # with --speed; it runs until wait_dev ends it: no idle timer, which a host starved of the CPU
 # on a loaded machine would outlast mid-job), ADDR = the pty path or HOST:PORT it printed first
@@ -42,7 +46,7 @@ start_dev() {
 # executor holds, then reports) and waits for it (at most 60 s: an event, generous under load).
 wait_dev() {
     local p=${devpid[$1]}
-    kill "$p" 2>/dev/null
+    stop_dev "$p"
     wait_until 60 gone "$p"
     kill "$p" 2>/dev/null
     wait "$p" 2>/dev/null

@@ -17,6 +17,10 @@ pens=$(grep -c '^pen ' "$T/job.seg")
 lowers=$(grep -c "^pen $down\$" "$T/job.seg")
 expect "plan: pen events ($pens, $lowers down)" [ "$pens" -gt 2 -a "$lowers" -gt 1 ]
 
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
 # one NAME DEVICE-LINK HOST-LINK [stream options]: the device, the stream, the device's report
 one() {
     local name=$1 dev=$2 host=$3
@@ -28,7 +32,7 @@ one() {
     wait_pty "$T/$name.sim" 60
     timeout -k 5 90 "$CS" stream $host "$PTY" --machine "$MC" "$@" "$JOB" >"$T/$name.out" 2>&1
     expect "$name: stream exit 0" [ $? -eq 0 ]
-    kill "$sp" # the host has exited: SIGTERM ends the device with its report
+    stop_dev "$sp" # the host has exited: SIGTERM ends the device with its report
     wait_until 60 gone "$sp"
     wait "$sp"
     expect "$name: device exit 0" [ $? -eq 0 ]
