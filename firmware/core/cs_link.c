@@ -31,11 +31,20 @@ static bool elapsed(uint32_t now, uint32_t since, uint32_t span)
     return (uint32_t)(now - since) >= span;
 }
 
-/* Progress (the peer answered): the next timeout is rto again, the silence count starts over. */
+/* Progress (the peer answered): the next timeout is rto again. */
 static void progress(cs_link_t *l)
 {
     l->retries = 0;
-    l->rto_now = l->cfg.rto;
+}
+
+/* The timeout after `retries` timeouts in a row: min(rto * 2^retries, rto_max), doubled step by
+ * step (no shift past 32 bits; at most 32 steps before the cap). */
+static uint32_t rto_now(const cs_link_t *l)
+{
+    uint32_t t = l->cfg.rto;
+    for (unsigned k = 0; k < l->retries && t < l->cfg.rto_max; k++)
+        t = t > l->cfg.rto_max / 2u ? l->cfg.rto_max : 2u * t;
+    return t;
 }
 
 static void tx_reset_ring(cs_link_t *l, uint32_t nonce, uint32_t now)
@@ -54,7 +63,6 @@ static void tx_reset_ring(cs_link_t *l, uint32_t nonce, uint32_t now)
     l->ping_out = false;
     l->blocked = false;
     progress(l);
-    l->quiet_at = now;
     l->timer_at = l->ping_at = l->heard_at = now;
 }
 
@@ -326,23 +334,20 @@ static cs_err_t emit_ping(cs_link_t *l, uint32_t now, const uint8_t **bytes, siz
     return emit_ctl(l, &m, bytes, len);
 }
 
-/* One more timeout without progress, on a frame or PING (re)sent at sent_at: false (and CLOSED)
- * once give_up has passed since the first unanswered send of the run; else the next timeout
- * doubles, capped at rto_max (exponential backoff: a peer starved of the CPU for seconds finds
- * the link still open, and a dead one costs a few frames per second, not 200). */
-static bool retry(cs_link_t *l, uint32_t now, uint32_t sent_at)
+/* One more timeout without progress: false (and CLOSED) once the peer has been silent for
+ * give_up; else the next timeout doubles, capped at rto_max (exponential backoff: a peer starved
+ * of the CPU for seconds finds the link still open, and a dead one costs a few frames a second,
+ * not 200). */
+static bool retry(cs_link_t *l, uint32_t now)
 {
     inc(&l->stats.timeouts);
-    if (l->retries == 0)
-        l->quiet_at = sent_at;
-    if (elapsed(now, l->quiet_at, l->cfg.give_up)) {
+    if (elapsed(now, l->heard_at, l->cfg.give_up)) {
         l->state = CS_LINK_CLOSED;
         l->ping_out = false;
         return false;
     }
-    if (l->retries != UINT16_MAX)
+    if (l->retries != UINT8_MAX)
         l->retries++;
-    l->rto_now = l->rto_now > l->cfg.rto_max / 2u ? l->cfg.rto_max : 2u * l->rto_now;
     return true;
 }
 
@@ -367,9 +372,9 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
         return emit_ctl(l, &m, bytes, len);
     }
     if (l->state == CS_LINK_CONNECTING) {
-        if (l->ping_out && !elapsed(now, l->ping_at, l->rto_now))
+        if (l->ping_out && !elapsed(now, l->ping_at, rto_now(l)))
             return CS_END;
-        if (l->ping_out && !retry(l, now, l->ping_at))
+        if (l->ping_out && !retry(l, now))
             return CS_ERR_TIMEOUT;
         return emit_ping(l, now, bytes, len);
     }
@@ -377,8 +382,8 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
         return CS_END;
     if (l->base != l->next) {
         /* Data outstanding: its retransmissions are the probe (no PING, one timer, one count). */
-        if (l->send_pos != l->base && elapsed(now, l->timer_at, l->rto_now)) {
-            if (!retry(l, now, l->timer_at))
+        if (l->send_pos != l->base && elapsed(now, l->timer_at, rto_now(l))) {
+            if (!retry(l, now))
                 return CS_ERR_TIMEOUT;
             l->send_pos = l->base; /* go back N */
         }
@@ -399,9 +404,9 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
     /* Nothing to send: probe a silent peer when we wait for credits (the window update may have
      * been lost) or when keepalive says so; unanswered probes count as timeouts. */
     if (l->ping_out) {
-        if (!elapsed(now, l->ping_at, l->rto_now))
+        if (!elapsed(now, l->ping_at, rto_now(l)))
             return CS_END;
-        if (!retry(l, now, l->ping_at))
+        if (!retry(l, now))
             return CS_ERR_TIMEOUT;
         return emit_ping(l, now, bytes, len);
     }

@@ -33,8 +33,9 @@ CS_STATIC_ASSERT(CS_LINK_WINDOW >= 1 && CS_LINK_WINDOW <= 128 &&
  * 3.3): the k-th timeout in a row without progress (k = 0, 1, ...) waits min(rto * 2^k, rto_max)
  * after the frame or PING it covers was (re)sent; the first progress (an ACK that moves the
  * window, or the echo of our PING) starts again at rto. The link is closed by the first timeout
- * that finds give_up ticks passed since the first unanswered (re)send of the run, so a silent
- * peer is declared dead between give_up and give_up + rto_max after it went silent. */
+ * that finds the peer silent (no valid ACK from it since the link was opened or started) for
+ * give_up ticks, so a dead peer is declared so between give_up and give_up + rto_max after its
+ * last ACK. */
 typedef struct {
     uint32_t rto;         /* first retransmission timeout: > round trip + one window, >= 1 */
     uint32_t rto_max;     /* cap of the doubled timeout, >= rto */
@@ -104,12 +105,10 @@ typedef struct {
     uint32_t nonce;    /* of the outstanding or last PING; never 0 */
     bool ping_out;     /* a PING waits for its echo */
     bool blocked;      /* a send was refused for want of credits */
-    uint16_t retries;  /* timeouts in a row without progress (saturating) */
-    uint32_t rto_now;  /* the next timeout: rto doubled per timeout in a row, capped at rto_max */
-    uint32_t quiet_at; /* first unanswered (re)send of the current run of timeouts */
+    uint8_t retries;   /* timeouts in a row without progress (saturating): the backoff's k */
     uint32_t timer_at; /* oldest frame last sent, or last progress */
     uint32_t ping_at;  /* PING last sent */
-    uint32_t heard_at; /* last valid ACK from the peer */
+    uint32_t heard_at; /* last valid ACK from the peer (or the start): silence for give_up */
     /* receiver */
     uint32_t boot_id;       /* our own boot id, in every ACK */
     uint16_t next_expected; /* next sequence to deliver */

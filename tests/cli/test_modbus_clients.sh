@@ -37,9 +37,11 @@ start_sim() {
     PORT=${ADDR##*:}
 }
 
-# stop_sim NAME: SIGTERM, then its report is complete
+# stop_sim NAME: SIGTERM to the device itself (through its timeout wrapper, -k 5, it would be
+# killed 5 s later, before an ASan build under load has checked the job), then its report is
+# complete
 stop_sim() {
-    kill -TERM "$SIMPID" 2>/dev/null
+    kill -TERM $(pgrep -P "$SIMPID") 2>/dev/null || kill -TERM "$SIMPID" 2>/dev/null
     wait_until 60 gone "$SIMPID"
     wait "$SIMPID" 2>/dev/null
     SIMRC=$?

@@ -443,9 +443,9 @@ static void test_device_reset_mid_stream(void **state)
     assert_int_equal(sim.dev.delivered, TOTAL - sim.dev.first_index); /* checked in order */
 }
 
-/* The line goes dead: the sender reports CS_ERR_TIMEOUT give_up after its first unanswered
- * frame (sent at most rto before the cut, else it would have timed out before), within one
- * capped timeout; an idle end finds out through its keepalive probes. */
+/* The line goes dead: the sender reports CS_ERR_TIMEOUT give_up after the last ACK it heard
+ * (at most the line's latency before the cut), within one capped timeout; an idle end finds out
+ * through its keepalive probes. */
 static void test_dead_line_is_reported(void **state)
 {
     (void)state;
@@ -653,17 +653,19 @@ static void test_credits_and_window(void **state)
 /* --- backoff (docs/protocol.md 3.3) ------------------------------------------------------- */
 enum { BACKOFF_MAX = 64 };
 
-/* The rule as the protocol states it: the first frame goes out at s0; the k-th timeout in a
- * row fires min(rto * 2^k, rto_max) after the last send and sends again, unless give_up has
- * passed since s0: then the link closes there. at[]: the sends; returns their number. */
-static int backoff_expected(const cs_link_cfg_t *c, uint64_t s0, uint64_t *at, uint64_t *closed)
+/* The rule as the protocol states it: the peer was last heard at `heard`, the first frame goes
+ * out at s0; the k-th timeout in a row fires min(rto * 2^k, rto_max) after the last send and
+ * sends again, unless the peer has been silent for give_up: then the link closes there. at[]:
+ * the sends; returns their number. */
+static int backoff_expected(const cs_link_cfg_t *c, uint64_t heard, uint64_t s0, uint64_t *at,
+                            uint64_t *closed)
 {
     int n = 0;
     uint64_t s = s0, d = c->rto;
     at[n++] = s0;
     for (int k = 1;; k++) {
         uint64_t t = s + d;
-        if (t - s0 >= c->give_up) {
+        if (t - heard >= c->give_up) {
             *closed = t;
             return n;
         }
@@ -697,10 +699,11 @@ static int backoff_observed(cs_link_t *l, uint64_t t0, uint64_t step, uint64_t *
     }
 }
 
-static void assert_backoff(const cs_link_cfg_t *c, cs_link_t *l, uint64_t t0, uint64_t step)
+static void assert_backoff(const cs_link_cfg_t *c, cs_link_t *l, uint64_t heard, uint64_t t0,
+                           uint64_t step)
 {
     uint64_t want[BACKOFF_MAX], got[BACKOFF_MAX], want_closed = 0, got_closed = 0;
-    int nw = backoff_expected(c, t0, want, &want_closed);
+    int nw = backoff_expected(c, heard, t0, want, &want_closed);
     int ng = backoff_observed(l, t0, step, got, &got_closed);
     assert_int_equal(ng, nw);
     for (int i = 0; i < nw; i++)
@@ -717,20 +720,21 @@ static void test_backoff_doubles_then_gives_up(void **state)
     connect_pair(0, 8);
     assert_int_equal(send_seg(&la), CS_OK);
     cs_link_cfg_t c = la.cfg;
-    assert_backoff(&c, &la, 10, 1); /* sends at 10, 110, 310, 710, 1110; closed at 1510 */
+    /* last ACK at 2 (the connection); sends at 10, 110, 310, 710, 1110; closed at 1510 */
+    assert_backoff(&c, &la, 2, 10, 1);
     assert_int_equal(la.stats.timeouts, 5);
     /* Connecting to nobody: the PINGs follow the same rule. */
     assert_int_equal(cs_link_init(&la, &c, 1, 99, 0, 0), CS_OK);
-    assert_backoff(&c, &la, 0, 1);
+    assert_backoff(&c, &la, 0, 0, 1);
     /* The timing every end uses at memory speed, in microseconds: 5 ms doubling to 1 s, closed
      * 30 s after the silence began (tens of seconds of a starved peer survive). */
     assert_int_equal(cs_linktime_link(&c, 0, 1000000u), CS_OK);
     assert_int_equal(cs_link_init(&la, &c, 1, 99, 0, 0), CS_OK);
     uint64_t at[BACKOFF_MAX], closed = 0;
-    int n = backoff_expected(&c, 0, at, &closed);
+    int n = backoff_expected(&c, 0, 0, at, &closed);
     assert_true(closed >= 30000000u && closed <= 31000000u);
     print_message("memory speed: %d PINGs, closed %.3f s after the first\n", n, closed / 1e6);
-    assert_backoff(&c, &la, 0, 1000); /* every timeout is a whole number of ms */
+    assert_backoff(&c, &la, 0, 0, 1000); /* every timeout is a whole number of ms */
 }
 
 /* The first good ACK after timeouts starts the backoff over at rto. */
