@@ -385,8 +385,11 @@ static void test_stream_link_closed(void **state)
     child_out_t o;
     finish_device(&dv, &o);
     assert_int_equal(o.executed, 777);
-    /* the hang-up is seen at once: well before the retransmission timeouts would say so */
-    assert_true(r.link.timeouts < 3);
+    /* the hang-up is what ended it, not the retransmission timeouts (30 s of silence): a count
+     * of timeouts would depend on the machine's load (a few 5-20 ms ones may pass before the
+     * device's close is seen; "< 3" failed once at load 12) */
+    if (strstr(r.why, "the line closed") == NULL)
+        fail_msg("ended by '%s', not by the hang-up", r.why);
 
     /* a silent device (cable cut, no hang-up): closed give_up after it went silent (2 s here;
      * 30 s by default), the timeouts backing off from 5 ms to 1 s meanwhile */
