@@ -95,6 +95,28 @@ static int make_raw(int fd, uint32_t baud)
     return tcsetattr(fd, TCSANOW, &t);
 }
 
+/* A pseudo-terminal's /dev/pts entry can be missing for a moment right after its creation:
+ * on this project's Linux 6.18 machine, with the pty index just freed by the previous device,
+ * stat and open of the path the creator printed fail with ENOENT on and off for up to 57 ms
+ * (3 of 300 creations; `curvestep stream` to a fresh `curvestep-sim --pty` failed to open it 2
+ * times in 300). A path under /dev/pts/ is therefore retried on ENOENT until this deadline. */
+#define CS_SERIAL_PTS_WAIT_S 5.0
+
+static int open_tty(const char *path)
+{
+    const int flags = O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC;
+    int fd = open(path, flags);
+    if (fd >= 0 || errno != ENOENT || strncmp(path, "/dev/pts/", 9) != 0)
+        return fd;
+    double end = cs_serial_now_s() + CS_SERIAL_PTS_WAIT_S;
+    while (fd < 0 && errno == ENOENT && cs_serial_now_s() < end) {
+        struct timespec ts = {0, 5000000L}; /* 5 ms: the entry comes back within a few */
+        nanosleep(&ts, NULL);
+        fd = open(path, flags);
+    }
+    return fd;
+}
+
 int cs_serial_open(cs_serial_t *s, const char *path, uint32_t baud)
 {
     init_struct(s, -1);
@@ -102,7 +124,7 @@ int cs_serial_open(cs_serial_t *s, const char *path, uint32_t baud)
         errno = EINVAL;
         return -1;
     }
-    int fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    int fd = open_tty(path);
     if (fd < 0)
         return -1;
     if (!isatty(fd)) {

@@ -21,7 +21,7 @@ start_sim() {
     timeout -k 5 120 "$SIM" --pty $pace --idle-exit 3 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     SIMPID=$!
-    wait_pty "$T/$name.sim" 5
+    wait_pty "$T/$name.sim" 60
 }
 # start_grbl NAME ARGS...: the front end on the device's pty (GPTY: its own pty, GPID).
 start_grbl() {
@@ -29,14 +29,15 @@ start_grbl() {
     timeout -k 5 120 "$CS" grbl --port "$PTY" "$@" >"$T/$name.grbl" 2>"$T/$name.grblerr" &
     pids+=($!)
     GPID=$!
-    wait_pty "$T/$name.grbl" 5
+    wait_pty "$T/$name.grbl" 60
     GPTY=$PTY
 }
-# stop_all: ends the front end, then waits (at most 10 s) for the device's report.
+# stop_all: ends the front end, then the device, and waits for its report (SIGTERM: it finishes
+# what its executor holds, then reports; every client below waits for Idle first, and a device
+# that executed nothing never reaches its idle exit).
 stop_all() {
     kill "$GPID" 2>/dev/null
     wait "$GPID" 2>/dev/null
-    wait_until 10 gone "$SIMPID"
     kill "$SIMPID" 2>/dev/null
     wait "$SIMPID" 2>/dev/null
 }
@@ -51,7 +52,7 @@ expect "reference final position" [ -n "$REF_POS" ]
 # 1. character counting: every line ok, the device's final position exact.
 start_sim cc --reference "$PROG" --check
 start_grbl cc
-expect "cc: pty path printed" [ -c "$GPTY" ]
+expect "cc: pty path printed" wait_until 60 test -c "$GPTY"
 client "$GPTY" stream "$PROG" --method counting >"$T/cc.out"; rc=$?
 stop_all
 expect "cc: client exit 0" [ $rc -eq 0 ]
@@ -187,7 +188,7 @@ start_sim tcp
 timeout -k 5 60 "$CS" grbl --port "$PTY" --listen 0 >"$T/tcp.grbl" 2>"$T/tcp.grblerr" &
 pids+=($!)
 GPID=$!
-wait_pty "$T/tcp.grbl" 5
+wait_pty "$T/tcp.grbl" 60
 expect "tcp: 127.0.0.1:PORT printed" grep -qE '^127\.0\.0\.1:[0-9]+$' "$T/tcp.grbl"
 client "$PTY" cmd '$I' >"$T/tcp.out"
 expect "tcp: \$I answered" grep -qE '^\[VER:1\.1h' "$T/tcp.out"

@@ -63,7 +63,7 @@ ctl() { c=$1; shift; timeout -k 5 120 "$CS" "$c" --port "$PTY" --machine "$MC" "
 
 start_harness "$T/h.out" --switch-min x=$XMIN --switch-max x=$XMAX --switch-max z=$ZMAX \
     --probe-z $PZ
-expect "harness: pty" [ -c "$PTY" ]
+expect "harness: pty" wait_until 60 test -c "$PTY"
 
 # 1. a hard limit mid-job
 printf 'G21 G90\nG1 X10 F3000\nG1 Y5\nG1 X60\nG1 X0\n' >"$T/trip.nc"

@@ -41,16 +41,15 @@ expect "plan: pen events ($npen)" [ "$npen" -ge 6 ]
 read -r PX PY < <(awk '!/^#/ && !/^pen/ { for (i = 2; i <= 3; i++) t[i] += ($i < 0 ? -$i : $i) }
                        END { print t[2] + 0, t[3] + 0 }' "$T/job.seg")
 
-timeout -k 5 90 "$H" --pty --idle-exit 0.5 --timeout 80 "$ELF" >"$T/h.out" 2>"$T/h.err" &
+timeout -k 5 310 "$H" --pty --idle-exit 0.5 --timeout 300 "$ELF" >"$T/h.out" 2>"$T/h.err" &
 HPID=$!
 pids+=("$HPID")
-wait_until 20 test -s "$T/h.out"
-PTY=$(head -n1 "$T/h.out")
-expect "harness printed a pty path" [ -c "$PTY" ]
-timeout -k 5 80 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$T/m.ini" --no-sort \
+wait_pty "$T/h.out" 60
+expect "harness printed a pty path" wait_until 60 test -c "$PTY"
+timeout -k 5 300 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$T/m.ini" --no-sort \
     --no-merge "$T/job.svg" >"$T/s.out" 2>"$T/s.err"
 expect "stream: exit 0" [ $? -eq 0 ]
-wait_until 30 gone "$HPID"
+wait_until 60 gone "$HPID"
 wait "$HPID"
 expect "harness: exit 0" [ $? -eq 0 ]
 line=$(grep '^servo: ' "$T/h.out")

@@ -107,7 +107,7 @@ ref_pos=$(sed -n 's/^final position: x=\(-*[0-9]*\) steps .* y=\(-*[0-9]*\) step
 ref_steps=$(sed -n 's/^replay: [0-9]* segments, \([0-9]*\) steps.*/\1/p' "$T/replay.out")
 expect "reference: plan and replay ran" [ -n "$ref_pos" ] && [ -n "$ref_steps" ] && [ "$nseg" -gt 100 ]
 start_fw seg
-expect "qemu printed the UART's pty" [ -c "$PTY" ]
+expect "qemu printed the UART's pty" wait_until 60 test -c "$PTY"
 timeout -k 5 240 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 --port "$PTY" "$JOB" \
     >"$T/seg.out" 2>"$T/seg.err"
 rc=$?
@@ -152,7 +152,7 @@ expect "curves: steps in total = simulator" grep -q "^fw: steps total $sim_steps
 
 # 3. Ctrl-C mid-job: HOLD then ABORT reach the image; the host's last executed is the image's.
 start_fw int
-timeout --foreground -k 5 60 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 \
+timeout --foreground -k 5 300 "$CS" stream --machine "$INI" --feed $FEED --line-rate 115200 \
     --port "$PTY" "$JOB" >"$T/int.out" 2>"$T/int.err" &
 spid=$!
 pids+=("$spid")
@@ -204,7 +204,7 @@ expect "hold: STEP/DIR pins position = replay" grep -q "^fw: position (STEP/DIR 
 # 4. a machine file at another tick rate: the image's HELLO is refused (exit 4), nothing moves.
 sed 's/^tick_hz = .*/tick_hz = 1000000/' "$INI" >"$T/fast.ini"
 start_fw bad
-timeout -k 5 30 "$CS" stream --machine "$T/fast.ini" --port "$PTY" "$JOB" >"$T/bad.out" 2>&1
+timeout -k 5 120 "$CS" stream --machine "$T/fast.ini" --port "$PTY" "$JOB" >"$T/bad.out" 2>&1
 rc=$?
 kill "$QPID" 2>/dev/null
 wait_fw

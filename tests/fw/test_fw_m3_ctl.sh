@@ -22,7 +22,7 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d
 timeout -k 5 400 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
 QPID=$!
 pids+=("$QPID")
-wait_until 20 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
+wait_until 60 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
 FPTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/fw.out")
 expect "qemu: pty" [ -n "$FPTY" ]
 ctl() { c=$1; shift; timeout -k 5 180 "$CS" "$c" --port "$FPTY" --machine "$MC" "$@"; }
@@ -48,7 +48,7 @@ expect "jog back: exit 0 (got $rc)" [ $rc -eq 0 ]
 ctl spindle --ccw 250 >"$T/sp.out" 2>&1; rc=$?
 expect "spindle M4 S250: exit 0 (got $rc)" [ $rc -eq 0 ]
 kill -TERM "$QPID" 2>/dev/null
-wait_until 30 gone "$QPID"
+wait_until 60 gone "$QPID"
 expect "image: control line" grep -q '^fw: control: 2 axes homed, [1-9] alarms (now 0), 1 probe cycles' \
     "$T/fw.out"
 expect "image: spindle last set to duty 250/1000, counter-clockwise" \

@@ -25,7 +25,7 @@ expect "plan has pen events ($pens)" [ "$pens" -gt 300 ]
 timeout -k 5 300 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
 QPID=$!
 pids+=("$QPID")
-wait_until 20 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
+wait_until 60 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
 FPTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/fw.out")
 expect "qemu: pty" [ -n "$FPTY" ]
 timeout -k 5 300 "$CS" stream --machine "$MC" "${LAY[@]}" --line-rate 115200 --port "$FPTY" \

@@ -34,7 +34,7 @@ expect "sim: $nseg segments logged ($simlog)" [ "${simlog%% *}" = "$nseg" ]
 timeout -k 5 120 "${QEMU[@]}" >"$T/fw.out" 2>&1 &
 QPID=$!
 pids+=("$QPID")
-wait_until 20 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
+wait_until 60 grep -q '^char device redirected to /dev/pts/' "$T/fw.out"
 FPTY=$(sed -n 's#^char device redirected to \(/dev/pts/[0-9]*\) .*#\1#p' "$T/fw.out")
 expect "qemu: pty" [ -n "$FPTY" ]
 timeout -k 5 120 "$CS" stream --machine "$MC" --feed $FEED --line-rate 115200 --port "$FPTY" "$JOB" >"$T/st.out" 2>"$T/st.err"

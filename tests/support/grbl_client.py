@@ -21,6 +21,7 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
   waitfor STATE   (no soft reset first) waits for the state STATE (Alarm, Idle...), prints
                   the pushed lines seen meanwhile (ALARM:N...) and "state: <...>"
   raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
+                  (the first line within the deadline, then lines until 1 s without one)
 Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
 Every wait has a deadline (--deadline S, default 60); a missed one exits 3.
 """
@@ -49,7 +50,17 @@ class Grbl:
             self.fd = self.sock.fileno()
         else:
             self.sock = None
-            self.fd = os.open(where, os.O_RDWR | os.O_NOCTTY)
+            # a fresh pty's /dev/pts entry can be missing on and off for its first ~60 ms
+            # (host/cs_serial.c open_tty): retried until the deadline
+            end = time.monotonic() + deadline
+            while True:
+                try:
+                    self.fd = os.open(where, os.O_RDWR | os.O_NOCTTY)
+                    break
+                except FileNotFoundError:
+                    if time.monotonic() > end:
+                        raise
+                    time.sleep(0.005)
             tty.setraw(self.fd)
             termios.tcflush(self.fd, termios.TCIOFLUSH)
 
@@ -281,11 +292,15 @@ def main(argv):
     elif cmd == "raw":
         for b in argv[3:]:
             g.write(bytes([int(b, 16)]))
+        # the first answer within the deadline (a loaded machine is slow), then whatever else
+        # comes within 1 s of the last line
+        wait = None
         while True:
-            line = g.readline(1.0)
+            line = g.readline(wait)
             if line is None:
                 break
             print(line, flush=True)
+            wait = 1.0
     return 0
 
 

@@ -18,7 +18,10 @@
 #                         `timeout 10` would multiply the wait); fails at the deadline;
 #   gone PID              succeeds when process PID has ended;
 #   wait_pty FILE SECS    sets PTY to the first line of FILE (where `curvestep-sim --pty` prints
-#                         its terminal) once there is one, or to "" after SECS seconds;
+#                         its terminal) once there is one (a /dev path: once it is a character
+#                         device; TCP devices print their address there), or to
+#                         "" after SECS seconds (a fresh pty's /dev/pts entry can be missing on
+#                         and off for its first ~60 ms here: host/cs_serial.c open_tty);
 #   (a script that failed leaves its temp files in $B/failed/<script>.<pid>/ for diagnosis)
 #   finish                prints "cli: N passed, M failed" and returns non-zero on a failure
 #                         (the last command of a script, so it is the script's exit status).
@@ -111,7 +114,10 @@ gone() { ! kill -0 "$1" 2>/dev/null; }
 
 cs_cli_pty_ready() {
     PTY=$(head -n1 "$1" 2>/dev/null)
-    [ -n "$PTY" ]
+    case $PTY in
+    /dev/*) [ -c "$PTY" ] ;;
+    *) [ -n "$PTY" ] ;; # a device's TCP address (curvestep-sim --modbus-tcp prints one)
+    esac
 }
 wait_pty() {
     PTY=
