@@ -172,11 +172,14 @@ print-%:
 # --- tests ----------------------------------------------------------------------------------
 # Each variant builds everything (host program and simulator too: tests may run them) and runs
 # every unit test binary; scripts/run-tests.sh prints the cmocka totals as "N passed, N failed".
+# The builds run CS_JOBS compilers at once and the tests CS_TEST_JOBS at once (both default to
+# the number of cores; scripts/run-tests.sh).
+CS_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test: deps
-	$(MAKE) --no-print-directory VARIANT=plain test-variant
-	$(MAKE) --no-print-directory VARIANT=asan test-variant
-	@$(MAKE) --no-print-directory core-check cross
-	$(MAKE) --no-print-directory fw-test
+	$(MAKE) --no-print-directory -j$(CS_JOBS) VARIANT=plain test-variant
+	$(MAKE) --no-print-directory -j$(CS_JOBS) VARIANT=asan test-variant
+	@$(MAKE) --no-print-directory -j$(CS_JOBS) core-check cross
+	$(MAKE) --no-print-directory -j$(CS_JOBS) fw-test
 
 # Host only: the host program and simulator, built and tested (unit and CLI tests, plain), and
 # the freestanding check of the core, with no cross toolchain, emulator or clang.

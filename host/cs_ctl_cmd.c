@@ -15,6 +15,7 @@
 #include "cs_conv.h"
 #include "cs_ctlcfg.h"
 #include "cs_err_text.h"
+#include "cs_gpio_ctl.h"
 #include "cs_machine_ini.h"
 #include "cs_path.h"
 #include "cs_serial.h"
@@ -35,6 +36,7 @@ static void on_sigint(int sig)
 typedef struct {
     const char *who; /* "home", "jog", ... */
     const char *port, *machine_file;
+    const char *gpio; /* --gpio CHIP: the GPIO link instead (cs_gpio_ctl) */
     long baud;
     double feed; /* jog, probe: mm/s */
     double xyz[3];
@@ -54,24 +56,6 @@ typedef struct {
     unsigned homed;
 } ctl_seen_t;
 
-static const char *alarm_text(uint8_t code)
-{
-    static const char *const t[] = {
-        "?",
-        "hard limit: a limit switch tripped",
-        "soft limit: a target outside the machine's travel",
-        "aborted during a cycle",
-        "probe: already in the state sought at the start",
-        "probe: no contact within the move",
-        "homing: reset during the cycle",
-        "homing: door open",
-        "homing: the switch still active after the pull-off",
-        "homing: the switch not found within the search distance",
-        "e-stop pressed",
-    };
-    return code < sizeof t / sizeof t[0] ? t[code] : "?";
-}
-
 static void print_pos(const cs_machine_t *m, const int32_t *steps)
 {
     for (unsigned i = 0; i < m->n_axes; i++)
@@ -87,7 +71,7 @@ static void on_event(void *ctx, const cs_proto_event_t *ev)
         s->alarm = true;
         s->alarm_code = ev->code;
         printf("%s: ALARM:%u (%s), inputs 0x%03x, stopped at ", s->a->who, (unsigned)ev->code,
-               alarm_text(ev->code), (unsigned)ev->inputs);
+               cs_ctlcfg_alarm_text(ev->code), (unsigned)ev->inputs);
     } else if (ev->kind == CS_PROTO_EVENT_PROBE) {
         s->probed = true;
         s->contact = ev->code != 0;
@@ -157,21 +141,21 @@ static void usage(FILE *f, const char *who)
     static const struct {
         const char *who, *synopsis, *what;
     } u[] = {
-        {"home", "home --port DEV [--baud N] [--machine FILE.ini] [--axes ORDER]",
+        {"home", "home (--port DEV [--baud N] | --gpio CHIP) [--machine FILE.ini] [--axes ORDER]",
          "Homes the axes in the order of the machine file's [homing] (or --axes ORDER, e.g.\n"
          "zxy): the device seeks each switch, backs off, latches slowly and pulls off, then\n"
          "sets the axis's position to [homing] x_pos (default: the travel's end at the\n"
          "switch). Homing also clears an alarm.\n"},
-        {"jog", "jog --port DEV [--baud N] [--machine FILE.ini] --feed MM/S X Y Z",
+        {"jog", "jog (--port DEV [--baud N] | --gpio CHIP) [--machine FILE.ini] --feed MM/S X Y Z",
          "Moves straight to the machine position X Y Z (mm) at --feed, planned and\n"
          "accelerated on the device; Ctrl-C decelerates it to rest and drops the rest.\n"},
         {"probe",
-         "probe --port DEV [--baud N] [--machine FILE.ini] --feed MM/S [--away]\n"
+         "probe (--port DEV [--baud N] | --gpio CHIP) [--machine FILE.ini] --feed MM/S [--away]\n"
          "                       [--no-error] X Y Z",
          "Moves towards X Y Z at --feed until the probe touches (G38.2) and prints the\n"
          "contact position; --away: until it lets go (G38.4); --no-error: no alarm when the\n"
          "move ends without contact (G38.3, G38.5).\n"},
-        {"unlock", "unlock --port DEV [--baud N] [--machine FILE.ini]",
+        {"unlock", "unlock (--port DEV [--baud N] | --gpio CHIP) [--machine FILE.ini]",
          "Leaves the device's alarm state (Grbl's $X); refused while the e-stop is pressed.\n"},
         {"spindle",
          "spindle --port DEV [--baud N] [--machine FILE.ini] [--ccw | --off]\n"
@@ -185,15 +169,20 @@ static void usage(FILE *f, const char *who)
         k++;
     fprintf(f,
             "usage: curvestep %s\n%s"
-            "Over the serial link to a device (a board or the simulator; docs/controller.md).\n"
+            "Over the serial link to a device (a board or the simulator; docs/controller.md)%s.\n"
             "Options:\n"
-            "  --port DEV         the device's serial line (required)\n"
+            "  --port DEV         the device's serial line\n"
             "  --baud N           its rate (default 115200)\n"
+            "%s"
             "  --machine FILE     the machine file (default: as `curvestep plan`)\n"
             "Exit status: 0 done, 1 bad input (machine file), 2 usage, 3 internal error, 4 no\n"
             "device, 5 device reset, 6 link closed, 7 the device refused a message or raised an\n"
             "alarm (ALARM:N printed), 8 interrupted (Ctrl-C).\n",
-            u[k].synopsis, u[k].what);
+            u[k].synopsis, u[k].what, strcmp(who, "spindle") == 0 ? "" : ",\nor over GPIO lines",
+            strcmp(who, "spindle") == 0
+                ? ""
+                : "  --gpio CHIP        drive the machine's [gpio] lines directly (or record:FILE:\n"
+                  "                     no hardware, simulated switches; docs/gpio.md \"Inputs\")\n");
 }
 
 /* Parses the shared options and the command's own; returns -1 to go on, else an exit status. */
@@ -216,6 +205,8 @@ static int parse(int argc, char **argv, ctl_args_t *a, const char **axes)
             return CS_EXIT_OK;
         } else if (strcmp(s, "--port") == 0 && has) {
             a->port = argv[++i];
+        } else if (strcmp(s, "--gpio") == 0 && has && strcmp(a->who, "spindle") != 0) {
+            a->gpio = argv[++i];
         } else if (strcmp(s, "--machine") == 0 && has) {
             a->machine_file = argv[++i];
         } else if (strcmp(s, "--baud") == 0 && has) {
@@ -249,8 +240,11 @@ static int parse(int argc, char **argv, ctl_args_t *a, const char **axes)
             return CS_EXIT_USAGE;
         }
     }
-    if (a->port == NULL) {
-        fprintf(stderr, "curvestep %s: --port DEV is required\n", a->who);
+    if ((a->port == NULL) == (a->gpio == NULL)) {
+        fprintf(stderr, "curvestep %s: %s\n", a->who,
+                a->port ? "--port and --gpio exclude each other"
+                : strcmp(a->who, "spindle") == 0 ? "--port DEV is required"
+                                                 : "--port DEV or --gpio CHIP is required");
         return CS_EXIT_USAGE;
     }
     return -1;
@@ -277,6 +271,22 @@ static int start(int argc, char **argv, ctl_args_t *a, const char *who, const ch
         return CS_EXIT_INPUT;
     }
     return -1;
+}
+
+/* The command over the GPIO link (cs_gpio_ctl). */
+static int via_gpio(const ctl_args_t *a, const cs_ctlcfg_t *c,
+                    int (*fn)(const cs_gpio_ctl_args_t *g))
+{
+    cs_gpio_ctl_args_t g = {.who = a->who,
+                            .chip = a->gpio,
+                            .machine_file = a->machine_file,
+                            .m = &a->m,
+                            .ctl = c,
+                            .feed = a->feed,
+                            .xyz = {a->xyz[0], a->xyz[1], a->xyz[2]},
+                            .away = a->away,
+                            .no_error = a->no_error};
+    return fn(&g);
 }
 
 static int add_msg(cs_stream_job_t *j, const cs_proto_msg_t *m)
@@ -314,6 +324,8 @@ int cs_cmd_home(int argc, char **argv)
                 a.machine_file ? a.machine_file : "the built-in machine");
         return CS_EXIT_INPUT;
     }
+    if (a.gpio != NULL)
+        return via_gpio(&a, &c, cs_gpio_ctl_home);
     cs_stream_job_t job;
     cs_stream_job_init(&job, CS_STREAM_CURVES);
     for (unsigned k = 0; k < c.n_order; k++) {
@@ -370,6 +382,12 @@ static int one_msg(int argc, char **argv, const char *who, uint8_t type)
         rc = target_msg(&a, &m);
         if (rc >= 0)
             return rc;
+    }
+    if (a.gpio != NULL) {
+        cs_stream_job_free(&job);
+        return via_gpio(&a, NULL, type == CS_PROTO_JOG     ? cs_gpio_ctl_jog
+                                  : type == CS_PROTO_PROBE ? cs_gpio_ctl_probe
+                                                           : cs_gpio_ctl_unlock);
     }
     /* UNLOCK takes no slot, so nothing would report it executed: a SPINDLE off (what the
      * alarm left anyway) behind it does */

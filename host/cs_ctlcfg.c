@@ -243,3 +243,21 @@ bool cs_ctlcfg_has_inputs(const cs_ctlcfg_t *c)
             return true;
     return c->has_probe;
 }
+
+const char *cs_ctlcfg_alarm_text(uint8_t code)
+{
+    static const char *const t[] = {
+        "?",
+        "hard limit: a limit switch tripped",
+        "soft limit: a target outside the machine's travel",
+        "aborted during a cycle",
+        "probe: already in the state sought at the start",
+        "probe: no contact within the move",
+        "homing: reset during the cycle",
+        "homing: door open",
+        "homing: the switch still active after the pull-off",
+        "homing: the switch not found within the search distance",
+        "e-stop pressed",
+    };
+    return code < sizeof t / sizeof t[0] ? t[code] : "?";
+}

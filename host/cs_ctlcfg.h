@@ -55,6 +55,8 @@ cs_err_t cs_ctlcfg_home_msg(const cs_ctlcfg_t *c, const cs_machine_t *m, unsigne
 /* The simulator's input bits (CS_PROTO_IN_*) at position mm[0..CS_AXES): a min switch is active
  * at or below its trip point, a max switch at or above, the probe at or below the surface. */
 uint16_t cs_ctlcfg_inputs(const cs_ctlcfg_t *c, const double mm[CS_AXES]);
+/* What ALARM:code means (Grbl's alarm codes, curvestep's 10 = e-stop; docs/controller.md). */
+const char *cs_ctlcfg_alarm_text(uint8_t code);
 /* True when [limits] or [probe] give the simulator anything to trip on. */
 bool cs_ctlcfg_has_inputs(const cs_ctlcfg_t *c);
 

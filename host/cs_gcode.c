@@ -87,6 +87,10 @@ cs_err_t cs_gcode_add(gc_t *g, const cs_bezier_t *c, cs_path_kind_t kind, unsign
     double feed = rapid ? 0.0 : g->feed * g->unit / 60.0;
     if (cs_path_add_move(g->path, c, kind, cs_gcode_loc(g, col), feed, rapid) != CS_OK)
         return cs_path_diag_set(g->diag, CS_ERR_FULL, cs_gcode_loc(g, col), "out of memory");
+    /* the spindle / laser with each move, so a plan carries its power (cs_motion power marks) */
+    cs_path_elem_t *el = &g->path->elems[g->path->n - 1];
+    el->spindle = (uint8_t)(g->spindle / 10);
+    el->spindle_s = g->speed;
     return CS_OK;
 }
 

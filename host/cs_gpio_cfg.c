@@ -26,6 +26,10 @@ void cs_gpio_cfg_default(cs_gpio_cfg_t *c, const cs_machine_t *m)
         c->step[i] = c->dir[i] = -1;
     c->enable = -1;
     c->pen = -1;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        c->lim_min[i] = c->lim_max[i] = -1;
+    c->probe = c->estop = -1;
+    c->limit_active_low = c->probe_active_low = c->estop_active_low = true;
     c->step_active_low = false;
     c->enable_active_low = true;
     /* The executor's own pulse (what the simulator and a firmware port give): the longest of
@@ -40,6 +44,14 @@ void cs_gpio_cfg_default(cs_gpio_cfg_t *c, const cs_machine_t *m)
     c->enable_ns = 10000000;
     c->spin_ns = 100000;
     c->rt_priority = 50;
+}
+
+bool cs_gpio_cfg_has_inputs(const cs_gpio_cfg_t *c)
+{
+    bool any = c->probe >= 0 || c->estop >= 0;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        any = any || c->lim_min[i] >= 0 || c->lim_max[i] >= 0;
+    return any;
 }
 
 bool cs_gpio_cfg_wired(const cs_gpio_cfg_t *c, unsigned axis)
@@ -99,24 +111,28 @@ static int parse_bool(const char *v)
     return -1;
 }
 
-/* The key naming line offset `off` other than `self`, or NULL. */
+/* The key naming line offset `off` other than `self`, or NULL (each line is used once, so the
+ * order the keys are looked at in does not matter). */
 static const char *offset_owner(const cs_gpio_cfg_t *c, int off, const int *self, char *buf,
                                 size_t len)
 {
-    for (unsigned i = 0; i < CS_AXES; i++) {
-        if (&c->step[i] != self && c->step[i] == off) {
-            snprintf(buf, len, "%s_step", axis_names[i]);
-            return buf;
-        }
-        if (&c->dir[i] != self && c->dir[i] == off) {
-            snprintf(buf, len, "%s_dir", axis_names[i]);
-            return buf;
-        }
-    }
-    if (&c->enable != self && c->enable == off)
-        return "enable";
-    if (&c->pen != self && c->pen == off)
-        return "pen";
+    const struct {
+        const int *v;
+        const char *suffix;
+    } per_axis[] = {{c->step, "step"}, {c->dir, "dir"}, {c->lim_min, "min"}, {c->lim_max, "max"}};
+    for (unsigned k = 0; k < sizeof per_axis / sizeof per_axis[0]; k++)
+        for (unsigned i = 0; i < CS_AXES; i++)
+            if (&per_axis[k].v[i] != self && per_axis[k].v[i] == off) {
+                snprintf(buf, len, "%s_%s", axis_names[i], per_axis[k].suffix);
+                return buf;
+            }
+    const struct {
+        const int *v;
+        const char *name;
+    } one[] = {{&c->enable, "enable"}, {&c->pen, "pen"}, {&c->probe, "probe"}, {&c->estop, "estop"}};
+    for (unsigned k = 0; k < sizeof one / sizeof one[0]; k++)
+        if (one[k].v != self && *one[k].v == off)
+            return one[k].name;
     return NULL;
 }
 
@@ -128,6 +144,34 @@ static bool us_to_ns(const char *v, double lo, double hi, uint32_t *ns)
         return false;
     *ns = (uint32_t)llround(d * 1000.0);
     return true;
+}
+
+/* The line-offset field that key `name` sets, or NULL when it is not a line key. */
+static int *offset_slot(cs_gpio_cfg_t *c, const char *name)
+{
+    int *slot = NULL;
+    if (strcasecmp(name, "enable") == 0)
+        slot = &c->enable;
+    else if (strcasecmp(name, "pen") == 0)
+        slot = &c->pen;
+    else if (strcasecmp(name, "probe") == 0)
+        slot = &c->probe;
+    else if (strcasecmp(name, "estop") == 0)
+        slot = &c->estop;
+    for (unsigned i = 0; i < CS_AXES && slot == NULL; i++) {
+        size_t n = strlen(axis_names[i]);
+        if (strncasecmp(name, axis_names[i], n) == 0 && name[n] == '_') {
+            if (strcasecmp(name + n + 1, "step") == 0)
+                slot = &c->step[i];
+            else if (strcasecmp(name + n + 1, "dir") == 0)
+                slot = &c->dir[i];
+            else if (strcasecmp(name + n + 1, "min") == 0)
+                slot = &c->lim_min[i];
+            else if (strcasecmp(name + n + 1, "max") == 0)
+                slot = &c->lim_max[i];
+        }
+    }
+    return slot;
 }
 
 static int handler(void *user, const char *section, const char *name, const char *value)
@@ -143,20 +187,7 @@ static int handler(void *user, const char *section, const char *name, const char
         cs_gpio_cfg_chip_name(value, c->chip, sizeof c->chip);
         return 1;
     }
-    int *slot = NULL;
-    if (strcasecmp(name, "enable") == 0)
-        slot = &c->enable;
-    else if (strcasecmp(name, "pen") == 0)
-        slot = &c->pen;
-    for (unsigned i = 0; i < CS_AXES && slot == NULL; i++) {
-        size_t n = strlen(axis_names[i]);
-        if (strncasecmp(name, axis_names[i], n) == 0 && name[n] == '_') {
-            if (strcasecmp(name + n + 1, "step") == 0)
-                slot = &c->step[i];
-            else if (strcasecmp(name + n + 1, "dir") == 0)
-                slot = &c->dir[i];
-        }
-    }
+    int *slot = offset_slot(c, name);
     if (slot) {
         double d;
         if (strcasecmp(value, "none") == 0) {
@@ -173,14 +204,23 @@ static int handler(void *user, const char *section, const char *name, const char
         *slot = (int)d;
         return 1;
     }
-    if (strcasecmp(name, "step_active_low") == 0 || strcasecmp(name, "enable_active_low") == 0) {
+    bool *flag = strcasecmp(name, "step_active_low") == 0     ? &c->step_active_low
+                 : strcasecmp(name, "enable_active_low") == 0 ? &c->enable_active_low
+                 : strcasecmp(name, "limit_active_low") == 0  ? &c->limit_active_low
+                 : strcasecmp(name, "probe_active_low") == 0  ? &c->probe_active_low
+                 : strcasecmp(name, "estop_active_low") == 0  ? &c->estop_active_low
+                                                              : NULL;
+    if (flag) {
         int b = parse_bool(value);
         if (b < 0)
             return fail(x, "[gpio] %s: expected true or false", name);
-        if (tolower((unsigned char)name[0]) == 's')
-            c->step_active_low = b == 1;
-        else
-            c->enable_active_low = b == 1;
+        *flag = b == 1;
+        return 1;
+    }
+    if (strcasecmp(name, "state") == 0) {
+        if (value[0] == '\0' || strlen(value) >= sizeof c->state)
+            return fail(x, "[gpio] state: expected a file path (< %zu chars)", sizeof c->state);
+        snprintf(c->state, sizeof c->state, "%s", value);
         return 1;
     }
     if (strcasecmp(name, "pulse_us") == 0) {
@@ -206,7 +246,9 @@ static int handler(void *user, const char *section, const char *name, const char
         return fail(x,
                     "[gpio] %s: unknown key (expected chip, x_step, x_dir, y_step, y_dir, z_step, "
                     "z_dir, a_step, a_dir, enable, pen, step_active_low, enable_active_low, pulse_us, "
-                    "dir_setup_us, enable_ms, spin_us or rt_priority)",
+                    "dir_setup_us, enable_ms, spin_us, rt_priority, x_min, x_max, y_min, y_max, "
+                    "z_min, z_max, a_min, a_max, probe, estop, limit_active_low, "
+                    "probe_active_low, estop_active_low or state)",
                     name);
     }
     return 1;
@@ -229,6 +271,11 @@ static int finish(ctx_t *x, int rc, const char *name, char *err, size_t errlen)
         if ((c->step[i] >= 0) != (c->dir[i] >= 0)) {
             snprintf(err, errlen, "%s:0: [gpio] %s_step and %s_dir go together (one is missing)",
                      name, axis_names[i], axis_names[i]);
+            return -1;
+        }
+        if ((c->lim_min[i] >= 0 || c->lim_max[i] >= 0) && i >= m->n_axes) {
+            snprintf(err, errlen, "%s:0: [gpio] %s_%s: the machine has no %s axis", name,
+                     axis_names[i], c->lim_min[i] >= 0 ? "min" : "max", axis_names[i]);
             return -1;
         }
         if (c->step[i] >= 0 && i >= m->n_axes) {

@@ -28,6 +28,15 @@ typedef struct {
     uint32_t enable_ns;     /* from ENABLE asserted to the first step, ns (default 10 ms) */
     uint32_t spin_ns;       /* sleep until this long before an edge, then spin (default 100 us) */
     int rt_priority;        /* SCHED_FIFO priority of the step thread, 1..99; 0 = do not ask */
+    /* inputs (read with line events: cs_gpio_in), bits as CS_PROTO_IN_* */
+    int lim_min[CS_AXES];   /* x_min ..: the switch at each axis's minimum end, -1 = none */
+    int lim_max[CS_AXES];   /* x_max ..: at its maximum end */
+    int probe;              /* the probe input, -1 = none */
+    int estop;              /* the e-stop input, -1 = none */
+    bool limit_active_low;  /* limit switches read active low (default true: to ground, pull-up) */
+    bool probe_active_low;  /* the probe likewise (default true) */
+    bool estop_active_low;  /* the e-stop likewise (default true) */
+    char state[256];        /* state = PATH: alarm and position between commands ("" = default) */
 } cs_gpio_cfg_t;
 
 /* The defaults for machine *m: nothing wired, no chip, STEP active high, ENABLE active low,
@@ -43,6 +52,8 @@ int cs_gpio_cfg_load(const char *path, const cs_machine_t *m, cs_gpio_cfg_t *c, 
 /* Same, from a string (`name` used in messages). */
 int cs_gpio_cfg_parse(const char *text, const char *name, const cs_machine_t *m, cs_gpio_cfg_t *c,
                       char *err, size_t errlen);
+/* True when any input line (limit switch, probe, e-stop) is wired. */
+bool cs_gpio_cfg_has_inputs(const cs_gpio_cfg_t *c);
 /* True when axis i has both its STEP and DIR lines. */
 bool cs_gpio_cfg_wired(const cs_gpio_cfg_t *c, unsigned axis);
 /* The chip name as libgpiod 1.6 spells it, from what a user may type: "gpiochip0",

@@ -12,11 +12,8 @@
 #include <unistd.h>
 
 #include "cs_cmd.h"
-#include "cs_gpio_cfg.h"
-#include "cs_gpio_io.h"
-#include "cs_gpio_pwm.h"
-#include "cs_gpio_run.h"
-#include "cs_joblink.h"
+#include "cs_gpio_link.h"
+#include "cs_proto.h"
 #include "cs_stream_cmd.h"
 #include "cs_stream_report.h"
 
@@ -111,28 +108,7 @@ static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
         fprintf(stderr, "curvestep: note: memory not locked (AddressSanitizer build)\n");
 }
 
-/* The link's state between open and close. */
-typedef struct {
-    const cs_machine_t *m;
-    const char *record; /* record:FILE: the file; NULL: a chip */
-    cs_gpio_cfg_t cfg;
-    cs_gpio_lines_t lines;
-    cs_gpio_run_opts_t ro;
-    cs_gpio_io_t io;
-    bool io_open;
-    cs_segment_t *own;           /* segments taken from the job's messages (the daemon) */
-    cs_motion_pen_t *own_pens;   /* and their pen events */
-    const cs_motion_pen_t *pens; /* servo pen events ([pen] mode = servo): cs_gpio_pwm */
-    size_t npens;
-    cs_gpio_io_t pio; /* the pen's line, its own request */
-    bool pio_open;
-    cs_gpio_pwm_t pw;
-    const cs_segment_t *segs;
-    size_t nsegs, first;
-    uint64_t ticks; /* the job's planned time from segment `first` on, executor ticks */
-    cs_gpio_run_t run;
-    double wall;
-} gpio_link_t;
+typedef cs_gpio_link_t gpio_link_t;
 
 /* Steps the job makes on each axis (from segment `first` on). */
 static void job_steps(const gpio_link_t *g, uint64_t *steps)
@@ -318,6 +294,71 @@ static int open_pen(cs_joblink_t *l, gpio_link_t *g)
     return CS_EXIT_OK;
 }
 
+/* The inputs (a chip's lines, or the recorder's simulated switches, probe and e-stop file) and
+ * the state kept between commands; an alarm refuses a job unless `ctl` (the control commands
+ * decide themselves). */
+static int open_inputs(cs_joblink_t *l, gpio_link_t *g, bool ctl)
+{
+    cs_ctlcfg_default(&g->ctl);
+    if (l->cfg.machine_file &&
+        cs_ctlcfg_load(l->cfg.machine_file, g->m, &g->ctl, l->why, sizeof l->why) != 0)
+        return CS_EXIT_INPUT;
+    if (g->record) {
+        char estop[400];
+        snprintf(estop, sizeof estop, "%s.estop", g->record);
+        cs_gpio_in_open_sim(&g->in, g->m, &g->ctl, NULL, estop);
+    } else if (cs_gpio_in_open_chip(&g->in, g->io.chip, l->cfg.gpio, &g->cfg, l->why,
+                                    sizeof l->why) != 0) {
+        return CS_EXIT_NO_DEVICE;
+    }
+    g->in_open = true;
+    g->has_in = cs_gpio_in_any(&g->in);
+    if (!g->has_in)
+        return CS_EXIT_OK; /* nothing can trip: no state to keep */
+    if (cs_gpio_state_path(g->cfg.state, g->record, l->cfg.gpio, g->state_path,
+                           sizeof g->state_path) != 0) {
+        snprintf(l->why, sizeof l->why,
+                 "%s:0: [gpio] state: no XDG_RUNTIME_DIR or HOME for the GPIO state file: give "
+                 "state = PATH (docs/gpio.md, \"Inputs\")",
+                 l->cfg.machine_file ? l->cfg.machine_file : "the built-in machine");
+        return CS_EXIT_INPUT;
+    }
+    if (cs_gpio_state_load(g->state_path, &g->st, l->why, sizeof l->why) != 0)
+        return CS_EXIT_INPUT;
+    g->st_loaded = true;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        g->in.off[i] = g->st.off[i];
+    if (g->st.alarm && !ctl) {
+        snprintf(l->why, sizeof l->why,
+                 "the machine is in alarm (ALARM:%u, %s; %s): motion is refused until `curvestep "
+                 "unlock --gpio %s` (or `curvestep home --gpio %s`) clears it",
+                 (unsigned)g->st.alarm, cs_ctlcfg_alarm_text(g->st.alarm), g->state_path,
+                 l->cfg.gpio, l->cfg.gpio);
+        return CS_EXIT_DEV_ERROR;
+    }
+    return CS_EXIT_OK;
+}
+
+/* The output lines for a job moving steps[] (a chip, or a recorder with room for cap set calls),
+ * then the inputs. */
+static int open_lines(cs_joblink_t *l, gpio_link_t *g, const uint64_t *steps, size_t cap, bool ctl)
+{
+    bool any;
+    int rc = CS_EXIT_OK;
+    int unwired = wire_lines(g, steps, &any);
+    if (!g->record) {
+        rc = open_chip(l, g, steps, unwired, any);
+    } else if (cs_gpio_io_open_recorder(&g->io, &g->lines, cap) != 0) {
+        snprintf(l->why, sizeof l->why, "--gpio record: out of memory");
+        rc = CS_EXIT_INTERNAL;
+    } else {
+        g->io_open = true;
+    }
+    if (rc == CS_EXIT_OK)
+        rc = open_inputs(l, g, ctl);
+    return rc;
+}
+
 static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
 {
     gpio_link_t *g = gpio_new(l, j->m);
@@ -331,23 +372,33 @@ static int gpio_open(cs_joblink_t *l, const cs_joblink_job_t *j)
         return rc;
     uint64_t steps[CS_AXES];
     job_steps(g, steps);
-    bool any;
-    int unwired = wire_lines(g, steps, &any);
-    if (!g->record) {
-        rc = open_chip(l, g, steps, unwired, any);
-    } else if (cs_gpio_io_open_recorder(
-                   &g->io, &g->lines,
-                   cs_gpio_run_record_capacity(g->segs + g->first, g->nsegs - g->first)) != 0) {
-        snprintf(l->why, sizeof l->why, "--gpio record: out of memory");
-        rc = CS_EXIT_INTERNAL;
-    } else {
-        g->io_open = true;
-    }
+    rc = open_lines(l, g, steps,
+                    cs_gpio_run_record_capacity(g->segs + g->first, g->nsegs - g->first), false);
     if (rc == CS_EXIT_OK && g->npens > 0) /* the pen servo: its own line and thread */
         rc = open_pen(l, g);
     if (rc == CS_EXIT_OK)
         say_lines(l, g);
     return rc;
+}
+
+int cs_gpio_link_open_ctl(cs_joblink_t *l, const cs_machine_t *m, unsigned axes, size_t record_cap)
+{
+    gpio_link_t *g = gpio_new(l, m);
+    if (g == NULL)
+        return CS_EXIT_INTERNAL;
+    l->gpio = g;
+    int rc = gpio_config(l, g, NULL);
+    if (rc != CS_EXIT_OK)
+        return rc;
+    uint64_t steps[CS_AXES];
+    for (unsigned i = 0; i < CS_AXES; i++)
+        steps[i] = i < m->n_axes && (axes >> i & 1u) ? 1 : 0; /* the axes the command moves */
+    return open_lines(l, g, steps, record_cap, true);
+}
+
+cs_gpio_link_t *cs_gpio_link_of(cs_joblink_t *l)
+{
+    return l->gpio;
 }
 
 /* The calling thread while the step thread runs: the interrupt (1: hold then end, 2: stop at
@@ -376,10 +427,25 @@ static void gpio_watch(gpio_link_t *g, const cs_joblink_ctl_t *c, progress_t *pg
             cs_stream_progress_held(c->progress, cs_gpio_run_executed(r), g->nsegs, "segments");
             told = true;
         }
+        if (g->in_open)
+            cs_gpio_in_poll(&g->in); /* the recorder's e-stop file */
         progress(pg, g->segs, g->nsegs, g->ticks, g->m->tick_hz, r, false);
         struct timespec ts = {0, 20000000};
         nanosleep(&ts, NULL);
     }
+}
+
+/* "ALARM:1 (hard limit: ...), inputs 0x010, stopped at X Y Z mm" */
+static void alarm_line(const gpio_link_t *g, char *out, size_t len)
+{
+    const cs_gpio_run_t *r = &g->run;
+    int n = snprintf(out, len, "ALARM:%u (%s), inputs 0x%03x, stopped at", (unsigned)r->trip_code,
+                     cs_ctlcfg_alarm_text(r->trip_code), (unsigned)r->trip_inputs);
+    for (unsigned i = 0; i < g->m->n_axes && n > 0 && (size_t)n < len; i++)
+        n += snprintf(out + n, len - (size_t)n, " %.4f",
+                      g->st.pos[i] * (double)CS_MOTION_ONE / g->m->axis[i].steps_per_mm);
+    if (n > 0 && (size_t)n < len)
+        snprintf(out + n, len - (size_t)n, " mm");
 }
 
 /* The step thread's outcome as every link's result. */
@@ -409,6 +475,15 @@ static void gpio_result(const gpio_link_t *g, const cs_joblink_job_t *j, cs_stre
         r->what = "interrupted: stopped at once, mid-segment (STEP low, ENABLE off)";
         r->mid_message = true;
         break;
+    case CS_GPIO_RUN_TRIPPED: /* as the device: an ERROR about the segment cut, exit 7 */
+        r->outcome = CS_STREAM_DEVICE_ERROR;
+        r->what = "the machine raised an alarm";
+        r->dev_error.code =
+            (uint8_t)(run->trip_code == CS_PROTO_ALARM_ESTOP ? CS_ERR_STATE : CS_ERR_LIMIT);
+        r->dev_error_msg = r->executed + 1;
+        r->mid_message = true;
+        alarm_line(g, r->why, sizeof r->why);
+        break;
     case CS_GPIO_RUN_BAD_SEGMENT:
         r->outcome = CS_STREAM_DEVICE_ERROR;
         r->what = "the executor refused a segment";
@@ -424,6 +499,32 @@ static void gpio_result(const gpio_link_t *g, const cs_joblink_job_t *j, cs_stre
     }
 }
 
+/* The step thread's inputs: the link's, with the bits an operation waits for. */
+static void inputs_opts(gpio_link_t *g, uint16_t watch, uint16_t release, bool hard_limits)
+{
+    cs_gpio_run_opts_t *ro = &g->ro;
+    ro->in = g->has_in ? &g->in : NULL;
+    ro->watch = watch;
+    ro->release = release;
+    ro->hard_limits = hard_limits;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        ro->start_pos[i] = g->st.pos[i];
+}
+
+/* After a run: the machine position follows the steps on the lines; a trip other than the
+ * operation's own input is the alarm (kept in the state file until unlock or homing). */
+static void after_run(gpio_link_t *g)
+{
+    const cs_gpio_run_t *r = &g->run;
+    if (g->t0_first == 0)
+        g->t0_first = r->t0_ns;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        g->st.pos[i] += r->pos[i];
+    g->st.inputs = r->inputs;
+    if (r->outcome == CS_GPIO_RUN_TRIPPED && r->trip_code != 0)
+        g->st.alarm = r->trip_code;
+}
+
 static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_joblink_ctl_t *c,
                          cs_stream_result_t *r)
 {
@@ -436,6 +537,7 @@ static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_jo
     ro->nsegs = g->nsegs;
     ro->first = g->first;
     ro->realtime = true;
+    inputs_opts(g, 0, 0, true);
     int rc = cs_gpio_run_start(&g->run, ro);
     if (rc != 0) {
         fprintf(stderr, "curvestep: cannot start the step thread: %s\n", strerror(rc));
@@ -457,12 +559,42 @@ static cs_err_t gpio_run(cs_joblink_t *l, const cs_joblink_job_t *j, const cs_jo
     pg.first = g->first;
     gpio_watch(g, c, &pg);
     cs_gpio_run_join(&g->run);
+    after_run(g);
     if (g->npens > 0)
         cs_gpio_pwm_stop(&g->pw); /* the last width out a few times, the line low */
     progress(&pg, g->segs, g->nsegs, g->ticks, g->m->tick_hz, &g->run, true);
     g->wall = now_s() - t_start;
     gpio_result(g, j, r);
     return CS_OK;
+}
+
+int cs_gpio_link_move(cs_joblink_t *l, const cs_segment_t *segs, size_t n, uint16_t watch,
+                      uint16_t release, bool hard_limits, volatile sig_atomic_t *interrupt)
+{
+    gpio_link_t *g = l->gpio;
+    cs_gpio_run_opts_t *ro = &g->ro;
+    ro->m = g->m;
+    ro->cfg = &g->cfg;
+    ro->io = &g->io;
+    ro->segs = g->segs = segs;
+    ro->nsegs = g->nsegs = n;
+    ro->first = g->first = 0;
+    ro->realtime = true;
+    inputs_opts(g, watch, release, hard_limits);
+    int rc = cs_gpio_run_start(&g->run, ro);
+    if (rc != 0)
+        return rc;
+    warn_rt(&g->run, &g->cfg);
+    while (!cs_gpio_run_finished(&g->run)) {
+        if (interrupt != NULL && *interrupt > 0)
+            cs_gpio_run_hold(&g->run, 2);
+        cs_gpio_in_poll(&g->in);
+        struct timespec ts = {0, 5000000};
+        nanosleep(&ts, NULL);
+    }
+    cs_gpio_run_join(&g->run);
+    after_run(g);
+    return 0;
 }
 
 /* "stream: S steps (x .., y ..) in T s (job time ..); STEP edges late by: ..." and, after a stop
@@ -497,9 +629,9 @@ static int write_record(const gpio_link_t *g)
     char hdr[200];
     snprintf(hdr, sizeof hdr, "tick_hz=%u pulse_ns=%u dir_setup_ns=%u t0=tick0",
              (unsigned)g->m->tick_hz, (unsigned)g->cfg.pulse_ns, (unsigned)g->cfg.dir_setup_ns);
-    int wr = f ? cs_gpio_io_write_record(&g->io, f, g->run.t0_ns, hdr) : -1;
+    int wr = f ? cs_gpio_io_write_record(&g->io, f, g->t0_first, hdr) : -1;
     if (wr == 0 && g->pio_open) /* the pen's line after the others, its own header line */
-        wr = cs_gpio_io_write_record(&g->pio, f, g->run.t0_ns, "pen servo: software PWM, 50 Hz");
+        wr = cs_gpio_io_write_record(&g->pio, f, g->t0_first, "pen servo: software PWM, 50 Hz");
     if (f && fclose(f) != 0)
         wr = -1;
     if (wr != 0) {
@@ -521,9 +653,17 @@ static int gpio_close(cs_joblink_t *l, int rc)
         return rc;
     if (g->pio_open)
         cs_gpio_io_close(&g->pio);
+    if (g->in_open)
+        cs_gpio_in_close(&g->in); /* before the outputs: they own the chip */
+    if (g->st_loaded && cs_gpio_state_save(g->state_path, &g->st) != 0) {
+        fprintf(stderr, "curvestep: cannot write the GPIO state %s: %s\n", g->state_path,
+                strerror(errno));
+        if (rc == CS_EXIT_OK)
+            rc = CS_EXIT_INTERNAL;
+    }
     if (g->io_open) {
         cs_gpio_io_close(&g->io);
-        if (g->record && g->run.t0_ns != 0) {
+        if (g->record && g->t0_first != 0) {
             int wrc = write_record(g);
             if (rc == CS_EXIT_OK)
                 rc = wrc;

@@ -6,6 +6,7 @@
 #include "cs_gpio_run.h"
 
 #include "cs_hold.h"
+#include "cs_proto.h"
 
 #include <errno.h>
 #include <sched.h>
@@ -42,7 +43,12 @@ static int load_hold(const cs_gpio_run_t *r)
 /* True when the run is asked to stop at once (a cancel): ends a wait early. */
 static bool stop_now(const void *ctx)
 {
-    return load_hold((const cs_gpio_run_t *)ctx) >= 2;
+    const cs_gpio_run_t *r = ctx;
+    /* the e-stop ends a long wait too (a dwell, a slow axis): seen within one sleep slice */
+    const cs_gpio_in_t *in = r->o.in;
+    if (in != NULL && (__atomic_load_n(&in->bits, __ATOMIC_ACQUIRE) & CS_PROTO_IN_ESTOP))
+        return true;
+    return load_hold(r) >= 2;
 }
 
 /* Waits until CLOCK_MONOTONIC reaches t. false when asked to stop at once meanwhile. */
@@ -109,7 +115,45 @@ typedef struct {
     int64_t shift;                  /* ns added to the plan by pauses */
     bool unsent;                    /* stopped with a call's steps computed, not on lines */
     int32_t unsent_pos[CS_AXES];    /* the executor's position without them */
+    uint16_t in_prev;               /* the input bits last read */
 } stepper_run_t;
+
+/* The inputs with the lines at executor position pos: true (and the outcome TRIPPED) when the
+ * e-stop is active, an input the operation watches changed as it waits for, or a limit switch
+ * became active with hard limits on -- the device's rule (cs_fw_ctl_inputs_isr), in the same
+ * order. */
+static bool inputs_trip(stepper_run_t *s, const int32_t pos[CS_AXES])
+{
+    const cs_gpio_run_opts_t *o = s->o;
+    if (o->in == NULL)
+        return false;
+    int32_t p[CS_AXES];
+    for (unsigned i = 0; i < CS_AXES; i++)
+        p[i] = o->start_pos[i] + pos[i];
+    uint16_t b = cs_gpio_in_read(o->in, p);
+    uint16_t on = (uint16_t)(b & ~s->in_prev), off = (uint16_t)(s->in_prev & ~b);
+    s->in_prev = b;
+    s->r->inputs = b;
+    int code = -1;
+    if (b & CS_PROTO_IN_ESTOP)
+        code = CS_PROTO_ALARM_ESTOP;
+    else if ((b & o->watch) || (off & o->release))
+        code = 0;
+    else if (o->hard_limits && (on & CS_PROTO_IN_LIMITS))
+        code = CS_PROTO_ALARM_HARD_LIMIT;
+    if (code < 0)
+        return false;
+    s->r->trip_code = (uint8_t)code;
+    s->r->trip_inputs = b;
+    s->oc = CS_GPIO_RUN_TRIPPED;
+    return true;
+}
+
+static void exec_pos(const stepper_run_t *s, int32_t pos[CS_AXES])
+{
+    for (unsigned i = 0; i < CS_AXES; i++)
+        pos[i] = cs_stepper_position(s->st, i);
+}
 
 /* Pushes segment s->next (after the hold's admission) into the executor. false when the
  * executor refused it (BAD_SEGMENT) or the hold keeps it back. */
@@ -153,6 +197,12 @@ static void step_begin(stepper_run_t *s)
         s->ok = cs_gpio_io_set(s->io, s->en, s->en, cs_gpio_io_now_ns(), &t) == 0;
     s->next = o->first;
     s->oc = CS_GPIO_RUN_DONE;
+    if (o->in != NULL) { /* the levels at the start: a switch already pressed is no new edge */
+        int32_t p[CS_AXES];
+        for (unsigned i = 0; i < CS_AXES; i++)
+            p[i] = o->start_pos[i];
+        s->in_prev = cs_gpio_in_read(o->in, p) & (uint16_t)~CS_PROTO_IN_ESTOP;
+    }
     if (s->ok && s->next < o->nsegs)
         (void)feed_next(s, false);
     cs_stepper_tick(s->st, &s->out);
@@ -174,8 +224,12 @@ static bool emit_steps(stepper_run_t *s, const int32_t before[CS_AXES])
     cs_gpio_run_t *r = s->r;
     uint32_t lines = step_lines(s->o, s->out.step_mask);
     int64_t at = s->planned > s->t_dir + s->setup ? s->planned : s->t_dir + s->setup;
-    if (!wait_until(r, at, s->spin)) {
-        s->oc = CS_GPIO_RUN_STOPPED;
+    bool waited = wait_until(r, at, s->spin);
+    /* the inputs read after the wait (an edge while waiting, or the e-stop that ended it) */
+    bool tripped = inputs_trip(s, before);
+    if (!waited || tripped) { /* stopped or tripped: this call's steps are not made */
+        if (!tripped)
+            s->oc = CS_GPIO_RUN_STOPPED;
         s->unsent = true;
         for (unsigned i = 0; i < CS_AXES; i++)
             s->unsent_pos[i] = before[i];
@@ -205,7 +259,10 @@ static bool emit_dir(stepper_run_t *s)
     if (want == s->dir)
         return true;
     if (!s->out.step_mask && !wait_until(s->r, s->planned, s->spin)) {
-        s->oc = CS_GPIO_RUN_STOPPED;
+        int32_t pos[CS_AXES];
+        exec_pos(s, pos);
+        if (!inputs_trip(s, pos))
+            s->oc = CS_GPIO_RUN_STOPPED;
         return false;
     }
     int64_t at = s->out.step_mask ? s->planned + s->pulse : s->planned;
@@ -256,6 +313,10 @@ static bool pause_wait(stepper_run_t *s)
 static bool step_requests(stepper_run_t *s)
 {
     cs_gpio_run_t *r = s->r;
+    int32_t pos[CS_AXES];
+    exec_pos(s, pos);
+    if (inputs_trip(s, pos)) /* after the last call's steps: stop before the next */
+        return false;
     int h = load_hold(r);
     bool p = __atomic_load_n(&r->pause, __ATOMIC_ACQUIRE) != 0;
     if (s->out.next_ticks == 0) { /* the executor ran dry: the end, or a hold at rest */

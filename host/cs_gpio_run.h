@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include "cs_gpio_cfg.h"
+#include "cs_gpio_in.h"
 #include "cs_gpio_io.h"
 #include "cs_machine.h"
 #include "cs_segment.h"
@@ -35,6 +36,13 @@ typedef struct {
     size_t nsegs;
     size_t first;  /* segments 0..first-1 were executed already (--resume-from) */
     bool realtime; /* ask for SCHED_FIFO (cfg->rt_priority) and mlockall */
+    /* inputs (NULL: none), read after every call that stepped and just before every STEP rise:
+     * the e-stop active, an input of watch active, one of release inactive, or (hard_limits) a
+     * limit switch becoming active stops the steps there (TRIPPED) */
+    cs_gpio_in_t *in;
+    uint16_t watch, release; /* CS_PROTO_IN_* bits an operation waits for (homing, probe) */
+    bool hard_limits;
+    int32_t start_pos[CS_AXES]; /* machine position at the start, steps (the recorder's model) */
 } cs_gpio_run_opts_t;
 
 typedef enum {
@@ -43,6 +51,7 @@ typedef enum {
     CS_GPIO_RUN_STOPPED = 2,     /* stop at once (mid-segment) */
     CS_GPIO_RUN_IO_ERROR = 3,    /* a set call failed (io_errno) */
     CS_GPIO_RUN_BAD_SEGMENT = 4, /* the executor refused a segment (bad_segment) */
+    CS_GPIO_RUN_TRIPPED = 5,     /* an input stopped the steps at once (trip_code, trip_inputs) */
 } cs_gpio_run_outcome_t;
 
 typedef struct {
@@ -68,6 +77,9 @@ typedef struct {
     uint64_t ticks;     /* executor ticks run */
     uint64_t steps[CS_AXES];
     int32_t pos[CS_AXES]; /* executor position, steps (the steps on the lines) */
+    uint8_t trip_code;    /* TRIPPED: 0 the watched input, else the cs_proto_alarm_t */
+    uint16_t trip_inputs; /* TRIPPED: the input bits at the trip */
+    uint16_t inputs;      /* the input bits last read */
     uint64_t rises;       /* STEP rising edges (calls with a step) */
     int64_t late_max_ns;  /* largest lateness of a STEP rise after its planned time */
     double late_sum_ns;

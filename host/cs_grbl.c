@@ -120,7 +120,9 @@ static cs_err_t plan_chunk(grbl_t *g, cs_path_t *path, cs_grbl_item_t *it, cs_pa
     jp.read_ok = true;
     cs_stream_job_init(&it->job, CS_STREAM_SEGMENTS);
     cs_err_t e = cs_jobplan_plan(&jp, "grbl", &g->m, g->plan_pos, g->tol, CS_TRACE_SUBDIV, g->feed);
-    if (e == CS_OK)
+    if (e == CS_OK && g->ctl.laser)
+        e = cs_grbl_laser_job(g, &jp.mo.segs, &it->job);
+    else if (e == CS_OK)
         e = cs_stream_job_add_segments(&it->job, jp.mo.segs.v, jp.mo.segs.n);
     if (e == CS_OK)
         memcpy(g->plan_pos, jp.mo.pl.pos, sizeof g->plan_pos);
@@ -146,6 +148,9 @@ static void alarm_planner(grbl_t *g, const cs_path_diag_t *d)
  * executed; curvestep to what is not yet planned: a chunk already on the device keeps its feed). */
 static void apply_overrides(grbl_t *g, cs_path_t *path)
 {
+    for (size_t k = 0; g->ctl.laser && k < path->n; k++)
+        if (path->elems[k].rapid) /* a rapid slowed into a feed move keeps the laser off */
+            path->elems[k].spindle_s = 0;
     double rapid = INFINITY;
     for (int a = 0; a < 3 && a < g->m.n_axes; a++)
         rapid = fmin(rapid, g->m.axis[a].max_rate / 65536.0);
@@ -325,9 +330,16 @@ static void gcode_line(grbl_t *g, const char *line)
     cs_path_diag_t d;
     bool end;
     g->in_reader = true; /* a G38.x waits on the device inside the reader */
+    g->probe_failed = false;
     cs_err_t e = cs_grbl_gc_line(&g->gc, line, g->lineno, &lp, &d, &end);
     g->in_reader = false;
     bool ok = e == CS_OK;
+    if (!ok && g->probe_failed) {
+        cs_path_free(&lp); /* Grbl: ALARM:5 and [PRB:..:0] (said), then ok for the line */
+        drop_all(g);
+        cs_grbl_say(g, "ok");
+        return;
+    }
     if (!ok) {
         reply_error(g, &d);
     } else if (!inside_travel(g, &lp, 0)) {

@@ -109,6 +109,11 @@ cs_err_t cs_grbl_probe(void *ctx, int code, const double from[3], const double t
     /* Grbl reports every probe cycle: [PRB:x,y,z:ok], machine coordinates */
     memcpy(g->prb, hit, sizeof g->prb);
     g->prb_ok = *contact;
+    /* Grbl 1.1's mc_probe_cycle on no contact: the alarm (ALARM:5, from the realtime check) is
+     * reported first, then [PRB:..:0], then the line's own "ok" (gc_execute_line returns
+     * STATUS_OK; the alarm locks what follows): cs_grbl probe_failed answers ok for the line */
+    cs_grbl_watch_alarm(g);
+    g->probe_failed = !*contact && g->alarm;
     cs_grbl_say(g, "[PRB:%.3f,%.3f,%.3f:%d]", hit[0], hit[1], hit[2], *contact ? 1 : 0);
     return CS_OK;
 }
@@ -138,47 +143,51 @@ cs_err_t cs_grbl_spindle(void *ctx, int code, double s)
     grbl_t *g = ctx;
     if (g->check_mode)
         return CS_OK;
+    if (g->ctl.laser && code == g->sp_code && code != GC_M5) {
+        /* Grbl's laser mode: an S change takes effect with the next move, without a stop;
+         * the moves carry their S (cs_path_elem_t) into the plan's power marks */
+        g->sp_s = s;
+        return CS_OK;
+    }
+    /* M3/M4/M5 are synchronous, in laser mode too (Grbl's gc_execute_block: spindle_sync) */
     cs_grbl_flush(g); /* the moves before the change run with the state before it */
     g->sp_code = code;
     g->sp_s = s;
     if (g->ctl.laser && code != GC_M5)
-        return CS_OK; /* the power goes with each run of moves (cs_grbl_flush) */
+        return CS_OK; /* the power goes with the moves (cs_grbl_laser_job) */
     cs_proto_msg_t m = spindle_msg(g, code, s, false, 0);
     return cs_grbl_run_msgs(g, &m, 1, false) ? CS_OK : CS_ERR_STATE;
 }
 
 void cs_grbl_flush(grbl_t *g)
 {
-    cs_path_t *p = &g->pending;
-    if (!g->ctl.laser || g->sp_code == GC_M5 || p->n == 0) {
-        cs_grbl_queue_path(g, p);
-        return;
-    }
-    /* laser on: a run of moves with one rapid flag and one feed gets its own power */
+    cs_grbl_queue_path(g, &g->pending);
+}
+
+cs_err_t cs_grbl_laser_job(const grbl_t *g, const cs_motion_segs_t *sg, cs_stream_job_t *job)
+{
+    /* each power mark of the plan becomes a SPINDLE right before its first SEGMENT: the device
+     * takes it from the queue in order and sets it with that segment, without stopping
+     * (cs_fw_ctl_take: a laser SPINDLE that is not M5 is "live") */
     size_t k0 = 0;
-    bool ok = true;
-    while (k0 < p->n && ok) {
-        size_t k1 = k0 + 1;
-        while (k1 < p->n && p->elems[k1].rapid == p->elems[k0].rapid &&
-               p->elems[k1].feed_mm_s == p->elems[k0].feed_mm_s)
-            k1++;
-        cs_path_t run;
-        cs_path_init(&run);
-        ok = cs_path_grow((void **)&run.elems, &run.cap, k1 - k0, sizeof *run.elems);
-        if (ok) {
-            memcpy(run.elems, p->elems + k0, (k1 - k0) * sizeof *run.elems);
-            run.n = k1 - k0;
-            run.blend_tol_mm = p->blend_tol_mm;
-            double feed = p->elems[k0].feed_mm_s > 0 ? p->elems[k0].feed_mm_s
-                                                     : (g->feed > 0 ? g->feed : g->m.default_feed) /
-                                                           65536.0;
-            cs_proto_msg_t m = spindle_msg(g, g->sp_code, g->sp_s, p->elems[k0].rapid, feed);
-            ok = cs_grbl_run_msgs(g, &m, 1, false) && cs_grbl_queue_path(g, &run);
-        }
-        cs_path_free(&run);
-        k0 = k1;
+    cs_err_t e = CS_OK;
+    for (size_t p = 0; p <= sg->npowers && e == CS_OK; p++) {
+        size_t k1 = p < sg->npowers ? sg->powers[p].seg : sg->n;
+        if (k1 > k0)
+            e = cs_stream_job_add_segments(job, sg->v + k0, k1 - k0);
+        k0 = k1 > k0 ? k1 : k0;
+        if (e != CS_OK || p == sg->npowers)
+            continue;
+        const cs_motion_power_t *pw = &sg->powers[p];
+        if (pw->spindle != 3 && pw->spindle != 4)
+            continue; /* M5 moves: the synchronous M5 before them turned it off */
+        double feed = pw->feed_mm_s > 0 ? pw->feed_mm_s
+                                        : (g->feed > 0 ? g->feed : g->m.default_feed) / 65536.0;
+        cs_proto_msg_t m = spindle_msg(g, pw->spindle == 4 ? GC_M4 : GC_M3, pw->s, pw->rapid,
+                                       feed);
+        e = cs_stream_job_add_msg(job, &m);
     }
-    p->n = 0;
+    return e;
 }
 
 void cs_grbl_pins(const grbl_t *g, const cs_grbl_dev_snap_t *s, char *out, size_t cap)

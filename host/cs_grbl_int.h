@@ -13,7 +13,9 @@
 #include "cs_grbl_dev.h"
 #include "cs_grbl_gc.h"
 #include "cs_grbl_ov.h"
+#include "cs_motion.h"
 #include "cs_serial.h"
+#include "cs_stream.h"
 
 /* Grbl 1.1 error codes we answer (grbl wiki, "Interface", error codes). */
 enum {
@@ -69,6 +71,7 @@ typedef struct {
     double sp_s;             /* ... and its S */
     bool in_reader;          /* a line is being read (a probe may be waiting on the device) */
     bool reset_pending;      /* Ctrl-X came meanwhile: the reset follows the line */
+    bool probe_failed;       /* the line's G38.2/.4 ended in ALARM:5: its answer is ok */
 } grbl_t;
 
 /* Writes a line + "\r\n" to the client; a client that does not read loses it (never blocks). */
@@ -95,9 +98,13 @@ cs_err_t cs_grbl_probe(void *ctx, int code, const double from[3], const double t
                        double feed_mm_s, bool *contact, double hit[3]);
 /* The reader's M3/M4/M5 and S (cs_gcode_spindle_fn; ctx is the grbl_t). */
 cs_err_t cs_grbl_spindle(void *ctx, int code, double s);
-/* Queues the pending moves: with a laser on ([spindle] laser = true), split where the power
- * changes (off in rapids, the F of each feed run for M4) with a SPINDLE message before each. */
+/* Queues the pending moves as one chunk (laser mode: cs_grbl_laser_job). */
 void cs_grbl_flush(grbl_t *g);
+/* Laser mode ([spindle] laser = true): the plan's segments into job with a live SPINDLE before
+ * the first segment of each power mark (off in rapids, S with the spindle override, M4's full
+ * power at the moves' F), so power changes never stop the motion. CS_ERR_FULL / _RANGE as
+ * cs_stream_job_add_segments. */
+cs_err_t cs_grbl_laser_job(const grbl_t *g, const cs_motion_segs_t *sg, cs_stream_job_t *job);
 /* "|Pn:XYZP" from the device's last inputs ("" when none is active). */
 void cs_grbl_pins(const grbl_t *g, const cs_grbl_dev_snap_t *s, char *out, size_t cap);
 /* The device raised an alarm since the last call: ALARM:N said, everything dropped. */

@@ -25,12 +25,44 @@ void cs_motion_segs_free(cs_motion_segs_t *s)
 {
     free(s->v);
     free(s->pens);
+    free(s->powers);
     memset(s, 0, sizeof *s);
 }
 
 void cs_motion_free(cs_motion_t *mo)
 {
     cs_motion_segs_free(&mo->segs);
+    free(mo->pend);
+    mo->pend = NULL;
+    mo->npend = mo->cappend = mo->pend0 = 0;
+}
+
+cs_err_t cs_motion_power(cs_motion_t *mo, const cs_motion_power_t *p)
+{
+    void *b = mo->pend;
+    if (!cs_path_grow(&b, &mo->cappend, mo->npend + 1, sizeof *mo->pend))
+        return CS_ERR_FULL;
+    mo->pend = b;
+    mo->pend[mo->npend] = *p;
+    mo->pend[mo->npend++].seg = mo->blocks; /* the number of the next block queued */
+    return CS_OK;
+}
+
+/* The marks whose block is the next one cut (or every one, all) go to segs.powers, at the next
+ * segment. */
+static cs_err_t land_powers(cs_motion_t *mo, bool all)
+{
+    cs_motion_segs_t *v = &mo->segs;
+    for (; mo->pend0 < mo->npend && (all || mo->pend[mo->pend0].seg <= mo->blocks_cut);
+         mo->pend0++) {
+        void *b = v->powers;
+        if (!cs_path_grow(&b, &v->cappowers, v->npowers + 1, sizeof *v->powers))
+            return CS_ERR_FULL;
+        v->powers = b;
+        v->powers[v->npowers] = mo->pend[mo->pend0];
+        v->powers[v->npowers++].seg = v->n;
+    }
+    return CS_OK;
 }
 
 /* Records a pen event before segment seg. */
@@ -73,6 +105,10 @@ static cs_err_t push(cs_motion_t *mo, const cs_segment_t *s)
 static cs_err_t cut_one_block(cs_motion_t *mo)
 {
     cs_segment_t s;
+    cs_err_t le = land_powers(mo, false);
+    if (le != CS_OK)
+        return le;
+    mo->blocks_cut++;
     do {
         cs_err_t e = cs_segment_next(&mo->gen, &mo->pl, &s);
         if (e != CS_OK)
@@ -140,7 +176,7 @@ cs_err_t cs_motion_finish(cs_motion_t *mo)
         if (e != CS_OK)
             return e;
     }
-    return CS_OK;
+    return land_powers(mo, true); /* marks after the last move: at the end */
 }
 
 static void write_seg(FILE *f, const cs_machine_t *m, const cs_segment_t *s)
@@ -161,17 +197,43 @@ int cs_motion_write(FILE *f, const cs_machine_t *m, const cs_segment_t *s, size_
     return ferror(f) ? -1 : 0;
 }
 
+bool cs_motion_spindle_used(const cs_motion_segs_t *s)
+{
+    for (size_t q = 0; q < s->npowers; q++)
+        if (s->powers[q].spindle == 3 || s->powers[q].spindle == 4)
+            return true;
+    return false;
+}
+
+/* The power marks before segment k (all: every one left) as comment lines. */
+static void write_powers(FILE *f, const cs_motion_segs_t *s, size_t *q, size_t k, bool all)
+{
+    for (; *q < s->npowers && (all || s->powers[*q].seg == k); (*q)++) {
+        const cs_motion_power_t *p = &s->powers[*q];
+        if (p->spindle == 5)
+            fprintf(f, "# spindle M5\n");
+        else if (p->rapid)
+            fprintf(f, "# spindle M%u S%g rapid\n", (unsigned)p->spindle, p->s);
+        else
+            fprintf(f, "# spindle M%u S%g F%.3f\n", (unsigned)p->spindle, p->s, p->feed_mm_s);
+    }
+}
+
 int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s)
 {
     cs_motion_write(f, m, s->v, 0); /* the header */
-    size_t p = 0;
+    size_t p = 0, q = s->npowers;
+    if (cs_motion_spindle_used(s))
+        q = 0; /* a job that never turns a spindle on says nothing about it */
     for (size_t k = 0; k < s->n; k++) {
         for (; p < s->npens && s->pens[p].seg == k; p++)
             fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
+        write_powers(f, s, &q, k, false);
         write_seg(f, m, &s->v[k]);
     }
     for (; p < s->npens; p++)
         fprintf(f, "pen %u\n", (unsigned)s->pens[p].pulse_us);
+    write_powers(f, s, &q, s->n, true);
     return ferror(f) ? -1 : 0;
 }
 
@@ -344,6 +406,24 @@ static cs_err_t servo_before(cs_motion_t *mo, const cs_path_t *path, size_t k, b
     return e != CS_OK ? cs_path_diag_set(diag, e, el->loc, "pen event: %s", cs_err_text(e)) : e;
 }
 
+/* A power mark before element el's moves (travel: before the rapid travel to its start) when
+ * the input gave a spindle state and it differs from *last. */
+static cs_err_t mark_power(cs_motion_t *mo, const cs_path_elem_t *el, bool travel,
+                           int32_t el_feed, cs_motion_power_t *last, cs_path_diag_t *diag)
+{
+    if (el->spindle == 0)
+        return CS_OK;
+    cs_motion_power_t p = {0, el->spindle, travel || el->rapid, el->spindle_s,
+                           travel || el->rapid ? 0.0 : (double)el_feed / CS_MOTION_ONE};
+    if (p.spindle == last->spindle && p.rapid == last->rapid && p.s == last->s &&
+        p.feed_mm_s == last->feed_mm_s)
+        return CS_OK;
+    *last = p;
+    if (cs_motion_power(mo, &p) != CS_OK)
+        return cs_path_diag_set(diag, CS_ERR_FULL, el->loc, "out of memory");
+    return CS_OK;
+}
+
 cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t tol, int method,
                              int32_t feed, cs_path_diag_t *diag)
 {
@@ -351,6 +431,7 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
         feed = mo->m->default_feed;
     cs_vec3_t cur = {mo->pl.pos[0], mo->pl.pos[1], mo->pl.pos[2]};
     bool down = false;
+    cs_motion_power_t last = {0};
     for (size_t k = 0; k < path->n; k++) {
         const cs_path_elem_t *el = &path->elems[k];
         const cs_bezier_t *c = &el->curve;
@@ -359,11 +440,18 @@ cs_err_t cs_motion_plan_path(cs_motion_t *mo, const cs_path_t *path, cs_pos_t to
             return pe;
         /* The job's own feed (G-code F) wins; rapid moves (G0) run at the axes' max rates. */
         int32_t el_feed = el->rapid ? 0 : el->feed_mm_s > 0 ? cs_motion_speed(el->feed_mm_s) : feed;
-        if (c->p[0].x != cur.x || c->p[0].y != cur.y || c->p[0].z != cur.z) {
+        bool travel = c->p[0].x != cur.x || c->p[0].y != cur.y || c->p[0].z != cur.z;
+        cs_err_t me = mark_power(mo, el, travel, el_feed, &last, diag);
+        if (me != CS_OK)
+            return me;
+        if (travel) {
             cs_err_t e = move_to(mo, &c->p[0], 0, el->loc, diag); /* rapid travel */
             if (e != CS_OK)
                 return e;
         }
+        me = mark_power(mo, el, false, el_feed, &last, diag);
+        if (me != CS_OK)
+            return me;
         cs_trace_t tr;
         cs_err_t e = cs_trace_begin(&tr, c, tol, (cs_trace_method_t)method);
         if (e != CS_OK)

@@ -22,11 +22,23 @@ typedef struct {
     uint16_t pulse_us;
 } cs_motion_pen_t;
 
+/* The spindle / laser from a segment on (G-code M3/M4/M5 and S, carried by the path's elements):
+ * a change of power never stops the motion, it starts with the first segment of its move. */
+typedef struct {
+    size_t seg;       /* the first segment it applies to */
+    uint8_t spindle;  /* 3, 4 or 5: M3, M4, M5 */
+    bool rapid;       /* the moves are rapids (a laser is off in them) */
+    double s;         /* S: spindle speed, laser power */
+    double feed_mm_s; /* the moves' programmed feed (M4 laser: the speed of full power) */
+} cs_motion_power_t;
+
 typedef struct {
     cs_segment_t *v;
     size_t n, cap;
     cs_motion_pen_t *pens; /* in segment order ([pen] mode = servo; none otherwise) */
     size_t npens, cappens;
+    cs_motion_power_t *powers; /* in segment order (G-code jobs; none otherwise) */
+    size_t npowers, cappowers;
 } cs_motion_segs_t;
 
 /* Most step segments one plan holds by default: 2^23 (8.4 M, 168 MB of segments; hours of
@@ -45,6 +57,10 @@ typedef struct {
     uint64_t ticks;       /* sum of the segments' durations */
     int64_t steps;        /* sum of |steps| over every axis */
     int64_t pos[CS_AXES]; /* sum of the segments' steps: the final position */
+    /* power marks waiting for their block to be cut (seg holds the block's number) */
+    cs_motion_power_t *pend;
+    size_t npend, cappend, pend0;
+    size_t blocks_cut; /* blocks cut into segments so far */
 } cs_motion_t;
 
 /* Planner and generator for machine *m (which must outlive mo), no segments yet. */
@@ -56,7 +72,11 @@ void cs_motion_segs_free(cs_motion_segs_t *s);
 /* Appends a servo pen event: an exact stop (cs_motion_finish), then settle_ms of rest (one or
  * more segments without steps) that begins with the pulse pulse_us. CS_ERR_FULL on OOM. */
 cs_err_t cs_motion_pen(cs_motion_t *mo, uint16_t pulse_us, double settle_ms);
-/* As cs_motion_write, with the "pen PULSE_US" line before each pen event's segment. */
+/* True when a power mark turns a spindle or laser on (M3 or M4). */
+bool cs_motion_spindle_used(const cs_motion_segs_t *s);
+/* As cs_motion_write, with the "pen PULSE_US" line before each pen event's segment and, when
+ * cs_motion_spindle_used, a comment line before the first segment of each power mark:
+ * "# spindle M3|M4 S<S> F<mm/s>" (feed moves), "# spindle M3|M4 S<S> rapid", "# spindle M5". */
 int cs_motion_write_segs(FILE *f, const cs_machine_t *m, const cs_motion_segs_t *s);
 /* Queues a straight move to target (mm) at feed (mm/s Q15.16, <= 0 rapid); cuts segments first
  * when the ring is full. Planner errors pass through (CS_ERR_LIMIT: nothing was queued). */
@@ -65,6 +85,9 @@ cs_err_t cs_motion_line(cs_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t
 /* Same in mm (double) for x, y, z (a unchanged); CS_ERR_RANGE when a value is not a cs_pos_t. */
 cs_err_t cs_motion_line_mm(cs_motion_t *mo, double x, double y, double z, double feed_mm_s,
                            uint32_t line);
+/* Marks *p (seg ignored) to take effect with the next move queued: it lands in segs.powers at
+ * that move's first segment, with no stop. CS_ERR_FULL on OOM. */
+cs_err_t cs_motion_power(cs_motion_t *mo, const cs_motion_power_t *p);
 /* Cuts every queued block (the job ends with an exact stop). */
 cs_err_t cs_motion_finish(cs_motion_t *mo);
 /* Writes segments as text: a header line "# curvestep segments tick_hz=N axes=N" then one line

@@ -93,6 +93,8 @@ cs_err_t cs_path_add_move(cs_path_t *p, const cs_bezier_t *curve, cs_path_kind_t
     e->subpath = p->nsubpaths - 1;
     e->feed_mm_s = feed_mm_s;
     e->rapid = rapid;
+    e->spindle = 0;
+    e->spindle_s = 0;
     return CS_OK;
 }
 

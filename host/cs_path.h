@@ -47,6 +47,9 @@ typedef struct {
     unsigned subpath;  /* 0-based, counts only subpaths that hold at least one element */
     double feed_mm_s;  /* feed for this move in mm/s; 0 = the machine's default (cs_path_add) */
     bool rapid;        /* a travel move (G-code G0): at the machine's rapid rate, not drawn */
+    uint8_t spindle;   /* G-code: the spindle / laser in force, 3, 4 or 5 (M3, M4, M5); 0: the
+                        * input says nothing about it (SVG, HP-GL, curves) */
+    double spindle_s;  /* ... and its S (G-code: spindle speed, laser power) */
 } cs_path_elem_t;
 
 /* Most elements a path holds by default: 2^20 (1 M curves, about 190 MB), far above

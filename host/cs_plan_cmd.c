@@ -24,6 +24,9 @@ static void usage(FILE *f)
           "The machine starts at 0 and moves in straight rapid travel to each subpath start;\n"
           "G-code G0 moves are rapid too (each axis at its max_rate), G1/G2/G3 use their F.\n"
           "A summary goes to standard error: blocks, segments, steps, job time.\n"
+          "A G-code job that turns a spindle or laser on (M3/M4) gets a comment line\n"
+          "\"# spindle M4 S500 F10.000\" (F: the moves' feed, mm/s; \"rapid\" for G0 moves,\n"
+          "\"M5\" when off) before the first segment of each change of M, S or feed.\n"
           "  --machine FILE.ini  machine description (default: the first machine.ini found in\n"
           "                      $XDG_CONFIG_HOME/curvestep, ~/.config/curvestep,\n"
           "                      /etc/curvestep, else a built-in 3-axis plotter, 80 steps/mm;\n"
@@ -45,6 +48,18 @@ static void usage(FILE *f)
     fputs("Exit status: 0 ok, 1 bad input (file:line:col: reason; a move outside the travel\n"
           "is refused before any segment is written), 2 bad command line, 3 internal error.\n",
           f);
+}
+
+
+/* The spindle / laser line of the summary: how many power changes, the largest S. */
+static void spindle_summary(const cs_motion_segs_t *s)
+{
+    double smax = 0;
+    for (size_t q = 0; q < s->npowers; q++)
+        if (s->powers[q].spindle != 5 && s->powers[q].s > smax)
+            smax = s->powers[q].s;
+    fprintf(stderr, "plan: spindle: %zu changes (\"# spindle\" lines), largest S %g\n",
+            s->npowers, smax);
 }
 
 int cs_cmd_plan(int argc, char **argv)
@@ -135,6 +150,8 @@ int cs_cmd_plan(int argc, char **argv)
                     jp.path.n, jp.mo.blocks, jp.mo.segs.n, (long long)jp.mo.steps,
                     (double)jp.mo.ticks / m.tick_hz, (unsigned long long)jp.mo.ticks,
                     (unsigned)m.tick_hz);
+        if (rc == CS_EXIT_OK && cs_motion_spindle_used(&jp.mo.segs))
+            spindle_summary(&jp.mo.segs);
     }
     cs_jobplan_free(&jp);
     return rc;

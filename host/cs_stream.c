@@ -563,6 +563,19 @@ bool cs_stream_hello_mismatch(const cs_proto_hello_t *h, uint8_t axes, uint32_t 
     return true;
 }
 
+/* A job of device-planned control messages only (HOME, JOG, PROBE, SPINDLE: `curvestep home`
+ * and the like, sent in curves mode so that the tick rate need not match) needs no CURVE
+ * capability: a segments-only device (the ATmega328p's) runs them too. */
+static bool control_only(const cs_stream_job_t *j)
+{
+    if (j->mode != CS_STREAM_CURVES)
+        return false;
+    for (size_t i = 0; i < j->n; i++)
+        if (j->v[i].type == CS_PROTO_CURVE || j->v[i].type == CS_PROTO_SEGMENT)
+            return false;
+    return true;
+}
+
 /* The HELLO against the machine and the job: INCOMPATIBLE with the reason in r->why. */
 static void check_hello(run_t *s)
 {
@@ -571,7 +584,11 @@ static void check_hello(run_t *s)
     if (h->version != CS_PROTO_VERSION)
         snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
                  (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
-    else
+    else if (control_only(s->job)) {
+        if (h->axes != s->o->axes)
+            snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",
+                     (unsigned)h->axes, (unsigned)s->o->axes);
+    } else
         (void)cs_stream_hello_mismatch(h, s->o->axes, s->o->tick_hz, s->job->mode, r->why,
                                        sizeof r->why);
     if (r->why[0] != '\0')

@@ -11,16 +11,18 @@ AVR_NM      := avr-nm
 AVR_DIR     := $(BUILD)/fw/avr
 AVR_PORT    := firmware/ports/avr
 AVR_MCU     := -mmcu=atmega328p -DF_CPU=16000000UL
-# The 2 KB build: segments only (the host plans; no tracer or planner on board), a 7-slot
-# motion queue, a 2-frame link window with 40-byte payloads (STATUS with 4 axes is the longest
-# message the device sends or needs), an 8-segment executor ring; x/y at 100 mm/s (8000 steps/s
-# at 80 steps/mm), what the step interrupt sustains with room for the link (docs/firmware-avr.md);
-# 2 waiting ERRORs (a 2-frame window) and 16-byte UART reads a pass (on the stack), which pay for
-# protocol 2's longer STATUS and keep the stack clear of the static data.
-# machine.ini in $(AVR_PORT) says the same for the host.
-AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_CTL=0 -DCS_FW_QUEUE=7 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40 \
-               -DCS_STEPPER_RING=8 -DCS_FW_XY_RATE=100 -DCS_FW_XY_ACCEL=2000 \
-               -DCS_FW_ERRQ=2 -DCS_FW_RX_CHUNK=16
+# The 2 KB build: segments only (the host plans; no tracer or planner on board) with machine
+# control (CS_FW_CTL=1: limits, e-stop, probe, homing and jogs at constant speed, spindle PWM),
+# a 7-slot motion queue, a 2-frame link window with 40-byte payloads (STATUS with 4 axes is the
+# longest message the device sends or needs), a 4-segment executor ring (20 ms of 5 ms segments;
+# 34 B a slot), an 8-entry sequence map (ring + 3), 2 waiting EVENTs; x/y at 100 mm/s (8000
+# steps/s at 80 steps/mm), what the step interrupt sustains with room for the link
+# (docs/firmware-avr.md); 2 waiting ERRORs (a 2-frame window) and 16-byte UART reads a pass (on
+# the stack). Static RAM 1456 B + 496..511 B of stack measured in simavr (docs/firmware-avr.md,
+# "The 2 KB build"). machine.ini in $(AVR_PORT) says the same for the host.
+AVR_DEFS    := -DCS_FW_CURVES=0 -DCS_FW_CTL=1 -DCS_FW_QUEUE=7 -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40 \
+               -DCS_STEPPER_RING=4 -DCS_FW_XY_RATE=100 -DCS_FW_XY_ACCEL=2000 \
+               -DCS_FW_ERRQ=2 -DCS_FW_RX_CHUNK=16 -DCS_FW_EVQ=2 -DCS_FW_SEQMAP=8
 # -flto: the executor's call (cs_stepper_tick, in the core) is inlined into the step interrupt
 # at link time, so the interrupt saves only the registers it uses and passes its answer in
 # registers (about 40 cycles of the ~440 a call takes; docs/firmware-avr.md).

@@ -783,7 +783,16 @@ int cs_sim_write_trace(const char *file, const cs_machine_t *m, const cs_sim_exe
     static const char names[] = "xyza";
     int64_t pos[CS_AXES] = {0, 0, 0, 0};
     fprintf(f, "t_s,axis,dir,x_mm,y_mm,z_mm\n");
-    for (size_t e = 0; e < ex->n; e++) {
+    size_t sp = 0;
+    for (size_t e = 0; e <= ex->n; e++) {
+        /* the spindle / laser settings in time order among the edges: axis "s", the duty
+         * (1/1000, 0 when off) in the dir column, the position where it was set */
+        for (; sp < ex->nspins && (e == ex->n || ex->spins[sp].t <= ex->edges[e].t); sp++)
+            fprintf(f, "%.6f,s,%u,%.5f,%.5f,%.5f\n", (double)ex->spins[sp].t / m->tick_hz,
+                    ex->spins[sp].mode != 0 ? (unsigned)ex->spins[sp].duty : 0u,
+                    (double)pos[0] / spm[0], (double)pos[1] / spm[1], (double)pos[2] / spm[2]);
+        if (e == ex->n)
+            break;
         const port_posix_edge_t *d = &ex->edges[e];
         pos[d->axis] += d->dir;
         fprintf(f, "%.6f,%c,%d,%.5f,%.5f,%.5f\n", (double)d->t / m->tick_hz,

@@ -58,7 +58,8 @@ int cs_sim_draw_svg(const char *file, const cs_machine_t *m, const cs_sim_exec_t
 /* width_px: picture width (height follows the drawing's aspect ratio). */
 int cs_sim_draw_png(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex,
                     const cs_sim_ref_t *ref, int width_px);
-/* Writes every step edge as CSV: t_s,axis,dir,x_mm,y_mm,z_mm (position after the step). */
+/* Writes every step edge as CSV: t_s,axis,dir,x_mm,y_mm,z_mm (position after the step), and each
+ * spindle / laser setting among them as t_s,s,duty,x_mm,y_mm,z_mm (duty 1/1000, 0 when off). */
 int cs_sim_write_trace(const char *file, const cs_machine_t *m, const cs_sim_exec_t *ex);
 
 #endif

@@ -64,9 +64,8 @@ static void send_hello(cs_fw_app_t *a)
     h.u.hello.axes = a->m->n_axes;
     h.u.hello.queue_size = a->cfg.motion.queue_size;
     h.u.hello.tick_hz = a->m->tick_hz;
-    uint16_t ctl = CS_FW_CTL ? (uint16_t)(CS_PROTO_CAP_SPINDLE |
-                                          (CS_FW_CURVES ? CS_PROTO_CAP_CONTROL : 0u))
-                             : 0u;
+    /* HOME, JOG, PROBE: planned on board, or without the planner by cs_fw_ctl's line generator */
+    uint16_t ctl = CS_FW_CTL ? (uint16_t)(CS_PROTO_CAP_SPINDLE | CS_PROTO_CAP_CONTROL) : 0u;
     h.u.hello.caps =
         (uint16_t)(CS_PROTO_CAP_SEGMENTS | (CS_FW_CURVES ? CS_PROTO_CAP_CURVES : 0u) | ctl);
     /* the first message of a freshly opened sender: the window has room */

@@ -13,14 +13,27 @@ enum { PH_SEEK, PH_BACKOFF, PH_LATCH, PH_PULLOFF };
 /* the latch searches 2 x pull-off + this (mm Q16): the switch is pulloff away after the back-off */
 #define LATCH_MARGIN ((cs_pos_t)CS_POS_ONE_MM)
 #define NO_STATE     0xFFu
+/* Keeps a function out of line (GCC and Clang; elsewhere a hint the compiler may ignore). */
+#if defined(__GNUC__)
+#define CS_FW_CTL_NOINLINE __attribute__((noinline))
+#else
+#define CS_FW_CTL_NOINLINE
+#endif
 
-cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm)
+CS_FW_CTL_NOINLINE cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm)
 {
     /* mm Q16 = steps * 2^32 / spm(Q16), rounded to nearest */
     return (cs_pos_t)cs_fixed_div_round((int64_t)steps * ((int64_t)1 << 32), spm);
 }
 
 #if CS_FW_CTL
+/* |(x, y, z)| (mm Q16), one copy for the laser's speed and the line generator: the 64-bit square
+ * root is large on an 8-bit target. */
+static CS_FW_CTL_NOINLINE uint64_t path_len(const int64_t d[3])
+{
+    return cs_fixed_vec_len64(d[0], d[1], d[2]);
+}
+
 /* --- the input interrupt and the executor's load hook --------------------------------------- */
 
 void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
@@ -129,12 +142,13 @@ static void enter_alarm(cs_fw_motion_t *mo, uint8_t code, uint16_t bits)
 
 /* --- operations: moves planned on the device ------------------------------------------------ */
 
-#if CS_FW_CURVES
-static int32_t pos_to_steps(cs_pos_t p, int32_t spm)
+static CS_FW_CTL_NOINLINE int32_t pos_to_steps(cs_pos_t p, int32_t spm)
 {
     /* round(p * spm): Q16 x Q16 = Q32 (|p| <= 2^28, spm <= 2^28) */
     return (int32_t)cs_fixed_round_shift64((int64_t)p * spm, 32);
 }
+
+#if CS_FW_CURVES
 
 /* A straight move of the operation from where the executor is to target (mm), planned on the
  * wide machine (homing) or the real one (probe: the travel is checked), watching the inputs. */
@@ -159,6 +173,98 @@ static cs_err_t op_move_to(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES], i
     c->op_move = true;
     return CS_OK;
 }
+#else
+/* The line generator: a straight move from steps_pos (where everything pushed ends) to target
+ * (mm) at feed (mm/s Q16), capped at the max_rate of the slowest moving axis and at a step every
+ * 2 ticks (the planner's rule), at constant speed (no planner: no ramp). Soft limits unless
+ * wide. Item n; mark: its last segment executes it. Out of line: its 64-bit arithmetic is large
+ * on an 8-bit target and must not be copied into every caller. */
+static CS_FW_CTL_NOINLINE cs_err_t line_start(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES],
+                                              int32_t feed, bool wide, uint32_t n, bool mark)
+{
+    cs_fw_ctl_t *c = &mo->ctl;
+    const cs_machine_t *m = mo->m;
+    int32_t d[CS_AXES] = {0};
+    int64_t mm[3] = {0, 0, 0};
+    uint32_t most = 0;
+    for (unsigned i = 0; i < m->n_axes; i++) {
+        const cs_axis_cfg_t *ax = &m->axis[i];
+        if (!wide && (target[i] < ax->travel_min || target[i] > ax->travel_max))
+            return CS_ERR_LIMIT;
+        d[i] = pos_to_steps(target[i], ax->steps_per_mm) - mo->steps_pos[i];
+        uint32_t a = (uint32_t)(d[i] < 0 ? -d[i] : d[i]);
+        if (a != 0 && ax->max_rate < feed)
+            feed = ax->max_rate;
+        most = a > most ? a : most;
+        if (i < 3)
+            mm[i] = (int64_t)target[i] - cs_fw_ctl_steps_to_pos(mo->steps_pos[i], ax->steps_per_mm);
+    }
+    if (feed <= 0)
+        return CS_ERR_ARG;
+    /* ticks = length (mm Q16) / feed (mm/s Q16) x tick_hz */
+    uint64_t ticks = path_len(mm) * m->tick_hz / (uint64_t)feed;
+    if (ticks < 2u * (uint64_t)most)
+        ticks = 2u * (uint64_t)most;
+    if (ticks > CS_FW_CTL_LINE_TICKS_MAX)
+        return CS_ERR_ARG;
+    for (unsigned i = 0; i < CS_AXES; i++)
+        c->ln_left[i] = d[i];
+    c->ln_ticks = (uint32_t)ticks;
+    c->ln_item = n;
+    c->ln_mark = mark;
+    return CS_OK;
+}
+
+static cs_err_t op_move_to(cs_fw_motion_t *mo, const cs_pos_t target[CS_AXES], int32_t feed,
+                           bool wide, uint16_t watch, uint16_t release)
+{
+    cs_fw_ctl_t *c = &mo->ctl;
+    cs_err_t e = line_start(mo, target, feed, wide, c->op_item, false);
+    if (e != CS_OK)
+        return e;
+    set_watch(c, watch, release);
+    c->op_move = true;
+    return CS_OK;
+}
+
+/* round(k x t / left), |k| <= left / 2 + 1, t <= left < 2^31: the line's steps in t of its
+ * remaining ticks. */
+static CS_FW_CTL_NOINLINE int32_t share(int32_t k, uint32_t t, uint32_t left)
+{
+    return (int32_t)cs_fixed_div_round((int64_t)k * t, left);
+}
+
+bool cs_fw_ctl_line_next(cs_fw_motion_t *mo, cs_segment_t *s, uint32_t *done)
+{
+    cs_fw_ctl_t *c = &mo->ctl;
+    uint32_t left = c->ln_ticks;
+    if (left == 0)
+        return false;
+    uint32_t seg = mo->m->segment_ticks > 0 ? mo->m->segment_ticks : 1u;
+    /* the last piece is whatever remains; before it, equal pieces (a short tail joins them) */
+    uint32_t t = left < 2u * seg ? left : seg;
+    s->ticks = t;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        /* round(left_i x t / left): the pieces add up to the line exactly (the last is all) */
+        int32_t k = t == left ? c->ln_left[i] : share(c->ln_left[i], t, left);
+        s->steps[i] = k;
+        c->ln_left[i] -= k;
+    }
+    c->ln_ticks = left - t;
+    *done = c->ln_ticks == 0 && c->ln_mark ? c->ln_item : c->ln_item - 1u;
+    return true;
+}
+
+bool cs_fw_ctl_line_busy(const cs_fw_motion_t *mo)
+{
+    return mo->ctl.ln_ticks != 0;
+}
+
+void cs_fw_ctl_line_stop(cs_fw_motion_t *mo)
+{
+    mo->ctl.ln_ticks = 0;
+}
+#endif
 
 static uint16_t home_bit(const cs_proto_home_t *h)
 {
@@ -193,9 +299,7 @@ static void home_phase(cs_fw_motion_t *mo, uint8_t ph)
     if (e != CS_OK)
         enter_alarm(mo, CS_PROTO_ALARM_HOMING_RESET, c->inputs);
 }
-#endif
 
-#if CS_FW_CURVES
 /* The operation is over: its item counts as executed, the planner goes back to the machine. */
 static void op_finish(cs_fw_motion_t *mo)
 {
@@ -203,8 +307,10 @@ static void op_finish(cs_fw_motion_t *mo)
     c->op = CS_FW_OP_NONE;
     c->op_move = false;
     set_watch(c, 0, 0);
+#if CS_FW_CURVES
     (void)cs_planner_init(&mo->pl, mo->m);
     mo->pl_stale = true;
+#endif
     cs_fw_motion_mark(mo, c->op_item);
     mo->news = true;
 }
@@ -295,7 +401,6 @@ static void op_moved(cs_fw_motion_t *mo, bool tripped, uint16_t bits)
         break;
     }
 }
-#endif
 
 /* The input interrupt halted the executor: drop what was planned, restart from where it is. */
 static void handle_trip(cs_fw_motion_t *mo)
@@ -316,10 +421,8 @@ static void handle_trip(cs_fw_motion_t *mo)
         alarm_about(mo, code, bits, c->op != CS_FW_OP_NONE ? c->op_seq : seq, busy);
         return;
     }
-#if CS_FW_CURVES
     if (c->op_move)
         op_moved(mo, true, bits);
-#endif
 }
 
 /* --- the API -------------------------------------------------------------------------------- */
@@ -351,9 +454,6 @@ cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)
         return CS_ERR_STATE;
     if (mo->ctl.alarm != 0)
         return CS_ERR_STATE;
-    if (!CS_FW_CURVES &&
-        (type == CS_PROTO_HOME || type == CS_PROTO_JOG || type == CS_PROTO_PROBE))
-        return CS_ERR_UNSUPPORTED;
     return CS_OK;
 }
 
@@ -379,9 +479,18 @@ bool cs_fw_ctl_take(cs_fw_motion_t *mo, const void *item, uint32_t n)
         port_irq_restore(s);
         return true;
     }
-#if CS_FW_CURVES
     if (it->type == CS_PROTO_JOG) {
+#if CS_FW_CURVES
         cs_fw_motion_plan_line(mo, &it->u.jog.target, it->u.jog.feed, n);
+#else
+        const cs_vec3_t *g = &it->u.jog.target;
+        cs_pos_t t[CS_AXES] = {g->x, g->y, g->z, 0};
+        if (mo->m->n_axes > 3) /* a stays */
+            t[3] = cs_fw_ctl_steps_to_pos(mo->steps_pos[3], mo->m->axis[3].steps_per_mm);
+        cs_err_t e = line_start(mo, t, it->u.jog.feed, false, n, true);
+        if (e != CS_OK)
+            cs_fw_motion_error(mo, e, it->seq);
+#endif
         c->jogging = true;
         c->jog_last = n;
         return true;
@@ -392,7 +501,6 @@ bool cs_fw_ctl_take(cs_fw_motion_t *mo, const void *item, uint32_t n)
     else
         c->u.probe = it->u.probe;
     c->op_wait = true;
-#endif
     return false;
 }
 
@@ -445,13 +553,11 @@ void cs_fw_ctl_poll(cs_fw_motion_t *mo)
     if (c->trip != CS_FW_TRIP_NONE)
         handle_trip(mo);
     poll_cancel(mo);
-#if CS_FW_CURVES
     if (c->op_wait && at_rest(mo))
         op_start(mo);
     else if (c->op_move && !mo->hold.hold && cs_fw_motion_still(mo) &&
              c->trip == CS_FW_TRIP_NONE) /* a hold at rest is no end of the move */
         op_moved(mo, false, c->inputs);
-#endif
     poll_spindle(mo);
     if (c->jogging && !c->cancel && cs_fw_motion_executed(mo, c->jog_last))
         c->jogging = false;
@@ -472,7 +578,7 @@ uint16_t cs_fw_ctl_aux(const cs_fw_motion_t *mo, const cs_segment_t *s)
     int64_t d[3] = {0, 0, 0};
     for (unsigned i = 0; i < mo->m->n_axes && i < 3; i++)
         d[i] = cs_fw_ctl_steps_to_pos(s->steps[i], mo->m->axis[i].steps_per_mm);
-    uint64_t len = cs_fixed_vec_len64(d[0], d[1], d[2]);
+    uint64_t len = path_len(d);
     if (len == 0)
         return 0; /* a dwell or a pen's settle: the beam is off while nothing moves */
     if (c->sp_feed <= 0)
@@ -626,6 +732,28 @@ bool cs_fw_ctl_peek_event(const cs_fw_motion_t *mo, cs_proto_event_t *e)
 }
 
 void cs_fw_ctl_drop_event(cs_fw_motion_t *mo)
+{
+    (void)mo;
+}
+#endif
+
+#if !CS_FW_CTL || CS_FW_CURVES
+/* No line generator: the planner moves the operations, or there are none. */
+bool cs_fw_ctl_line_next(cs_fw_motion_t *mo, cs_segment_t *s, uint32_t *done)
+{
+    (void)mo;
+    (void)s;
+    (void)done;
+    return false;
+}
+
+bool cs_fw_ctl_line_busy(const cs_fw_motion_t *mo)
+{
+    (void)mo;
+    return false;
+}
+
+void cs_fw_ctl_line_stop(cs_fw_motion_t *mo)
 {
     (void)mo;
 }

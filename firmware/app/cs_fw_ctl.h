@@ -7,7 +7,9 @@
  * interrupt (port_inputs_attach) and the executor's load hook (cs_stepper_on_load) run here; the
  * rest runs in the main loop from cs_fw_motion. Touches hardware only through port.h;
  * freestanding C99: no heap, no float, no libc. HOME, JOG and PROBE are planned with the device's
- * planner, so they exist with CS_FW_CURVES only (HELLO caps CS_PROTO_CAP_CONTROL). */
+ * planner; a build without it (CS_FW_CURVES=0, the ATmega328p's) runs them as straight lines at
+ * constant speed cut into step segments here (the line generator below: no acceleration ramp),
+ * and HELLO caps CS_PROTO_CAP_CONTROL either way. */
 #ifndef CS_FW_CTL_H
 #define CS_FW_CTL_H
 
@@ -22,9 +24,8 @@
 #ifndef CS_FW_CURVES /* as cs_fw_motion.h: 1 = the on-board planner is there */
 #define CS_FW_CURVES 1
 #endif
-/* 1 (default): machine control built in; 0: left out (the smallest builds: the ATmega328p's
- * 2 KB are full), HELLO then offers no CONTROL or SPINDLE capability and the messages are
- * refused with CS_ERR_UNSUPPORTED. */
+/* 1 (default, the ATmega328p's too): machine control built in; 0: left out, HELLO then offers
+ * no CONTROL or SPINDLE capability and the messages are refused with CS_ERR_UNSUPPORTED. */
 #ifndef CS_FW_CTL
 #define CS_FW_CTL 1
 #endif
@@ -33,6 +34,8 @@
 #define CS_FW_EVQ 4
 #endif
 CS_STATIC_ASSERT(CS_FW_EVQ >= 2 && CS_FW_EVQ <= 255, fw_evq_size);
+/* The line generator's longest move, ticks (19 h at 31250 Hz; its counts stay below 2^31). */
+#define CS_FW_CTL_LINE_TICKS_MAX 0x7FFFFFFFu
 
 /* The operation the device runs itself (taken from the queue like a PEN). */
 typedef enum {
@@ -90,6 +93,12 @@ typedef struct {
     uint32_t alarms, probes, homings; /* counters */
 #if CS_FW_CURVES
     cs_machine_t wide; /* the machine with the travel opened up: homing moves are not limited */
+#else
+    /* the line generator (no planner on board): a straight move at constant speed */
+    int32_t ln_left[CS_AXES]; /* steps still to make per axis */
+    uint32_t ln_ticks;        /* ticks still to run; 0: no line */
+    uint32_t ln_item;         /* the item the line belongs to */
+    bool ln_mark;             /* its last segment executes the item (a JOG; not HOME/PROBE) */
 #endif
 } cs_fw_ctl_t;
 #else
@@ -131,6 +140,13 @@ uint8_t cs_fw_ctl_state(const struct cs_fw_motion_s *mo);
 /* The oldest event not yet sent: true and *e; drop it once sent. Main loop. */
 bool cs_fw_ctl_peek_event(const struct cs_fw_motion_s *mo, cs_proto_event_t *e);
 void cs_fw_ctl_drop_event(struct cs_fw_motion_s *mo);
+/* Without the planner (CS_FW_CURVES=0): the line generator's next step segment (at most the
+ * machine's segment_ticks long) with *done the item executed once it has run: true, or false
+ * when no line is under way. Busy: a line has segments left. Stop: the line is dropped. Main
+ * loop. (With the planner: false, false, nothing.) */
+bool cs_fw_ctl_line_next(struct cs_fw_motion_s *mo, cs_segment_t *s, uint32_t *done);
+bool cs_fw_ctl_line_busy(const struct cs_fw_motion_s *mo);
+void cs_fw_ctl_line_stop(struct cs_fw_motion_s *mo);
 /* Position in mm Q16 of a step count (rounded to nearest). */
 cs_pos_t cs_fw_ctl_steps_to_pos(int32_t steps, int32_t spm);
 

@@ -36,6 +36,8 @@ bool cs_fw_motion_still(const cs_fw_motion_t *a)
     if (a->tracing || a->gen_busy || cs_planner_count(&a->pl) != 0)
         return false;
 #endif
+    if (cs_fw_ctl_line_busy(a))
+        return false;
     uint32_t s = port_irq_save();
     bool idle = cs_stepper_idle(&a->st);
     port_irq_restore(s);
@@ -244,6 +246,8 @@ static bool next_segment(cs_fw_motion_t *a, cs_segment_t *s, uint32_t *done)
             continue;
         }
 #endif
+        if (cs_fw_ctl_line_next(a, s, done)) /* HOME, PROBE, JOG without the planner */
+            return true;
         if (!may_take_item(a))
             return false;
         cs_fw_item_t it;
@@ -437,6 +441,8 @@ cs_err_t cs_fw_motion_queue(cs_fw_motion_t *a, const cs_proto_msg_t *msg, uint16
 #if CS_FW_CURVES
     else if (msg->type == CS_PROTO_CURVE)
         it->u.curve = msg->u.curve;
+#endif
+#if CS_FW_CTL
     else if (msg->type == CS_PROTO_HOME)
         it->u.home = msg->u.home;
     else if (msg->type == CS_PROTO_JOG)
@@ -461,6 +467,7 @@ void cs_fw_motion_flush(cs_fw_motion_t *a)
 {
     a->has_pend = false;
     a->pen_wait = false;
+    cs_fw_ctl_line_stop(a);
 #if CS_FW_CURVES
     a->tracing = false;
     a->rapid_pending = false;

@@ -50,7 +50,10 @@
 #define CS_FW_SEQMAP 64
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + CS_PLANNER_RING + 3, fw_seqmap_room);
 #else
+/* Overridable for the smallest builds (the AVR's 16: its ring of 8 + 3 fits). */
+#ifndef CS_FW_SEQMAP
 #define CS_FW_SEQMAP 32
+#endif
 CS_STATIC_ASSERT(CS_FW_SEQMAP >= CS_STEPPER_RING + 3, fw_seqmap_room);
 #endif
 CS_STATIC_ASSERT((CS_FW_SEQMAP & (CS_FW_SEQMAP - 1)) == 0, fw_seqmap_power_of_two);
@@ -74,6 +77,8 @@ typedef struct {
         cs_proto_spindle_t spindle;
 #if CS_FW_CURVES
         cs_proto_curve_t curve;
+#endif
+#if CS_FW_CTL
         cs_proto_home_t home;
         cs_proto_jog_t jog;
         cs_proto_probe_t probe;

@@ -25,23 +25,7 @@ set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 
 MC=$T/m.ini
-cat >"$MC" <<'EOF'
-[machine]
-tick_hz = 100000
-[x]
-travel_min = -100
-travel_max = 100
-[z]
-travel_min = -20
-travel_max = 0
-[limits]
-x_min = -5
-x_max = 50
-z_max = 2
-[probe]
-z = -3
-EOF
-cat tests/data/ctl-homing.ini >>"$MC"
+cat tests/data/ctl-switches.ini tests/data/ctl-homing.ini >"$MC"
 
 # near A B TOL: |A - B| <= TOL
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }

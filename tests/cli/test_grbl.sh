@@ -220,7 +220,8 @@ expect "state: located error" grep -q "badstate.ngc:2:5: G10 sets work offsets w
 #    by hand, with the switches at x -5, y -5 (min) and z 3 (max), pull-off 1 and every axis
 #    set to 0 where it ends, the machine's 0 is the simulator's (-4, -4, 2); its probe surface at
 #    z -2.5 is machine z -4.5. $H homes (ok, at 0 0 0); G38.2 from 10 10 0 touches at
-#    [PRB:10.000,10.000,-4.500:1]; a G38.2 that touches nothing is ALARM:5, G-code is then
+#    [PRB:10.000,10.000,-4.500:1]; a G38.2 that touches nothing is ALARM:5 (then its PRB and ok,
+#    as Grbl's), G-code is then
 #    locked (error:9) until $X; a G0 X-20 trips the x switch at machine -1 (ALARM:1, Pn:X);
 #    $H clears that alarm and homes again.
 printf '%s\n' '[homing]' 'order = zxy' 'x = min' 'y = min' 'z = max' 'x_pos = 0' 'y_pos = 0' \
@@ -237,6 +238,10 @@ expect "ctl: probe contact" grep -qx '\[PRB:10.000,10.000,-4.500:1\]' "$T/ctl.ou
 expect "ctl: \$# PRB" [ "$(grep -c '^\[PRB:10.000,10.000,-4.500:1\]$' "$T/ctl.out")" -eq 2 ]
 expect "ctl: probe without contact: PRB :0" grep -qx '\[PRB:10.000,10.000,-1.000:0\]' "$T/ctl.out"
 expect "ctl: ALARM:5" grep -qx 'ALARM:5' "$T/ctl.out"
+# Grbl 1.1 (gnea/grbl motion_control.c mc_probe_cycle, gcode.c): a probe without contact raises
+# ALARM:5 from the realtime check, then reports [PRB:..:0], then the line returns STATUS_OK: ok
+expect "ctl: failed probe answers ALARM:5, [PRB:..:0], ok (as Grbl), no error" \
+    [ "$(grep -A2 -x 'ALARM:5' "$T/ctl.out" | tr '\n' ' ')" = 'ALARM:5 [PRB:10.000,10.000,-1.000:0] ok ' ]
 expect "ctl: Alarm state where it stopped" grep -q '^<Alarm|MPos:10.000,10.000,-1.000|' "$T/ctl.out"
 expect "ctl: locked until \$X (error:9)" grep -qx 'error:9' "$T/ctl.out"
 expect "ctl: \$X unlocks" grep -qx '\[MSG:Caution: Unlocked\]' "$T/ctl.out"
@@ -261,6 +266,73 @@ expect "laser: client exit 0" [ $rc -eq 0 ]
 expect "laser: 8 ok" grep -q '^acks: 8 0$' "$T/laser.out"
 expect "laser: largest duty 600/1000" grep -q 'largest duty 600/1000' "$T/laser.sim"
 expect "laser: final position as plan + replay" grep -qxF "$LASER_POS" "$T/laser.sim"
+
+# 10. laser mode runs through power changes (Grbl's $32=1): M4 with S changing mid-straight (at
+#     X10, collinear) and at a corner (20,0), then a rapid home. The sim's trace gives every laser
+#     setting with the position and time it was set (each is the start of a segment), so from
+#     one setting to the next the executed speed is v = |P1 - P0| / (t1 - t0). Checked from it:
+#     - at X10 the speed on both sides is the feed (20 mm/s, >= 95 %): no stop (a stop at
+#       200 mm/s^2 would leave the 5 ms segment there at <= 0.5 mm/s);
+#     - at the corner both sides move >= 1 mm/s (a stop: <= 0.5 mm/s, a t_seg / 2);
+#     - M4: every setting during the cuts is S / s_max x min(1, v / F) x 1000, S the power of the
+#       move it starts (x < 10: 1000, then 500 up to x = 20, then 1000 along y), within 1 % of
+#       S plus 1 (the device truncates to 1/1000);
+#     - the rapid back to 0,0 runs with the laser off (duty 0 from the corner's end on).
+printf '%s\n' '[x]' 'steps_per_mm = 400' 'max_rate = 100' 'max_accel = 200' '[y]' \
+    'steps_per_mm = 400' 'max_rate = 100' 'max_accel = 200' '[spindle]' 'laser = true' \
+    's_max = 1000' >"$T/blend.ini"
+printf '%s\n' 'G21 G90' 'M4 S1000' 'G1 X10 F1200' 'G1 X20 S500' 'G1 X20 Y10 S1000' 'G0 X0 Y0' \
+    'M5' >"$T/blend.nc"
+start_sim blend --machine "$T/blend.ini" --trace "$T/blend.csv" --svg "$T/blend.svg"
+start_grbl blend --machine "$T/blend.ini"
+client "$GPTY" stream "$T/blend.nc" --method burst >"$T/blend.out"; rc=$?
+stop_all
+expect "blend: client exit 0, 7 ok" grep -q '^acks: 7 0$' "$T/blend.out"
+python3 - "$T/blend.csv" >"$T/blend.chk" <<'PY'
+import math, sys
+rows = [l.split(",") for l in open(sys.argv[1]).read().split("\n")[1:] if ",s," in l]
+st = [(float(r[0]), int(r[2]), float(r[3]), float(r[4])) for r in rows]
+F = 20.0
+def s_of(x, y):  # the programmed power of the move a segment starting at (x, y) belongs to
+    return 1000 if y > 1e-9 or x >= 20 - 1e-9 else 500 if x >= 10 - 1e-9 else 1000
+segs = []  # (x0, y0, x1, y1, v, duty)
+for a, b in zip(st, st[1:]):
+    dt = b[0] - a[0]
+    d = math.hypot(b[2] - a[2], b[3] - a[3])
+    segs.append((a[2], a[3], b[2], b[3], d / dt if dt > 0 else 0.0, a[1]))
+def speed_around(x, y):  # mean speeds of the moving segments ending and starting at (x, y)
+    end = [g[4] for g in segs if abs(g[2] - x) < 1e-9 and abs(g[3] - y) < 1e-9 and g[4] > 0]
+    beg = [g[4] for g in segs if abs(g[0] - x) < 1e-9 and abs(g[1] - y) < 1e-9 and g[4] > 0]
+    return min(end[-1:] + beg[:1]) if end and beg else 0.0
+print("x10 %.3f" % speed_around(10, 0))
+print("corner %.3f" % speed_around(20, 0))
+bad = n = 0
+worst = 0.0
+cut_end = max(i for i, g in enumerate(segs) if g[3] <= 10 + 1e-9 and g[2] >= 20 - 1e-9 and g[4] > 0 and g[1] < 10 - 1e-9)
+for g in segs[:cut_end + 1]:
+    S = s_of(g[0], g[1])
+    want = S * min(1.0, g[4] / F)
+    err = abs(g[5] - want)
+    n += 1
+    worst = max(worst, err)
+    if err > 0.01 * S + 1:
+        bad += 1
+        print("bad: at %.4f,%.4f v %.3f duty %d want %.1f" % (g[0], g[1], g[4], g[5], want))
+print("power %d segments, %d off, worst %.2f" % (n, bad, worst))
+rapid_on = [g for g in segs[cut_end + 1:] if g[5] != 0]
+print("rapid lit %d" % len(rapid_on))
+PY
+expect "blend: the speed at the S change on X10 is the feed (>= 19 mm/s)" \
+    awk '$1 == "x10" && $2 >= 19 { ok = 1 } END { exit !ok }' "$T/blend.chk"
+expect "blend: the corner's S change keeps moving (>= 1 mm/s)" \
+    awk '$1 == "corner" && $2 >= 1 { ok = 1 } END { exit !ok }' "$T/blend.chk"
+expect "blend: M4 power / S = v / F within 1 % on every segment of the cuts" \
+    grep -Eq '^power [1-9][0-9]+ segments, 0 off' "$T/blend.chk"
+expect "blend: the rapid runs with the laser off" grep -qx 'rapid lit 0' "$T/blend.chk"
+# the drawing shows the power along the path: a band per lit stretch, as wide as the duty, so
+# the M4 ramps at the start and at the corner give many widths
+expect "blend: the picture draws the laser power, its width following the duty" \
+    [ "$(grep -o 'class="power"[^>]*stroke-width="[0-9.]*"' "$T/blend.svg" | sed 's/.*stroke-width=//' | sort -u | wc -l)" -ge 10 ]
 
 # 7. usage.
 run "help: exit 0" 0 grbl --help

@@ -90,6 +90,22 @@ done
 "$CS" plan --help >"$T/h1.txt"; rc=$?
 expect "plan --help" [ $rc -eq 0 ]
 expect "plan --help text" grep -q 'usage: curvestep plan' "$T/h1.txt"
+# 9. the spindle / laser in the plan: a "# spindle" comment line before the first segment of each
+#    change, none for a job that never turns one on. M4 S1000 to X10, S500 to X20 (one line),
+#    then a rapid home: the S500 line comes after exactly 10 mm x 80 steps/mm = 800 x steps,
+#    the rapid's after 20 x 80 = 1600; the summary counts the 3 changes.
+printf '%s\n' 'G21 G90' 'M4 S1000' 'G1 X10 F600' 'G1 X20 S500' 'G0 X0' 'M5' >"$T/sp.nc"
+"$CS" plan "$T/sp.nc" >"$T/sp.seg" 2>"$T/sp.err"; rc=$?
+expect "spindle: plan exit 0" [ $rc -eq 0 ]
+awk '/^# spindle/ { print $0 " after " x; next } !/^#/ { x += $2 }' "$T/sp.seg" >"$T/sp.marks"
+expect "spindle: M4 S1000 F10 before the first segment" grep -qx '# spindle M4 S1000 F10.000 after ' "$T/sp.marks"
+expect "spindle: S500 after 800 x steps" grep -qx '# spindle M4 S500 F10.000 after 800' "$T/sp.marks"
+expect "spindle: the rapid after 1600" grep -qx '# spindle M4 S500 rapid after 1600' "$T/sp.marks"
+expect "spindle: summary" grep -qxF 'plan: spindle: 3 changes ("# spindle" lines), largest S 1000' "$T/sp.err"
+expect "spindle: none without M3/M4" bash -c "! grep -q spindle '$T/seg.txt' '$T/err.txt'"
+"$SIM" --replay "$T/sp.seg" >"$T/sp.sim" 2>&1
+expect "spindle: the comments replay (x back at 0)" grep -q '^final position: x=0 steps' "$T/sp.sim"
+
 "$SIM" --help >"$T/h2.txt"; rc=$?
 expect "sim --help" [ $rc -eq 0 ]
 expect "sim --help text" grep -q -- '--replay SEGMENTS' "$T/h2.txt"

@@ -43,6 +43,20 @@ enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
 #define TCCR1A_ADDR  0x80 /* data-space address of TCCR1A (ATmega328P register summary) */
 #define SERVO_WIDTHS 256 /* distinct successive servo pulse widths kept for the report */
 #define SLICE        1024 /* cycles run between two services of the pty and the clocks */
+/* Machine-control pins (port_avr.h, Grbl's Uno map): inputs active low (pulled up), a switch per
+ * axis on PB1 / PB2 / PB4, the probe on PC5, the e-stop on PC0; the spindle's Timer2 PWM on
+ * OC2A, enable PC3, direction PC4. Data-space addresses from the ATmega328P register summary. */
+#define SW_MAX       8
+#define PROBE_BIT    5 /* PC5 */
+#define ESTOP_BIT    0 /* PC0 */
+#define SP_EN_BIT    3 /* PC3 */
+#define SP_DIR_BIT   4 /* PC4 */
+#define PORTC_ADDR   0x28
+#define TCCR2A_ADDR  0xB0
+#define TCCR2B_ADDR  0xB1
+#define OCR2A_ADDR   0xB3
+#define PWM_SETS     64 /* distinct successive spindle settings kept for the report */
+static const uint8_t limit_bit[AXES] = {1, 2, 4}; /* PB1 (D9), PB2 (D10), PB4 (D12) */
 
 typedef struct {
     uint64_t steps;   /* rising STEP edges */
@@ -57,6 +71,10 @@ typedef struct {
     uint64_t first_rise, last_rise;
     uint64_t dir_in_pulse; /* DIR changes while STEP was high */
 } axis_t;
+
+typedef struct {
+    uint8_t tccr2a, tccr2b, ocr2a, portc;
+} pwm_set_t;
 
 static struct {
     avr_t *avr;
@@ -86,6 +104,24 @@ static struct {
     uint64_t servo_dropped; /* compare matches simavr did not deliver (whole wraps late) */
     uint64_t servo_w[SERVO_WIDTHS];
     size_t servo_nw;
+    /* simulated switches: pressed while the axis's pin position is at or beyond `at` */
+    struct {
+        char port;   /* 'B' or 'C' */
+        uint8_t bit; /* pin */
+        int axis;
+        bool above; /* pressed while pos >= at (else pos <= at) */
+        int64_t at;
+        bool pressed;
+        uint64_t presses;
+        int64_t press_pos[AXES]; /* every axis's pin position at the last press */
+    } sw[SW_MAX];
+    int nsw;
+    uint8_t ext[2]; /* the levels driven on ports B and C (bit set = high = released) */
+    double estop_at; /* --estop-at: simulated second the e-stop is pressed (< 0: never) */
+    bool estop_done;
+    /* the spindle's settings as the registers show them, sampled every slice */
+    pwm_set_t pwm[PWM_SETS];
+    int npwm;
     FILE *csv;
     FILE *isr_csv;  /* --isr-csv: every step interrupt, "entry-cycle,cycles" */
     uint64_t *prof; /* --profile: cycles spent at each flash word inside the step interrupt */
@@ -108,6 +144,64 @@ static double wall_now(void)
 
 /* --- pins ---------------------------------------------------------------------------------- */
 
+/* Drives input pin (port, bit) to level, as simavr's default for an input too (so a write of
+ * PORT, which simavr turns into the pull-up level, keeps a pressed switch pressed). */
+static void drive(char port, uint8_t bit, bool high)
+{
+    uint8_t *e = &g.ext[port == 'B' ? 0 : 1];
+    *e = (uint8_t)(high ? *e | (1u << bit) : *e & ~(1u << bit));
+    avr_ioport_external_t x = {.name = (unsigned long)port, .mask = 0xFFu, .value = *e};
+    avr_ioctl(g.avr, AVR_IOCTL_IOPORT_SET_EXTERNAL(port), &x);
+    avr_raise_irq(avr_io_getirq(g.avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), high ? 1 : 0);
+}
+
+/* The switches against the pin positions: a pin goes low (active) while any switch on it is
+ * pressed. Called at start and after every STEP rise. */
+static void switches_update(void)
+{
+    for (int k = 0; k < g.nsw; k++) {
+        int64_t p = g.ax[g.sw[k].axis].pos;
+        bool on = g.sw[k].above ? p >= g.sw[k].at : p <= g.sw[k].at;
+        if (on && !g.sw[k].pressed) {
+            g.sw[k].presses++;
+            for (int i = 0; i < AXES; i++)
+                g.sw[k].press_pos[i] = g.ax[i].pos;
+        }
+        g.sw[k].pressed = on;
+    }
+    for (int k = 0; k < g.nsw; k++) {
+        bool low = false;
+        for (int j = 0; j < g.nsw; j++)
+            if (g.sw[j].port == g.sw[k].port && g.sw[j].bit == g.sw[k].bit && g.sw[j].pressed)
+                low = true;
+        uint8_t e = g.ext[g.sw[k].port == 'B' ? 0 : 1];
+        if (((e >> g.sw[k].bit) & 1u) != (low ? 0u : 1u))
+            drive(g.sw[k].port, g.sw[k].bit, !low);
+    }
+}
+
+/* The spindle's registers now, kept when they differ from the last kept. */
+static void pwm_sample(void)
+{
+    const uint8_t *d = g.avr->data;
+    uint8_t a = d[TCCR2A_ADDR], b = d[TCCR2B_ADDR], o = d[OCR2A_ADDR];
+    uint8_t c = (uint8_t)(d[PORTC_ADDR] & ((1u << SP_EN_BIT) | (1u << SP_DIR_BIT)));
+    if (g.npwm > 0) {
+        const pwm_set_t *l = &g.pwm[g.npwm - 1];
+        if (l->tccr2a == a && l->tccr2b == b && l->ocr2a == o && l->portc == c)
+            return;
+    } else if (a == 0 && b == 0 && c == 0) {
+        return; /* off since reset: nothing to say */
+    }
+    if (g.npwm < PWM_SETS) {
+        g.pwm[g.npwm].tccr2a = a;
+        g.pwm[g.npwm].tccr2b = b;
+        g.pwm[g.npwm].ocr2a = o;
+        g.pwm[g.npwm].portc = c;
+        g.npwm++;
+    }
+}
+
 static void on_step(struct avr_irq_t *irq, uint32_t value, void *param)
 {
     (void)irq;
@@ -124,6 +218,8 @@ static void on_step(struct avr_irq_t *irq, uint32_t value, void *param)
         a->steps++;
         bool positive = a->dir_high != (((g.invert >> (intptr_t)param) & 1u) != 0);
         a->pos += positive ? 1 : -1;
+        if (g.nsw > 0)
+            switches_update();
         if (a->first_rise == 0)
             a->first_rise = now;
         a->last_rise = now;
@@ -340,13 +436,41 @@ static double number(const char *v, double lo, double hi)
     return d;
 }
 
+/* "--switch-min x=STEPS" and the like: a switch on (port, bit) pressed while axis's position is
+ * at or beyond STEPS. */
+static void add_switch(const char *v, char port, int bit, bool above, int fixed_axis)
+{
+    int axis = fixed_axis;
+    if (axis < 0) {
+        if (v[0] < 'x' || v[0] > 'z' || v[1] != '=') {
+            fprintf(stderr, "avr_harness: '%s': expected AXIS=STEPS, AXIS x, y or z\n", v);
+            exit(EX_USAGE);
+        }
+        axis = v[0] - 'x';
+        v += 2;
+        bit = limit_bit[axis];
+    }
+    if (g.nsw >= SW_MAX) {
+        fprintf(stderr, "avr_harness: at most %d switches\n", SW_MAX);
+        exit(EX_USAGE);
+    }
+    g.sw[g.nsw].port = port;
+    g.sw[g.nsw].bit = (uint8_t)bit;
+    g.sw[g.nsw].axis = axis;
+    g.sw[g.nsw].above = above;
+    g.sw[g.nsw].at = (int64_t)number(v, -1e12, 1e12);
+    g.nsw++;
+}
+
 static void usage(FILE *f)
 {
     fprintf(
         f,
         "usage: avr_harness [--pty] [--cycles N] [--timeout SEC] [--idle-exit SEC] [--fast]\n"
         "                   [--batch] [--min-pulse-us US] [--min-dir-setup-us US] [--invert MASK]\n"
-        "                   [--steps-csv FILE] [--isr-csv FILE] [--profile FILE] FIRMWARE.elf\n"
+        "                   [--steps-csv FILE] [--isr-csv FILE] [--profile FILE]\n"
+        "                   [--switch-min AXIS=STEPS] [--switch-max AXIS=STEPS]\n"
+        "                   [--probe-z STEPS] [--estop-at SEC] FIRMWARE.elf\n"
         "Runs FIRMWARE.elf on a simulated ATmega328p at 16 MHz (simavr) and watches its\n"
         "STEP (PD2..PD4) and DIR (PD5..PD7) pins and its step interrupt (Timer1 COMPA).\n"
         "  --pty               USART0 on a new pseudo-terminal; its path is the first line\n"
@@ -369,9 +493,18 @@ static void usage(FILE *f)
         "  --isr-csv FILE      every step interrupt: entry-cycle,cycles (vector to RETI)\n"
         "  --profile FILE      cycles spent at each instruction inside the step interrupt:\n"
         "                      lines 'byte-address cycles' (avr-addr2line, nm to read)\n"
+        "  --switch-min AXIS=STEPS, --switch-max AXIS=STEPS  the limit switch of AXIS (x\n"
+        "                      PB1/D9, y PB2/D10, z PB4/D12; one pin an axis, as Grbl's)\n"
+        "                      is pressed (pin low) while the axis's STEP/DIR position is\n"
+        "                      <= (min) or >= (max) STEPS; evaluated at every STEP rise\n"
+        "  --probe-z STEPS     the probe (PC5/A5) touches while z <= STEPS\n"
+        "  --estop-at SEC      the e-stop (PC0/A0) is pressed at that simulated second\n"
+        "                      (reported at once: 'estop: pressed at SEC s')\n"
         "Prints (after the pty line): the run, the UART traffic, per-axis steps and final\n"
         "position, the shortest pulse and low time, DIR set-up and hold, the step\n"
-        "interrupt's cycles, the lowest stack pointer.\n"
+        "interrupt's cycles, the lowest stack pointer, each switch's presses with the\n"
+        "positions at the last one, and the spindle's settings in turn (Timer2's\n"
+        "registers and the enable / direction pins, sampled every 64 us).\n"
         "Exit status: 0 ok, 1 a pulse or DIR violation, 2 usage, 3 emulator error (ELF,\n"
         "crash), 4 wall timeout.\n");
 }
@@ -412,6 +545,14 @@ int main(int argc, char **argv)
             isr_csv = argv[++i];
         } else if (strcmp(a, "--profile") == 0 && more) {
             prof = argv[++i];
+        } else if (strcmp(a, "--switch-min") == 0 && more) {
+            add_switch(argv[++i], 'B', 0, false, -1);
+        } else if (strcmp(a, "--switch-max") == 0 && more) {
+            add_switch(argv[++i], 'B', 0, true, -1);
+        } else if (strcmp(a, "--probe-z") == 0 && more) {
+            add_switch(argv[++i], 'C', PROBE_BIT, false, 2);
+        } else if (strcmp(a, "--estop-at") == 0 && more) {
+            g.estop_at = number(argv[++i], 1e-6, 1e6);
         } else if (a[0] == '-' || elf != NULL) {
             fprintf(stderr, "avr_harness: bad argument '%s'\n", a);
             usage(stderr);
@@ -438,6 +579,8 @@ int main(int argc, char **argv)
         return EX_EMU;
     }
     g.master = g.slave = -1;
+    if (g.estop_at == 0)
+        g.estop_at = -1; /* (0 is refused above: a pressed e-stop at boot is not modelled) */
     g.isr_min = UINT64_MAX;
     g.min_sp = UINT64_MAX;
     g.hist = calloc(HIST_MAX, sizeof *g.hist);
@@ -491,6 +634,14 @@ int main(int argc, char **argv)
             avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('D'), (int)(DIR_BIT0 + i)), on_dir,
             (void *)i);
     }
+    /* every machine-control input released (high: the pull-ups), then the switches' state */
+    g.ext[0] = 0xFF;
+    g.ext[1] = 0xFF;
+    for (int b = 0; b < AXES; b++)
+        drive('B', limit_bit[b], true);
+    drive('C', PROBE_BIT, true);
+    drive('C', ESTOP_BIT, true);
+    switches_update();
     avr_irq_t *vecb = avr_get_interrupt_irq(avr, VEC_T1_COMPB);
     if (vecb == NULL) {
         fprintf(stderr, "avr_harness: no vector %d\n", VEC_T1_COMPB);
@@ -567,6 +718,13 @@ int main(int argc, char **argv)
             break;
         }
         service_uart();
+        pwm_sample();
+        if (g.estop_at >= 0 && !g.estop_done && (double)avr->cycle / 16e6 >= g.estop_at) {
+            drive('C', ESTOP_BIT, false);
+            g.estop_done = true;
+            fprintf(out, "estop: pressed at %.3f s\n", g.estop_at); /* now: tests wait on it */
+            fflush(out);
+        }
         if (g_stop) {
             why = "signal";
             break;
@@ -669,6 +827,32 @@ int main(int argc, char **argv)
         fprintf(out, "\n");
     } else {
         fprintf(out, "servo: OC1B no period\n");
+    }
+    for (int k = 0; k < g.nsw; k++) {
+        fprintf(out, "switch: P%c%d %s %c %s %lld: %llu presses", g.sw[k].port, g.sw[k].bit,
+                g.sw[k].port == 'C' ? "probe" : "limit", names[g.sw[k].axis],
+                g.sw[k].above ? ">=" : "<=", (long long)g.sw[k].at,
+                (unsigned long long)g.sw[k].presses);
+        if (g.sw[k].presses > 0) {
+            fprintf(out, ", last at");
+            for (int i = 0; i < AXES; i++)
+                fprintf(out, " %c=%lld", names[i], (long long)g.sw[k].press_pos[i]);
+        }
+        fprintf(out, "\n");
+    }
+    if (g.estop_at >= 0 && !g.estop_done)
+        fprintf(out, "estop: not reached (%.3f s)\n", g.estop_at);
+    for (int k = 0; k < g.npwm; k++) {
+        const pwm_set_t *w = &g.pwm[k];
+        /* on: OC2A connected non-inverting (COM2A = 2) in fast PWM (WGM 3), clocked */
+        bool on = (w->tccr2a & 0xC3u) == 0x83u && (w->tccr2b & 0x0Fu) != 0;
+        fprintf(out, "pwm: %d: TCCR2A=0x%02x TCCR2B=0x%02x OCR2A=%u enable=%d dir=%d", k,
+                w->tccr2a, w->tccr2b, w->ocr2a, (w->portc >> SP_EN_BIT) & 1,
+                (w->portc >> SP_DIR_BIT) & 1);
+        if (on)
+            fprintf(out, " duty %u/256\n", w->ocr2a + 1u);
+        else
+            fprintf(out, " off\n");
     }
     if (g.min_sp != UINT64_MAX)
         fprintf(out, "stack: lowest SP 0x%04llx (%llu bytes below the top of RAM 0x08ff)%s\n",

@@ -7,8 +7,9 @@ protocols): send-response (one line, then wait for its ok / error:N) and charact
 128-byte receive buffer). Written from that description, not from Grbl's stream.py.
 
 usage: grbl_client.py PTY|HOST:PORT COMMAND ...
-  stream FILE [--method simple|counting] [--hold-after N] [--status-every N]
-        streams FILE; prints one line per error ("error: line L: error:N"), the first status
+  stream FILE [--method simple|counting|burst] [--hold-after N] [--status-every N]
+        streams FILE (burst: character counting with the lines that fit written together, so
+        the front end never sees a pause between them); prints one line per error ("error: line L: error:N"), the first status
         seen while running ("running: <...>"), with --hold-after N sends ! after N lines,
         reports "held: <...>" once the state is Hold:0 and the position has stopped, then ~;
         at the end waits for Idle and prints "final: <...>" and "acks: OK ERR".
@@ -195,12 +196,19 @@ def stream(g, lines, method, hold_after, status_every):
             acks["err"] += 1
             print("error: line %d: %s" % (num, line), flush=True)
 
+    burst = b""
     for k, line in enumerate(lines, 1):
         data = (line + "\n").encode()
-        if method == "counting":
+        if method in ("counting", "burst"):
             while sent and sum(n for _, n in sent) + len(data) > RX_SIZE - 1:
+                if burst:
+                    g.write(burst)
+                    burst = b""
                 take(g.need())
         sent.append((k, len(data)))
+        if method == "burst":
+            burst += data
+            continue
         g.write(data)
         if method == "simple":
             while sent:
@@ -211,6 +219,8 @@ def stream(g, lines, method, hold_after, status_every):
             while sent:
                 take(g.need())
             hold_and_resume(g)
+    if burst:
+        g.write(burst)
     while sent:
         take(g.need())
     if not seen_run:

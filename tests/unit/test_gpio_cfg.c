@@ -163,6 +163,44 @@ static void test_errors(void **state)
     assert_string_equal(err, "/nonexistent/m.ini:0: cannot read the machine file");
 }
 
+/* The inputs: defaults (none wired, every polarity active low), each key, the state path. */
+static void test_input_keys(void **state)
+{
+    (void)state;
+    cs_machine_t m;
+    cs_machine_ini_default(&m);
+    cs_gpio_cfg_t c;
+    char err[256];
+    cs_gpio_cfg_default(&c, &m);
+    assert_false(cs_gpio_cfg_has_inputs(&c));
+    assert_true(c.limit_active_low && c.probe_active_low && c.estop_active_low);
+    assert_string_equal(c.state, "");
+    const char *t = "[gpio]\nx_min = 5\nx_max = 6\ny_min = 7\nz_max = 13\nprobe = 19\n"
+                    "estop = 26\nlimit_active_low = no\nprobe_active_low = 0\n"
+                    "estop_active_low = yes\nstate = /run/cs.state\n";
+    assert_int_equal(cs_gpio_cfg_parse(t, "i.ini", &m, &c, err, sizeof err), 0);
+    assert_true(cs_gpio_cfg_has_inputs(&c));
+    assert_int_equal(c.lim_min[0], 5);
+    assert_int_equal(c.lim_max[0], 6);
+    assert_int_equal(c.lim_min[1], 7);
+    assert_int_equal(c.lim_max[1], -1);
+    assert_int_equal(c.lim_min[2], -1);
+    assert_int_equal(c.lim_max[2], 13);
+    assert_int_equal(c.probe, 19);
+    assert_int_equal(c.estop, 26);
+    assert_false(c.limit_active_low);
+    assert_false(c.probe_active_low);
+    assert_true(c.estop_active_low);
+    assert_string_equal(c.state, "/run/cs.state");
+    assert_int_equal(cs_gpio_cfg_parse("[gpio]\nprobe = 4\nz_min = 4\n", "d.ini", &m, &c, err,
+                                       sizeof err),
+                     -1);
+    assert_string_equal(err, "d.ini:3: [gpio] z_min: line 4 is already probe");
+    assert_int_equal(cs_gpio_cfg_parse("[gpio]\nestop = x\n", "e.ini", &m, &c, err, sizeof err),
+                     -1);
+    assert_string_equal(err, "e.ini:2: [gpio] estop: expected a line offset 0..65535 (or none)");
+}
+
 static void test_chip_names(void **state)
 {
     (void)state;
@@ -200,6 +238,7 @@ int main(void)
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_every_key),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_input_keys),
         cmocka_unit_test(test_chip_names),
         cmocka_unit_test(test_machine_reader_accepts_the_section),
     };

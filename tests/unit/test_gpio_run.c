@@ -6,8 +6,9 @@
  * configured width; DIR stable at least the set-up time before every STEP rise; edges in order
  * and never before their planned time; ENABLE on before the first step and off at the end.
  * Hold (slow down, stop at a segment end), stop at once and resume. The edge timing error is
- * printed, not asserted (timing goals: tests/bench/bench_gpio.c). Also the recorder itself and
- * the message for a missing chip. */
+ * printed, not asserted (timing goals: tests/bench/bench_gpio.c). Also the recorder itself, the
+ * message for a missing chip, and the inputs (the recorder's simulated switches, probe and e-stop
+ * stopping the thread on the very step that trips them). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -19,12 +20,16 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
+#include "cs_ctlcfg.h"
 #include "cs_gpio_cfg.h"
+#include "cs_gpio_in.h"
 #include "cs_gpio_io.h"
 #include "cs_gpio_run.h"
 #include "cs_machine_ini.h"
 #include "cs_motion.h"
+#include "cs_proto.h"
 #include "cs_sim.h"
 
 /* A job of straight moves (mm, 4 axes) planned whole: the segments `curvestep plan` would give. */
@@ -183,6 +188,9 @@ static void report_timing(const char *what, decoded_t *d)
 
 /* Runs segs[first..n) on the step thread through a recorder; waits (bounded) for the end, or
  * asks for a hold of `hold_level` after hold_after_ms. */
+/* The inputs run_job hands the thread (test_inputs_trip sets them; none otherwise). */
+static cs_gpio_run_opts_t g_in_opts;
+
 static void run_job(const cs_machine_t *m, const cs_gpio_cfg_t *cfg, const cs_segment_t *segs,
                     size_t n, size_t first, bool realtime, int hold_level, int hold_after_ms,
                     cs_gpio_io_t *io, cs_gpio_run_t *r)
@@ -198,6 +206,11 @@ static void run_job(const cs_machine_t *m, const cs_gpio_cfg_t *cfg, const cs_se
     o.nsegs = n;
     o.first = first;
     o.realtime = realtime;
+    o.in = g_in_opts.in;
+    o.watch = g_in_opts.watch;
+    o.release = g_in_opts.release;
+    o.hard_limits = g_in_opts.hard_limits;
+    memcpy(o.start_pos, g_in_opts.start_pos, sizeof o.start_pos);
     assert_int_equal(cs_gpio_run_start(r, &o), 0);
     int64_t t_start = cs_gpio_io_now_ns();
     bool held = false;
@@ -579,6 +592,85 @@ static void test_missing_chip(void **state)
 }
 
 /* The histogram quantiles: upper bounds within a factor of 2, never above the max. */
+/* One run with the recorder's simulated inputs: the outcome, the trip, the steps on the lines. */
+static void run_inputs(const cs_machine_t *m, const cs_ctlcfg_t *ctl, const char *estop,
+                       const double (*pts)[4], size_t npts, int32_t start_x, uint16_t watch,
+                       cs_gpio_run_t *r, cs_gpio_io_t *io)
+{
+    cs_gpio_cfg_t cfg;
+    cs_gpio_cfg_default(&cfg, m);
+    cs_motion_t mo;
+    plan(m, pts, npts, 80, &mo);
+    static cs_gpio_in_t in;
+    cs_gpio_in_open_sim(&in, m, ctl, NULL, estop);
+    memset(&g_in_opts, 0, sizeof g_in_opts);
+    g_in_opts.in = &in;
+    g_in_opts.watch = watch;
+    g_in_opts.hard_limits = true;
+    g_in_opts.start_pos[0] = start_x;
+    run_job(m, &cfg, mo.segs.v, mo.segs.n, 0, false, 0, 0, io, r);
+    memset(&g_in_opts, 0, sizeof g_in_opts);
+    cs_motion_free(&mo);
+}
+
+/* x rises in the record (every one counted, so a step after the trip would show). */
+static uint64_t x_rises(const cs_gpio_io_t *io)
+{
+    uint64_t n = 0;
+    for (size_t k = 0; k < io->nrec; k++)
+        if ((io->rec[k].mask & 1u) && (io->rec[k].levels & 1u)) /* line 0: x_step */
+            n++;
+    return n;
+}
+
+/* Inputs on the step thread: a max switch at 12.5 mm (80 steps/mm: active from step 1000 on)
+ * stops a 30 mm move on exactly its 1000th step with ALARM:1 and the x max bit; started 900
+ * steps along, on the 100th; the probe surface at z = -2 mm (the watched input) stops a move
+ * down on step 160 with no alarm code; an e-stop pressed before the start: no step at all. */
+static void test_inputs_trip(void **state)
+{
+    (void)state;
+    cs_machine_t m;
+    cs_machine_ini_default(&m);
+    cs_ctlcfg_t ctl;
+    cs_ctlcfg_default(&ctl);
+    ctl.has_max[0] = true;
+    ctl.max_mm[0] = 12.5;
+    ctl.has_probe = true;
+    ctl.probe_z = -2;
+    static const double x30[][4] = {{30, 0, 0, 0}};
+    static const double zdown[][4] = {{0, 0, -5, 0}};
+    cs_gpio_run_t r;
+    cs_gpio_io_t io;
+    run_inputs(&m, &ctl, NULL, x30, 1, 0, 0, &r, &io);
+    assert_int_equal(r.outcome, CS_GPIO_RUN_TRIPPED);
+    assert_int_equal(r.trip_code, CS_PROTO_ALARM_HARD_LIMIT);
+    assert_int_equal(r.trip_inputs, CS_PROTO_IN_MAX(0));
+    assert_int_equal(r.pos[0], 1000);
+    assert_int_equal(x_rises(&io), 1000);
+    cs_gpio_io_free(&io);
+    run_inputs(&m, &ctl, NULL, x30, 1, 900, 0, &r, &io);
+    assert_int_equal(r.outcome, CS_GPIO_RUN_TRIPPED);
+    assert_int_equal(r.pos[0], 100);
+    assert_int_equal(x_rises(&io), 100);
+    cs_gpio_io_free(&io);
+    run_inputs(&m, &ctl, NULL, zdown, 1, 0, CS_PROTO_IN_PROBE, &r, &io);
+    assert_int_equal(r.outcome, CS_GPIO_RUN_TRIPPED);
+    assert_int_equal(r.trip_code, 0);
+    assert_int_equal(r.pos[2], -160);
+    cs_gpio_io_free(&io);
+    char estop[] = "/tmp/cs_test_gpio_estopXXXXXX";
+    int fd = mkstemp(estop);
+    assert_true(fd >= 0);
+    run_inputs(&m, &ctl, estop, x30, 1, 0, 0, &r, &io);
+    assert_int_equal(r.outcome, CS_GPIO_RUN_TRIPPED);
+    assert_int_equal(r.trip_code, CS_PROTO_ALARM_ESTOP);
+    assert_int_equal(r.pos[0], 0);
+    assert_int_equal(x_rises(&io), 0);
+    cs_gpio_io_free(&io);
+    unlink(estop);
+}
+
 static void test_late_quantile(void **state)
 {
     (void)state;
@@ -600,6 +692,7 @@ int main(void)
         cmocka_unit_test(test_recorder),
         cmocka_unit_test(test_missing_chip),
         cmocka_unit_test(test_late_quantile),
+        cmocka_unit_test(test_inputs_trip),
         cmocka_unit_test(test_thread_matches_simulator),
         cmocka_unit_test(test_thread_4_axes_inverted_long_setup),
         cmocka_unit_test(test_hold_stops_at_a_segment_end),

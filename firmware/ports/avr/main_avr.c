@@ -12,15 +12,21 @@
 
 static cs_machine_t machine;
 static cs_fw_app_t app;
-/* power-up SRAM contents: noise on a real chip (zeros in simavr), mixed into the boot id; a warm
- * reset keeps them, and the value written back makes the next boot id differ */
-__attribute__((section(".noinit"))) static uint32_t noise[8];
-
+/* Power-up SRAM contents: noise on a real chip (zeros in simavr), mixed into the boot id. Read
+ * from the first MAIN_AVR_NOISE_WORDS words of free RAM past the static data (__heap_start, the
+ * avr-libc linker script's end of .noinit; no heap here), which the C start-up code never clears
+ * and the stack, growing down from the top, has not reached yet: the 32 bytes of a .noinit array
+ * without taking them from the static budget (docs/firmware-avr.md, "The 2 KB build"). A warm
+ * reset keeps them (unless the stack went that deep since), and the value written back makes the
+ * next boot id differ. */
+#define MAIN_AVR_NOISE_WORDS 8u
+extern uint8_t __heap_start;
 int main(void)
 {
     port_init();
     uint32_t boot = 2166136261u; /* FNV-1a over the noise */
-    for (unsigned i = 0; i < sizeof noise / sizeof noise[0]; i++)
+    volatile uint32_t *noise = (volatile uint32_t *)(void *)&__heap_start;
+    for (unsigned i = 0; i < MAIN_AVR_NOISE_WORDS; i++)
         boot = (boot ^ noise[i]) * 16777619u;
     boot ^= port_ticks_now();
     noise[0] = boot + 1u;

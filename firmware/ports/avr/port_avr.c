@@ -18,6 +18,8 @@
 #include <avr/interrupt.h>
 #include <avr/io.h>
 
+#include "cs_proto.h"
+
 CS_STATIC_ASSERT((PORT_AVR_RX_RING & (PORT_AVR_RX_RING - 1)) == 0 && PORT_AVR_RX_RING <= 256,
                  avr_rx_ring_pow2);
 CS_STATIC_ASSERT((PORT_AVR_TX_RING & (PORT_AVR_TX_RING - 1)) == 0 && PORT_AVR_TX_RING <= 256,
@@ -65,11 +67,15 @@ static volatile uint8_t rx_head, rx_tail; /* head: RX ISR only; tail: main loop 
 static volatile uint8_t tx_buf[PORT_AVR_TX_RING];
 static volatile uint8_t tx_head, tx_tail; /* head: main loop only; tail: UDRE ISR only */
 
+static inline void end_pulse(uint16_t t0);
+
 /* Axis mask (bit i = axis i) -> PORTD bits at bit0. */
 static inline uint8_t lines(uint8_t mask, uint8_t bit0)
 {
     return (uint8_t)((uint8_t)(mask & 0x07u) << bit0);
 }
+
+static void ctl_pins_init(void);
 
 void port_init(void)
 {
@@ -80,6 +86,7 @@ void port_init(void)
     DDRD = (uint8_t)(DDRD | STEP_LINES | DIR_LINES);
     PORTB = (uint8_t)(PORTB & (uint8_t) ~(EN_LINE | LED_LINE));
     DDRB = (uint8_t)(DDRB | EN_LINE | LED_LINE);
+    ctl_pins_init();
     /* Timer1: normal mode (free-running 0..0xFFFF), clock / 8, overflow interrupt on; the
      * compare A interrupt stays off until port_timer_arm */
     TCCR1A = 0;
@@ -200,6 +207,15 @@ void port_timer_stop(void)
     uint8_t s = SREG;
     cli();
     stop_timer();
+    /* the step the executor computed last and counted, still pending in the pipeline (see the
+     * top of this file): emitted now, so the pins end where the executor's count does (a hard
+     * limit or a probe contact halts it from an input interrupt) */
+    uint8_t b = pend_step;
+    pend_step = 0;
+    if (b != 0) {
+        PORTD = (uint8_t)(PORTD | b);
+        end_pulse(TCNT1);
+    }
     SREG = s;
 }
 
@@ -262,6 +278,7 @@ void port_pen_set(uint16_t pulse_us)
     cli();
     if (servo_counts == 0 && c != 0) { /* first setting: start the train, rising soon */
         PORTB = (uint8_t)(PORTB & (uint8_t)~SERVO_PIN);
+        PCMSK0 = (uint8_t)(PCMSK0 & (uint8_t)~SERVO_PIN); /* D10 is no y switch any more */
         DDRB = (uint8_t)(DDRB | SERVO_PIN);
         OCR1B = (uint16_t)(TCNT1 + 64u);
         TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1B_SET) | COM1B_SET);
@@ -288,28 +305,140 @@ ISR(TIMER1_COMPB_vect)
     }
 }
 
-/* The machine's inputs: none wired in this port (its build leaves machine control out,
- * CS_FW_CTL=0: the ATmega328P's 2 KB of RAM are full; docs/firmware.md, "Machine control"):
- * every input reads inactive, no edge is reported. */
+/* The machine's inputs (Grbl 1.1's Uno pins, port_avr.h): one switch per axis on PB1 / PB2 / PB4
+ * (D9, D10, D12), read as both that axis's min and max bits (Grbl wires one pin per axis, for
+ * either end: homing seeks the end the HOME names, a hard limit trips on either), the probe on
+ * PC5 (A5), the e-stop on PC0 (A0). Pin-change interrupts PCINT0 (port B) and PCINT1 (port C)
+ * report changes; an AVR interrupt never preempts another (the I bit is clear inside one), so the
+ * hook cannot preempt the step interrupt, as port.h asks. Once a PEN message has started the
+ * servo's pulse train, D10 is its output (OC1B) and the y switch reads released. */
+#define LIM_X_PIN  ((uint8_t)(1u << PB1))
+#define LIM_Y_PIN  ((uint8_t)(1u << PB2))
+#define LIM_Z_PIN  ((uint8_t)(1u << PB4))
+#define LIM_PINS   ((uint8_t)(LIM_X_PIN | LIM_Y_PIN | LIM_Z_PIN))
+#define PROBE_PIN  ((uint8_t)(1u << PC5))
+#define ESTOP_PIN  ((uint8_t)(1u << PC0))
+#define CTL_C_PINS ((uint8_t)(PROBE_PIN | ESTOP_PIN))
+#define SP_EN_PIN  ((uint8_t)(1u << PC3)) /* A3: spindle enable, high = on */
+#define SP_DIR_PIN ((uint8_t)(1u << PC4)) /* A4: spindle direction, high = counter-clockwise */
+#define SP_PWM_PIN ((uint8_t)(1u << PB3)) /* D11: OC2A */
+CS_STATIC_ASSERT(((LIM_PINS | SERVO_PIN | SP_PWM_PIN | EN_LINE | LED_LINE) & 0xC0u) == 0 &&
+                     (LIM_PINS & (SP_PWM_PIN | EN_LINE | LED_LINE)) == 0 &&
+                     (CTL_C_PINS & (SP_EN_PIN | SP_DIR_PIN)) == 0,
+                 avr_ctl_pins_distinct);
+#if PORT_AVR_INPUTS_ACTIVE_LOW
+#define ACTIVE(v) ((uint8_t) ~(v))
+#else
+#define ACTIVE(v) ((uint8_t)(v))
+#endif
+
+static void (*in_fn)(void *ctx, uint16_t bits);
+static void *in_ctx;
+static uint16_t in_last;
+
 uint16_t port_inputs_read(void)
 {
-    return 0;
+    uint8_t b = (uint8_t)(ACTIVE(PINB) & LIM_PINS);
+    if (servo_counts != 0)
+        b = (uint8_t)(b & (uint8_t)~LIM_Y_PIN); /* D10 drives the pen servo */
+    uint8_t c = (uint8_t)(ACTIVE(PINC) & CTL_C_PINS);
+    uint16_t in = 0;
+    if (b & LIM_X_PIN)
+        in |= (uint16_t)(CS_PROTO_IN_MIN(0) | CS_PROTO_IN_MAX(0));
+    if (b & LIM_Y_PIN)
+        in |= (uint16_t)(CS_PROTO_IN_MIN(1) | CS_PROTO_IN_MAX(1));
+    if (b & LIM_Z_PIN)
+        in |= (uint16_t)(CS_PROTO_IN_MIN(2) | CS_PROTO_IN_MAX(2));
+    if (c & PROBE_PIN)
+        in |= CS_PROTO_IN_PROBE;
+    if (c & ESTOP_PIN)
+        in |= CS_PROTO_IN_ESTOP;
+    return in;
+}
+
+/* The bits changed since last reported: tell the application. Interrupts masked. */
+static void inputs_report(void)
+{
+    uint16_t b = port_inputs_read();
+    if (b == in_last)
+        return;
+    in_last = b;
+    if (in_fn != NULL)
+        in_fn(in_ctx, b);
 }
 
 void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
 {
-    (void)fn;
-    (void)ctx;
+    uint8_t s = SREG;
+    cli();
+    in_fn = fn;
+    in_ctx = ctx;
+    in_last = 0;
+    inputs_report(); /* what is active already is a change from nothing */
+    SREG = s;
 }
 
-/* The spindle / laser output: kept for a debugger, no PWM pin driven yet. */
-static volatile uint16_t spindle_duty;
-static volatile uint8_t spindle_mode;
+ISR(PCINT0_vect)
+{
+    inputs_report();
+}
+
+ISR(PCINT1_vect)
+{
+    inputs_report();
+}
+
+/* The spindle / laser output, Grbl's: Timer2 fast PWM (WGM 3, TOP 0xFF) at F_CPU / 8 / 256 =
+ * 7.8 kHz on OC2A (D11), non-inverting: the pin is high for OCR2A + 1 of every 256 counts
+ * (ATmega328P data sheet 18.7.3), so n/256 with n = round(duty x 256 / 1000); n = 0 (or mode
+ * off) disconnects OC2A and holds the pin low (OCR2A = 0 would still pulse 1/256). Timer2 runs
+ * only while the output is on. Enable on A3, direction on A4. */
+#define SP_TCCR2A_ON ((uint8_t)((1u << COM2A1) | (1u << WGM21) | (1u << WGM20)))
+#define SP_TCCR2B_ON ((uint8_t)(1u << CS21))
+#define SP_STEPS     256u /* Timer2's counts a period */
+#define SP_DUTY_FULL 1000u
 
 void port_spindle_set(uint16_t duty, uint8_t mode)
 {
-    spindle_duty = duty;
-    spindle_mode = mode;
+    uint16_t d = duty > SP_DUTY_FULL ? (uint16_t)SP_DUTY_FULL : duty;
+    uint16_t n = (uint16_t)(((uint32_t)d * SP_STEPS + SP_DUTY_FULL / 2u) / SP_DUTY_FULL);
+    uint8_t s = SREG;
+    cli();
+    if (mode == CS_PROTO_SPINDLE_OFF || n == 0) {
+        TCCR2A = 0;
+        TCCR2B = 0;
+        PORTB = (uint8_t)(PORTB & (uint8_t)~SP_PWM_PIN);
+    } else {
+        OCR2A = (uint8_t)(n - 1u);
+        TCCR2A = SP_TCCR2A_ON;
+        TCCR2B = SP_TCCR2B_ON;
+    }
+    uint8_t c = (uint8_t)(PORTC & (uint8_t) ~(SP_EN_PIN | SP_DIR_PIN));
+    if (mode != CS_PROTO_SPINDLE_OFF)
+        c = (uint8_t)(c | SP_EN_PIN);
+    if (mode == CS_PROTO_SPINDLE_CCW)
+        c = (uint8_t)(c | SP_DIR_PIN);
+    PORTC = c;
+    SREG = s;
+}
+
+/* Inputs with the pull-ups on (PORT_AVR_INPUTS_ACTIVE_LOW: switches to ground, Grbl's wiring)
+ * or off (external pull-downs), their pin-change interrupts on; the spindle's pins outputs, low.
+ * Interrupts masked. */
+static void ctl_pins_init(void)
+{
+    DDRB = (uint8_t)((DDRB & (uint8_t)~LIM_PINS) | SP_PWM_PIN);
+    DDRC = (uint8_t)((DDRC & (uint8_t)~CTL_C_PINS) | SP_EN_PIN | SP_DIR_PIN);
+    PORTB = (uint8_t)(PORTB & (uint8_t)~SP_PWM_PIN);
+    PORTC = (uint8_t)(PORTC & (uint8_t) ~(SP_EN_PIN | SP_DIR_PIN));
+#if PORT_AVR_INPUTS_ACTIVE_LOW
+    PORTB = (uint8_t)(PORTB | LIM_PINS);
+    PORTC = (uint8_t)(PORTC | CTL_C_PINS);
+#endif
+    PCMSK0 = LIM_PINS;
+    PCMSK1 = CTL_C_PINS;
+    PCIFR = (uint8_t)((1u << PCIF0) | (1u << PCIF1));
+    PCICR = (uint8_t)((1u << PCIE0) | (1u << PCIE1));
 }
 
 void port_dir_set(uint8_t mask)

@@ -46,10 +46,19 @@
 #endif
 
 /* Pins (Grbl 1.1, Uno): STEP x/y/z = PD2/PD3/PD4, DIR x/y/z = PD5/PD6/PD7, stepper enable = PB0
- * (active low, as on the CNC shield: low = drivers on). Three axes; an a axis has no pin. */
+ * (active low, as on the CNC shield: low = drivers on). Three axes; an a axis has no pin.
+ * Machine control: limit / home switches x/y/z = PB1/PB2/PB4 (D9, D10, D12), probe PC5 (A5),
+ * e-stop PC0 (A0: Grbl's reset pin), spindle PWM PB3 (D11, OC2A on Timer2), spindle enable PC3
+ * (A3), direction PC4 (A4); the pen servo keeps OC1B (D10, then no y switch). */
 #define PORT_AVR_AXES      3
 #define PORT_AVR_STEP_BIT0 2
 #define PORT_AVR_DIR_BIT0  5
+
+/* 1 (Grbl's wiring): switches, probe and e-stop pull their pin to ground, the internal pull-ups
+ * hold it high otherwise, so low = active; 0: active high (external pull-downs). */
+#ifndef PORT_AVR_INPUTS_ACTIVE_LOW
+#define PORT_AVR_INPUTS_ACTIVE_LOW 1
+#endif
 
 /* Diagnostics, for tests and benchmarks (read with interrupts masked or when idle). */
 typedef struct {

@@ -1,0 +1,34 @@
+/* cs_gpio_ctl: the machine-control commands over the GPIO link (`curvestep home|probe|jog|unlock
+ * --gpio CHIP`): the device's rules (cs_fw_ctl: homing's seek, back-off, latch and pull-off,
+ * G38.2-G38.5 probing, the alarm and its unlock) carried out by the host on the step thread with
+ * the link's inputs watched (cs_gpio_link), the alarm and the position kept in the GPIO state
+ * file between commands. Output lines and exit codes as over the serial link (cs_ctl_cmd.c).
+ * Host only. */
+#ifndef CS_GPIO_CTL_H
+#define CS_GPIO_CTL_H
+
+#include <stdbool.h>
+
+#include "cs_ctlcfg.h"
+#include "cs_machine.h"
+
+typedef struct {
+    const char *who;          /* "home", "probe", "jog", "unlock" */
+    const char *chip;         /* --gpio CHIP or record:FILE */
+    const char *machine_file; /* NULL: the built-in machine */
+    const cs_machine_t *m;
+    const cs_ctlcfg_t *ctl; /* [homing] (order: the axes to home) */
+    double feed;            /* probe, jog: mm/s */
+    double xyz[3];          /* probe, jog: the target, machine mm */
+    bool away, no_error;    /* probe: G38.4/.5, G38.3/.5 */
+} cs_gpio_ctl_args_t;
+
+/* Each runs the command and returns its exit status (0 done, 1 bad machine file, 2 usage, 3
+ * internal, 4 chip, 7 an alarm or a refusal, 8 Ctrl-C). Main thread; installs a SIGINT handler
+ * for its duration. */
+int cs_gpio_ctl_home(const cs_gpio_ctl_args_t *a);
+int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a);
+int cs_gpio_ctl_jog(const cs_gpio_ctl_args_t *a);
+int cs_gpio_ctl_unlock(const cs_gpio_ctl_args_t *a);
+
+#endif
