@@ -268,8 +268,10 @@ void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes,
     o->tick_hz = tick_hz;
     o->link.keepalive = 500000;
     cs_stream_link_timing(&o->link, 0);
-    o->hello_ms = 5000;
-    o->status_ms = 3000;
+    /* as long as the link's own give-up (30 s of silence): a device starved of the CPU on a
+     * loaded machine is late, not gone (the link's backoff keeps probing it meanwhile) */
+    o->hello_ms = CS_LINKTIME_GIVE_UP_S * 1000u;
+    o->status_ms = CS_LINKTIME_GIVE_UP_S * 1000u;
 }
 
 void cs_stream_link_timing(cs_link_cfg_t *c, uint32_t bits_per_s)
@@ -357,8 +359,10 @@ static int pump_out(run_t *s, uint32_t now)
             return 0;
         if (e == CS_ERR_TIMEOUT) {
             snprintf(s->r->why, sizeof s->r->why,
-                     "the device stopped answering (%u retransmission timeouts of %u ms)",
-                     (unsigned)s->o->link.max_retries + 1u, (unsigned)s->o->link.rto / 1000u);
+                     "the device stopped answering (silent for %u s: %u retransmission timeouts, "
+                     "%u ms doubling up to %u ms)",
+                     (unsigned)(s->o->link.give_up / 1000000u), (unsigned)s->link.retries + 1u,
+                     (unsigned)s->o->link.rto / 1000u, (unsigned)s->o->link.rto_max / 1000u);
             finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
             return 0;
         }

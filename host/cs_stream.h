@@ -125,7 +125,7 @@ typedef struct {
 } cs_stream_result_t;
 
 /* Defaults: link timing for a pty at memory speed (cs_linktime_link(.., 0, 1000000)), keepalive
- * 500 ms, HELLO within 5 s, final STATUS within 3 s. */
+ * 500 ms, HELLO and the final STATUS each within 30 s (the link's give-up time). */
 void cs_stream_opts_default(cs_stream_opts_t *o, cs_serial_t *ser, uint8_t axes, uint32_t tick_hz);
 /* The device's identity (HELLO, or the Modbus status block) against the machine and the job:
  * true with a sentence in why when the axes, the tick rate (segments only) or the capabilities

@@ -43,6 +43,7 @@ struct cs_sim_motion {
     /* pacing */
     double anchor_wall;
     uint64_t anchor_ticks;
+    double last_wall; /* wall time of the last advance, 0 before the first */
     bool dry; /* the executor ran dry after executing something */
     double dry_since;
     uint8_t inv; /* DIR lines inverted (port_posix_reset) */
@@ -126,6 +127,8 @@ static void sync_res(sim_dev_t *d)
     r->out_of_order = d->app.out_of_order;
 }
 
+#define SIM_STALL_S 0.05
+
 /* Runs the executor up to wall time `wall` (simulated time = speed x wall time since the executor
  * last started), feeding it from the motion side between runs as the main loop would. */
 static void advance(sim_dev_t *d, double wall)
@@ -138,6 +141,14 @@ static void advance(sim_dev_t *d, double wall)
      * idle executor restarts the clock's anchor (time spent waiting for the host is skipped) */
     bool held_rest = cs_stepper_idle(&mo->st) && mo->hold.hold && !cs_fw_motion_done(mo);
     if (d->cfg->speed > 0) {
+        /* A simulator not scheduled for a while (a loaded machine) is a device whose clock stood
+         * still meanwhile: wall time beyond SIM_STALL_S between two passes (the main loop waits
+         * at most 5 ms) is skipped, so a starved simulator neither runs its executor ahead of
+         * the link nor moves its trace. A host starved meanwhile still lets the queue run dry,
+         * and that is reported. */
+        if (d->last_wall > 0 && wall - d->last_wall > SIM_STALL_S && !held_rest)
+            d->anchor_wall += wall - d->last_wall - SIM_STALL_S;
+        d->last_wall = wall;
         if (cs_stepper_idle(&mo->st) && !held_rest) {
             d->anchor_wall = wall;
             d->anchor_ticks = port_posix_now();
@@ -149,11 +160,17 @@ static void advance(sim_dev_t *d, double wall)
         if (held_rest)
             port_posix_idle_until(target);
     }
+    /* At speed, in steps of 1 ms of simulated time with the motion side polled between them, as
+     * a device's main loop keeps the executor's ring fed: a simulator starved of the CPU for a
+     * while catches up without draining the ring while its queue holds segments (which would
+     * restart the executor a tick late, moving every later edge, with no gap to report). */
+    uint64_t chunk = d->m->tick_hz / 1000u > 0 ? d->m->tick_hz / 1000u : 1u;
     for (int k = 0; k < passes; k++) {
         cs_fw_motion_poll(mo);
         if (cs_stepper_idle(&mo->st))
             break;
-        port_posix_run(target);
+        uint64_t now = port_posix_now();
+        port_posix_run(d->cfg->speed > 0 && target > now + chunk ? now + chunk : target);
         if (port_posix_now() >= target)
             break;
     }

@@ -75,7 +75,7 @@ typedef struct {
     cs_fw_motion_cfg_t motion;
     uint32_t (*clock)(void); /* the link's clock (port_ticks_now on a board) */
     uint32_t clock_hz;       /* its ticks per second */
-    cs_link_cfg_t link;      /* rto, nak_holdoff in clock ticks; keepalive; max_retries */
+    cs_link_cfg_t link;      /* rto, rto_max, give_up, nak_holdoff, keepalive: ticks */
     uint32_t status_ms;      /* STATUS period while running or held (idle: 250 ms) */
 } cs_fw_app_cfg_t;
 

@@ -170,8 +170,10 @@ int64_t cs_fixed_mul64_q30(int64_t x, int32_t t)
     /* |x| = xh * 2^32 + xl: |x| * |t| / 2^30 = xh * |t| * 4 + xl * |t| / 2^30, and only the
      * second term needs rounding. Each partial product stays below 2^62. */
     uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
-    uint64_t at = t < 0 ? (uint64_t)0 - (uint64_t)(int64_t)t : (uint64_t)t;
-    uint64_t hi = (m >> 32) * at, lo = (m & 0xFFFFFFFFu) * at;
+    /* |t| <= 2^31 and both halves of m fit 32 bits: two 32x32 -> 64 products (UMULL on a
+     * Cortex-M3), not 64x64 ones. */
+    uint32_t at = t < 0 ? 0u - (uint32_t)t : (uint32_t)t;
+    uint64_t hi = (uint64_t)(uint32_t)(m >> 32) * at, lo = (uint64_t)(uint32_t)m * at;
     uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
     return ((x < 0) != (t < 0)) ? -(int64_t)r : (int64_t)r;
 }

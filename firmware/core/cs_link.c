@@ -31,6 +31,22 @@ static bool elapsed(uint32_t now, uint32_t since, uint32_t span)
     return (uint32_t)(now - since) >= span;
 }
 
+/* Progress (the peer answered): the next timeout is rto again. */
+static void progress(cs_link_t *l)
+{
+    l->retries = 0;
+}
+
+/* The timeout after `retries` timeouts in a row: min(rto * 2^retries, rto_max), doubled step by
+ * step (no shift past 32 bits; at most 32 steps before the cap). */
+static uint32_t rto_now(const cs_link_t *l)
+{
+    uint32_t t = l->cfg.rto;
+    for (unsigned k = 0; k < l->retries && t < l->cfg.rto_max; k++)
+        t = t > l->cfg.rto_max / 2u ? l->cfg.rto_max : 2u * t;
+    return t;
+}
+
 static void tx_reset_ring(cs_link_t *l, uint32_t nonce, uint32_t now)
 {
     for (unsigned i = 0; i < CS_LINK_WINDOW; i++) {
@@ -46,14 +62,15 @@ static void tx_reset_ring(cs_link_t *l, uint32_t nonce, uint32_t now)
     l->nonce = nonce;
     l->ping_out = false;
     l->blocked = false;
-    l->retries = 0;
+    progress(l);
     l->timer_at = l->ping_at = l->heard_at = now;
 }
 
 cs_err_t cs_link_init(cs_link_t *l, const cs_link_cfg_t *cfg, uint32_t boot_id, uint32_t nonce,
                       uint16_t rx_first_seq, uint32_t now)
 {
-    if (l == NULL || cfg == NULL || cfg->rto == 0 || cfg->max_retries == 0 || nonce == 0)
+    if (l == NULL || cfg == NULL || cfg->rto == 0 || cfg->rto_max < cfg->rto ||
+        cfg->give_up == 0 || nonce == 0)
         return CS_ERR_ARG;
     *l = (cs_link_t){0};
     l->cfg = *cfg;
@@ -112,7 +129,7 @@ static cs_err_t tx_on_ack(cs_link_t *l, const cs_proto_ack_t *a, uint32_t now, c
         l->peer_boot = a->boot_id;
         l->state = CS_LINK_OPEN;
         l->ping_out = false;
-        l->retries = 0;
+        progress(l);
         l->timer_at = l->heard_at = now;
         ev->what |= CS_LINK_EV_OPEN;
         ev->new_boot = a->boot_id;
@@ -127,7 +144,7 @@ static cs_err_t tx_on_ack(cs_link_t *l, const cs_proto_ack_t *a, uint32_t now, c
     l->heard_at = now;
     if (l->ping_out && a->echo == l->nonce) {
         l->ping_out = false;
-        l->retries = 0;
+        progress(l);
     }
     uint16_t adv = seq_diff(a->next_expected, l->base);
     uint16_t out = seq_diff(l->next, l->base);
@@ -152,7 +169,7 @@ static cs_err_t tx_on_ack(cs_link_t *l, const cs_proto_ack_t *a, uint32_t now, c
             l->send_pos = a->next_expected; /* a rewind had not got that far yet */
         l->base = a->next_expected;
         l->credits = a->credits;
-        l->retries = 0;
+        progress(l);
         l->ping_out = false; /* the peer is alive: any probe is answered */
         l->timer_at = now;
     } else if (a->credits > l->credits) {
@@ -317,16 +334,20 @@ static cs_err_t emit_ping(cs_link_t *l, uint32_t now, const uint8_t **bytes, siz
     return emit_ctl(l, &m, bytes, len);
 }
 
-/* One more timeout without progress; false (and CLOSED) when the retries are used up. */
-static bool retry(cs_link_t *l)
+/* One more timeout without progress: false (and CLOSED) once the peer has been silent for
+ * give_up; else the next timeout doubles, capped at rto_max (exponential backoff: a peer starved
+ * of the CPU for seconds finds the link still open, and a dead one costs a few frames a second,
+ * not 200). */
+static bool retry(cs_link_t *l, uint32_t now)
 {
     inc(&l->stats.timeouts);
-    if (l->retries >= l->cfg.max_retries) {
+    if (elapsed(now, l->heard_at, l->cfg.give_up)) {
         l->state = CS_LINK_CLOSED;
         l->ping_out = false;
         return false;
     }
-    l->retries++;
+    if (l->retries != UINT8_MAX)
+        l->retries++;
     return true;
 }
 
@@ -351,9 +372,9 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
         return emit_ctl(l, &m, bytes, len);
     }
     if (l->state == CS_LINK_CONNECTING) {
-        if (l->ping_out && !elapsed(now, l->ping_at, l->cfg.rto))
+        if (l->ping_out && !elapsed(now, l->ping_at, rto_now(l)))
             return CS_END;
-        if (l->ping_out && !retry(l))
+        if (l->ping_out && !retry(l, now))
             return CS_ERR_TIMEOUT;
         return emit_ping(l, now, bytes, len);
     }
@@ -361,8 +382,8 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
         return CS_END;
     if (l->base != l->next) {
         /* Data outstanding: its retransmissions are the probe (no PING, one timer, one count). */
-        if (l->send_pos != l->base && elapsed(now, l->timer_at, l->cfg.rto)) {
-            if (!retry(l))
+        if (l->send_pos != l->base && elapsed(now, l->timer_at, rto_now(l))) {
+            if (!retry(l, now))
                 return CS_ERR_TIMEOUT;
             l->send_pos = l->base; /* go back N */
         }
@@ -383,9 +404,9 @@ cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uin
     /* Nothing to send: probe a silent peer when we wait for credits (the window update may have
      * been lost) or when keepalive says so; unanswered probes count as timeouts. */
     if (l->ping_out) {
-        if (!elapsed(now, l->ping_at, l->cfg.rto))
+        if (!elapsed(now, l->ping_at, rto_now(l)))
             return CS_END;
-        if (!retry(l))
+        if (!retry(l, now))
             return CS_ERR_TIMEOUT;
         return emit_ping(l, now, bytes, len);
     }

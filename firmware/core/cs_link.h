@@ -29,13 +29,20 @@ CS_STATIC_ASSERT(CS_LINK_WINDOW >= 1 && CS_LINK_WINDOW <= 128 &&
 /* Bytes of the largest link-control frame (ACK). */
 #define CS_LINK_CTL_WIRE CS_FRAME_WIRE_LEN(CS_PROTO_LEN_ACK)
 
-/* Timing, in the caller's ticks (any unit, uint32, wrapping is fine). */
+/* Timing, in the caller's ticks (any unit, uint32, wrapping is fine). Backoff (docs/protocol.md
+ * 3.3): the k-th timeout in a row without progress (k = 0, 1, ...) waits min(rto * 2^k, rto_max)
+ * after the frame or PING it covers was (re)sent; the first progress (an ACK that moves the
+ * window, or the echo of our PING) starts again at rto. The link is closed by the first timeout
+ * that finds the peer silent (no valid ACK from it since the link was opened or started) for
+ * give_up ticks, so a dead peer is declared so between give_up and give_up + rto_max after its
+ * last ACK. */
 typedef struct {
-    uint32_t rto;         /* retransmission timeout: > round trip + one window of frames, >= 1 */
+    uint32_t rto;         /* first retransmission timeout: > round trip + one window, >= 1 */
+    uint32_t rto_max;     /* cap of the doubled timeout, >= rto */
+    uint32_t give_up;     /* silence before the link is closed, >= 1 */
     uint32_t nak_holdoff; /* a NAK resends only if the frame it names went out this long ago:
                            * about one round trip (frame + ACK), so repeats are ignored */
     uint32_t keepalive;   /* silence from the peer before a PING probes it; 0 = no probing */
-    uint8_t max_retries;  /* timeouts in a row without progress before the link is closed, >= 1 */
 } cs_link_cfg_t;
 
 /* Sender states. */
@@ -98,10 +105,10 @@ typedef struct {
     uint32_t nonce;    /* of the outstanding or last PING; never 0 */
     bool ping_out;     /* a PING waits for its echo */
     bool blocked;      /* a send was refused for want of credits */
-    uint8_t retries;   /* timeouts in a row without progress */
+    uint8_t retries;   /* timeouts in a row without progress (saturating): the backoff's k */
     uint32_t timer_at; /* oldest frame last sent, or last progress */
     uint32_t ping_at;  /* PING last sent */
-    uint32_t heard_at; /* last valid ACK from the peer */
+    uint32_t heard_at; /* last valid ACK from the peer (or the start): silence for give_up */
     /* receiver */
     uint32_t boot_id;       /* our own boot id, in every ACK */
     uint16_t next_expected; /* next sequence to deliver */
@@ -113,7 +120,8 @@ typedef struct {
 
 /* Set up an endpoint: receiver expecting rx_first_seq, sender CONNECTING (its first poll sends a
  * PING with nonce). boot_id: our own random boot id; nonce: != 0, should differ per start.
- * CS_ERR_ARG for a NULL pointer, cfg->rto or cfg->max_retries of 0, or nonce 0. */
+ * CS_ERR_ARG for a NULL pointer, cfg->rto or cfg->give_up of 0, cfg->rto_max < cfg->rto, or
+ * nonce 0. */
 cs_err_t cs_link_init(cs_link_t *l, const cs_link_cfg_t *cfg, uint32_t boot_id, uint32_t nonce,
                       uint16_t rx_first_seq, uint32_t now);
 /* Restart the sender only (after RESET or CLOSED, or to start a new job): drops every queued
@@ -146,7 +154,7 @@ cs_err_t cs_link_send_msg(cs_link_t *l, const cs_proto_msg_t *m, uint16_t *seq);
 /* Next bytes to write to the transport: an ACK when one is due, else a PING when connecting or
  * probing, else the next new or retransmitted frame. CS_OK with *bytes and *len set (valid until
  * the next call), CS_END when nothing is to be written now, CS_ERR_TIMEOUT once when the peer has
- * stopped answering (state becomes CLOSED). Call it after feeding bytes and every few ticks.
+ * stopped answering for cfg.give_up (state becomes CLOSED). Call it after feeding bytes and every few ticks.
  * free_slots: as for cs_link_feed (sent as the credits of the ACK). */
 cs_err_t cs_link_poll(cs_link_t *l, uint32_t now, uint16_t free_slots, const uint8_t **bytes,
                       size_t *len);

@@ -2,7 +2,6 @@
  * docs/fixed-point.md, "Predicted-step tracer"). */
 #include "cs_predict.h"
 
-#include "cs_subdiv.h"
 
 #define F               CS_PREDICT_FRAC
 #define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
@@ -33,6 +32,13 @@ static uint64_t majorant(int64_t c1, int64_t c2)
     if (2 * q <= p)
         return same ? 456 * p + 272 * q : 456 * p - 190 * q;
     return same ? 416 * p + 352 * q : 426 * p - 130 * q;
+}
+
+/* a b for |a|, |b| < 2^31: one 32x32 -> 64 multiply (SMULL on a Cortex-M3, one call of the
+ * 32x32 product on the M0+) where int64 operands would take a 64x64 product. */
+static int64_t mul32(int32_t a, int32_t b)
+{
+    return (int64_t)a * b;
 }
 
 static uint64_t uabs64(int64_t v)
@@ -69,16 +75,35 @@ bool cs_predict_accepts(const cs_bezier_t *c)
     return true;
 }
 
-cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+/* What both begins share: the checks (tolerance, then the curve, then its range; a polynomial
+ * curve for cs_predict_begin, a conic for cs_predict_begin_conic) and the tracing state. */
+static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol, bool conic)
 {
     p->done = true;
     if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    if (!cs_predict_accepts(c))
+    if (!cs_predict_accepts(c) || c->rational != conic)
         return CS_ERR_UNSUPPORTED;
     for (unsigned i = 0; i <= c->degree; i++)
         if (!cs_fixed_vec_ok(&c->p[i]))
             return CS_ERR_RANGE;
+    p->t = 0;
+    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->thr = tol - CS_PREDICT_SLACK_LSB;
+    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
+    p->z = c->p[0].z;
+    p->end = c->p[c->degree];
+    return CS_OK;
+}
+
+static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
+static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
+
+cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_err_t e = begin_common(p, c, tol, false);
+    if (e != CS_OK)
+        return e;
     for (unsigned k = 0; k < 2; k++) {
         /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
         int64_t q[4] = {0, 0, 0, 0};
@@ -100,37 +125,53 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
         p->a[2][k] = a2 * ((int64_t)1 << F);
         p->a[3][k] = a3 * ((int64_t)1 << F);
     }
-    p->conic = c->rational;
-    for (unsigned i = 0; i <= 2 && p->conic; i++) {
+    p->next = next_poly;
+    p->done = false;
+    return CS_OK;
+}
+
+cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
+{
+    cs_err_t e = begin_common(p, c, tol, true);
+    if (e != CS_OK)
+        return e;
+    for (unsigned i = 0; i <= 2; i++) {
         int64_t w = c->w[i]; /* exact products: |w x| < 2^58 */
         p->h[i][0] = w * c->p[i].x;
         p->h[i][1] = w * c->p[i].y;
         p->h[i][2] = w;
     }
-    p->t = 0;
-    p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
-    p->thr = tol - CS_PREDICT_SLACK_LSB;
-    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
-    p->z = c->p[0].z;
-    p->end = c->p[c->degree];
+    p->next = next_conic;
     p->done = false;
     return CS_OK;
 }
 
-/* x t / 2^30 rounded half away from zero: bit for bit cs_fixed_mul64_q30, inlined with one
- * 128-bit multiply where the compiler has the type (64-bit hosts), the out-of-line 64x32
- * product in two halves elsewhere. Every Horner step of the tracer goes through it. */
-static int64_t mul_t(int64_t x, cs_param_t t)
+/* x t / 2^30 rounded half away from zero, for 0 <= t <= 2^30 (every parameter and step of the
+ * tracer) and |x| < 2^62: bit for bit cs_fixed_mul64_q30, inline. With |x| = xh 2^32 + xl the
+ * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
+ * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
+ * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
+/* Inline on cores with a 32x32 -> 64 multiply instruction (about 8 instructions a call saved on
+ * the M3, 32 calls a chord); out of line where it would be two libgcc calls (M0+, AVR): there the
+ * flash matters more. */
+#if defined(__GNUC__) && (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && \
+                                                        __ARM_ARCH_ISA_THUMB >= 2))
+#define MUL_T_INLINE __attribute__((always_inline)) inline
+#else
+#define MUL_T_INLINE
+#endif
+static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
+    uint64_t m = uabs64(x);
+    uint32_t ut = (uint32_t)t;
 #if defined(__SIZEOF_INT128__)
     __extension__ typedef unsigned __int128 u128_t;
-    uint64_t m = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
-    uint64_t at = t < 0 ? (uint64_t)0 - (uint64_t)(int64_t)t : (uint64_t)t;
-    uint64_t r = (uint64_t)(((u128_t)m * at + ((uint64_t)1 << 29)) >> 30);
-    return ((x < 0) != (t < 0)) ? -(int64_t)r : (int64_t)r;
+    uint64_t r = (uint64_t)(((u128_t)m * ut + ((uint64_t)1 << 29)) >> 30);
 #else
-    return cs_fixed_mul64_q30(x, t);
+    uint64_t hi = (uint64_t)(uint32_t)(m >> 32) * ut, lo = (uint64_t)(uint32_t)m * ut;
+    uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
 #endif
+    return x < 0 ? -(int64_t)r : (int64_t)r;
 }
 
 /* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
@@ -144,65 +185,43 @@ static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
     }
 }
 
-/* v / 2^s rounded half up, for |v| < 2^61 and 0 < s < 62, on v + 2^62 (non-negative, so no
- * >> of a negative value, implementation-defined in C99): branch-free, one shift. */
-#define RSH_BIAS ((uint64_t)1 << 62)
-static int64_t rsh_round(int64_t v, unsigned s)
+/* v / 2^s rounded half up, for 0 < s < 32 and a result that fits int32: the result's bits are
+ * bits s..s+31 of v + 2^(s-1) in two's complement (a logical and an arithmetic shift differ only
+ * in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by two
+ * constant-width shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and
+ * no negative value is shifted (implementation-defined in C99). */
+static int32_t rsh_round32(int64_t v, unsigned s)
 {
-    uint64_t u = (uint64_t)v + RSH_BIAS + ((uint64_t)1 << (s - 1));
-    return (int64_t)(u >> s) - (int64_t)(RSH_BIAS >> s);
+    uint64_t u = (uint64_t)v + ((uint64_t)1 << (s - 1));
+#if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
+    uint32_t r = (uint32_t)(u >> s);
+#else
+    uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
+    uint32_t r = (lo >> s) | (hi << (32 - s));
+#endif
+    return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
 }
-
-/* A trial step h = m 2^-s (Q30 when s = 30). Predicted steps are cut to SHORT_BITS significant
- * bits (a relative change below 2^-15, nothing to the chord count), so each product x h is one
- * native 64-bit multiply and a rounding shift (|x| < 2^45, m < 2^16: below 2^61) instead of a
- * 64x32 product in two halves; a step with more bits (the rest of the curve, rem) takes
- * cs_fixed_mul64_q30. Both round once: <= 1/2 unit. */
-#define SHORT_BITS 16
-typedef struct {
-    int64_t m;
-    unsigned s;
-    bool short_step;
-} step_t;
-
-static step_t step_of(cs_param_t h)
-{
-    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
-    step_t st = {h, CS_PARAM_FRAC_BITS, false};
-    if (((uint32_t)h & (((uint32_t)1 << e) - 1u)) == 0) {
-        st.m = h >> e;
-        st.s = CS_PARAM_FRAC_BITS - e;
-        st.short_step = true;
-    }
-    return st;
-}
-
-static int64_t mul_step(int64_t x, step_t h)
-{
-    if (!h.short_step)
-        return mul_t(x, (cs_param_t)h.m);
-    return rsh_round(x * h.m, h.s);
-}
-
-/* h cut to its SHORT_BITS leading bits (rounded down). */
-static int64_t short_of(int64_t h)
-{
-    unsigned e = shift_below((uint64_t)h, SHORT_BITS);
-    return h & ~(((int64_t)1 << e) - 1);
-}
+/* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
+ * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
+ * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
+CS_STATIC_ASSERT(((int64_t)8 * CS_POS_LIMIT << F) < ((int64_t)1 << (UNIT_BITS + 31)),
+                 predict_unit_shift_below_32);
+CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS + 31)),
+                 predict_thr_shift_below_32);
 
 /* The sub-curve [t, t + h] relative to B(t), as 3 (Q1 - Q0), 3 (Q2 - Q0), 3 (Q3 - Q0) in
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, int64_t d[2][2], step_t h, int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
+                      int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
-        int64_t c1 = mul_step(d[0][k], h);
-        int64_t c2 = mul_step(mul_step(d[1][k], h), h);
-        int64_t c3 = mul_step(mul_step(mul_step(p->a[3][k], h), h), h);
+        int64_t c1 = mul_t(d[0][k], h);
+        int64_t c2 = mul_t(mul_t(d[1][k], h), h);
+        int64_t c3 = mul_t(mul_t(mul_t(p->a[3][k], h), h), h);
         v[0][k] = c1;
         v[1][k] = 2 * c1 + c2;
         v[2][k] = 3 * (c1 + c2 + c3);
@@ -240,24 +259,38 @@ static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
     return l == 0 ? 0 : (l + dd / l) / 2;
 }
 
+/* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
+ * test's 32-bit components (below 2^27: products below 2^54, |V - D|^2 below 2^57), with
+ * dot = V . D and dd = |D|^2 already computed; r2 = r^2. */
+static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t dot, int64_t dd,
+                        uint64_t r2)
+{
+    if (dd == 0 || dot <= 0) /* nearest point is 0 (also a zero-length chord) */
+        return (uint64_t)(mul32(v[0], v[0]) + mul32(v[1], v[1])) <= r2;
+    if (dot >= dd) { /* nearest point is D */
+        int32_t ex = v[0] - d[0], ey = v[1] - d[1];
+        return (uint64_t)(mul32(ex, ex) + mul32(ey, ey)) <= r2;
+    }
+    uint64_t c = uabs64(mul32(d[0], v[1]) - mul32(d[1], v[0])); /* |D x V| <= r |D| */
+    return cs_fixed_cmp_prod_u64(c, c, r2, (uint64_t)dd) <= 0;
+}
+
 /* Convex-hull test for short chords and pieces whose inner points project outside the chord:
  * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
  * dist(V_i, D) <= 4 T in the 3x-scaled units. */
-static bool hull_flat(int64_t v[3][2], int64_t T)
+static bool hull_flat(int32_t v[3][2], int64_t dot1, int64_t dot2, int64_t dd, int64_t T)
 {
-    cs_vec3_t o = {0, 0, 0}, d = {(cs_pos_t)v[2][0], (cs_pos_t)v[2][1], 0};
-    cs_vec3_t q1 = {(cs_pos_t)v[0][0], (cs_pos_t)v[0][1], 0};
-    cs_vec3_t q2 = {(cs_pos_t)v[1][0], (cs_pos_t)v[1][1], 0};
-    return cs_subdiv_dist_ok(&q1, &o, &d, (uint32_t)(4 * T)) &&
-           cs_subdiv_dist_ok(&q2, &o, &d, (uint32_t)(4 * T));
+    uint64_t r2 = (uint64_t)(16 * T * T); /* T < 2^20 */
+    return seg_dist_ok(v[0], v[2], dot1, dd, r2) && seg_dist_ok(v[1], v[2], dot2, dd, r2);
 }
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
-static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint32_t *room)
+static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
 {
+    const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
-    sub_curve(p, d, step_of(h), v);
+    sub_curve(p, d, h, v);
     uint64_t m = 0;
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
@@ -271,25 +304,28 @@ static bool test_step(const cs_predict_t *p, int64_t d[2][2], cs_param_t h, uint
         *room = F16_ONE / 4;
         return false;
     }
-    if (s > 0) /* rounded (half up: <= 1/2 unit), inline: this is the hot path */
-        for (unsigned i = 0; i < 3; i++)
-            for (unsigned k = 0; k < 2; k++)
-                v[i][k] = rsh_round(v[i][k], s);
-    int64_t dd = v[2][0] * v[2][0] + v[2][1] * v[2][1];
-    int64_t dot1 = v[0][0] * v[2][0] + v[0][1] * v[2][1];
-    int64_t dot2 = v[1][0] * v[2][0] + v[1][1] * v[2][1];
+    /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
+     * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
+     * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
+    int32_t w[3][2];
+    for (unsigned i = 0; i < 3; i++)
+        for (unsigned k = 0; k < 2; k++)
+            w[i][k] = s > 0 ? rsh_round32(v[i][k], s) : (int32_t)v[i][k];
+    int64_t dd = mul32(w[2][0], w[2][0]) + mul32(w[2][1], w[2][1]);
+    int64_t dot1 = mul32(w[0][0], w[2][0]) + mul32(w[0][1], w[2][1]);
+    int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
     if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
-        bool ok = hull_flat(v, T);
+        bool ok = hull_flat(w, dot1, dot2, dd, T);
         *room = ok ? F16_ONE : F16_ONE / 4;
         return ok;
     }
-    int64_t c1 = v[2][0] * v[0][1] - v[2][1] * v[0][0];
-    int64_t c2 = v[2][0] * v[1][1] - v[2][1] * v[1][0];
+    int64_t c1 = mul32(w[2][0], w[0][1]) - mul32(w[2][1], w[0][0]);
+    int64_t c2 = mul32(w[2][0], w[1][1]) - mul32(w[2][1], w[1][0]);
     uint64_t found = majorant(c1, c2);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
     unsigned sh;
-    uint32_t len = approx_len(v[2][0], v[2][1], &sh);
+    uint32_t len = approx_len(w[2][0], w[2][1], &sh);
     uint64_t allowed = k * len, f1 = (found >> sh) + 1; /* f1 > found / 2^sh */
     *room = room_q16(allowed, f1 - 1); /* both scaled by 2^-sh */
     /* Clear cases decided on the estimate: len <= 1.0022 |D| / 2^sh, so f1 (1 + 1/32) <=
@@ -377,9 +413,9 @@ static void conic_start(const cs_predict_t *p, conic_start_t *c0)
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_t h,
-                       uint32_t *room)
+static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
 {
+    const conic_start_t *c0 = ctx;
     int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
     const int64_t *q0 = c0->q0;
     cs_param_t t1 = p->t + h;
@@ -424,23 +460,26 @@ static bool test_conic(const cs_predict_t *p, const conic_start_t *c0, cs_param_
     return cs_fixed_cmp_prod_u64(found, found, lim2, (uint64_t)dd) <= 0;
 }
 
-static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
+/* The vertex at p->t: the conic's blossom b(t, t) divided once, rounded to the nearest LSB. */
+static void eval_conic(const cs_predict_t *p, cs_vec3_t *pt)
 {
-    if (p->conic) {
-        int64_t b[3], q[2];
-        blossom(p, t, t, b);
-        for (unsigned k = 0; k < 2; k++) /* rounded to the nearest LSB */
-            q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
-        pt->x = (cs_pos_t)q[0];
-        pt->y = (cs_pos_t)q[1];
-        pt->z = p->z;
-        return;
-    }
+    int64_t b[3], q[2];
+    blossom(p, p->t, p->t, b);
+    for (unsigned k = 0; k < 2; k++)
+        q[k] = (2 * b[k] + (b[k] < 0 ? -b[2] : b[2])) / (2 * b[2]);
+    pt->x = (cs_pos_t)q[0];
+    pt->y = (cs_pos_t)q[1];
+    pt->z = p->z;
+}
+
+/* The vertex at p->t: B(t) by Horner, rounded to the LSB. */
+static void eval_poly(const cs_predict_t *p, cs_vec3_t *pt)
+{
     int64_t r[2];
     for (unsigned k = 0; k < 2; k++) {
-        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], t);
-        acc = p->a[1][k] + mul_t(acc, t);
-        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F);
+        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], p->t);
+        acc = p->a[1][k] + mul_t(acc, p->t);
+        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, p->t), F);
     }
     /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
     pt->x = (cs_pos_t)r[0];
@@ -448,23 +487,20 @@ static void eval_at(const cs_predict_t *p, cs_param_t t, cs_vec3_t *pt)
     pt->z = p->z;
 }
 
+/* One flatness test of the piece [t, t + h]; ctx is what every trial piece from t shares
+ * (B'(t) and B''(t)/2, or the conic's start). */
+typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room);
+
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_room)
+static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
+                            uint32_t *lo_room)
 {
-    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? short_of(p->h_next) : rem;
-    /* What every trial step from t shares: B'(t), B''(t)/2, or the conic's start (Q0 of each
-     * trial piece and the blossom's first level at t, computed once). */
-    int64_t d[2][2] = {{0, 0}, {0, 0}};
-    conic_start_t c0; /* set and read only for a conic */
-    if (!p->conic)
-        derivs(p, p->t, d);
-    else
-        conic_start(p, &c0);
+    cs_param_t rem = CS_PARAM_ONE - p->t;
+    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         uint32_t room;
-        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
-                     : test_step(p, d, (cs_param_t)h, &room)) {
+        if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
             if (h == rem || room <= F16_ACCEPT)
@@ -477,8 +513,6 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
             nh = rem;
         if (nh <= lo || nh >= hi)
             nh = lo + (hi - lo) / 2;
-        if (nh != rem)
-            nh = short_of(nh);
         if (nh <= lo || nh == h || hi - lo <= 1)
             break;
         h = nh;
@@ -488,8 +522,7 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
         if (h == 0)
             break;
         uint32_t room;
-        if (p->conic ? test_conic(p, &c0, (cs_param_t)h, &room)
-                     : test_step(p, d, (cs_param_t)h, &room)) {
+        if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
         }
@@ -498,26 +531,54 @@ static cs_param_t find_step(const cs_predict_t *p, cs_param_t rem, uint32_t *lo_
     return (cs_param_t)lo;
 }
 
-cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+/* Moves to the next vertex by the step find_step gave: CS_OK and *eval when the caller
+ * computes the vertex at p->t, CS_OK and *pt = P_n at the end, CS_ERR_DEPTH for no step. */
+static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t *pt, bool *eval)
 {
-    if (p->done)
-        return CS_END;
-    cs_param_t rem = CS_PARAM_ONE - p->t;
-    uint32_t room = F16_ONE;
-    cs_param_t h = find_step(p, rem, &room);
-    if (h == 0) {
-        p->done = true;
+    *eval = false;
+    p->done = true;
+    if (h == 0)
         return CS_ERR_DEPTH;
-    }
     p->t += h;
     if (p->t == CS_PARAM_ONE) {
         *pt = p->end;
-        p->done = true;
         return CS_OK;
     }
     /* Next chord: about as long in t as this one, corrected by the room this one left. */
     int64_t nh = predict(h, room);
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
-    eval_at(p, p->t, pt);
+    p->done = false;
+    *eval = true;
     return CS_OK;
+}
+
+static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt)
+{
+    int64_t d[2][2];
+    derivs(p, p->t, d);
+    uint32_t room = F16_ONE;
+    bool eval;
+    cs_param_t h = find_step(p, test_step, d, &room); /* sets room: before step_to reads it */
+    cs_err_t e = step_to(p, h, room, pt, &eval);
+    if (eval)
+        eval_poly(p, pt);
+    return e;
+}
+
+static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt)
+{
+    conic_start_t c0;
+    conic_start(p, &c0);
+    uint32_t room = F16_ONE;
+    bool eval;
+    cs_param_t h = find_step(p, test_conic, &c0, &room); /* sets room: before step_to reads it */
+    cs_err_t e = step_to(p, h, room, pt, &eval);
+    if (eval)
+        eval_conic(p, pt);
+    return e;
+}
+
+cs_err_t cs_predict_next(cs_predict_t *p, cs_vec3_t *pt)
+{
+    return p->done ? CS_END : p->next(p, pt);
 }

@@ -28,12 +28,14 @@
 /* Flatness tests allowed per chord before the step is only halved (predictor gave up). */
 #define CS_PREDICT_MAX_TESTS 12
 
-/* Tracer state: the curve in power basis (x, y: LSB * 2^CS_PREDICT_FRAC), the parameter
- * reached, and the last accepted step. 176 bytes; no stack. */
-typedef struct {
+/* Tracer state: the curve in power basis (x, y: LSB * 2^CS_PREDICT_FRAC) or the conic's
+ * homogeneous points, the parameter reached, the last accepted step, and the vertex routine its
+ * begin chose (so an image that never calls cs_predict_begin_conic links no conic code). */
+typedef struct cs_predict cs_predict_t;
+struct cs_predict {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
     int64_t h[3][3]; /* conic: homogeneous points w_i x_i, w_i y_i (LSB * 2^30), w_i (Q30) */
-    bool conic;
+    cs_err_t (*next)(cs_predict_t *p, cs_vec3_t *pt);
     cs_param_t t;      /* parameter of the last vertex returned */
     cs_param_t h_next; /* the step predicted for the next chord */
     cs_pos_t thr;      /* tol - slack, LSB */
@@ -41,16 +43,20 @@ typedef struct {
     cs_pos_t z;        /* the plane's z (every control point has it) */
     cs_vec3_t end;     /* P_n, returned exactly as the last vertex */
     bool done;
-} cs_predict_t;
+};
 
 /* True when cs_predict takes c: every control point at the same z, and polynomial of degree
  * 1..3, or rational of degree 2 with every weight >= 1/16 and w1^2 <= w0 w2 (an ellipse or
  * parabola arc: the conic's shoulder is then its farthest point from the chord). */
 bool cs_predict_accepts(const cs_bezier_t *c);
-/* Start tracing c with chord tolerance tol (LSB). CS_ERR_TOLERANCE outside
- * CS_PREDICT_TOL_MIN..MAX, CS_ERR_UNSUPPORTED when !cs_predict_accepts(c), CS_ERR_RANGE for a
- * point outside CS_POS_LIMIT. ISR-safe (pure). */
+/* Start tracing the polynomial curve c with chord tolerance tol (LSB). CS_ERR_TOLERANCE outside
+ * CS_PREDICT_TOL_MIN..MAX, CS_ERR_UNSUPPORTED when !cs_predict_accepts(c) or c is rational,
+ * CS_ERR_RANGE for a point outside CS_POS_LIMIT. ISR-safe (pure). */
 cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol);
+/* The same for a conic arc (rational c with cs_predict_accepts(c); CS_ERR_UNSUPPORTED for a
+ * polynomial one). A separate entry so that only images that trace arcs link the conic path.
+ * ISR-safe (pure). */
+cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol);
 /* Next vertex (see cs_trace_next): CS_OK with *pt, CS_END after P_n, CS_ERR_DEPTH if no step
  * of 2^-30 passes (cannot happen for a valid curve). Bounded work: at most
  * CS_PREDICT_MAX_TESTS + 30 tests a vertex, typically one or two. */

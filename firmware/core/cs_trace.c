@@ -29,7 +29,8 @@ static cs_err_t begin_predict(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
     if (cs_predict_accepts(c)) {
         tr->impl = CS_TRACE_IMPL_PREDICT;
-        return cs_predict_begin(&tr->u.pr, c, tol);
+        return c->rational ? cs_predict_begin_conic(&tr->u.pr, c, tol)
+                           : cs_predict_begin(&tr->u.pr, c, tol);
     }
 #endif
     return begin_reach(tr, c, tol);

@@ -565,14 +565,16 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
     printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost): the "
            "wall clock of this shared machine is noisy (compare within one table); by "
            "instructions (callgrind, the three sets at the three tolerances) the tracer spends "
-           "1,067 a point and 41.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.04x cairo's "
-           "curves/s and 0.64x its points/s. Each chord costs 1.2-2.4 verified flatness tests "
-           "(a sub-curve of 12 products, cross and dot products, a 4-piece majorant, three 32-bit "
-           "divisions for the predictor) plus B(t) and its derivatives by Horner; cairo's "
-           "subdivision spends fewer instructions a point but emits 1.6x the chords. Arcs (conic "
-           "pieces): 1,563 instructions a point and 252 k an arc against cairo_arc's 673 and "
-           "171 k (0.68x its arcs/s by instructions); each test projects two homogeneous points "
-           "by 64-bit divisions, which cost far more cycles than instructions.\n\n");
+           "1,020 a point and 39.4 k a curve against cairo's 674 and 42.6 k, i.e. 1.08x cairo's "
+           "curves/s and 0.66x its points/s. Each chord costs 1.2-2.4 verified flatness tests "
+           "(a sub-curve of 12 Q30 products, cross and dot products, a 4-piece majorant, three "
+           "32-bit divisions for the predictor) plus B(t) and its derivatives by Horner; cairo's "
+           "subdivision spends fewer instructions a point but emits 1.6x the chords, and the "
+           "tracer's divisions and data-dependent branches cost more cycles per instruction "
+           "than cairo's loop. Arcs (conic pieces): 1,342 instructions a point and 216 k an arc "
+           "against cairo_arc's 672 and 171 k (0.79x its arcs/s by instructions); each test "
+           "projects two homogeneous points by 64-bit divisions, which cost far more cycles "
+           "than instructions.\n\n");
 }
 
 static void arcs_report(FILE *csv)

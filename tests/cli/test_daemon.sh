@@ -84,7 +84,7 @@ expect "pause: exit 0" [ $rc -eq 0 ]
 expect "pause: device held" grep -q "^OK paused (device held)" "$T/p.out"
 # the event: the device confirmed the hold (it reported HELD), status says "(held)"
 job1_held() { C status 2>/dev/null >"$T/st2.out" && grep -qE "^job 1 running: .* \(held\)$" "$T/st2.out"; }
-expect "paused: the device confirmed the hold" wait_until 30 job1_held
+expect "paused: the device confirmed the hold" wait_until 60 job1_held
 C status >"$T/st3.out"
 expect "paused: status says so" grep -q "queue paused" "$T/st2.out"
 a=$(sed -n "s/^job 1 running: .*: \([0-9]*\)\/$N1 segments executed (held)$/\1/p" "$T/st2.out")

@@ -50,7 +50,7 @@ expect "job 1 queued" grep -q "^OK job 1 queued: .*out.nc: $N segments$" "$T/sub
 expect "job 1: a quarter ran" wait_until 60 dmn_quarter
 C pause >"$T/p"
 expect "pause: said" grep -q "^OK paused (device held)" "$T/p"
-expect "pause: the step thread held at rest" wait_until 30 dmn_still
+expect "pause: the step thread held at rest" wait_until 60 dmn_still
 a=$(dmn_progress)
 expect "pause: mid-job ($a of $N)" [ -n "$a" ] && [ "$a" -gt 0 ] && [ "$a" -lt "$N" ]
 C resume >/dev/null

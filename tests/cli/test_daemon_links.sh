@@ -21,7 +21,7 @@ for mode in tcp rtu; do
         2>"$T/$mode.simerr" &
     SIMPID=$!
     pids+=($SIMPID)
-    wait_pty "$T/$mode.sim" 5
+    wait_pty "$T/$mode.sim" 60
     ADDR=$PTY
     expect "$mode: device started" [ -n "$ADDR" ]
     dmn_start "--modbus-$mode" "$ADDR"
@@ -29,10 +29,10 @@ for mode in tcp rtu; do
     expect "$mode: status names the link" grep -q "^OK device $ADDR, queue running$" "$T/$mode.st0"
     C submit "$JOB" >"$T/$mode.sub" 2>&1
     expect "$mode: submitted" grep -q "^OK job 1 queued: .*: $N segments$" "$T/$mode.sub"
-    expect "$mode: a quarter ran" wait_until 30 dmn_quarter
+    expect "$mode: a quarter ran" wait_until 60 dmn_quarter
     C pause >"$T/$mode.p"
     expect "$mode: paused, device held" grep -q "^OK paused (device held)" "$T/$mode.p"
-    expect "$mode: held: progress stands still" wait_until 20 dmn_still
+    expect "$mode: held: progress stands still" wait_until 60 dmn_still
     C resume >/dev/null
     expect "$mode: job ended" wait_until 60 dmn_finished
     C status >"$T/$mode.st" 2>&1

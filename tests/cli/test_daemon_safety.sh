@@ -13,7 +13,7 @@ LIB=$(dirname "${BASH_SOURCE[0]}")/lib
 
 timeout -k 5 120 "$SIM" --pty --speed 50 >"$T/sim.out" 2>"$T/sim.err" &
 pids+=($!)
-wait_pty "$T/sim.out" 20
+wait_pty "$T/sim.out" 60
 expect "sim printed a pty path" [ -c "$PTY" ]
 
 # 1. a socket directory writable by others (/tmp's kind) is refused: exit 3, nothing created.
@@ -37,14 +37,14 @@ XDG_RUNTIME_DIR=$T/rt timeout -k 5 120 "$CS" serve --port "$PTY" 2>"$T/serve.err
 DPID=$!
 pids+=($DPID)
 S=$T/rt/curvestep/curvestep.sock
-wait_until 20 [ -S "$S" ]
+wait_until 60 [ -S "$S" ]
 expect "default socket in \$XDG_RUNTIME_DIR/curvestep/" [ -S "$S" ]
 expect "its directory is 0700" [ "$(stat -c %a "$T/rt/curvestep")" = 700 ]
 C() { timeout -k 5 30 "$CS" "$@" --socket "$S"; }
 XDG_RUNTIME_DIR=$T/rt timeout -k 5 30 "$CS" status >"$T/st0.out" 2>&1; rc=$?
 expect "clients find the default socket" [ $rc -eq 0 ]
 kill -TERM $DPID
-wait_until 30 gone $DPID
+wait_until 60 gone $DPID
 expect "default socket removed on stop" [ ! -e "$S" ]
 
 # The rest with --socket in a private directory (as the old daemon could be run).
@@ -53,14 +53,14 @@ S=$T/priv/d.sock
 timeout -k 5 120 "$CS" serve --port "$PTY" --socket "$S" --max-input-mb 1 2>"$T/serve2.err" &
 DPID=$!
 pids+=($DPID)
-wait_until 20 [ -S "$S" ]
+wait_until 60 [ -S "$S" ]
 expect "second daemon up" [ -S "$S" ]
 
 # 4. sixteen silent clients (the old limit) and more: status still answers.
 python3 "$LIB/holdconn.py" "$S" 20 40 >"$T/hold.out" 2>&1 &
 HPID=$!
 pids+=($HPID)
-wait_until 20 grep -qs holding "$T/hold.out"
+wait_until 60 grep -qs holding "$T/hold.out"
 C status >"$T/st1.out" 2>&1; rc=$?
 expect "20 silent clients: status exit 0" [ $rc -eq 0 ]
 expect "20 silent clients: status answered" grep -q "^OK device" "$T/st1.out"
@@ -126,7 +126,7 @@ if [ "$(id -u)" = 0 ] && command -v setpriv >/dev/null; then
     $NOB timeout -k 5 60 python3 "$LIB/fakeserver.py" "$T/squat/s.sock" "$T/squat/log" \
         >"$T/fake.out" 2>&1 &
     pids+=($!)
-    wait_until 20 grep -qs ready "$T/fake.out"
+    wait_until 60 grep -qs ready "$T/fake.out"
     C0() { timeout -k 5 30 "$CS" "$@" --socket "$T/squat/s.sock"; }
     C0 submit "$T/a.txt" >"$T/sq.out" 2>&1; rc=$?
     expect "squatted socket: client refuses (exit 4)" [ $rc -eq 4 ]
@@ -137,7 +137,7 @@ fi
 
 # 9. the daemon stops on SIGTERM and removes its socket.
 kill -TERM $DPID
-wait_until 30 gone $DPID
+wait_until 60 gone $DPID
 expect "serve stopped" gone $DPID
 expect "socket removed" [ ! -e "$S" ]
 finish

@@ -17,9 +17,14 @@ JOB=tests/data/svg/resvg/M-L-Z-A.svg
 SMALL=$T/small.nc
 printf 'G21 G90\nG1 X10 Y0 F3000\nG2 X10 Y10 I0 J5\nG1 X0 Y10\nG3 X0 Y0 I0 J-5\n' >"$SMALL"
 
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
 # start_dev NAME ser|tcp|rtu ARGS...: the device in the background (--instant unless ARGS start
-# with --speed; it leaves IDLE seconds, default 0.5, after the last request once it executed
-# something), ADDR = the pty path or HOST:PORT it printed first ("" when it did not start).
+# with --speed; it runs until wait_dev ends it: no idle timer, which a host starved of the CPU
+# on a loaded machine would outlast mid-job), ADDR = the pty path or HOST:PORT it printed first
+# ("" when it did not start).
 declare -A devpid
 start_dev() {
     local name=$1 mode=$2
@@ -31,17 +36,17 @@ start_dev() {
     tcp) set -- --modbus-tcp 127.0.0.1:0 "$@" ;;
     rtu) set -- --modbus-rtu pty "$@" ;;
     esac
-    timeout -k 5 120 "$SIM" "$@" $pace --idle-exit "${IDLE:-0.5}" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    timeout -k 5 300 "$SIM" "$@" $pace >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     devpid[$name]=$!
     wait_pty "$T/$name.sim" 60
     ADDR=$PTY
 }
-# wait_dev NAME [kill]: waits (at most 60 s: an event, generous under load) for device NAME to finish its report; kill: stops it
-# first (a device that executed nothing never leaves by itself).
+# wait_dev NAME: once its host has exited, ends device NAME (SIGTERM: it finishes what its
+# executor holds, then reports) and waits for it (at most 60 s: an event, generous under load).
 wait_dev() {
     local p=${devpid[$1]}
-    [ "${2:-}" = kill ] && kill "$p" 2>/dev/null
+    stop_dev "$p"
     wait_until 60 gone "$p"
     kill "$p" 2>/dev/null
     wait "$p" 2>/dev/null
@@ -58,8 +63,8 @@ stream_to() {
     rc=$?
 }
 # launch NAME ser|tcp|rtu "SIM ARGS" HOST ARGS...: a device (with --trace $T/NAME.csv) and a host
-# streaming to it, in the background; landed waits for every launch and every device's report
-# (KILL_DEV=kill: stops the devices first), the host's exit status then in $T/NAME.rc.
+# streaming to it, in the background; landed waits for every host, then ends every device and
+# waits for its report, the host's exit status then in $T/NAME.rc.
 launched=()
 hostpids=()
 launch() {
@@ -74,7 +79,7 @@ launch() {
 landed() {
     local name
     wait "${hostpids[@]}"
-    for name in "${launched[@]}"; do wait_dev "$name" ${KILL_DEV:-}; done
+    for name in "${launched[@]}"; do wait_dev "$name"; done
     launched=()
     hostpids=()
 }
@@ -185,7 +190,7 @@ done
 # 4. exception 4 (server device failure) on the 100th write: exit 7, a clear sentence, the last
 # executed segment; --resume-from finishes, each segment once.
 # (the device stays up between the two hosts; SIGTERM ends it, with its report)
-IDLE=30 start_dev fail tcp --faults fail-at=100 --trace "$T/fail.csv"
+start_dev fail tcp --faults fail-at=100 --trace "$T/fail.csv"
 stream_to fail tcp "$SMALL"
 expect "failure: exit 7" [ $rc -eq 7 ]
 expect "failure: says which exception" grep -q 'Modbus exception 4 (server device failure)' "$T/fail.out"
@@ -193,14 +198,14 @@ expect "failure: about segment 100" grep -q 'about segment no. 100)' "$T/fail.ou
 expect "failure: last executed 99" grep -q 'last executed: 99$' "$T/fail.out"
 expect "failure: says how to resume" grep -q -- '--resume-from 99 ' "$T/fail.out"
 stream_to fail tcp --resume-from 99 "$SMALL"
-wait_dev fail kill
+wait_dev fail
 expect "resume: exit 0" [ $rc -eq 0 ]
 expect "resume: job executed" grep -q "job executed" "$T/fail.out"
 once_as_base fail
 
 # 5. a wrong unit id: the device does not answer, the host says to check --unit (exit 4).
 for mode in tcp rtu; do launch "unit_$mode" $mode "" --unit 7 "$SMALL"; done
-KILL_DEV=kill landed
+landed
 for mode in tcp rtu; do
     expect "unit $mode: exit 4" [ "$(rc_of "unit_$mode")" = 4 ]
     expect "unit $mode: says so" grep -qE 'no device answered \(no answer from unit 7: [0-9]+ tries in [0-9.]+ s; is --unit right' "$T/unit_$mode.out"

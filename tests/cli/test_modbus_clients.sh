@@ -31,15 +31,17 @@ start_sim() {
         >"$T/$name.out" 2>"$T/$name.err" &
     SIMPID=$!
     pids+=($SIMPID)
-    wait_until 30 [ -s "$T/$name.out" ]
+    wait_until 60 [ -s "$T/$name.out" ]
     ADDR=$(head -n1 "$T/$name.out")
     HOST=${ADDR%:*}
     PORT=${ADDR##*:}
 }
 
-# stop_sim NAME: SIGTERM, then its report is complete
+# stop_sim NAME: SIGTERM to the device itself (through its timeout wrapper, -k 5, it would be
+# killed 5 s later, before an ASan build under load has checked the job), then its report is
+# complete
 stop_sim() {
-    kill -TERM "$SIMPID" 2>/dev/null
+    kill -TERM $(pgrep -P "$SIMPID") 2>/dev/null || kill -TERM "$SIMPID" 2>/dev/null
     wait_until 60 gone "$SIMPID"
     wait "$SIMPID" 2>/dev/null
     SIMRC=$?
@@ -102,7 +104,7 @@ wait_until 60 grep -qs '^polling' "$T/poll.out"
 pids+=($!)
 wait_until 200 [ -s "$T/poll-host.rc" ]
 touch "$T/stop"
-wait_until 30 grep -qs '^polls: ' "$T/poll.out"
+wait_until 60 grep -qs '^polls: ' "$T/poll.out"
 polls=$(sed -n 's/^polls: \([0-9]*\) answered, 0 bad, 0 reconnections$/\1/p' "$T/poll.out")
 expect "poll: the flat-out poller was served too, never refused or cut ($(cat "$T/poll.out" | tail -n1))" \
     [ "${polls:-0}" -ge 100 ]
@@ -135,7 +137,7 @@ expect "... every segment" grep -q "^stream: $N of $N segments executed" "$T/hos
 rm -f "$T/stop"
 "$T/mbc" "$HOST" "$PORT" hold 4343 "$T/stop" >"$T/hold.out" 2>&1 &
 pids+=($!)
-wait_until 30 sh -c "'$T/mbc' '$HOST' '$PORT' status | grep -q '^LEASE 1 '"
+wait_until 60 sh -c "'$T/mbc' '$HOST' '$PORT' status | grep -q '^LEASE 1 '"
 stream host3
 wait_until 120 [ -s "$T/host3.rc" ]
 touch "$T/stop"

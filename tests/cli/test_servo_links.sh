@@ -17,17 +17,22 @@ pens=$(grep -c '^pen ' "$T/job.seg")
 lowers=$(grep -c "^pen $down\$" "$T/job.seg")
 expect "plan: pen events ($pens, $lowers down)" [ "$pens" -gt 2 -a "$lowers" -gt 1 ]
 
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
 # one NAME DEVICE-LINK HOST-LINK [stream options]: the device, the stream, the device's report
 one() {
     local name=$1 dev=$2 host=$3
     shift 3
-    timeout -k 5 120 "$SIM" $dev --instant --idle-exit 1 --machine "$MC" --reference "$JOB" \
+    timeout -k 5 300 "$SIM" $dev --instant --machine "$MC" --reference "$JOB" \
         --check >"$T/$name.sim" 2>"$T/$name.simerr" &
     local sp=$!
     pids+=($sp)
     wait_pty "$T/$name.sim" 60
     timeout -k 5 90 "$CS" stream $host "$PTY" --machine "$MC" "$@" "$JOB" >"$T/$name.out" 2>&1
     expect "$name: stream exit 0" [ $? -eq 0 ]
+    stop_dev "$sp" # the host has exited: SIGTERM ends the device with its report
     wait_until 60 gone "$sp"
     wait "$sp"
     expect "$name: device exit 0" [ $? -eq 0 ]

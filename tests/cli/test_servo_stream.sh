@@ -20,7 +20,11 @@ lowers=$(grep -c "^pen $downs\$" "$T/job.seg")
 nseg=$(grep -vc -e '^#' -e '^pen ' "$T/job.seg")
 expect "plan has pen events ($pens, $lowers lowerings to $downs us)" [ "$pens" -gt 0 -a "$lowers" -gt 0 ]
 
-timeout -k 5 120 "$SIM" --pty --instant --idle-exit 1 --machine "$MC" --reference "$JOB" \
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
+timeout -k 5 300 "$SIM" --pty --instant --machine "$MC" --reference "$JOB" \
     --check >"$T/dev.sim" 2>"$T/dev.simerr" &
 pids+=($!)
 SIMPID=$!
@@ -28,6 +32,7 @@ wait_pty "$T/dev.sim" 60
 expect "sim printed a pty path" [ -c "$PTY" ]
 timeout -k 5 120 "$CS" stream --machine "$MC" --port "$PTY" "$JOB" >"$T/st.out" 2>"$T/st.err"
 rc=$?
+stop_dev "$SIMPID" # the host has exited: SIGTERM ends the device with its report
 wait_until 60 gone "$SIMPID"
 wait "$SIMPID"; simrc=$?
 expect "stream: exit 0" [ $rc -eq 0 ]
@@ -61,9 +66,9 @@ job_done() { timeout -k 5 10 "$CS" status --socket "$S" 2>/dev/null | grep -q '^
 wait_until 90 job_done
 expect "daemon: job 1 done" job_done
 kill "$DPID"
-wait_until 30 gone "$DPID"
-kill "$SIMPID"
-wait_until 30 gone "$SIMPID"
+wait_until 60 gone "$DPID"
+stop_dev "$SIMPID"
+wait_until 60 gone "$SIMPID"
 wait "$SIMPID"; simrc=$?
 expect "daemon device: exit 0 (got $simrc)" [ $simrc -eq 0 ]
 expect "daemon device: check passes" grep -q '^check: ok$' "$T/dd.sim"

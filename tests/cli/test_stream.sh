@@ -10,22 +10,29 @@ set -u
 JOB=tests/data/svg/w3c/paths-data-12-t.svg
 ARCS=tests/data/svg/resvg/M-L-Z-A.svg
 
+# stop_dev PID: SIGTERM to the device running under `timeout` PID, to the device itself: through
+# timeout (-k 5) it would be killed 5 s later, before an ASan build under load has written its
+# report.
+stop_dev() { kill $(pgrep -P "$1") 2>/dev/null || kill "$1" 2>/dev/null; }
 # start_sim NAME ARGS...: starts the device on a pty in the background (bounded by timeout;
-# --instant unless ARGS start with --speed),
+# --instant unless ARGS start with --speed; no idle timer: wait_sim ends it, so a host starved
+# of the CPU between two runs or mid-job never finds the device gone),
 # sets PTY to its path (empty when it did not start).
 start_sim() {
     local name=$1; shift
     local pace=--instant
     [ "${1:-}" = --speed ] && pace=
-    timeout -k 5 120 "$SIM" --pty $pace --idle-exit 1 "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
+    timeout -k 5 300 "$SIM" --pty $pace "$@" >"$T/$name.sim" 2>"$T/$name.simerr" &
     pids+=($!)
     SIMPID=$!
     wait_pty "$T/$name.sim" 60
 }
-# wait_sim: waits (at most 60 s: an event, generous under load) for the device started last to finish its report.
+# wait_sim: once the host has exited, ends the device started last (SIGTERM: it finishes what
+# its executor holds, then reports) and waits for it (at most 60 s: an event, generous under load).
 wait_sim() {
+    stop_dev "$SIMPID"
     wait_until 60 gone "$SIMPID"
-    kill "$SIMPID" 2>/dev/null
+    kill -KILL "$SIMPID" 2>/dev/null
     wait "$SIMPID" 2>/dev/null
 }
 

@@ -11,7 +11,7 @@
 
 #include "cs_link.h"
 
-static const cs_link_cfg_t cfg = {.rto = 50, .nak_holdoff = 5, .keepalive = 200, .max_retries = 4};
+static const cs_link_cfg_t cfg = {.rto = 50, .nak_holdoff = 5, .keepalive = 200, .rto_max = 200, .give_up = 750};
 
 static size_t frame(uint16_t seq, const cs_proto_msg_t *m, uint8_t *out)
 {

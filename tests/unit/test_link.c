@@ -16,6 +16,7 @@
 #include <cmocka.h>
 
 #include "cs_link.h"
+#include "cs_linktime.h"
 
 static uint64_t rng_state;
 static uint64_t rng(void)
@@ -168,10 +169,11 @@ typedef struct {
 } end_t;
 
 /* rto: a window of 8 segment frames (8 x 15 ticks) + a round trip (~70 ticks) + margin.
- * max_retries: with 1 % of bytes corrupted a 29-byte frame is lost 25 % of the time, so a lone
- * frame and its ACK get through 60 % of the time; 20 retries fail together with p = 4e-9. */
+ * give_up: with 1 % of bytes corrupted a 29-byte frame is lost 25 % of the time, so a lone
+ * frame and its ACK get through 60 % of the time; timeouts of 400, 800, 1600, 1600 ... ticks
+ * (rto_max = 4 rto) give 9 tries in 12000 ticks, failing together with p = 0.4^9 = 3e-4. */
 static const cs_link_cfg_t cfg = {
-    .rto = 400, .nak_holdoff = 80, .keepalive = 3000, .max_retries = 20};
+    .rto = 400, .rto_max = 1600, .give_up = 12000, .nak_holdoff = 80, .keepalive = 3000};
 
 static uint16_t free_slots(const end_t *e)
 {
@@ -441,8 +443,9 @@ static void test_device_reset_mid_stream(void **state)
     assert_int_equal(sim.dev.delivered, TOTAL - sim.dev.first_index); /* checked in order */
 }
 
-/* The line goes dead: the sender reports CS_ERR_TIMEOUT after its retries (about
- * (max_retries + 1) * rto), and an idle end finds out through its keepalive probes. */
+/* The line goes dead: the sender reports CS_ERR_TIMEOUT give_up after the last ACK it heard
+ * (at most the line's latency before the cut), within one capped timeout; an idle end finds out
+ * through its keepalive probes. */
 static void test_dead_line_is_reported(void **state)
 {
     (void)state;
@@ -478,9 +481,9 @@ static void test_dead_line_is_reported(void **state)
                   (unsigned long long)(dev_closed - cut_at));
     assert_true(host_closed > cut_at && dev_closed > cut_at);
     assert_true(sim.dev.delivered > 500); /* it was working before the cut */
-    uint64_t r = cfg.rto, n = cfg.max_retries;
-    assert_true(host_closed - cut_at >= n * r && host_closed - cut_at <= (n + 2) * r);
-    assert_true(dev_closed - cut_at <= cfg.keepalive + (n + 2) * r);
+    assert_true(host_closed - cut_at + cfg.rto >= cfg.give_up);
+    assert_true(host_closed - cut_at <= (uint64_t)cfg.give_up + cfg.rto_max);
+    assert_true(dev_closed - cut_at <= (uint64_t)cfg.keepalive + cfg.give_up + cfg.rto_max);
     assert_int_equal(cs_link_state(&sim.host.link), CS_LINK_CLOSED);
     assert_int_equal(cs_link_state(&sim.dev.link), CS_LINK_CLOSED);
     uint8_t abort_msg = CS_PROTO_ABORT;
@@ -520,7 +523,7 @@ static int move(cs_link_t *a, cs_link_t *b, uint32_t now, uint16_t a_slots, uint
 
 static void connect_pair(uint16_t b_first, uint16_t b_slots)
 {
-    const cs_link_cfg_t c = {.rto = 100, .nak_holdoff = 10, .keepalive = 0, .max_retries = 3};
+    const cs_link_cfg_t c = {.rto = 100, .rto_max = 400, .give_up = 1500, .nak_holdoff = 10, .keepalive = 0};
     assert_int_equal(cs_link_init(&la, &c, 0xAAAA0001u, 77, 5, 0), CS_OK);
     assert_int_equal(cs_link_init(&lb, &c, 0xBBBB0001u, 88, b_first, 0), CS_OK);
     assert_int_equal(cs_link_state(&la), CS_LINK_CONNECTING);
@@ -557,12 +560,15 @@ static void test_seq_compare_wraps(void **state)
 static void test_init_refuses_bad_config(void **state)
 {
     (void)state;
-    cs_link_cfg_t c = {.rto = 0, .max_retries = 1};
+    cs_link_cfg_t c = {.rto = 0, .rto_max = 10, .give_up = 1};
     assert_int_equal(cs_link_init(&la, &c, 1, 1, 0, 0), CS_ERR_ARG);
     c.rto = 10;
-    c.max_retries = 0;
+    c.give_up = 0;
     assert_int_equal(cs_link_init(&la, &c, 1, 1, 0, 0), CS_ERR_ARG);
-    c.max_retries = 1;
+    c.give_up = 1;
+    c.rto_max = 9; /* a cap below the first timeout */
+    assert_int_equal(cs_link_init(&la, &c, 1, 1, 0, 0), CS_ERR_ARG);
+    c.rto_max = 10;
     assert_int_equal(cs_link_init(&la, &c, 1, 0, 0, 0), CS_ERR_ARG); /* nonce 0 */
     assert_int_equal(cs_link_init(&la, &c, 1, 1, 0, 0), CS_OK);
     /* Not open yet: nothing can be queued; ACK and PING are never user messages. */
@@ -576,7 +582,7 @@ static void test_init_refuses_bad_config(void **state)
 static void test_connect_ignores_foreign_ack(void **state)
 {
     (void)state;
-    const cs_link_cfg_t c = {.rto = 100, .nak_holdoff = 10, .keepalive = 0, .max_retries = 3};
+    const cs_link_cfg_t c = {.rto = 100, .rto_max = 400, .give_up = 1500, .nak_holdoff = 10, .keepalive = 0};
     assert_int_equal(cs_link_init(&la, &c, 1, 1234, 0, 0), CS_OK);
     const uint8_t *b;
     size_t n;
@@ -642,6 +648,132 @@ static void test_credits_and_window(void **state)
     assert_int_equal(send_seg(&la), CS_OK);
     assert_int_equal(send_seg(&la), CS_OK);
     assert_int_equal(send_seg(&la), CS_ERR_FULL);
+}
+
+/* --- backoff (docs/protocol.md 3.3) ------------------------------------------------------- */
+enum { BACKOFF_MAX = 64 };
+
+/* The rule as the protocol states it: the peer was last heard at `heard`, the first frame goes
+ * out at s0; the k-th timeout in a row fires min(rto * 2^k, rto_max) after the last send and
+ * sends again, unless the peer has been silent for give_up: then the link closes there. at[]:
+ * the sends; returns their number. */
+static int backoff_expected(const cs_link_cfg_t *c, uint64_t heard, uint64_t s0, uint64_t *at,
+                            uint64_t *closed)
+{
+    int n = 0;
+    uint64_t s = s0, d = c->rto;
+    at[n++] = s0;
+    for (int k = 1;; k++) {
+        uint64_t t = s + d;
+        if (t - heard >= c->give_up) {
+            *closed = t;
+            return n;
+        }
+        assert_true(n < BACKOFF_MAX);
+        at[n++] = s = t;
+        d = (uint64_t)c->rto << (k < 32 ? k : 32);
+        if (d > c->rto_max)
+            d = c->rto_max;
+    }
+}
+
+/* Polls l every step ticks from t0 with nobody answering: the ticks it wrote at, *closed = the
+ * tick of CS_ERR_TIMEOUT. Returns the number of writes. */
+static int backoff_observed(cs_link_t *l, uint64_t t0, uint64_t step, uint64_t *at,
+                            uint64_t *closed)
+{
+    int n = 0;
+    for (uint64_t t = t0;; t += step) {
+        const uint8_t *b;
+        size_t len;
+        cs_err_t e = cs_link_poll(l, (uint32_t)t, 0, &b, &len);
+        if (e == CS_ERR_TIMEOUT) {
+            *closed = t;
+            return n;
+        }
+        if (e == CS_OK) {
+            assert_true(n < BACKOFF_MAX);
+            at[n++] = t;
+        }
+        assert_true(t - t0 < 100000000u);
+    }
+}
+
+static void assert_backoff(const cs_link_cfg_t *c, cs_link_t *l, uint64_t heard, uint64_t t0,
+                           uint64_t step)
+{
+    uint64_t want[BACKOFF_MAX], got[BACKOFF_MAX], want_closed = 0, got_closed = 0;
+    int nw = backoff_expected(c, heard, t0, want, &want_closed);
+    int ng = backoff_observed(l, t0, step, got, &got_closed);
+    assert_int_equal(ng, nw);
+    for (int i = 0; i < nw; i++)
+        assert_int_equal(got[i], want[i]);
+    assert_int_equal(got_closed, want_closed);
+    assert_int_equal(cs_link_state(l), CS_LINK_CLOSED);
+}
+
+/* A silent peer: the data frame's retransmissions and the connecting PINGs back off by doubling,
+ * and the link closes when give_up has passed, not after a count. */
+static void test_backoff_doubles_then_gives_up(void **state)
+{
+    (void)state;
+    connect_pair(0, 8);
+    assert_int_equal(send_seg(&la), CS_OK);
+    cs_link_cfg_t c = la.cfg;
+    /* last ACK at 2 (the connection); sends at 10, 110, 310, 710, 1110; closed at 1510 */
+    assert_backoff(&c, &la, 2, 10, 1);
+    assert_int_equal(la.stats.timeouts, 5);
+    /* Connecting to nobody: the PINGs follow the same rule. */
+    assert_int_equal(cs_link_init(&la, &c, 1, 99, 0, 0), CS_OK);
+    assert_backoff(&c, &la, 0, 0, 1);
+    /* The timing every end uses at memory speed, in microseconds: 5 ms doubling to 1 s, closed
+     * 30 s after the silence began (tens of seconds of a starved peer survive). */
+    assert_int_equal(cs_linktime_link(&c, 0, 1000000u), CS_OK);
+    assert_int_equal(cs_link_init(&la, &c, 1, 99, 0, 0), CS_OK);
+    uint64_t at[BACKOFF_MAX], closed = 0;
+    int n = backoff_expected(&c, 0, 0, at, &closed);
+    assert_true(closed >= 30000000u && closed <= 31000000u);
+    print_message("memory speed: %d PINGs, closed %.3f s after the first\n", n, closed / 1e6);
+    assert_backoff(&c, &la, 0, 0, 1000); /* every timeout is a whole number of ms */
+}
+
+/* The first good ACK after timeouts starts the backoff over at rto. */
+static void test_backoff_resets_on_progress(void **state)
+{
+    (void)state;
+    connect_pair(0, 8);
+    assert_int_equal(send_seg(&la), CS_OK);
+    const uint8_t *b;
+    size_t n;
+    uint64_t at[BACKOFF_MAX];
+    int sends = 0;
+    /* lost three times: sent at 10, then timeouts at 110 (+100), 310 (+200), 710 (+400) */
+    for (uint32_t t = 10; t <= 710; t++)
+        if (cs_link_poll(&la, t, 0, &b, &n) == CS_OK)
+            at[sends++] = t;
+    assert_int_equal(sends, 4);
+    assert_int_equal(at[1], 110);
+    assert_int_equal(at[2], 310);
+    assert_int_equal(at[3], 710);
+    /* the copy of 710 gets through, its ACK comes back */
+    int delivered = 0;
+    for (size_t i = 0; i < n; i++) {
+        cs_link_event_t ev;
+        assert_int_equal(cs_link_feed(&lb, b[i], 711, 8, &ev), CS_OK);
+        delivered += (ev.what & CS_LINK_EV_DELIVER) != 0;
+    }
+    assert_int_equal(delivered, 1);
+    move(&lb, &la, 712, 7, 0, NULL, NULL);
+    assert_int_equal(cs_link_unacked(&la), 0);
+    /* the next frame, lost: its first timeout is rto again (100), not 800 */
+    assert_int_equal(send_seg(&la), CS_OK);
+    sends = 0;
+    for (uint32_t t = 800; t <= 1000 && sends < 2; t++)
+        if (cs_link_poll(&la, t, 0, &b, &n) == CS_OK)
+            at[sends++] = t;
+    assert_int_equal(sends, 2);
+    assert_int_equal(at[0], 800);
+    assert_int_equal(at[1], 900);
 }
 
 /* Duplicates are dropped, a gap gets one NAK, the NAK rewinds the sender. */
@@ -800,6 +932,8 @@ int main(void)
         cmocka_unit_test(test_no_room_refuses_then_retransmits),
         cmocka_unit_test(test_new_boot_in_status_is_a_reset),
         cmocka_unit_test(test_sender_restart_continues_sequence),
+        cmocka_unit_test(test_backoff_doubles_then_gives_up),
+        cmocka_unit_test(test_backoff_resets_on_progress),
         cmocka_unit_test(test_dead_line_is_reported),
         cmocka_unit_test(test_device_reset_mid_stream),
         cmocka_unit_test(test_100k_segments_over_lossy_line),

@@ -61,18 +61,21 @@ static void test_link(void **state)
     (void)state;
     for (size_t r = 0; r < sizeof rates / sizeof rates[0]; r++)
         for (size_t t = 0; t < sizeof ticks / sizeof ticks[0]; t++) {
-            cs_link_cfg_t c = {0, 0, 1234, 0};
+            cs_link_cfg_t c = {.keepalive = 1234};
             double hz = ticks[t], frame = ref_chars(CS_FRAME_WIRE_MAX, 10, rates[r], hz);
             double rto = ceil(0.040 * hz) + 3.0 * CS_LINK_WINDOW * frame;
             cs_err_t e = cs_linktime_link(&c, rates[r], ticks[t]);
-            if (rto >= 4294967295.0) {
+            /* backoff: doubled up to max(rto, 1 s); closed after max(30 s, 2 rto_max) */
+            double rto_max = fmax(rto, hz), give_up = fmax(30.0 * hz, 2.0 * rto_max);
+            if (rto >= 4294967295.0 || give_up >= 4294967295.5) {
                 assert_int_equal(e, CS_ERR_RANGE);
                 continue;
             }
             assert_int_equal(e, CS_OK);
             within_one(rto, c.rto);
             within_one(2.0 * frame, c.nak_holdoff);
-            assert_int_equal(c.max_retries, 20);
+            within_one(rto_max, c.rto_max);
+            within_one(give_up, c.give_up);
             assert_int_equal(c.keepalive, 1234); /* left as it was */
         }
     /* hand computed, the host's microseconds at 115200 baud with the default sizes: a frame of
@@ -91,7 +94,8 @@ static void test_memory_speed_and_args(void **state)
     assert_int_equal(cs_linktime_link(&c, 0, 1000000), CS_OK);
     assert_int_equal(c.rto, 5000);
     assert_int_equal(c.nak_holdoff, 0);
-    assert_int_equal(c.max_retries, 200);
+    assert_int_equal(c.rto_max, 1000000); /* 1 s */
+    assert_int_equal(c.give_up, 30000000); /* 30 s */
     assert_int_equal(cs_linktime_link(&c, 0, 32768), CS_OK);
     assert_int_equal(c.rto, 164); /* ceil(5 ms * 32768 Hz) = ceil(163.84) */
     assert_int_equal(cs_linktime_link(NULL, 115200, 1000000), CS_ERR_ARG);

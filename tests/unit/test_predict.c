@@ -40,7 +40,7 @@ static cs_err_t run(const cs_bezier_t *c, cs_pos_t tol, size_t *n)
 {
     static cs_predict_t p;
     *n = 0;
-    cs_err_t e = cs_predict_begin(&p, c, tol);
+    cs_err_t e = c->rational ? cs_predict_begin_conic(&p, c, tol) : cs_predict_begin(&p, c, tol);
     if (e != CS_OK)
         return e;
     while (*n < MAX_VERTS && (e = cs_predict_next(&p, &verts[*n])) == CS_OK)
@@ -178,6 +178,15 @@ static void test_refuse(void **state)
     h.w[0] = CS_WEIGHT_ONE / 32; /* a weight below 1/16 */
     h.w[1] = CS_WEIGHT_ONE / 64;
     assert_false(cs_predict_accepts(&h));
+    /* A conic goes to cs_predict_begin_conic only, a polynomial curve to cs_predict_begin. */
+    cs_bezier_t q = curve_cases_planar(2, hyp, 0);
+    q.rational = true;
+    q.w[0] = q.w[2] = CS_WEIGHT_ONE;
+    q.w[1] = CS_WEIGHT_ONE / 2; /* w1^2 <= w0 w2: an ellipse arc */
+    assert_true(cs_predict_accepts(&q));
+    assert_int_equal(cs_predict_begin(&p, &q, MM(0.01)), CS_ERR_UNSUPPORTED);
+    assert_int_equal(cs_predict_begin_conic(&p, &c, MM(0.01)), CS_ERR_UNSUPPORTED);
+    assert_int_equal(cs_predict_begin_conic(&p, &q, MM(0.01)), CS_OK);
     cs_bezier_t big = c;
     big.p[1].x = CS_POS_LIMIT + 1;
     assert_int_equal(cs_predict_begin(&p, &big, MM(0.01)), CS_ERR_RANGE);
