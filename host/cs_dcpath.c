@@ -184,6 +184,9 @@ static double slope_cos(dc_ctx_t *c, double x, double y, double top, double g[2]
             return 0;
     }
     double gx = (z[0] - z[1]) / (2 * DC_WALL_D), gy = (z[2] - z[3]) / (2 * DC_WALL_D);
+    double ms = c->o->max_slope;
+    if (ms > 0 && gx * gx + gy * gy > ms * ms)
+        return 0; /* steep ground another strategy serves */
     g[0] = gx;
     g[1] = gy;
     return 1 / sqrt(1 + gx * gx + gy * gy);

@@ -31,6 +31,8 @@ typedef struct {
     double box[4];     /* x0 y0 x1 y1: the region the tool axis covers */
     double min_z;      /* the floor: the tip never goes lower */
     size_t max_passes; /* refinement stops here (a warning) */
+    double max_slope;  /* > 0: the scallop refinement skips ground steeper than this (another
+                        * strategy serves it, cs_dccombo.h); 0: only walls (slope > 5) */
 } cs_dcpath_opts_t;
 
 typedef struct {

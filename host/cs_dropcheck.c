@@ -29,6 +29,7 @@ typedef struct {
     double *peak; /* highest sample whose nearest node this is: a wall shows above top */
     double *cmax; /* per sample cell: its highest sample z (prunes the gouge test) */
     double *dropm; /* per node: the ideal drop height there, NAN until needed (rest_at) */
+    unsigned char *gap; /* per node, or NULL: 1 where a cutter would close a gap (cs_dropcheck_gaps) */
     long stride;  /* nodes between the ideal cutter's positions (rest_at) */
 } ck_t;
 
@@ -373,8 +374,9 @@ static double ideal_drop(ck_t *k, const cs_dropcut_tool_t *t, long cx, long cy)
 /* How near any cutter position from above comes to the surface point over node (ix, iy): min
  * over axis positions c (the stride lattice) within R + dcap of the distance to the cutter
  * dropped at c. More than H: rest material, no 3-axis cutter of this shape reaches it. */
-static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy)
+static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, size_t *arg)
 {
+    *arg = (size_t)-1;
     double r = t->r_mm + k->dcap, best = HUGE_VAL;
     long rn = (long)ceil(r / k->step / (double)k->stride) * k->stride;
     long bx = ix / k->stride * k->stride, by = iy / k->stride * k->stride;
@@ -387,8 +389,11 @@ static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy)
                 continue;
             double z = ideal_drop(k, t, cx, cy);
             double pc[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
-            if (z > -HUGE_VAL)
-                best = fmin(best, tool_dist(t, pc, sx, sy, sz));
+            double dd = z > -HUGE_VAL ? tool_dist(t, pc, sx, sy, sz) : HUGE_VAL;
+            if (dd < best) {
+                best = dd;
+                *arg = node(k, cx, cy);
+            }
         }
     return best;
 }
@@ -425,8 +430,9 @@ static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *fa
         }
         out->nodes++;
         double left = k->env[n];
+        size_t arg = (size_t)-1;
         if (left > h_mm) { /* is it within reach at all? */
-            double ideal = ideal_dist(k, t, (long)(n % k->mx), (long)(n / k->mx));
+            double ideal = ideal_dist(k, t, (long)(n % k->mx), (long)(n / k->mx), &arg);
             if (ideal > h_mm) {
                 out->rest_nodes++;
                 if (ideal > out->rest_mm) {
@@ -437,6 +443,8 @@ static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *fa
                 left -= ideal; /* what the path leaves beyond the best it could do */
             }
         }
+        if (left > h_mm && arg != (size_t)-1 && k->gap)
+            k->gap[arg] = 1; /* the position from which the ideal cutter comes nearest */
         if (left > out->scallop_mm) {
             out->scallop_mm = left;
             out->scallop_at[0] = k->box[0] + (double)(n % k->mx) * k->step;
@@ -468,9 +476,28 @@ static cs_err_t maps(ck_t *k, const double box[4], double step_mm)
     return CS_OK;
 }
 
-cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
-                          const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out)
+/* The gap positions marked in k->gap, as xy points into *at (malloc'd). */
+static cs_err_t collect(const ck_t *k, double (**at)[2], size_t *nat)
+{
+    size_t nn = k->mx * k->my, m = 0;
+    for (size_t n = 0; n < nn; n++)
+        m += k->gap[n];
+    *at = malloc((m ? m : 1) * sizeof **at);
+    if (!*at)
+        return CS_ERR_FULL;
+    *nat = 0;
+    for (size_t n = 0; n < nn; n++)
+        if (k->gap[n]) {
+            (*at)[*nat][0] = k->box[0] + (double)(n % k->mx) * k->step;
+            (*at)[(*nat)++][1] = k->box[1] + (double)(n / k->mx) * k->step;
+        }
+    return CS_OK;
+}
+
+static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                      const double (*pts)[3], const size_t *start, size_t npass,
+                      const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
+                      double (**at)[2], size_t *nat)
 {
     memset(out, 0, sizeof *out);
     ck_t k;
@@ -490,8 +517,13 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
         if (!far || !interior(&k, (long)ceil(t->r_mm / step_mm), far))
             e = CS_ERR_FULL;
     }
+    if (e == CS_OK && at && !(k.gap = calloc(k.mx * k.my, 1)))
+        e = CS_ERR_FULL;
     if (e == CS_OK)
         measure(&k, t, far, h_mm, out);
+    if (e == CS_OK && at)
+        e = collect(&k, at, nat);
+    free(k.gap);
     free(far);
     free(k.s);
     free(k.start);
@@ -502,4 +534,21 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     free(k.peak);
     free(k.dropm);
     return e;
+}
+
+cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                          const double (*pts)[3], const size_t *start, size_t npass,
+                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out)
+{
+    return check(sf, t, pts, start, npass, box, step_mm, h_mm, out, NULL, NULL);
+}
+
+cs_err_t cs_dropcheck_gaps(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                           const double (*pts)[3], const size_t *start, size_t npass,
+                           const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
+                           double (**at)[2], size_t *nat)
+{
+    *at = NULL;
+    *nat = 0;
+    return check(sf, t, pts, start, npass, box, step_mm, h_mm, out, at, nat);
 }

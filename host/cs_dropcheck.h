@@ -46,4 +46,14 @@ cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
                           const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out);
 
+/* The same, and the gaps: *at (malloc'd, *nat points, the caller frees) gets the axis positions
+ * (x, y, mm; the 0.1 mm lattice of the ideal cutter) from which a cutter dropped onto the
+ * surface comes nearest to each node left more than h_mm beyond the best any cutter could do,
+ * where one more cutter position closes the gap (the planner's fill-in, cs_dropcut_cmd.c).
+ * CS_ERR_FULL out of memory. */
+cs_err_t cs_dropcheck_gaps(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
+                           const double (*pts)[3], const size_t *start, size_t npass,
+                           const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
+                           double (**at)[2], size_t *nat);
+
 #endif

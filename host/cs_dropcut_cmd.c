@@ -10,6 +10,7 @@
 
 #include "cs_cmd.h"
 #include "cs_conv.h"
+#include "cs_dccombo.h"
 #include "cs_dcpath.h"
 #include "cs_dcwater.h"
 #include "cs_dropcheck.h"
@@ -25,7 +26,7 @@
 typedef struct {
     const char *file, *gcode, *name;
     double scale, tol, feed, plunge, safe_z, spindle, min_z, check_step;
-    bool have_safe_z, have_min_z, have_stock, check, stats, centre, no_link, waterline;
+    bool have_safe_z, have_min_z, have_stock, check, stats, centre, no_link, waterline, combo;
     cs_dropcut_tool_t tool;
     const char *tool_kind;
     cs_dcpath_opts_t po;
@@ -86,9 +87,10 @@ static int parse_value(int c, const char *v, dc_args_t *a)
     case 'k': a->have_stock = true; return parse_box(v, a->po.box) ? 0 : bad("--stock", v, "X0,Y0,X1,Y1 (mm, X0 < X1, Y0 < Y1)");
     case 'K': return cs_conv_number(v, &a->check_step) && a->check_step > 0 ? 0 : bad("--check-step", v, "a distance in mm > 0");
     case 'W':
-        if (strcmp(v, "raster") && strcmp(v, "waterline"))
-            return bad("--strategy", v, "raster or waterline");
+        if (strcmp(v, "raster") && strcmp(v, "waterline") && strcmp(v, "raster+waterline"))
+            return bad("--strategy", v, "raster, waterline or raster+waterline");
         a->waterline = strcmp(v, "waterline") == 0;
+        a->combo = strcmp(v, "raster+waterline") == 0;
         return 0;
     case 'o':
         if (strcmp(v, "tip") && strcmp(v, "centre") && strcmp(v, "center"))
@@ -257,15 +259,59 @@ static int build_mesh(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *
     return CS_EXIT_OK;
 }
 
+/* Fill-in (raster+waterline): the check's own measure of the passes (cs_dropcheck_gaps) finds
+ * the nodes left more than H - eps that a cutter from above could reach, and the axis position
+ * from which the ideal cutter comes nearest to each; a short pass there (three drops tol / 2
+ * apart along x) closes the gap. Two rounds at most; *added counts the passes. */
+static int fill_in(const dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms,
+                   cs_dcpath_t *p, size_t *added)
+{
+    double step = a->check_step > 0 ? a->check_step : 0.05, d = a->tol / 2;
+    for (int round = 0; round < 2; round++) {
+        cs_dropcheck_t ck;
+        double(*at)[2];
+        size_t nat;
+        if (cs_dropcheck_gaps(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass, a->po.box,
+                              step, a->po.scallop_mm - ms->eps, &ck, &at, &nat) != CS_OK)
+            return CS_EXIT_INTERNAL;
+        cs_err_t e = CS_OK;
+        for (size_t i = 0; i < nat && e == CS_OK; i++) {
+            double q[3][3];
+            for (int j = 0; j < 3; j++) {
+                bool hit;
+                q[j][0] = at[i][0] + (j - 1) * d;
+                q[j][1] = at[i][1];
+                double z = cs_dropcut_drop(ms, &a->tool, q[j][0], q[j][1], &hit);
+                q[j][2] = hit ? fmax(z, a->po.min_z) : a->po.min_z;
+                p->drops++;
+            }
+            e = cs_dcpath_append(p, (const double(*)[3])q, 3, at[i][1]);
+            *added += 1;
+        }
+        free(at);
+        if (e != CS_OK)
+            return CS_EXIT_INTERNAL;
+        if (nat == 0)
+            break;
+    }
+    return CS_EXIT_OK;
+}
+
 /* The passes of the chosen strategy, joined where the link is clear (unless --no-link). */
-static int plan(dc_args_t *a, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
+static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
 {
     cs_err_t e = a->waterline ? cs_dcwater_plan(p, ms, &a->tool, &a->po)
+                 : a->combo   ? cs_dccombo_plan(p, ms, &a->tool, &a->po)
                               : cs_dcpath_raster(p, ms, &a->tool, &a->po);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep toolpath: cannot plan the passes: %s\n",
                 e == CS_ERR_FULL ? "out of memory" : "the region or step-over is empty");
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_USAGE;
+    }
+    size_t filled = 0;
+    if (a->combo && fill_in(a, sf, ms, p, &filled) != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep toolpath: fill-in: out of memory\n");
+        return CS_EXIT_INTERNAL;
     }
     size_t before = p->npass;
     if (!a->no_link)
@@ -277,11 +323,12 @@ static int plan(dc_args_t *a, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
     if (a->stats)
         fprintf(stderr,
                 "toolpath: %s cutter R %g mm corner %g mm, %s: mesh %zu triangles within %.6f mm, "
-                "%zu passes (%zu added for the scallop), %zu linked at cutting height (%zu "
+                "%zu passes (%zu added for the scallop, %zu short fill-in passes), %zu linked at cutting height (%zu "
                 "retracts), %zu points, %zu drops, estimated scallop %.6f mm (nan: not estimated), "
                 "%.6f mm where no pass can be added (rest material, walls)\n",
-                a->tool_kind, a->tool.r_mm, a->tool.c_mm, a->waterline ? "waterline" : "raster",
-                ms->ntri, ms->eps, before, p->refined, p->links, p->npass, p->n, p->drops,
+                a->tool_kind, a->tool.r_mm, a->tool.c_mm,
+                a->waterline ? "waterline" : a->combo ? "raster+waterline" : "raster",
+                ms->ntri, ms->eps, before, p->refined, filled, p->links, p->npass, p->n, p->drops,
                 p->max_left, p->max_stuck);
     return CS_EXIT_OK;
 }
@@ -294,7 +341,7 @@ static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
     int status = build_mesh(a, sf, &ms);
     double safe = a->have_safe_z ? a->safe_z : ms.box[5] + a->tool.r_mm + 5;
     if (status == CS_EXIT_OK)
-        status = plan(a, &ms, &p);
+        status = plan(a, sf, &ms, &p);
     if (status == CS_EXIT_OK) {
         write_points(a, &p);
         if (a->gcode && !write_gcode(a, &p, safe)) {

@@ -167,5 +167,5 @@ run "slope waterline" 0 toolpath --patches "$T/slope.txt" --cutter ball:2 --scal
 g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop.*/\1/p' "$T/err")
 expect "slope waterline: gouge $g <= 0.01" awk -v g="$g" 'BEGIN { exit !(g != "" && g <= 0.01) }'
 run "strategy bad" 2 toolpath --patches "$T/slope.txt" --cutter ball:2 --scallop 0.1 --strategy spiral &&
-    expect_err "strategy bad" "raster or waterline"
+    expect_err "strategy bad" "raster, waterline or raster\\+waterline"
 finish

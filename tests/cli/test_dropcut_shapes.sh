@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Drop-cutter finishing (`curvestep toolpath --cutter`, issue 20) on a teacup-like surface of
+# revolution (an outer wall, a rounded rim, an inner wall and a bottom: steep inside and out) and
+# on an n-sided (Varady) patch: every strategy is gouge-free by the independent --check, raster
+# and raster+waterline leave at most H for every cutter, and the G-code plans on the router and
+# passes the simulator's check. Coarse H and tol on small parts keep it to seconds of CPU; the
+# teapot's figures are in the benchmark (tests/bench/bench_dropcut.c).
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
+need_bin "$CS" "$SIM"
+M=contrib/machines/router-3018.ini
+
+# The teacup, computed here from its profile (r, z above the foot at z = -20, axis at (15, 15)):
+# each profile cubic turned by four quarter arcs with handles k = 4/3 tan(pi/8), patch row i =
+# profile point i, column j = arc point j (the exact tensor product of the profile and the arc).
+awk 'BEGIN {
+    pi = 3.14159265358979; k = 4 / 3 * sin(pi / 8) / cos(pi / 8); n = 0
+    seg[n++] = "4 0  5.5 1  6 3  6 5"            # outer wall
+    seg[n++] = "6 5  6 5.6  5.2 5.6  5.2 5"      # rounded rim
+    seg[n++] = "5.2 5  5.2 3  4.5 1.5  3 1"      # inner wall into the bottom
+    seg[n++] = "3 1  2 1  1 1  0 1"              # inner bottom, flat, to the axis
+    print "curvestep-surfaces 1"
+    for (s = 0; s < n; s++) {
+        split(seg[s], q, " ")
+        for (a = 0; a < 4; a++) {
+            t = a * pi / 2; c = cos(t); d = sin(t)
+            ax[0] = c; ay[0] = d; ax[1] = c - k * d; ay[1] = d + k * c
+            ax[3] = -d; ay[3] = c; ax[2] = -d + k * c; ay[2] = c + k * d
+            print "bezier 3 3"
+            for (i = 0; i < 4; i++) {
+                line = " "
+                for (j = 0; j < 4; j++)
+                    line = line sprintf(" %.9g %.9g %.9g", 15 + q[2 * i + 1] * ax[j],
+                                        15 + q[2 * i + 1] * ay[j], -20 + q[2 * i + 2])
+                print line
+            }
+        }
+    }
+}' >"$T/cup.txt"
+# The five-sided patch of tests/data/surfaces/pentagon.txt, halved and moved into the router's
+# travel (x' = x / 2 + 15, y' = y / 2 + 15, z' = z / 2 - 20).
+awk 'NF > 3 && $1 == 3 { l = "  3"; for (i = 2; i <= NF; i += 3)
+        l = l sprintf("  %.6g %.6g %.6g", $i / 2 + 15, $(i + 1) / 2 + 15, $(i + 2) / 2 - 20)
+    print l; next } { print }' tests/data/surfaces/pentagon.txt >"$T/pent.txt"
+expect "teacup: 16 bicubic patches" [ "$(grep -c '^bezier 3 3' "$T/cup.txt")" = 16 ]
+
+# gouge <= tol and (unless "any") scallop <= H, from the check's line in $T/err.
+gs() {
+    local name=$1 h=$2 g
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm.*/\1 \2/p' "$T/err")
+    expect "$name: gouge <= 0.02, scallop <= $h ($g)" awk -v g="$g" -v h="$h" \
+        'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.02 && (h == "any" || a[2] <= h)) }'
+}
+
+for s in cup pent; do
+    for c in ball:1.5 flat:1.5 bull:1.5:0.5; do
+        run "$s raster+waterline $c" 0 toolpath --patches "$T/$s.txt" --cutter "$c" --scallop 0.1 \
+            --tol 0.02 --strategy raster+waterline --check --safe-z 5 --gcode "$T/$s.$c.nc" &&
+            gs "$s raster+waterline $c" 0.1
+        [ "$c" = ball:1.5 ] && cp "$T/out" "$T/$s.combo.pts"
+    done
+    run "$s raster ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
+        --tol 0.02 --check && gs "$s raster ball" 0.1
+    # waterline alone leaves up to its level step on shallow ground (reported, not failed)
+    run "$s waterline ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
+        --tol 0.02 --strategy waterline --check && gs "$s waterline ball" any
+    # the G-code runs on the router as written, and the simulator's check passes
+    run "$s: gcode plans on the router" 0 plan --machine "$M" -o "$T/$s.seg" "$T/$s.ball:1.5.nc"
+    "$SIM" --replay "$T/$s.seg" --machine "$M" --reference "$T/$s.ball:1.5.nc" --check \
+        >"$T/$s.sim" 2>&1
+    expect "$s: simulator check passes" [ $? -eq 0 ]
+    expect "$s: simulator final position exact" grep -q 'rounded to steps: exact' "$T/$s.sim"
+done
+
+# The combination serves both: raster passes (z varies along them) and waterline contours
+# (constant z) over the cup's walls.
+kinds=$(awk 'NF == 0 { if (n > 2) { if (hi - lo < 1e-9) w++; else r++ } n = 0; next }
+    { if (!n) { lo = $3; hi = $3 } lo = $3 < lo ? $3 : lo; hi = $3 > hi ? $3 : hi; n++ }
+    END { if (n > 2) { if (hi - lo < 1e-9) w++; else r++ } print r + 0, w + 0 }' "$T/cup.combo.pts")
+expect "cup raster+waterline: raster and level passes ($kinds)" \
+    bash -c "set -- $kinds; [ \$1 -ge 1 ] && [ \$2 -gt 5 ]"
+# Over the cup's flat inner bottom (z = -19 within 3 mm of the axis) a ball of radius 1.5 whose
+# axis is within 1 mm of the axis rests on it: its tip is at -19 (the mesh bound adds at most
+# 2 eps = tol / 2).
+bot=$(awk 'NF == 3 && ($1 - 15) ^ 2 + ($2 - 15) ^ 2 < 1 { m++; if ($3 < -19 - 1e-9 || $3 > -19 + 0.01) bad++ }
+    END { print bad + 0, m + 0 }' "$T/cup.combo.pts")
+expect "cup: tips over the flat bottom at z = -19 ($bot: bad, checked)" \
+    bash -c "set -- $bot; [ \$1 = 0 ] && [ \$2 -gt 20 ]"
+finish
