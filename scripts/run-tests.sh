@@ -21,8 +21,8 @@ case "$JOBS" in '' | *[!0-9]* | 0) echo "run-tests.sh: CS_TEST_JOBS must be a po
 # side by side. The slow ones start first, so that the runners end together (the list is by
 # their time on this machine, longest first: a script or a unit binary by its name); then the
 # other scripts; the unit binaries, mostly short, fill in at the end.
-slow_first="test_dropcut test_dropcut_shapes test_grbl test_predict test_resume test_plan test_modbus_clients"
-slow_first+=" test_safety_inputs test_help test_modbus test_stream test_daemon test_fw_m3_page"
+slow_first="test_dropcut_shapes test_dropcut test_predict test_resume test_modbus_clients test_plan"
+slow_first+=" test_safety_inputs test_help test_grbl test_modbus test_stream test_daemon test_fw_m3_page"
 all=("${CLI_DIR:-tests/cli}"/test_*.sh "$@")
 items=()
 for s in $slow_first; do
