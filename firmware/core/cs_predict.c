@@ -89,6 +89,7 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
             return CS_ERR_RANGE;
     p->t = 0;
     p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->h_ideal = 0;
     p->thr = tol - CS_PREDICT_SLACK_LSB;
     p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
     p->z = c->p[0].z;
@@ -365,6 +366,17 @@ static int64_t predict(cs_param_t h, uint32_t room)
     return (int64_t)(nh - nh / 64);
 }
 
+/* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
+ * ideal step changes smoothly along the curve), at least a/2; a alone when there is no last
+ * one (b = 0). 0 <= a <= 2^30 and 0 < b <= 2^30: 2a - b < 2^31, no overflow. */
+static cs_param_t trend(cs_param_t a, cs_param_t b)
+{
+    if (b == 0)
+        return a;
+    cs_param_t n = 2 * a - b;
+    return n < a / 2 ? a / 2 : n;
+}
+
 /* --- conic arcs ------------------------------------------------------------------------- */
 /* a + (b - a) u, u in Q30 (|b - a| < 2^60: one rounding of 1/2 unit). */
 static int64_t lerp(int64_t a, int64_t b, cs_param_t u)
@@ -544,8 +556,12 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t 
         *pt = p->end;
         return CS_OK;
     }
-    /* Next chord: about as long in t as this one, corrected by the room this one left. */
+    /* Next chord: the step this one would have needed to fill the tolerance (its step
+     * corrected by its room), times the trend of that ideal step from the chord before. */
     int64_t nh = predict(h, room);
+    cs_param_t ideal = nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    nh = trend(ideal, p->h_ideal);
+    p->h_ideal = room == F16_ONE ? 0 : ideal; /* a hull test says nothing of the trend */
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
     p->done = false;
     *eval = true;
