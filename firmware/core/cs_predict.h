@@ -34,6 +34,7 @@
 typedef struct cs_predict cs_predict_t;
 struct cs_predict {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
+    int64_t d[2][2]; /* B'(t), B''(t) / 2 at the last vertex (per axis x, y) */
     int64_t h[3][3]; /* conic: homogeneous points w_i x_i, w_i y_i (LSB * 2^30), w_i (Q30) */
     cs_err_t (*next)(cs_predict_t *p, cs_vec3_t *pt);
     cs_param_t t;      /* parameter of the last vertex returned */
