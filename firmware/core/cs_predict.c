@@ -185,7 +185,7 @@ static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 /* At the vertex t: B(t) rounded to the LSB into *pt (when pt is not NULL), and B'(t), B''(t) / 2
  * for the chords from t into p->d (per axis, LSB * 2^F). One Horner scheme shares a3 t:
  * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
- * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 1 in B before its
+ * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
  * rounding to the LSB (docs/fixed-point.md). */
 static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
