@@ -332,10 +332,6 @@ CS_STATIC_ASSERT(((LIM_PINS | SERVO_PIN | SP_PWM_PIN | EN_LINE | LED_LINE) & 0xC
 #define ACTIVE(v) ((uint8_t)(v))
 #endif
 
-static void (*in_fn)(void *ctx, uint16_t bits);
-static void *in_ctx;
-static uint16_t in_last;
-
 uint16_t port_inputs_read(void)
 {
     uint8_t b = (uint8_t)(ACTIVE(PINB) & LIM_PINS);
@@ -356,36 +352,34 @@ uint16_t port_inputs_read(void)
     return in;
 }
 
-/* The bits changed since last reported: tell the application. Interrupts masked. */
-static void inputs_report(void)
-{
-    uint16_t b = port_inputs_read();
-    if (b == in_last)
-        return;
-    in_last = b;
-    if (in_fn != NULL)
-        in_fn(in_ctx, b);
-}
+/* The edge hook (port.h): every pin change of a switch, the probe or the e-stop calls it; the
+ * application reads the pins and keeps what changed. */
+static void (*in_fn)(void *ctx);
+static void *in_ctx;
 
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx)
 {
     uint8_t s = SREG;
     cli();
     in_fn = fn;
     in_ctx = ctx;
-    in_last = 0;
-    inputs_report(); /* what is active already is a change from nothing */
     SREG = s;
+}
+
+static void inputs_edge(void)
+{
+    if (in_fn != NULL)
+        in_fn(in_ctx);
 }
 
 ISR(PCINT0_vect)
 {
-    inputs_report();
+    inputs_edge();
 }
 
 ISR(PCINT1_vect)
 {
-    inputs_report();
+    inputs_edge();
 }
 
 /* The spindle / laser output, Grbl's: Timer2 fast PWM (WGM 3, TOP 0xFF) at F_CPU / 8 / 256 =
