@@ -229,6 +229,7 @@ wait "$JPID"
 rc=$?
 stop_harness
 expect "jog cancel: exit 8 (got $rc)" [ $rc -eq 8 ]
+expect "jog cancel: harness ok (pulses, DIR setup)" grep -q '^result: ok$' "$T/jc.out"
 jx=$(sed -n 's/^jog: machine position \([-0-9.]*\) .*/\1/p' "$T/jc.jog")
 cx=$(sed -n 's/^position: x=\(-\?[0-9]*\) .*/\1/p' "$T/jc.out")
 expect "jog cancel: stopped short of x $JT mm (x ${jx:-?} mm)" \
@@ -271,6 +272,7 @@ ctl unlock >"$T/yu.out" 2>&1
 read -r _ uy _ < <(sed -n 's/^unlock: machine position \(.*\) mm$/\1/p' "$T/yu.out")
 stop_harness
 expect "pins: the y switch trips the servo job (exit 7, got $rc)" [ $rc -eq 7 ]
+expect "pins: harness ok" grep -q '^result: ok$' "$T/y.out"
 expect "pins: y switch A1 (PC1) pressed once at y $YS" \
     grep -q "^switch: PC1 limit y >= $YS: 1 presses, last at x=[0-9]* y=$YS z=0$" "$T/y.out"
 expect "pins: stopped on the y switch, $(mm $YS) mm within a step (got ${uy:-?})" \
