@@ -56,7 +56,7 @@ enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
 #define TCCR2B_ADDR  0xB1
 #define OCR2A_ADDR   0xB3
 #define PWM_SETS     64 /* distinct successive spindle settings kept for the report */
-static const uint8_t limit_bit[AXES] = {1, 1, 4};        /* PB1 (D9), PC1 (A1), PB4 (D12) */
+static const uint8_t limit_bit[AXES] = {1, 1, 4}; /* PB1 (D9), PC1 (A1), PB4 (D12) */
 static const char limit_port[AXES] = {'B', 'C', 'B'};
 
 typedef struct {
@@ -833,8 +833,7 @@ int main(int argc, char **argv)
     for (int k = 0; k < g.nsw; k++) {
         fprintf(out, "switch: P%c%d %s %c %s %lld: %llu presses", g.sw[k].port, g.sw[k].bit,
                 g.sw[k].port == 'C' && g.sw[k].bit == PROBE_BIT ? "probe" : "limit",
-                names[g.sw[k].axis],
-                g.sw[k].above ? ">=" : "<=", (long long)g.sw[k].at,
+                names[g.sw[k].axis], g.sw[k].above ? ">=" : "<=", (long long)g.sw[k].at,
                 (unsigned long long)g.sw[k].presses);
         if (g.sw[k].presses > 0) {
             fprintf(out, ", last at");
