@@ -162,8 +162,8 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
 /* Inline on cores with a 32x32 -> 64 multiply instruction (about 8 instructions a call saved on
  * the M3, 32 calls a chord); out of line where it would be two libgcc calls (M0+, AVR): there the
  * flash matters more. */
-#if defined(__GNUC__) && (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && \
-                                                        __ARM_ARCH_ISA_THUMB >= 2))
+#if defined(__GNUC__) &&                                                                           \
+    (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB >= 2))
 #define MUL_T_INLINE __attribute__((always_inline)) inline
 #else
 #define MUL_T_INLINE
@@ -236,8 +236,7 @@ CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS +
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
-                      int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
@@ -251,14 +250,15 @@ static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h
     }
 }
 
-/* log2(v) in Q8 for v > 0, within 0.006 (0.4 %): the bit length gives the integer part, the
- * next 15 bits x (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x),
- * c = 89/256 (the error of this parabola is below 0.005). The predictor's only logarithm. */
+/* log2(v) in Q8 for v > 0: the bit length gives the integer part, the next 15 bits x
+ * (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x), c = 89/256;
+ * within [-0.0115, +0.0079] of the exact log2 v (checked on all 2^15 mantissas, the truncation
+ * to 16 bits and to Q8 included). The predictor's only logarithm. */
 static int32_t log2_q8(uint64_t v)
 {
     unsigned n = cs_fixed_bitlen64(v);
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
-    uint32_t x = m - (1u << 15);                                                 /* Q15 */
+    uint32_t x = m - (1u << 15);                                               /* Q15 */
     uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
     return (int32_t)((n - 1) * ROOM_ONE + (l >> 7));
 }
@@ -314,7 +314,7 @@ static bool hull_flat(int32_t v[3][2], int64_t dot1, int64_t dot2, int64_t dd, i
 }
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
- * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
+ * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
 static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
 {
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
@@ -327,7 +327,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
     int64_t thr_f = (int64_t)p->thr << F;
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
-        s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
+        s = p->thr_shift;         /* thr_f >> s < 2^THR_BITS */
     int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
     if (T <= 0) {
         *room = ROOM_FAIL;
@@ -361,11 +361,11 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
  * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). */
 static int64_t predict(cs_param_t h, int32_t room)
 {
-    int32_t e = room - ROOM_MIN;                 /* >= 0: no negative value is shifted */
-    int32_t i = (e >> 9) - (-ROOM_MIN >> 9);      /* floor(room / 512), -15 .. 2 */
-    uint32_t f = ((uint32_t)e & 511u) << 6;       /* Q15 */
+    int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
+    int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
+    uint32_t f = ((uint32_t)e & 511u) << 6;  /* Q15 */
     uint32_t m = (1u << 15) + f - ((((f * ((1u << 15) - f)) >> 15) * 88u) >> 8);
-    uint64_t nh = (uint64_t)(uint32_t)h * m;      /* h 2^f in Q15, < 2^46 */
+    uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
     nh = i >= 0 ? nh << i : nh >> -i;
     nh >>= 15;
     return (int64_t)(nh - nh / 64);
@@ -492,8 +492,7 @@ typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, in
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
-                            int32_t *lo_room)
+static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
 {
     cs_param_t rem = CS_PARAM_ONE - p->t;
     int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
@@ -544,7 +543,7 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *
         return CS_OK;
     }
     /* Next chord: the step this one would have needed to fill the tolerance (its step
-     * corrected by its room), times the trend of that ideal step from the chord before. */
+     * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
     int64_t nh = predict(h, room);
     cs_param_t ideal = nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
     nh = trend(ideal, p->h_ideal);

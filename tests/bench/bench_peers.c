@@ -707,7 +707,8 @@ static int profile(const bench_set_t *sets)
 
 int main(int argc, char **argv)
 {
-    static const char usage[] = "usage: bench_peers [OUT.csv | --profile]\n"
+    static const char usage[] =
+        "usage: bench_peers [OUT.csv | --profile]\n"
         "curvestep's tracers beside cairo and AGG on one corpus of cubics; a Markdown\n"
         "section on stdout, the figures in OUT.csv. --profile: only the default tracer and\n"
         "cairo, once over the corpus and the arcs (for callgrind, see profile_curves).\n";

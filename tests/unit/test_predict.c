@@ -34,7 +34,6 @@ static cs_vec3_t verts[MAX_VERTS];
 
 static uint64_t rng = 0x2545F4914F6CDD1Dull;
 
-
 /* Traces c with cs_predict directly; returns the final code, *n vertices. */
 static cs_err_t run(const cs_bezier_t *c, cs_pos_t tol, size_t *n)
 {
