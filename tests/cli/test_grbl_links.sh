@@ -8,7 +8,8 @@
 #    G38.2, M3) is error:5 / error:20 with a [MSG:] naming the link, M5 is ok;
 #  - the GPIO link's recorder (`--gpio record:FILE`): a program whose end the test computes from
 #    its G-code (mm x 80 steps/mm, rounded to a step), with ? and a hold / resume: the final
-#    status and the GPIO state's position are exactly that; and with the simulated switches and
+#    status and the GPIO state's position are exactly that; Ctrl-X stops a move short, at the
+#    position its recorded STEP edges give; and with the simulated switches and
 #    probe of tests/data/ctl-*.ini (by hand, as tests/cli/test_gpio_inputs.sh: home ends at
 #    machine -99, 0, 0; the probe surface is machine z -4; the x max switch is machine x -45):
 #    $H ok at -99 0 0, G38.2 touches at z -4, M3 is error:20, a move past the switch is ALARM:1
@@ -104,6 +105,18 @@ expect "modbus: a new session starts where the registers say (2 mm), X1 more: 3"
     grep -q '^state: <Idle|MPos:3.000,0.000,0.000|' "$T/mbc2.out"
 expect "modbus ctl: the device moved x to 3 mm (240 steps)" grep -q '^final position: x=240 steps' "$T/mbc.sim"
 
+# Modbus RTU (the simulator's RTU server on a pty): the same front end, a move and a jog.
+timeout -k 5 120 "$SIM" --modbus-rtu pty --instant >"$T/rtu.sim" 2>"$T/rtu.simerr" &
+pids+=($!)
+SIMPID=$!
+wait_pty "$T/rtu.sim" 60
+start_grbl rtu --modbus-rtu "$PTY"
+client "$GPTY" cmd 'G21 G90 G0 X4 Y-2' '@waitfor Idle' '$J=G91 Y3 F600' '@waitfor Idle' >"$T/rtu.out"
+stop_grbl
+stop_dev "$SIMPID"
+expect "modbus rtu: the move and the jog end at 4, 1" grep -q '^state: <Idle|MPos:4.000,1.000,0.000|' "$T/rtu.out"
+expect "modbus rtu: the device agrees (320, 80 steps)" grep -q '^final position: x=320 steps (4.0000 mm) y=80 steps' "$T/rtu.sim"
+
 # --- GPIO (the recorder) ----------------------------------------------------------------------
 # a program ending at X12.33 Y7.88 (machine mm): 80 steps/mm, the end rounded to a step
 printf '%s\n' 'G21 G90' 'G1 X20 Y10 F6000' 'G2 X30 Y20 I10 J0' 'G1 X0 Y30 F6000' \
@@ -112,6 +125,8 @@ read -r wx wy < <(awk 'BEGIN { x = int(12.33 * 80 + 0.5); y = int(7.88 * 80 + 0.
 want=$(awk -v x="$wx" -v y="$wy" 'BEGIN { printf "%.3f,%.3f,0.000", x / 80, y / 80 }')
 start_grbl gp --gpio "record:$T/gp.csv"
 client "$GPTY" stream "$T/g.nc" --method simple --status-every 1 --hold-after 3 >"$T/gp.out"; rc=$?
+cp "$T/gp.csv.state" "$T/gp.state1"
+client "$GPTY" reset 'G91 G1 X50 F600' >"$T/gpr.out" # Ctrl-X mid-move: 5 s long
 stop_grbl
 expect "gpio: client exit 0" [ $rc -eq 0 ]
 expect "gpio: 5 ok, 0 errors" grep -q '^acks: 5 0$' "$T/gp.out"
@@ -122,8 +137,16 @@ h=$(sed -n 's/^held: <Hold:0|\(MPos:[^|]*\)|.*/\1/p' "$T/gp.out")
 expect "gpio: held still 0.3 s later" grep -q "^still-held: <Hold:0|$h|" "$T/gp.out"
 expect "gpio: held away from the end ($h)" bash -c "[ '$h' != 'MPos:$want' ] && [ -n '$h' ]"
 expect "gpio: ends Idle exactly at the program's end ($want)" grep -q "^final: <Idle|MPos:$want|" "$T/gp.out"
-expect "gpio: the state keeps that position ($wx $wy steps)" grep -q "^pos $wx $wy 0 " "$T/gp.csv.state"
-expect "gpio: the record holds the last chunk's edges" grep -q ',x_step,1' "$T/gp.csv"
+expect "gpio: the state keeps that position ($wx $wy steps)" grep -q "^pos $wx $wy 0 " "$T/gp.state1"
+# Ctrl-X: stopped short, where the record's edges of that chunk (the last) put the machine
+read -r n s < <(awk -F, '$3 == "x_dir" { d = $4 ? 1 : -1 } $3 == "x_step" && $4 == 1 { n++; s += d }
+    END { print n + 0, s + 0 }' "$T/gp.csv")
+xr=$(sed -n 's/^final: <Idle|MPos:\([0-9.-]*\),.*/\1/p' "$T/gpr.out")
+expect "gpio reset: moving before Ctrl-X" grep -q '^moving: <Run|MPos:' "$T/gpr.out"
+expect "gpio reset: stopped short of X+50 ($n steps, all +x)" [ "$n" -gt 0 ] && [ "$n" -lt 4000 ] && [ "$n" = "$s" ]
+expect "gpio reset: Idle where the record's steps put it (x $xr)" \
+    awk -v x="$xr" -v s="$s" -v x0="$wx" 'BEGIN { exit !(x != "" && sprintf("%.3f", (x0 + s) / 80) == x) }'
+expect "gpio reset: the state agrees" grep -q "^pos $((wx + s)) $wy 0 " "$T/gp.csv.state"
 
 # machine control on GPIO: the switches and probe of the machine file (see the top)
 M=$T/ctl.ini

@@ -17,6 +17,8 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
                   "@waitfor STATE" is not sent: it waits as waitfor does
   jogcancel LINE  sends the $J= LINE, waits for the Jog state, sends 0x85 and prints
                   "jogging: <...>" and "final: <...>" once Idle
+  reset LINE      sends LINE, waits for Run with the position moved, sends Ctrl-X and prints
+                  "moving: <...>" and "final: <...>" once Idle
   idle            (no soft reset first) waits for Idle, prints "final: <...>"
   waitfor STATE   (no soft reset first) waits for the state STATE (Alarm, Idle...), prints
                   the pushed lines seen meanwhile (ALARM:N...) and "state: <...>"
@@ -277,6 +279,21 @@ def main(argv):
                 print(reply, flush=True)
                 if is_ack(reply):
                     break
+    elif cmd == "reset":  # Ctrl-X mid-move: the machine stops, the rest is dropped
+        g.write((argv[3] + "\n").encode())
+        print("reply: " + g.need(), flush=True)
+        first = None
+        end = time.monotonic() + deadline
+        while time.monotonic() < end:
+            st = g.status()
+            pos = st.split("|")[1]
+            first = first or pos
+            if st.startswith("<Run") and pos != first:
+                print("moving: " + st, flush=True)
+                break
+            time.sleep(0.05)
+        g.write(b"\x18")
+        print("final: " + wait_idle(g), flush=True)
     elif cmd == "jogcancel":
         g.write((argv[3] + "\n").encode())
         print("reply: " + g.need(), flush=True)
