@@ -135,7 +135,8 @@ expect "gpio: every status well formed" bash -c "! grep -q '^malformed' '$T/gp.o
 expect "gpio: held (Hold:0)" grep -q '^held: <Hold:0|MPos:' "$T/gp.out"
 h=$(sed -n 's/^held: <Hold:0|\(MPos:[^|]*\)|.*/\1/p' "$T/gp.out")
 expect "gpio: held still 0.3 s later" grep -q "^still-held: <Hold:0|$h|" "$T/gp.out"
-expect "gpio: held away from the end ($h)" bash -c "[ '$h' != 'MPos:$want' ] && [ -n '$h' ]"
+expect "gpio: held away from the start and the end ($h)" \
+    bash -c "[ '$h' != 'MPos:$want' ] && [ '$h' != 'MPos:0.000,0.000,0.000' ] && [ -n '$h' ]"
 expect "gpio: ends Idle exactly at the program's end ($want)" grep -q "^final: <Idle|MPos:$want|" "$T/gp.out"
 expect "gpio: the state keeps that position ($wx $wy steps)" grep -q "^pos $wx $wy 0 " "$T/gp.state1"
 # Ctrl-X: stopped short, where the record's edges of that chunk (the last) put the machine
@@ -185,5 +186,8 @@ run "two links: exit 2" 2 grbl --port /dev/null --gpio record:"$T/x.csv"
 expect_err "two links: said" 'exclude each other'
 run "bad unit: exit 2" 2 grbl --modbus-tcp 127.0.0.1:1 --unit 0
 run "no Modbus device: exit 4" 4 grbl --modbus-tcp 127.0.0.1:1
+run "no GPIO chip: exit 4" 4 grbl --gpio gpiochip9
+expect_err "no GPIO chip: named" 'cannot open GPIO chip gpiochip9'
+run "--line-rate off --port: exit 2" 2 grbl --gpio "record:$T/x.csv" --line-rate 100
 
 finish
