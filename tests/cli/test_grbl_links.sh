@@ -106,16 +106,24 @@ expect "modbus: a new session starts where the registers say (2 mm), X1 more: 3"
 expect "modbus ctl: the device moved x to 3 mm (240 steps)" grep -q '^final position: x=240 steps' "$T/mbc.sim"
 
 # Modbus RTU (the simulator's RTU server on a pty): the same front end, a move and a jog.
-timeout -k 5 120 "$SIM" --modbus-rtu pty --instant >"$T/rtu.sim" 2>"$T/rtu.simerr" &
+timeout -k 5 120 "$SIM" --modbus-rtu pty --speed 1 >"$T/rtu.sim" 2>"$T/rtu.simerr" &
 pids+=($!)
 SIMPID=$!
 wait_pty "$T/rtu.sim" 60
 start_grbl rtu --modbus-rtu "$PTY"
 client "$GPTY" cmd 'G21 G90 G0 X4 Y-2' '@waitfor Idle' '$J=G91 Y3 F600' '@waitfor Idle' >"$T/rtu.out"
+client "$GPTY" reset 'G91 G1 X50 F600' >"$T/mbr.out" # Ctrl-X mid-move (5 s long)
 stop_grbl
 stop_dev "$SIMPID"
 expect "modbus rtu: the move and the jog end at 4, 1" grep -q '^state: <Idle|MPos:4.000,1.000,0.000|' "$T/rtu.out"
-expect "modbus rtu: the device agrees (320, 80 steps)" grep -q '^final position: x=320 steps (4.0000 mm) y=80 steps' "$T/rtu.sim"
+xs=$(sed -n 's/^final position: x=\(-*[0-9]*\) steps.*/\1/p' "$T/rtu.sim")
+xr=$(sed -n 's/^final: <Idle|MPos:\([0-9.-]*\),.*/\1/p' "$T/mbr.out")
+expect "modbus reset: moving before Ctrl-X" grep -q '^moving: <Run|MPos:' "$T/mbr.out"
+expect "modbus reset: the device stopped short of X54 ($xs steps)" [ "${xs:-0}" -gt 320 ] && [ "${xs:-0}" -lt 4320 ]
+expect "modbus reset: Idle where the device stopped (x $xr)" \
+    awk -v x="$xr" -v s="${xs:-0}" 'BEGIN { exit !(x != "" && sprintf("%.3f", s / 80) == x) }'
+expect "modbus reset: the device held, then aborted" grep -qE ' 1 holds, 1 aborts' "$T/rtu.sim"
+expect "modbus rtu: the device's y is the jog's end (80 steps)" grep -q '^final position: x=-*[0-9]* steps ([0-9.-]* mm) y=80 steps' "$T/rtu.sim"
 
 # --- GPIO (the recorder) ----------------------------------------------------------------------
 # a program ending at X12.33 Y7.88 (machine mm): 80 steps/mm, the end rounded to a step
