@@ -163,7 +163,7 @@ cat tests/data/ctl-switches.ini >"$M" # ctl-homing.ini's cycle, faster (the same
 printf '%s\n' '[homing]' 'order = zx' 'seek = 50' 'latch = 5' 'pulloff = 1' 'z = max' 'z_pos = 0' \
     'x = min' 'x_pos = -99' >>"$M"
 start_grbl gc --gpio "record:$T/gc.csv" --machine "$M"
-client "$GPTY" cmd '$H' '?' 'G38.2 Z-10 F300' 'M3 S100' 'G0 Z0' 'G1 X-40 F3000' '@waitfor Alarm' \
+client "$GPTY" cmd '$H' '?' 'G38.2 Z-10 F600' 'M3 S100' 'G0 Z0' 'G1 X-40 F6000' '@waitfor Alarm' \
     'G0 X-60' '$X' 'G0 X-60' '@waitfor Idle' >"$T/gc.out"; rc=$?
 client "$GPTY" jogcancel '$J=G91 X-30 F300' >"$T/gj.out"; rc2=$?
 stop_grbl
