@@ -76,6 +76,7 @@ expect "modbus: ends Idle at the program's end" grep -q '^final: <Idle|MPos:0.00
 expect "modbus: the device saw the hold" grep -qE ' [1-9][0-9]* holds' "$T/mb.sim"
 expect "modbus: device check ok" grep -q '^check: ok$' "$T/mb.sim"
 expect "modbus: final position exact, as plan + replay" grep -qxF "$REF_POS" "$T/mb.sim"
+expect "modbus: the device's end is the program's, rounded to steps" grep -q 'rounded to steps: exact' "$T/mb.sim"
 
 # what Modbus cannot do: refused with Grbl's error and the reason, never run; M5 is ok
 printf '%s\n' '[homing]' 'order = x' 'x = min' 'x_pos = 0' '[probe]' 'z = -2' >"$T/mbctl.ini"
