@@ -569,9 +569,9 @@ void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
 
 void cs_fw_motion_override(cs_fw_motion_t *a, const cs_proto_override_t *ov)
 {
-    /* Q16 = per-mille x 65536 / 1000, rounded */
-    cs_hold_override(&a->hold, (uint32_t)(((uint64_t)ov->feed * CS_HOLD_SCALE_ONE + 500u) /
-                                          CS_PROTO_OVERRIDE_ONE));
+    /* Q16 = per-mille x 65536 / 1000, rounded (below 2^31: feed <= CS_PROTO_OVERRIDE_MAX) */
+    cs_hold_override(&a->hold, ((uint32_t)ov->feed * CS_HOLD_SCALE_ONE + 500u) /
+                                   CS_PROTO_OVERRIDE_ONE);
     cs_fw_ctl_override(a, ov->spindle);
 }
 
@@ -623,9 +623,8 @@ void cs_fw_motion_give_back(cs_fw_motion_t *a)
 /* ABORT, a reboot: no override. */
 static void override_reset(cs_fw_motion_t *a)
 {
-    cs_proto_override_t one = {CS_PROTO_OVERRIDE_ONE, CS_PROTO_OVERRIDE_ONE,
-                               CS_PROTO_OVERRIDE_ONE};
-    cs_fw_motion_override(a, &one);
+    cs_hold_override(&a->hold, CS_HOLD_SCALE_ONE);
+    cs_fw_ctl_override(a, CS_PROTO_OVERRIDE_ONE);
 }
 
 void cs_fw_motion_abort(cs_fw_motion_t *a)

@@ -63,23 +63,21 @@ bool cs_hold_active(const cs_hold_t *h)
 }
 
 /* The segment's real duration for a mean scale (s0 + s1) / 2: t = 2 tau / (s0 + s1), rounded
- * up, never shorter than its largest |steps| (one step a tick at most) nor longer than the
- * executor takes. */
-static uint32_t retime(const cs_segment_t *s, uint64_t s0, uint64_t s1)
+ * up, never longer than the executor takes nor shorter than its largest |steps| (one step a
+ * tick at most: only a scale above 1 can come near it). */
+static uint32_t retime(const cs_segment_t *s, uint32_t s0, uint32_t s1)
 {
-    uint64_t sum = s0 + s1;
+    uint64_t sum = (uint64_t)s0 + s1;
     uint64_t t = sum == 0 ? CS_HOLD_MAX_TICKS : (((uint64_t)s->ticks << 17) + sum - 1u) / sum;
-    uint64_t most = 1;
-    for (unsigned i = 0; i < CS_AXES; i++) {
-        uint64_t a = s->steps[i] < 0 ? (uint64_t)(-(int64_t)s->steps[i]) : (uint64_t)s->steps[i];
-        if (a > most)
-            most = a;
-    }
-    if (t < most)
-        t = most;
     if (t > CS_HOLD_MAX_TICKS)
         t = CS_HOLD_MAX_TICKS > s->ticks ? CS_HOLD_MAX_TICKS : s->ticks;
-    return (uint32_t)t;
+    uint32_t r = (uint32_t)t;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        uint32_t a = s->steps[i] < 0 ? 0u - (uint32_t)s->steps[i] : (uint32_t)s->steps[i];
+        if (a > r)
+            r = a;
+    }
+    return r;
 }
 
 bool cs_hold_admit_to(cs_hold_t *h, cs_segment_t *s, uint32_t goal)
@@ -100,14 +98,18 @@ bool cs_hold_admit_to(cs_hold_t *h, cs_segment_t *s, uint32_t goal)
      * t = 2 tau / (s0 + s1). A hold whose ramp ends inside a segment runs that segment as if
      * it ended at rest (s1 = 0: t = 2 tau / s0, a deceleration of at most v s0^2 / (2 tau) <=
      * v / T) and stops after it. Q32 squares of Q16 scales (below 2^41: CS_HOLD_SCALE_MAX). */
-    uint64_t s0 = h->scale;
-    uint64_t sq = s0 * s0, gq = (uint64_t)goal * goal;
+    uint32_t s0 = h->scale, s1;
+    uint64_t sq = (uint64_t)s0 * s0;
     uint64_t d = ((uint64_t)s->ticks << 33) / h->ramp_ticks;
-    if (sq > gq)
-        sq = sq - gq > d ? sq - d : gq;
-    else
-        sq = gq - sq > d ? sq + d : gq;
-    uint32_t s1 = sq == gq ? goal : cs_fixed_isqrt64(sq);
+    if (s0 > goal) {
+        s1 = sq > d ? cs_fixed_isqrt64(sq - d) : 0;
+        if (s1 < goal)
+            s1 = goal;
+    } else {
+        s1 = cs_fixed_isqrt64(sq + d);
+        if (s1 > goal)
+            s1 = goal;
+    }
     s->ticks = retime(s, s0, s1);
     h->scale = s1;
     return true;
