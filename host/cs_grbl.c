@@ -201,6 +201,8 @@ bool cs_grbl_queue_path(grbl_t *g, cs_path_t *path)
         alarm_planner(g, &d);
         return false;
     }
+    it.ov_feed = g->ov.feed; /* the device scales it by the override now / this */
+    it.ov_rapid = g->ov.rapid;
     if (!wait_room(g) || !cs_grbl_dev_push(&g->dev, &it)) {
         cs_stream_job_free(&it.job);
         return false;
@@ -724,12 +726,27 @@ static void soft_reset(grbl_t *g)
     cs_grbl_gc_reset_modal(&g->gc, true);
     cs_grbl_ov_init(&g->ov); /* Grbl's reset puts the overrides back at 100 % */
     g->ov_changed = true;
+    cs_grbl_dev_override(&g->dev, g->ov.feed, g->ov.rapid, g->ov.spindle);
     cs_grbl_say(g, "%s", "");
     cs_grbl_say(g, "%s", GRBL_WELCOME);
 }
 
+/* An override byte changed g->ov: the running chunk gets it on the device within ~0.1 s
+ * (cs_grbl_dev_override: OVERRIDE), what is planned next is planned at it (apply_overrides).
+ * A spindle override while nothing runs goes to the device at once in a job of no messages
+ * (its session sends the OVERRIDE), as Grbl changes a running spindle at once. */
+static void override_byte(grbl_t *g, unsigned char b)
+{
+    g->ov_changed = true;
+    cs_grbl_dev_override(&g->dev, g->ov.feed, g->ov.rapid, g->ov.spindle);
+    if (b >= 0x99 && b <= 0x9D && g->sp_code != GC_M5 && !g->ctl.laser && !g->check_mode &&
+        cs_grbl_dev_idle(&g->dev))
+        (void)cs_grbl_run_msgs(g, NULL, 0, false);
+}
+
 /* A real-time byte (grbl wiki "Interface": picked out of the stream wherever it comes). True
- * when b was one. The overrides 0x90..0x9D change what is planned next (cs_grbl_ov); safety
+ * when b was one. The overrides 0x90..0x9D act on the running motion and what is planned next
+ * (override_byte); safety
  * door 0x84 and the toggles 0x9E..0xA1 are accepted and ignored (docs/controller.md). */
 static bool realtime(grbl_t *g, unsigned char b)
 {
@@ -767,7 +784,7 @@ static bool realtime(grbl_t *g, unsigned char b)
         return true;
     default:
         if (cs_grbl_ov_byte(&g->ov, b)) {
-            g->ov_changed = true;
+            override_byte(g, b);
             return true;
         }
         return b >= 0x80;

@@ -146,7 +146,8 @@ static cs_proto_msg_t spindle_msg(const grbl_t *g, int code, double s, bool rapi
     m.u.spindle.mode = code == GC_M3   ? CS_PROTO_SPINDLE_CW
                        : code == GC_M4 ? CS_PROTO_SPINDLE_CCW
                                        : CS_PROTO_SPINDLE_OFF;
-    double duty = g->ctl.s_max > 0 ? s / g->ctl.s_max * g->ov.spindle / 100.0 : 0;
+    /* the spindle override is the device's (OVERRIDE, cs_grbl_dev_override): S as programmed */
+    double duty = g->ctl.s_max > 0 ? s / g->ctl.s_max : 0;
     duty = fmin(fmax(duty, 0.0), 1.0) * CS_PROTO_SPINDLE_FULL;
     m.u.spindle.power = code == GC_M5 || rapid ? 0 : (uint16_t)lround(duty);
     if (g->ctl.laser) {

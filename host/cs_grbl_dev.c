@@ -38,6 +38,19 @@ static void take_status(cs_grbl_dev_t *d, const cs_stream_result_t *r)
     d->s.dev_state = r->dev_state;
 }
 
+/* Called with the lock held: the OVERRIDE for the running job (docs/protocol.md: feed and
+ * rapid relative to the job's plan, spindle absolute; 1/1000). */
+static void take_override(cs_grbl_dev_t *d)
+{
+    uint16_t v[3];
+    for (int k = 0; k < 3; k++) {
+        double base = k < 2 && d->cur_ov[k] > 0 ? d->cur_ov[k] : 100;
+        double r = 1000.0 * d->req_ov[k] / base;
+        v[k] = (uint16_t)lround(fmin(fmax(r, 1), CS_PROTO_OVERRIDE_MAX));
+    }
+    d->run_ov = (cs_proto_override_t){v[0], v[1], v[2]};
+}
+
 /* The progress FILE's write: the text itself is not needed, only the moment. */
 static ssize_t progress_write(void *cookie, const char *buf, size_t len)
 {
@@ -50,6 +63,7 @@ static ssize_t progress_write(void *cookie, const char *buf, size_t len)
         take_status(d, d->cur);
     d->run_interrupt = d->req_cancel;
     d->run_pause = d->req_hold;
+    take_override(d);
     pthread_mutex_unlock(&d->mu);
     return (ssize_t)len;
 }
@@ -122,10 +136,16 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     o.on_event = on_event;
     o.jog_cancel = it->jog; /* Grbl's 0x85 on the device's JOG: JOG_CANCEL */
     o.event_ctx = d;
+    o.override = &d->run_ov;
     o.progress = open_progress(d);
     o.progress_tty = true; /* ten updates a second */
     cs_stream_result_t r;
     begin_run(d, &r);
+    pthread_mutex_lock(&d->mu);
+    d->cur_ov[0] = it->ov_feed;
+    d->cur_ov[1] = it->ov_rapid;
+    take_override(d);
+    pthread_mutex_unlock(&d->mu);
     tcflush(d->ser->fd, TCIFLUSH); /* what the device said between chunks */
     cs_err_t e = cs_stream_run(&it->job, &o, &r);
     end_run(d, e, &r, o.progress);
@@ -207,6 +227,7 @@ static cs_err_t start_worker(cs_grbl_dev_t *d, const cs_machine_t *m)
     d->tick_hz = m->tick_hz;
     for (unsigned i = 0; i < m->n_axes && i < CS_PROTO_AXES_MAX; i++)
         d->steps_per_mm[i] = m->axis[i].steps_per_mm;
+    d->req_ov[0] = d->req_ov[1] = d->req_ov[2] = 100;
     pthread_mutex_init(&d->mu, NULL);
     pthread_cond_init(&d->cv, NULL);
     if (pthread_create(&d->th, NULL, worker, d) != 0)
@@ -301,6 +322,15 @@ bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
     d->req_hold = false; /* a cancelled hold is over (Grbl: the hold ends with the flush) */
     pthread_mutex_unlock(&d->mu);
     return true;
+}
+
+void cs_grbl_dev_override(cs_grbl_dev_t *d, int feed, int rapid, int spindle)
+{
+    pthread_mutex_lock(&d->mu);
+    d->req_ov[0] = feed;
+    d->req_ov[1] = rapid;
+    d->req_ov[2] = spindle;
+    pthread_mutex_unlock(&d->mu);
 }
 
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on)

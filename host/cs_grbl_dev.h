@@ -28,7 +28,8 @@ typedef struct {
     bool dwell;          /* a G4: wait dwell_s seconds; else run job */
     bool jog;            /* a $J= move (cancellable with 0x85) */
     double dwell_s;
-    cs_stream_job_t job; /* owned by the queue once pushed */
+    int ov_feed, ov_rapid; /* the feed / rapid override (%) the job was planned at (0: 100) */
+    cs_stream_job_t job;   /* owned by the queue once pushed */
 } cs_grbl_item_t;
 
 /* What the status report needs, copied under the lock. */
@@ -73,6 +74,9 @@ typedef struct {
      * starts and at each progress call, ten times a second, so a hold or cancel takes effect
      * within ~0.1 s and no flag is shared without the lock) */
     volatile sig_atomic_t run_interrupt, run_pause;
+    int req_ov[3];                /* feed, rapid, spindle override in force (%), under mu */
+    int cur_ov[2];                /* the running job's planned feed, rapid (%; worker only) */
+    cs_proto_override_t run_ov;   /* what cs_stream_run sends (worker thread only, as above) */
     cs_stream_result_t *cur;         /* the running chunk's result (worker thread only) */
     double t_move;                   /* when the reported position last changed */
     cs_grbl_dev_snap_t s;
@@ -100,6 +104,9 @@ bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need);
  * Cancels the running item (decelerating hold, then abort), waits until it has stopped and ends
  * the feed hold. False when only_jogs and something is not a jog (then nothing is done). */
 bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
+/* The overrides in force (Grbl's percentages): the running job gets them within ~0.1 s as an
+ * OVERRIDE relative to what it was planned at (cs_grbl_item_t.ov_*), the spindle's absolute. */
+void cs_grbl_dev_override(cs_grbl_dev_t *d, int feed, int rapid, int spindle);
 /* Feed hold on (true) or off. */
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on);
 /* Clears the failure (Grbl's $X). */
