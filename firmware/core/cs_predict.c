@@ -111,26 +111,18 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     cs_err_t e = begin_common(p, c, tol, false);
     if (e != CS_OK)
         return e;
+    unsigned n = c->degree;
     for (unsigned k = 0; k < 2; k++) {
-        /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
+        /* Power basis from the Bernstein points: a_i = C(n, i) (i-th forward difference of the
+         * points), exact integers (|a_i| < 2^32 LSB); a_i = 0 above the degree. */
         int64_t q[4] = {0, 0, 0, 0};
-        for (unsigned i = 0; i <= c->degree; i++)
+        for (unsigned i = 0; i <= n; i++)
             q[i] = k == 0 ? c->p[i].x : c->p[i].y;
-        int64_t a1, a2 = 0, a3 = 0;
-        if (c->degree == 1) {
-            a1 = q[1] - q[0];
-        } else if (c->degree == 2) {
-            a1 = 2 * (q[1] - q[0]);
-            a2 = q[0] - 2 * q[1] + q[2];
-        } else {
-            a1 = 3 * (q[1] - q[0]);
-            a2 = 3 * (q[0] - 2 * q[1] + q[2]);
-            a3 = q[3] - q[0] + 3 * (q[1] - q[2]);
-        }
-        p->a[0][k] = q[0] * ((int64_t)1 << F);
-        p->a[1][k] = a1 * ((int64_t)1 << F);
-        p->a[2][k] = a2 * ((int64_t)1 << F);
-        p->a[3][k] = a3 * ((int64_t)1 << F);
+        for (unsigned j = 1; j <= n; j++)
+            for (unsigned i = n; i >= j; i--)
+                q[i] -= q[i - 1];
+        for (unsigned i = 0; i < 4; i++) /* C(n, i) is n for 0 < i < n when n <= 3, else 1 */
+            p->a[i][k] = q[i] * (int64_t)(i > 0 && i < n ? n : 1) * ((int64_t)1 << F);
     }
     eval_poly(p, NULL); /* B'(0), B''(0) / 2 */
     p->next = next_poly;
