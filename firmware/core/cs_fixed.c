@@ -40,7 +40,7 @@ int64_t cs_fixed_round_shift64(int64_t v, unsigned n)
     /* Work on the magnitude so rounding is symmetric (half away from zero); INT64_MIN has no
      * magnitude in int64, but no caller can produce it (products of two int32 are > -2^62). */
     uint64_t m = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
-    m = (m + ((uint64_t)1 << (n - 1))) >> n;
+    m = ((m >> (n - 1)) + 1) >> 1; /* = (m + 2^(n-1)) >> n: floors nest; no 64-bit left shift */
     return v < 0 ? -(int64_t)m : (int64_t)m;
 }
 
@@ -245,18 +245,25 @@ int64_t cs_fixed_div_round(int64_t n, int64_t d)
 
 unsigned cs_fixed_bitlen64(uint64_t v)
 {
-#if defined(__GNUC__)
-    /* one count-leading-zeros instruction (libgcc's on the M0+ and AVR): the predicted-step
-     * tracer asks for a bit length several times a flatness test */
+#if defined(__GNUC__) && !(defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB == 1)
+    /* one count-leading-zeros instruction: the predicted-step tracer asks for a bit length
+     * several times a flatness test */
     return v == 0 ? 0u : 64u - (unsigned)__builtin_clzll(v);
 #else
-    unsigned b = 0;
-    for (unsigned step = 32; step != 0; step >>= 1) /* halving: 6 steps */
-        if ((v >> step) != 0) {
-            v >>= step;
+    /* Thumb-1 (Cortex-M0+) has no CLZ and libgcc's takes 84 bytes: halving on the 32-bit half
+     * that holds the top bit, 5 steps */
+    uint32_t x = (uint32_t)(v >> 32);
+    unsigned b = 32;
+    if (x == 0) {
+        x = (uint32_t)v;
+        b = 0;
+    }
+    for (unsigned step = 16; step != 0; step >>= 1)
+        if ((x >> step) != 0) {
+            x >>= step;
             b += step;
         }
-    return b + (unsigned)v; /* v is now 0 or 1 */
+    return b + (unsigned)x; /* x is now 0 or 1 */
 #endif
 }
 

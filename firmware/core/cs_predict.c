@@ -21,6 +21,24 @@
  * 9 % more M3 instructions for 0.1 % fewer chords; 1.15 saves 2.3 % for 0.1 % more. */
 #define ROOM_ACCEPT 35
 
+/* The small helpers of the hot path (mul_t, dot, uabs64): inline on cores with a 32x32 -> 64
+ * multiply instruction (about 8 instructions a call saved on the M3, 32 calls a chord); one
+ * out-of-line copy where each would be libgcc calls or a 64-bit sequence (M0+, AVR): there the
+ * flash matters more (issue 18: the M0+ curve core <= 3 KB). */
+#if defined(__GNUC__) &&                                                                           \
+    (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB >= 2))
+#define HOT_INLINE __attribute__((always_inline)) inline
+#elif defined(__GNUC__)
+#define HOT_INLINE __attribute__((noinline))
+#else
+#define HOT_INLINE
+#endif
+
+static HOT_INLINE uint64_t uabs64(int64_t v)
+{
+    return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+}
+
 /* Piecewise-linear majorant of m(a, b) = max_{t in [0,1]} |3t(1-t)((1-t) a + t b)|, in 1/1024,
  * for p = max(|a|, |b|), q = min(|a|, |b|): m is convex and positively homogeneous in (a, b)
  * (a maximum of linear functions), so on each segment between the sampled ratios
@@ -28,16 +46,24 @@
  * m(1,0) = 4/9, m(1,+-1/2) = 1/sqrt(3), 0.35210, m(1,1) = 3/4, m(1,-1) = sqrt(3)/6, each rounded
  * up to 1/1024. Worst overestimate 1.3 %. */
 #define MAJ_SCALE 1024
+static const int16_t maj_coef[4][2] = {/* p, q coefficients: q/p <= 1/2 then > 1/2, same sign */
+                                       {456, 272}, {456, -190}, {416, 352}, {426, -130}};
 static uint64_t majorant(int64_t c1, int64_t c2)
 {
-    uint64_t a1 = c1 < 0 ? (uint64_t)0 - (uint64_t)c1 : (uint64_t)c1;
-    uint64_t a2 = c2 < 0 ? (uint64_t)0 - (uint64_t)c2 : (uint64_t)c2;
-    uint64_t p = a1 > a2 ? a1 : a2, q = a1 > a2 ? a2 : a1;
-    bool same = (c1 >= 0) == (c2 >= 0) || c1 == 0 || c2 == 0;
-    if (2 * q <= p)
-        return same ? 456 * p + 272 * q : 456 * p - 190 * q;
-    return same ? 416 * p + 352 * q : 426 * p - 130 * q;
+    uint64_t p = uabs64(c1), q = uabs64(c2);
+    if (p < q) { /* p = max, q = min */
+        uint64_t x = p;
+        p = q;
+        q = x;
+    }
+    /* Signs compared on the top bits; a zero c1 or c2 counts as either sign (q = 0 then, and
+     * both rows of the first segment give 456 p). */
+    bool same = (((uint64_t)c1 ^ (uint64_t)c2) >> 63) == 0;
+    const int16_t *cf = maj_coef[(2 * q <= p ? 0 : 2) + (same ? 0 : 1)];
+    /* modulo 2^64 with the negative coefficient: the true value is >= 0 (q <= p) and < 2^63 */
+    return p * (uint64_t)cf[0] + q * (uint64_t)(int64_t)cf[1];
 }
+
 
 /* a b for |a|, |b| < 2^31: one 32x32 -> 64 multiply (SMULL on a Cortex-M3, one call of the
  * 32x32 product on the M0+) where int64 operands would take a 64x64 product. */
@@ -46,9 +72,12 @@ static int64_t mul32(int32_t a, int32_t b)
     return (int64_t)a * b;
 }
 
-static uint64_t uabs64(int64_t v)
+/* a . b of two planar vectors with components below 2^28 in magnitude (< 2^57): every product
+ * of the flatness test is one of these (a cross product is a dot with the normal (-y, x)), so
+ * the M0+ carries one copy of the two 32x32 -> 64 calls; inline where they are instructions. */
+static HOT_INLINE int64_t dot(const int32_t a[2], const int32_t b[2])
 {
-    return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+    return mul32(a[0], b[0]) + mul32(a[1], b[1]);
 }
 
 /* Smallest k with v >> k < 2^bits. */
@@ -70,9 +99,10 @@ static bool conic_ok(const cs_bezier_t *c)
     return (int64_t)c->w[1] * c->w[1] <= (int64_t)c->w[0] * c->w[2];
 }
 
-bool cs_predict_accepts(const cs_bezier_t *c)
+/* Degree 1..3 and every control point at the first one's z (what both kinds share). */
+static bool planar_ok(const cs_bezier_t *c)
 {
-    if (c->degree < 1 || c->degree > 3 || (c->rational && !conic_ok(c)))
+    if (c->degree < 1 || c->degree > 3)
         return false;
     for (unsigned i = 1; i <= c->degree; i++)
         if (c->p[i].z != c->p[0].z)
@@ -80,14 +110,19 @@ bool cs_predict_accepts(const cs_bezier_t *c)
     return true;
 }
 
-/* What both begins share: the checks (tolerance, then the curve, then its range; a polynomial
- * curve for cs_predict_begin, a conic for cs_predict_begin_conic) and the tracing state. */
-static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol, bool conic)
+bool cs_predict_accepts(const cs_bezier_t *c)
+{
+    return planar_ok(c) && (!c->rational || conic_ok(c));
+}
+
+/* What both begins share: the checks (tolerance, then the curve: ok is the caller's verdict on
+ * it, so that the polynomial begin links no conic check, then its range) and the tracing state. */
+static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol, bool ok)
 {
     p->done = true;
     if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    if (!cs_predict_accepts(c) || c->rational != conic)
+    if (!ok)
         return CS_ERR_UNSUPPORTED;
     for (unsigned i = 0; i <= c->degree; i++)
         if (!cs_fixed_vec_ok(&c->p[i]))
@@ -108,23 +143,30 @@ static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
 
 cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
 {
-    cs_err_t e = begin_common(p, c, tol, false);
+    cs_err_t e = begin_common(p, c, tol, !c->rational && planar_ok(c));
     if (e != CS_OK)
         return e;
     unsigned n = c->degree;
     for (unsigned k = 0; k < 2; k++) {
         /* Power basis from the Bernstein points: a_i = C(n, i) (i-th forward difference of the
          * points), exact integers (|a_i| < 2^32 LSB); a_i = 0 above the degree. */
-        int64_t q[4] = {0, 0, 0, 0};
-        for (unsigned i = 0; i <= n; i++)
-            q[i] = k == 0 ? c->p[i].x : c->p[i].y;
+        int64_t q[4];
+        for (unsigned i = 0; i < 4; i++)
+            q[i] = i > n ? 0 : k == 0 ? c->p[i].x : c->p[i].y;
         for (unsigned j = 1; j <= n; j++)
             for (unsigned i = n; i >= j; i--)
                 q[i] -= q[i - 1];
-        for (unsigned i = 0; i < 4; i++) /* C(n, i) is n for 0 < i < n when n <= 3, else 1 */
-            p->a[i][k] = q[i] * (int64_t)(i > 0 && i < n ? n : 1) * ((int64_t)1 << F);
+        for (unsigned i = 0; i < 4; i++) {
+            /* C(n, i) is n for 0 < i < n when n <= 3, else 1: C(n, i) q_i by additions (no
+             * 64-bit multiply call on the M0+) */
+            int64_t a = 0;
+            for (unsigned r = i > 0 && i < n ? n : 1; r > 0; r--)
+                a += q[i];
+            p->a[i][k] = a * ((int64_t)1 << F);
+        }
     }
-    eval_poly(p, NULL); /* B'(0), B''(0) / 2 */
+    cs_vec3_t p0;
+    eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
     p->next = next_poly;
     p->done = false;
     return CS_OK;
@@ -132,7 +174,7 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
 
 cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
 {
-    cs_err_t e = begin_common(p, c, tol, true);
+    cs_err_t e = begin_common(p, c, tol, c->rational && cs_predict_accepts(c));
     if (e != CS_OK)
         return e;
     for (unsigned i = 0; i <= 2; i++) {
@@ -151,16 +193,7 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
  * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
  * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
  * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
-/* Inline on cores with a 32x32 -> 64 multiply instruction (about 8 instructions a call saved on
- * the M3, 32 calls a chord); out of line where it would be two libgcc calls (M0+, AVR): there the
- * flash matters more. */
-#if defined(__GNUC__) &&                                                                           \
-    (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB >= 2))
-#define MUL_T_INLINE __attribute__((always_inline)) inline
-#else
-#define MUL_T_INLINE
-#endif
-static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
+static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
     uint64_t m = uabs64(x);
     uint32_t ut = (uint32_t)t;
@@ -174,7 +207,7 @@ static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
     return x < 0 ? -(int64_t)r : (int64_t)r;
 }
 
-/* At the vertex t: B(t) rounded to the LSB into *pt (when pt is not NULL), and B'(t), B''(t) / 2
+/* At the vertex t: B(t) rounded to the LSB into *pt, and B'(t), B''(t) / 2
  * for the chords from t into p->d (per axis, LSB * 2^F). One Horner scheme shares a3 t:
  * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
  * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
@@ -186,33 +219,27 @@ static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
         int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
         p->d[1][k] = a2 + 3 * a3t;
         p->d[0][k] = p->a[1][k] + mul_t(2 * a2 + 3 * a3t, t);
-        if (pt) {
-            int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
-            /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
-            cs_pos_t r = (cs_pos_t)cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F);
-            if (k == 0)
-                pt->x = r;
-            else
-                pt->y = r;
-        }
+        int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
+        /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
+        cs_fixed_vec_set(pt, k, (cs_pos_t)cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F));
     }
-    if (pt)
-        pt->z = p->z;
+    pt->z = p->z;
 }
 
-/* v / 2^s rounded half up, for 0 < s < 32 and a result that fits int32: the result's bits are
- * bits s..s+31 of v + 2^(s-1) in two's complement (a logical and an arithmetic shift differ only
- * in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by two
- * constant-width shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and
- * no negative value is shifted (implementation-defined in C99). */
+/* v / 2^s rounded half up, for 0 <= s < 32 and a result that fits int32: the result's bits are
+ * bits s..s+31 of v + floor(2^(s-1)) in two's complement (a logical and an arithmetic shift
+ * differ only in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by
+ * 32-bit shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and no
+ * negative value is shifted (implementation-defined in C99). hi << (32 - s) is written
+ * (hi << 1) << (31 - s), 0 for s = 0 with no shift by 32 (undefined): no branch for s = 0. */
 static int32_t rsh_round32(int64_t v, unsigned s)
 {
-    uint64_t u = (uint64_t)v + ((uint64_t)1 << (s - 1));
+    uint64_t u = (uint64_t)v + ((1u << s) >> 1); /* 32-bit shifts: s < 32 */
 #if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
     uint32_t r = (uint32_t)(u >> s);
 #else
     uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
-    uint32_t r = (lo >> s) | (hi << (32 - s));
+    uint32_t r = (lo >> s) | ((hi << 1) << (31 - s));
 #endif
     return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
 }
@@ -238,7 +265,8 @@ static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h
         int64_t c3 = mul_t(mul_t(mul_t(p->a[3][k], h), h), h);
         v[0][k] = c1;
         v[1][k] = 2 * c1 + c2;
-        v[2][k] = 3 * (c1 + c2 + c3);
+        int64_t q3 = c1 + c2 + c3;
+        v[2][k] = q3 + q3 + q3; /* 3 (Q3 - Q0) by additions: no 64-bit multiply call on the M0+ */
     }
 }
 
@@ -281,28 +309,35 @@ static bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
 }
 
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
- * test's 32-bit components (below 2^27: products below 2^54, |V - D|^2 below 2^57), with
- * dot = V . D and dd = |D|^2 already computed; r2 = r^2. */
-static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t dot, int64_t dd,
-                        uint64_t r2)
+ * test's 32-bit components (below 2^27: |V - D|^2 below 2^57), with vd = V . D, cr = D x V and
+ * dd = |D|^2 already computed; r2 = r^2. */
+static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t vd, int64_t cr,
+                        int64_t dd, uint64_t r2)
 {
-    if (dd == 0 || dot <= 0) /* nearest point is 0 (also a zero-length chord) */
-        return (uint64_t)(mul32(v[0], v[0]) + mul32(v[1], v[1])) <= r2;
-    if (dot >= dd) { /* nearest point is D */
-        int32_t ex = v[0] - d[0], ey = v[1] - d[1];
-        return (uint64_t)(mul32(ex, ex) + mul32(ey, ey)) <= r2;
+    if (dd == 0 || vd <= 0 || vd >= dd) { /* nearest point is an end: 0 (also D = 0) or D */
+        int32_t e[2];
+        for (unsigned k = 0; k < 2; k++)
+            e[k] = vd <= 0 ? v[k] : v[k] - d[k];
+        return (uint64_t)dot(e, e) <= r2;
     }
-    uint64_t c = uabs64(mul32(d[0], v[1]) - mul32(d[1], v[0])); /* |D x V| <= r |D| */
+    uint64_t c = uabs64(cr); /* |D x V| <= r |D| */
     return cs_fixed_cmp_prod_u64(c, c, r2, (uint64_t)dd) <= 0;
 }
 
+/* The products of the test: dd = D . D, V1 . D, V2 . D, D x V1, D x V2 (D = V3; w[3] is D's
+ * normal (-D.y, D.x), so D x V = w[3] . V), as pairs of rows of w: one loop, one product. */
+enum { P_DD, P_DOT1, P_DOT2, P_CR1, P_CR2, P_N };
+static const uint8_t prod_rows[P_N][2] = {{2, 2}, {0, 2}, {1, 2}, {3, 0}, {3, 1}};
+
 /* Convex-hull test for short chords and pieces whose inner points project outside the chord:
  * max deviation <= 3/4 max dist(Q_i, chord) (interior Bernstein weights sum to <= 3/4), so
- * dist(V_i, D) <= 4 T in the 3x-scaled units. */
-static bool hull_flat(int32_t v[3][2], int64_t dot1, int64_t dot2, int64_t dd, int64_t T)
+ * dist(V_i, D) <= 4 T in the 3x-scaled units; r2 = (4 T)^2. */
+static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
 {
-    uint64_t r2 = (uint64_t)(16 * T * T); /* T < 2^20 */
-    return seg_dist_ok(v[0], v[2], dot1, dd, r2) && seg_dist_ok(v[1], v[2], dot2, dd, r2);
+    for (unsigned i = 0; i < 2; i++) /* V1, then V2 */
+        if (!seg_dist_ok(w[i], w[2], pr[P_DOT1 + i], pr[P_CR1 + i], pr[P_DD], r2))
+            return false;
+    return true;
 }
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
@@ -316,51 +351,51 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
             m |= uabs64(v[i][k]);
-    int64_t thr_f = (int64_t)p->thr << F;
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
-        s = p->thr_shift;         /* thr_f >> s < 2^THR_BITS */
-    int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
-    if (T <= 0) {
-        *room = ROOM_FAIL;
-        return false;
-    }
+        s = p->thr_shift; /* thr 2^F >> s < 2^THR_BITS */
+    /* thr 2^F >> s in 32 bits (thr > 0; no 64-bit shift), less 2 units for the rounding of the
+     * shift below */
+    int32_t T = (s >= F ? p->thr >> (s - F) : p->thr << (F - s)) - 2;
     /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
      * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
      * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
-    int32_t w[3][2];
+    int32_t w[4][2];
     for (unsigned i = 0; i < 3; i++)
         for (unsigned k = 0; k < 2; k++)
-            w[i][k] = s > 0 ? rsh_round32(v[i][k], s) : (int32_t)v[i][k];
-    int64_t dd = mul32(w[2][0], w[2][0]) + mul32(w[2][1], w[2][1]);
-    int64_t dot1 = mul32(w[0][0], w[2][0]) + mul32(w[0][1], w[2][1]);
-    int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
-    if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
-        bool ok = hull_flat(w, dot1, dot2, dd, T);
+            w[i][k] = rsh_round32(v[i][k], s);
+    w[3][0] = -w[2][1];
+    w[3][1] = w[2][0];
+    int64_t pr[P_N];
+    for (unsigned i = 0; i < P_N; i++)
+        pr[i] = dot(w[prod_rows[i][0]], w[prod_rows[i][1]]);
+    int64_t tt = mul32(T, T), dd = pr[P_DD];
+    /* dd >= 0: as unsigned, a negative V . D is above dd too (one compare for 0 <= dot <= dd) */
+    if (T <= 0 || dd < 64 * tt || (uint64_t)pr[P_DOT1] > (uint64_t)dd ||
+        (uint64_t)pr[P_DOT2] > (uint64_t)dd) { /* T <= 0 fails here: no room for the rounding */
+        bool ok = T > 0 && hull_flat((const int32_t(*)[2])w, pr, (uint64_t)(16 * tt));
         *room = ok ? ROOM_HULL : ROOM_FAIL;
         return ok;
     }
-    int64_t c1 = mul32(w[2][0], w[0][1]) - mul32(w[2][1], w[0][0]);
-    int64_t c2 = mul32(w[2][0], w[1][1]) - mul32(w[2][1], w[1][0]);
-    uint64_t found = majorant(c1, c2);
+    uint64_t found = majorant(pr[P_CR1], pr[P_CR2]);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
-    uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
+    uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^20: < 2^32, a 32-bit product */
     return room_ok(k, (uint64_t)dd, found, room);
 }
 
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
  * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
- * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). */
-static int64_t predict(cs_param_t h, int32_t room)
+ * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). At most cap (0 <= cap <= 2^30). */
+static cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
 {
     int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
     int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
     uint32_t f = ((uint32_t)e & 511u) << 6;  /* Q15 */
     uint32_t m = (1u << 15) + f - ((((f * ((1u << 15) - f)) >> 15) * 88u) >> 8);
     uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
-    nh = i >= 0 ? nh << i : nh >> -i;
-    nh >>= 15;
-    return (int64_t)(nh - nh / 64);
+    nh >>= 15 - i; /* = (nh 2^i) >> 15 for i >= 0 (no overflow: < 2^48), floors nest for i < 0 */
+    nh -= nh / 64;
+    return nh > (uint64_t)cap ? cap : (cs_param_t)nh; /* both callers cap it: once, here */
 }
 
 /* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
@@ -486,11 +521,12 @@ typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, in
  * between the largest passing and the smallest failing step. 0 when none passes. */
 static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
 {
+    /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
     cs_param_t rem = CS_PARAM_ONE - p->t;
-    int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
+    int32_t lo = 0, hi = rem + 1, h = p->h_next < rem ? p->h_next : rem;
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         int32_t room;
-        if (test(p, ctx, (cs_param_t)h, &room)) {
+        if (test(p, ctx, h, &room)) {
             lo = h;
             *lo_room = room;
             if (h == rem || room <= ROOM_ACCEPT)
@@ -498,9 +534,7 @@ static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx
         } else {
             hi = h;
         }
-        int64_t nh = predict((cs_param_t)h, room);
-        if (nh > rem)
-            nh = rem;
+        int32_t nh = predict(h, room, rem);
         if (nh <= lo || nh >= hi)
             nh = lo + (hi - lo) / 2;
         if (nh <= lo || nh == h || hi - lo <= 1)
@@ -512,7 +546,7 @@ static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx
         if (h == 0)
             break;
         int32_t room;
-        if (test(p, ctx, (cs_param_t)h, &room)) {
+        if (test(p, ctx, h, &room)) {
             lo = h;
             *lo_room = room;
         }
@@ -536,11 +570,10 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *
     }
     /* Next chord: the step this one would have needed to fill the tolerance (its step
      * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
-    int64_t nh = predict(h, room);
-    cs_param_t ideal = nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
-    nh = trend(ideal, p->h_ideal);
+    cs_param_t ideal = predict(h, room, CS_PARAM_ONE);
+    cs_param_t nh = trend(ideal, p->h_ideal); /* < 2^31 (trend above) */
     p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
-    p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : nh;
     p->done = false;
     *eval = true;
     return CS_OK;
