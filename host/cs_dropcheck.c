@@ -46,17 +46,18 @@ typedef struct {
     long stride;  /* nodes between the ideal cutter's positions (rest_at) */
 } ck_t;
 
-static cs_err_t push_sample(ck_t *k, const double p[3])
+/* Appends point p to the growing array *a (*n points of room *cap). */
+static cs_err_t push3(double (**a)[3], size_t *n, size_t *cap, const double p[3])
 {
-    if (k->ns == k->scap) {
-        size_t cap = k->scap ? 2 * k->scap : 65536;
-        double(*n)[3] = realloc(k->s, cap * sizeof *n);
-        if (!n)
+    if (*n == *cap) {
+        size_t c = *cap ? 2 * *cap : 65536;
+        double(*m)[3] = realloc(*a, c * sizeof *m);
+        if (!m)
             return CS_ERR_FULL;
-        k->s = n;
-        k->scap = cap;
+        *a = m;
+        *cap = c;
     }
-    memcpy(k->s[k->ns++], p, 3 * sizeof *p);
+    memcpy((*a)[(*n)++], p, 3 * sizeof *p);
     return CS_OK;
 }
 
@@ -129,7 +130,7 @@ static cs_err_t sample_grid(ck_t *k, ck_eval_fn ev, const void *ctx, int nu, int
         double *prev = row + (size_t)((i + 1) & 1) * (size_t)(nv + 1) * 3;
         for (int j = 0; j <= nv && e == CS_OK; j++) {
             ev(ctx, (double)i / nu, (double)j / nv, &cur[j * 3]);
-            e = push_sample(k, &cur[j * 3]);
+            e = push3(&k->s, &k->ns, &k->scap, &cur[j * 3]);
             splat(k, &cur[j * 3]);
         }
         for (int j = 0; i > 0 && j < nv; j++) {
@@ -289,20 +290,6 @@ static double tool_dist(const cs_dropcut_tool_t *t, const double p[3], double sx
     return d > 0 ? d : 0;
 }
 
-static cs_err_t push_tip(ck_t *k, const double p[3])
-{
-    if (k->np == k->pcap) {
-        size_t cap = k->pcap ? 2 * k->pcap : 65536;
-        double(*n)[3] = realloc(k->p, cap * sizeof *n);
-        if (!n)
-            return CS_ERR_FULL;
-        k->p = n;
-        k->pcap = cap;
-    }
-    memcpy(k->p[k->np++], p, 3 * sizeof *p);
-    return CS_OK;
-}
-
 /* Every chord sampled at spacing <= step: the gouge at each sample, the samples kept. */
 static cs_err_t walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3],
                      const size_t *start, size_t npass, cs_dropcheck_t *o)
@@ -321,7 +308,7 @@ static cs_err_t walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3]
                 for (int c = 0; c < 3; c++)
                     p[c] = a[c] + f * (b[c] - a[c]);
                 visit_gouge(k, t, p, o);
-                e = push_tip(k, p);
+                e = push3(&k->p, &k->np, &k->pcap, p);
                 o->path_samples++;
             }
         }
