@@ -36,11 +36,16 @@ static CS_FW_CTL_NOINLINE uint64_t path_len(const int64_t d[3])
 
 /* --- the input interrupt and the executor's load hook --------------------------------------- */
 
-void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
+/* The one change detector of every port: the port's edge hook only says "a pin may have
+ * changed" (port.h); the bits are read here and compared with the last ones seen. */
+void cs_fw_ctl_inputs_isr(void *ctx)
 {
     cs_fw_motion_t *mo = ctx;
     cs_fw_ctl_t *c = &mo->ctl;
+    uint16_t bits = port_inputs_read();
     uint16_t prev = c->inputs;
+    if (bits == prev)
+        return; /* a spurious edge, a bounce already settled, or a step with no switch crossed */
     c->inputs = bits;
     uint16_t on = (uint16_t)(bits & ~prev), off = (uint16_t)(prev & ~bits);
     if (c->trip != CS_FW_TRIP_NONE)
@@ -443,8 +448,11 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
     uint32_t s = port_irq_save();
     cs_stepper_on_load(&mo->st, on_load, mo);
     port_irq_restore(s);
-    /* the port reports what is active already (an e-stop pressed at boot: the alarm) */
     port_inputs_attach(cs_fw_ctl_inputs_isr, mo);
+    /* what is active already is a change from nothing (an e-stop pressed at boot: the alarm) */
+    s = port_irq_save();
+    cs_fw_ctl_inputs_isr(mo);
+    port_irq_restore(s);
 }
 
 cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)
@@ -661,10 +669,9 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
     cs_fw_motion_zero(&mo->ctl, sizeof mo->ctl);
 }
 
-void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits)
+void cs_fw_ctl_inputs_isr(void *ctx)
 {
     (void)ctx;
-    (void)bits;
 }
 
 cs_err_t cs_fw_ctl_admit(cs_fw_motion_t *mo, uint8_t type)

@@ -113,9 +113,11 @@ struct cs_fw_motion_s;
 /* Clears the control state, attaches the input interrupt and the executor's load hook, reads the
  * inputs (an e-stop pressed at boot is an alarm). Called by cs_fw_motion_init. Not ISR-safe. */
 void cs_fw_ctl_init(struct cs_fw_motion_s *mo);
-/* The input interrupt (port_inputs_attach): halts the executor on the e-stop, a limit switch
- * becoming active while hard limits are armed, or the input an operation watches. ISR. */
-void cs_fw_ctl_inputs_isr(void *ctx, uint16_t bits);
+/* The input interrupt (the edge hook given to port_inputs_attach; ctx the cs_fw_motion_t):
+ * reads port_inputs_read and, when the bits changed since the last call, halts the executor on
+ * the e-stop, a limit switch becoming active while hard limits are armed, or the input an
+ * operation watches. ISR (or interrupts masked). */
+void cs_fw_ctl_inputs_isr(void *ctx);
 /* Queues check: CS_ERR_STATE in alarm (a HOME unlocks first, unless the e-stop is pressed),
  * CS_ERR_UNSUPPORTED for HOME / JOG / PROBE without curves; CS_OK otherwise. Main loop. */
 cs_err_t cs_fw_ctl_admit(struct cs_fw_motion_s *mo, uint8_t type);

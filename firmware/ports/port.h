@@ -44,11 +44,12 @@ void port_pen_set(uint16_t pulse_us);
 /* The machine's inputs now: CS_PROTO_IN_* bits (cs_proto.h: min / max limit switch per axis,
  * probe, e-stop), set = active whatever the wiring's polarity (the port inverts). ISR-safe. */
 uint16_t port_inputs_read(void);
-/* The port calls fn(ctx, bits) whenever the input bits change, from an interrupt that cannot
- * preempt the step interrupt (same priority, or the step interrupt itself where the port samples
- * the inputs there), and at once when any is active already; fn may halt the executor. NULL fn:
- * none. Not ISR-safe. */
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx);
+/* The edge hook: the port calls fn(ctx) from its pin-change / edge interrupt on the input pins
+ * (or where it samples them, e.g. after a step), an interrupt that cannot preempt the step
+ * interrupt (same priority, or the step interrupt itself); fn reads port_inputs_read and keeps
+ * what changed (firmware/app/cs_fw_ctl.c: the one change detector), so a call with nothing
+ * changed is harmless. fn may halt the executor. NULL fn: none. Not ISR-safe. */
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx);
 /* The spindle / laser output: PWM duty in 1/1000 of the period (0..1000), mode 0 off (enable
  * low, duty 0), 1 clockwise, 2 counter-clockwise (direction line high). ISR-safe. */
 void port_spindle_set(uint16_t duty, uint8_t mode);

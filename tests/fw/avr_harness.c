@@ -43,8 +43,8 @@ enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
 #define TCCR1A_ADDR  0x80 /* data-space address of TCCR1A (ATmega328P register summary) */
 #define SERVO_WIDTHS 256 /* distinct successive servo pulse widths kept for the report */
 #define SLICE        1024 /* cycles run between two services of the pty and the clocks */
-/* Machine-control pins (port_avr.h, Grbl's Uno map): inputs active low (pulled up), a switch per
- * axis on PB1 / PB2 / PB4, the probe on PC5, the e-stop on PC0; the spindle's Timer2 PWM on
+/* Machine-control pins (port_avr.h): inputs active low (pulled up), a switch per axis on PB1
+ * (D9) / PC1 (A1) / PB4 (D12), the probe on PC5, the e-stop on PC0; the spindle's Timer2 PWM on
  * OC2A, enable PC3, direction PC4. Data-space addresses from the ATmega328P register summary. */
 #define SW_MAX       8
 #define PROBE_BIT    5 /* PC5 */
@@ -56,7 +56,8 @@ enum { EX_OK = 0, EX_VIOLATION = 1, EX_USAGE = 2, EX_EMU = 3, EX_TIMEOUT = 4 };
 #define TCCR2B_ADDR  0xB1
 #define OCR2A_ADDR   0xB3
 #define PWM_SETS     64 /* distinct successive spindle settings kept for the report */
-static const uint8_t limit_bit[AXES] = {1, 2, 4}; /* PB1 (D9), PB2 (D10), PB4 (D12) */
+static const uint8_t limit_bit[AXES] = {1, 1, 4}; /* PB1 (D9), PC1 (A1), PB4 (D12) */
+static const char limit_port[AXES] = {'B', 'C', 'B'};
 
 typedef struct {
     uint64_t steps;   /* rising STEP edges */
@@ -449,6 +450,7 @@ static void add_switch(const char *v, char port, int bit, bool above, int fixed_
         axis = v[0] - 'x';
         v += 2;
         bit = limit_bit[axis];
+        port = limit_port[axis];
     }
     if (g.nsw >= SW_MAX) {
         fprintf(stderr, "avr_harness: at most %d switches\n", SW_MAX);
@@ -494,7 +496,7 @@ static void usage(FILE *f)
         "  --profile FILE      cycles spent at each instruction inside the step interrupt:\n"
         "                      lines 'byte-address cycles' (avr-addr2line, nm to read)\n"
         "  --switch-min AXIS=STEPS, --switch-max AXIS=STEPS  the limit switch of AXIS (x\n"
-        "                      PB1/D9, y PB2/D10, z PB4/D12; one pin an axis, as Grbl's)\n"
+        "                      PB1/D9, y PC1/A1, z PB4/D12; one pin an axis, as Grbl's)\n"
         "                      is pressed (pin low) while the axis's STEP/DIR position is\n"
         "                      <= (min) or >= (max) STEPS; evaluated at every STEP rise\n"
         "  --probe-z STEPS     the probe (PC5/A5) touches while z <= STEPS\n"
@@ -830,8 +832,8 @@ int main(int argc, char **argv)
     }
     for (int k = 0; k < g.nsw; k++) {
         fprintf(out, "switch: P%c%d %s %c %s %lld: %llu presses", g.sw[k].port, g.sw[k].bit,
-                g.sw[k].port == 'C' ? "probe" : "limit", names[g.sw[k].axis],
-                g.sw[k].above ? ">=" : "<=", (long long)g.sw[k].at,
+                g.sw[k].port == 'C' && g.sw[k].bit == PROBE_BIT ? "probe" : "limit",
+                names[g.sw[k].axis], g.sw[k].above ? ">=" : "<=", (long long)g.sw[k].at,
                 (unsigned long long)g.sw[k].presses);
         if (g.sw[k].presses > 0) {
             fprintf(out, ", last at");

@@ -18,7 +18,15 @@
 #     / 8: 7.8 kHz) with (OCR2A + 1) / 256 within 1/512 of S / s_max, enable (A3) on, direction
 #     (A4) low for M3 and high for M4; all off after --off; laser mode at power 800, full at 20
 #     mm/s, during a 10 mm/s jog: 800 x 10 / 20 = 400 of s_max, dark when the jog ends;
-#  5. the e-stop (A0) pressed by the harness: an alarm that `curvestep unlock` cannot clear.
+#  5. the e-stop (A0) pressed by the harness: an alarm that `curvestep unlock` cannot clear;
+#  6. a jog cancel (Ctrl-C: JOG_CANCEL, 0x85) mid-jog at JV mm/s: exit 8, stopped short of the
+#     target, the host's position the pins', and the harness's step times show the feed-hold
+#     ramp: the speed (over one 5 ms segment's steps) falls, and from where it drops below 90 %
+#     to rest the axis runs 0.81 x v T / 2 (a linear ramp from v to 0 over T, T = 5/4 x the
+#     slowest max_rate / max_accel of machine.ini: cs_hold.h), less half the speed window;
+#  7. the pin map: the pen servo (OC1B, D10) runs while the y switch (A1) trips a job (ALARM,
+#     the switch pressed at its position), and a second function on a pin is a build error
+#     (port_avr.c's static assert, tried on a copy with the y switch moved onto the e-stop).
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
 B=${CS_BUILD:-build}
@@ -207,4 +215,80 @@ expect "e-stop: unlock refused (exit 7, got $rc)" [ $rc -eq 7 ]
 stop_harness
 expect "e-stop: pressed" grep -q '^estop: pressed at 0.300 s$' "$T/e.out"
 expect "e-stop: harness ok" grep -q '^result: ok$' "$T/e.out"
+
+# 6. a jog cancelled mid-move: JV mm/s towards x 100 mm, Ctrl-C once the harness has written its
+# first block of step times (4 KB: a few hundred steps, so the jog is at speed)
+JV=20 JT=100
+start_harness "$T/jc.out" --steps-csv "$T/jc.csv"
+timeout -k 5 100 "$CS" jog --port "$PTY" --machine "$MC" --feed $JV -- $JT 0 0 >"$T/jc.jog" \
+    2>"$T/jc.err" &
+JPID=$!
+expect "jog cancel: the jog is moving" wait_until 60 test -s "$T/jc.csv"
+kill -INT "$(pgrep -P "$JPID" -x curvestep)" # one Ctrl-C: JOG_CANCEL, then wait for rest
+wait "$JPID"
+rc=$?
+stop_harness
+expect "jog cancel: exit 8 (got $rc)" [ $rc -eq 8 ]
+expect "jog cancel: harness ok (pulses, DIR setup)" grep -q '^result: ok$' "$T/jc.out"
+jx=$(sed -n 's/^jog: machine position \([-0-9.]*\) .*/\1/p' "$T/jc.jog")
+cx=$(sed -n 's/^position: x=\(-\?[0-9]*\) .*/\1/p' "$T/jc.out")
+expect "jog cancel: stopped short of x $JT mm (x ${jx:-?} mm)" \
+    awk -v x="${jx:-x}" -v t=$JT 'BEGIN { exit !(x > 1 && x < t) }'
+expect "jog cancel: the host's position is the pins' (${jx:-?} mm, ${cx:-?} steps)" \
+    near "${jx:-x}" "$(mm "${cx:-0}")" 0.00001
+# T from machine.ini (max over the axes of max_rate / max_accel, x 5/4), and the ramp in steps
+RT=$(awk -F' *= *' '/^\[/ { ax = $0 } /^max_rate/ { r[ax] = $2 } /^max_accel/ { a[ax] = $2 }
+    END { for (k in r) if (r[k] / a[k] > t) t = r[k] / a[k]; print t * 5 / 4 }' "$MC")
+W=$(awk -v v=$JV -v k=$SPM 'BEGIN { print v * k * 0.005 }') # steps of one 5 ms segment
+want=$(awk -v v=$JV -v k=$SPM -v t="$RT" -v w="$W" 'BEGIN { print 0.81 * v * k * t / 2 - w / 2 }')
+read -r vmax run vend < <(awk -F, -v w="$W" -v v=$JV -v k=$SPM '
+    $2 == 0 { t[++n] = $1 }
+    END { for (i = w + 1; i <= n; i++) { s = w * 16e6 / (t[i] - t[i - w])
+              if (s > m) m = s
+              if (!c && i > 3 * w && s < 0.9 * v * k) c = i }
+          print m, (c ? n - c : -1), w * 16e6 / (t[n] - t[n - w]) }' "$T/jc.csv")
+expect "jog cancel: at $JV mm/s before the cancel (${vmax:-?} steps/s, want $((JV * SPM)) within 1 %)" \
+    near "${vmax:-0}" $((JV * SPM)) $((JV * SPM / 100))
+expect "jog cancel: decelerated to under half speed at the last step (${vend:-?} steps/s)" \
+    awk -v s="${vend:-1e9}" -v f=$((JV * SPM)) 'BEGIN { exit !(s < f / 2) }'
+expect "jog cancel: ${run:-?} steps from 90 % of the speed to rest, want $want within 2 segments (T $RT s)" \
+    near "${run:--99}" "$want" $((2 * W))
+
+# 7. the pen servo on D10 and the y switch on A1 together: a servo-pen drawing whose pen-up
+# travel runs y to 35 mm (the SVG's y is flipped) trips the y switch at 30 mm
+YS=$((30 * SPM))
+{ cat "$MC"; printf '\n[pen]\nmode = servo\nup_us = 2000\ndown_us = 1100\nsettle_ms = 60\n'; } \
+    >"$T/pen.ini"
+cat >"$T/y.svg" <<'SVG'
+<svg xmlns="http://www.w3.org/2000/svg" width="20mm" height="40mm" viewBox="0 0 20 40">
+  <path d="M 5 5 L 5 35" fill="none" stroke="black"/>
+</svg>
+SVG
+start_harness "$T/y.out" --switch-max y=$YS
+timeout -k 5 60 "$CS" stream --line-rate 115200 --port "$PTY" --machine "$T/pen.ini" --no-sort \
+    "$T/y.svg" >"$T/y.stream" 2>&1
+rc=$?
+ctl unlock >"$T/yu.out" 2>&1
+read -r _ uy _ < <(sed -n 's/^unlock: machine position \(.*\) mm$/\1/p' "$T/yu.out")
+stop_harness
+expect "pins: the y switch trips the servo job (exit 7, got $rc)" [ $rc -eq 7 ]
+expect "pins: harness ok" grep -q '^result: ok$' "$T/y.out"
+expect "pins: y switch A1 (PC1) pressed once at y $YS" \
+    grep -q "^switch: PC1 limit y >= $YS: 1 presses, last at x=[0-9]* y=$YS z=0$" "$T/y.out"
+expect "pins: stopped on the y switch, $(mm $YS) mm within a step (got ${uy:-?})" \
+    near "${uy:-x}" "$(mm $YS)" "$(mm 1)"
+np=$(sed -n 's/^servo: OC1B \([0-9]*\) periods.*/\1/p' "$T/y.out")
+expect "pins: the servo's pulse train ran on OC1B meanwhile (${np:-0} periods, 3 at least)" \
+    [ "${np:-0}" -ge 3 ]
+if command -v avr-gcc >/dev/null; then
+    P=firmware/ports/avr/port_avr.c
+    AVRC=(avr-gcc -std=c99 -mmcu=atmega328p -DF_CPU=16000000UL -Ifirmware/app -Ifirmware/core
+        -Ifirmware/ports -Ifirmware/ports/avr -fsyntax-only)
+    sed 's/^#define LIM_Y_PIN .*/#define LIM_Y_PIN ((uint8_t)(1u << PC0))/' "$P" >"$T/clash.c"
+    expect "pins: the port's map compiles" "${AVRC[@]}" "$P"
+    expect "pins: y switch on the e-stop's pin is refused (static assert)" \
+        eval '! "${AVRC[@]}" "$T/clash.c" 2>"$T/clash.err" && grep -q avr_pins_one_function_each "$T/clash.err"'
+else
+    ko "pins: avr-gcc missing (make firmware)"
+fi
 finish

@@ -278,7 +278,6 @@ void port_pen_set(uint16_t pulse_us)
     cli();
     if (servo_counts == 0 && c != 0) { /* first setting: start the train, rising soon */
         PORTB = (uint8_t)(PORTB & (uint8_t)~SERVO_PIN);
-        PCMSK0 = (uint8_t)(PCMSK0 & (uint8_t)~SERVO_PIN); /* D10 is no y switch any more */
         DDRB = (uint8_t)(DDRB | SERVO_PIN);
         OCR1B = (uint16_t)(TCNT1 + 64u);
         TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1B_SET) | COM1B_SET);
@@ -305,47 +304,50 @@ ISR(TIMER1_COMPB_vect)
     }
 }
 
-/* The machine's inputs (Grbl 1.1's Uno pins, port_avr.h): one switch per axis on PB1 / PB2 / PB4
- * (D9, D10, D12), read as both that axis's min and max bits (Grbl wires one pin per axis, for
- * either end: homing seeks the end the HOME names, a hard limit trips on either), the probe on
- * PC5 (A5), the e-stop on PC0 (A0). Pin-change interrupts PCINT0 (port B) and PCINT1 (port C)
- * report changes; an AVR interrupt never preempts another (the I bit is clear inside one), so the
- * hook cannot preempt the step interrupt, as port.h asks. Once a PEN message has started the
- * servo's pulse train, D10 is its output (OC1B) and the y switch reads released. */
-#define LIM_X_PIN  ((uint8_t)(1u << PB1))
-#define LIM_Y_PIN  ((uint8_t)(1u << PB2))
-#define LIM_Z_PIN  ((uint8_t)(1u << PB4))
-#define LIM_PINS   ((uint8_t)(LIM_X_PIN | LIM_Y_PIN | LIM_Z_PIN))
-#define PROBE_PIN  ((uint8_t)(1u << PC5))
-#define ESTOP_PIN  ((uint8_t)(1u << PC0))
-#define CTL_C_PINS ((uint8_t)(PROBE_PIN | ESTOP_PIN))
+/* The machine's inputs (port_avr.h's pin table): one switch per axis, x on PB1 (D9) and z on
+ * PB4 (D12) as Grbl 1.1's, y on PC1 (A1: Grbl's D10 is the pen servo's OC1B here), read as both
+ * that axis's min and max bits (Grbl wires one pin per axis, for either end: homing seeks the end
+ * the HOME names, a hard limit trips on either), the probe on PC5 (A5), the e-stop on PC0 (A0).
+ * Pin-change interrupts PCINT0 (port B) and PCINT1 (port C) call the edge hook; an AVR interrupt
+ * never preempts another (the I bit is clear inside one), so the hook cannot preempt the step
+ * interrupt, as port.h asks. */
+#define LIM_X_PIN  ((uint8_t)(1u << PB1)) /* D9 */
+#define LIM_Y_PIN  ((uint8_t)(1u << PC1)) /* A1 */
+#define LIM_Z_PIN  ((uint8_t)(1u << PB4)) /* D12 */
+#define LIM_B_PINS ((uint8_t)(LIM_X_PIN | LIM_Z_PIN))
+#define PROBE_PIN  ((uint8_t)(1u << PC5)) /* A5 */
+#define ESTOP_PIN  ((uint8_t)(1u << PC0)) /* A0 */
+#define CTL_C_PINS ((uint8_t)(LIM_Y_PIN | PROBE_PIN | ESTOP_PIN))
 #define SP_EN_PIN  ((uint8_t)(1u << PC3)) /* A3: spindle enable, high = on */
 #define SP_DIR_PIN ((uint8_t)(1u << PC4)) /* A4: spindle direction, high = counter-clockwise */
 #define SP_PWM_PIN ((uint8_t)(1u << PB3)) /* D11: OC2A */
-CS_STATIC_ASSERT(((LIM_PINS | SERVO_PIN | SP_PWM_PIN | EN_LINE | LED_LINE) & 0xC0u) == 0 &&
-                     (LIM_PINS & (SP_PWM_PIN | EN_LINE | LED_LINE)) == 0 &&
-                     (CTL_C_PINS & (SP_EN_PIN | SP_DIR_PIN)) == 0,
-                 avr_ctl_pins_distinct);
+#define UART_PINS  ((uint8_t)((1u << PD0) | (1u << PD1)))
+/* No two functions on one pin: per port, the functions' masks summed equal them or-ed (a + b =
+ * (a | b) + (a & b), so the sum exceeds the or as soon as two masks share a bit), and every pin
+ * exists (port B and C: bits 0..5 on the Uno; PB6/PB7 carry the crystal, PC6 is RESET). */
+#define PINS_B_SUM (EN_LINE + LIM_X_PIN + SERVO_PIN + SP_PWM_PIN + LIM_Z_PIN + LED_LINE)
+#define PINS_B_OR  (EN_LINE | LIM_X_PIN | SERVO_PIN | SP_PWM_PIN | LIM_Z_PIN | LED_LINE)
+#define PINS_C_SUM (ESTOP_PIN + LIM_Y_PIN + SP_EN_PIN + SP_DIR_PIN + PROBE_PIN)
+#define PINS_C_OR  (ESTOP_PIN | LIM_Y_PIN | SP_EN_PIN | SP_DIR_PIN | PROBE_PIN)
+#define PINS_D_SUM (UART_PINS + STEP_LINES + DIR_LINES)
+#define PINS_D_OR  (UART_PINS | STEP_LINES | DIR_LINES)
+CS_STATIC_ASSERT(PINS_B_SUM == PINS_B_OR && PINS_C_SUM == PINS_C_OR && PINS_D_SUM == PINS_D_OR &&
+                     (PINS_B_OR & 0xC0u) == 0 && (PINS_C_OR & 0xC0u) == 0,
+                 avr_pins_one_function_each);
 #if PORT_AVR_INPUTS_ACTIVE_LOW
 #define ACTIVE(v) ((uint8_t) ~(v))
 #else
 #define ACTIVE(v) ((uint8_t)(v))
 #endif
 
-static void (*in_fn)(void *ctx, uint16_t bits);
-static void *in_ctx;
-static uint16_t in_last;
-
 uint16_t port_inputs_read(void)
 {
-    uint8_t b = (uint8_t)(ACTIVE(PINB) & LIM_PINS);
-    if (servo_counts != 0)
-        b = (uint8_t)(b & (uint8_t)~LIM_Y_PIN); /* D10 drives the pen servo */
+    uint8_t b = (uint8_t)(ACTIVE(PINB) & LIM_B_PINS);
     uint8_t c = (uint8_t)(ACTIVE(PINC) & CTL_C_PINS);
     uint16_t in = 0;
     if (b & LIM_X_PIN)
         in |= (uint16_t)(CS_PROTO_IN_MIN(0) | CS_PROTO_IN_MAX(0));
-    if (b & LIM_Y_PIN)
+    if (c & LIM_Y_PIN)
         in |= (uint16_t)(CS_PROTO_IN_MIN(1) | CS_PROTO_IN_MAX(1));
     if (b & LIM_Z_PIN)
         in |= (uint16_t)(CS_PROTO_IN_MIN(2) | CS_PROTO_IN_MAX(2));
@@ -356,36 +358,34 @@ uint16_t port_inputs_read(void)
     return in;
 }
 
-/* The bits changed since last reported: tell the application. Interrupts masked. */
-static void inputs_report(void)
-{
-    uint16_t b = port_inputs_read();
-    if (b == in_last)
-        return;
-    in_last = b;
-    if (in_fn != NULL)
-        in_fn(in_ctx, b);
-}
+/* The edge hook (port.h): every pin change of a switch, the probe or the e-stop calls it; the
+ * application reads the pins and keeps what changed. */
+static void (*in_fn)(void *ctx);
+static void *in_ctx;
 
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx)
 {
     uint8_t s = SREG;
     cli();
     in_fn = fn;
     in_ctx = ctx;
-    in_last = 0;
-    inputs_report(); /* what is active already is a change from nothing */
     SREG = s;
+}
+
+static void inputs_edge(void)
+{
+    if (in_fn != NULL)
+        in_fn(in_ctx);
 }
 
 ISR(PCINT0_vect)
 {
-    inputs_report();
+    inputs_edge();
 }
 
 ISR(PCINT1_vect)
 {
-    inputs_report();
+    inputs_edge();
 }
 
 /* The spindle / laser output, Grbl's: Timer2 fast PWM (WGM 3, TOP 0xFF) at F_CPU / 8 / 256 =
@@ -423,19 +423,19 @@ void port_spindle_set(uint16_t duty, uint8_t mode)
 }
 
 /* Inputs with the pull-ups on (PORT_AVR_INPUTS_ACTIVE_LOW: switches to ground, Grbl's wiring)
- * or off (external pull-downs), their pin-change interrupts on; the spindle's pins outputs, low.
- * Interrupts masked. */
+ * or off (external pull-downs), their pin-change interrupts on; the spindle's pins and the
+ * servo's (no pulse until the first PEN) outputs, low. Interrupts masked. */
 static void ctl_pins_init(void)
 {
-    DDRB = (uint8_t)((DDRB & (uint8_t)~LIM_PINS) | SP_PWM_PIN);
+    DDRB = (uint8_t)((DDRB & (uint8_t)~LIM_B_PINS) | SP_PWM_PIN | SERVO_PIN);
     DDRC = (uint8_t)((DDRC & (uint8_t)~CTL_C_PINS) | SP_EN_PIN | SP_DIR_PIN);
-    PORTB = (uint8_t)(PORTB & (uint8_t)~SP_PWM_PIN);
+    PORTB = (uint8_t)(PORTB & (uint8_t) ~(SP_PWM_PIN | SERVO_PIN));
     PORTC = (uint8_t)(PORTC & (uint8_t) ~(SP_EN_PIN | SP_DIR_PIN));
 #if PORT_AVR_INPUTS_ACTIVE_LOW
-    PORTB = (uint8_t)(PORTB | LIM_PINS);
+    PORTB = (uint8_t)(PORTB | LIM_B_PINS);
     PORTC = (uint8_t)(PORTC | CTL_C_PINS);
 #endif
-    PCMSK0 = LIM_PINS;
+    PCMSK0 = LIM_B_PINS;
     PCMSK1 = CTL_C_PINS;
     PCIFR = (uint8_t)((1u << PCIF0) | (1u << PCIF1));
     PCICR = (uint8_t)((1u << PCIE0) | (1u << PCIE1));

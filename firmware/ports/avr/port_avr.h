@@ -47,9 +47,12 @@
 
 /* Pins (Grbl 1.1, Uno): STEP x/y/z = PD2/PD3/PD4, DIR x/y/z = PD5/PD6/PD7, stepper enable = PB0
  * (active low, as on the CNC shield: low = drivers on). Three axes; an a axis has no pin.
- * Machine control: limit / home switches x/y/z = PB1/PB2/PB4 (D9, D10, D12), probe PC5 (A5),
- * e-stop PC0 (A0: Grbl's reset pin), spindle PWM PB3 (D11, OC2A on Timer2), spindle enable PC3
- * (A3), direction PC4 (A4); the pen servo keeps OC1B (D10, then no y switch). */
+ * Machine control: limit / home switches x/y/z = PB1 (D9) / PC1 (A1) / PB4 (D12), probe PC5
+ * (A5), e-stop PC0 (A0: Grbl's reset pin), spindle PWM PB3 (D11, OC2A on Timer2), spindle enable
+ * PC3 (A3), direction PC4 (A4), the pen servo OC1B = PB2 (D10, Timer1 compare B: the one
+ * hardware-timed output left, so Grbl's y switch pin moved to A1). Timers: Timer1 the tick
+ * counter, the step deadline (compare A) and the servo (compare B); Timer2 the spindle; Timer0
+ * unused. port_avr.c static-asserts that no two functions share a pin. */
 #define PORT_AVR_AXES      3
 #define PORT_AVR_STEP_BIT0 2
 #define PORT_AVR_DIR_BIT0  5

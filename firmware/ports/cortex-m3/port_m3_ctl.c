@@ -34,9 +34,8 @@
 
 CS_STATIC_ASSERT(PWM_LOAD <= 0xFFFFu && PWM_LOAD >= 1000u, spindle_pwm_load_fits_16_bits);
 
-static void (*in_fn)(void *, uint16_t);
+static void (*in_fn)(void *);
 static void *in_ctx;
-static volatile uint16_t in_last;
 static struct {
     uint16_t bit;
     uint8_t axis;
@@ -115,44 +114,38 @@ uint16_t port_inputs_read(void)
     return (uint16_t)(b | sim_read());
 }
 
-/* The bits changed since last reported: tell the application (ISR context). */
-static void report(void)
+/* The edge hook (port.h): the application reads the pins and keeps what changed (ISR context). */
+static void edge(void)
 {
-    uint16_t b = port_inputs_read();
-    if (b == in_last)
-        return;
-    in_last = b;
     if (in_fn != NULL)
-        in_fn(in_ctx, b);
+        in_fn(in_ctx);
 }
 
 void GPIOB_Handler(void);
 void GPIOB_Handler(void)
 {
     GPIO_ICR(GPIO_PORTB) = LIMIT_PINS;
-    report();
+    edge();
 }
 
 void GPIOE_Handler(void);
 void GPIOE_Handler(void)
 {
     GPIO_ICR(GPIO_PORTE) = PROBE_PIN | ESTOP_PIN;
-    report();
+    edge();
 }
 
 void port_m3_ctl_stepped(void)
 {
     if (nsim != 0)
-        report();
+        edge(); /* the simulated switches move with the machine: sampled after each step */
 }
 
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx)
 {
     uint32_t s = port_irq_save();
     in_fn = fn;
     in_ctx = ctx;
-    in_last = 0;
-    report(); /* what is active already is a change from nothing */
     port_irq_restore(s);
 }
 

@@ -28,7 +28,7 @@ struct posix_state {
     port_posix_spindle_t *spins;
     size_t nspins, capspins;
     uint16_t inputs, force_mask, force_val;
-    void (*in_fn)(void *, uint16_t);
+    void (*in_fn)(void *);
     void *in_ctx;
     uint16_t (*model)(void *, const int64_t *);
     void *model_ctx;
@@ -46,7 +46,7 @@ void port_posix_reset(uint32_t tick_hz, uint8_t invert_mask)
     free(g.pens);
     free(g.spins);
     cs_stepper_t *st = g.st;
-    void (*in_fn)(void *, uint16_t) = g.in_fn;
+    void (*in_fn)(void *) = g.in_fn;
     void *in_ctx = g.in_ctx;
     uint16_t (*model)(void *, const int64_t *) = g.model;
     void *model_ctx = g.model_ctx;
@@ -187,7 +187,8 @@ const port_posix_spindle_t *port_posix_spindles(size_t *n)
     return g.spins;
 }
 
-/* The bits from the model and the forced ones; the hook hears of a change (the pin interrupt). */
+/* The pins: the bits from the model and the forced ones; a pin that changed fires the edge hook
+ * (a board's pin-change interrupt fires on a change only). */
 static void inputs_update(void)
 {
     uint16_t b = g.model != NULL ? g.model(g.model_ctx, g.pos) : 0;
@@ -196,7 +197,7 @@ static void inputs_update(void)
         return;
     g.inputs = b;
     if (g.in_fn != NULL)
-        g.in_fn(g.in_ctx, b);
+        g.in_fn(g.in_ctx);
 }
 
 uint16_t port_inputs_read(void)
@@ -204,7 +205,7 @@ uint16_t port_inputs_read(void)
     return g.inputs;
 }
 
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx)
 {
     g.in_fn = fn;
     g.in_ctx = ctx;

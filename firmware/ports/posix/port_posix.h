@@ -35,8 +35,8 @@ typedef struct {
 
 /* The simulated inputs: model(ctx, pos) gives the input bits for the positions pos[0..8) in
  * steps seen on the STEP/DIR lines (the physical machine); evaluated after every step interrupt
- * that stepped, and the attached hook (port_inputs_attach) is called there when the bits change,
- * as a real board's pin interrupt would. NULL: every input inactive. Kept across resets. */
+ * that stepped, and the attached edge hook (port_inputs_attach) is called there when the bits
+ * change, as a real board's pin interrupt would. NULL: every input inactive. Kept across resets. */
 void port_posix_inputs_model(uint16_t (*model)(void *ctx, const int64_t *pos), void *ctx);
 /* Forces the bits in mask to the levels in value (an e-stop pressed by a test) and reports the
  * change to the hook at once; mask 0 releases them. */

@@ -69,11 +69,12 @@ uint16_t port_inputs_read(void)
     return 0;
 }
 
-void port_inputs_attach(void (*fn)(void *ctx, uint16_t bits), void *ctx)
+void port_inputs_attach(void (*fn)(void *ctx), void *ctx)
 {
-    /* Keep fn and ctx; enable a pin-change / edge interrupt on every input pin at the step
-     * timer's priority (so fn never preempts the step interrupt). Its handler calls
-     * fn(ctx, port_inputs_read()) when the bits differ from the last ones it reported. */
+    /* Keep fn and ctx (interrupts masked); enable a pin-change / edge interrupt on every input
+     * pin at the step timer's priority (so fn never preempts the step interrupt). Its handler
+     * clears the flag and calls fn(ctx), nothing more: the application reads port_inputs_read
+     * and keeps what changed, and reads the pins once at start (a switch already pressed). */
     (void)fn;
     (void)ctx;
 }
