@@ -423,6 +423,18 @@ static double profile2(const cs_dropcut_tool_t *t, double d2)
     return cs_dropcut_profile(t, sqrt(d2));
 }
 
+/* Can a point at horizontal distance sqrt(d2) <= R and height at most top hold the cutter above
+ * best, top - h > best? For a ball without a square root: h < top - best, i.e.
+ * sqrt(R^2 - d2) > R - (top - best), always when the right side is negative. */
+static bool can_beat(const cs_dropcut_tool_t *t, double top, double d2, double best)
+{
+    if (t->c_mm >= t->r_mm) {
+        double m = t->c_mm - (top - best);
+        return m < 0 || t->c_mm * t->c_mm - d2 > m * m;
+    }
+    return top - profile2(t, d2) > best;
+}
+
 /* f(p) = p.z - h(d) along the edge a -> b, for s in [s0, s1] where d <= R: concave in s. */
 static double edge_f(const cs_dropcut_tool_t *t, const double a[3], const double b[3], double x,
                      double y, double s)
@@ -586,11 +598,9 @@ static bool heap_push(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, size_t 
     double size = ms->cell * (double)((size_t)1 << lev);
     double x0 = ms->box[0] + (double)cx * size, y0 = ms->box[1] + (double)cy * size;
     double d2 = box_dist2(x0, y0, x0 + size, y0 + size, x, y);
-    if (d2 > t->r_mm * t->r_mm)
+    if (d2 > t->r_mm * t->r_mm || !can_beat(t, top, d2, best))
         return true;
     double bound = top - profile2(t, d2);
-    if (bound <= best)
-        return true;
     if (*n == ms->cqcap) {
         size_t cap = ms->cqcap ? 2 * ms->cqcap : 256;
         struct cs_dropcut_cq *q = realloc(ms->cq, cap * sizeof *q);
@@ -637,7 +647,7 @@ static double tri_drop(const cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                        const struct cs_dropcut_ent *en, double x, double y, double best)
 {
     double d2 = box_dist2(en->x0, en->y0, en->x1, en->y1, x, y), r2 = t->r_mm * t->r_mm;
-    if (d2 > r2 || en->top - profile2(t, d2) <= best)
+    if (d2 > r2 || !can_beat(t, en->top, d2, best))
         return best;
     const cs_dropcut_tri_t *tr = &ms->tri[en->tri];
     const double *pl = ms->pl[en->tri];
@@ -650,7 +660,7 @@ static double tri_drop(const cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
     for (int e = 0; e < 3; e++) {
         const double *a = tr->v[e], *b = tr->v[(e + 1) % 3];
         double de2 = seg_dist2(a, b, x, y);
-        if (de2 <= r2 && fmax(a[2], b[2]) - profile2(t, de2) > best)
+        if (de2 <= r2 && can_beat(t, fmax(a[2], b[2]), de2, best))
             best = fmax(best, edge_drop(t, a, b, x, y));
     }
     return best;
