@@ -13,7 +13,7 @@
 #include "cs_varady.h"
 
 #define DC_GRID_MAX  512  /* cells a patch in each direction, at most */
-#define DC_GOLDEN_IT 40   /* golden-section steps: the bracket shrinks by 0.618^40 ~ 4e-9 */
+#define DC_ROOT_IT   100  /* steps of the search for f's peak along a bull-nose's edge, at most */
 #define DC_MAX_CELLS 4000 /* grid cells in each direction, at most */
 #define DC_CELL_TRIS 16   /* triangles' area a grid cell, about (measured on the teapot: 4 to 25) */
 #define DC_EPS_MIN   1e-6 /* mm: the least enlargement of the cutter (see cs_dropcut_drop) */
@@ -486,9 +486,59 @@ static double ball_peak(const cs_dropcut_tool_t *t, const double a[3], const dou
     return (foot + m * rho / sqrt(1 + m * m)) / l;
 }
 
+/* f'(s) along the edge: z's slope less h'(d) d'(s), h'(d) = e / sqrt(r^2 - e^2) with e = d - (R - r)
+ * past the flat bottom (0 on it); +-HUGE_VAL where the corner turns vertical (e = r). */
+static double edge_df(const cs_dropcut_tool_t *t, const double a[3], const double b[3], double x,
+                      double y, double s)
+{
+    double ux = b[0] - a[0], uy = b[1] - a[1];
+    double px = a[0] + s * ux - x, py = a[1] + s * uy - y, d = sqrt(px * px + py * py);
+    double e = d - (t->r_mm - t->c_mm);
+    if (e <= 0)
+        return b[2] - a[2];
+    double q = t->c_mm * t->c_mm - e * e, dd = (px * ux + py * uy) / d;
+    if (q <= 0)
+        return dd > 0 ? -HUGE_VAL : dd < 0 ? HUGE_VAL : b[2] - a[2];
+    return b[2] - a[2] - e / sqrt(q) * dd;
+}
+
+/* A bull-nose's maximum of f over [s0, s1]: f is concave, so f' falls; its root is bracketed
+ * and found by regula falsi with the Illinois step (bisection where f' is infinite), to 1e-12
+ * of the span; f at the bracket's ends, points of the edge, bounds the maximum from below. */
+static double bull_peak(const cs_dropcut_tool_t *t, const double a[3], const double b[3],
+                        double x, double y, double s0, double s1)
+{
+    double lo = s0, hi = s1, glo = edge_df(t, a, b, x, y, lo), ghi = edge_df(t, a, b, x, y, hi);
+    if (glo <= 0 || ghi >= 0) /* the peak at an end: edge_drop has both */
+        return -HUGE_VAL;
+    int side = 0;
+    for (int k = 0; k < DC_ROOT_IT && hi - lo > 1e-12 * (s1 - s0 + 1e-300); k++) {
+        double m = isinf(glo) || isinf(ghi) ? (lo + hi) / 2 : (lo * ghi - hi * glo) / (ghi - glo);
+        if (!(m > lo && m < hi))
+            m = (lo + hi) / 2;
+        double gm = edge_df(t, a, b, x, y, m);
+        if (gm > 0) {
+            lo = m;
+            glo = gm;
+            if (side == 1)
+                ghi /= 2; /* Illinois: the end kept twice weighs half */
+            side = 1;
+        } else if (gm < 0) {
+            hi = m;
+            ghi = gm;
+            if (side == -1)
+                glo /= 2;
+            side = -1;
+        } else {
+            lo = hi = m;
+        }
+    }
+    return fmax(edge_f(t, a, b, x, y, lo), edge_f(t, a, b, x, y, hi));
+}
+
 /* f's maximum along the edge (concave in s): a ball's closed-form peak, or the end of the span
  * nearer to it (concavity); a flat end's higher end of the span (f is linear there); a
- * bull-nose's by golden-section search. */
+ * bull-nose's where f' changes sign (bull_peak). */
 static double edge_drop(const cs_dropcut_tool_t *t, const double a[3], const double b[3],
                         double x, double y)
 {
@@ -502,26 +552,7 @@ static double edge_drop(const cs_dropcut_tool_t *t, const double a[3], const dou
     double best = fmax(edge_f(t, a, b, x, y, s0), edge_f(t, a, b, x, y, s1));
     if (t->c_mm <= 0)
         return best;
-    const double g = 0.61803398874989484820;
-    double lo = s0, hi = s1;
-    double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
-    double f1 = edge_f(t, a, b, x, y, m1), f2 = edge_f(t, a, b, x, y, m2);
-    for (int k = 0; k < DC_GOLDEN_IT; k++) {
-        if (f1 < f2) {
-            lo = m1;
-            m1 = m2;
-            f1 = f2;
-            m2 = lo + g * (hi - lo);
-            f2 = edge_f(t, a, b, x, y, m2);
-        } else {
-            hi = m2;
-            m2 = m1;
-            f2 = f1;
-            m1 = hi - g * (hi - lo);
-            f1 = edge_f(t, a, b, x, y, m1);
-        }
-    }
-    return fmax(best, fmax(f1, f2));
+    return fmax(best, bull_peak(t, a, b, x, y, s0, s1));
 }
 
 /* Is (px, py) inside the triangle's xy projection (boundary included)? */

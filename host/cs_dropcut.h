@@ -16,9 +16,10 @@
  * f(p) = p.z - h(d(p)), h the cutter's profile at horizontal distance d from the axis. h is
  * convex and non-decreasing in d and d is convex in p, so f is concave over the triangle: its
  * maximum is the facet contact (the tangent plane touching the cutter, closed form) when that
- * contact lies inside the triangle, else on an edge, where the 1-D concave maximum is found by
- * golden-section search (OpenCAMLib's facet / edge / vertex split, derived here from concavity).
- * Host only, double precision. */
+ * contact lies inside the triangle, else on an edge, where the 1-D concave maximum is closed-form
+ * for a ball and a flat end and the root of f' for a bull-nose (OpenCAMLib's facet / edge /
+ * vertex split, derived here from concavity). The index is a grid with a pyramid of cell tops
+ * above it, searched by branch and bound (cs_dropcut.c). Host only, double precision. */
 #ifndef CS_DROPCUT_H
 #define CS_DROPCUT_H
 

@@ -3,7 +3,9 @@
  *  - facet contact on a horizontal and a tilted plane for ball, flat and bull-nose cutters:
  *    ball tip = m x0 + R (sqrt(1 + m^2) - 1); flat tip = m (x0 + R); bull tip =
  *    m (x0 + R - r) + r (sqrt(1 + m^2) - 1) (the torus's tube circle meets the rising direction);
- *  - vertex and edge contact: tip = z - h(d), h the profile at distance d;
+ *  - vertex and edge contact: tip = z - h(d), h the profile at distance d; on a sloped edge (the
+ *    top of a vertical blade) against the maximum of z - h(d) along it by golden-section search
+ *    written here (200 steps);
  *  - the mesh bound: sampled |S - L| of a bicubic and its triangulation below cs_dropcut_grid_eps;
  *  - gouge-free and tight on random bicubic bumps: the drop is never below the brute-force drop
  *    on dense samples of the exact patch (evaluated here by Bernstein sums), and at most
@@ -107,6 +109,56 @@ static void test_vertex_edge(void **state)
         assert_true(hit);
         /* The flank may hold the cutter higher than the ridge alone: never lower. */
         assert_true(got >= 10 - h - 1e-9);
+        cs_dropcut_free(&ms);
+    }
+}
+
+/* A vertical blade whose top edge rises m mm per mm along x through (0, 0, 0): the cutter beside
+ * it at lateral distance w rests on that edge (the blade's face is vertical, its other edges
+ * lower or beyond R), so the drop is the maximum over the edge of z - h(d). */
+static double blade_ref(const cs_dropcut_tool_t *t, double m, double x0, double w)
+{
+    double lo = x0 - sqrt(t->r_mm * t->r_mm - w * w), hi = x0 + sqrt(t->r_mm * t->r_mm - w * w);
+    const double g = 0.61803398874989484820;
+    for (int k = 0; k < 200; k++) {
+        double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+        double fa = m * a - cs_dropcut_profile(t, fmin(hypot(a - x0, w), t->r_mm));
+        double fb = m * b - cs_dropcut_profile(t, fmin(hypot(b - x0, w), t->r_mm));
+        if (fa < fb)
+            lo = a;
+        else
+            hi = b;
+    }
+    double s = (lo + hi) / 2;
+    return m * s - cs_dropcut_profile(t, fmin(hypot(s - x0, w), t->r_mm));
+}
+
+static void test_blade_edge(void **state)
+{
+    (void)state;
+    const cs_dropcut_tool_t tools[] = {{3, 1}, {2, 0.5}, {2, 2}, {3, 0}};
+    const double slopes[] = {0.5, 2}, offs[] = {0.5, 1.5, 1.9, 2.6};
+    for (size_t i = 0; i < 2; i++) {
+        double m = slopes[i];
+        cs_dropcut_mesh_t ms;
+        cs_dropcut_init(&ms);
+        double a[3] = {-50, 0, -50 * m}, b[3] = {50, 0, 50 * m}, c[3] = {50, 0, -50 * m - 100};
+        assert_int_equal(cs_dropcut_add(&ms, a, b, c), CS_OK);
+        assert_int_equal(cs_dropcut_index(&ms, 5), CS_OK);
+        for (size_t k = 0; k < sizeof tools / sizeof tools[0]; k++)
+            for (size_t j = 0; j < 4; j++) {
+                const cs_dropcut_tool_t *t = &tools[k];
+                double x0 = 1.25, w = offs[j] * t->r_mm / 3;
+                bool hit;
+                double got = cs_dropcut_drop_exact(&ms, t, x0, w, &hit);
+                double want = blade_ref(t, m, x0, w);
+                assert_true(hit);
+                if (fabs(got - want) > 1e-9) {
+                    printf("slope %g tool R %g r %g offset %g: %.12f, want %.12f\n", m, t->r_mm,
+                           t->c_mm, w, got, want);
+                    fail();
+                }
+            }
         cs_dropcut_free(&ms);
     }
 }
@@ -474,6 +526,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_planes),
         cmocka_unit_test(test_vertex_edge),
+        cmocka_unit_test(test_blade_edge),
         cmocka_unit_test(test_grid_eps),
         cmocka_unit_test(test_gouge_free),
         cmocka_unit_test(test_soup),
