@@ -89,8 +89,14 @@ static void add_line(cs_gpio_lines_t *l, unsigned offset, bool active_low, const
     snprintf(l->name[i], sizeof l->name[i], "%s", name);
 }
 
+/* Said once per process: the daemon and `curvestep grbl` start the step thread for every job
+ * or chunk, and what the system grants does not change between them. */
 static void warn_rt(const cs_gpio_run_t *r, const cs_gpio_cfg_t *cfg)
 {
+    static bool warned;
+    if (warned)
+        return;
+    warned = true;
     if (r->sched_err > 0)
         fprintf(stderr,
                 "curvestep: warning: SCHED_FIFO priority %d not granted (%s): the step "

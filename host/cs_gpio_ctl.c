@@ -33,6 +33,8 @@ typedef struct {
     const cs_gpio_ctl_args_t *a;
     cs_joblink_t l;
     cs_gpio_link_t *g;
+    FILE *out;                   /* a->out, else stdout */
+    volatile sig_atomic_t *stop; /* a->stop, else the SIGINT flag */
 } sess_t;
 
 static double steps_mm(const cs_machine_t *m, unsigned i, int64_t steps)
@@ -44,11 +46,11 @@ static double steps_mm(const cs_machine_t *m, unsigned i, int64_t steps)
 static void say_pos(const sess_t *s, const char *what)
 {
     const cs_machine_t *m = s->a->m;
-    printf("%s: %s", s->a->who, what);
+    fprintf(s->out, "%s: %s", s->a->who, what);
     for (unsigned i = 0; i < m->n_axes; i++)
-        printf("%s%.4f", i ? " " : "", steps_mm(m, i, s->g->st.pos[i]));
-    printf(" mm\n");
-    fflush(stdout);
+        fprintf(s->out, "%s%.4f", i ? " " : "", steps_mm(m, i, s->g->st.pos[i]));
+    fprintf(s->out, " mm\n");
+    fflush(s->out);
 }
 
 /* Opens the link for a command moving the axes of mask `axes`, with room for `cap` recorded set
@@ -69,17 +71,29 @@ static int sess_open(sess_t *s, const cs_gpio_ctl_args_t *a, unsigned axes, size
         return s->l.ops ? cs_joblink_close(&s->l, rc) : rc;
     }
     s->g = cs_gpio_link_of(&s->l);
-    interrupted = 0;
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
-    sigaction(SIGINT, &sa, NULL);
+    s->out = a->out != NULL ? a->out : stdout;
+    s->stop = a->stop != NULL ? a->stop : &interrupted;
+    if (a->stop == NULL) { /* the caller steers otherwise (and owns its signals) */
+        interrupted = 0;
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_sigint;
+        sigaction(SIGINT, &sa, NULL);
+    }
     return -1;
 }
 
 static int sess_close(sess_t *s, int rc)
 {
-    signal(SIGINT, SIG_DFL);
+    if (s->a->stop == NULL)
+        signal(SIGINT, SIG_DFL);
+    cs_gpio_ctl_result_t *res = s->a->res;
+    if (res != NULL && s->g != NULL && s->g->st_loaded) {
+        res->have_state = true;
+        memcpy(res->pos, s->g->st.pos, sizeof res->pos);
+        res->alarm = s->g->st.alarm;
+        res->inputs = s->g->st.inputs;
+    }
     return cs_joblink_close(&s->l, rc);
 }
 
@@ -98,9 +112,10 @@ static int alarm(sess_t *s, uint8_t code, uint16_t bits)
     snprintf(what, sizeof what, "ALARM:%u (%s), inputs 0x%03x, stopped at ", (unsigned)code,
              cs_ctlcfg_alarm_text(code), (unsigned)bits);
     say_pos(s, what);
-    printf("%s: the machine is in alarm: `curvestep unlock --gpio %s` (or `curvestep home --gpio "
-           "%s`) clears it\n",
-           s->a->who, s->a->chip, s->a->chip);
+    fprintf(s->out,
+            "%s: the machine is in alarm: `curvestep unlock --gpio %s` (or `curvestep home --gpio "
+            "%s`) clears it\n",
+            s->a->who, s->a->chip, s->a->chip);
     return CS_EXIT_DEV_ERROR;
 }
 
@@ -110,9 +125,10 @@ static int refuse_alarm(sess_t *s)
     uint8_t c = s->g->st.alarm;
     if (c == 0)
         return -1;
-    printf("%s: refused: the machine is in alarm (ALARM:%u, %s): `curvestep unlock --gpio %s` (or "
-           "`curvestep home --gpio %s`) clears it\n",
-           s->a->who, (unsigned)c, cs_ctlcfg_alarm_text(c), s->a->chip, s->a->chip);
+    fprintf(s->out,
+            "%s: refused: the machine is in alarm (ALARM:%u, %s): `curvestep unlock --gpio %s` (or "
+            "`curvestep home --gpio %s`) clears it\n",
+            s->a->who, (unsigned)c, cs_ctlcfg_alarm_text(c), s->a->chip, s->a->chip);
     return CS_EXIT_DEV_ERROR;
 }
 
@@ -140,12 +156,11 @@ static int move(sess_t *s, const cs_machine_t *pm, const double to[CS_AXES], dou
         e = cs_motion_finish(&mo);
     int rc = -1;
     if (e != CS_OK) {
-        printf("%s: refused: %s\n", s->a->who,
-               e == CS_ERR_LIMIT ? "the target is outside the machine's travel (soft limits)"
-                                 : "the move cannot be planned");
+        fprintf(s->out, "%s: refused: %s\n", s->a->who,
+                e == CS_ERR_LIMIT ? "the target is outside the machine's travel (soft limits)"
+                                  : "the move cannot be planned");
         rc = e == CS_ERR_LIMIT ? CS_EXIT_DEV_ERROR : CS_EXIT_USAGE;
-    } else if (cs_gpio_link_move(&s->l, mo.segs.v, mo.segs.n, watch, release, true,
-                                 &interrupted) != 0) {
+    } else if (cs_gpio_link_move(&s->l, mo.segs.v, mo.segs.n, watch, release, true, s->stop) != 0) {
         fprintf(stderr, "curvestep %s: cannot start the step thread\n", s->a->who);
         rc = CS_EXIT_INTERNAL;
     }
@@ -333,6 +348,8 @@ static int run_target(const cs_gpio_ctl_args_t *a, bool probe)
         rc = move(&s, a->m, to, a->feed, a->away ? 0 : p, a->away ? p : 0, &hit);
     }
     if (rc < 0 && probe) {
+        if (a->res != NULL)
+            a->res->contact = hit;
         say_pos(&s, hit ? "contact at " : "no contact; ended at ");
         if (!hit && !a->no_error)
             rc = alarm(&s, CS_PROTO_ALARM_PROBE_CONTACT, s.g->run.inputs);
@@ -362,8 +379,8 @@ int cs_gpio_ctl_unlock(const cs_gpio_ctl_args_t *a)
         return rc;
     uint16_t in = inputs_now(&s);
     if (in & CS_PROTO_IN_ESTOP) {
-        printf("unlock: refused: the e-stop is pressed (inputs 0x%03x); release it first\n",
-               (unsigned)in);
+        fprintf(s.out, "unlock: refused: the e-stop is pressed (inputs 0x%03x); release it first\n",
+                (unsigned)in);
         if (s.g->st.alarm == 0)
             s.g->st.alarm = CS_PROTO_ALARM_ESTOP;
         return sess_close(&s, CS_EXIT_DEV_ERROR);

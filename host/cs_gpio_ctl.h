@@ -7,10 +7,22 @@
 #ifndef CS_GPIO_CTL_H
 #define CS_GPIO_CTL_H
 
+#include <signal.h>
 #include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
 
 #include "cs_ctlcfg.h"
 #include "cs_machine.h"
+
+/* The machine after a command, for a caller that keeps its own picture (`curvestep grbl`). */
+typedef struct {
+    bool have_state;      /* the link keeps a state (inputs wired): pos, alarm, inputs valid */
+    int32_t pos[CS_AXES]; /* machine position, steps */
+    uint8_t alarm;        /* 0, or the cs_proto_alarm_t the machine is in */
+    uint16_t inputs;      /* the input bits last read */
+    bool contact;         /* probe: the probe input stopped the move */
+} cs_gpio_ctl_result_t;
 
 typedef struct {
     const char *who;          /* "home", "probe", "jog", "unlock" */
@@ -21,11 +33,18 @@ typedef struct {
     double feed;            /* probe, jog: mm/s */
     double xyz[3];          /* probe, jog: the target, machine mm */
     bool away, no_error;    /* probe: G38.4/.5, G38.3/.5 */
+    /* a caller that runs the command inside its own program (`curvestep grbl`; all NULL for
+     * the commands of their own): the lines said on out (NULL: stdout), the command stopped at
+     * once when *stop > 0 (NULL: Ctrl-C, a SIGINT handler installed for the command), the
+     * machine after it in *res */
+    FILE *out;
+    volatile sig_atomic_t *stop;
+    cs_gpio_ctl_result_t *res;
 } cs_gpio_ctl_args_t;
 
 /* Each runs the command and returns its exit status (0 done, 1 bad machine file, 2 usage, 3
- * internal, 4 chip, 7 an alarm or a refusal, 8 Ctrl-C). Main thread; installs a SIGINT handler
- * for its duration. */
+ * internal, 4 chip, 7 an alarm or a refusal, 8 Ctrl-C). Installs a SIGINT handler for its
+ * duration when a->stop is NULL (then main thread only). */
 int cs_gpio_ctl_home(const cs_gpio_ctl_args_t *a);
 int cs_gpio_ctl_probe(const cs_gpio_ctl_args_t *a);
 int cs_gpio_ctl_jog(const cs_gpio_ctl_args_t *a);

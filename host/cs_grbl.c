@@ -201,6 +201,8 @@ bool cs_grbl_queue_path(grbl_t *g, cs_path_t *path)
         alarm_planner(g, &d);
         return false;
     }
+    it.ov_feed = g->ov.feed; /* the device scales it by the override now / this */
+    it.ov_rapid = g->ov.rapid;
     if (!wait_room(g) || !cs_grbl_dev_push(&g->dev, &it)) {
         cs_stream_job_free(&it.job);
         return false;
@@ -724,12 +726,27 @@ static void soft_reset(grbl_t *g)
     cs_grbl_gc_reset_modal(&g->gc, true);
     cs_grbl_ov_init(&g->ov); /* Grbl's reset puts the overrides back at 100 % */
     g->ov_changed = true;
+    cs_grbl_dev_override(&g->dev, g->ov.feed, g->ov.rapid, g->ov.spindle);
     cs_grbl_say(g, "%s", "");
     cs_grbl_say(g, "%s", GRBL_WELCOME);
 }
 
+/* An override byte changed g->ov: the running chunk gets it on the device within ~0.1 s
+ * (cs_grbl_dev_override: OVERRIDE), what is planned next is planned at it (apply_overrides).
+ * A spindle override while nothing runs goes to the device at once in a job of no messages
+ * (its session sends the OVERRIDE), as Grbl changes a running spindle at once. */
+static void override_byte(grbl_t *g, unsigned char b)
+{
+    g->ov_changed = true;
+    cs_grbl_dev_override(&g->dev, g->ov.feed, g->ov.rapid, g->ov.spindle);
+    if (b >= 0x99 && b <= 0x9D && g->sp_code != GC_M5 && !g->ctl.laser && !g->check_mode &&
+        cs_grbl_dev_idle(&g->dev))
+        (void)cs_grbl_run_msgs(g, NULL, 0, false);
+}
+
 /* A real-time byte (grbl wiki "Interface": picked out of the stream wherever it comes). True
- * when b was one. The overrides 0x90..0x9D change what is planned next (cs_grbl_ov); safety
+ * when b was one. The overrides 0x90..0x9D act on the running motion and what is planned next
+ * (override_byte); safety
  * door 0x84 and the toggles 0x9E..0xA1 are accepted and ignored (docs/controller.md). */
 static bool realtime(grbl_t *g, unsigned char b)
 {
@@ -767,7 +784,7 @@ static bool realtime(grbl_t *g, unsigned char b)
         return true;
     default:
         if (cs_grbl_ov_byte(&g->ov, b)) {
-            g->ov_changed = true;
+            override_byte(g, b);
             return true;
         }
         return b >= 0x80;
@@ -987,24 +1004,33 @@ static int start(grbl_t *g)
                 d.loc.col, d.reason);
         return CS_EXIT_INPUT;
     }
-    if (cs_serial_open(&g->ser, g->cfg->port, g->cfg->baud) != 0) {
-        fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", g->cfg->port, strerror(errno));
+    const cs_joblink_cfg_t *dc = &g->cfg->dev; /* serial: cs_stream; else cs_grbl_link */
+    if (dc->port != NULL && cs_serial_open(&g->ser, dc->port, dc->baud) != 0) {
+        fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", dc->port, strerror(errno));
         return CS_EXIT_NO_DEVICE;
     }
+    if (dc->port != NULL)
+        cs_serial_set_line_rate(&g->ser, dc->line_rate);
     /* the worker takes no signals: SIGINT and SIGTERM stop the main loop */
     sigset_t set, old;
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &set, &old);
-    uint32_t bps = strncmp(g->cfg->port, "/dev/pts/", 9) == 0 ? 0 : g->cfg->baud;
-    cs_err_t e = cs_grbl_dev_start(&g->dev, &g->ser, &g->m, bps);
+    char why[640] = "cannot start the device thread";
+    if (dc->port == NULL)
+        rc = cs_grbl_dev_start_link(&g->dev, dc, &g->m, &g->ctl, why, sizeof why);
+    else if (cs_grbl_dev_start(&g->dev, &g->ser, &g->m,
+                               cs_joblink_line_bps(dc->port, dc->baud, dc->line_rate)) != CS_OK)
+        rc = CS_EXIT_INTERNAL;
     pthread_sigmask(SIG_SETMASK, &old, NULL);
-    if (e != CS_OK) {
-        fprintf(stderr, "curvestep grbl: cannot start the device thread\n");
-        cs_serial_close(&g->ser);
-        return CS_EXIT_INTERNAL;
+    if (rc != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep grbl: %s\n", why);
+        if (dc->port != NULL)
+            cs_serial_close(&g->ser);
+        return rc;
     }
+    cs_grbl_sync(g); /* Modbus, GPIO: the reader starts where the link says the machine is */
     return CS_EXIT_OK;
 }
 
@@ -1034,12 +1060,14 @@ int cs_grbl_serve(const cs_grbl_cfg_t *cfg)
     int lfd, slave;
     rc = open_front(g, &lfd, &slave);
     if (rc == CS_EXIT_OK) {
-        fprintf(stderr, "curvestep grbl: serving Grbl 1.1 on %s for the device on %s\n",
-                cfg->listen ? "TCP" : "a pseudo-terminal", cfg->port);
+        fprintf(stderr, "curvestep grbl: serving Grbl 1.1 on %s for the %s device on %s\n",
+                cfg->listen ? "TCP" : "a pseudo-terminal", cs_grbl_dev_kind(&g->dev),
+                g->dev.link ? g->dev.link->l.name : cfg->dev.port);
         serve_loop(g, lfd);
     }
     cs_grbl_dev_stop(&g->dev);
-    cs_serial_close(&g->ser);
+    if (cfg->dev.port != NULL)
+        cs_serial_close(&g->ser);
     if (rc == CS_EXIT_OK && cfg->state != NULL && cs_grbl_gc_save(&g->gc, cfg->state) != CS_OK)
         fprintf(stderr, "curvestep grbl: cannot write %s: %s\n", cfg->state, strerror(errno));
     if (cfg->link != NULL && cfg->listen == NULL)

@@ -1,8 +1,9 @@
 /* cs_grbl: the Grbl 1.1 front end (`curvestep grbl`). Serves one client at a time on a
  * pseudo-terminal or a TCP port with Grbl's text protocol (ok / error:N, the real-time bytes,
  * status reports, $ commands, $J= jogs), reads its G-code a line at a time (cs_grbl_gc), plans it
- * in chunks with the host planner and streams the chunks to a device over the serial link
- * (cs_grbl_dev). What is and is not supported: docs/controller.md. Host only. */
+ * in chunks with the host planner and runs the chunks on a device over any link: the serial wire
+ * protocol, Modbus TCP / RTU or GPIO (cs_grbl_dev). What is and is not supported:
+ * docs/controller.md. Host only. */
 #ifndef CS_GRBL_H
 #define CS_GRBL_H
 
@@ -10,6 +11,7 @@
 #include <stdint.h>
 #include <netinet/in.h>
 
+#include "cs_joblink.h"
 #include "cs_jobplan.h"
 
 /* Grbl's serial receive buffer (RX_BUFFER_SIZE): what a character-counting sender fills. */
@@ -20,8 +22,8 @@
 #define CS_GRBL_CHUNK_IDLE_MS 30
 
 typedef struct {
-    const char *port;      /* --port DEV: the device's serial line */
-    uint32_t baud;         /* --baud, default 115200 */
+    cs_joblink_cfg_t dev;  /* the device's link: --port DEV (--baud, --line-rate), --modbus-tcp,
+                            * --modbus-rtu (--baud, --parity, --unit) or --gpio */
     cs_jobplan_opts_t job; /* --machine, --tol, --feed */
     const char *listen;    /* --listen [ADDR:]PORT; NULL: a pseudo-terminal */
     const char *link;      /* --link PATH: a symlink to the pty; NULL: none */

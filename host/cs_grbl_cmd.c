@@ -5,16 +5,21 @@
 
 #include "cs_cmd.h"
 #include "cs_grbl.h"
-#include "cs_serial.h"
+#include "cs_joblink.h"
+#include "cs_machine_ini.h"
 
 static void usage(FILE *f)
 {
-    fputs("usage: curvestep grbl --port DEV [--baud N] [--machine FILE.ini] [--tol MM]\n"
-          "                      [--feed MM/S] [--pty [--link PATH] | --listen [ADDR:]PORT]\n"
-          "                      [--state FILE]\n"
+    fputs("usage: curvestep grbl --port DEV [--baud N] [--line-rate BPS]\n"
+          "                      | --modbus-tcp HOST:PORT [--unit ID]\n"
+          "                      | --modbus-rtu DEV [--baud N] [--parity P] [--unit ID]\n"
+          "                      | --gpio CHIP\n"
+          "                      [--machine FILE.ini] [--tol MM] [--feed MM/S]\n"
+          "                      [--pty [--link PATH] | --listen [ADDR:]PORT] [--state FILE]\n"
           "Speaks Grbl 1.1's serial protocol to a G-code sender (Universal G-code Sender,\n"
-          "cncjs, bCNC, a streaming script) and drives the curvestep device on DEV (a serial\n"
-          "line, or the pty printed by `curvestep-sim --pty`) with its wire protocol.\n"
+          "cncjs, bCNC, a streaming script) and drives a curvestep device over any of the\n"
+          "links of `curvestep stream`: its wire protocol on a serial line (or the pty printed\n"
+          "by `curvestep-sim --pty`), Modbus TCP or RTU, or GPIO step/dir lines.\n"
           "  --pty              (default) create a pseudo-terminal; its path is the first line\n"
           "                     on standard output: open it in the sender as a serial port\n"
           "  --link PATH        also make PATH a symlink to that pty (e.g. /tmp/ttyCURVESTEP);\n"
@@ -22,7 +27,16 @@ static void usage(FILE *f)
           "  --listen [ADDR:]PORT  serve one TCP client at a time instead, on ADDR (default\n"
           "                     127.0.0.1: loopback only); PORT 0 picks one; ADDR:PORT is\n"
           "                     the first line on standard output\n"
-          "  --port DEV         the device's serial line; --baud N its speed (default 115200)\n"
+          "  --port DEV         the device's serial line; --baud N its speed (default 115200);\n"
+          "                     --line-rate BPS paces the writes as a line of BPS bits/s would\n"
+          "  --modbus-tcp HOST:PORT  a Modbus TCP device (docs/modbus.md); --unit ID its unit\n"
+          "                     id (default 1)\n"
+          "  --modbus-rtu DEV   a Modbus RTU device on serial line DEV; --baud N (default\n"
+          "                     115200), --parity none|even|odd (default even), --unit ID\n"
+          "  --gpio CHIP        step/dir lines of GPIO chip CHIP, wired as the machine file's\n"
+          "                     [gpio] section says (requested for each chunk); --gpio\n"
+          "                     record:FILE runs on no hardware and writes the last chunk's\n"
+          "                     edges to FILE (docs/gpio.md)\n"
           "  --machine FILE     machine description (default: the built-in plotter); $$ shows\n"
           "                     it as Grbl settings, read-only ($10 alone can be set)\n"
           "  --state FILE       keep the work offsets (G54..G59.3, set by G10) and the G28/G30\n"
@@ -36,15 +50,18 @@ static void usage(FILE *f)
           "Lines are LinuxCNC G-code read a line at a time: parameters, work offsets (G10,\n"
           "G54-G59.3, G92, G28/G30, G53) and O-word subroutines carry from line to line.\n"
           "Real-time bytes: ? status, ! feed hold, ~ resume, Ctrl-X reset, 0x85 jog cancel,\n"
-          "0x90-0x9D feed/rapid/spindle overrides (on moves not yet planned; Ov: in the\n"
-          "status). $$ $# $G $I $N $C $X $J= $H work. On the device: $H homes the axes of\n"
-          "the machine file's [homing], $X unlocks, G38.2-G38.5 probe ([PRB:] reported),\n"
-          "M3/M4/M5 S drive the spindle ([spindle] laser = true: Grbl's laser mode); its\n"
-          "alarms come as ALARM:N, its switches as Pn: in the status.\n"
-          "See docs/controller.md.\n"
+          "0x90-0x9D feed/rapid/spindle overrides (feed and spindle also on the chunk a\n"
+          "serial device runs, within its acceleration; over Modbus and GPIO from the next\n"
+          "chunk; Ov: in the status). $$ $# $G $I $N $C $X $J= $H work. On the device: $H\n"
+          "homes the axes of the machine file's [homing], $X unlocks, G38.2-G38.5 probe\n"
+          "([PRB:] reported), M3/M4/M5 S drive the spindle ([spindle] laser = true: Grbl's\n"
+          "laser mode); its alarms come as ALARM:N, its switches as Pn: in the status. Over\n"
+          "GPIO the host runs $H, G38.x and the hard limits on its step thread with the\n"
+          "[gpio] inputs; Modbus carries motion only: there $H is error:5 and G38.x, M3, M4\n"
+          "error:20 (GPIO: M3, M4), each with a [MSG:] saying why. See docs/controller.md.\n"
           "SIGINT or SIGTERM: the running chunk is held, aborted, and the command ends.\n"
           "Exit status: 0 stopped by a signal, 1 bad machine file, 2 bad command line,\n"
-          "3 internal error (pty, socket), 4 the port cannot be opened.\n",
+          "3 internal error (pty, socket), 4 the device cannot be opened.\n",
           f);
 }
 
@@ -52,12 +69,15 @@ int cs_cmd_grbl(int argc, char **argv)
 {
     cs_grbl_cfg_t c;
     memset(&c, 0, sizeof c);
-    c.baud = 115200;
+    c.dev.baud = 115200;
+    c.dev.unit = 1;
     cs_jobplan_opts_init(&c.job);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         bool has = i + 1 < argc;
         int r = cs_jobplan_option("grbl", argc, argv, &i, &c.job);
+        if (r == 0) /* --port, --modbus-tcp, --modbus-rtu, --gpio and their settings */
+            r = cs_joblink_option("grbl", argc, argv, &i, &c.dev);
         if (r < 0)
             return CS_EXIT_USAGE;
         if (r > 0)
@@ -65,16 +85,6 @@ int cs_cmd_grbl(int argc, char **argv)
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
             return CS_EXIT_OK;
-        } else if (strcmp(a, "--port") == 0 && has) {
-            c.port = argv[++i];
-        } else if (strcmp(a, "--baud") == 0 && has) {
-            char *e;
-            unsigned long b = strtoul(argv[++i], &e, 10);
-            if (*e != '\0' || b > 4000000 || !cs_serial_baud_ok((uint32_t)b)) {
-                fprintf(stderr, "curvestep grbl: --baud wants a termios rate (e.g. 115200)\n");
-                return CS_EXIT_USAGE;
-            }
-            c.baud = (uint32_t)b;
         } else if (strcmp(a, "--pty") == 0) {
             c.listen = NULL;
         } else if (strcmp(a, "--listen") == 0 && has) {
@@ -89,10 +99,20 @@ int cs_cmd_grbl(int argc, char **argv)
             return CS_EXIT_USAGE;
         }
     }
-    if (c.port == NULL) {
-        fprintf(stderr, "curvestep grbl: --port DEV is required (the device's serial line)\n");
+    cs_joblink_t pick;
+    if (cs_joblink_select(&pick, &c.dev) != CS_EXIT_OK) {
+        fprintf(stderr, "curvestep grbl: %s (the device's link)\n", pick.why);
         return CS_EXIT_USAGE;
     }
+    if (c.dev.line_rate != 0 && c.dev.port == NULL) {
+        fprintf(stderr, "curvestep grbl: --line-rate applies to --port only\n");
+        return CS_EXIT_USAGE;
+    }
+    static char found[4096];
+    if (c.dev.port == NULL && c.job.machine_file == NULL &&
+        cs_machine_ini_find(found, sizeof found))
+        c.job.machine_file = found;          /* as `curvestep stream` finds it */
+    c.dev.machine_file = c.job.machine_file; /* the GPIO link's [gpio] section */
     struct sockaddr_in sa;
     if (c.listen != NULL && !cs_grbl_listen_parse(c.listen, &sa)) {
         fprintf(stderr, "curvestep grbl: --listen wants [ADDR:]PORT (an IPv4 address), got '%s'\n",

@@ -13,6 +13,19 @@
 #include "cs_grbl_int.h"
 #include "cs_motion.h"
 
+/* True when the device's link carries messages of type t; else false, with why (what: the
+ * command) said to the client and in the log (docs/controller.md, "Links"). */
+static bool link_can(grbl_t *g, uint8_t t, const char *what)
+{
+    if (cs_grbl_dev_can(&g->dev, t))
+        return true;
+    const char *kind = cs_grbl_dev_kind(&g->dev);
+    cs_grbl_say(g, "[MSG:line %u: %s: the %s link cannot do it (%s can; docs/controller.md)]",
+                g->lineno, what, kind, t == CS_PROTO_SPINDLE ? "--port" : "--port or --gpio");
+    fprintf(stderr, "curvestep grbl: line %u: %s refused: the %s link cannot do it\n", g->lineno,
+            what, kind);
+    return false;
+}
 
 void cs_grbl_watch_alarm(grbl_t *g)
 {
@@ -30,6 +43,10 @@ void cs_grbl_home(grbl_t *g)
 {
     if (g->ctl.n_order == 0) {
         cs_grbl_say(g, "[MSG:homing is not configured: no [homing] order in the machine file]");
+        cs_grbl_say(g, "error:%d", ERR_HOMING);
+        return;
+    }
+    if (!link_can(g, CS_PROTO_HOME, "$H (homing)")) {
         cs_grbl_say(g, "error:%d", ERR_HOMING);
         return;
     }
@@ -90,6 +107,8 @@ cs_err_t cs_grbl_probe(void *ctx, int code, const double from[3], const double t
     *contact = true;
     if (g->check_mode) /* $C: checked, nothing moves; the contact is taken at the target */
         return CS_OK;
+    if (!link_can(g, CS_PROTO_PROBE, "G38.x (probing)"))
+        return CS_ERR_UNSUPPORTED;
     cs_grbl_flush(g); /* the moves before the probe run first */
     cs_proto_msg_t m = {.type = CS_PROTO_PROBE};
     if (cs_conv_mm_to_vec(to[0], to[1], to[2], &m.u.probe.target) != CS_OK)
@@ -127,7 +146,8 @@ static cs_proto_msg_t spindle_msg(const grbl_t *g, int code, double s, bool rapi
     m.u.spindle.mode = code == GC_M3   ? CS_PROTO_SPINDLE_CW
                        : code == GC_M4 ? CS_PROTO_SPINDLE_CCW
                                        : CS_PROTO_SPINDLE_OFF;
-    double duty = g->ctl.s_max > 0 ? s / g->ctl.s_max * g->ov.spindle / 100.0 : 0;
+    /* the spindle override is the device's (OVERRIDE, cs_grbl_dev_override): S as programmed */
+    double duty = g->ctl.s_max > 0 ? s / g->ctl.s_max : 0;
     duty = fmin(fmax(duty, 0.0), 1.0) * CS_PROTO_SPINDLE_FULL;
     m.u.spindle.power = code == GC_M5 || rapid ? 0 : (uint16_t)lround(duty);
     if (g->ctl.laser) {
@@ -143,6 +163,9 @@ cs_err_t cs_grbl_spindle(void *ctx, int code, double s)
     grbl_t *g = ctx;
     if (g->check_mode)
         return CS_OK;
+    if (code != GC_M5 &&
+        !link_can(g, CS_PROTO_SPINDLE, code == GC_M3 ? "M3 (spindle)" : "M4 (spindle)"))
+        return CS_ERR_UNSUPPORTED; /* M5: off, as a machine without one is */
     if (g->ctl.laser && code == g->sp_code && code != GC_M5) {
         /* Grbl's laser mode: an S change takes effect with the next move, without a stop;
          * the moves carry their S (cs_path_elem_t) into the plan's power marks */

@@ -1,8 +1,10 @@
 /* cs_grbl_dev: the worker that runs the Grbl front end's chunks on the device (see
- * cs_grbl_dev.h). cs_stream_run owns the link while a chunk runs; it draws its progress bar on a
- * FILE at most ten times a second, and that FILE is a cookie stream whose write function (called
- * on the worker thread, inside cs_stream_run) copies the device's last STATUS into the shared
- * snapshot: the position `?` reports is what the device said, never an estimate. */
+ * cs_grbl_dev.h). cs_stream_run (or on Modbus and GPIO cs_grbl_link's run) owns the link while a
+ * chunk runs; it draws its progress bar on a FILE at most ten times a second, and that FILE is a
+ * cookie stream whose write function (called on the worker thread, inside the run) copies the
+ * device's last report into the shared snapshot: the position `?` reports is what the device
+ * said (serial: its STATUS; Modbus: its status registers; GPIO: the segments the step thread
+ * has executed), never an estimate. */
 #define _GNU_SOURCE /* fopencookie */
 #include "cs_grbl_dev.h"
 
@@ -36,16 +38,32 @@ static void take_status(cs_grbl_dev_t *d, const cs_stream_result_t *r)
     d->s.dev_state = r->dev_state;
 }
 
+/* Called with the lock held: the OVERRIDE for the running job (docs/protocol.md: feed and
+ * rapid relative to the job's plan, spindle absolute; 1/1000). */
+static void take_override(cs_grbl_dev_t *d)
+{
+    uint16_t v[3];
+    for (int k = 0; k < 3; k++) {
+        double base = k < 2 && d->cur_ov[k] > 0 ? d->cur_ov[k] : 100;
+        double r = 1000.0 * d->req_ov[k] / base;
+        v[k] = (uint16_t)lround(fmin(fmax(r, 1), CS_PROTO_OVERRIDE_MAX));
+    }
+    d->run_ov = (cs_proto_override_t){v[0], v[1], v[2]};
+}
+
 /* The progress FILE's write: the text itself is not needed, only the moment. */
 static ssize_t progress_write(void *cookie, const char *buf, size_t len)
 {
     (void)buf;
     cs_grbl_dev_t *d = cookie;
     pthread_mutex_lock(&d->mu);
+    if (d->cur != NULL && d->link != NULL)
+        cs_grbl_link_where(d->link, d->cur); /* GPIO: the step thread's */
     if (d->cur != NULL)
         take_status(d, d->cur);
     d->run_interrupt = d->req_cancel;
     d->run_pause = d->req_hold;
+    take_override(d);
     pthread_mutex_unlock(&d->mu);
     return (ssize_t)len;
 }
@@ -69,6 +87,44 @@ static void on_event(void *ctx, const cs_proto_event_t *ev)
     pthread_mutex_unlock(&d->mu);
 }
 
+/* The progress FILE whose writes copy the running item's position (ten a second). */
+static FILE *open_progress(cs_grbl_dev_t *d)
+{
+    cookie_io_functions_t io = {.write = progress_write};
+    FILE *f = fopencookie(d, "w", io);
+    if (f != NULL)
+        setvbuf(f, NULL, _IONBF, 0);
+    return f;
+}
+
+/* The item's run starts: its result shared with the progress FILE, the flags as asked. */
+static void begin_run(cs_grbl_dev_t *d, cs_stream_result_t *r)
+{
+    pthread_mutex_lock(&d->mu);
+    d->cur = r;
+    d->run_interrupt = d->req_cancel;
+    d->run_pause = d->req_hold;
+    pthread_mutex_unlock(&d->mu);
+}
+
+/* The item's run ended (e, *r): the device's last word kept, a failure noted. */
+static void end_run(cs_grbl_dev_t *d, cs_err_t e, const cs_stream_result_t *r, FILE *progress)
+{
+    pthread_mutex_lock(&d->mu);
+    d->cur = NULL;
+    take_status(d, r);
+    if (e != CS_OK || (r->outcome != CS_STREAM_DONE && r->outcome != CS_STREAM_INTERRUPTED)) {
+        d->s.failed = true;
+        snprintf(d->s.why, sizeof d->s.why, "%s%s%.150s", cs_stream_outcome_text(r->outcome),
+                 r->why[0] ? ": " : "", r->why);
+    }
+    if (r->outcome == CS_STREAM_INTERRUPTED)
+        d->s.cancelled++;
+    pthread_mutex_unlock(&d->mu);
+    if (progress != NULL)
+        fclose(progress);
+}
+
 static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
 {
     cs_stream_opts_t o;
@@ -80,32 +136,39 @@ static void run_job(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
     o.on_event = on_event;
     o.jog_cancel = it->jog; /* Grbl's 0x85 on the device's JOG: JOG_CANCEL */
     o.event_ctx = d;
-    cookie_io_functions_t io = {.write = progress_write};
-    o.progress = fopencookie(d, "w", io);
+    o.override = &d->run_ov;
+    o.progress = open_progress(d);
     o.progress_tty = true; /* ten updates a second */
-    if (o.progress != NULL)
-        setvbuf(o.progress, NULL, _IONBF, 0);
     cs_stream_result_t r;
+    begin_run(d, &r);
     pthread_mutex_lock(&d->mu);
-    d->cur = &r;
-    d->run_interrupt = d->req_cancel;
-    d->run_pause = d->req_hold;
+    d->cur_ov[0] = it->ov_feed;
+    d->cur_ov[1] = it->ov_rapid;
+    take_override(d);
     pthread_mutex_unlock(&d->mu);
     tcflush(d->ser->fd, TCIFLUSH); /* what the device said between chunks */
     cs_err_t e = cs_stream_run(&it->job, &o, &r);
+    end_run(d, e, &r, o.progress);
+}
+
+/* An item over Modbus or GPIO (cs_grbl_link), from the position last reported. */
+static void run_link(cs_grbl_dev_t *d, const cs_grbl_item_t *it)
+{
+    cs_joblink_ctl_t c = {&d->run_interrupt, &d->run_pause, open_progress(d), true};
+    cs_stream_result_t r;
+    memset(&r, 0, sizeof r);
+    r.dev_state = 0xFF;
+    int32_t pos[CS_PROTO_AXES_MAX];
+    begin_run(d, &r);
     pthread_mutex_lock(&d->mu);
-    d->cur = NULL;
-    take_status(d, &r);
-    if (e != CS_OK || (r.outcome != CS_STREAM_DONE && r.outcome != CS_STREAM_INTERRUPTED)) {
-        d->s.failed = true;
-        snprintf(d->s.why, sizeof d->s.why, "%s%s%.150s", cs_stream_outcome_text(r.outcome),
-                 r.why[0] ? ": " : "", r.why);
-    }
-    if (r.outcome == CS_STREAM_INTERRUPTED)
-        d->s.cancelled++;
+    memcpy(pos, d->s.pos, sizeof pos);
+    d->link_stop = d->req_cancel;
     pthread_mutex_unlock(&d->mu);
-    if (o.progress != NULL)
-        fclose(o.progress);
+    cs_err_t e = cs_grbl_link_run(d->link, &it->job, pos, &c, &r, on_event, d);
+    if (e != CS_OK || (r.outcome != CS_STREAM_DONE && r.outcome != CS_STREAM_INTERRUPTED))
+        fprintf(stderr, "curvestep grbl: %s: %s%s%s\n", d->link->l.name,
+                cs_stream_outcome_text(r.outcome), r.why[0] ? ": " : "", r.why); /* the log */
+    end_run(d, e, &r, c.progress);
 }
 
 /* G4: waits, in 10 ms steps, while held or until cancelled. */
@@ -143,6 +206,8 @@ static void *worker(void *arg)
         pthread_mutex_unlock(&d->mu);
         if (it.dwell)
             run_dwell(d, it.dwell_s);
+        else if (d->link != NULL)
+            run_link(d, &it);
         else
             run_job(d, &it);
         cs_stream_job_free(&it.job);
@@ -155,23 +220,63 @@ static void *worker(void *arg)
     return NULL;
 }
 
-cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_t *m,
-                           uint32_t bits_per_s)
+/* The worker's state for machine m, and its thread. */
+static cs_err_t start_worker(cs_grbl_dev_t *d, const cs_machine_t *m)
 {
-    memset(d, 0, sizeof *d);
-    d->ser = ser;
     d->axes = m->n_axes;
     d->tick_hz = m->tick_hz;
     for (unsigned i = 0; i < m->n_axes && i < CS_PROTO_AXES_MAX; i++)
         d->steps_per_mm[i] = m->axis[i].steps_per_mm;
-    d->bits_per_s = bits_per_s;
-    d->s.dev_state = 0xFF;
+    d->req_ov[0] = d->req_ov[1] = d->req_ov[2] = 100;
     pthread_mutex_init(&d->mu, NULL);
     pthread_cond_init(&d->cv, NULL);
     if (pthread_create(&d->th, NULL, worker, d) != 0)
         return CS_ERR_STATE;
     d->started = true;
     return CS_OK;
+}
+
+int cs_grbl_dev_start_link(cs_grbl_dev_t *d, const cs_joblink_cfg_t *cfg, const cs_machine_t *m,
+                           const cs_ctlcfg_t *ctl, char *why, size_t cap)
+{
+    memset(d, 0, sizeof *d);
+    d->s.dev_state = 0xFF;
+    uint8_t alarm;
+    int rc = cs_grbl_link_start(&d->lk, cfg, m, ctl, &d->link_stop, d->s.pos, &alarm, why, cap);
+    if (rc != 0)
+        return rc;
+    d->link = &d->lk;
+    d->s.have_pos = true; /* the device's registers, the GPIO state (or its origin) */
+    d->s.dev_state = CS_PROTO_STATE_IDLE;
+    if (alarm != 0) { /* the GPIO state keeps an alarm: said as the device's */
+        d->s.alarms = 1;
+        d->s.alarm_code = alarm;
+    }
+    if (start_worker(d, m) != CS_OK) {
+        snprintf(why, cap, "cannot start the device thread");
+        return 3; /* CS_EXIT_INTERNAL */
+    }
+    return 0;
+}
+
+bool cs_grbl_dev_can(const cs_grbl_dev_t *d, uint8_t t)
+{
+    return d->link == NULL || cs_grbl_link_can(d->link, t);
+}
+
+const char *cs_grbl_dev_kind(const cs_grbl_dev_t *d)
+{
+    return d->link == NULL ? "serial" : cs_grbl_link_kind(d->link);
+}
+
+cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_t *m,
+                           uint32_t bits_per_s)
+{
+    memset(d, 0, sizeof *d);
+    d->ser = ser;
+    d->bits_per_s = bits_per_s;
+    d->s.dev_state = 0xFF;
+    return start_worker(d, m);
 }
 
 bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need)
@@ -211,11 +316,21 @@ bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs)
     d->n = 0;
     d->s.queued = 0;
     d->req_cancel = d->s.busy;
+    d->link_stop = d->s.busy; /* a GPIO $H, G38.x: stopped at once (it polls no other flag) */
     while (d->s.busy)
         pthread_cond_wait(&d->cv, &d->mu);
     d->req_hold = false; /* a cancelled hold is over (Grbl: the hold ends with the flush) */
     pthread_mutex_unlock(&d->mu);
     return true;
+}
+
+void cs_grbl_dev_override(cs_grbl_dev_t *d, int feed, int rapid, int spindle)
+{
+    pthread_mutex_lock(&d->mu);
+    d->req_ov[0] = feed;
+    d->req_ov[1] = rapid;
+    d->req_ov[2] = spindle;
+    pthread_mutex_unlock(&d->mu);
 }
 
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on)

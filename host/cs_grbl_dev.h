@@ -1,8 +1,10 @@
 /* cs_grbl_dev: the device side of the Grbl front end. A worker thread takes planned chunks (step
  * segments, cs_stream_job_t) and dwells from a short queue and runs each through cs_stream_run on
- * the serial link, one session per chunk (as the daemon runs one per job); feed hold / resume and
- * cancel reach the running chunk through cs_stream's pause and interrupt flags. It keeps what the
- * device last reported (position in steps, state) for the status report. Host only. */
+ * the serial link, one session per chunk (as the daemon runs one per job), or through
+ * cs_grbl_link on Modbus or GPIO (cs_joblink); feed hold / resume and cancel reach the running
+ * chunk through the pause and interrupt flags every link polls. It keeps what the device last
+ * reported (position in steps, state; on GPIO the step thread's position) for the status
+ * report. Host only. */
 #ifndef CS_GRBL_DEV_H
 #define CS_GRBL_DEV_H
 
@@ -12,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cs_grbl_link.h"
 #include "cs_machine.h"
 #include "cs_proto.h"
 #include "cs_serial.h"
@@ -25,7 +28,8 @@ typedef struct {
     bool dwell;          /* a G4: wait dwell_s seconds; else run job */
     bool jog;            /* a $J= move (cancellable with 0x85) */
     double dwell_s;
-    cs_stream_job_t job; /* owned by the queue once pushed */
+    int ov_feed, ov_rapid; /* the feed / rapid override (%) the job was planned at (0: 100) */
+    cs_stream_job_t job;   /* owned by the queue once pushed */
 } cs_grbl_item_t;
 
 /* What the status report needs, copied under the lock. */
@@ -54,7 +58,10 @@ typedef struct {
     pthread_t th;
     pthread_mutex_t mu;
     pthread_cond_t cv;
-    cs_serial_t *ser;
+    cs_serial_t *ser;     /* the serial link, or NULL: */
+    cs_grbl_link_t *link; /* Modbus or GPIO (&lk) */
+    cs_grbl_link_t lk;
+    volatile sig_atomic_t link_stop; /* cancel: a GPIO control command stops at once */
     uint8_t axes;
     uint32_t tick_hz;
     int32_t steps_per_mm[CS_PROTO_AXES_MAX]; /* Q15.16, for the speed */
@@ -67,7 +74,10 @@ typedef struct {
      * starts and at each progress call, ten times a second, so a hold or cancel takes effect
      * within ~0.1 s and no flag is shared without the lock) */
     volatile sig_atomic_t run_interrupt, run_pause;
-    const cs_stream_result_t *cur;   /* the running chunk's result (worker thread only) */
+    int req_ov[3];                /* feed, rapid, spindle override in force (%), under mu */
+    int cur_ov[2];                /* the running job's planned feed, rapid (%; worker only) */
+    cs_proto_override_t run_ov;   /* what cs_stream_run sends (worker thread only, as above) */
+    cs_stream_result_t *cur;         /* the running chunk's result (worker thread only) */
     double t_move;                   /* when the reported position last changed */
     cs_grbl_dev_snap_t s;
 } cs_grbl_dev_t;
@@ -76,6 +86,16 @@ typedef struct {
  * for a line of bits_per_s (0: a pty). CS_ERR_STATE when the thread cannot start. */
 cs_err_t cs_grbl_dev_start(cs_grbl_dev_t *d, cs_serial_t *ser, const cs_machine_t *m,
                            uint32_t bits_per_s);
+/* Starts the worker on the Modbus or GPIO link of cfg (cs_grbl_link_start: where the machine
+ * stands, an alarm its GPIO state keeps, counted as the device's) for machine m with [homing]
+ * ctl; m, ctl and cfg's strings outlive d. CS_EXIT_OK, or an exit status with one sentence in why
+ * (CS_EXIT_INTERNAL: the thread). */
+int cs_grbl_dev_start_link(cs_grbl_dev_t *d, const cs_joblink_cfg_t *cfg, const cs_machine_t *m,
+                           const cs_ctlcfg_t *ctl, char *why, size_t cap);
+/* True when the device's link carries messages of type t (the serial link: all). */
+bool cs_grbl_dev_can(const cs_grbl_dev_t *d, uint8_t t);
+/* The link's name in messages: "serial", "Modbus", "GPIO". */
+const char *cs_grbl_dev_kind(const cs_grbl_dev_t *d);
 /* Queues it (taking its job); false when the queue is full (it is then not taken). */
 bool cs_grbl_dev_push(cs_grbl_dev_t *d, cs_grbl_item_t *it);
 /* True when the queue can take need more items. */
@@ -84,6 +104,9 @@ bool cs_grbl_dev_room(cs_grbl_dev_t *d, size_t need);
  * Cancels the running item (decelerating hold, then abort), waits until it has stopped and ends
  * the feed hold. False when only_jogs and something is not a jog (then nothing is done). */
 bool cs_grbl_dev_cancel(cs_grbl_dev_t *d, bool only_jogs);
+/* The overrides in force (Grbl's percentages): the running job gets them within ~0.1 s as an
+ * OVERRIDE relative to what it was planned at (cs_grbl_item_t.ov_*), the spindle's absolute. */
+void cs_grbl_dev_override(cs_grbl_dev_t *d, int feed, int rapid, int spindle);
 /* Feed hold on (true) or off. */
 void cs_grbl_dev_hold(cs_grbl_dev_t *d, bool on);
 /* Clears the failure (Grbl's $X). */

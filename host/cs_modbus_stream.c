@@ -332,6 +332,8 @@ static void lost(mrun_t *s, cs_mb_rc_t rc, const char *doing)
  * executed, no axis moved (a foreign HOLD, a device that refuses everything): never wait on. */
 static bool stalled(mrun_t *s, double now)
 {
+    if (s->held) /* our own pause (a feed hold): at rest for as long as the operator wants */
+        s->t_progress = now;
     if (s->o->stall_ms == 0 || now - s->t_progress <= s->o->stall_ms / 1000.0)
         return false;
     snprintf(s->r->why, sizeof s->r->why,

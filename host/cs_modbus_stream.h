@@ -100,7 +100,8 @@ typedef struct {
     uint32_t hello_ms;  /* the first status must come within this */
     uint32_t status_ms; /* poll the status at least this often while streaming (ms) */
     uint32_t idle_ms;   /* all delivered, device not running, not all executed: give up */
-    uint32_t stall_ms;  /* no write taken, nothing executed, no axis moved this long: give up */
+    uint32_t stall_ms;  /* no write taken, nothing executed, no axis moved this long (a pause
+                         * excepted): give up */
 } cs_mb_stream_opts_t;
 
 /* Defaults: hello 2 s, status every 50 ms, idle 3 s, stall 30 s. */

@@ -292,6 +292,7 @@ typedef struct {
      * it had taken everything we sent (its ACK goes out before them), so they answer it */
     unsigned fresh;
     cs_proto_status_t last; /* the last STATUS */
+    cs_proto_override_t ov_dev; /* the OVERRIDE the device took ({0}: none sent yet) */
     double t0, t_first;
     cs_stream_progress_t prog;
 } run_t;
@@ -335,6 +336,11 @@ static void on_deliver(run_t *s, const cs_link_event_t *ev)
     } else if (m.type == CS_PROTO_STATUS) {
         on_status(s, &m.u.status);
     } else if (m.type == CS_PROTO_EVENT) {
+        if (m.u.event.kind == CS_PROTO_EVENT_ALARM) {
+            s->r->alarm = true;
+            s->r->alarm_ev = m.u.event;
+            s->r->alarm_msg = s->r->executed + 1;
+        }
         if (s->o->on_event != NULL)
             s->o->on_event(s->o->event_ctx, &m.u.event);
     } else if (m.type == CS_PROTO_ERROR) {
@@ -613,6 +619,13 @@ static bool run_controls(run_t *s, double *t_last_ack)
         }
         finish(s, CS_STREAM_INTERRUPTED);
         return true;
+    }
+    if (o->override != NULL && memcmp(o->override, &s->ov_dev, sizeof s->ov_dev) != 0) {
+        /* what the device has after the SETPOS (a fresh job: as planned) or a resume: sent */
+        cs_proto_msg_t m = {.type = CS_PROTO_OVERRIDE};
+        m.u.override = *o->override;
+        if (exchange(s, &m, ANY_STATE, ANY_STATE, 2000))
+            s->ov_dev = m.u.override;
     }
     if (o->pause != NULL && (*o->pause != 0) != s->held) {
         s->held = !s->held;

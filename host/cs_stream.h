@@ -92,6 +92,11 @@ typedef struct {
     /* interrupt < 2: send JOG_CANCEL (decelerate to rest, drop the rest, back to IDLE) instead
      * of HOLD then ABORT (a job of jogs) */
     bool jog_cancel;
+    /* NULL: none; else the overrides the running job should have (docs/protocol.md, OVERRIDE):
+     * read every pass, sent (OVERRIDE, acknowledged, answered by a STATUS) after the SETPOS and
+     * again whenever it changes. Change it only on the thread that runs cs_stream_run (from the
+     * progress stream's write, as cs_grbl_dev does), like the pause flag it is polled as. */
+    const cs_proto_override_t *override;
 } cs_stream_opts_t;
 
 typedef struct {
@@ -122,6 +127,9 @@ typedef struct {
                        * cs_stream_outcome_text): the GPIO link's "held, then stopped ..." */
     bool mid_message; /* stopped inside message `executed` + 1: the machine is past the last
                        * executed one, so no --resume-from hint (GPIO: stop at once) */
+    bool alarm;               /* the device reported an ALARM EVENT (hard limit, e-stop, ...) */
+    cs_proto_event_t alarm_ev; /* ... the last one: code, inputs, where it stopped */
+    size_t alarm_msg;          /* ... during job message no. (executed + 1 then) */
 } cs_stream_result_t;
 
 /* Defaults: link timing for a pty at memory speed (cs_linktime_link(.., 0, 1000000)), keepalive

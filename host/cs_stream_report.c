@@ -3,6 +3,7 @@
 #include "cs_stream_report.h"
 
 #include "cs_cmd.h"
+#include "cs_ctlcfg.h"
 #include "cs_err_text.h"
 #include "cs_stream_cmd.h"
 
@@ -56,6 +57,35 @@ static void outcome_line(FILE *out, const char *where, const cs_stream_result_t 
     fprintf(out, "\n");
 }
 
+/* "stream: ALARM:N (what): WHICH, during SEGMENT no. K; stopped at P steps": the device's
+ * alarm EVENT located in the job (the message executing) and on the machine (the inputs that
+ * tripped, the position). */
+static void alarm_line(FILE *out, const cs_stream_result_t *r, const char *one)
+{
+    static const char axes[] = "xyza";
+    const cs_proto_event_t *e = &r->alarm_ev;
+    fprintf(out, "stream: ALARM:%u (%s):", (unsigned)e->code, cs_ctlcfg_alarm_text(e->code));
+    unsigned shown = 0;
+    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++) {
+        if (e->inputs & CS_PROTO_IN_MIN(i))
+            fprintf(out, "%s %c min switch", shown++ ? "," : "", axes[i]);
+        if (e->inputs & CS_PROTO_IN_MAX(i))
+            fprintf(out, "%s %c max switch", shown++ ? "," : "", axes[i]);
+    }
+    if (e->inputs & CS_PROTO_IN_ESTOP)
+        fprintf(out, "%s e-stop", shown++ ? "," : "");
+    if (e->inputs & CS_PROTO_IN_PROBE)
+        fprintf(out, "%s probe", shown++ ? "," : "");
+    if (shown == 0)
+        fprintf(out, " no input active");
+    size_t at = r->outcome == CS_STREAM_DEVICE_ERROR && r->dev_error_msg ? r->dev_error_msg
+                                                                         : r->alarm_msg;
+    fprintf(out, ", during %s no. %zu; stopped at", one, at);
+    for (unsigned i = 0; i < e->axes && i < CS_PROTO_AXES_MAX; i++)
+        fprintf(out, " %c %ld", axes[i], (long)e->pos[i]);
+    fprintf(out, " steps\n");
+}
+
 void cs_stream_report_bytes(FILE *out, const cs_stream_result_t *r, size_t resume_from, bool curves)
 {
     fprintf(out,
@@ -73,6 +103,8 @@ int cs_stream_report(FILE *out, const char *where, size_t n, const cs_stream_res
     const char *what = curves ? "curves" : "segments", *one = curves ? "curve" : "segment";
     int rc = cs_stream_exit_code(r->outcome);
     outcome_line(out, where, r, one);
+    if (r->alarm)
+        alarm_line(out, r, one);
     cs_stream_report_counts(out, r->executed, n, r->delivered, r->sent, what);
     if (counters != NULL)
         counters(ctx, out, r);

@@ -161,6 +161,10 @@ static void on_deliver(cs_fw_app_t *a, const cs_link_event_t *ev)
     case CS_PROTO_JOG_CANCEL:
         cs_fw_ctl_jog_cancel(&a->mo);
         break;
+    case CS_PROTO_OVERRIDE: /* acts on the running motion at once (no queue slot) */
+        cs_fw_motion_override(&a->mo, &m.u.override);
+        a->status_due = true; /* the host waits for the answer, as to HOLD */
+        break;
     case CS_PROTO_UNLOCK:
         e = cs_fw_ctl_unlock(&a->mo);
         if (e != CS_OK)

@@ -110,6 +110,13 @@ static void spindle_out(cs_fw_ctl_t *c, uint16_t duty, uint8_t mode, bool laser)
     port_spindle_set(duty, mode);
 }
 
+/* The programmed power (1/1000) at the spindle override, at most full. */
+static uint16_t sp_scaled(const cs_fw_ctl_t *c, uint16_t power)
+{
+    uint32_t d = (uint32_t)power * c->sp_ov / CS_PROTO_OVERRIDE_ONE;
+    return d > CS_PROTO_SPINDLE_FULL ? (uint16_t)CS_PROTO_SPINDLE_FULL : (uint16_t)d;
+}
+
 static void set_watch(cs_fw_ctl_t *c, uint16_t watch, uint16_t release)
 {
     uint32_t s = port_irq_save();
@@ -445,6 +452,7 @@ void cs_fw_ctl_init(cs_fw_motion_t *mo)
 #endif
     c->armed = true;
     c->inputs_sent = 0;
+    c->sp_ov = CS_PROTO_OVERRIDE_ONE;
     uint32_t s = port_irq_save();
     cs_stepper_on_load(&mo->st, on_load, mo);
     port_irq_restore(s);
@@ -533,7 +541,7 @@ static void poll_spindle(cs_fw_motion_t *mo)
     const cs_proto_spindle_t *p = &c->u.spindle;
     c->power = p->power;
     c->sp_feed = p->feed;
-    spindle_out(c, p->mode == CS_PROTO_SPINDLE_OFF ? 0 : p->power, p->mode, false);
+    spindle_out(c, p->mode == CS_PROTO_SPINDLE_OFF ? 0 : sp_scaled(c, p->power), p->mode, false);
     c->sp_wait = false;
     cs_fw_motion_mark(mo, c->op_item);
 }
@@ -589,12 +597,30 @@ uint16_t cs_fw_ctl_aux(const cs_fw_motion_t *mo, const cs_segment_t *s)
     uint64_t len = path_len(d);
     if (len == 0)
         return 0; /* a dwell or a pen's settle: the beam is off while nothing moves */
+    uint16_t power = sp_scaled(c, c->power);
     if (c->sp_feed <= 0)
-        return c->power;
+        return power;
     uint64_t v = len * mo->m->tick_hz / s->ticks; /* mm/s Q16; len < 2^31, tick_hz < 2^24 */
     if (v >= (uint64_t)c->sp_feed)
-        return c->power;
-    return (uint16_t)((uint64_t)c->power * v / (uint64_t)c->sp_feed);
+        return power;
+    return (uint16_t)((uint64_t)power * v / (uint64_t)c->sp_feed);
+}
+
+bool cs_fw_ctl_overridable(const cs_fw_motion_t *mo)
+{
+    const cs_fw_ctl_t *c = &mo->ctl;
+    return c->op == CS_FW_OP_NONE && !c->jogging && !c->cancel;
+}
+
+void cs_fw_ctl_override(cs_fw_motion_t *mo, uint16_t spindle)
+{
+    cs_fw_ctl_t *c = &mo->ctl;
+    if (spindle == c->sp_ov)
+        return;
+    c->sp_ov = spindle;
+    /* a running spindle (M3/M4, not the laser: its power goes with each segment) at once */
+    if (!c->laser && c->sp_mode != CS_PROTO_SPINDLE_OFF)
+        spindle_out(c, sp_scaled(c, c->power), c->sp_mode, false);
 }
 
 cs_err_t cs_fw_ctl_unlock(cs_fw_motion_t *mo)
@@ -707,6 +733,18 @@ uint16_t cs_fw_ctl_aux(const cs_fw_motion_t *mo, const cs_segment_t *s)
     (void)mo;
     (void)s;
     return 0;
+}
+
+bool cs_fw_ctl_overridable(const cs_fw_motion_t *mo)
+{
+    (void)mo;
+    return true;
+}
+
+void cs_fw_ctl_override(cs_fw_motion_t *mo, uint16_t spindle)
+{
+    (void)mo;
+    (void)spindle;
 }
 
 cs_err_t cs_fw_ctl_unlock(cs_fw_motion_t *mo)

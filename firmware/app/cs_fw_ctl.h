@@ -69,6 +69,7 @@ typedef struct {
     volatile uint16_t duty_set; /* the last duty handed to port_spindle_set */
     uint16_t power;           /* programmed power, 1/1000 */
     int32_t sp_feed;          /* laser: full-power speed, mm/s Q16 (0: constant) */
+    uint16_t sp_ov;           /* spindle override, 1/1000 of the programmed power */
     /* main loop */
     uint8_t alarm; /* 0, or the cs_proto_alarm_t the device is in */
     uint8_t op;    /* cs_fw_op_t */
@@ -132,6 +133,13 @@ void cs_fw_ctl_poll(struct cs_fw_motion_s *mo);
 /* The aux word of segment s for the executor (laser: its duty), computed after a hold re-timed
  * it. Main loop. */
 uint16_t cs_fw_ctl_aux(const struct cs_fw_motion_s *mo, const cs_segment_t *s);
+/* True when the feed override applies to what the executor is fed now: not while homing,
+ * probing or jogging (Grbl leaves those at their own speed). Main loop. */
+bool cs_fw_ctl_overridable(const struct cs_fw_motion_s *mo);
+/* OVERRIDE's spindle scale (1/1000 of the programmed power, the output at most full): a
+ * running spindle is set again at once; the laser's power per segment takes it from the next
+ * segment handed to the executor (the ring's CS_STEPPER_RING segments keep theirs). Main loop. */
+void cs_fw_ctl_override(struct cs_fw_motion_s *mo, uint16_t spindle);
 /* UNLOCK / JOG_CANCEL from the link. Main loop. */
 cs_err_t cs_fw_ctl_unlock(struct cs_fw_motion_s *mo);
 void cs_fw_ctl_jog_cancel(struct cs_fw_motion_s *mo);

@@ -333,8 +333,105 @@ static bool apply_pen(cs_fw_motion_t *a)
     return true;
 }
 
-/* Keeps the executor's ring full; a hold re-times what it hands over and, at rest, keeps the
- * next segment back (cs_hold). A PEN stops the feeding until it is set. */
+/* --- overrides above 100 % ------------------------------------------------------------------
+ * The rule: the scale s may exceed 1 only inside a stretch of segments of one constant speed
+ * (every axis's rate within one step of the stretch's first segment: a cruise, up to the
+ * segments' rounding), never in the first segment of a stretch, and at the end of a segment no
+ * higher than sqrt(1 + 2 R / T), R the job ticks of the same stretch already queued after it:
+ * s can then ramp back to 1 (at cs_hold's slope, s^2 falling 2 tau / T per segment) before the
+ * stretch ends, so the job's own accelerations and junctions always run at s <= 1 (their
+ * planned acceleration or less) and inside the stretch only the ramp accelerates: <= 0.8
+ * max_accel (cs_hold.h). Each axis also stays within its max rate (and one step a tick). */
+#if CS_FW_OV_UP
+/* b runs at a's per-axis rates within one step over b's duration, and both move:
+ * |b_i / b_t - a_i / a_t| <= 1 / b_t, i.e. |b_i a_t - a_i b_t| <= a_t. */
+static bool same_speed(const cs_segment_t *a, const cs_segment_t *b)
+{
+    bool ma = false, mb = false;
+    for (unsigned i = 0; i < CS_AXES; i++) {
+        int64_t x = (int64_t)b->steps[i] * a->ticks - (int64_t)a->steps[i] * b->ticks;
+        if (x > (int64_t)a->ticks || x < -(int64_t)a->ticks)
+            return false;
+        ma = ma || a->steps[i] != 0;
+        mb = mb || b->steps[i] != 0;
+    }
+    return ma && mb;
+}
+
+/* The highest scale at which every axis of s stays within its max rate and one step a tick:
+ * min over axes of r_i x ticks / |steps_i|, r_i = max_rate x steps_per_mm / tick_hz steps a
+ * tick (Q16, at most 1). */
+static uint64_t rate_cap(const cs_fw_motion_t *a, const cs_segment_t *s)
+{
+    uint64_t cap = (uint64_t)CS_HOLD_SCALE_MAX;
+    for (unsigned i = 0; i < a->m->n_axes; i++) {
+        if (s->steps[i] == 0)
+            continue;
+        const cs_axis_cfg_t *ax = &a->m->axis[i];
+        uint64_t r = ((uint64_t)ax->max_rate * (uint64_t)ax->steps_per_mm >> 16) / a->m->tick_hz;
+        if (r > CS_HOLD_SCALE_ONE)
+            r = CS_HOLD_SCALE_ONE;
+        uint64_t n = s->steps[i] < 0 ? (uint64_t)(-(int64_t)s->steps[i]) : (uint64_t)s->steps[i];
+        uint64_t c = r * s->ticks / n;
+        if (c < cap)
+            cap = c;
+    }
+    return cap;
+}
+
+/* R: job ticks of the anchor's stretch queued after the pending segment, counted until they
+ * allow the target (need) or the stretch ends; 0 while the next segments come from the
+ * device's own planner or line generator. */
+static uint64_t stretch_room(const cs_fw_motion_t *a, uint64_t need)
+{
+#if CS_FW_CURVES
+    if (a->tracing || a->gen_busy || cs_planner_count(&a->pl) != 0)
+        return 0;
+#endif
+    uint64_t r = 0;
+    for (uint16_t k = 0; k < a->qcount && r < need; k++) {
+        const cs_fw_item_t *it = &a->q[(a->qhead + k) % CS_FW_QUEUE];
+        if (it->type != CS_PROTO_SEGMENT || !same_speed(&a->ov_anchor, &it->u.seg))
+            break;
+        r += it->u.seg.ticks;
+    }
+    return r;
+}
+
+/* The cap above 1 for the pending segment (>= 1, Q16); *fresh: it starts a new stretch. */
+static uint32_t ov_cap(const cs_fw_motion_t *a, bool *fresh)
+{
+    *fresh = !a->ov_has_anchor || !same_speed(&a->ov_anchor, &a->pend);
+    uint64_t t = a->hold.target;
+    if (*fresh || t <= CS_HOLD_SCALE_ONE)
+        return CS_HOLD_SCALE_ONE;
+    /* ramping from the target down to 1 takes job time T (target^2 - 1) / 2 (cs_hold) */
+    uint64_t one2 = (uint64_t)CS_HOLD_SCALE_ONE * CS_HOLD_SCALE_ONE;
+    uint64_t T = a->hold.ramp_ticks;
+    uint64_t need = (((t * t - one2) >> 16) * T >> 17) + 1u;
+    uint64_t room = stretch_room(a, need);
+    uint64_t brake = cs_fixed_isqrt64(one2 + (room << 33) / T); /* sqrt(1 + 2 R / T), Q16 */
+    uint64_t c = rate_cap(a, &a->pend);
+    if (brake < c)
+        c = brake;
+    return c < CS_HOLD_SCALE_ONE ? CS_HOLD_SCALE_ONE : (uint32_t)c;
+}
+#endif
+
+/* The scale the pending segment aims at (cs_hold_admit_to's goal); *fresh as ov_cap. */
+static uint32_t ov_goal(const cs_fw_motion_t *a, bool *fresh)
+{
+    bool ov = cs_fw_ctl_overridable(a);
+#if CS_FW_OV_UP
+    return cs_hold_goal(&a->hold, ov, ov_cap(a, fresh));
+#else
+    *fresh = false;
+    return cs_hold_goal(&a->hold, ov, CS_HOLD_SCALE_ONE);
+#endif
+}
+
+/* Keeps the executor's ring full; a hold or an override re-times what it hands over and, at
+ * rest, keeps the next segment back (cs_hold). A PEN stops the feeding until it is set. */
 static void feed(cs_fw_motion_t *a)
 {
     a->more = false;
@@ -347,8 +444,15 @@ static void feed(cs_fw_motion_t *a)
             a->has_pend = true;
         }
         cs_segment_t orig = a->pend;
-        if (!cs_hold_admit(&a->hold, &a->pend))
+        bool fresh;
+        if (!cs_hold_admit_to(&a->hold, &a->pend, ov_goal(a, &fresh)))
             break;
+#if CS_FW_OV_UP
+        if (fresh) {
+            a->ov_anchor = orig;
+            a->ov_has_anchor = true;
+        }
+#endif
         a->has_pend = false;
         push_segment(a, &a->pend, &orig, a->pend_done);
     }
@@ -463,9 +567,20 @@ void cs_fw_motion_hold(cs_fw_motion_t *a, bool on)
     a->news = true;
 }
 
+void cs_fw_motion_override(cs_fw_motion_t *a, const cs_proto_override_t *ov)
+{
+    /* Q16 = per-mille x 65536 / 1000, rounded (below 2^31: feed <= CS_PROTO_OVERRIDE_MAX) */
+    cs_hold_override(&a->hold, ((uint32_t)ov->feed * CS_HOLD_SCALE_ONE + 500u) /
+                                   CS_PROTO_OVERRIDE_ONE);
+    cs_fw_ctl_override(a, ov->spindle);
+}
+
 void cs_fw_motion_flush(cs_fw_motion_t *a)
 {
     a->has_pend = false;
+#if CS_FW_OV_UP
+    a->ov_has_anchor = false;
+#endif
     a->pen_wait = false;
     cs_fw_ctl_line_stop(a);
 #if CS_FW_CURVES
@@ -505,8 +620,16 @@ void cs_fw_motion_give_back(cs_fw_motion_t *a)
         a->popped = keep;
 }
 
+/* ABORT, a reboot: no override. */
+static void override_reset(cs_fw_motion_t *a)
+{
+    cs_hold_override(&a->hold, CS_HOLD_SCALE_ONE);
+    cs_fw_ctl_override(a, CS_PROTO_OVERRIDE_ONE);
+}
+
 void cs_fw_motion_abort(cs_fw_motion_t *a)
 {
+    override_reset(a);
     cs_fw_ctl_abort(a);
     cs_fw_motion_drop(a);
     a->aborted = true;
@@ -534,6 +657,7 @@ void cs_fw_motion_reboot(cs_fw_motion_t *a)
     /* a rebooted device knows neither the job nor where the machine is */
     a->job_flags = 0;
     a->job_id = a->job_base = 0;
+    override_reset(a);
 }
 
 uint32_t cs_fw_motion_job_no(const cs_fw_motion_t *a, uint32_t item)
@@ -577,6 +701,9 @@ cs_err_t cs_fw_motion_setpos(cs_fw_motion_t *a, const cs_proto_setpos_t *sp)
     a->job_id = sp->job_id;
     a->job_base = sp->base;
     a->job_item0 = a->popped + a->qcount; /* the next item received is base + 1 */
+    /* a new job runs as planned (the spindle's override stays: a running spindle keeps its
+     * power from one job to the next) */
+    cs_hold_override(&a->hold, CS_HOLD_SCALE_ONE);
     a->job_flags |= CS_PROTO_STATUS_JOB;
     a->news = true;
     return CS_OK;

@@ -38,6 +38,13 @@
 
 #include "cs_fw_ctl.h"
 
+/* 1: an override above 100 % acts on the segments already queued (the stretch tracking below
+ * costs a segment of RAM); 0 (builds without the planner: the ATmega328p's): the device's
+ * scale stays at or below 1, an override above 100 % acts from the next plan only. */
+#ifndef CS_FW_OV_UP
+#define CS_FW_OV_UP CS_FW_CURVES
+#endif
+
 #if CS_FW_CURVES
 #include "cs_planner.h"
 #include "cs_trace.h"
@@ -120,6 +127,11 @@ typedef struct cs_fw_motion_s {
     uint8_t tag[CS_FW_TAGS]; /* low 8 bits (items in flight: fewer than CS_FW_SEQMAP <= 128) */
     uint8_t pushed, completed;     /* segments pushed / known complete, mod 256 */
     cs_hold_t hold;
+#if CS_FW_OV_UP
+    /* the first segment of the stretch of constant speed the executor is in (override > 1) */
+    cs_segment_t ov_anchor;
+    bool ov_has_anchor;
+#endif
     cs_segment_t pend; /* produced, held back by a hold at rest */
     uint32_t pend_done;
     bool has_pend;
@@ -183,6 +195,11 @@ cs_err_t cs_fw_motion_init(cs_fw_motion_t *mo, const cs_machine_t *m, const cs_f
 cs_err_t cs_fw_motion_queue(cs_fw_motion_t *mo, const cs_proto_msg_t *msg, uint16_t seq);
 /* HOLD (on: decelerate along the path to rest, cs_hold) or RESUME (off: from rest). */
 void cs_fw_motion_hold(cs_fw_motion_t *mo, bool on);
+/* OVERRIDE: the queued motion's speed ramps (cs_hold's slope) to feed / 1000 of its planned
+ * speed, above 1 only inside stretches of constant speed and below each axis's max rate
+ * (docs/controller.md, "Overrides"); the spindle to spindle / 1000 of its programmed power
+ * (cs_fw_ctl). Fields as checked by cs_proto. Main loop. */
+void cs_fw_motion_override(cs_fw_motion_t *mo, const cs_proto_override_t *ov);
 /* ABORT: the queue and everything not yet in the executor's ring are dropped (the ring, at most
  * CS_STEPPER_RING segments, finishes), the hold is released. */
 void cs_fw_motion_abort(cs_fw_motion_t *mo);

@@ -100,6 +100,13 @@ static cs_err_t check_ctl(const cs_proto_msg_t *m)
                   p->power <= CS_PROTO_SPINDLE_FULL && p->feed >= 0;
         return ok ? CS_OK : CS_ERR_RANGE;
     }
+    case CS_PROTO_OVERRIDE: {
+        const cs_proto_override_t *o = &m->u.override;
+        bool ok = o->feed >= 1 && o->feed <= CS_PROTO_OVERRIDE_MAX && o->rapid >= 1 &&
+                  o->rapid <= CS_PROTO_OVERRIDE_MAX && o->spindle >= 1 &&
+                  o->spindle <= CS_PROTO_OVERRIDE_MAX;
+        return ok ? CS_OK : CS_ERR_RANGE;
+    }
     case CS_PROTO_JOG_CANCEL:
     case CS_PROTO_UNLOCK:
         return CS_OK;
@@ -201,6 +208,8 @@ static size_t msg_len(uint8_t type, uint8_t axes)
         return CS_PROTO_LEN_PROBE;
     case CS_PROTO_SPINDLE:
         return CS_PROTO_LEN_SPINDLE;
+    case CS_PROTO_OVERRIDE:
+        return CS_PROTO_LEN_OVERRIDE;
     default:
         return 0;
     }
@@ -283,6 +292,11 @@ static void encode_ctl(const cs_proto_msg_t *m, uint8_t *buf)
         put16(buf + 3, m->u.spindle.power);
         puti32(buf + 5, m->u.spindle.feed);
         break;
+    case CS_PROTO_OVERRIDE:
+        put16(buf + 1, m->u.override.feed);
+        put16(buf + 3, m->u.override.rapid);
+        put16(buf + 5, m->u.override.spindle);
+        break;
     default: /* JOG_CANCEL, UNLOCK: the type byte is the whole message */
         break;
     }
@@ -322,6 +336,11 @@ static void decode_ctl(const uint8_t *buf, cs_proto_msg_t *m)
         m->u.spindle.flags = buf[2];
         m->u.spindle.power = get16(buf + 3);
         m->u.spindle.feed = geti32(buf + 5);
+        break;
+    case CS_PROTO_OVERRIDE:
+        m->u.override.feed = get16(buf + 1);
+        m->u.override.rapid = get16(buf + 3);
+        m->u.override.spindle = get16(buf + 5);
         break;
     default:
         break;

@@ -42,6 +42,7 @@ typedef enum {
     CS_PROTO_PROBE = 0x29,      /* straight move that stops when the probe input changes */
     CS_PROTO_SPINDLE = 0x2A,    /* spindle / laser output, in queue order */
     CS_PROTO_UNLOCK = 0x2B,     /* leave the alarm state */
+    CS_PROTO_OVERRIDE = 0x2E,   /* feed / rapid / spindle overrides, acting on the running motion */
 } cs_proto_type_t;
 
 /* Payload sizes in bytes (n = number of axes a status carries, 1..CS_PROTO_AXES_MAX). */
@@ -60,6 +61,7 @@ typedef enum {
 #define CS_PROTO_LEN_JOG       17
 #define CS_PROTO_LEN_PROBE     18
 #define CS_PROTO_LEN_SPINDLE   9
+#define CS_PROTO_LEN_OVERRIDE  7
 #define CS_PROTO_LEN_MAX       CS_PROTO_LEN_CURVE
 
 /* ACK flags. */
@@ -240,6 +242,21 @@ typedef struct {
     int32_t feed;   /* mm/s Q15.16, >= 0: laser mode's speed of full power (0: constant) */
 } cs_proto_spindle_t;
 
+/* OVERRIDE: scales in 1/1000 (CS_PROTO_OVERRIDE_ONE = as planned / as programmed), each
+ * 1..CS_PROTO_OVERRIDE_MAX. feed: the speed of the motion the device holds, relative to its
+ * planned speed (the host plans what it sends next at its own override: it sends the ratio);
+ * rapid: carried for a device that marks rapid segments (this one does not: its step segments
+ * carry no class, so every step takes `feed`); spindle: the spindle / laser power relative to
+ * the programmed one (absolute). Takes no queue slot, acts at once; SETPOS puts feed and rapid
+ * back to ONE, ABORT and a reboot every scale (docs/protocol.md, OVERRIDE). */
+#define CS_PROTO_OVERRIDE_ONE 1000u
+#define CS_PROTO_OVERRIDE_MAX 20000u
+typedef struct {
+    uint16_t feed;
+    uint16_t rapid;
+    uint16_t spindle;
+} cs_proto_override_t;
+
 typedef struct {
     uint8_t type; /* cs_proto_type_t */
     union {
@@ -257,6 +274,7 @@ typedef struct {
         cs_proto_jog_t jog;
         cs_proto_probe_t probe;
         cs_proto_spindle_t spindle;
+        cs_proto_override_t override;
     } u; /* none for HOLD, RESUME, ABORT, JOG_CANCEL, UNLOCK, QUERY */
 } cs_proto_msg_t;
 

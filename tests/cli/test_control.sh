@@ -10,7 +10,8 @@
 #    z = -4 mm, within one step (1/80 mm); G38.3 (--no-error) above the surface: no contact,
 #    exit 0; G38.2 there: ALARM:5, exit 7.
 #  - a jog into the x max switch (device -45 mm): ALARM:1 naming the switch (inputs 0x010),
-#    stopped exactly there; the next jog refused (exit 7); `unlock` (exit 0); a jog back runs.
+#    stopped exactly there; the next jog refused (exit 7); `unlock` (exit 0); a jog back runs;
+#    `curvestep stream` into the same switch: exit 7 and a located ALARM line.
 #  - the e-stop (SIGUSR1 to the simulator): unlock refused while pressed, accepted after
 #    SIGUSR2.
 #  - laser mode (S 800, full power from 20 mm/s) during a 40 mm/s jog: the largest duty the
@@ -79,6 +80,18 @@ expect "unlock: exit 0 (got $rc)" [ $rc -eq 0 ]
 ctl jog --feed 50 -- -60 0 -1 >"$T/back.out" 2>&1; rc=$?
 expect "jog back after unlock: exit 0 (got $rc)" [ $rc -eq 0 ]
 expect "jog back: at -60" grep -q '^jog: machine position -60.0000 0.0000 -1.0000 mm$' "$T/back.out"
+
+# 3b. `curvestep stream` into the same switch (it plans from 0: +20 mm from device -60 crosses
+# the switch at device -45): exit 7 and a line naming the alarm, the switch, the segment and
+# where the device stopped (-45 x 80 = -3600 steps, z -1 mm = -80); unlock.
+printf '%s\n' 'G21 G90' 'G1 X20 F1200' >"$T/x20.nc"
+timeout -k 5 120 "$CS" stream --port "$PTY" --machine "$MC" "$T/x20.nc" >"$T/st.out" 2>&1; rc=$?
+expect "stream into the switch: exit 7 (got $rc)" [ $rc -eq 7 ]
+expect "stream: ALARM:1 located (switch, segment, position)" grep -qE \
+    '^stream: ALARM:1 \(hard limit: a limit switch tripped\): x max switch, during segment no\. [1-9][0-9]*; stopped at x -3600 y 0 z -80 steps$' \
+    "$T/st.out"
+ctl unlock >/dev/null 2>&1; rc=$?
+expect "unlock after the stream's alarm: exit 0 (got $rc)" [ $rc -eq 0 ]
 
 # 4. e-stop (to the simulator itself: `timeout` would die of SIGUSR1)
 DEVPID=$(pgrep -P "$SIMPID" -x curvestep-sim)

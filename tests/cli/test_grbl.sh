@@ -335,6 +335,27 @@ expect "blend: the rapid runs with the laser off" grep -qx 'rapid lit 0' "$T/ble
 expect "blend: the picture draws the laser power, its width following the duty" \
     [ "$(grep -o 'class="power"[^>]*stroke-width="[0-9.]*"' "$T/blend.svg" | sed 's/.*stroke-width=//' | sort -u | wc -l)" -ge 10 ]
 
+# 11. feed override on the running chunk: a 4 s straight cut at 1200 mm/min (real time), 0x91
+#     (+10 %) once it runs; the device's reported feed (FS:, from its STATUS positions) rises by
+#     10 % (within 4 %) while the same chunk still runs (reports in Run from 0.6 s after the
+#     byte), Ov shows 110, and the final position is exact (the check also bounds the acceleration).
+printf '%s\n' 'G21 G90' 'G1 X80 F1200' >"$T/ov.nc"
+start_sim ov --speed 1 --reference "$T/ov.nc" --check
+start_grbl ov
+client "$GPTY" override "$T/ov.nc" 91 >"$T/ov.out"; rc=$?
+stop_all
+ov_before=$(sed -n 's/^before: //p' "$T/ov.out")
+ov_after=$(sed -n 's/^after: //p' "$T/ov.out")
+expect "ov: client exit 0" [ $rc -eq 0 ]
+expect "ov: feed before near 1200 mm/min ($ov_before)" awk -v b="$ov_before" 'BEGIN {exit !(b > 1100 && b < 1300)}'
+expect "ov: reports in Run after the byte" grep -qE '^after-reports: [1-9]' "$T/ov.out"
+expect "ov: feed x 1.10 +- 0.04 mid-chunk ($ov_before -> $ov_after)" \
+    awk -v b="$ov_before" -v a="$ov_after" 'BEGIN {exit !(b > 0 && a / b > 1.06 && a / b < 1.14)}'
+expect "ov: Ov:110,100,100" grep -q '^ov: 110,100,100$' "$T/ov.out"
+expect "ov: ends Idle at X80" grep -q '^final: <Idle|MPos:80.000,0.000,0.000|' "$T/ov.out"
+expect "ov: device check ok" grep -q '^check: ok$' "$T/ov.sim"
+expect "ov: final position exact" grep -q 'rounded to steps: exact' "$T/ov.sim"
+
 # 7. usage.
 run "help: exit 0" 0 grbl --help
 expect "help: names --listen and the pty" grep -q -- '--listen \[ADDR:\]PORT' "$T/out"

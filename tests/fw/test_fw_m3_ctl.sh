@@ -10,8 +10,9 @@
 #  - `curvestep probe` down to z = -10: contact at pin z -240, device z -4 mm;
 #  - a jog into the x max switch: ALARM:1 with the x max bit (0x010), stopped at pin x 4000
 #    (device -45 mm); `unlock`; a jog back to -60 mm (pins 2800);
-#  - `curvestep spindle --ccw 250`: the port's PWM last set to duty 250/1000, mode 2 (the alarm
-#    and `unlock` set it off before).
+#  - `curvestep spindle --ccw 250`, then `curvestep grbl` on the same port: M4 S250 and the
+#    spindle override +10 % (0x9A, the OVERRIDE message) during a 5 mm move (pins x 3200):
+#    the port's PWM last set to duty 275/1000, mode 2 (the alarm and `unlock` set it off).
 # Every process is bounded by `timeout`. Prints "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/m3.sh" x_min=-400 x_max=4000 z_max=160 probe_z=-240
@@ -47,12 +48,25 @@ ctl jog --feed 50 -- -60 0 -1 >"$T/back.out" 2>&1; rc=$?
 expect "jog back: exit 0 (got $rc)" [ $rc -eq 0 ]
 ctl spindle --ccw 250 >"$T/sp.out" 2>&1; rc=$?
 expect "spindle M4 S250: exit 0 (got $rc)" [ $rc -eq 0 ]
+# the OVERRIDE message on the image: `curvestep grbl` on the same port, M4 S250 and a 5 mm move
+# at 100 mm/min (3 s), Grbl's spindle +10 % (0x9A) during it: the image sets 250 x 1.1 = 275
+timeout -k 5 120 "$CS" grbl --port "$FPTY" --machine "$MC" >"$T/g.grbl" 2>"$T/g.err" &
+GP=$!
+pids+=("$GP")
+wait_pty "$T/g.grbl" 60
+gc() { timeout -k 5 90 python3 tests/support/grbl_client.py "$PTY" "$@"; }
+printf '%s\n' 'M4 S250' 'G91 G1 X5 F100' >"$T/g.nc"
+gc override "$T/g.nc" 9a >"$T/g1.out" 2>&1
+kill -TERM "$GP" 2>/dev/null
+wait "$GP" 2>/dev/null
+expect "grbl: Ov:100,100,110 after 0x9A" grep -q '^ov: 100,100,110$' "$T/g1.out"
+expect "grbl: idle 5 mm further" grep -q '^final: <Idle|MPos:-55.000,0.000,-1.000|' "$T/g1.out"
 kill -TERM "$QPID" 2>/dev/null
 wait_until 60 gone "$QPID"
 expect "image: control line" grep -q '^fw: control: 2 axes homed, [1-9] alarms (now 0), 1 probe cycles' \
     "$T/fw.out"
-expect "image: spindle last set to duty 250/1000, counter-clockwise" \
-    grep -qE '; spindle: [0-9]+ settings, last duty 250 mode 2$' "$T/fw.out"
-expect "image: STEP/DIR pins at (2800, 0, 0)" \
-    grep -q '^fw: position (STEP/DIR pins): x=2800 y=0 z=0$' "$T/fw.out"
+expect "image: spindle last set to duty 275/1000 (S250 +10 %), counter-clockwise" \
+    grep -qE '; spindle: [0-9]+ settings, last duty 275 mode 2$' "$T/fw.out"
+expect "image: STEP/DIR pins at (3200, 0, 0) (the jog back, then 5 mm x 80)" \
+    grep -q '^fw: position (STEP/DIR pins): x=3200 y=0 z=0$' "$T/fw.out"
 finish

@@ -17,9 +17,14 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
                   "@waitfor STATE" is not sent: it waits as waitfor does
   jogcancel LINE  sends the $J= LINE, waits for the Jog state, sends 0x85 and prints
                   "jogging: <...>" and "final: <...>" once Idle
+  reset LINE      sends LINE, waits for Run with the position moved, sends Ctrl-X and prints
+                  "moving: <...>" and "final: <...>" once Idle
   idle            (no soft reset first) waits for Idle, prints "final: <...>"
   waitfor STATE   (no soft reset first) waits for the state STATE (Alarm, Idle...), prints
                   the pushed lines seen meanwhile (ALARM:N...) and "state: <...>"
+  override FILE BYTE  writes FILE's lines (< 128 bytes) at once, sends the real-time BYTE (hex)
+                  mid-job and prints the median FS: feed before and after it ("before: F",
+                  "after: F", "after-reports: N" taken in Run), the Ov field and "final: <...>"
   raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
                   (the first line within the deadline, then lines until 1 s without one)
 Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
@@ -240,6 +245,48 @@ def stream(g, lines, method, hold_after, status_every):
     print("acks: %d %d" % (acks["ok"], acks["err"]), flush=True)
 
 
+def feed_of(st):
+    """The FS: feed of a status report (mm/min), or None."""
+    for f in st.strip("<>").split("|"):
+        if f.startswith("FS:"):
+            return float(f[3:].split(",")[0])
+    return None
+
+
+def override_mid_job(g, lines, byte):
+    """Streams lines by character counting, then polls ? every 0.1 s: once 6 reports in Run
+    show a feed, sends the override byte; prints "before: F" and "after: F" (medians, mm/min;
+    after: the reports from 0.6 s after the byte while still in Run), "after-reports: N",
+    the Ov field seen after the byte, and the final report."""
+    data = b"".join((line + "\n").encode() for line in lines)
+    g.write(data)
+    end = time.monotonic() + g.deadline
+    before, after, ov, t_byte = [], [], None, None
+    while time.monotonic() < end:
+        st = g.status()
+        f = feed_of(st)
+        now = time.monotonic()
+        if st.startswith("<Run") and f:
+            if t_byte is None:
+                before.append(f)
+                if len(before) >= 6:
+                    g.write(bytes([byte]))
+                    t_byte = now
+            elif now - t_byte >= 0.6:
+                after.append(f)
+        if t_byte is not None and "|Ov:" in st:
+            ov = st.split("|Ov:")[1].rstrip(">")
+        if st.startswith("<Idle") and t_byte is not None:
+            break
+        time.sleep(0.1)
+    med = lambda v: sorted(v)[len(v) // 2] if v else 0.0
+    print("before: %.1f" % med(before[2:]), flush=True)
+    print("after: %.1f" % med(after), flush=True)
+    print("after-reports: %d" % len(after), flush=True)
+    print("ov: %s" % ov, flush=True)
+    print("final: " + wait_idle(g), flush=True)
+
+
 def main(argv):
     deadline = 60.0
     if "--deadline" in argv:
@@ -277,6 +324,21 @@ def main(argv):
                 print(reply, flush=True)
                 if is_ack(reply):
                     break
+    elif cmd == "reset":  # Ctrl-X mid-move: the machine stops, the rest is dropped
+        g.write((argv[3] + "\n").encode())
+        print("reply: " + g.need(), flush=True)
+        first = None
+        end = time.monotonic() + deadline
+        while time.monotonic() < end:
+            st = g.status()
+            pos = st.split("|")[1]
+            first = first or pos
+            if st.startswith("<Run") and pos != first:
+                print("moving: " + st, flush=True)
+                break
+            time.sleep(0.05)
+        g.write(b"\x18")
+        print("final: " + wait_idle(g), flush=True)
     elif cmd == "jogcancel":
         g.write((argv[3] + "\n").encode())
         print("reply: " + g.need(), flush=True)
@@ -289,6 +351,8 @@ def main(argv):
             time.sleep(0.05)
         g.write(b"\x85")
         print("final: " + wait_idle(g), flush=True)
+    elif cmd == "override":  # override FILE BYTE: the byte (hex) mid-job, the feed before/after
+        override_mid_job(g, program(argv[3]), int(argv[4], 16))
     elif cmd == "raw":
         for b in argv[3:]:
             g.write(bytes([int(b, 16)]))

@@ -4,8 +4,8 @@
  * max_accel), each segment's speed must fall and lie on the line of the ramp (slope 0.8 max_accel)
  * at its midpoint, within the rounding to whole ticks, the stop must come at rest (the last
  * segment at most the mean speed of a ramp through one segment), the steps are never touched;
- * then the resume mirrors it up to full speed. Plus the no-hold path (segments untouched) and the
- * machine checks. */
+ * then the resume mirrors it up to full speed. Plus the no-hold path (segments untouched), an
+ * override's goal above and below full speed, and the machine checks. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -122,6 +122,54 @@ static void test_hold_then_resume(void **state)
     assert_false(cs_hold_active(&h));
 }
 
+/* An override's goal (cs_hold_admit_to, no hold): from full speed up to 1.5 then down to 0.5,
+ * each segment's speed on the ramp's line (slope 200 mm/s / T) at its midpoint within the tick
+ * rounding, then steady at 300 and 100 mm/s (ticks 500 / 1.5 and 500 / 0.5, rounded up); the
+ * ramp to 1.5 takes (1.5^2 - 1) T / 2 of job time (the area under s). A goal of 20 stops at one
+ * step a tick (the executor's invariant). */
+static void test_override_goal(void **state)
+{
+    (void)state;
+    cs_hold_t h;
+    assert_int_equal(cs_hold_init(&h, &machine), CS_OK);
+    const double T = 1.25 * 0.2, slope = 200.0 / T;
+    const double goal[] = {1.5, 0.5};
+    double v0 = 200.0;
+    for (int g = 0; g < 2; g++) {
+        uint32_t q = (uint32_t)lround(goal[g] * CS_HOLD_SCALE_ONE);
+        double t = 0, job = 0, v = 0, v1 = 200.0 * goal[g];
+        int k = 0;
+        for (; k < 1000; k++) {
+            cs_segment_t s = seg();
+            assert_true(cs_hold_admit_to(&h, &s, q));
+            assert_int_equal(s.steps[0], SEG_STEPS);
+            double d = (double)s.ticks / machine.tick_hz, mid = t + d / 2;
+            v = speed(&s);
+            double ideal = v0 + (v1 > v0 ? slope : -slope) * mid;
+            if (v1 > v0 ? ideal < v1 : ideal > v1)
+                assert_true(fabs(v - ideal) <= v / (double)s.ticks + 0.5);
+            t += d;
+            job += (double)SEG_TICKS / machine.tick_hz;
+            if (h.scale == q)
+                break;
+        }
+        if (g == 0) /* (s1^2 - s0^2) T / 2 of job time, within one segment */
+            assert_true(fabs(job - (1.5 * 1.5 - 1) * T / 2) <= 0.005 + 1e-9);
+        cs_segment_t s = seg();
+        assert_true(cs_hold_admit_to(&h, &s, q));
+        assert_int_equal(s.ticks, (uint32_t)ceil(SEG_TICKS / goal[g] - 1e-9));
+        v0 = v1;
+    }
+    for (int k = 0; k < 2000; k++) {
+        cs_segment_t s = seg();
+        assert_true(cs_hold_admit_to(&h, &s, CS_HOLD_SCALE_MAX));
+        assert_true(s.ticks >= SEG_STEPS);
+    }
+    cs_segment_t s = seg();
+    assert_true(cs_hold_admit_to(&h, &s, CS_HOLD_SCALE_MAX));
+    assert_int_equal(s.ticks, SEG_STEPS);
+}
+
 static void test_reset_and_bad_machine(void **state)
 {
     (void)state;
@@ -146,6 +194,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_no_hold_untouched, setup),
         cmocka_unit_test_setup(test_hold_then_resume, setup),
+        cmocka_unit_test_setup(test_override_goal, setup),
         cmocka_unit_test_setup(test_reset_and_bad_machine, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

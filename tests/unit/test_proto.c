@@ -190,7 +190,7 @@ static void test_unknown_types_and_empty_payload(void **state)
 {
     (void)state;
     const uint8_t known[] = {0x01, 0x02, 0x10, 0x11, 0x12, 0x13, 0x20, 0x21, 0x22, 0x23, 0x24,
-                             0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B, 0x2C, 0x2D};
+                             0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B, 0x2C, 0x2D, 0x2E};
     uint8_t buf[CS_PROTO_LEN_MAX] = {0};
     cs_proto_msg_t m;
     unsigned unknown = 0;
@@ -686,6 +686,36 @@ static void test_spindle_and_short_layout(void **state)
     assert_false(cs_proto_state_busy(CS_PROTO_STATE_IDLE));
 }
 
+/* OVERRIDE feed 1100/1000 (0x044C), rapid 500 (0x01F4), spindle 20000 (0x4E20); 0 and 20001
+ * refused; no queue slot. */
+static void test_override_layout(void **state)
+{
+    (void)state;
+    cs_proto_msg_t m = {0};
+    m.type = CS_PROTO_OVERRIDE;
+    m.u.override = (cs_proto_override_t){1100, 500, 20000};
+    const uint8_t w[] = {0x2E, 0x4C, 0x04, 0xF4, 0x01, 0x20, 0x4E};
+    assert_int_equal(sizeof w, CS_PROTO_LEN_OVERRIDE);
+    expect_encoding(&m, w, sizeof w);
+    assert_false(cs_proto_uses_slot(CS_PROTO_OVERRIDE));
+    assert_true(cs_proto_sequenced(CS_PROTO_OVERRIDE));
+    for (unsigned f = 0; f < 3; f++) {
+        for (unsigned k = 0; k < 2; k++) {
+            uint8_t r[sizeof w];
+            memcpy(r, w, sizeof w);
+            cs_proto_msg_t bad = m;
+            uint16_t v = k == 0 ? 0 : (uint16_t)(CS_PROTO_OVERRIDE_MAX + 1u);
+            uint16_t *field = f == 0 ? &bad.u.override.feed
+                              : f == 1 ? &bad.u.override.rapid
+                                       : &bad.u.override.spindle;
+            *field = v;
+            r[1 + 2 * f] = (uint8_t)(v & 0xFFu);
+            r[2 + 2 * f] = (uint8_t)(v >> 8);
+            expect_range(&bad, r, sizeof r);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -704,6 +734,7 @@ int main(void)
         cmocka_unit_test(test_home_layout),
         cmocka_unit_test(test_jog_probe_layout),
         cmocka_unit_test(test_spindle_and_short_layout),
+        cmocka_unit_test(test_override_layout),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
