@@ -3,7 +3,8 @@
  * --scallop H --tol T --check` runs it (issue 20): the mesh (cs_dropcut_build), the raster with
  * its scallop refinement and the links (cs_dcpath), and the independent check (cs_dropcheck),
  * each timed in CPU seconds of this process, the plan also in wall seconds, with the load average
- * before and after (the machine is shared: wall time says more about the neighbours). The headline is H 0.05 mm, tol 0.01 mm with the check; then the plan alone at
+ * before and after (the machine is shared: wall time says more about the neighbours). The
+ * headline is H 0.05 mm, tol 0.01 mm with the check; then the plan alone at
  * two more scallop heights and two more tolerances, for how the time grows with 1/H and 1/tol.
  * Writes argv[1] (CSV) and prints a Markdown section. */
 #include <math.h>
@@ -130,7 +131,8 @@ int main(int argc, char **argv)
            "(issue 20 item 4; the same path: same passes, points and drops), and the first row "
            "672 s before the grid's branch-and-bound and the pruned check.\n\n"
            "| H (mm) | tol (mm) | triangles | passes | points | drops | retracts | mesh (s) | "
-           "plan (s) | plan wall (s) | check (s) | gouge (mm) | scallop (mm) | unreachable (mm²) |\n"
+           "plan (s) | plan wall (s) | check (s) | gouge (mm) | scallop (mm) | "
+           "unreachable (mm²) |\n"
            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
            load0, load_end);
     for (size_t k = 0; k < nr; k++) {

@@ -386,10 +386,14 @@ static void nearest_xy(const double t[3][3], double x, double y, double *d, doub
         const double *a = t[i], *b = t[(i + 1) % 3];
         s[i] = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
     }
-    double det = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
-    if (fabs(det) > 1e-9 && ((s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0))) {
-        double u = ((x - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (y - t[0][1])) / det;
-        double v = ((t[1][0] - t[0][0]) * (y - t[0][1]) - (x - t[0][0]) * (t[1][1] - t[0][1])) / det;
+    double det =
+        (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+    if (fabs(det) > 1e-9 &&
+        ((s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0))) {
+        double u =
+            ((x - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (y - t[0][1])) / det;
+        double v =
+            ((t[1][0] - t[0][0]) * (y - t[0][1]) - (x - t[0][0]) * (t[1][1] - t[0][1])) / det;
         *d = 0;
         *z = t[0][2] + u * (t[1][2] - t[0][2]) + v * (t[2][2] - t[0][2]);
         return;
@@ -446,7 +450,8 @@ static double ref_flat(const double (*tri)[3][3], size_t n, double r, double x, 
             if (hypot(a[0] - x, a[1] - y) <= r)
                 best = fmax(best, a[2]);
             double ax = a[0] - x, ay = a[1] - y, bx = b[0] - a[0], by = b[1] - a[1];
-            double qa = bx * bx + by * by, qb = 2 * (ax * bx + ay * by), qc = ax * ax + ay * ay - r * r;
+            double qa = bx * bx + by * by, qb = 2 * (ax * bx + ay * by),
+                   qc = ax * ax + ay * ay - r * r;
             double disc = qb * qb - 4 * qa * qc;
             for (int sg = -1; qa > 0 && disc >= 0 && sg <= 1; sg += 2) {
                 double f = (-qb + sg * sqrt(disc)) / (2 * qa);
@@ -457,7 +462,8 @@ static double ref_flat(const double (*tri)[3][3], size_t n, double r, double x, 
         double u[3], v[3];
         sub3(t[1], t[0], u);
         sub3(t[2], t[0], v);
-        double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
         if (fabs(nrm[2]) < 1e-9 * sqrt(dot3(nrm, nrm)))
             continue; /* vertical: its edges hold the maximum */
         double gx = -nrm[0] / nrm[2], gy = -nrm[1] / nrm[2], gl = hypot(gx, gy), d, z;
