@@ -388,7 +388,7 @@ cs_err_t cs_dropcut_index(cs_dropcut_mesh_t *ms, double rmax_mm)
 {
     if (ms->ntri == 0)
         return CS_ERR_DEGENERATE;
-    if (ms->ntri > UINT32_MAX)
+    if ((uint64_t)ms->ntri > UINT32_MAX) /* a cell entry holds the number in 32 bits */
         return CS_ERR_FULL;
     double w = ms->box[3] - ms->box[0], h = ms->box[4] - ms->box[1];
     /* Cells of about DC_CELL_TRIS triangles' area (a query stops early in each: its list is
