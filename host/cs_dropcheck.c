@@ -232,6 +232,18 @@ static cs_err_t bucket(ck_t *k, double cell)
     for (size_t c = nc; c > 0; c--)
         k->start[c] = k->start[c - 1];
     k->start[0] = 0;
+    /* The samples in cell order (a cell's samples contiguous in memory: the queries read them
+     * cell by cell), so that idx is the identity. */
+    double(*sorted)[3] = malloc((k->ns + 1) * sizeof *sorted);
+    if (!sorted)
+        return CS_ERR_FULL;
+    for (size_t m = 0; m < k->ns; m++) {
+        memcpy(sorted[m], k->s[k->idx[m]], sizeof *sorted);
+        k->idx[m] = m;
+    }
+    free(k->s);
+    k->s = sorted;
+    k->scap = k->ns + 1;
     return CS_OK;
 }
 
@@ -242,6 +254,21 @@ static double cell_dist(const ck_t *k, long cx, long cy, double x, double y)
     double dx = x < x0 ? x0 - x : x > x0 + k->cell ? x - x0 - k->cell : 0;
     double dy = y < y0 ? y0 - y : y > y0 + k->cell ? y - y0 - k->cell : 0;
     return sqrt(dx * dx + dy * dy);
+}
+
+/* A lower bound on the profile h(d) of tool t from d^2, without the profile's square roots: on the
+ * corner arc (e = d - (R - r) > 0) h = r - sqrt(r^2 - e^2) = e^2 / (r + sqrt(r^2 - e^2)) >=
+ * e^2 / (2 r); 0 on the flat bottom. A sample that stands no higher above the tip than this
+ * cannot be deeper inside the cutter than the deepest found (nor raise a drop). */
+static double profile_lb(const cs_dropcut_tool_t *t, double d2)
+{
+    double a = t->r_mm - t->c_mm;
+    if (t->c_mm <= 0)
+        return 0;
+    if (a <= 0)
+        return d2 / (2 * t->c_mm);
+    double e = sqrt(d2) - a;
+    return e > 0 ? e * e / (2 * t->c_mm) : 0;
 }
 
 /* One cutter position's deepest penetration: the samples within R, cell by cell; a cell whose
@@ -261,7 +288,7 @@ static void visit_gouge(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], 
             for (size_t m = k->start[c]; m < k->start[c + 1]; m++) {
                 const double *s = k->s[k->idx[m]];
                 double dx = s[0] - p[0], dy = s[1] - p[1], d2 = dx * dx + dy * dy;
-                if (d2 > r * r || s[2] - p[2] <= o->gouge_mm)
+                if (d2 > r * r || s[2] - p[2] - profile_lb(t, d2) <= o->gouge_mm)
                     continue;
                 double pen = s[2] - (p[2] + cs_dropcut_profile(t, sqrt(d2)));
                 if (pen > o->gouge_mm) {
@@ -346,6 +373,16 @@ static cs_err_t bucket_tips(ck_t *k)
         k->pstart[c] = k->pstart[c - 1];
     k->pstart[0] = 0;
     free(cell);
+    double(*sorted)[3] = malloc((k->np + 1) * sizeof *sorted); /* in cell order, as bucket() */
+    if (!sorted)
+        return CS_ERR_FULL;
+    for (size_t m = 0; m < k->np; m++) {
+        memcpy(sorted[m], k->p[k->pidx[m]], sizeof *sorted);
+        k->pidx[m] = m;
+    }
+    free(k->p);
+    k->p = sorted;
+    k->pcap = k->np + 1;
     return CS_OK;
 }
 
@@ -451,7 +488,7 @@ static double drop_cell(const ck_t *k, const cs_dropcut_tool_t *t, long gx, long
     for (size_t m = k->start[g]; m < k->start[g + 1]; m++) {
         const double *s = k->s[k->idx[m]];
         double dx = s[0] - x, dy = s[1] - y, d2 = dx * dx + dy * dy;
-        if (d2 > r * r || s[2] <= best)
+        if (d2 > r * r || s[2] - profile_lb(t, d2) <= best)
             continue;
         best = fmax(best, s[2] - cs_dropcut_profile(t, sqrt(d2)));
     }
