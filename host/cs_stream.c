@@ -314,6 +314,8 @@ static void on_status(run_t *s, const cs_proto_status_t *st)
     s->r->dev_state = st->state;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         s->r->dev_pos[i] = i < st->axes ? st->pos[i] : 0;
+    s->r->dev_timed = (st->flags & CS_PROTO_STATUS_TICK) != 0;
+    s->r->dev_tick = st->tick;
     if (!s->open)
         return;
     if (cs_link_unacked(&s->link) == 0)
@@ -591,9 +593,10 @@ static void check_hello(run_t *s)
 {
     cs_stream_result_t *r = s->r;
     const cs_proto_hello_t *h = &r->hello;
-    if (h->version != CS_PROTO_VERSION)
-        snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
-                 (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
+    if (h->version < CS_PROTO_VERSION_MIN || h->version > CS_PROTO_VERSION)
+        snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u..%u",
+                 (unsigned)h->version, (unsigned)CS_PROTO_VERSION_MIN,
+                 (unsigned)CS_PROTO_VERSION);
     else if (control_only(s->job)) {
         if (h->axes != s->o->axes)
             snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",

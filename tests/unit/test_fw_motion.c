@@ -289,14 +289,14 @@ static void test_setpos_numbers_the_job(void **state)
     (void)state;
     cs_proto_status_t st;
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, 0); /* after boot: no job, position not stated */
+    assert_int_equal(st.flags, CS_PROTO_STATUS_TICK); /* after boot: no job, position not stated */
     assert_int_equal(st.done, 0);
     assert_int_equal(st.recv, 0);
     /* a resumed job: messages 1..1000 ran before; the machine is at (800, -80) steps */
     cs_proto_setpos_t sp = {CS_PROTO_SETPOS_POS, 0xABCD1234u, 1000u, {800, -80, 0, 0}};
     assert_int_equal(cs_fw_motion_setpos(&mo, &sp), CS_OK);
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS);
+    assert_int_equal(st.flags, CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS | CS_PROTO_STATUS_TICK);
     assert_int_equal(st.job_id, 0xABCD1234u);
     assert_int_equal(st.done, 1000);
     assert_int_equal(st.recv, 1000);
@@ -334,7 +334,7 @@ static void test_setpos_numbers_the_job(void **state)
     /* a reboot forgets the job and the stated position */
     cs_fw_motion_reboot(&mo);
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, 0);
+    assert_int_equal(st.flags, CS_PROTO_STATUS_TICK);
     assert_int_equal(st.done, 0);
 }
 
