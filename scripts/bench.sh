@@ -186,9 +186,9 @@ fw_section() {
         echo
         echo "| goal | measured | verdict |"
         echo "|---|---|---|"
-        echo "| default tracer <= 1,500 M3 instructions a chord | $pc | $([ "${pc:-99999}" -le 1500 ] && echo met || echo "MISSED: 1.9 flatness tests a chord here, each ~600 instructions with its 12 Q30 products, plus ~300 for the vertex (docs/fixed-point.md)") |"
+        echo "| default tracer <= 1,500 M3 instructions a chord | $pc | $([ "${pc:-99999}" -le 1500 ] && echo met || echo "MISSED: each flatness test is ~600 instructions with its 12 Q30 products, the vertex ~250 (docs/fixed-point.md)") |"
         echo "| uniform FD of a planar polynomial cubic <= 40 M3 instructions a point | $fl (cs_fd3_fill inside a piece) | $([ "${fl:-99999}" -le 40 ] && echo met || echo MISSED) |"
-        echo "| curve core with the default tracer <= 3 KB on the M0+ | $predict bytes | $([ "$predict" -le 3072 ] && echo met || echo "MISSED: cs_predict alone is 3.4 KB (its flatness test 1.4 KB), plus libgcc's 64-bit multiply and shifts and the predictor's 32-bit division") |"
+        echo "| curve core with the default tracer <= 3 KB on the M0+ | $predict bytes | $([ "$predict" -le 3072 ] && echo met || echo "MISSED: cs_predict alone is 3.1 KB (its flatness test 1.1 KB: every 64-bit product in it is a libgcc call on the M0+), plus libgcc's 64-bit multiply and shifts (docs/fixed-point.md)") |"
         echo
     fi
     local b

@@ -2,19 +2,24 @@
  * docs/fixed-point.md, "Predicted-step tracer"). */
 #include "cs_predict.h"
 
+#include <stddef.h>
 
 #define F               CS_PREDICT_FRAC
 #define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
 #define THR_BITS        20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
 #define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
-#define F16_ONE         ((uint32_t)1 << 16)
-#define F16_CAP         (16u * F16_ONE) /* at most 4x growth of the step per test */
-/* Accept a passing step whose deviation bound is within 1/1.05 of the threshold (the step is
- * then within about 2.5 % of the largest that passes). 1.10 would save 7 % of the instructions
- * for 0.25 % more chords, but moves a vertex of test_predict's cusp where the reference's
- * vertex placement (first parameter within 2 LSB) picks the wrong branch (true error 0.54 LSB,
- * reported 1.79). */
-#define F16_ACCEPT ((F16_ONE * 105u) / 100u)
+/* The room a test leaves, (bound allowed) / (bound found), is carried as its base-2 logarithm
+ * in Q8 (ROOM_ONE = 1.0 in the log, i.e. a factor 2): products and square roots of rooms are
+ * then sums and halvings, and no division is needed anywhere in the predictor. */
+#define ROOM_ONE  256
+#define ROOM_CAP  (4 * ROOM_ONE)   /* room 16: at most 4x growth of the step per test */
+#define ROOM_FAIL (-2 * ROOM_ONE)  /* room 1/4: what a failing hull test or T <= 0 reports */
+#define ROOM_MIN  (-30 * ROOM_ONE) /* room 2^-30: the step shrinks at most 2^15 times */
+#define ROOM_HULL 0                /* room 1: a passing hull test (says nothing of the trend) */
+/* Accept a passing step whose deviation bound is within 1/1.10 of the threshold (log2(1.10) =
+ * 0.1375, 35/256): the step is then within about 5 % of the largest that passes. 1.05 costs
+ * 9 % more M3 instructions for 0.1 % fewer chords; 1.15 saves 2.3 % for 0.1 % more. */
+#define ROOM_ACCEPT 35
 
 /* Piecewise-linear majorant of m(a, b) = max_{t in [0,1]} |3t(1-t)((1-t) a + t b)|, in 1/1024,
  * for p = max(|a|, |b|), q = min(|a|, |b|): m is convex and positively homogeneous in (a, b)
@@ -89,6 +94,7 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
             return CS_ERR_RANGE;
     p->t = 0;
     p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
+    p->h_ideal = 0;
     p->thr = tol - CS_PREDICT_SLACK_LSB;
     p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
     p->z = c->p[0].z;
@@ -96,6 +102,7 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
     return CS_OK;
 }
 
+static void eval_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
 
@@ -104,27 +111,20 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     cs_err_t e = begin_common(p, c, tol, false);
     if (e != CS_OK)
         return e;
+    unsigned n = c->degree;
     for (unsigned k = 0; k < 2; k++) {
-        /* Power basis from the Bernstein points (exact integers; |a_i| < 2^32 LSB). */
+        /* Power basis from the Bernstein points: a_i = C(n, i) (i-th forward difference of the
+         * points), exact integers (|a_i| < 2^32 LSB); a_i = 0 above the degree. */
         int64_t q[4] = {0, 0, 0, 0};
-        for (unsigned i = 0; i <= c->degree; i++)
+        for (unsigned i = 0; i <= n; i++)
             q[i] = k == 0 ? c->p[i].x : c->p[i].y;
-        int64_t a1, a2 = 0, a3 = 0;
-        if (c->degree == 1) {
-            a1 = q[1] - q[0];
-        } else if (c->degree == 2) {
-            a1 = 2 * (q[1] - q[0]);
-            a2 = q[0] - 2 * q[1] + q[2];
-        } else {
-            a1 = 3 * (q[1] - q[0]);
-            a2 = 3 * (q[0] - 2 * q[1] + q[2]);
-            a3 = q[3] - q[0] + 3 * (q[1] - q[2]);
-        }
-        p->a[0][k] = q[0] * ((int64_t)1 << F);
-        p->a[1][k] = a1 * ((int64_t)1 << F);
-        p->a[2][k] = a2 * ((int64_t)1 << F);
-        p->a[3][k] = a3 * ((int64_t)1 << F);
+        for (unsigned j = 1; j <= n; j++)
+            for (unsigned i = n; i >= j; i--)
+                q[i] -= q[i - 1];
+        for (unsigned i = 0; i < 4; i++) /* C(n, i) is n for 0 < i < n when n <= 3, else 1 */
+            p->a[i][k] = q[i] * (int64_t)(i > 0 && i < n ? n : 1) * ((int64_t)1 << F);
     }
+    eval_poly(p, NULL); /* B'(0), B''(0) / 2 */
     p->next = next_poly;
     p->done = false;
     return CS_OK;
@@ -154,8 +154,8 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
 /* Inline on cores with a 32x32 -> 64 multiply instruction (about 8 instructions a call saved on
  * the M3, 32 calls a chord); out of line where it would be two libgcc calls (M0+, AVR): there the
  * flash matters more. */
-#if defined(__GNUC__) && (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && \
-                                                        __ARM_ARCH_ISA_THUMB >= 2))
+#if defined(__GNUC__) &&                                                                           \
+    (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB >= 2))
 #define MUL_T_INLINE __attribute__((always_inline)) inline
 #else
 #define MUL_T_INLINE
@@ -174,15 +174,30 @@ static MUL_T_INLINE int64_t mul_t(int64_t x, cs_param_t t)
     return x < 0 ? -(int64_t)r : (int64_t)r;
 }
 
-/* B'(t) and B''(t) / 2 at the start of the next chord (per axis, LSB * 2^F; each Horner step
- * rounded once: <= 1 unit in d1, 1/2 in d2). */
-static void derivs(const cs_predict_t *p, cs_param_t t, int64_t d[2][2])
+/* At the vertex t: B(t) rounded to the LSB into *pt (when pt is not NULL), and B'(t), B''(t) / 2
+ * for the chords from t into p->d (per axis, LSB * 2^F). One Horner scheme shares a3 t:
+ * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
+ * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
+ * rounding to the LSB (docs/fixed-point.md). */
+static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
+    cs_param_t t = p->t;
     for (unsigned k = 0; k < 2; k++) {
-        int64_t a3t = mul_t(3 * p->a[3][k], t);
-        d[1][k] = p->a[2][k] + a3t;
-        d[0][k] = p->a[1][k] + mul_t(2 * p->a[2][k] + a3t, t);
+        int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
+        p->d[1][k] = a2 + 3 * a3t;
+        p->d[0][k] = p->a[1][k] + mul_t(2 * a2 + 3 * a3t, t);
+        if (pt) {
+            int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
+            /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
+            cs_pos_t r = (cs_pos_t)cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F);
+            if (k == 0)
+                pt->x = r;
+            else
+                pt->y = r;
+        }
     }
+    if (pt)
+        pt->z = p->z;
 }
 
 /* v / 2^s rounded half up, for 0 < s < 32 and a result that fits int32: the result's bits are
@@ -213,8 +228,7 @@ CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS +
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
-                      int64_t v[3][2])
+static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
@@ -228,35 +242,42 @@ static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h
     }
 }
 
-/* Room left by a test, (bound allowed) / (bound found), in Q16, capped at F16_CAP. Both are
- * shifted right together until found < 2^16 (16 significant bits are plenty for a prediction),
- * so the quotient is one 32-bit division (no 64-bit division routine on 32-bit chips). */
-static uint32_t room_q16(uint64_t allowed, uint64_t found)
+/* log2(v) in Q8 for v > 0: the bit length gives the integer part, the next 15 bits x
+ * (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x), c = 89/256;
+ * within [-0.0115, +0.0079] of the exact log2 v (checked on all 2^15 mantissas, the truncation
+ * to 16 bits and to Q8 included). The predictor's only logarithm. */
+static int32_t log2_q8(uint64_t v)
 {
-    unsigned k = shift_below(found, 16);
-    allowed >>= k;
-    found >>= k;
-    if (found == 0 || allowed >= 16 * found)
-        return F16_CAP;
-    /* allowed < 2^20: allowed * 2^12 < 2^32 */
-    return ((uint32_t)allowed << 12) / (uint32_t)found << 4;
+    unsigned n = cs_fixed_bitlen64(v);
+    uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
+    uint32_t x = m - (1u << 15);                                               /* Q15 */
+    uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
+    return (int32_t)((n - 1) * ROOM_ONE + (l >> 7));
 }
 
-/* |(x, y)| within 0.3 % (for the predictor only), in units of 2^sh: the components are cut to
- * 15 bits, then max + 3/8 min (within 7 %) and one Newton step (error e -> e^2 / 2), all in 32
- * bits. */
-static uint32_t approx_len(int64_t x, int64_t y, unsigned *sh)
+/* log2 of the room k sqrt(dd) / found (Q8), clamped to [ROOM_MIN, ROOM_CAP]; dd, k > 0. Each
+ * log2_q8 is within [-0.0115, +0.0079] of the exact logarithm of its integer (checked on all
+ * 2^15 mantissas), the halving truncates by < 1/512: the result is within [-6.9, +6.0] / 256
+ * of the exact log2 of the room. */
+static int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
 {
-    uint64_t ax = uabs64(x), ay = uabs64(y);
-    /* components < 2^26: >> 11 leaves < 2^15; keep more bits if they are small */
-    unsigned k = shift_below(ax | ay, 15);
-    if (k > 11)
-        k = 11;
-    uint32_t bx = (uint32_t)(ax >> k), by = (uint32_t)(ay >> k);
-    uint32_t dd = bx * bx + by * by; /* < 2^31 */
-    uint32_t l = bx > by ? bx + 3 * by / 8 : by + 3 * bx / 8;
-    *sh = k;
-    return l == 0 ? 0 : (l + dd / l) / 2;
+    if (found == 0)
+        return ROOM_CAP;
+    int32_t r = log2_q8(k) + log2_q8(dd) / 2 - log2_q8(found);
+    return r > ROOM_CAP ? ROOM_CAP : r < ROOM_MIN ? ROOM_MIN : r;
+}
+
+/* found <= k sqrt(dd), i.e. found^2 <= k^2 dd (k < 2^32), with *room = its log: decided on the
+ * log when it is clear (|room| >= ROOM_SURE = 8/256 > the log's error, so its sign is the exact
+ * comparison's), otherwise exactly in 128 bits. */
+#define ROOM_SURE 8
+static bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
+{
+    int32_t r = room_log(k, dd, found);
+    *room = r;
+    if (r >= ROOM_SURE || r <= -ROOM_SURE)
+        return r > 0;
+    return cs_fixed_cmp_prod_u64(found, found, k * k, dd) <= 0;
 }
 
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
@@ -285,8 +306,8 @@ static bool hull_flat(int32_t v[3][2], int64_t dot1, int64_t dot2, int64_t dd, i
 }
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
- * *room = how much larger the deviation bound could be (Q16), for the step predictor. */
-static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
+ * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
+static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
 {
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
@@ -298,10 +319,10 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint
     int64_t thr_f = (int64_t)p->thr << F;
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
-        s = p->thr_shift; /* thr_f >> s < 2^THR_BITS */
+        s = p->thr_shift;         /* thr_f >> s < 2^THR_BITS */
     int64_t T = (thr_f >> s) - 2; /* 2 units for the rounding of the shift below */
     if (T <= 0) {
-        *room = F16_ONE / 4;
+        *room = ROOM_FAIL;
         return false;
     }
     /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
@@ -316,7 +337,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint
     int64_t dot2 = mul32(w[1][0], w[2][0]) + mul32(w[1][1], w[2][1]);
     if (dd < 64 * T * T || dot1 < 0 || dot2 < 0 || dot1 > dd || dot2 > dd) {
         bool ok = hull_flat(w, dot1, dot2, dd, T);
-        *room = ok ? F16_ONE : F16_ONE / 4;
+        *room = ok ? ROOM_HULL : ROOM_FAIL;
         return ok;
     }
     int64_t c1 = mul32(w[2][0], w[0][1]) - mul32(w[2][1], w[0][0]);
@@ -324,45 +345,33 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, uint
     uint64_t found = majorant(c1, c2);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint64_t)(3 * MAJ_SCALE) * (uint64_t)T;
-    unsigned sh;
-    uint32_t len = approx_len(w[2][0], w[2][1], &sh);
-    uint64_t allowed = k * len, f1 = (found >> sh) + 1; /* f1 > found / 2^sh */
-    *room = room_q16(allowed, f1 - 1); /* both scaled by 2^-sh */
-    /* Clear cases decided on the estimate: len <= 1.0022 |D| / 2^sh, so f1 (1 + 1/32) <=
-     * allowed + 1 proves found <= 3072 T |D| (docs/fixed-point.md); a bound 1/16 above the
-     * estimate fails when len has 10 bits or more (then len >= 0.998 |D| / 2^sh). The rest
-     * exactly on squares (128 bits): found^2 <= (3072 T)^2 dd. */
-    if (f1 + (f1 >> 5) <= allowed)
-        return true;
-    if (len >= 1024u && f1 - 1 >= allowed + (allowed >> 4))
-        return false;
-    return cs_fixed_cmp_prod_u64(found, found, k * k, (uint64_t)dd) <= 0;
+    return room_ok(k, (uint64_t)dd, found, room);
 }
 
-/* sqrt(x) in Q16 for x in Q16 (0 < x <= F16_CAP), within 0.2 %: x = m 4^e with m in [1/2, 2),
- * sqrt(m) ~ the mean of the arithmetic and harmonic means of 1 and m ((1+m)/4 + m/(1+m)),
- * one 32-bit division (the predictor needs no more). */
-static uint32_t sqrt_q16(uint32_t x)
+/* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
+ * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
+ * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). */
+static int64_t predict(cs_param_t h, int32_t room)
 {
-    int e = 0;
-    while (x >= 2 * F16_ONE) {
-        x >>= 2;
-        e++;
-    }
-    while (x < F16_ONE / 2) {
-        x <<= 2;
-        e--;
-    }
-    uint32_t y = (x + F16_ONE) / 4 + F16_ONE - (uint32_t)(0xFFFFFFFFu / (x + F16_ONE));
-    return e >= 0 ? y << e : y >> -e;
-}
-
-/* Step predicted from a tested one: deviation ~ h^2, so h * sqrt(room), 1.6 % short. */
-static int64_t predict(cs_param_t h, uint32_t room)
-{
-    uint64_t r = room == 0 ? 0 : sqrt_q16(room); /* sqrt(room) * 2^16 */
-    uint64_t nh = ((uint64_t)h * r) >> 16;
+    int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
+    int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
+    uint32_t f = ((uint32_t)e & 511u) << 6;  /* Q15 */
+    uint32_t m = (1u << 15) + f - ((((f * ((1u << 15) - f)) >> 15) * 88u) >> 8);
+    uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
+    nh = i >= 0 ? nh << i : nh >> -i;
+    nh >>= 15;
     return (int64_t)(nh - nh / 64);
+}
+
+/* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
+ * ideal step changes smoothly along the curve), at least a/2; a alone when there is no last
+ * one (b = 0). 0 <= a <= 2^30 and 0 < b <= 2^30: 2a - b < 2^31, no overflow. */
+static cs_param_t trend(cs_param_t a, cs_param_t b)
+{
+    if (b == 0)
+        return a;
+    cs_param_t n = 2 * a - b;
+    return n < a / 2 ? a / 2 : n;
 }
 
 /* --- conic arcs ------------------------------------------------------------------------- */
@@ -413,7 +422,7 @@ static void conic_start(const cs_predict_t *p, conic_start_t *c0)
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room)
+static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
 {
     const conic_start_t *c0 = ctx;
     int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
@@ -435,7 +444,7 @@ static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, uin
         s = p->thr_shift;
     int64_t T = (((int64_t)p->thr << F) >> s) - 2;
     if (T <= 0) {
-        *room = F16_ONE / 4;
+        *room = ROOM_FAIL;
         return false;
     }
     for (unsigned k = 0; k < 2 && s > 0; k++) {
@@ -450,14 +459,11 @@ static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, uin
     if (dot <= 0 || dot >= dd) { /* nearest chord point is an end: distance to it */
         int64_t ex = dot <= 0 ? v[0] : v[0] - d[0], ey = dot <= 0 ? v[1] : v[1] - d[1];
         bool ok = cs_fixed_cmp_prod_u64((uint64_t)(ex * ex + ey * ey), phi * phi, lim2, 1) <= 0;
-        *room = ok ? F16_ONE : F16_ONE / 4;
+        *room = ok ? ROOM_HULL : ROOM_FAIL;
         return ok;
     }
     uint64_t found = uabs64(d[0] * v[1] - d[1] * v[0]) * phi; /* < 2^49 * 2^9 */
-    unsigned sh;
-    uint32_t len = approx_len(d[0], d[1], &sh);
-    *room = room_q16(lim * len, found >> sh);
-    return cs_fixed_cmp_prod_u64(found, found, lim2, (uint64_t)dd) <= 0;
+    return room_ok(lim, (uint64_t)dd, found, room);
 }
 
 /* The vertex at p->t: the conic's blossom b(t, t) divided once, rounded to the nearest LSB. */
@@ -472,38 +478,22 @@ static void eval_conic(const cs_predict_t *p, cs_vec3_t *pt)
     pt->z = p->z;
 }
 
-/* The vertex at p->t: B(t) by Horner, rounded to the LSB. */
-static void eval_poly(const cs_predict_t *p, cs_vec3_t *pt)
-{
-    int64_t r[2];
-    for (unsigned k = 0; k < 2; k++) {
-        int64_t acc = p->a[2][k] + mul_t(p->a[3][k], p->t);
-        acc = p->a[1][k] + mul_t(acc, p->t);
-        r[k] = cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, p->t), F);
-    }
-    /* |B(t)| <= CS_POS_LIMIT + 1: inside the convex hull of valid points, plus rounding. */
-    pt->x = (cs_pos_t)r[0];
-    pt->y = (cs_pos_t)r[1];
-    pt->z = p->z;
-}
-
 /* One flatness test of the piece [t, t + h]; ctx is what every trial piece from t shares
  * (B'(t) and B''(t)/2, or the conic's start). */
-typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, uint32_t *room);
+typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room);
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
-                            uint32_t *lo_room)
+static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
 {
     cs_param_t rem = CS_PARAM_ONE - p->t;
     int64_t lo = 0, hi = (int64_t)rem + 1, h = p->h_next < rem ? p->h_next : rem;
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
-        uint32_t room;
+        int32_t room;
         if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
-            if (h == rem || room <= F16_ACCEPT)
+            if (h == rem || room <= ROOM_ACCEPT)
                 break;
         } else {
             hi = h;
@@ -521,7 +511,7 @@ static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx
         h = hi / 2; /* the predictor gave up: halve until a step passes */
         if (h == 0)
             break;
-        uint32_t room;
+        int32_t room;
         if (test(p, ctx, (cs_param_t)h, &room)) {
             lo = h;
             *lo_room = room;
@@ -533,7 +523,7 @@ static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx
 
 /* Moves to the next vertex by the step find_step gave: CS_OK and *eval when the caller
  * computes the vertex at p->t, CS_OK and *pt = P_n at the end, CS_ERR_DEPTH for no step. */
-static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t *pt, bool *eval)
+static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *pt, bool *eval)
 {
     *eval = false;
     p->done = true;
@@ -544,8 +534,12 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t 
         *pt = p->end;
         return CS_OK;
     }
-    /* Next chord: about as long in t as this one, corrected by the room this one left. */
+    /* Next chord: the step this one would have needed to fill the tolerance (its step
+     * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
     int64_t nh = predict(h, room);
+    cs_param_t ideal = nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
+    nh = trend(ideal, p->h_ideal);
+    p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : (cs_param_t)nh;
     p->done = false;
     *eval = true;
@@ -554,11 +548,9 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, uint32_t room, cs_vec3_t 
 
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
-    int64_t d[2][2];
-    derivs(p, p->t, d);
-    uint32_t room = F16_ONE;
+    int32_t room = ROOM_HULL;
     bool eval;
-    cs_param_t h = find_step(p, test_step, d, &room); /* sets room: before step_to reads it */
+    cs_param_t h = find_step(p, test_step, p->d, &room); /* sets room: before step_to reads it */
     cs_err_t e = step_to(p, h, room, pt, &eval);
     if (eval)
         eval_poly(p, pt);
@@ -569,7 +561,7 @@ static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt)
 {
     conic_start_t c0;
     conic_start(p, &c0);
-    uint32_t room = F16_ONE;
+    int32_t room = ROOM_HULL;
     bool eval;
     cs_param_t h = find_step(p, test_conic, &c0, &room); /* sets room: before step_to reads it */
     cs_err_t e = step_to(p, h, room, pt, &eval);

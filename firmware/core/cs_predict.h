@@ -1,8 +1,9 @@
 /* cs_predict: the predicted-step tracer for planar polynomial curves of degree 1..3 (lines,
  * quadratics, cubics: what SVG, G5 and G5.1 give) and planar conic arcs (rational quadratics
  * with w1^2 <= w0 w2: the circles and ellipses of cs_arc, SVG 'A', G2/G3). Each chord's parameter
- * step is predicted from the last one and from how much room the last flatness test left (deviation
- * ~ h^2), then VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are
+ * step is predicted from the last one, the room the last flatness test left (deviation ~ h^2) and
+ * the trend of that over the last two chords (no division: rooms are carried as logarithms), then
+ * VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are
  * computed directly from the power-basis Taylor expansion at t (no chain of de Casteljau splits).
  * The test bounds the exact deviation of the sub-curve from its chord by a piecewise-linear
  * majorant of max_t |B1(t) d1 + B2(t) d2| (d1, d2 the signed distances of the inner control
@@ -34,14 +35,16 @@
 typedef struct cs_predict cs_predict_t;
 struct cs_predict {
     int64_t a[4][2]; /* B(t) = a0 + a1 t + a2 t^2 + a3 t^3, per axis x, y */
+    int64_t d[2][2]; /* B'(t), B''(t) / 2 at the last vertex (per axis x, y) */
     int64_t h[3][3]; /* conic: homogeneous points w_i x_i, w_i y_i (LSB * 2^30), w_i (Q30) */
     cs_err_t (*next)(cs_predict_t *p, cs_vec3_t *pt);
-    cs_param_t t;      /* parameter of the last vertex returned */
-    cs_param_t h_next; /* the step predicted for the next chord */
-    cs_pos_t thr;      /* tol - slack, LSB */
-    uint8_t thr_shift; /* least shift of thr * 2^F below 2^20 (the test's unit) */
-    cs_pos_t z;        /* the plane's z (every control point has it) */
-    cs_vec3_t end;     /* P_n, returned exactly as the last vertex */
+    cs_param_t t;       /* parameter of the last vertex returned */
+    cs_param_t h_next;  /* the step predicted for the next chord */
+    cs_param_t h_ideal; /* the step the last chord would have needed (0: none known) */
+    cs_pos_t thr;       /* tol - slack, LSB */
+    uint8_t thr_shift;  /* least shift of thr * 2^F below 2^20 (the test's unit) */
+    cs_pos_t z;         /* the plane's z (every control point has it) */
+    cs_vec3_t end;      /* P_n, returned exactly as the last vertex */
     bool done;
 };
 

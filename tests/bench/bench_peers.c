@@ -563,18 +563,20 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
     printf("| points/s >= cairo's | %.2fx (arcs %.2fx) | %s |\n\n", pps, arcs_worst_pps,
            pps >= 1 && arcs_worst_pps >= 1 ? "met" : "MISSED");
     printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost): the "
-           "wall clock of this shared machine is noisy (compare within one table); by "
-           "instructions (callgrind, the three sets at the three tolerances) the tracer spends "
-           "1,020 a point and 39.4 k a curve against cairo's 674 and 42.6 k, i.e. 1.08x cairo's "
-           "curves/s and 0.66x its points/s. Each chord costs 1.2-2.4 verified flatness tests "
-           "(a sub-curve of 12 Q30 products, cross and dot products, a 4-piece majorant, three "
-           "32-bit divisions for the predictor) plus B(t) and its derivatives by Horner; cairo's "
+           "wall clock of this shared machine is noisy (compare within one table, and expect "
+           "the ratios to move by 2x between runs); by instructions (`bench_peers --profile` "
+           "under callgrind, the three sets at the three tolerances) the tracer spends 859 a "
+           "point and 33.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.29x cairo's "
+           "curves/s and 0.79x its points/s (before issue 18's second pass: 1,024 and 39.5 k). "
+           "Each chord costs 1.15-1.26 verified flatness tests (a sub-curve of 12 Q30 products, "
+           "cross and dot products, a 4-piece majorant, three logarithms for the predictor: no "
+           "division) plus B(t) and its derivatives by one Horner scheme (8 products); cairo's "
            "subdivision spends fewer instructions a point but emits 1.6x the chords, and the "
-           "tracer's divisions and data-dependent branches cost more cycles per instruction "
-           "than cairo's loop. Arcs (conic pieces): 1,342 instructions a point and 216 k an arc "
-           "against cairo_arc's 672 and 171 k (0.79x its arcs/s by instructions); each test "
-           "projects two homogeneous points by 64-bit divisions, which cost far more cycles "
-           "than instructions.\n\n");
+           "tracer's data-dependent branches cost more cycles per instruction than cairo's loop. "
+           "Arcs (conic pieces): 1,220 instructions a point and 197 k an arc against "
+           "cairo_arc's 672 and 171 k (0.87x its arcs/s by instructions); each test projects "
+           "two homogeneous points by 64-bit divisions, which cost far more cycles than "
+           "instructions.\n\n");
 }
 
 static void arcs_report(FILE *csv)
@@ -643,15 +645,78 @@ static void arcs_report(FILE *csv)
     printf("\n");
 }
 
+/* --profile: each of the default tracer and cairo flattens the three sets at the three
+ * tolerances once, then the arcs; one function per engine and corpus, so that a profiler's
+ * inclusive cost of it is that engine's work (valgrind --tool=callgrind, callgrind_annotate
+ * --inclusive=yes: profile_curves_pred against profile_curves_cairo). Prints the curve and
+ * chord counts. */
+static size_t profile_curves(const bench_set_t *sets, int e, size_t *curves)
+{
+    size_t chords = 0;
+    for (int si = 0; si < 3; si++)
+        for (int ti = 0; ti < N_TOLS; ti++)
+            for (size_t k = 0; k < sets[si].n; k++) {
+                chords += flatten(&sets[si].c[k], tols_mm[ti], e, false);
+                ++*curves;
+            }
+    return chords;
+}
+
+static size_t profile_arcs(int e, size_t *curves)
+{
+    size_t chords = 0;
+    for (int ti = 0; ti < N_TOLS; ti++)
+        for (size_t k = 0; k < N_ARCS; k++) {
+            chords += arc_flatten(&arcs[k], tols_mm[ti], e, NULL);
+            ++*curves;
+        }
+    return chords;
+}
+
+__attribute__((noinline)) static size_t profile_curves_pred(const bench_set_t *s, size_t *n)
+{
+    return profile_curves(s, ENG_PRED, n);
+}
+
+__attribute__((noinline)) static size_t profile_curves_cairo(const bench_set_t *s, size_t *n)
+{
+    return profile_curves(s, ENG_CAIRO, n);
+}
+
+__attribute__((noinline)) static size_t profile_arcs_pred(size_t *n)
+{
+    return profile_arcs(ENG_PRED, n);
+}
+
+__attribute__((noinline)) static size_t profile_arcs_cairo(size_t *n)
+{
+    return profile_arcs(ENG_CAIRO, n);
+}
+
+static int profile(const bench_set_t *sets)
+{
+    size_t n[4] = {0, 0, 0, 0};
+    size_t c[4] = {profile_curves_pred(sets, &n[0]), profile_curves_cairo(sets, &n[1]),
+                   profile_arcs_pred(&n[2]), profile_arcs_cairo(&n[3])};
+    static const char *what[4] = {"curves, predict", "curves, cairo", "arcs, predict",
+                                  "arcs, cairo"};
+    for (int i = 0; i < 4; i++)
+        printf("%s: %zu elements, %zu chords\n", what[i], n[i], c[i]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    static const char usage[] = "usage: bench_peers [OUT.csv]\n"
+    static const char usage[] =
+        "usage: bench_peers [OUT.csv | --profile]\n"
         "curvestep's tracers beside cairo and AGG on one corpus of cubics; a Markdown\n"
-        "section on stdout, the figures in OUT.csv.\n";
-    int usage_rc = bench_args_check(argc, argv, usage, 1);
+        "section on stdout, the figures in OUT.csv. --profile: only the default tracer and\n"
+        "cairo, once over the corpus and the arcs (for callgrind, see profile_curves).\n";
+    bool prof = argc == 2 && strcmp(argv[1], "--profile") == 0;
+    int usage_rc = prof ? -1 : bench_args_check(argc, argv, usage, 1);
     if (usage_rc >= 0)
         return usage_rc;
-    FILE *csv = argc > 1 ? fopen(argv[1], "w") : NULL;
+    FILE *csv = argc > 1 && !prof ? fopen(argv[1], "w") : NULL;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
     cr = cairo_create(surf);
     bench_set_t sets[3] = {{"random cubics + hard cases", NULL, 0, 0},
@@ -660,6 +725,10 @@ int main(int argc, char **argv)
     random_and_hard(&sets[0]);
     size_t skipped = bench_svg_curves(&sets[1], NULL, 0, planar_cubic);
     teapot_set(&sets[2]);
+    if (prof) {
+        arcs_set();
+        return profile(sets);
+    }
     static result_t res[3][N_TOLS][N_ENG];
     static size_t greedy[3][N_TOLS];
     if (csv)
