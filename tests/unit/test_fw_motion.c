@@ -94,6 +94,9 @@ static void test_segments_in_order(void **state)
     assert_int_equal(port_posix_position(0), want[0]);
     assert_int_equal(port_posix_position(1), want[1]);
     assert_int_equal(port_posix_now(), 500u * NSEG + 1u); /* never ran dry: one kick tick */
+    /* protocol 3: the executor's clock when pos was read */
+    assert_true(st.flags & CS_PROTO_STATUS_TICK);
+    assert_int_equal(st.tick, 500u * NSEG + 1u);
 }
 
 static void test_hold_resume(void **state)
@@ -101,6 +104,12 @@ static void test_hold_resume(void **state)
     (void)state;
     queue_job(NSEG);
     run_until(500u * 30); /* mid-job, at full speed */
+    cs_proto_status_t mid; /* moving: the position and the clock of one instant */
+    cs_fw_motion_status(&mo, &mid);
+    assert_int_equal(mid.tick, (uint32_t)port_posix_now());
+    assert_int_equal(mid.pos[0], port_posix_position(0));
+    assert_int_equal(mid.pos[1], port_posix_position(1));
+    assert_true(mid.pos[0] != 0 || mid.pos[1] != 0);
     cs_fw_motion_hold(&mo, true);
     run_until(UINT64_MAX);
     cs_proto_status_t st;
