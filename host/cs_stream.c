@@ -375,7 +375,11 @@ static int pump_out(run_t *s, uint32_t now)
             return 0;
         }
         if (e == CS_OK && cs_serial_write(s->o->ser, b, n) != 0) {
-            snprintf(s->r->why, sizeof s->r->why, "write failed: %s", strerror(errno));
+            /* a hung-up line (the device closed it, a USB adapter pulled) fails the write with
+             * EIO, ENXIO or EPIPE before a read sees the hang-up: the same event, one text */
+            bool hup = errno == EIO || errno == ENXIO || errno == EPIPE;
+            snprintf(s->r->why, sizeof s->r->why, "%s: %s",
+                     hup ? "the line closed (write)" : "write failed", strerror(errno));
             finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
             return -1;
         }
