@@ -10,8 +10,15 @@
 #include "cs_varady.h"
 
 #define CK_MAX_K 1200 /* samples a patch in each direction, at most */
-#define CK_IDEAL_STEP 0.1 /* mm: the lattice of the ideal cutter's positions (ideal_dist) */
+#define CK_IDEAL_STEP 0.05 /* mm: the lattice of the ideal cutter's positions (ideal_dist) */
 #define CK_WALL       5   /* a wall: the surface rises more than 5 map steps within one (79 deg) */
+#define CK_TRACE      64  /* sphere-tracing steps along a ray (path_thick) */
+#define CK_HIT        1e-7 /* mm: a ray this near a cutter has reached it */
+/* The ideal cutter stands on a lattice of axis positions, so where a real cutter touches the
+ * surface the nearest lattice cutter may stay a little off it (on a 65 deg flank with a 2 mm
+ * ball and 0.05 mm nodes, up to about 0.002 mm): nearer than this fraction of H it counts as
+ * touching, and the path is measured from the surface itself (the stricter measure). */
+#define CK_TOUCH      0.25
 
 typedef struct {
     /* surface samples bucketed by xy cell */
@@ -24,8 +31,14 @@ typedef struct {
     /* the z-map over the region */
     double box[4], step;
     size_t mx, my;
-    double *top, *env; /* env: per node, the nearest any cutter position came to the surface */
-    double dcap;       /* mm: distances beyond this are not measured (env stays there) */
+    double *top;
+    double dcap;  /* mm: distances beyond this are not measured */
+    /* the path's cutter positions (tips, every chord sampled at <= step) bucketed by xy cell,
+     * each cell with its lowest tip: a cell whose cutters cannot come nearer is skipped */
+    double (*p)[3];
+    size_t np, pcap;
+    size_t pgx, pgy, *pstart, *pidx;
+    double *pzlo;
     double *peak; /* highest sample whose nearest node this is: a wall shows above top */
     double *cmax; /* per sample cell: its highest sample z (prunes the gouge test) */
     double *dropm; /* per node: the ideal drop height there, NAN until needed (rest_at) */
@@ -33,17 +46,18 @@ typedef struct {
     long stride;  /* nodes between the ideal cutter's positions (rest_at) */
 } ck_t;
 
-static cs_err_t push_sample(ck_t *k, const double p[3])
+/* Appends point p to the growing array *a (*n points of room *cap). */
+static cs_err_t push3(double (**a)[3], size_t *n, size_t *cap, const double p[3])
 {
-    if (k->ns == k->scap) {
-        size_t cap = k->scap ? 2 * k->scap : 65536;
-        double(*n)[3] = realloc(k->s, cap * sizeof *n);
-        if (!n)
+    if (*n == *cap) {
+        size_t c = *cap ? 2 * *cap : 65536;
+        double(*m)[3] = realloc(*a, c * sizeof *m);
+        if (!m)
             return CS_ERR_FULL;
-        k->s = n;
-        k->scap = cap;
+        *a = m;
+        *cap = c;
     }
-    memcpy(k->s[k->ns++], p, 3 * sizeof *p);
+    memcpy((*a)[(*n)++], p, 3 * sizeof *p);
     return CS_OK;
 }
 
@@ -116,7 +130,7 @@ static cs_err_t sample_grid(ck_t *k, ck_eval_fn ev, const void *ctx, int nu, int
         double *prev = row + (size_t)((i + 1) & 1) * (size_t)(nv + 1) * 3;
         for (int j = 0; j <= nv && e == CS_OK; j++) {
             ev(ctx, (double)i / nu, (double)j / nv, &cur[j * 3]);
-            e = push_sample(k, &cur[j * 3]);
+            e = push3(&k->s, &k->ns, &k->scap, &cur[j * 3]);
             splat(k, &cur[j * 3]);
         }
         for (int j = 0; i > 0 && j < nv; j++) {
@@ -218,6 +232,18 @@ static cs_err_t bucket(ck_t *k, double cell)
     for (size_t c = nc; c > 0; c--)
         k->start[c] = k->start[c - 1];
     k->start[0] = 0;
+    /* The samples in cell order (a cell's samples contiguous in memory: the queries read them
+     * cell by cell), so that idx is the identity. */
+    double(*sorted)[3] = malloc((k->ns + 1) * sizeof *sorted);
+    if (!sorted)
+        return CS_ERR_FULL;
+    for (size_t m = 0; m < k->ns; m++) {
+        memcpy(sorted[m], k->s[k->idx[m]], sizeof *sorted);
+        k->idx[m] = m;
+    }
+    free(k->s);
+    k->s = sorted;
+    k->scap = k->ns + 1;
     return CS_OK;
 }
 
@@ -228,6 +254,21 @@ static double cell_dist(const ck_t *k, long cx, long cy, double x, double y)
     double dx = x < x0 ? x0 - x : x > x0 + k->cell ? x - x0 - k->cell : 0;
     double dy = y < y0 ? y0 - y : y > y0 + k->cell ? y - y0 - k->cell : 0;
     return sqrt(dx * dx + dy * dy);
+}
+
+/* A lower bound on the profile h(d) of tool t from d^2, without the profile's square roots: on the
+ * corner arc (e = d - (R - r) > 0) h = r - sqrt(r^2 - e^2) = e^2 / (r + sqrt(r^2 - e^2)) >=
+ * e^2 / (2 r); 0 on the flat bottom. A sample that stands no higher above the tip than this
+ * cannot be deeper inside the cutter than the deepest found (nor raise a drop). */
+static double profile_lb(const cs_dropcut_tool_t *t, double d2)
+{
+    double a = t->r_mm - t->c_mm;
+    if (t->c_mm <= 0)
+        return 0;
+    if (a <= 0)
+        return d2 / (2 * t->c_mm);
+    double e = sqrt(d2) - a;
+    return e > 0 ? e * e / (2 * t->c_mm) : 0;
 }
 
 /* One cutter position's deepest penetration: the samples within R, cell by cell; a cell whose
@@ -247,7 +288,7 @@ static void visit_gouge(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], 
             for (size_t m = k->start[c]; m < k->start[c + 1]; m++) {
                 const double *s = k->s[k->idx[m]];
                 double dx = s[0] - p[0], dy = s[1] - p[1], d2 = dx * dx + dy * dy;
-                if (d2 > r * r || s[2] - p[2] <= o->gouge_mm)
+                if (d2 > r * r || s[2] - p[2] - profile_lb(t, d2) <= o->gouge_mm)
                     continue;
                 double pen = s[2] - (p[2] + cs_dropcut_profile(t, sqrt(d2)));
                 if (pen > o->gouge_mm) {
@@ -276,48 +317,131 @@ static double tool_dist(const cs_dropcut_tool_t *t, const double p[3], double sx
     return d > 0 ? d : 0;
 }
 
-/* One cutter position: the distance from the surface point over each node within R + the
- * largest distance that matters (dcap), row by row, into the distance map. */
-static void visit(ck_t *k, const cs_dropcut_tool_t *t, const double p[3], cs_dropcheck_t *o)
+/* Every chord sampled at spacing <= step: the gouge at each sample, the samples kept. */
+static cs_err_t walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3],
+                     const size_t *start, size_t npass, cs_dropcheck_t *o)
 {
-    visit_gouge(k, t, p, o);
-    double r = t->r_mm + k->dcap;
-    long iy0 = (long)ceil((p[1] - r - k->box[1]) / k->step), iy1 = (long)floor((p[1] + r - k->box[1]) / k->step);
-    for (long iy = iy0 < 0 ? 0 : iy0; iy <= iy1 && iy < (long)k->my; iy++) {
-        double y = k->box[1] + (double)iy * k->step, dy = y - p[1], w2 = r * r - dy * dy;
-        if (w2 < 0)
-            continue;
-        double w = sqrt(w2);
-        long ix0 = (long)ceil((p[0] - w - k->box[0]) / k->step), ix1 = (long)floor((p[0] + w - k->box[0]) / k->step);
-        for (long ix = ix0 < 0 ? 0 : ix0; ix <= ix1 && ix < (long)k->mx; ix++) {
-            size_t n = (size_t)iy * k->mx + (size_t)ix;
-            if (k->env[n] == 0 || k->top[n] == -HUGE_VAL)
-                continue;
-            double d = tool_dist(t, p, k->box[0] + (double)ix * k->step, y, k->top[n]);
-            k->env[n] = fmin(k->env[n], d);
-        }
-    }
-}
-
-static void walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3], const size_t *start,
-                 size_t npass, cs_dropcheck_t *o)
-{
+    cs_err_t e = CS_OK;
     for (size_t pass = 0; pass < npass; pass++)
-        for (size_t i = start[pass]; i < start[pass + 1]; i++) {
+        for (size_t i = start[pass]; i < start[pass + 1] && e == CS_OK; i++) {
             const double *a = pts[i], *b = i + 1 < start[pass + 1] ? pts[i + 1] : pts[i];
             double len = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
                               (b[2] - a[2]) * (b[2] - a[2]));
             size_t n = (size_t)ceil(len / k->step);
-            for (size_t j = 0; j <= n || j == 0; j++) {
+            /* the chord's last sample is the next chord's first */
+            size_t last = n == 0 || i + 2 > start[pass + 1] ? n : n - 1;
+            for (size_t j = 0; j <= last && e == CS_OK; j++) {
                 double f = n ? (double)j / (double)n : 0, p[3];
                 for (int c = 0; c < 3; c++)
                     p[c] = a[c] + f * (b[c] - a[c]);
-                visit(k, t, p, o);
+                visit_gouge(k, t, p, o);
+                e = push3(&k->p, &k->np, &k->pcap, p);
                 o->path_samples++;
-                if (n == 0)
-                    break;
             }
         }
+    return e;
+}
+
+/* Buckets the path's cutter positions over the sample cells' grid (same origin and size). */
+static cs_err_t bucket_tips(ck_t *k)
+{
+    k->pgx = k->gx, k->pgy = k->gy;
+    size_t nc = k->pgx * k->pgy;
+    k->pstart = calloc(nc + 1, sizeof *k->pstart);
+    k->pidx = malloc((k->np + 1) * sizeof *k->pidx);
+    k->pzlo = malloc(nc * sizeof *k->pzlo);
+    if (!k->pstart || !k->pidx || !k->pzlo)
+        return CS_ERR_FULL;
+    size_t *cell = malloc((k->np + 1) * sizeof *cell);
+    if (!cell)
+        return CS_ERR_FULL;
+    for (size_t c = 0; c < nc; c++)
+        k->pzlo[c] = HUGE_VAL;
+    for (size_t i = 0; i < k->np; i++) {
+        double fx = floor((k->p[i][0] - k->org[0]) / k->cell), fy = floor((k->p[i][1] - k->org[1]) / k->cell);
+        size_t cx = fx < 0 ? 0 : fx >= (double)k->pgx ? k->pgx - 1 : (size_t)fx;
+        size_t cy = fy < 0 ? 0 : fy >= (double)k->pgy ? k->pgy - 1 : (size_t)fy;
+        cell[i] = cy * k->pgx + cx;
+        k->pstart[cell[i] + 1]++;
+        k->pzlo[cell[i]] = fmin(k->pzlo[cell[i]], k->p[i][2]);
+    }
+    for (size_t c = 0; c < nc; c++)
+        k->pstart[c + 1] += k->pstart[c];
+    for (size_t i = 0; i < k->np; i++)
+        k->pidx[k->pstart[cell[i]]++] = i;
+    for (size_t c = nc; c > 0; c--)
+        k->pstart[c] = k->pstart[c - 1];
+    k->pstart[0] = 0;
+    free(cell);
+    double(*sorted)[3] = malloc((k->np + 1) * sizeof *sorted); /* in cell order, as bucket() */
+    if (!sorted)
+        return CS_ERR_FULL;
+    for (size_t m = 0; m < k->np; m++) {
+        memcpy(sorted[m], k->p[k->pidx[m]], sizeof *sorted);
+        k->pidx[m] = m;
+    }
+    free(k->p);
+    k->p = sorted;
+    k->pcap = k->np + 1;
+    return CS_OK;
+}
+
+/* How far along the ray o + u d (u a unit vector) the path's cutters begin: the material's
+ * thickness there, capped at dcap. For one cutter the distance f(d) = tool_dist(o + u d) is
+ * convex and 1-Lipschitz, so d += f(d) from d = f(0) never passes the first hit and reaches
+ * it (sphere tracing); a cutter no nearer than the best hit is skipped. A ray that has not
+ * reached a cutter within CK_TRACE steps (grazing it) counts as missing it: the thickness is
+ * then overstated, never understated. A cell's cutters all lie in the half-cylinders of radius
+ * R - r over its box from its lowest corner centres up, so none comes nearer than the distance
+ * to that set less r (tool_dist's form): such a cell is skipped. Cells at the grid's edge hold
+ * the tips beyond it too (clamped): never skipped by their box. */
+static double path_thick(const ck_t *k, const cs_dropcut_tool_t *t, const double o[3],
+                         const double u[3])
+{
+    double best = k->dcap, r = t->r_mm + best, a = t->r_mm - t->c_mm;
+    long cx0 = (long)floor((o[0] - r - k->org[0]) / k->cell), cx1 = (long)floor((o[0] + r - k->org[0]) / k->cell);
+    long cy0 = (long)floor((o[1] - r - k->org[1]) / k->cell), cy1 = (long)floor((o[1] + r - k->org[1]) / k->cell);
+    long mx = (long)k->pgx - 1, my = (long)k->pgy - 1;
+    cx0 = cx0 < 0 ? 0 : cx0, cy0 = cy0 < 0 ? 0 : cy0, cx1 = cx1 > mx ? mx : cx1, cy1 = cy1 > my ? my : cy1;
+    for (long cy = cy0; cy <= cy1; cy++)
+        for (long cx = cx0; cx <= cx1; cx++) {
+            size_t c = (size_t)cy * k->pgx + (size_t)cx;
+            if (k->pstart[c] == k->pstart[c + 1])
+                continue;
+            bool edge = cx == 0 || cy == 0 || cx == mx || cy == my;
+            double e = edge ? 0 : fmax(0, cell_dist(k, cx, cy, o[0], o[1]) - a);
+            double dz = fmax(0, k->pzlo[c] + t->c_mm - o[2]);
+            if (sqrt(e * e + dz * dz) - t->c_mm >= best)
+                continue;
+            for (size_t m = k->pstart[c]; m < k->pstart[c + 1]; m++) {
+                const double *p = k->p[k->pidx[m]];
+                double d = tool_dist(t, p, o[0], o[1], o[2]), f = d;
+                for (int i = 0; i < CK_TRACE && f > CK_HIT && d < best; i++) {
+                    f = tool_dist(t, p, o[0] + u[0] * d, o[1] + u[1] * d, o[2] + u[2] * d);
+                    d += f;
+                }
+                if (f <= CK_HIT && d < best)
+                    best = d;
+            }
+        }
+    return best;
+}
+
+/* The unit normal (upwards) of the rasterised top at node (ix, iy): central differences where
+ * both neighbours have surface, one-sided where one has. */
+static void top_normal(const ck_t *k, long ix, long iy, double u[3])
+{
+    double z0 = k->top[node(k, ix, iy)], g[2];
+    for (int c = 0; c < 2; c++) {
+        size_t np = node(k, ix + (c == 0), iy + (c == 1)), nm = node(k, ix - (c == 0), iy - (c == 1));
+        bool hp = np != (size_t)-1 && k->top[np] > -HUGE_VAL, hm = nm != (size_t)-1 && k->top[nm] > -HUGE_VAL;
+        g[c] = hp && hm ? (k->top[np] - k->top[nm]) / (2 * k->step)
+               : hp     ? (k->top[np] - z0) / k->step
+               : hm     ? (z0 - k->top[nm]) / k->step
+                        : 0;
+    }
+    double l = sqrt(1 + g[0] * g[0] + g[1] * g[1]);
+    u[0] = -g[0] / l, u[1] = -g[1] / l, u[2] = 1 / l;
 }
 
 /* Marks in far[] the nodes at least r_nodes (chessboard distance) from every node with no
@@ -350,31 +474,59 @@ static bool interior(const ck_t *k, long r_nodes, unsigned char *far)
     return true;
 }
 
-/* The ideal drop at node c (on the stride lattice): the highest the rasterised top within R holds
- * a cutter whose axis stands at c, max over nodes q of top(q) - h(|q - c|). Memoised. */
+/* The drop at (x, y) over one sample cell, given the best so far: skipped when even its highest
+ * sample at the cell's nearest point cannot beat it. */
+static double drop_cell(const ck_t *k, const cs_dropcut_tool_t *t, long gx, long gy, double x,
+                        double y, double best)
+{
+    if (gx < 0 || gy < 0 || gx >= (long)k->gx || gy >= (long)k->gy)
+        return best;
+    size_t g = (size_t)gy * k->gx + (size_t)gx;
+    double r = t->r_mm, cd = cell_dist(k, gx, gy, x, y);
+    if (cd > r || k->cmax[g] - cs_dropcut_profile(t, cd) <= best)
+        return best;
+    for (size_t m = k->start[g]; m < k->start[g + 1]; m++) {
+        const double *s = k->s[k->idx[m]];
+        double dx = s[0] - x, dy = s[1] - y, d2 = dx * dx + dy * dy;
+        if (d2 > r * r || s[2] - profile_lb(t, d2) <= best)
+            continue;
+        best = fmax(best, s[2] - cs_dropcut_profile(t, sqrt(d2)));
+    }
+    return best;
+}
+
+/* The ideal drop at node c: the highest tip of a cutter whose axis stands at c that no surface
+ * sample enters, max over samples q within R of q.z - h(|q - c|) (the dense samples of the exact
+ * surface, as the gouge test). The cells in rings from the axis out: the highest contacts come
+ * first, so that most cells farther out are pruned by their bound. Memoised. */
 static double ideal_drop(ck_t *k, const cs_dropcut_tool_t *t, long cx, long cy)
 {
     size_t c = node(k, cx, cy);
     if (!isnan(k->dropm[c]))
         return k->dropm[c];
-    double r = t->r_mm, best = -HUGE_VAL;
-    long rn = (long)floor(r / k->step / (double)k->stride) * k->stride;
-    for (long qy = cy - rn; qy <= cy + rn; qy += k->stride)
-        for (long qx = cx - rn; qx <= cx + rn; qx += k->stride) {
-            size_t q = node(k, qx, qy);
-            if (q == (size_t)-1 || k->top[q] == -HUGE_VAL)
-                continue;
-            double d = hypot((double)(qx - cx), (double)(qy - cy)) * k->step;
-            if (d <= r)
-                best = fmax(best, k->top[q] - cs_dropcut_profile(t, d));
+    double best = -HUGE_VAL;
+    double x = k->box[0] + (double)cx * k->step, y = k->box[1] + (double)cy * k->step;
+    long gx = (long)floor((x - k->org[0]) / k->cell), gy = (long)floor((y - k->org[1]) / k->cell);
+    long rings = (long)ceil(t->r_mm / k->cell) + 1;
+    for (long ring = 0; ring <= rings; ring++)
+        for (long i = -ring; i <= ring; i++) {
+            best = drop_cell(k, t, gx + i, gy - ring, x, y, best);
+            if (ring > 0)
+                best = drop_cell(k, t, gx + i, gy + ring, x, y, best);
+            if (i > -ring && i < ring) {
+                best = drop_cell(k, t, gx - ring, gy + i, x, y, best);
+                best = drop_cell(k, t, gx + ring, gy + i, x, y, best);
+            }
         }
     return k->dropm[c] = best;
 }
 
-/* How near any cutter position from above comes to the surface point over node (ix, iy): min
- * over axis positions c (the stride lattice) within R + dcap of the distance to the cutter
- * dropped at c. More than H: rest material, no 3-axis cutter of this shape reaches it. */
-static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, size_t *arg)
+/* How near any cutter position from above comes to the surface point s over node (ix, iy): min
+ * over axis positions c (every node within R + dcap) of the distance to the cutter dropped at
+ * c; *arg gets that c, pc its tip. More than H: rest material, no 3-axis cutter of this shape
+ * reaches it. */
+static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, size_t *arg,
+                         double pc[3])
 {
     *arg = (size_t)-1;
     double r = t->r_mm + k->dcap, best = HUGE_VAL;
@@ -385,17 +537,33 @@ static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, 
     for (long cy = by - rn; cy <= by + rn && best > 0; cy += k->stride)
         for (long cx = bx - rn; cx <= bx + rn && best > 0; cx += k->stride) {
             double d = hypot((double)(cx - ix), (double)(cy - iy)) * k->step;
-            if (d > r || node(k, cx, cy) == (size_t)-1)
-                continue;
+            if (d > r || d - t->r_mm >= best || node(k, cx, cy) == (size_t)-1)
+                continue; /* (no cutter whose axis stands d away comes nearer than d - R) */
             double z = ideal_drop(k, t, cx, cy);
-            double pc[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
-            double dd = z > -HUGE_VAL ? tool_dist(t, pc, sx, sy, sz) : HUGE_VAL;
+            double q[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
+            double dd = z > -HUGE_VAL ? tool_dist(t, q, sx, sy, sz) : HUGE_VAL;
             if (dd < best) {
                 best = dd;
                 *arg = node(k, cx, cy);
+                memcpy(pc, q, sizeof q);
             }
         }
     return best;
+}
+
+/* The point q of the solid of tool t (tip at p) nearest to s: the nearest point m of the
+ * half-cylinder of radius R - r from the corner centres up (tool_dist), then r towards s. */
+static void tool_nearest(const cs_dropcut_tool_t *t, const double p[3], const double s[3],
+                         double q[3])
+{
+    double dx = s[0] - p[0], dy = s[1] - p[1], rho = sqrt(dx * dx + dy * dy), a = t->r_mm - t->c_mm;
+    double f = rho > a ? a / rho : 1;
+    double m[3] = {p[0] + f * dx, p[1] + f * dy, fmax(s[2], p[2] + t->c_mm)};
+    double v[3] = {s[0] - m[0], s[1] - m[1], s[2] - m[2]};
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    double g = l > t->c_mm ? t->c_mm / l : 1; /* inside: s itself */
+    for (int c = 0; c < 3; c++)
+        q[c] = m[c] + g * v[c];
 }
 
 /* Is there a wall at node n: the rasterised top of a neighbour more than CK_WALL steps above or
@@ -417,7 +585,9 @@ static bool wall_at(const ck_t *k, size_t n)
     return false;
 }
 
-/* The scallop and rest material over every node with the cutter over the surface all round. */
+/* The scallop and rest material over every node with the cutter over the surface all round
+ * (cs_dropcheck.h): the path's distance to the surface point s, or where that exceeds H, to the
+ * point q of the ideal envelope nearest to s, whichever is less. */
 static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *far, double h_mm,
                     cs_dropcheck_t *out)
 {
@@ -429,26 +599,42 @@ static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *fa
             continue;
         }
         out->nodes++;
-        double left = k->env[n];
+        long ix = (long)(n % k->mx), iy = (long)(n / k->mx);
+        double s[3] = {k->box[0] + (double)ix * k->step, k->box[1] + (double)iy * k->step, k->top[n]};
+        double un[3];
+        top_normal(k, ix, iy, un);
+        double left = path_thick(k, t, s, un); /* the material over s along the normal */
         size_t arg = (size_t)-1;
         if (left > h_mm) { /* is it within reach at all? */
-            double ideal = ideal_dist(k, t, (long)(n % k->mx), (long)(n / k->mx), &arg);
+            double pc[3] = {0, 0, 0}, q[3];
+            double ideal = ideal_dist(k, t, ix, iy, &arg, pc);
             if (ideal > h_mm) {
                 out->rest_nodes++;
                 if (ideal > out->rest_mm) {
                     out->rest_mm = ideal;
-                    out->rest_at[0] = k->box[0] + (double)(n % k->mx) * k->step;
-                    out->rest_at[1] = k->box[1] + (double)(n / k->mx) * k->step;
+                    memcpy(out->rest_at, s, sizeof out->rest_at);
                 }
-                left -= ideal; /* what the path leaves beyond the best it could do */
+            }
+            if (arg != (size_t)-1 && ideal > CK_TOUCH * h_mm) {
+                tool_nearest(t, pc, s, q);
+                /* from q on, away from the surface: the ideal envelope's normal there */
+                double v[3] = {q[0] - s[0], q[1] - s[1], q[2] - s[2]};
+                double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                for (int c = 0; c < 3; c++)
+                    v[c] = l > 0 ? v[c] / l : un[c];
+                double beyond = path_thick(k, t, q, v);
+                if (beyond < left && ideal <= h_mm) { /* rest under the envelope, <= H */
+                    out->corner_nodes++;
+                    out->corner_left_mm = fmax(out->corner_left_mm, left);
+                }
+                left = fmin(left, beyond);
             }
         }
         if (left > h_mm && arg != (size_t)-1 && k->gap)
             k->gap[arg] = 1; /* the position from which the ideal cutter comes nearest */
         if (left > out->scallop_mm) {
             out->scallop_mm = left;
-            out->scallop_at[0] = k->box[0] + (double)(n % k->mx) * k->step;
-            out->scallop_at[1] = k->box[1] + (double)(n / k->mx) * k->step;
+            memcpy(out->scallop_at, s, sizeof out->scallop_at);
         }
     }
 }
@@ -463,14 +649,12 @@ static cs_err_t maps(ck_t *k, const double box[4], double step_mm)
     k->my = (size_t)floor((box[3] - box[1]) / step_mm) + 1;
     size_t nn = k->mx * k->my;
     k->top = malloc(nn * sizeof *k->top);
-    k->env = malloc(nn * sizeof *k->env);
     k->peak = malloc(nn * sizeof *k->peak);
     k->dropm = malloc(nn * sizeof *k->dropm);
-    if (!k->top || !k->env || !k->peak || !k->dropm)
+    if (!k->top || !k->peak || !k->dropm)
         return CS_ERR_FULL;
     for (size_t n = 0; n < nn; n++) {
         k->top[n] = k->peak[n] = -HUGE_VAL;
-        k->env[n] = k->dcap;
         k->dropm[n] = NAN;
     }
     return CS_OK;
@@ -511,8 +695,12 @@ static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     if (e == CS_OK)
         e = bucket(&k, fmax(t->r_mm / 8, 2 * step_mm));
     if (e == CS_OK) {
-        walk(&k, t, pts, start, npass, out);
+        e = walk(&k, t, pts, start, npass, out);
         out->surf_samples = k.ns;
+    }
+    if (e == CS_OK)
+        e = bucket_tips(&k);
+    if (e == CS_OK) {
         far = malloc(k.mx * k.my);
         if (!far || !interior(&k, (long)ceil(t->r_mm / step_mm), far))
             e = CS_ERR_FULL;
@@ -530,7 +718,10 @@ static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     free(k.idx);
     free(k.cmax);
     free(k.top);
-    free(k.env);
+    free(k.p);
+    free(k.pstart);
+    free(k.pidx);
+    free(k.pzlo);
     free(k.peak);
     free(k.dropm);
     return e;

@@ -16,9 +16,10 @@
  * f(p) = p.z - h(d(p)), h the cutter's profile at horizontal distance d from the axis. h is
  * convex and non-decreasing in d and d is convex in p, so f is concave over the triangle: its
  * maximum is the facet contact (the tangent plane touching the cutter, closed form) when that
- * contact lies inside the triangle, else on an edge, where the 1-D concave maximum is found by
- * golden-section search (OpenCAMLib's facet / edge / vertex split, derived here from concavity).
- * Host only, double precision. */
+ * contact lies inside the triangle, else on an edge, where the 1-D concave maximum is closed-form
+ * for a ball and a flat end and the root of f' for a bull-nose (OpenCAMLib's facet / edge /
+ * vertex split, derived here from concavity). The index is a grid with a pyramid of cell tops
+ * above it, searched by branch and bound (cs_dropcut.c). Host only, double precision. */
 #ifndef CS_DROPCUT_H
 #define CS_DROPCUT_H
 
@@ -38,6 +39,9 @@ typedef struct {
     double v[3][3]; /* vertices, mm */
 } cs_dropcut_tri_t;
 
+/* Levels of the index's pyramid at most: enough for 2^15 cells a side. */
+#define CS_DROPCUT_LEVELS 16
+
 /* The mesh and its index. */
 typedef struct {
     cs_dropcut_tri_t *tri;
@@ -46,13 +50,18 @@ typedef struct {
     double box[6];    /* x0 y0 z0 x1 y1 z1 of the mesh, mm */
     double cell;      /* grid cell size, mm */
     size_t gx, gy;    /* grid cells in x and y */
-    size_t *start;    /* gx * gy + 1 offsets into idx */
-    size_t *idx;      /* triangle numbers, by cell */
+    size_t *start;    /* gx * gy + 1 offsets into ent */
+    struct cs_dropcut_ent *ent; /* each cell's triangles with their boxes and tops, highest first */
     unsigned *stamp;  /* per triangle: the query that last visited it */
     unsigned query;   /* the current query's number */
-    double (*bb)[5];  /* per triangle: x0 y0 x1 y1 of its xy box and its highest z, mm */
-    double *ctop;     /* per cell: the highest z of the triangles listed in it, mm */
-    struct cs_dropcut_cq *cq; /* scratch: the cells of one query's footprint, by bound */
+    double (*pl)[4];  /* per triangle: its plane's unit normal, nz >= 0 (all 0 when degenerate or
+                       * vertical), and n . v0 (mm) */
+    double *top;      /* per node of the pyramid: the highest z of the triangles listed under it,
+                       * mm (level 0 the cells, a node above the 2 x 2 nodes below it) */
+    size_t lev;       /* levels; the last has one node */
+    size_t lgx[CS_DROPCUT_LEVELS], lgy[CS_DROPCUT_LEVELS]; /* nodes in x and y, by level */
+    size_t loff[CS_DROPCUT_LEVELS]; /* a level's first node in top */
+    struct cs_dropcut_cq *cq; /* scratch: the heap of one query's nodes, by bound */
     size_t cqcap;
 } cs_dropcut_mesh_t;
 

@@ -216,6 +216,12 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
                 "reaches from above, up to %.4f mm of rest material at (%.3f, %.3f)\n",
                 ck.rest_nodes, (double)ck.rest_nodes * step * step, ck.rest_mm, ck.rest_at[0],
                 ck.rest_at[1]);
+    if (ck.corner_nodes > 0)
+        fprintf(stderr,
+                "toolpath: check: rest material <= H: %zu nodes (%.2f mm^2) in corners the "
+                "cutter's shape keeps off, scallop measured from the best envelope it can leave "
+                "there; up to %.4f mm left over the surface\n",
+                ck.corner_nodes, (double)ck.corner_nodes * step * step, ck.corner_left_mm);
     /* Waterline levels lie dz apart in z, far apart in xy on shallow ground: there the scallop
      * exceeds H by design (docs/surfaces.md); it is reported, the gouge alone decides. */
     bool gouged = ck.gouge_mm > a->tol, high = ck.scallop_mm > a->po.scallop_mm && !a->waterline;

@@ -14,25 +14,26 @@
 #include <termios.h>
 #include <time.h>
 
-/* Called with the lock held: takes the device's report from the running chunk's result. */
+/* Called with the lock held: takes the device's report from the running chunk's result. The
+ * feed (FS:) is the device's speed over its own clock when the report carries it (protocol 3's
+ * STATUS tick, the GPIO step thread's), else over the host's time of seeing each new position
+ * (Modbus) over a longer window (cs_feedrate; docs/controller.md "FS"). At rest: 0. */
 static void take_status(cs_grbl_dev_t *d, const cs_stream_result_t *r)
 {
     if (r->dev_state == 0xFF)
         return;
-    double now = cs_serial_now_s(), dist2 = 0;
-    bool moved = false;
-    for (unsigned i = 0; i < d->axes && i < CS_PROTO_AXES_MAX; i++) {
-        if (r->dev_pos[i] != d->s.pos[i])
-            moved = true;
-        double mm = (double)(r->dev_pos[i] - d->s.pos[i]) * 65536.0 / d->steps_per_mm[i];
-        dist2 += mm * mm;
-    }
-    if (moved && d->s.have_pos && now > d->t_move)
-        d->s.speed_mm_min = sqrt(dist2) / (now - d->t_move) * 60.0;
-    else if (!moved && now - d->t_move > 0.5)
-        d->s.speed_mm_min = 0;
-    if (moved || !d->s.have_pos)
-        d->t_move = now;
+    if (r->dev_timed)
+        cs_feedrate_add_tick(&d->fr, r->dev_tick, d->tick_hz, r->dev_pos);
+    else
+        cs_feedrate_add_host(&d->fr, cs_serial_now_s(), r->dev_pos);
+    double spmm[CS_PROTO_AXES_MAX], v;
+    for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
+        spmm[i] = d->steps_per_mm[i] > 0 ? d->steps_per_mm[i] / 65536.0 : 1.0;
+    if (!cs_proto_state_busy(r->dev_state) && r->dev_state != CS_PROTO_STATE_HELD) {
+        d->s.speed_mm_min = 0; /* at rest; the next motion starts a new window */
+        cs_feedrate_reset(&d->fr);
+    } else if (cs_feedrate_mm_min(&d->fr, d->axes, spmm, &v))
+        d->s.speed_mm_min = v;
     memcpy(d->s.pos, r->dev_pos, sizeof d->s.pos);
     d->s.have_pos = true;
     d->s.dev_state = r->dev_state;

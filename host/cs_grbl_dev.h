@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cs_feedrate.h"
 #include "cs_grbl_link.h"
 #include "cs_machine.h"
 #include "cs_proto.h"
@@ -40,7 +41,7 @@ typedef struct {
     bool have_pos;   /* the device has reported a position */
     int32_t pos[CS_PROTO_AXES_MAX]; /* steps, from its last STATUS */
     uint8_t dev_state;              /* CS_PROTO_STATE_*, 0xFF: none yet */
-    double speed_mm_min;            /* between the last two different reported positions */
+    double speed_mm_min;            /* FS: the device's speed over a short window (cs_feedrate) */
     bool failed;                    /* a chunk ended other than done or cancelled */
     char why[200];                  /* ... why */
     unsigned cancelled;             /* runs ended by cancel (interrupt) so far */
@@ -78,7 +79,7 @@ typedef struct {
     int cur_ov[2];                /* the running job's planned feed, rapid (%; worker only) */
     cs_proto_override_t run_ov;   /* what cs_stream_run sends (worker thread only, as above) */
     cs_stream_result_t *cur;         /* the running chunk's result (worker thread only) */
-    double t_move;                   /* when the reported position last changed */
+    cs_feedrate_t fr;                /* timed positions, for FS (under mu) */
     cs_grbl_dev_snap_t s;
 } cs_grbl_dev_t;
 

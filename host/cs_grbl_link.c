@@ -287,9 +287,13 @@ void cs_grbl_link_where(cs_grbl_link_t *k, cs_stream_result_t *r)
         return;
     const cs_gpio_link_t *g = cs_gpio_link_of(&k->l);
     size_t ex = cs_gpio_run_executed(&g->run);
-    for (; k->sum_k < ex && k->sum_k < g->nsegs; k->sum_k++)
+    for (; k->sum_k < ex && k->sum_k < g->nsegs; k->sum_k++) {
         for (unsigned i = 0; i < CS_PROTO_AXES_MAX && i < CS_AXES; i++)
             k->sum[i] += g->segs[k->sum_k].steps[i];
+        k->ticks += g->segs[k->sum_k].ticks;
+    }
     memcpy(r->dev_pos, k->sum, sizeof r->dev_pos);
+    r->dev_timed = true;
+    r->dev_tick = k->ticks;
     r->dev_state = cs_gpio_run_paused(&g->run) ? CS_PROTO_STATE_HELD : CS_PROTO_STATE_RUNNING;
 }

@@ -31,6 +31,7 @@ typedef struct {
     bool running;
     size_t sum_k;                   /* segments summed into sum */
     int32_t sum[CS_PROTO_AXES_MAX]; /* steps: where the chunk started, plus those segments */
+    uint32_t ticks; /* the step thread's clock: ticks of every segment it executed (wraps) */
 } cs_grbl_link_t;
 
 /* Picks the link of cfg for machine m with [homing] ctl (both outlive k) and reads where the
@@ -52,7 +53,9 @@ cs_err_t cs_grbl_link_run(cs_grbl_link_t *k, const cs_stream_job_t *job,
                           const int32_t pos[CS_PROTO_AXES_MAX], const cs_joblink_ctl_t *c,
                           cs_stream_result_t *r, cs_grbl_link_event_fn ev, void *ev_ctx);
 /* While a GPIO chunk runs: its position now into r->dev_pos (whole segments executed by the
- * step thread) and r->dev_state (HELD once a pause is at rest). Nothing on Modbus: its run
+ * step thread), the step thread's time of it into r->dev_tick (r->dev_timed: the segments'
+ * ticks summed, so the speed is the executed one) and r->dev_state (HELD once a pause is at
+ * rest). Nothing on Modbus: its run
  * fills r from the device's registers. Worker thread (from the run's progress output). */
 void cs_grbl_link_where(cs_grbl_link_t *k, cs_stream_result_t *r);
 

@@ -314,6 +314,8 @@ static void on_status(run_t *s, const cs_proto_status_t *st)
     s->r->dev_state = st->state;
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
         s->r->dev_pos[i] = i < st->axes ? st->pos[i] : 0;
+    s->r->dev_timed = (st->flags & CS_PROTO_STATUS_TICK) != 0;
+    s->r->dev_tick = st->tick;
     if (!s->open)
         return;
     if (cs_link_unacked(&s->link) == 0)
@@ -373,7 +375,11 @@ static int pump_out(run_t *s, uint32_t now)
             return 0;
         }
         if (e == CS_OK && cs_serial_write(s->o->ser, b, n) != 0) {
-            snprintf(s->r->why, sizeof s->r->why, "write failed: %s", strerror(errno));
+            /* a hung-up line (the device closed it, a USB adapter pulled) fails the write with
+             * EIO, ENXIO or EPIPE before a read sees the hang-up: the same event, one text */
+            bool hup = errno == EIO || errno == ENXIO || errno == EPIPE;
+            snprintf(s->r->why, sizeof s->r->why, "%s: %s",
+                     hup ? "the line closed (write)" : "write failed", strerror(errno));
             finish(s, s->open ? CS_STREAM_CLOSED : CS_STREAM_NO_DEVICE);
             return -1;
         }
@@ -591,9 +597,10 @@ static void check_hello(run_t *s)
 {
     cs_stream_result_t *r = s->r;
     const cs_proto_hello_t *h = &r->hello;
-    if (h->version != CS_PROTO_VERSION)
-        snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u",
-                 (unsigned)h->version, (unsigned)CS_PROTO_VERSION);
+    if (h->version < CS_PROTO_VERSION_MIN || h->version > CS_PROTO_VERSION)
+        snprintf(r->why, sizeof r->why, "protocol version %u, this host speaks %u..%u",
+                 (unsigned)h->version, (unsigned)CS_PROTO_VERSION_MIN,
+                 (unsigned)CS_PROTO_VERSION);
     else if (control_only(s->job)) {
         if (h->axes != s->o->axes)
             snprintf(r->why, sizeof r->why, "the device has %u axes, the machine file %u",

@@ -111,6 +111,9 @@ typedef struct {
     size_t dev_error_msg;        /* DEVICE_ERROR: job number of the message it is about (0: ?) */
     uint8_t dev_state;           /* last STATUS */
     int32_t dev_pos[CS_PROTO_AXES_MAX];
+    bool dev_timed;   /* dev_tick is the device's clock when dev_pos was sampled (protocol 3's
+                       * STATUS; the GPIO link's step thread); false: only the host's timing */
+    uint32_t dev_tick; /* ... executor ticks (hello.tick_hz a second), wraps at 2^32 */
     size_t resume_from;   /* the run started after this message (o->resume_from, or the
                            * device's answer to --resume) */
     size_t resume_done;   /* --resume: the last message the device had finished then */

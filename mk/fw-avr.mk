@@ -13,8 +13,8 @@ AVR_PORT    := firmware/ports/avr
 AVR_MCU     := -mmcu=atmega328p -DF_CPU=16000000UL
 # The 2 KB build: segments only (the host plans; no tracer or planner on board) with machine
 # control (CS_FW_CTL=1: limits, e-stop, probe, homing and jogs at constant speed, spindle PWM),
-# a 7-slot motion queue, a 2-frame link window with 40-byte payloads (STATUS with 4 axes is the
-# longest message the device sends or needs), a 4-segment executor ring (20 ms of 5 ms segments;
+# a 7-slot motion queue, a 2-frame link window with 40-byte payloads (STATUS with 3 axes and its
+# tick is the longest message the device sends or needs), a 4-segment executor ring (20 ms of 5 ms segments;
 # 34 B a slot), an 8-entry sequence map (ring + 3), 2 waiting EVENTs; x/y at 100 mm/s (8000
 # steps/s at 80 steps/mm), what the step interrupt sustains with room for the link
 # (docs/firmware-avr.md); 2 waiting ERRORs (a 2-frame window) and 16-byte UART reads a pass (on

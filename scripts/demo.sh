@@ -4,9 +4,9 @@
 # device's check report: max deviation from the exact curves, job time, retransmissions, final
 # position, and the picture it drew. Part 1 streams step segments; part 2 the same drawing as
 # cubic curves the device interpolates itself, over a line paced at 115200 baud; part 3 keeps the
-# first demo's flattening picture; part 4 makes the Utah teapot's iso wireframe and ball-end
-# finishing path (`curvestep toolpath --gcode`), plans them and runs them through the simulator,
-# which checks and draws them; part 5 draws one curves file holding every basis of the core
+# first demo's flattening picture; part 4 makes the Utah teapot's iso wireframe and drop-cutter
+# finishing path (ball R 2 mm, gouge-free from above: `curvestep toolpath --cutter --gcode`),
+# plans them and runs them through the simulator, which checks and draws them; part 5 draws one curves file holding every basis of the core
 # (flatten, plan, simulator). Exits non-zero when any check fails. Every background process
 # is bounded by `timeout` and killed on exit.
 set -u
@@ -98,8 +98,10 @@ else
 fi
 
 # demo 4: the Utah teapot (tests/data/teapot, 10 mm per unit): its iso wireframe for a pen plotter
-# and its ball-end finishing path, each written as G-code by `curvestep toolpath`, planned, and
-# executed and drawn by the simulator (coarse settings keep it to a few seconds).
+# and its drop-cutter finishing path for a router (ball R 2 mm dropped onto the surface from above,
+# so it never gouges; the tool tip programmed, with feeds), each written as G-code by `curvestep
+# toolpath`, planned, and executed and drawn by the simulator (H 0.2 mm, tol 0.02 mm: about 1.5 s
+# of planning; the finer H 0.05 / tol 0.01 is docs/benchmarks.md's bench_dropcut).
 TEAPOT=tests/data/teapot/newell_teapot.txt
 echo
 echo "demo 4: the Utah teapot through the simulator (toolpath --gcode, plan, curvestep-sim)"
@@ -134,7 +136,7 @@ surface() {
 # The wireframe is projected to the iso view by toolpath (a 2D job): the simulator draws it as is.
 surface teapot-wireframe top --view iso --lines 4
 echo
-surface teapot-finish iso --ball 2 --scallop 0.5
+surface teapot-finish iso --cutter ball:2 --scallop 0.2 --tol 0.02
 
 # demo 5: every basis of the core in one picture, from one curves file (docs/inputs.md): flattened
 # (chords within 0.01 mm, measured), then planned and run by the simulator against the file.

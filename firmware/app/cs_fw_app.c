@@ -243,6 +243,9 @@ cs_err_t cs_fw_app_init_cfg(cs_fw_app_t *app, const cs_machine_t *m, uint32_t bo
 {
     if (app == NULL || m == NULL || c == NULL || c->clock == NULL || c->clock_hz < 1000u)
         return CS_ERR_ARG;
+    /* a STATUS this build's frames cannot carry (4 axes need CS_FRAME_PAYLOAD_MAX >= 44) */
+    if (m->n_axes > CS_PROTO_AXES_MAX || CS_PROTO_LEN_STATUS(m->n_axes) > CS_FRAME_PAYLOAD_MAX)
+        return CS_ERR_RANGE;
     cs_fw_motion_zero(app, sizeof *app);
     app->m = m;
     app->cfg = *c;

@@ -12,7 +12,7 @@
  *   -DCS_FW_CURVES=0                                                  2720 B M3,  2616 B AVR
  *   -DCS_FW_CURVES=0 -DCS_FW_QUEUE=8 -DCS_LINK_WINDOW=2
  *     -DCS_FRAME_PAYLOAD_MAX=27 -DCS_STEPPER_RING=8                    1196 B M3,  1142 B AVR
- *   (protocol 1; the AVR image now has -DCS_FRAME_PAYLOAD_MAX=40 for protocol 2's STATUS and
+ *   (protocol 1; the AVR image now has -DCS_FRAME_PAYLOAD_MAX=40 for protocol 3's 3-axis STATUS and
  *   -DCS_FW_ERRQ=2 -DCS_FW_RX_CHUNK=16: 1198 B AVR)
  * The macros:
  *   CS_FW_QUEUE       motion-queue slots (HELLO queue_size = link credits; the most a run may

@@ -732,9 +732,15 @@ void cs_fw_motion_status(const cs_fw_motion_t *a, cs_proto_status_t *st)
     st->queue_fill = a->qcount;
     st->last_seq = a->exec_seq;
     st->axes = a->m->n_axes;
+    /* one snapshot: the step interrupt masked while the counters and the clock are read, so
+     * tick is the executor's time of this very position (a host divides position differences
+     * by tick differences: the device's speed, whatever the line's delays; docs/protocol.md) */
+    uint32_t s = port_irq_save();
+    st->tick = port_ticks_now();
     for (unsigned i = 0; i < CS_PROTO_AXES_MAX; i++)
-        st->pos[i] = i < a->m->n_axes ? cs_fw_motion_position(a, i) : 0;
-    st->flags = a->job_flags;
+        st->pos[i] = i < a->m->n_axes ? cs_stepper_position(&a->st, i) : 0;
+    port_irq_restore(s);
+    st->flags = (uint8_t)(a->job_flags | CS_PROTO_STATUS_TICK);
     st->job_id = a->job_id;
     st->done = cs_fw_motion_job_no(a, a->exec_item);
     st->recv = cs_fw_motion_job_no(a, a->popped + a->qcount);

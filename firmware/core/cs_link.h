@@ -18,7 +18,7 @@
 #include "cs_proto.h"
 
 /* Unacknowledged frames the sender keeps for retransmission: a power of two, 1..128 (a 2 KB AVR
- * build may use -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40: STATUS with 4 axes). */
+ * build may use -DCS_LINK_WINDOW=2 -DCS_FRAME_PAYLOAD_MAX=40: STATUS with 3 axes and its tick). */
 #ifndef CS_LINK_WINDOW
 #define CS_LINK_WINDOW 8
 #endif

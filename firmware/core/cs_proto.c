@@ -9,10 +9,11 @@ CS_STATIC_ASSERT(CS_PROTO_AXES_MAX == CS_AXES, proto_axes_match_machine);
 CS_STATIC_ASSERT(CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX) <= CS_PROTO_LEN_MAX, status_fits);
 CS_STATIC_ASSERT(CS_PROTO_LEN_SEGMENT <= CS_PROTO_LEN_MAX, segment_fits);
 CS_STATIC_ASSERT(CS_PROTO_LEN_SETPOS <= CS_PROTO_LEN_MAX, setpos_fits);
-/* The link must at least carry its own control messages, status and segments in every build;
- * a build whose CS_FRAME_PAYLOAD_MAX is below CS_PROTO_LEN_CURVE cannot carry curves (the link
- * then refuses them with CS_ERR_ARG). */
-CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX), frame_fits_status);
+/* The link must at least carry its own control messages, a three-axis status and segments in
+ * every build (a 4-axis STATUS needs 44 bytes: cs_fw_app_init refuses a machine whose STATUS the
+ * build's frames cannot carry); a build whose CS_FRAME_PAYLOAD_MAX is below CS_PROTO_LEN_CURVE
+ * cannot carry curves (the link then refuses them with CS_ERR_ARG). */
+CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_STATUS(3), frame_fits_status);
 CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_SEGMENT, frame_fits_seg);
 CS_STATIC_ASSERT(CS_FRAME_PAYLOAD_MAX >= CS_PROTO_LEN_ACK, frame_fits_ack);
 
@@ -358,6 +359,9 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
                    : m->type == CS_PROTO_EVENT ? m->u.event.axes
                                                : 0;
     size_t n = msg_len(m->type, axes);
+    bool tick = m->type == CS_PROTO_STATUS && (m->u.status.flags & CS_PROTO_STATUS_TICK);
+    if (m->type == CS_PROTO_STATUS && !tick)
+        n = (size_t)CS_PROTO_LEN_STATUS2(axes);
     if (cap < n)
         return CS_ERR_FULL;
     buf[0] = m->type;
@@ -392,6 +396,8 @@ cs_err_t cs_proto_encode(const cs_proto_msg_t *m, uint8_t *buf, size_t cap, size
         put32(buf + 12 + 4 * axes, m->u.status.job_id);
         put32(buf + 16 + 4 * axes, m->u.status.done);
         put32(buf + 20 + 4 * axes, m->u.status.recv);
+        if (tick)
+            put32(buf + 24 + 4 * axes, m->u.status.tick);
         break;
     case CS_PROTO_SETPOS:
         buf[1] = m->u.setpos.flags;
@@ -447,7 +453,9 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
     size_t n = msg_len(type, axes);
     if (n == 0)
         return CS_ERR_UNSUPPORTED;
-    if (len != n)
+    /* a protocol 2 STATUS: no tick, and its flags must say so (checked below) */
+    bool short_status = type == CS_PROTO_STATUS && len == (size_t)CS_PROTO_LEN_STATUS2(axes);
+    if (len != n && !short_status)
         return CS_ERR_FRAME;
     *m = (cs_proto_msg_t){0};
     m->type = type;
@@ -482,6 +490,12 @@ cs_err_t cs_proto_decode(const uint8_t *buf, size_t len, cs_proto_msg_t *m)
         m->u.status.job_id = get32(buf + 12 + 4 * axes);
         m->u.status.done = get32(buf + 16 + 4 * axes);
         m->u.status.recv = get32(buf + 20 + 4 * axes);
+        if ((m->u.status.flags & CS_PROTO_STATUS_TICK) != 0 && short_status)
+            return CS_ERR_FRAME; /* the flag promises a tick the length lacks */
+        if ((m->u.status.flags & CS_PROTO_STATUS_TICK) == 0 && !short_status)
+            return CS_ERR_FRAME; /* 4 bytes nobody named */
+        if (!short_status)
+            m->u.status.tick = get32(buf + 24 + 4 * axes);
         break;
     case CS_PROTO_SETPOS:
         m->u.setpos.flags = buf[1];

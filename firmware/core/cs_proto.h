@@ -14,8 +14,12 @@
 #include "cs_segment.h"
 
 /* 2: STATUS carries the job's confirmed progress (flags, job id, done, received); QUERY and
- * SETPOS (issue 17: resume from what the device did). */
-#define CS_PROTO_VERSION 2
+ * SETPOS (issue 17: resume from what the device did). 3: STATUS carries the executor's tick of
+ * its position sample (issue 21: the speed a host reports is the device's, not its own timing
+ * of arrivals). A host takes a device of CS_PROTO_VERSION_MIN..CS_PROTO_VERSION: protocol 2's
+ * STATUS is the same without the tick (CS_PROTO_LEN_STATUS2, flag CS_PROTO_STATUS_TICK clear). */
+#define CS_PROTO_VERSION     3
+#define CS_PROTO_VERSION_MIN 2
 /* Axes a hello or a status may announce (x, y, z, a: cs_machine.h's CS_AXES). */
 #define CS_PROTO_AXES_MAX 4
 
@@ -49,7 +53,8 @@ typedef enum {
 #define CS_PROTO_LEN_ACK       14
 #define CS_PROTO_LEN_PING      5
 #define CS_PROTO_LEN_HELLO     15
-#define CS_PROTO_LEN_STATUS(n) (24 + 4 * (n))
+#define CS_PROTO_LEN_STATUS(n)  (28 + 4 * (n)) /* with the tick (protocol 3) */
+#define CS_PROTO_LEN_STATUS2(n) (24 + 4 * (n)) /* without it (protocol 2) */
 #define CS_PROTO_LEN_ERROR     4
 #define CS_PROTO_LEN_SEGMENT   (5 + 4 * CS_AXES)
 #define CS_PROTO_LEN_CURVE     53
@@ -77,7 +82,8 @@ typedef enum {
 /* STATUS flags: what the device knows since its boot. */
 #define CS_PROTO_STATUS_JOB 0x01u /* a SETPOS numbered the job: job_id, done, recv are valid */
 #define CS_PROTO_STATUS_POS 0x02u /* a SETPOS stated the position: pos is the machine's */
-#define CS_PROTO_STATUS_ALL (CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS)
+#define CS_PROTO_STATUS_TICK 0x04u /* tick is on the wire (protocol 3; the length says so too) */
+#define CS_PROTO_STATUS_ALL (CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS | CS_PROTO_STATUS_TICK)
 /* SETPOS flags. */
 #define CS_PROTO_SETPOS_POS 0x01u /* set the position counters to pos[] (device idle only) */
 
@@ -126,6 +132,9 @@ typedef struct {
     uint32_t job_id;                /* the job SETPOS named (0: none since boot) */
     uint32_t done; /* job number of the last queue item the executor finished (0: none) */
     uint32_t recv; /* job number of the last queue item received (done..recv: still to run) */
+    /* with CS_PROTO_STATUS_TICK: the executor's clock (port_ticks_now, HELLO tick_hz a second,
+     * wraps at 2^32: compare differences) when pos was sampled; else 0 and not on the wire */
+    uint32_t tick;
 } cs_proto_status_t;
 
 /* SETPOS: from the next queue item on, items are numbered base+1, base+2, ... in job job_id;

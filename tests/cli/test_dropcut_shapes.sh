@@ -3,8 +3,9 @@
 # revolution (an outer wall, a rounded rim, an inner wall and a bottom: steep inside and out) and
 # on an n-sided (Varady) patch: every strategy is gouge-free by the independent --check, raster
 # and raster+waterline leave at most H for every cutter, and the G-code plans on the router and
-# passes the simulator's check. Coarse H and tol on small parts keep it to seconds of CPU; the
-# teapot's figures are in the benchmark (tests/bench/bench_dropcut.c).
+# passes the simulator's check; and the check's own measures against hand formulas (the cusp of
+# ball passes over a plane, the rest material in a V groove). Coarse H and tol on small parts
+# keep it to seconds of CPU; the teapot's figures are in the benchmark (tests/bench/bench_dropcut.c).
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
 need_bin "$CS" "$SIM"
@@ -71,6 +72,47 @@ for s in cup pent; do
     expect "$s: simulator check passes" [ $? -eq 0 ]
     expect "$s: simulator final position exact" grep -q 'rounded to steps: exact' "$T/$s.sim"
 done
+
+# The check's measures against hand formulas. (1) Passes of a ball R, w apart, over a plane leave
+# the cusp R - sqrt(R^2 - (w/2)^2) over the midline (z-map nodes lie on it: the map starts R
+# before the plane, 0.05 mm apart); the check's cutter positions are at most 0.05 mm apart along
+# a pass, so the ray from a node may meet a ball up to 0.025 mm along the pass from its axis:
+# at most R - sqrt(R^2 - (w/2)^2 - 0.025^2).
+cat >"$T/plane.txt" <<'EOF'
+curvestep-surfaces 1
+bezier 1 1
+  10 10 -15   10 20 -15
+  20 10 -15   20 20 -15
+EOF
+run "plane: ball passes 1 mm apart" 0 toolpath --patches "$T/plane.txt" --cutter ball:1.5 \
+    --stepover 1 --scallop 0.2 --tol 0.02 --check
+g=$(sed -n 's/.*scallop \([0-9.]*\) mm.*/\1/p' "$T/err")
+expect "plane: scallop on the cusp formula 0.085786 .. 0.085995 mm ($g)" awk -v g="$g" \
+    'BEGIN { R = 1.5; w = 1; lo = R - sqrt(R * R - w * w / 4); hi = R - sqrt(R * R - w * w / 4 - 0.025 ^ 2)
+             exit !(g != "" && g >= lo - 1e-6 && g <= hi + 1e-6) }'
+# (2) A 90-degree V groove (z = |x - 15| - 15): a ball R rests on both flanks, its centre
+# R sqrt 2 above the valley, which keeps R (sqrt 2 - 1) of rest material there (the deepest
+# unreachable node); the flanks stay more than H from that ball where
+# sqrt(x^2 + (R sqrt 2 - x)^2) > R + H, |x| < (R sqrt 2 - sqrt(2 (R + H)^2 - 2 R^2)) / 2 = 0.667:
+# 27 node columns (+-2) along the valley's interior (its 10 mm less R at each end: 139 to 143
+# rows).
+cat >"$T/vee.txt" <<'EOF'
+curvestep-surfaces 1
+bezier 1 1
+  10 10 -10   10 20 -10
+  15 10 -15   15 20 -15
+bezier 1 1
+  15 10 -15   15 20 -15
+  20 10 -10   20 20 -10
+EOF
+run "vee: raster ball" 0 toolpath --patches "$T/vee.txt" --cutter ball:1.5 --scallop 0.1 \
+    --tol 0.02 --check && gs "vee raster ball" 0.1
+v=$(sed -n 's/.*unreachable: \([0-9]*\) nodes.*up to \([0-9.]*\) mm of rest.*/\1 \2/p' "$T/err")
+expect "vee: rest R (sqrt 2 - 1) = 0.6213 mm at the valley, 0.667 mm each side ($v)" \
+    awk -v v="$v" 'BEGIN { split(v, a, " "); R = 1.5; H = 0.1; d = a[2] - R * (sqrt(2) - 1)
+        cols = 2 * int((sqrt(2) * R - sqrt(2 * (R + H) ^ 2 - 2 * R * R)) / 2 / 0.05) + 1
+        exit !(a[2] != "" && d <= 0.001 && d >= -0.002 && a[1] >= (cols - 2) * 139 &&
+               a[1] <= (cols + 2) * 143) }'
 
 # The combination serves both: raster passes (z varies along them) and waterline contours
 # (constant z) over the cup's walls.

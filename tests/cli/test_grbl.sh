@@ -336,18 +336,24 @@ expect "blend: the picture draws the laser power, its width following the duty" 
     [ "$(grep -o 'class="power"[^>]*stroke-width="[0-9.]*"' "$T/blend.svg" | sed 's/.*stroke-width=//' | sort -u | wc -l)" -ge 10 ]
 
 # 11. feed override on the running chunk: a 4 s straight cut at 1200 mm/min (real time), 0x91
-#     (+10 %) once it runs; the device's reported feed (FS:, from its STATUS positions) rises by
-#     10 % (within 4 %) while the same chunk still runs (reports in Run from 0.6 s after the
-#     byte), Ov shows 110, and the final position is exact (the check also bounds the acceleration).
+#     (+10 %) once it is half done; the device's reported feed (FS:, the device's speed over its
+#     own clock: STATUS positions and ticks, cs_feedrate) rises by 10 % (within 4 %) while the
+#     same chunk still runs (reports in Run from 0.6 s after the byte), Ov shows 110, and the
+#     final position is exact (the check also bounds the acceleration). Before the byte, every
+#     report in Run past the ramp shows 1200 within 2 % (the client computes where the ramp and
+#     the FS window end from $120: grbl_client.py override).
 printf '%s\n' 'G21 G90' 'G1 X80 F1200' >"$T/ov.nc"
 start_sim ov --speed 1 --reference "$T/ov.nc" --check
 start_grbl ov
-client "$GPTY" override "$T/ov.nc" 91 >"$T/ov.out"; rc=$?
+client "$GPTY" override "$T/ov.nc" 91 40 1200 >"$T/ov.out"; rc=$?
 stop_all
 ov_before=$(sed -n 's/^before: //p' "$T/ov.out")
 ov_after=$(sed -n 's/^after: //p' "$T/ov.out")
 expect "ov: client exit 0" [ $rc -eq 0 ]
 expect "ov: feed before near 1200 mm/min ($ov_before)" awk -v b="$ov_before" 'BEGIN {exit !(b > 1100 && b < 1300)}'
+expect "ov: at least 5 reports past the ramp ($(grep '^steady:' "$T/ov.out"))" \
+    grep -qE '^steady: ([5-9]|[1-9][0-9]+) ' "$T/ov.out"
+expect "ov: FS 1200 +- 2 % on every one ($(grep '^off:' "$T/ov.out"))" grep -qx 'off:' "$T/ov.out"
 expect "ov: reports in Run after the byte" grep -qE '^after-reports: [1-9]' "$T/ov.out"
 expect "ov: feed x 1.10 +- 0.04 mid-chunk ($ov_before -> $ov_after)" \
     awk -v b="$ov_before" -v a="$ov_after" 'BEGIN {exit !(b > 0 && a / b > 1.06 && a / b < 1.14)}'

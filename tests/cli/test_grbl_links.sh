@@ -14,7 +14,8 @@
 #    machine -99, 0, 0; the probe surface is machine z -4; the x max switch is machine x -45):
 #    $H ok at -99 0 0, G38.2 touches at z -4, M3 is error:20, a move past the switch is ALARM:1
 #    stopped at -45 with Pn:X, then G-code is locked (error:9) until $X; a 0x85 stops a jog
-#    short of its end, and the GPIO state file keeps where it stopped; a new session (Modbus:
+#    short of its end, and the GPIO state file keeps where it stopped; FS: on a straight cut
+#    at F1200 is 1200 within 2 % on every report past the ramp; a new session (Modbus:
 #    the device's registers; GPIO: the state file) starts where the machine stands.
 # Every process is bounded by `timeout` and killed on exit. Prints "cli: N passed, M failed".
 set -u
@@ -157,6 +158,19 @@ expect "gpio reset: stopped short of X+50 ($n steps, all +x)" [ "$n" -gt 0 ] && 
 expect "gpio reset: Idle where the record's steps put it (x $xr)" \
     awk -v x="$xr" -v s="$s" -v x0="$wx" 'BEGIN { exit !(x != "" && sprintf("%.3f", (x0 + s) / 80) == x) }'
 expect "gpio reset: the state agrees" grep -q "^pos $((wx + s)) $wy 0 " "$T/gp.csv.state"
+
+# FS: on GPIO the step thread's clock (the executed segments' ticks against their steps): a
+# straight 40 mm cut at F1200 from a fresh state (X0), every report in Run past the ramp within
+# 2 % of 1200 (the client computes where from $120; the byte, 0x90 feed 100 %, changes nothing)
+printf '%s\n' 'G21 G90' 'G1 X40 F1200' >"$T/gf.nc"
+start_grbl gf --gpio "record:$T/gf.csv"
+client "$GPTY" override "$T/gf.nc" 90 30 1200 >"$T/gf.out"; rc=$?
+stop_grbl
+expect "gpio fs: client exit 0, ends at X40" \
+    [ $rc -eq 0 -a -n "$(grep '^final: <Idle|MPos:40.000,0.000,0.000|' "$T/gf.out")" ]
+expect "gpio fs: at least 5 reports past the ramp ($(grep '^steady:' "$T/gf.out"))" \
+    grep -qE '^steady: ([5-9]|[1-9][0-9]+) ' "$T/gf.out"
+expect "gpio fs: FS 1200 +- 2 % on every one ($(grep '^off:' "$T/gf.out"))" grep -qx 'off:' "$T/gf.out"
 
 # machine control on GPIO: the switches and probe of the machine file (see the top)
 M=$T/ctl.ini

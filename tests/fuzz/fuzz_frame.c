@@ -111,11 +111,15 @@ int main(int argc, char **argv)
                                      99,
                                      4,
                                      {-1, 2, -300000, 40000},
-                                     CS_PROTO_STATUS_JOB,
+                                     CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_TICK,
                                      0x12345678u,
                                      1000u,
-                                     1005u};
+                                     1005u,
+                                     0xFFFFFF00u};
     write_seed(argv[1], "status", &m, 2);
+    m.u.status.flags = CS_PROTO_STATUS_JOB; /* protocol 2's, without the tick */
+    m.u.status.tick = 0;
+    write_seed(argv[1], "status2", &m, 2);
     m.type = CS_PROTO_ERROR;
     m.u.error = (cs_proto_error_t){CS_ERR_LIMIT, 77};
     write_seed(argv[1], "error", &m, 3);

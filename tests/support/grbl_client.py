@@ -22,9 +22,12 @@ usage: grbl_client.py PTY|HOST:PORT COMMAND ...
   idle            (no soft reset first) waits for Idle, prints "final: <...>"
   waitfor STATE   (no soft reset first) waits for the state STATE (Alarm, Idle...), prints
                   the pushed lines seen meanwhile (ALARM:N...) and "state: <...>"
-  override FILE BYTE  writes FILE's lines (< 128 bytes) at once, sends the real-time BYTE (hex)
-                  mid-job and prints the median FS: feed before and after it ("before: F",
-                  "after: F", "after-reports: N" taken in Run), the Ov field and "final: <...>"
+  override FILE BYTE X F  prints $120 ("accel: A"), writes FILE's lines (< 128 bytes: a
+                  straight cut along +X at F mm/min) at once, sends the real-time BYTE (hex)
+                  once a report in Run is at X >= X mm, prints the median FS: feed before and
+                  after it ("before: F", "after: F", "after-reports: N" taken in Run), the Ov
+                  field, "final: <...>", and of the reports before the byte past the ramp
+                  "steady: N from X0" and "off: X:F ..." (those not within 2 % of F)
   raw BYTE...     sends real-time bytes (hex, e.g. 18 for Ctrl-X) and prints what comes back
                   (the first line within the deadline, then lines until 1 s without one)
 Every command but idle starts with a soft reset (Ctrl-X) and the welcome line.
@@ -253,11 +256,41 @@ def feed_of(st):
     return None
 
 
-def override_mid_job(g, lines, byte):
-    """Streams lines by character counting, then polls ? every 0.1 s: once 6 reports in Run
-    show a feed, sends the override byte; prints "before: F" and "after: F" (medians, mm/min;
-    after: the reports from 0.6 s after the byte while still in Run), "after-reports: N",
-    the Ov field seen after the byte, and the final report."""
+def setting(g, n):
+    """Grbl's $N from $$ (send-response), as a float."""
+    g.write(b"$$\n")
+    val = None
+    while True:
+        line = g.need()
+        if is_ack(line):
+            return val
+        if line.startswith("$%d=" % n):
+            val = float(line.split("=", 1)[1])
+
+
+def x_of(st):
+    """The first coordinate of a status report's position (mm)."""
+    return float(st.split("|")[1].split(":")[1].split(",")[0])
+
+
+# The front end's FS window over device time (host/cs_feedrate.h CS_FEEDRATE_WINDOW_DEV_S), s,
+# and how long it may have seen no STATUS on a loaded machine (its window then starts earlier).
+FS_WINDOW_S, FS_STALL_S = 0.2, 0.3
+
+
+def override_mid_job(g, lines, byte, at_x, feed):
+    """Prints the acceleration $120 ("accel: A", mm/s^2), streams lines (a straight cut along +X
+    at feed mm/min) by character counting, then polls ? every 0.1 s: once a report in Run shows
+    X >= at_x, sends the override byte; prints "before: F" and "after: F" (medians, mm/min;
+    after: the reports from 0.6 s after the byte while still in Run), "after-reports: N", the
+    Ov field seen after the byte, the final report, and the reports in Run before the byte past
+    the ramp: "steady: N from X" (X = v^2 / 2a + v (FS_WINDOW_S + FS_STALL_S)) and "off: X:F..."
+    for those whose feed is not within 2 % of feed."""
+    accel = setting(g, 120)
+    print("accel: %g" % accel, flush=True)
+    v = feed / 60.0
+    past = v * v / (2 * accel) + v * (FS_WINDOW_S + FS_STALL_S)
+    steady, off = 0, []
     data = b"".join((line + "\n").encode() for line in lines)
     g.write(data)
     end = time.monotonic() + g.deadline
@@ -269,7 +302,11 @@ def override_mid_job(g, lines, byte):
         if st.startswith("<Run") and f:
             if t_byte is None:
                 before.append(f)
-                if len(before) >= 6:
+                if x_of(st) >= past:
+                    steady += 1
+                    if abs(f / feed - 1) > 0.02:
+                        off.append("%.3f:%g" % (x_of(st), f))
+                if x_of(st) >= at_x:
                     g.write(bytes([byte]))
                     t_byte = now
             elif now - t_byte >= 0.6:
@@ -285,6 +322,8 @@ def override_mid_job(g, lines, byte):
     print("after-reports: %d" % len(after), flush=True)
     print("ov: %s" % ov, flush=True)
     print("final: " + wait_idle(g), flush=True)
+    print("steady: %d from %.3f" % (steady, past), flush=True)
+    print("off:" + "".join(" " + o for o in off), flush=True)
 
 
 def main(argv):
@@ -351,8 +390,8 @@ def main(argv):
             time.sleep(0.05)
         g.write(b"\x85")
         print("final: " + wait_idle(g), flush=True)
-    elif cmd == "override":  # override FILE BYTE: the byte (hex) mid-job, the feed before/after
-        override_mid_job(g, program(argv[3]), int(argv[4], 16))
+    elif cmd == "override":  # override FILE BYTE X F: the byte (hex) at X mm; FS against F
+        override_mid_job(g, program(argv[3]), int(argv[4], 16), float(argv[5]), float(argv[6]))
     elif cmd == "raw":
         for b in argv[3:]:
             g.write(bytes([int(b, 16)]))

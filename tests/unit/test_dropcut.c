@@ -3,11 +3,18 @@
  *  - facet contact on a horizontal and a tilted plane for ball, flat and bull-nose cutters:
  *    ball tip = m x0 + R (sqrt(1 + m^2) - 1); flat tip = m (x0 + R); bull tip =
  *    m (x0 + R - r) + r (sqrt(1 + m^2) - 1) (the torus's tube circle meets the rising direction);
- *  - vertex and edge contact: tip = z - h(d), h the profile at distance d;
+ *  - vertex and edge contact: tip = z - h(d), h the profile at distance d; on a sloped edge (the
+ *    top of a vertical blade) against the maximum of z - h(d) along it by golden-section search
+ *    written here (200 steps);
  *  - the mesh bound: sampled |S - L| of a bicubic and its triangulation below cs_dropcut_grid_eps;
  *  - gouge-free and tight on random bicubic bumps: the drop is never below the brute-force drop
  *    on dense samples of the exact patch (evaluated here by Bernstein sums), and at most
- *    2 eps + the sampling's own error above it. */
+ *    2 eps + the sampling's own error above it;
+ *  - exact on a random triangle soup (small and large, gentle, steep and vertical triangles, the
+ *    grid's pyramid several levels deep): a ball's drop against the highest centre height at
+ *    which the ball still meets a triangle (bisection on the 3-D point-triangle distance), a flat
+ *    end's against the highest point of the triangle within R (vertices, edge-circle crossings,
+ *    the rim point up the plane's gradient), both to 1e-7 mm. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -102,6 +109,56 @@ static void test_vertex_edge(void **state)
         assert_true(hit);
         /* The flank may hold the cutter higher than the ridge alone: never lower. */
         assert_true(got >= 10 - h - 1e-9);
+        cs_dropcut_free(&ms);
+    }
+}
+
+/* A vertical blade whose top edge rises m mm per mm along x through (0, 0, 0): the cutter beside
+ * it at lateral distance w rests on that edge (the blade's face is vertical, its other edges
+ * lower or beyond R), so the drop is the maximum over the edge of z - h(d). */
+static double blade_ref(const cs_dropcut_tool_t *t, double m, double x0, double w)
+{
+    double lo = x0 - sqrt(t->r_mm * t->r_mm - w * w), hi = x0 + sqrt(t->r_mm * t->r_mm - w * w);
+    const double g = 0.61803398874989484820;
+    for (int k = 0; k < 200; k++) {
+        double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+        double fa = m * a - cs_dropcut_profile(t, fmin(hypot(a - x0, w), t->r_mm));
+        double fb = m * b - cs_dropcut_profile(t, fmin(hypot(b - x0, w), t->r_mm));
+        if (fa < fb)
+            lo = a;
+        else
+            hi = b;
+    }
+    double s = (lo + hi) / 2;
+    return m * s - cs_dropcut_profile(t, fmin(hypot(s - x0, w), t->r_mm));
+}
+
+static void test_blade_edge(void **state)
+{
+    (void)state;
+    const cs_dropcut_tool_t tools[] = {{3, 1}, {2, 0.5}, {2, 2}, {3, 0}};
+    const double slopes[] = {0.5, 2}, offs[] = {0.5, 1.5, 1.9, 2.6};
+    for (size_t i = 0; i < 2; i++) {
+        double m = slopes[i];
+        cs_dropcut_mesh_t ms;
+        cs_dropcut_init(&ms);
+        double a[3] = {-50, 0, -50 * m}, b[3] = {50, 0, 50 * m}, c[3] = {50, 0, -50 * m - 100};
+        assert_int_equal(cs_dropcut_add(&ms, a, b, c), CS_OK);
+        assert_int_equal(cs_dropcut_index(&ms, 5), CS_OK);
+        for (size_t k = 0; k < sizeof tools / sizeof tools[0]; k++)
+            for (size_t j = 0; j < 4; j++) {
+                const cs_dropcut_tool_t *t = &tools[k];
+                double x0 = 1.25, w = offs[j] * t->r_mm / 3;
+                bool hit;
+                double got = cs_dropcut_drop_exact(&ms, t, x0, w, &hit);
+                double want = blade_ref(t, m, x0, w);
+                assert_true(hit);
+                if (fabs(got - want) > 1e-9) {
+                    printf("slope %g tool R %g r %g offset %g: %.12f, want %.12f\n", m, t->r_mm,
+                           t->c_mm, w, got, want);
+                    fail();
+                }
+            }
         cs_dropcut_free(&ms);
     }
 }
@@ -244,13 +301,241 @@ static void test_gouge_free(void **state)
     }
 }
 
+
+/* --- a random triangle soup against independent references ---------------------------------- */
+
+#define SOUP_N 3000 /* triangles over [0, 40]^2 */
+
+static void sub3(const double a[3], const double b[3], double o[3])
+{
+    for (int k = 0; k < 3; k++)
+        o[k] = a[k] - b[k];
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Closest point of triangle a b c to p (Ericson, Real-Time Collision Detection, 5.1.5). */
+static void closest_on_tri(const double p[3], const double a[3], const double b[3],
+                           const double c[3], double q[3])
+{
+    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    sub3(p, a, ap);
+    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0 && d2 <= 0) {
+        memcpy(q, a, 3 * sizeof *q);
+        return;
+    }
+    sub3(p, b, bp);
+    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0 && d4 <= d3) {
+        memcpy(q, b, 3 * sizeof *q);
+        return;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double v = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + v * ab[k];
+        return;
+    }
+    sub3(p, c, cp);
+    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0 && d5 <= d6) {
+        memcpy(q, c, 3 * sizeof *q);
+        return;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double w = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + w * ac[k];
+        return;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++)
+            q[k] = b[k] + w * (c[k] - b[k]);
+        return;
+    }
+    double den = 1 / (va + vb + vc), v = vb * den, w = vc * den;
+    for (int k = 0; k < 3; k++)
+        q[k] = a[k] + ab[k] * v + ac[k] * w;
+}
+
+static double dist_to_tri(const double p[3], const double t[3][3])
+{
+    double q[3], d[3];
+    closest_on_tri(p, t[0], t[1], t[2], q);
+    sub3(p, q, d);
+    return sqrt(dot3(d, d));
+}
+
+/* The point of the triangle's xy projection nearest (x, y), with the triangle's highest z over
+ * it: inside the projection (a non-vertical triangle) its plane's z, else the nearest point of an
+ * edge. *d gets the horizontal distance. */
+static void nearest_xy(const double t[3][3], double x, double y, double *d, double *z)
+{
+    double s[3];
+    for (int i = 0; i < 3; i++) {
+        const double *a = t[i], *b = t[(i + 1) % 3];
+        s[i] = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    }
+    double det =
+        (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+    if (fabs(det) > 1e-9 &&
+        ((s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0))) {
+        double u =
+            ((x - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (y - t[0][1])) / det;
+        double v =
+            ((t[1][0] - t[0][0]) * (y - t[0][1]) - (x - t[0][0]) * (t[1][1] - t[0][1])) / det;
+        *d = 0;
+        *z = t[0][2] + u * (t[1][2] - t[0][2]) + v * (t[2][2] - t[0][2]);
+        return;
+    }
+    *d = HUGE_VAL;
+    for (int i = 0; i < 3; i++) {
+        const double *a = t[i], *b = t[(i + 1) % 3];
+        double bx = b[0] - a[0], by = b[1] - a[1], l2 = bx * bx + by * by;
+        double f = l2 > 0 ? ((x - a[0]) * bx + (y - a[1]) * by) / l2 : 0;
+        f = f < 0 ? 0 : f > 1 ? 1 : f;
+        double e = hypot(a[0] + f * bx - x, a[1] + f * by - y), ez = a[2] + f * (b[2] - a[2]);
+        if (e < *d - 1e-12 || (e <= *d + 1e-12 && ez > *z)) {
+            *d = fmin(e, *d);
+            *z = ez;
+        }
+    }
+}
+
+/* A ball of radius r dropped at (x, y): for each triangle the vertical line of centres meets the
+ * triangle swept by the ball in an interval; its top, found by bisection on the 3-D distance
+ * from a centre inside it (over the nearest point in xy) up to one above every vertex. */
+static double ref_ball(const double (*tri)[3][3], size_t n, double r, double x, double y)
+{
+    double best = -HUGE_VAL;
+    for (size_t i = 0; i < n; i++) {
+        double d, z;
+        nearest_xy(tri[i], x, y, &d, &z);
+        if (d > r)
+            continue;
+        double lo = z + sqrt(r * r - d * d);
+        double hi = fmax(fmax(tri[i][0][2], tri[i][1][2]), tri[i][2][2]) + r + 1;
+        for (int k = 0; k < 200 && hi - lo > 1e-11; k++) {
+            double m = (lo + hi) / 2, c[3] = {x, y, m};
+            if (dist_to_tri(c, tri[i]) <= r)
+                lo = m;
+            else
+                hi = m;
+        }
+        best = fmax(best, lo - r);
+    }
+    return best;
+}
+
+/* A flat end of radius r: the highest point of each triangle within r of the axis. z is linear,
+ * the region (triangle and disk) convex: the maximum lies at a vertex inside the disk, where an
+ * edge crosses the circle, or at the rim point up the plane's gradient when inside the triangle. */
+static double ref_flat(const double (*tri)[3][3], size_t n, double r, double x, double y)
+{
+    double best = -HUGE_VAL;
+    for (size_t i = 0; i < n; i++) {
+        const double(*t)[3] = tri[i];
+        for (int e = 0; e < 3; e++) {
+            const double *a = t[e], *b = t[(e + 1) % 3];
+            if (hypot(a[0] - x, a[1] - y) <= r)
+                best = fmax(best, a[2]);
+            double ax = a[0] - x, ay = a[1] - y, bx = b[0] - a[0], by = b[1] - a[1];
+            double qa = bx * bx + by * by, qb = 2 * (ax * bx + ay * by),
+                   qc = ax * ax + ay * ay - r * r;
+            double disc = qb * qb - 4 * qa * qc;
+            for (int sg = -1; qa > 0 && disc >= 0 && sg <= 1; sg += 2) {
+                double f = (-qb + sg * sqrt(disc)) / (2 * qa);
+                if (f >= 0 && f <= 1)
+                    best = fmax(best, a[2] + f * (b[2] - a[2]));
+            }
+        }
+        double u[3], v[3];
+        sub3(t[1], t[0], u);
+        sub3(t[2], t[0], v);
+        double nrm[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+        if (fabs(nrm[2]) < 1e-9 * sqrt(dot3(nrm, nrm)))
+            continue; /* vertical: its edges hold the maximum */
+        double gx = -nrm[0] / nrm[2], gy = -nrm[1] / nrm[2], gl = hypot(gx, gy), d, z;
+        double px = gl > 0 ? x + r * gx / gl : x, py = gl > 0 ? y + r * gy / gl : y;
+        nearest_xy(t, px, py, &d, &z);
+        if (d == 0)
+            best = fmax(best, z);
+    }
+    return best;
+}
+
+static void random_soup(double (*tri)[3][3], size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double cx = 40 * rnd(), cy = 40 * rnd(), s = 0.2 + 2.8 * rnd() * rnd();
+        double base = 5 * sin(cx / 5) * cos(cy / 7);
+        for (int v = 0; v < 3; v++) {
+            tri[i][v][0] = cx + s * (2 * rnd() - 1);
+            tri[i][v][1] = cy + s * (2 * rnd() - 1);
+            tri[i][v][2] = base + 3 * s * (2 * rnd() - 1);
+        }
+        if (i % 20 == 0) { /* vertical: the third vertex straight above the first */
+            tri[i][2][0] = tri[i][0][0];
+            tri[i][2][1] = tri[i][0][1];
+            tri[i][2][2] = tri[i][0][2] + s;
+        }
+    }
+}
+
+static void test_soup(void **state)
+{
+    (void)state;
+    double(*tri)[3][3] = malloc(SOUP_N * sizeof *tri);
+    assert_non_null(tri);
+    random_soup(tri, SOUP_N);
+    cs_dropcut_mesh_t ms;
+    cs_dropcut_init(&ms);
+    for (size_t i = 0; i < SOUP_N; i++)
+        assert_int_equal(cs_dropcut_add(&ms, tri[i][0], tri[i][1], tri[i][2]), CS_OK);
+    assert_int_equal(cs_dropcut_index(&ms, 0.5), CS_OK);
+    assert_true(ms.lev >= 4); /* the branch and bound descends a pyramid, not one level */
+    const cs_dropcut_tool_t tools[] = {{2, 2}, {0.5, 0.5}, {1.5, 0}};
+    int hits = 0;
+    for (size_t k = 0; k < sizeof tools / sizeof tools[0]; k++)
+        for (int q = 0; q < 400; q++) {
+            const cs_dropcut_tool_t *t = &tools[k];
+            double x = -2 + 44 * rnd(), y = -2 + 44 * rnd();
+            bool hit;
+            double got = cs_dropcut_drop_exact(&ms, t, x, y, &hit);
+            double want = t->c_mm > 0 ? ref_ball((const double(*)[3][3])tri, SOUP_N, t->r_mm, x, y)
+                                      : ref_flat((const double(*)[3][3])tri, SOUP_N, t->r_mm, x, y);
+            hits += hit;
+            if (hit != (want > -HUGE_VAL) || (hit && fabs(got - want) > 1e-7)) {
+                printf("tool R %g r %g at (%.6f, %.6f): drop %.9f (hit %d), reference %.9f\n",
+                       t->r_mm, t->c_mm, x, y, got, hit, want);
+                fail();
+            }
+        }
+    assert_true(hits > 1000); /* most queries land on triangles */
+    cs_dropcut_free(&ms);
+    free(tri);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_planes),
         cmocka_unit_test(test_vertex_edge),
+        cmocka_unit_test(test_blade_edge),
         cmocka_unit_test(test_grid_eps),
         cmocka_unit_test(test_gouge_free),
+        cmocka_unit_test(test_soup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

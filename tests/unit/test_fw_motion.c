@@ -94,6 +94,9 @@ static void test_segments_in_order(void **state)
     assert_int_equal(port_posix_position(0), want[0]);
     assert_int_equal(port_posix_position(1), want[1]);
     assert_int_equal(port_posix_now(), 500u * NSEG + 1u); /* never ran dry: one kick tick */
+    /* protocol 3: the executor's clock when pos was read */
+    assert_true(st.flags & CS_PROTO_STATUS_TICK);
+    assert_int_equal(st.tick, 500u * NSEG + 1u);
 }
 
 static void test_hold_resume(void **state)
@@ -101,6 +104,12 @@ static void test_hold_resume(void **state)
     (void)state;
     queue_job(NSEG);
     run_until(500u * 30); /* mid-job, at full speed */
+    cs_proto_status_t mid; /* moving: the position and the clock of one instant */
+    cs_fw_motion_status(&mo, &mid);
+    assert_int_equal(mid.tick, (uint32_t)port_posix_now());
+    assert_int_equal(mid.pos[0], port_posix_position(0));
+    assert_int_equal(mid.pos[1], port_posix_position(1));
+    assert_true(mid.pos[0] != 0 || mid.pos[1] != 0);
     cs_fw_motion_hold(&mo, true);
     run_until(UINT64_MAX);
     cs_proto_status_t st;
@@ -289,14 +298,14 @@ static void test_setpos_numbers_the_job(void **state)
     (void)state;
     cs_proto_status_t st;
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, 0); /* after boot: no job, position not stated */
+    assert_int_equal(st.flags, CS_PROTO_STATUS_TICK); /* after boot: no job, position not stated */
     assert_int_equal(st.done, 0);
     assert_int_equal(st.recv, 0);
     /* a resumed job: messages 1..1000 ran before; the machine is at (800, -80) steps */
     cs_proto_setpos_t sp = {CS_PROTO_SETPOS_POS, 0xABCD1234u, 1000u, {800, -80, 0, 0}};
     assert_int_equal(cs_fw_motion_setpos(&mo, &sp), CS_OK);
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS);
+    assert_int_equal(st.flags, CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS | CS_PROTO_STATUS_TICK);
     assert_int_equal(st.job_id, 0xABCD1234u);
     assert_int_equal(st.done, 1000);
     assert_int_equal(st.recv, 1000);
@@ -334,7 +343,7 @@ static void test_setpos_numbers_the_job(void **state)
     /* a reboot forgets the job and the stated position */
     cs_fw_motion_reboot(&mo);
     cs_fw_motion_status(&mo, &st);
-    assert_int_equal(st.flags, 0);
+    assert_int_equal(st.flags, CS_PROTO_STATUS_TICK);
     assert_int_equal(st.done, 0);
 }
 

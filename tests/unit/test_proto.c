@@ -112,7 +112,8 @@ static void test_status_layout_every_axis_count(void **state)
                                          CS_PROTO_STATUS_JOB | CS_PROTO_STATUS_POS,
                                          0xCAFEF00Du,
                                          70000u,
-                                         70016u};
+                                         70016u,
+                                         0};
         uint8_t w[CS_PROTO_LEN_STATUS(CS_PROTO_AXES_MAX)] = {0x11, CS_PROTO_STATE_HELD};
         le32(w + 2, 0x89ABCDEFu);
         le16(w + 6, 7);
@@ -126,12 +127,40 @@ static void test_status_layout_every_axis_count(void **state)
         le32(w + 12 + 4 * axes, 0xCAFEF00Du);
         le32(w + 16 + 4 * axes, 70000u);
         le32(w + 20 + 4 * axes, 70016u);
+        /* protocol 2's STATUS: 24 + 4n bytes, no tick */
+        assert_int_equal(CS_PROTO_LEN_STATUS2(axes), 24 + 4 * axes);
+        expect_encoding(&m, w, (size_t)CS_PROTO_LEN_STATUS2(axes));
+        /* protocol 3's: flag bit 2, then the tick (0xFFFFFFF0: near the wrap) after recv */
+        m.u.status.flags |= CS_PROTO_STATUS_TICK;
+        m.u.status.tick = 0xFFFFFFF0u;
+        w[11 + 4 * axes] = 0x07;
+        le32(w + 24 + 4 * axes, 0xFFFFFFF0u);
+        assert_int_equal(CS_PROTO_LEN_STATUS(axes), 28 + 4 * axes);
         expect_encoding(&m, w, (size_t)CS_PROTO_LEN_STATUS(axes));
+        /* the flag and the length disagree: malformed (a tick promised and missing, or four
+         * bytes nobody named) */
+        cs_proto_msg_t back;
+        assert_int_equal(cs_proto_decode(w, (size_t)CS_PROTO_LEN_STATUS2(axes), &back),
+                         CS_ERR_FRAME);
+        w[11 + 4 * axes] = 0x03;
+        assert_int_equal(cs_proto_decode(w, (size_t)CS_PROTO_LEN_STATUS(axes), &back),
+                         CS_ERR_FRAME);
         /* an unknown flag bit is refused both ways */
-        m.u.status.flags = 0x04;
-        w[11 + 4 * axes] = 0x04;
+        m.u.status.flags = 0x08 | CS_PROTO_STATUS_TICK;
+        w[11 + 4 * axes] = 0x0C;
         expect_range(&m, w, (size_t)CS_PROTO_LEN_STATUS(axes));
     }
+    /* the example of docs/protocol.md: 3 axes, held, tick 0x00BC614E = 12345678 */
+    static const uint8_t doc[] = {0x11, 0x02, 0xEF, 0xCD, 0xAB, 0x89, 0x07, 0x00, 0xFE, 0xFF,
+                                  0x03, 0x00, 0x00, 0x00, 0x80, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF,
+                                  0xFF, 0xFF, 0x7F, 0x07, 0x0D, 0xF0, 0xFE, 0xCA, 0x70, 0x11,
+                                  0x01, 0x00, 0x80, 0x11, 0x01, 0x00, 0x4E, 0x61, 0xBC, 0x00};
+    cs_proto_msg_t d;
+    assert_int_equal(sizeof doc, CS_PROTO_LEN_STATUS(3));
+    assert_int_equal(cs_proto_decode(doc, sizeof doc, &d), CS_OK);
+    assert_int_equal(d.u.status.tick, 12345678u);
+    assert_int_equal(d.u.status.pos[2], INT32_MAX);
+    assert_int_equal(d.u.status.recv, 70016u);
 }
 
 static void test_error_segment_curve_control_layout(void **state)
@@ -374,10 +403,12 @@ static void test_random_round_trips(void **state)
             m.u.status.axes = (uint8_t)(1 + rng() % 4);
             for (unsigned i = 0; i < m.u.status.axes; i++)
                 m.u.status.pos[i] = (int32_t)(uint32_t)rng();
-            m.u.status.flags = (uint8_t)(rng() % 4);
+            m.u.status.flags = (uint8_t)(rng() % 8);
             m.u.status.job_id = (uint32_t)rng();
             m.u.status.done = (uint32_t)rng();
             m.u.status.recv = (uint32_t)rng();
+            /* not on the wire without the flag: decodes as 0 */
+            m.u.status.tick = (m.u.status.flags & CS_PROTO_STATUS_TICK) ? (uint32_t)rng() : 0;
             break;
         case CS_PROTO_SETPOS:
             m.u.setpos.flags = (uint8_t)(rng() % 2);
