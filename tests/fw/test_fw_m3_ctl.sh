@@ -56,7 +56,7 @@ pids+=("$GP")
 wait_pty "$T/g.grbl" 60
 gc() { timeout -k 5 90 python3 tests/support/grbl_client.py "$PTY" "$@"; }
 printf '%s\n' 'M4 S250' 'G91 G1 X5 F100' >"$T/g.nc"
-gc override "$T/g.nc" 9a >"$T/g1.out" 2>&1
+gc override "$T/g.nc" 9a -59 100 >"$T/g1.out" 2>&1 # the byte once x >= -59 mm (the move: -60 to -55)
 kill -TERM "$GP" 2>/dev/null
 wait "$GP" 2>/dev/null
 expect "grbl: Ov:100,100,110 after 0x9A" grep -q '^ov: 100,100,110$' "$T/g1.out"
