@@ -11,6 +11,7 @@
 #define DC_PASS_MAXPTS (1u << 22)
 #define DC_WALL_D      0.05 /* mm: the step of the slope test (slope_cos) */
 #define DC_WALL_SLOPE  5    /* steeper (79 deg): a wall, left to the check's report */
+#define DC_ALONG_ITER  12   /* golden-section steps on one chord: 0.618^12 = 3e-3 of it */
 
 /* One pass being built: points along s, in increasing s. */
 typedef struct {
@@ -205,20 +206,104 @@ static double contact_axis(const dc_ctx_t *c, double wp, const double g[2])
     return wp - off * ge;
 }
 
-/* The gap (lines g, g + 1) holding cross offset w, or SIZE_MAX. */
+/* The gap (lines g, g + 1) holding cross offset w, or SIZE_MAX (ws ascending: bisection). */
 static size_t gap_of(const double *ws, size_t n, double w)
 {
-    for (size_t g = 0; g + 1 < n; g++)
-        if (ws[g] <= w && w < ws[g + 1])
-            return g;
-    return (size_t)-1;
+    if (n < 2 || !(ws[0] <= w && w < ws[n - 1]))
+        return (size_t)-1;
+    size_t lo = 0, hi = n - 1; /* ws[lo] <= w < ws[hi] */
+    while (hi - lo > 1) {
+        size_t m = (lo + hi) / 2;
+        if (ws[m] <= w)
+            lo = m;
+        else
+            hi = m;
+    }
+    return lo;
+}
+
+/* Is line j one of the two bounding gap i or gap ca (SIZE_MAX: none)? The search
+ * along the passes takes those: the lines nearest the point and those nearest the axis of a
+ * cutter touching the surface there. The others count at the same position only: a subset of
+ * the path's cutters, so the estimate stays an upper bound. */
+static bool near_line(size_t j, size_t i, size_t ca)
+{
+    return (j >= i && j <= i + 1) || (ca != (size_t)-1 && j >= ca && j <= ca + 1);
+}
+
+/* The first index of l whose s is at least s (l->n when none). */
+static size_t line_lower(const dc_line_t *l, double s)
+{
+    size_t lo = 0, hi = l->n;
+    while (lo < hi) {
+        size_t m = (lo + hi) / 2;
+        if (l->s[m] < s)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo;
+}
+
+/* The tip height of the chord from (sa, za) to (sb, zb) at t (a vertical step: its lower end,
+ * where the pass also stands). */
+static double chord_z(double sa, double za, double sb, double zb, double t)
+{
+    return sb > sa ? za + (t - sa) / (sb - sa) * (zb - za) : fmin(za, zb);
+}
+
+/* z(t) + h(hypot(dw, t - s)): the cutter of that chord at t over the point (s, dw). */
+static double chord_env(const dc_ctx_t *c, double sa, double za, double sb, double zb, double t,
+                        double s, double dw)
+{
+    return chord_z(sa, za, sb, zb, t) +
+           cs_dropcut_profile(c->t, fmin(c->t->r_mm, hypot(dw, t - s)));
+}
+
+/* The least of best and the height a cutter of line l leaves over the point at along-pass s,
+ * cross distance dw (<= R) from the line: the minimum over the line's positions t within R of
+ * the point of z(t) + h(hypot(dw, t - s)). Along a chord z is linear and h(hypot) convex
+ * (h convex non-decreasing, hypot convex), so the sum is convex: a golden-section search
+ * (DC_ALONG_ITER steps) finds its minimum; a chord whose lower bound (its lower end plus h at its
+ * nearest distance) cannot beat best is skipped, and the search stops once best <= stop (the
+ * caller needs no less). Every value taken is the cutter at a position of the pass, so the
+ * result is never below the envelope the pass leaves there: the estimate stays conservative. */
+static double line_env(const dc_ctx_t *c, const dc_line_t *l, double s, double dw, double best,
+                       double stop)
+{
+    double r = c->t->r_mm, a = sqrt(fmax(0, r * r - dw * dw)), s0 = s - a, s1 = s + a;
+    size_t k = line_lower(l, s0);
+    for (k = k > 0 ? k - 1 : 0; k + 1 < l->n && l->s[k] <= s1 && best > stop; k++) {
+        double sa = l->s[k], sb = l->s[k + 1], za = l->z[k], zb = l->z[k + 1];
+        double lo = fmax(sa, s0), hi = fmin(sb, s1);
+        if (hi < lo)
+            continue;
+        double zl = chord_z(sa, za, sb, zb, lo), zh = chord_z(sa, za, sb, zb, hi);
+        double near = s < lo ? lo - s : s > hi ? s - hi : 0;
+        if (fmin(zl, zh) + cs_dropcut_profile(c->t, fmin(r, hypot(dw, near))) >= best)
+            continue;
+        double x = lo, y = hi; /* golden section on [x, y] */
+        for (int it = 0; it < DC_ALONG_ITER; it++) {
+            double m1 = y - (y - x) * 0.6180339887498949, m2 = x + (y - x) * 0.6180339887498949;
+            if (chord_env(c, sa, za, sb, zb, m1, s, dw) <= chord_env(c, sa, za, sb, zb, m2, s, dw))
+                y = m2;
+            else
+                x = m1;
+        }
+        best = fmin(best, chord_env(c, sa, za, sb, zb, (x + y) / 2, s, dw));
+        best = fmin(best, fmin(chord_env(c, sa, za, sb, zb, lo, s, dw),
+                               chord_env(c, sa, za, sb, zb, hi, s, dw)));
+    }
+    return best;
 }
 
 /* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
- * with the cutters of every line within R of the point (at the same along-pass position); *cusp
- * gets the gap to refine for the worst point: the gap holding the axis of a cutter that touches
- * the surface there (on a slope not gap i: each cutter touches the surface uphill of its axis),
- * else the gap next to the lowest cutter, towards the second lowest. */
+ * with the cutters of every line within R of the point, at every position along it within R
+ * (line_env); *cusp gets the gap to refine for the worst point: the gap holding the axis of a
+ * cutter that touches the surface there (on a slope not gap i: each cutter touches the surface
+ * uphill of its axis), else the gap next to the lowest cutter, towards the second lowest. A point
+ * whose estimate at the same along-pass position (an upper bound) is no more than the worst so
+ * far cannot change the result and is not searched along the passes. */
 static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w, size_t n,
                            size_t i, double min_gap, size_t *cusp, double *stuck)
 {
@@ -240,7 +325,16 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
         double s = fine->s[k];
         for (int f = 1; f <= nf; f++) {
             double wp = w[i] + (w[i + 1] - w[i]) * f / (nf + 1.0);
-            double env = HUGE_VAL, env2 = HUGE_VAL;
+            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top, cs;
+            double g[2];
+            if (!cs_dropcut_top(c->ms, x, y, &top) || near_rim(c, x, y) ||
+                (cs = slope_cos(c, x, y, top, g)) == 0)
+                continue; /* the scallop is promised where the cutter lies over the surface */
+            /* A ball's envelope runs parallel to the surface: across it the height left is the
+             * vertical one times cos. A flat or bull-nose end's bottom is level, not parallel:
+             * the vertical height bounds the distance to it (the check's measure). */
+            double fac = c->t->c_mm >= c->t->r_mm ? cs : 1, base = fmax(top, c->o->min_z);
+            double env = HUGE_VAL, env2 = HUGE_VAL, stop = base + worst / fac;
             size_t j1 = i, j2 = i + 1;
             for (size_t j = lo; j <= hi; j++) {
                 double d = fabs(w[j] - wp);
@@ -254,18 +348,21 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
                     env2 = e, j2 = j;
                 }
             }
-            double x = s * c->d[0] + wp * c->e[0], y = s * c->d[1] + wp * c->e[1], top, cs;
-            double g[2];
-            if (!cs_dropcut_top(c->ms, x, y, &top) || env == HUGE_VAL || near_rim(c, x, y) ||
-                (cs = slope_cos(c, x, y, top, g)) == 0)
-                continue; /* the scallop is promised where the cutter lies over the surface */
-            /* A ball's envelope runs parallel to the surface: across it the height left is the
-             * vertical one times cos. A flat or bull-nose end's bottom is level, not parallel:
-             * the vertical height bounds the distance to it (the check's measure). */
-            double left = (env - fmax(top, c->o->min_z)) * (c->t->c_mm >= c->t->r_mm ? cs : 1);
+            if (env == HUGE_VAL || env <= stop)
+                continue;
+            size_t ca = gap_of(w, n, contact_axis(c, wp, g));
+            for (size_t j = lo; j <= hi && env > stop; j++) {
+                double d = fabs(w[j] - wp);
+                if (d > r || lines[j].n == 0 || !near_line(j, i, ca))
+                    continue;
+                double e = line_env(c, &lines[j], s, d, env, stop);
+                if (e < env && j != j1)
+                    env2 = env, j2 = j1, j1 = j;
+                env = e;
+            }
+            double left = (env - base) * fac;
             if (left > worst) {
-                size_t ga = gap_of(w, n, contact_axis(c, wp, g));
-                ga = ga != (size_t)-1 ? ga : j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
+                size_t ga = ca != (size_t)-1 ? ca : j2 > j1 ? j1 : (j1 > 0 ? j1 - 1 : 0);
                 if (ga + 1 >= n || w[ga + 1] - w[ga] < 2 * min_gap) {
                     /* no pass can be added there: rest material (a slot narrower than the
                      * cutter, a corner) or a wall; reported, not chased */
@@ -368,8 +465,9 @@ static cs_err_t set_insert(dc_set_t *set, size_t at, dc_line_t *l, double w)
 }
 
 /* Halves the gap whose cutters leave more than H - eps between them (found from every gap in
- * turn), until none does or the gap is below min_gap (steep walls, concave corners narrower
- * than the cutter: reported by max_left). */
+ * turn), until none does or the gap is narrower than 2 min_gap, so that both halves stay at
+ * least min_gap wide: the least gap lies between min_gap and 2 min_gap (steep walls, concave
+ * corners narrower than the cutter: reported by max_stuck). */
 static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double min_gap)
 {
     /* The mesh stands up to eps off the surface and a pass's chords up to tol / 2 off the drop

@@ -7,13 +7,23 @@
  * Spacing: the nominal step-over is the flat-ground one (ball 2 sqrt(2RH - H^2); bull-nose
  * 2(R - r) + 2 sqrt(2rH - H^2); flat end mill 2R x 0.9), then every neighbouring pair is checked
  * at cross points (at least 7, no farther apart than the least gap) and every sample of the
- * finer pass: the cutters of the passes within R at the same along-pass position leave
- * E = min(z_j + h(|w_j - w|)) above the mesh top S; the scallop is (E - S) cos(slope) for a ball
+ * finer pass: the cutters of the passes within R at the same along-pass position and, for the
+ * two passes bounding the gap and the two bounding the axis of a cutter touching the surface
+ * there, at every position along the pass within R of the point (the pass's chords: the
+ * minimum of a convex function on each, by golden section), leave
+ * E = min(z_j(t) + h(hypot(w_j - w, t - s))) above the mesh top S (on ground rising along the
+ * passes the cutter at s stands R tan or R (1/cos - 1) above S, its neighbours along the pass
+ * do not); the scallop is (E - S) cos(slope) for a ball
  * (its envelope is parallel to the surface), E - S for a flat or bull-nose end (a level bottom).
  * Where it exceeds H - eps - tol / 2 a pass is added in the gap holding the axis of a cutter
- * touching the surface there (r sin(slope) + R - r downhill of the point). Points whose gap is at
- * the least width (rest material, walls) are reported, not chased. Cutters at other along-pass
- * positions only cut more, so the estimate is conservative. Points within R of the rim of the
+ * touching the surface there (r sin(slope) + R - r downhill of the point). A gap narrower than
+ * twice the least width (a sixteenth of a ball's flat-ground step) is not split, so gaps end
+ * between it and twice it; points whose gap cannot be split (rest material, walls) are
+ * reported, not chased. Every value is a cutter of the path, so the estimate at a cross point
+ * is never below the envelope (the cross points lie at most the least width apart, and between
+ * them it may miss a ball's cusp peak by up to the cusp's slope times half that step, which
+ * is not allowed for: on a plane, passes 0.875 mm apart, R 2, it reads 0.0428 mm where the cusp
+ * is 0.0484). Points within R of the rim of the
  * surface's projection and on walls (slope > 5) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H

@@ -91,6 +91,32 @@ for c in flat:3 bull:3:1; do
     expect "$c: gouge <= 0.01, scallop <= 0.05 ($g)" \
         awk -v g="$g" 'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.01 && a[2] <= 0.05) }'
 done
+# The same plane rising ALONG the passes (z = 0.5 x + c, passes along x): a cutter touches the
+# plane uphill of its axis, so at its own position it stands R (1 / cos - 1) (ball) or R tan
+# (flat) above the plane, but its neighbours along the pass cut that material: the scallop
+# estimate takes every position of each pass within R. Across the passes the plane is level, so
+# the ball needs the flat-ground step 2 sqrt(2RH - H^2) over the axis' region (the plane and R
+# beyond: 14 mm), plus at most one pass per two gaps (it used to be 67 passes, every gap at the
+# least width, 0.2118 mm "where no pass can be added").
+printf 'curvestep-surfaces 1\nbezier 1 1\n  5 5 -12   5 15 -12\n  15 5 -7  15 15 -7\n' \
+    >"$T/along.txt"
+n0=$(awk 'BEGIN { r = 2; h = 0.05; n = 14 / (2 * sqrt(2 * r * h - h * h));
+    printf "%d", (n == int(n) ? n : int(n) + 1) + 1 }')
+for c in ball:2 flat:2; do
+    run "$c along" 0 toolpath --patches "$T/along.txt" --cutter "$c" --scallop 0.05 --tol 0.01 \
+        --check --stats
+    np=$(sed -n 's/.* \([0-9]*\) passes (.*/\1/p' "$T/err" | head -1)
+    st=$(sed -n 's/.*, \([0-9.]*\) mm where no pass can be added.*/\1/p' "$T/err")
+    g=$(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm.*/\1 \2/p' "$T/err")
+    expect "$c along: gouge <= 0.01, scallop <= 0.05 ($g)" \
+        awk -v g="$g" 'BEGIN { split(g, a, " "); exit !(a[1] != "" && a[1] <= 0.01 && a[2] <= 0.05) }'
+    expect "$c along: nothing where no pass can be added ($st)" \
+        awk -v s="$st" 'BEGIN { exit !(s != "" && s + 0 == 0) }'
+    if [ "$c" = ball:2 ]; then
+        expect "ball along: $np passes, flat-ground $n0 .. $((n0 + (n0 - 1) / 2))" \
+            awk -v n="$np" -v n0="$n0" 'BEGIN { exit !(n != "" && n >= n0 && n <= n0 + int((n0 - 1) / 2)) }'
+    fi
+done
 # A flat end on a plane of slope m stands on its uphill rim: tip = m (y + R) + c.
 run "flat formula" 0 toolpath --patches "$T/slope.txt" --cutter flat:3 --stepover 2
 bad=$(awk 'NF == 3 && $1 >= 8 && $1 <= 22 && $2 >= 5 && $2 <= 22 {
