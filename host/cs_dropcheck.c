@@ -196,6 +196,32 @@ static cs_err_t sample_all(ck_t *k, const cs_surffile_t *sf)
     return e;
 }
 
+/* Puts the n points *pts in the order of their cells (cell[i] of nc, start[c + 1] holding each
+ * cell's count on entry): start becomes each cell's first index, idx the identity, and a cell's
+ * points lie contiguous in memory (the queries read them cell by cell). */
+static cs_err_t cell_order(double (**pts)[3], size_t n, size_t *cap, const size_t *cell,
+                           size_t *start, size_t *idx, size_t nc)
+{
+    for (size_t c = 0; c < nc; c++)
+        start[c + 1] += start[c];
+    for (size_t i = 0; i < n; i++)
+        idx[start[cell[i]]++] = i;
+    for (size_t c = nc; c > 0; c--)
+        start[c] = start[c - 1];
+    start[0] = 0;
+    double(*sorted)[3] = malloc((n + 1) * sizeof *sorted);
+    if (!sorted)
+        return CS_ERR_FULL;
+    for (size_t m = 0; m < n; m++) {
+        memcpy(sorted[m], (*pts)[idx[m]], sizeof *sorted);
+        idx[m] = m;
+    }
+    free(*pts);
+    *pts = sorted;
+    *cap = n + 1;
+    return CS_OK;
+}
+
 /* Buckets the samples by xy cells of size cell. */
 static cs_err_t bucket(ck_t *k, double cell)
 {
@@ -214,37 +240,22 @@ static cs_err_t bucket(ck_t *k, double cell)
     k->start = calloc(nc + 1, sizeof *k->start);
     k->idx = malloc((k->ns + 1) * sizeof *k->idx);
     k->cmax = malloc(nc * sizeof *k->cmax);
-    if (!k->start || !k->idx || !k->cmax)
+    size_t *at = malloc((k->ns + 1) * sizeof *at);
+    if (!k->start || !k->idx || !k->cmax || !at) {
+        free(at);
         return CS_ERR_FULL;
+    }
     for (size_t c = 0; c < nc; c++)
         k->cmax[c] = -HUGE_VAL;
     for (size_t i = 0; i < k->ns; i++) {
         size_t cx = (size_t)((k->s[i][0] - lo[0]) / cell), cy = (size_t)((k->s[i][1] - lo[1]) / cell);
-        k->start[cy * k->gx + cx + 1]++;
-        k->cmax[cy * k->gx + cx] = fmax(k->cmax[cy * k->gx + cx], k->s[i][2]);
+        at[i] = cy * k->gx + cx;
+        k->start[at[i] + 1]++;
+        k->cmax[at[i]] = fmax(k->cmax[at[i]], k->s[i][2]);
     }
-    for (size_t c = 0; c < nc; c++)
-        k->start[c + 1] += k->start[c];
-    for (size_t i = 0; i < k->ns; i++) {
-        size_t cx = (size_t)((k->s[i][0] - lo[0]) / cell), cy = (size_t)((k->s[i][1] - lo[1]) / cell);
-        k->idx[k->start[cy * k->gx + cx]++] = i;
-    }
-    for (size_t c = nc; c > 0; c--)
-        k->start[c] = k->start[c - 1];
-    k->start[0] = 0;
-    /* The samples in cell order (a cell's samples contiguous in memory: the queries read them
-     * cell by cell), so that idx is the identity. */
-    double(*sorted)[3] = malloc((k->ns + 1) * sizeof *sorted);
-    if (!sorted)
-        return CS_ERR_FULL;
-    for (size_t m = 0; m < k->ns; m++) {
-        memcpy(sorted[m], k->s[k->idx[m]], sizeof *sorted);
-        k->idx[m] = m;
-    }
-    free(k->s);
-    k->s = sorted;
-    k->scap = k->ns + 1;
-    return CS_OK;
+    cs_err_t e = cell_order(&k->s, k->ns, &k->scap, at, k->start, k->idx, nc);
+    free(at);
+    return e;
 }
 
 /* Horizontal distance from (x, y) to the box of sample cell (cx, cy): no sample in it is nearer. */
@@ -365,25 +376,9 @@ static cs_err_t bucket_tips(ck_t *k)
         k->pstart[cell[i] + 1]++;
         k->pzlo[cell[i]] = fmin(k->pzlo[cell[i]], k->p[i][2]);
     }
-    for (size_t c = 0; c < nc; c++)
-        k->pstart[c + 1] += k->pstart[c];
-    for (size_t i = 0; i < k->np; i++)
-        k->pidx[k->pstart[cell[i]]++] = i;
-    for (size_t c = nc; c > 0; c--)
-        k->pstart[c] = k->pstart[c - 1];
-    k->pstart[0] = 0;
+    cs_err_t e = cell_order(&k->p, k->np, &k->pcap, cell, k->pstart, k->pidx, nc);
     free(cell);
-    double(*sorted)[3] = malloc((k->np + 1) * sizeof *sorted); /* in cell order, as bucket() */
-    if (!sorted)
-        return CS_ERR_FULL;
-    for (size_t m = 0; m < k->np; m++) {
-        memcpy(sorted[m], k->p[k->pidx[m]], sizeof *sorted);
-        k->pidx[m] = m;
-    }
-    free(k->p);
-    k->p = sorted;
-    k->pcap = k->np + 1;
-    return CS_OK;
+    return e;
 }
 
 /* How far along the ray o + u d (u a unit vector) the path's cutters begin: the material's
