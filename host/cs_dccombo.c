@@ -72,49 +72,25 @@ static cs_err_t classify(dcc_grid_t *gr, cs_dropcut_mesh_t *ms, const cs_dropcut
 }
 
 /* keep[1]: within rho of a steep node; keep[0]: within rho of a shallow node. */
-static void dilate(dcc_grid_t *gr, double rho)
+static bool dilate(dcc_grid_t *gr, double rho)
 {
-    long rn = (long)ceil(rho / gr->g);
-    long nx = (long)gr->nx, ny = (long)gr->ny;
-    for (long j = 0; j < ny; j++)
-        for (long i = 0; i < nx; i++) {
-            int s = gr->steep[j * nx + i];
-            for (long dj = -rn; dj <= rn; dj++)
-                for (long di = -rn; di <= rn; di++) {
-                    long a = i + di, c = j + dj;
-                    if (a < 0 || c < 0 || a >= nx || c >= ny ||
-                        (double)(di * di + dj * dj) * gr->g * gr->g > rho * rho)
-                        continue;
-                    gr->keep[s][c * nx + a] = 1;
-                }
-        }
+    size_t nn = gr->nx * gr->ny;
+    unsigned char *shallow = malloc(nn);
+    if (!shallow)
+        return false;
+    for (size_t k = 0; k < nn; k++)
+        shallow[k] = !gr->steep[k];
+    cs_dcwater_dilate(gr->steep, gr->keep[1], gr->nx, gr->ny, gr->g, gr->g, rho);
+    cs_dcwater_dilate(shallow, gr->keep[0], gr->nx, gr->ny, gr->g, gr->g, rho);
+    free(shallow);
+    return true;
 }
 
-static bool kept(const dcc_grid_t *gr, int which, const double *q)
-{
-    double fi = floor((q[0] - gr->x0) / gr->g + 0.5), fj = floor((q[1] - gr->y0) / gr->g + 0.5);
-    size_t i = fi < 0 ? 0 : fi >= (double)gr->nx ? gr->nx - 1 : (size_t)fi;
-    size_t j = fj < 0 ? 0 : fj >= (double)gr->ny ? gr->ny - 1 : (size_t)fj;
-    return gr->keep[which][j * gr->nx + i] != 0;
-}
-
-/* Appends to out the runs (two points or more) of in's passes that lie in region `which`. */
+/* Appends to out the runs of in's passes that lie in region `which` (cs_dcwater_clip). */
 static cs_err_t clip_into(cs_dcpath_t *out, const cs_dcpath_t *in, const dcc_grid_t *gr, int which)
 {
-    for (size_t k = 0; k < in->npass; k++) {
-        size_t i = in->start[k], end = in->start[k + 1];
-        while (i < end) {
-            while (i < end && !kept(gr, which, in->pt[i]))
-                i++;
-            size_t s = i;
-            while (i < end && kept(gr, which, in->pt[i]))
-                i++;
-            if (i - s >= 2 &&
-                cs_dcpath_append(out, (const double(*)[3])in->pt + s, i - s, in->w[k]) != CS_OK)
-                return CS_ERR_FULL;
-        }
-    }
-    return CS_OK;
+    cs_dcwater_mask_t m = {gr->x0, gr->y0, gr->g, gr->g, gr->nx, gr->ny, gr->keep[which]};
+    return cs_dcwater_clip(out, in, &m);
 }
 
 cs_err_t cs_dccombo_plan(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
@@ -133,12 +109,12 @@ cs_err_t cs_dccombo_plan(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut
         wo.step_mm = cs_dcwater_zstep(t, h) * (t->c_mm > 0 ? sin(atan(DCC_STEEP)) : 1);
     }
     cs_err_t e = classify(&gr, ms, t, o);
-    if (e == CS_OK) {
-        dilate(&gr, t->r_mm + 2 * gr.g);
-        e = cs_dcpath_raster(&ra, ms, t, &ro);
-    }
     if (e == CS_OK)
-        e = cs_dcwater_plan(&wl, ms, t, &wo);
+        e = dilate(&gr, t->r_mm + 2 * gr.g) ? CS_OK : CS_ERR_FULL;
+    if (e == CS_OK)
+        e = cs_dcpath_raster(&ra, ms, t, &ro);
+    if (e == CS_OK)
+        e = cs_dcwater_contours(&wl, ms, t, &wo);
     if (e == CS_OK)
         e = clip_into(p, &ra, &gr, 0);
     if (e == CS_OK)

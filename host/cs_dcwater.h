@@ -15,9 +15,22 @@
  * Level spacing: the scallop a ball of radius R leaves on a vertical wall between two levels dz
  * apart is the flat-ground one turned on its side, so dz = 2 sqrt(2RH - H^2) (the raster's
  * step-over formula, cs_dcpath_step, applied vertically); a bull-nose meets a vertical wall with
- * its corner: dz = 2 sqrt(2rH - H^2); a flat end's terraces are at most dz high: dz = H. On
- * shallow ground the levels lie far apart in xy and leave more than H: waterline is for the
- * steep parts, the raster for the rest. Host only, double precision. */
+ * its corner: dz = 2 sqrt(2rH - H^2); a flat end's terraces are at most dz high: dz = H. H is
+ * taken less the mesh bound and half the chord tolerance (both may add to what is left).
+ *
+ * Shallow ground (cs_dcwater_plan; Mastercam's "add cuts in shallow areas"): on ground of
+ * slope theta the levels lie dz / tan(theta) apart in xy, and the step they may take there is
+ * cs_dclevel's (ball dz <= sin(theta) 2 sqrt(2RH - H^2); flat end dz <= min(H / cos(theta),
+ * 2R tan(theta)); bull-nose from its section). Each grid node gets that step from its slope
+ * (central differences of the drops). Between two levels, where a node with its drop between
+ * them wants less than their spacing, the level halfway is added, its contour clipped to those
+ * nodes and two cells round them (marching squares on those cells only), and each half is
+ * treated the same way, down to 1/16 of the level step. **Flat areas** (Mastercam's "flat
+ * areas"): nodes whose slope allows less than that least step (a plateau, the cup's bottom, a
+ * crest) are cut by a raster at the flat-ground step-over (cs_dcpath_step, the same drop),
+ * one over each group's box grown by R + 2 cells, clipped to the nodes within that distance of
+ * a flat node. Nodes where the cutter rests on the floor, not the surface, want nothing.
+ * Host only, double precision. */
 #ifndef CS_DCWATER_H
 #define CS_DCWATER_H
 
@@ -26,11 +39,29 @@
 
 /* The level spacing (mm) of tool t for scallop height h on a vertical wall (see above). */
 double cs_dcwater_zstep(const cs_dropcut_tool_t *t, double h);
-/* Plans the waterline contours over mesh ms for tool t into p (levels from the top down, each
- * contour one pass, its level in p->w), within o's box, above o->min_z, level step from
- * o->scallop_mm (or o->step_mm when given). CS_ERR_FULL out of memory, CS_ERR_RANGE for an
+/* A node mask over a grid (x0 + i gx, y0 + j gy), on[j nx + i] != 0 where kept. */
+typedef struct {
+    double x0, y0, gx, gy;
+    size_t nx, ny;
+    const unsigned char *on;
+} cs_dcwater_mask_t;
+
+/* Plans the waterline over mesh ms for tool t into p (levels from the top down, each contour
+ * one pass, its level in p->w; the added levels above each level; the flat areas' raster passes
+ * last; p->refined counts the added and flat passes), within o's box, above o->min_z, level step
+ * from o->scallop_mm (or o->step_mm when given). CS_ERR_FULL out of memory, CS_ERR_RANGE for an
  * empty region. */
 cs_err_t cs_dcwater_plan(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                          const cs_dcpath_opts_t *o);
+/* The even levels' contours only (no added levels, no flat areas: raster+waterline's steep
+ * part, cs_dccombo.h), level step from o->step_mm or else the wall step for H. Errors as above. */
+cs_err_t cs_dcwater_contours(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                             const cs_dcpath_opts_t *o);
+/* Appends to out the runs (two points or more) of in's passes whose points' nearest node is on
+ * in m. CS_ERR_FULL out of memory. */
+cs_err_t cs_dcwater_clip(cs_dcpath_t *out, const cs_dcpath_t *in, const cs_dcwater_mask_t *m);
+/* dst (nx * ny) = the nodes within rho (mm) of a node set in src, grid spacing gx, gy. */
+void cs_dcwater_dilate(const unsigned char *src, unsigned char *dst, size_t nx, size_t ny,
+                       double gx, double gy, double rho);
 
 #endif

@@ -222,13 +222,7 @@ static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dc
                 "cutter's shape keeps off, scallop measured from the best envelope it can leave "
                 "there; up to %.4f mm left over the surface\n",
                 ck.corner_nodes, (double)ck.corner_nodes * step * step, ck.corner_left_mm);
-    /* Waterline levels lie dz apart in z, far apart in xy on shallow ground: there the scallop
-     * exceeds H by design (docs/surfaces.md); it is reported, the gouge alone decides. */
-    bool gouged = ck.gouge_mm > a->tol, high = ck.scallop_mm > a->po.scallop_mm && !a->waterline;
-    if (a->waterline && ck.scallop_mm > a->po.scallop_mm)
-        fprintf(stderr, "toolpath: check: waterline leaves %.6f mm at (%.3f, %.3f), over H %g mm: "
-                        "shallow ground between levels wants the raster\n",
-                ck.scallop_mm, ck.scallop_at[0], ck.scallop_at[1], a->po.scallop_mm);
+    bool gouged = ck.gouge_mm > a->tol, high = ck.scallop_mm > a->po.scallop_mm;
     if (gouged)
         fprintf(stderr,
                 "toolpath: check FAILED: the cutter enters the surface by %.6f mm at (%.3f, %.3f, "

@@ -62,9 +62,12 @@ for s in cup pent; do
     done
     run "$s raster ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
         --tol 0.02 --check && gs "$s raster ball" 0.1
-    # waterline alone leaves up to its level step on shallow ground (reported, not failed)
-    run "$s waterline ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
-        --tol 0.02 --strategy waterline --check && gs "$s waterline ball" any
+    # waterline: levels added on shallow ground, flat areas by a clipped raster, the check's
+    # fill-in in corners: at most H with every cutter, --check fails (exit 1) otherwise
+    for c in ball:1.5 flat:1.5 bull:1.5:0.5; do
+        run "$s waterline $c" 0 toolpath --patches "$T/$s.txt" --cutter "$c" --scallop 0.1 \
+            --tol 0.02 --strategy waterline --check && gs "$s waterline $c" 0.1
+    done
     # the G-code runs on the router as written, and the simulator's check passes
     run "$s: gcode plans on the router" 0 plan --machine "$M" -o "$T/$s.seg" "$T/$s.ball:1.5.nc"
     "$SIM" --replay "$T/$s.seg" --machine "$M" --reference "$T/$s.ball:1.5.nc" --check \
