@@ -12,7 +12,7 @@
 #include "cs_dclevel.h"
 
 #define WL_LEVEL_DEPTH 4     /* halvings of a level step on shallow ground: down to 1/16 */
-#define WL_KINK        0.5   /* a concave corner: second difference over distance, at least */
+#define WL_KINK        0.15  /* a concave corner: second difference over distance, at least */
 #define WL_CORNER_DIV  4     /* the corner rasters' step-over: the flat-ground one over this */
 #define WL_MAX_DEPTH 12      /* chord refinements of one contour segment */
 #define WL_MAX_NODES 4000000 /* grid nodes, at most */

@@ -15,8 +15,10 @@
  * Level spacing: the scallop a ball of radius R leaves on a vertical wall between two levels dz
  * apart is the flat-ground one turned on its side, so dz = 2 sqrt(2RH - H^2) (the raster's
  * step-over formula, cs_dcpath_step, applied vertically); a bull-nose meets a vertical wall with
- * its corner: dz = 2 sqrt(2rH - H^2); a flat end's terraces are at most dz high: dz = H. H is
- * taken less the mesh bound and half the chord tolerance (both may add to what is left).
+ * its corner: dz = 2 sqrt(2rH - H^2); a flat end's terraces are at most dz high: dz = H
+ * (cs_dcwater_plan starts a flat end at 2H: a terrace leaves dz cos(theta) along the normal,
+ * and the added levels serve slopes under 60 degrees). H is taken less the mesh bound and half
+ * the chord tolerance (both may add to what is left).
  *
  * Shallow ground (cs_dcwater_plan; Mastercam's "add cuts in shallow areas"): on ground of
  * slope theta the levels lie dz / tan(theta) apart in xy, and the step they may take there is
@@ -25,11 +27,14 @@
  * (central differences of the drops). Between two levels, where a node with its drop between
  * them wants less than their spacing, the level halfway is added, its contour clipped to those
  * nodes and two cells round them (marching squares on those cells only), and each half is
- * treated the same way, down to 1/16 of the level step. **Flat areas** (Mastercam's "flat
+ * treated the same way, down to 1/16 of the level step. Flat areas (Mastercam's "flat
  * areas"): nodes whose slope allows less than that least step (a plateau, the cup's bottom, a
  * crest) are cut by a raster at the flat-ground step-over (cs_dcpath_step, the same drop),
  * one over each group's box grown by R + 2 cells, clipped to the nodes within that distance of
- * a flat node. Nodes where the cutter rests on the floor, not the surface, want nothing.
+ * a flat node. Concave corners of the drop surface (a valley's floor, a wall's foot: a
+ * second difference over a node steeper than WL_KINK), which levels on the grid cannot hug,
+ * get a raster each way at a quarter of that step-over (at most sqrt(2rH - H^2)), clipped
+ * the same way. Nodes where the cutter rests on the floor, not the surface, want nothing.
  * Host only, double precision. */
 #ifndef CS_DCWATER_H
 #define CS_DCWATER_H
