@@ -8,6 +8,8 @@
 # DCM_SURFACES (default "teapot cup pent") picks surfaces; CS_BUILD the build directory.
 set -u
 cd "$(dirname "$0")/../.."
+. scripts/args.sh
+cs_args "usage: tests/bench/dropcut_matrix.sh [OUT.csv]\nRuns curvestep toolpath --check for every drop-cutter strategy x cutter x test surface\n(DCM_SURFACES, default \"teapot cup pent\"); Markdown on stdout, CSV in OUT.csv." 1 "$@"
 . tests/cli/lib/shapes.sh
 B=${CS_BUILD:-build}
 CS=$B/curvestep
