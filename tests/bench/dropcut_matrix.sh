@@ -47,7 +47,7 @@ for s in ${DCM_SURFACES:-teapot cup pent}; do
             /usr/bin/time -f "%U %S" -o "$T/time" "$CS" toolpath "${src[@]}" --cutter "$c" \
                 --strategy "$st" --scallop "$H" --tol "$tol" --check --stats >/dev/null 2>"$T/err"
             rc=$?
-            cpu=$(awk '{ printf "%.1f", $1 + $2 }' "$T/time" 2>/dev/null)
+            cpu=$(tail -n1 "$T/time" | awk '{ printf "%.1f", $1 + $2 }' 2>/dev/null)
             read -r passes points < <(sed -n 's/.*, \([0-9]*\) passes (.*, \([0-9]*\) points,.*/\1 \2/p' "$T/err" | head -n1)
             read -r gouge scallop at < <(sed -n 's/.*gouge \([0-9.]*\) mm, scallop \([0-9.]*\) mm at (\([^)]*\)).*/\1 \2 \3/p' "$T/err" | tr -d ',' | head -n1)
             unr=$(sed -n 's/.*unreachable: [0-9]* nodes (\([0-9.]*\) mm^2).*/\1/p' "$T/err" | head -n1)
