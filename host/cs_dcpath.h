@@ -19,8 +19,8 @@
  * touching the surface there (r sin(slope) + R - r downhill of the point). A gap narrower than
  * twice the least width (a sixteenth of a ball's flat-ground step) is not split, so gaps end
  * between it and twice it; points whose gap cannot be split (rest material, walls) are
- * reported and flagged for the fill-in (cs_dcpath_fill), not chased. Every value is a cutter of the path, so the estimate at a cross point
- * is never below the envelope (the cross points lie at most the least width apart, and between
+ * reported and flagged for the fill-in (cs_dcpath_fill), not chased. Every value is a cutter
+ * of the path, so the estimate at a cross point is never below the envelope (the cross points lie at most the least width apart, and between
  * them it may miss a ball's cusp peak by up to the cusp's slope times half that step, which
  * is not allowed for: on a plane, passes 0.875 mm apart, R 2, it reads 0.0428 mm where the cusp
  * is 0.0484). Points within R of the rim of the

@@ -538,8 +538,9 @@ static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, 
     double sz = k->top[node(k, ix, iy)];
     for (long cy = by - rn; cy <= by + rn && best > 0; cy += k->stride)
         for (long cx = bx - rn; cx <= bx + rn && best > 0; cx += k->stride) {
-            double d = hypot((double)(cx - ix), (double)(cy - iy)) * k->step;
-            if (d > r || d - t->r_mm >= best || node(k, cx, cy) == (size_t)-1)
+            double dx = (double)(cx - ix) * k->step, dy = (double)(cy - iy) * k->step;
+            double d2 = dx * dx + dy * dy, near = t->r_mm + best; /* squares: no root */
+            if (d2 > r * r || d2 >= near * near || node(k, cx, cy) == (size_t)-1)
                 continue; /* (no cutter whose axis stands d away comes nearer than d - R) */
             double z = ideal_drop(k, cx, cy);
             double q[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
