@@ -567,7 +567,7 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
     return e;
 }
 
-/* One short pass at each axis position at (n, xy): three drops tol / 2 apart along x. */
+/* One short pass at each of the n axis positions at (xy, mm): three drops tol / 2 apart along x. */
 static cs_err_t fill_at(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                         const cs_dcpath_opts_t *o, const double (*at)[2], size_t n)
 {
