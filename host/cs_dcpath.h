@@ -20,10 +20,10 @@
  * twice the least width (a sixteenth of a ball's flat-ground step) is not split, so gaps end
  * between it and twice it; points whose gap cannot be split (rest material, walls) are
  * reported and flagged for the fill-in (cs_dcpath_fill), not chased. Every value is a cutter
- * of the path, so the estimate at a cross point is never below the envelope (the cross points lie at most the least width apart, and between
- * them it may miss a ball's cusp peak by up to the cusp's slope times half that step, which
- * is not allowed for: on a plane, passes 0.875 mm apart, R 2, it reads 0.0428 mm where the cusp
- * is 0.0484). Points within R of the rim of the
+ * of the path, so the estimate at a cross point is never below the envelope (the cross points
+ * lie at most the least width apart, and between them it may miss a ball's cusp peak by up to
+ * the cusp's slope times half that step, which is not allowed for: on a plane, passes 0.875 mm
+ * apart, R 2, it reads 0.0428 mm where the cusp is 0.0484). Points within R of the rim of the
  * surface's projection and on walls (slope > 5) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H
