@@ -33,6 +33,10 @@ for s in cup pent; do
     done
     run "$s raster ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
         --tol 0.02 --check && gs "$s raster ball" 0.1
+    for c in flat:1.5 bull:1.5:0.5; do # the raster's fill-in where its estimate flags rest material
+        run "$s raster $c" 0 toolpath --patches "$T/$s.txt" --cutter "$c" --scallop 0.1 \
+            --tol 0.02 --check && gs "$s raster $c" 0.1
+    done
     # waterline alone leaves up to its level step on shallow ground (reported, not failed)
     run "$s waterline ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
         --tol 0.02 --strategy waterline --check && gs "$s waterline ball" any
