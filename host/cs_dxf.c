@@ -44,11 +44,11 @@
 static const char DX_BINARY[] = "AutoCAD Binary DXF";
 
 typedef struct {
-    size_t off;     /* value's first non-blank byte */
-    uint32_t len;   /* value's length, blanks trimmed */
-    int32_t code;   /* group code */
-    uint32_t line;  /* value's line (1-based) */
-    uint32_t col;   /* value's column */
+    size_t off;    /* value's first non-blank byte */
+    uint32_t len;  /* value's length, blanks trimmed */
+    int32_t code;  /* group code */
+    uint32_t line; /* value's line (1-based) */
+    uint32_t col;  /* value's column */
 } dx_grp_t;
 
 typedef struct {
@@ -57,9 +57,9 @@ typedef struct {
 } dx_layer_t;
 
 typedef struct {
-    size_t name;        /* group index of the name (code 2 of BLOCK) */
-    size_t first, end;  /* its entities: groups [first, end) */
-    double bx, by;      /* base point */
+    size_t name;       /* group index of the name (code 2 of BLOCK) */
+    size_t first, end; /* its entities: groups [first, end) */
+    double bx, by;     /* base point */
 } dx_block_t;
 
 typedef struct {
@@ -81,8 +81,8 @@ typedef struct {
     unsigned long long visits;
     char warned[DX_MAX_WARNED][48];
     unsigned nwarned;
-    cs_gnurbs_t nb;  /* a SPLINE's control points and knots */
-    size_t emit_at;  /* the SPLINE whose segments spline_emit adds */
+    cs_gnurbs_t nb; /* a SPLINE's control points and knots */
+    size_t emit_at; /* the SPLINE whose segments spline_emit adds */
 } dx_t;
 
 /* One entity's groups [i, end) (group i is its "0 TYPE") and the map to machine mm. */
@@ -104,7 +104,8 @@ static cs_path_loc_t loc_of(const dx_t *d, size_t gi)
 }
 
 /* A located error at group gi: "file:line:col: reason" (cs_path_diag_set formats it). */
-#define DX_FAIL(d, gi, code, ...) cs_path_diag_set((d)->diag, (code), loc_of((d), (gi)), __VA_ARGS__)
+#define DX_FAIL(d, gi, code, ...)                                                                  \
+    cs_path_diag_set((d)->diag, (code), loc_of((d), (gi)), __VA_ARGS__)
 
 /* Hands one warning to the caller's function, or prints it. */
 static void emit_warning(const dx_t *d, const cs_path_diag_t *w)
@@ -116,11 +117,11 @@ static void emit_warning(const dx_t *d, const cs_path_diag_t *w)
 }
 
 /* A located warning at group gi. */
-#define DX_WARN(d, gi, ...)                                                                       \
-    do {                                                                                          \
-        cs_path_diag_t w_;                                                                        \
-        cs_path_diag_set(&w_, CS_OK, loc_of((d), (gi)), __VA_ARGS__);                             \
-        emit_warning((d), &w_);                                                                   \
+#define DX_WARN(d, gi, ...)                                                                        \
+    do {                                                                                           \
+        cs_path_diag_t w_;                                                                         \
+        cs_path_diag_set(&w_, CS_OK, loc_of((d), (gi)), __VA_ARGS__);                              \
+        emit_warning((d), &w_);                                                                    \
     } while (0)
 
 /* One warning per key (an entity kind or a topic): true the first time. */
@@ -150,8 +151,7 @@ static bool is(const dx_t *d, size_t gi, const char *s)
 
 static bool same_name(const dx_t *d, size_t a, size_t b)
 {
-    return d->g[a].len == d->g[b].len &&
-           strncasecmp(val(d, a), val(d, b), d->g[a].len) == 0;
+    return d->g[a].len == d->g[b].len && strncasecmp(val(d, a), val(d, b), d->g[a].len) == 0;
 }
 
 /* The value as printable text for messages (cut at 40 characters). */
@@ -224,8 +224,7 @@ static cs_err_t lex(dx_t *d)
         }
         while (ve > vs && blank(d->buf[ve - 1]))
             ve--;
-        if (d->ng == d->capg &&
-            !cs_path_grow((void **)&d->g, &d->capg, d->ng + 1, sizeof *d->g))
+        if (d->ng == d->capg && !cs_path_grow((void **)&d->g, &d->capg, d->ng + 1, sizeof *d->g))
             return cs_path_diag_set(d->diag, CS_ERR_FULL, l, "out of memory");
         if (ve - vs > UINT32_MAX)
             return cs_path_diag_set(d->diag, CS_ERR_RANGE, l, "value line too long");
@@ -248,14 +247,14 @@ static cs_err_t num(dx_t *d, size_t gi, double *v)
     size_t n = d->g[gi].len;
     char *end = NULL;
     if (n == 0 || n > DX_NUM_CHARS)
-        return DX_FAIL(d, gi, CS_ERR_PARSE, "group %d: a number expected, found '%s'", d->g[gi].code,
-                    shown(d, gi, b));
+        return DX_FAIL(d, gi, CS_ERR_PARSE, "group %d: a number expected, found '%s'",
+                       d->g[gi].code, shown(d, gi, b));
     memcpy(tmp, val(d, gi), n);
     tmp[n] = '\0';
     double x = strtod(tmp, &end);
     if (*end != '\0' || !isfinite(x))
-        return DX_FAIL(d, gi, CS_ERR_PARSE, "group %d: a number expected, found '%s'", d->g[gi].code,
-                    shown(d, gi, b));
+        return DX_FAIL(d, gi, CS_ERR_PARSE, "group %d: a number expected, found '%s'",
+                       d->g[gi].code, shown(d, gi, b));
     *v = x;
     return CS_OK;
 }
@@ -269,9 +268,16 @@ static cs_err_t inum(dx_t *d, size_t gi, long lo, long hi, long *v)
         return e;
     if (x != floor(x) || x < (double)lo || x > (double)hi)
         return DX_FAIL(d, gi, CS_ERR_RANGE, "group %d: an integer %ld..%ld expected, found %g",
-                    d->g[gi].code, lo, hi, x);
+                       d->g[gi].code, lo, hi, x);
     *v = (long)x;
     return CS_OK;
+}
+
+/* A flag or enumeration value read as a number, as an integer: out-of-range values (no
+ * meaning in DXF) are clamped first, so the conversion is always defined. */
+static long flag(double v)
+{
+    return v > 1e9 ? 1000000000L : v < -1e9 ? -1000000000L : (long)v;
 }
 
 /* Index of the next group of code 0 at or after i (d->ng when none). */
@@ -288,9 +294,27 @@ static size_t next0(const dx_t *d, size_t i)
 static double insunits_mm(long u)
 {
     static const double mm[] = {
-        0,       25.4,    304.8,  1609344.0, 1,   10,  1000, 1e6, 25.4e-6, 0.0254, 914.4,
-        1e-7,    1e-6,    1e-3,   100,       1e4, 1e5, 1e12, 1.495978707e14,
-        9.4607304725808e18, 3.0856775814913673e19,
+        0,
+        25.4,
+        304.8,
+        1609344.0,
+        1,
+        10,
+        1000,
+        1e6,
+        25.4e-6,
+        0.0254,
+        914.4,
+        1e-7,
+        1e-6,
+        1e-3,
+        100,
+        1e4,
+        1e5,
+        1e12,
+        1.495978707e14,
+        9.4607304725808e18,
+        3.0856775814913673e19,
         1200000.0 / 3937.0,        /* 21 US survey foot: 1200/3937 m */
         100000.0 / 3937.0,         /* 22 US survey inch */
         3600000.0 / 3937.0,        /* 23 US survey yard */
@@ -423,7 +447,7 @@ static bool layer_hidden(dx_t *d, size_t i, size_t end)
             char b[48];
             L->warned = true;
             DX_WARN(d, k, "layer '%s' is %s: its entities are not drawn", shown(d, L->name, b),
-                 L->frozen ? "frozen" : "off");
+                    L->frozen ? "frozen" : "off");
         }
         return true;
     }
@@ -440,9 +464,9 @@ static cs_err_t conv(dx_t *d, const cs_path_affine_t *m, double x, double y, siz
     cs_path_affine_point(m, x, y, &px, &py);
     if (cs_conv_mm_to_vec(px, py, 0.0, out) != CS_OK)
         return DX_FAIL(d, gi, CS_ERR_RANGE,
-                    "point (%.6g, %.6g) = (%.6g, %.6g) mm is outside the accepted range of "
-                    "+/-%d mm",
-                    x, y, px, py, CS_POS_LIMIT_MM);
+                       "point (%.6g, %.6g) = (%.6g, %.6g) mm is outside the accepted range of "
+                       "+/-%d mm",
+                       x, y, px, py, CS_POS_LIMIT_MM);
     return CS_OK;
 }
 
@@ -450,7 +474,7 @@ static cs_err_t add(dx_t *d, const cs_bezier_t *c, cs_path_kind_t kind, size_t g
 {
     if (cs_path_add(d->path, c, kind, loc_of(d, gi)) != CS_OK)
         return DX_FAIL(d, gi, d->path->over_limit ? CS_ERR_RANGE : CS_ERR_FULL,
-                    d->path->over_limit ? "too many curves" : "out of memory");
+                       d->path->over_limit ? "too many curves" : "out of memory");
     return CS_OK;
 }
 
@@ -483,8 +507,8 @@ typedef struct {
     double cx, cy, ux, uy, vx, vy, t0, sweep;
 } dx_conic_t;
 
-static cs_err_t conic(dx_t *d, const cs_path_affine_t *m, const dx_conic_t *k,
-                      const cs_vec3_t *a, const cs_vec3_t *b, size_t gi)
+static cs_err_t conic(dx_t *d, const cs_path_affine_t *m, const dx_conic_t *k, const cs_vec3_t *a,
+                      const cs_vec3_t *b, size_t gi)
 {
     bool full = fabs(k->sweep) >= 2 * M_PI;
     double t1 = k->t0 + k->sweep;
@@ -498,7 +522,7 @@ static cs_err_t conic(dx_t *d, const cs_path_affine_t *m, const dx_conic_t *k,
     if (cs_conv_mm_to_vec(mu[0], mu[1], 0, &U) != CS_OK ||
         cs_conv_mm_to_vec(mv[0], mv[1], 0, &V) != CS_OK)
         return DX_FAIL(d, gi, CS_ERR_RANGE, "arc radius too large for the +/-%d mm range",
-                    CS_POS_LIMIT_MM);
+                       CS_POS_LIMIT_MM);
     if ((U.x == 0 && U.y == 0) || (V.x == 0 && V.y == 0))
         return full ? CS_OK : line(d, a, b, gi); /* below one LSB: a point, or its chord */
     cs_param_t c0, s0, c1, s1;
@@ -518,7 +542,7 @@ static cs_err_t conic(dx_t *d, const cs_path_affine_t *m, const dx_conic_t *k,
         return line(d, a, b, gi); /* flattened to a segment (a projected circle seen edge-on) */
     if (e != CS_OK)
         return DX_FAIL(d, gi, e == CS_ERR_OVERFLOW ? CS_ERR_RANGE : e, "arc cannot be built: %s",
-                    cs_err_text(e));
+                       cs_err_text(e));
     if (n < 1 || n > CS_ARC_MAX_SEGMENTS || lsb_dist(&seg[0].p[0], a) > DX_ARC_SNAP_MAX_LSB ||
         lsb_dist(&seg[n - 1].p[2], b) > DX_ARC_SNAP_MAX_LSB)
         return DX_FAIL(d, gi, CS_ERR_ARG, "arc builder's end points are off the arc's ends");
@@ -550,9 +574,8 @@ static cs_err_t conic_alone(dx_t *d, const cs_path_affine_t *m, const dx_conic_t
 /* The segment from p (vertex point a) to q (b) with bulge = tan(sweep / 4), sweep positive
  * counter-clockwise (DXF Reference, LWPOLYLINE group 42). Centre = chord midpoint + left normal
  * * (1 - bulge^2) / (4 bulge) (the normal as long as the chord). */
-static cs_err_t bulge_seg(dx_t *d, const cs_path_affine_t *m, const double p[2],
-                          const double q[2], double bulge, const cs_vec3_t *a, const cs_vec3_t *b,
-                          size_t gi)
+static cs_err_t bulge_seg(dx_t *d, const cs_path_affine_t *m, const double p[2], const double q[2],
+                          double bulge, const cs_vec3_t *a, const cs_vec3_t *b, size_t gi)
 {
     double dx = q[0] - p[0], dy = q[1] - p[1];
     if (bulge == 0 || (dx == 0 && dy == 0))
@@ -657,15 +680,17 @@ static cs_err_t entity_ocs(dx_t *d, const dx_ent_t *en, double z, cs_path_affine
     if (!ocs_map(f.v[0], f.v[1], f.v[2], z, &o)) {
         *ok = false;
         if (first_time(d, "ocs-edge"))
-            DX_WARN(d, at, "extrusion (%g, %g, %g): the entity's plane is seen edge-on from above "
-                        "(or the normal is zero): not drawn",
-                 f.v[0], f.v[1], f.v[2]);
+            DX_WARN(d, at,
+                    "extrusion (%g, %g, %g): the entity's plane is seen edge-on from above "
+                    "(or the normal is zero): not drawn",
+                    f.v[0], f.v[1], f.v[2]);
         return CS_OK;
     }
     if (!(f.v[0] == 0 && f.v[1] == 0) && first_time(d, "ocs-tilted"))
-        DX_WARN(d, at, "extrusion (%g, %g, %g): an entity in a tilted plane is drawn projected "
-                    "onto XY (as seen from above)",
-             f.v[0], f.v[1], f.v[2]);
+        DX_WARN(d, at,
+                "extrusion (%g, %g, %g): an entity in a tilted plane is drawn projected "
+                "onto XY (as seen from above)",
+                f.v[0], f.v[1], f.v[2]);
     *m = cs_path_affine_mul(en->m, o);
     return CS_OK;
 }
@@ -734,17 +759,18 @@ static cs_err_t ent_ellipse(dx_t *d, const dx_ent_t *en)
     double nx = f.v[8], ny = f.v[9], nz = f.v[10], nl = sqrt(nx * nx + ny * ny + nz * nz);
     if (!(ratio > 0)) /* above 1 (some writers) the "minor" axis is the longer: still exact */
         return DX_FAIL(d, f.at[5] != SIZE_MAX ? f.at[5] : en->i, CS_ERR_PARSE,
-                    "ellipse ratio %g is not positive", ratio);
+                       "ellipse ratio %g is not positive", ratio);
     if (!(nl > 0))
         return DX_FAIL(d, f.at[8] != SIZE_MAX ? f.at[8] : en->i, CS_ERR_PARSE,
-                    "ellipse normal is zero");
+                       "ellipse normal is zero");
     nx /= nl;
     ny /= nl;
     nz /= nl;
     if ((nx != 0 || ny != 0) && first_time(d, "ocs-tilted"))
-        DX_WARN(d, f.at[8], "extrusion (%g, %g, %g): an entity in a tilted plane is drawn projected "
-                         "onto XY (as seen from above)",
-             nx, ny, nz);
+        DX_WARN(d, f.at[8],
+                "extrusion (%g, %g, %g): an entity in a tilted plane is drawn projected "
+                "onto XY (as seen from above)",
+                nx, ny, nz);
     dx_conic_t k;
     k.cx = f.v[0];
     k.cy = f.v[1];
@@ -845,9 +871,10 @@ static cs_err_t ent_lwpoly(dx_t *d, const dx_ent_t *en)
     if (e == CS_OK)
         e = entity_ocs(d, en, elev, &m, &ok);
     if (e == CS_OK && wide && first_time(d, "width"))
-        DX_WARN(d, en->i, "polyline widths are not drawn: a wide polyline is drawn as its centre line");
+        DX_WARN(d, en->i,
+                "polyline widths are not drawn: a wide polyline is drawn as its centre line");
     if (e == CS_OK && ok)
-        e = draw_verts(d, &m, &v, ((long)flags & 1) != 0);
+        e = draw_verts(d, &m, &v, (flag(flags) & 1) != 0);
     vfree(&v);
     return e;
 }
@@ -864,7 +891,7 @@ static cs_err_t ent_polyline(dx_t *d, const dx_ent_t *en, bool draw, size_t *nex
     cs_err_t e = fields(d, en->i, en->end, codes, def, 2, &f);
     if (e != CS_OK)
         return e;
-    long flags = (long)f.v[0];
+    long flags = flag(f.v[0]);
     dx_verts_t v = {0};
     size_t k = en->end;
     static const int vcodes[] = {10, 20, 42, 70};
@@ -873,7 +900,7 @@ static cs_err_t ent_polyline(dx_t *d, const dx_ent_t *en, bool draw, size_t *nex
         size_t ke = next0(d, k + 1);
         dx_fields_t vf;
         e = fields(d, k, ke, vcodes, vdef, 4, &vf);
-        if (e == CS_OK && !((long)vf.v[3] & 16) && (e = vpush(d, &v, k)) == CS_OK) {
+        if (e == CS_OK && !(flag(vf.v[3]) & 16) && (e = vpush(d, &v, k)) == CS_OK) {
             v.p[v.n - 1][0] = vf.v[0];
             v.p[v.n - 1][1] = vf.v[1];
             v.bulge[v.n - 1] = vf.v[2];
@@ -885,8 +912,9 @@ static cs_err_t ent_polyline(dx_t *d, const dx_ent_t *en, bool draw, size_t *nex
         /* hidden: its vertices are skipped */
     } else if (e == CS_OK && (flags & (16 | 64))) {
         if (first_time(d, "POLYLINE-mesh"))
-            DX_WARN(d, en->i, "POLYLINE: polygon and polyface meshes are not drawn (3-D surfaces): "
-                           "geometry is missing");
+            DX_WARN(d, en->i,
+                    "POLYLINE: polygon and polyface meshes are not drawn (3-D surfaces): "
+                    "geometry is missing");
     } else if (e == CS_OK) {
         cs_path_affine_t m = en->m;
         bool ok = true;
@@ -982,9 +1010,10 @@ static cs_err_t spline_fit(dx_t *d, const dx_ent_t *en, const dx_verts_t *fp)
     cs_err_t e = CS_OK;
     if (fp->n > CS_SPLINE_MAX_POINTS) {
         if (first_time(d, "SPLINE-fitmax"))
-            DX_WARN(d, en->i, "SPLINE with %zu fit points and no control points: drawn as lines "
-                           "through them (at most %d are interpolated)",
-                 fp->n, CS_SPLINE_MAX_POINTS);
+            DX_WARN(d, en->i,
+                    "SPLINE with %zu fit points and no control points: drawn as lines "
+                    "through them (at most %d are interpolated)",
+                    fp->n, CS_SPLINE_MAX_POINTS);
         return draw_verts(d, &en->m, fp, false);
     }
     for (size_t i = 0; i < fp->n && e == CS_OK; i++) {
@@ -1009,137 +1038,162 @@ static cs_err_t spline_fit(dx_t *d, const dx_ent_t *en, const dx_verts_t *fp)
     return e;
 }
 
-/* SPLINE: 70 flags, 71 degree, 40 knots, 41 weights, 10/20/30 control points; 11/21 fit
- * points when there are no control points. */
-static cs_err_t ent_spline(dx_t *d, const dx_ent_t *en)
+/* A SPLINE's groups: control points cp (10/20), fit points fp (11/21), knots kv (40) and weights
+ * wv (41, in the .bulge of their dx_verts_t), degree 71. */
+typedef struct {
+    dx_verts_t cp, fp, kv, wv;
+    double deg;
+    size_t at_deg;
+} dx_spline_t;
+
+static cs_err_t spline_read(dx_t *d, const dx_ent_t *en, dx_spline_t *sp)
 {
-    dx_verts_t cp = {0}, fp = {0}, kv = {0}, wv = {0};
-    double deg = 3;
-    size_t at_deg = en->i;
     cs_err_t e = CS_OK;
+    sp->deg = 3;
+    sp->at_deg = en->i;
     for (size_t k = en->i + 1; e == CS_OK && k < en->end; k++) {
         int c = d->g[k].code;
-        if (c == 10 && (e = vpush(d, &cp, k)) == CS_OK)
-            e = num(d, k, &cp.p[cp.n - 1][0]);
-        else if (c == 20 && cp.n > 0)
-            e = num(d, k, &cp.p[cp.n - 1][1]);
-        else if (c == 11 && (e = vpush(d, &fp, k)) == CS_OK)
-            e = num(d, k, &fp.p[fp.n - 1][0]);
-        else if (c == 21 && fp.n > 0)
-            e = num(d, k, &fp.p[fp.n - 1][1]);
-        else if (c == 40 && (e = vpush(d, &kv, k)) == CS_OK)
-            e = num(d, k, &kv.bulge[kv.n - 1]);
-        else if (c == 41 && (e = vpush(d, &wv, k)) == CS_OK)
-            e = num(d, k, &wv.bulge[wv.n - 1]);
-        else if (c == 71 && (e = num(d, k, &deg)) == CS_OK)
-            at_deg = k;
+        if (c == 10 && (e = vpush(d, &sp->cp, k)) == CS_OK)
+            e = num(d, k, &sp->cp.p[sp->cp.n - 1][0]);
+        else if (c == 20 && sp->cp.n > 0)
+            e = num(d, k, &sp->cp.p[sp->cp.n - 1][1]);
+        else if (c == 11 && (e = vpush(d, &sp->fp, k)) == CS_OK)
+            e = num(d, k, &sp->fp.p[sp->fp.n - 1][0]);
+        else if (c == 21 && sp->fp.n > 0)
+            e = num(d, k, &sp->fp.p[sp->fp.n - 1][1]);
+        else if (c == 40 && (e = vpush(d, &sp->kv, k)) == CS_OK)
+            e = num(d, k, &sp->kv.bulge[sp->kv.n - 1]);
+        else if (c == 41 && (e = vpush(d, &sp->wv, k)) == CS_OK)
+            e = num(d, k, &sp->wv.bulge[sp->wv.n - 1]);
+        else if (c == 71 && (e = num(d, k, &sp->deg)) == CS_OK)
+            sp->at_deg = k;
     }
-    if (e != CS_OK)
-        goto out;
-    if (cp.n == 0) {
-        e = spline_fit(d, en, &fp);
-        goto out;
-    }
-    if (deg != floor(deg) || deg < 1 || deg > CS_NURBS_MAX_DEGREE) {
-        if (deg >= 1 && deg == floor(deg) && deg <= 25) {
-            if (first_time(d, "SPLINE-degree"))
-                DX_WARN(d, at_deg, "SPLINE of degree %g not drawn (curvestep converts degrees 1 to "
-                                "3): geometry is missing",
-                     deg);
-        } else {
-            e = DX_FAIL(d, at_deg, CS_ERR_PARSE, "SPLINE degree %g is not an integer 1..25", deg);
-        }
-        goto out;
-    }
-    unsigned p = (unsigned)deg;
-    size_t n = cp.n;
-    if (kv.n != n + p + 1) {
-        e = DX_FAIL(d, kv.n ? kv.at[0] : en->i, CS_ERR_PARSE,
-                 "SPLINE: %zu control points of degree %u need %zu knots (group 40), not %zu", n,
-                 p, n + p + 1, kv.n);
-        goto out;
-    }
-    if (wv.n != 0 && wv.n != n) {
-        e = DX_FAIL(d, wv.at[0], CS_ERR_PARSE,
-                 "SPLINE: %zu weights (group 41) for %zu control points", wv.n, n);
-        goto out;
-    }
-    for (size_t i = 1; i < kv.n; i++)
-        if (!(kv.bulge[i] >= kv.bulge[i - 1])) {
-            e = DX_FAIL(d, kv.at[i], CS_ERR_PARSE, "SPLINE: knot %g is below the one before it",
-                     kv.bulge[i]);
-            goto out;
-        }
+    return e;
+}
+
+/* The knots and weights of a spline of degree p: counts, order, no break inside the domain,
+ * positive weights, a finite non-empty domain. */
+static cs_err_t spline_check(dx_t *d, const dx_ent_t *en, const dx_spline_t *sp, unsigned p)
+{
+    size_t n = sp->cp.n;
+    const double *K = sp->kv.bulge, *W = sp->wv.bulge;
+    if (sp->kv.n != n + p + 1)
+        return DX_FAIL(d, sp->kv.n ? sp->kv.at[0] : en->i, CS_ERR_PARSE,
+                       "SPLINE: %zu control points of degree %u need %zu knots (group 40), not "
+                       "%zu",
+                       n, p, n + p + 1, sp->kv.n);
+    if (sp->wv.n != 0 && sp->wv.n != n)
+        return DX_FAIL(d, sp->wv.at[0], CS_ERR_PARSE,
+                       "SPLINE: %zu weights (group 41) for %zu control points", sp->wv.n, n);
+    for (size_t i = 1; i < sp->kv.n; i++)
+        if (!(K[i] >= K[i - 1]))
+            return DX_FAIL(d, sp->kv.at[i], CS_ERR_PARSE,
+                           "SPLINE: knot %g is below the one before it", K[i]);
     for (size_t i = p + 1, m = 1; i < n; i++) { /* interior knots: at most p-fold */
-        m = kv.bulge[i] == kv.bulge[i - 1] ? m + 1 : 1;
-        if (m > p && kv.bulge[i] > kv.bulge[p] && kv.bulge[i] < kv.bulge[n]) {
-            e = DX_FAIL(d, kv.at[i], CS_ERR_PARSE,
-                     "SPLINE: knot %g repeated %zu times: the curve is discontinuous there", kv.bulge[i],
-                     m);
-            goto out;
-        }
+        m = K[i] == K[i - 1] ? m + 1 : 1;
+        if (m > p && K[i] > K[p] && K[i] < K[n])
+            return DX_FAIL(d, sp->kv.at[i], CS_ERR_PARSE,
+                           "SPLINE: knot %g repeated %zu times: the curve is discontinuous there",
+                           K[i], m);
     }
-    for (size_t i = 0; i < wv.n; i++)
-        if (!(wv.bulge[i] > 0)) {
-            e = DX_FAIL(d, wv.at[i], CS_ERR_WEIGHT, "SPLINE: weight %g is not positive",
-                     wv.bulge[i]);
-            goto out;
-        }
-    if (!(kv.bulge[n] > kv.bulge[p])) {
-        e = DX_FAIL(d, kv.at[0], CS_ERR_PARSE, "SPLINE: the knots span nothing");
-        goto out;
-    }
-    double(*pw)[3] = malloc((n + 2 * p + 2) * sizeof *pw);
-    double *kn = malloc((n + 3 * p + 3) * sizeof *kn);
-    if (!pw || !kn) {
-        free(pw);
-        free(kn);
-        e = DX_FAIL(d, en->i, CS_ERR_FULL, "out of memory");
-        goto out;
-    }
+    for (size_t i = 0; i < sp->wv.n; i++)
+        if (!(W[i] > 0))
+            return DX_FAIL(d, sp->wv.at[i], CS_ERR_WEIGHT, "SPLINE: weight %g is not positive",
+                           W[i]);
+    if (!(K[n] > K[p]) || !isfinite(K[sp->kv.n - 1] - K[0]))
+        return DX_FAIL(d, sp->kv.at[0], CS_ERR_PARSE,
+                       "SPLINE: the knots span nothing (or more than a double holds)");
+    return CS_OK;
+}
+
+/* Machine-space homogeneous control points pw (x w, y w, w; weights scaled to at most 1, which
+ * leaves the curve as it is and nothing can overflow), clamped, into d->nb. */
+static cs_err_t spline_load(dx_t *d, const dx_ent_t *en, const dx_spline_t *sp, unsigned p,
+                            double (*pw)[3], double *kn)
+{
+    size_t n = sp->cp.n;
+    double wmax = 0;
+    for (size_t i = 0; i < sp->wv.n; i++)
+        wmax = fmax(wmax, sp->wv.bulge[i]);
     for (size_t i = 0; i < n; i++) {
-        double w = wv.n ? wv.bulge[i] : 1.0, x, y;
-        cs_vec3_t chk;
-        if ((e = conv(d, &en->m, cp.p[i][0], cp.p[i][1], cp.at[i], &chk)) != CS_OK) {
-            free(pw);
-            free(kn);
-            goto out;
-        }
-        cs_path_affine_point(&en->m, cp.p[i][0], cp.p[i][1], &x, &y);
+        double w = sp->wv.n ? sp->wv.bulge[i] / wmax : 1.0, x, y;
+        cs_vec3_t chk; /* a point out of range is reported at its own group */
+        cs_err_t e = conv(d, &en->m, sp->cp.p[i][0], sp->cp.p[i][1], sp->cp.at[i], &chk);
+        if (e != CS_OK)
+            return e;
+        cs_path_affine_point(&en->m, sp->cp.p[i][0], sp->cp.p[i][1], &x, &y);
         pw[i][0] = x * w;
         pw[i][1] = y * w;
         pw[i][2] = w;
     }
-    memcpy(kn, kv.bulge, kv.n * sizeof *kn);
+    memcpy(kn, sp->kv.bulge, sp->kv.n * sizeof *kn);
     if (!clamped(kn, n, p))
         clamp_spline(pw, &n, kn, p);
     cs_gnurbs_begin(&d->nb, p + 1);
+    cs_err_t e = CS_OK;
     for (size_t i = 0; e == CS_OK && i < n + p + 1; i++)
         e = cs_gnurbs_knot(&d->nb, kn[i]);
     for (size_t i = 0; e == CS_OK && i < n; i++) {
         double q[3] = {pw[i][0] / pw[i][2], pw[i][1] / pw[i][2], 0};
         e = cs_gnurbs_push(&d->nb, q, pw[i][2]);
     }
+    if (e != CS_OK)
+        return DX_FAIL(d, en->i, e, "SPLINE: %s",
+                       e == CS_ERR_FULL ? "too many control points or out of memory"
+                                        : cs_err_text(e));
+    return CS_OK;
+}
+
+/* The checked spline of degree p through cs_gnurbs (the G-code NURBS blocks' converter). */
+static cs_err_t spline_draw(dx_t *d, const dx_ent_t *en, const dx_spline_t *sp, unsigned p)
+{
+    size_t n = sp->cp.n;
+    double(*pw)[3] = malloc((n + 2 * p + 2) * sizeof *pw); /* room for 2p insertions */
+    double *kn = malloc((n + 3 * p + 3) * sizeof *kn);
+    cs_err_t e = pw && kn ? spline_load(d, en, sp, p, pw, kn)
+                          : DX_FAIL(d, en->i, CS_ERR_FULL, "out of memory");
     free(pw);
     free(kn);
-    if (e != CS_OK) {
-        e = DX_FAIL(d, en->i, e, "SPLINE: %s", e == CS_ERR_FULL ? "too many control points or "
-                                                               "out of memory"
-                                                             : cs_err_text(e));
-        goto out;
-    }
+    if (e != CS_OK)
+        return e;
     char why[160];
     cs_path_new_subpath(d->path);
     d->emit_at = en->i;
     e = cs_gnurbs_build(&d->nb, spline_emit, d, why, sizeof why);
     if (e != CS_OK)
-        e = DX_FAIL(d, en->i, e == CS_ERR_FULL && d->path->over_limit ? CS_ERR_RANGE : e,
-                 "SPLINE: %s", why);
-out:
-    vfree(&cp);
-    vfree(&fp);
-    vfree(&kv);
-    vfree(&wv);
+        return DX_FAIL(d, en->i, e == CS_ERR_FULL && d->path->over_limit ? CS_ERR_RANGE : e,
+                       "SPLINE: %s", why);
+    return CS_OK;
+}
+
+/* SPLINE: 70 flags, 71 degree, 40 knots, 41 weights, 10/20/30 control points; 11/21 fit
+ * points when there are no control points. Degrees 4..25 are skipped (warned). */
+static cs_err_t ent_spline(dx_t *d, const dx_ent_t *en)
+{
+    dx_spline_t sp;
+    memset(&sp, 0, sizeof sp);
+    cs_err_t e = spline_read(d, en, &sp);
+    double deg = sp.deg;
+    bool whole = deg == floor(deg);
+    if (e != CS_OK) {
+        /* the error is set */
+    } else if (sp.cp.n == 0) {
+        e = spline_fit(d, en, &sp.fp);
+    } else if (!whole || deg < 1 || deg > 25) {
+        e = DX_FAIL(d, sp.at_deg, CS_ERR_PARSE, "SPLINE degree %g is not an integer 1..25", deg);
+    } else if (deg > CS_NURBS_MAX_DEGREE) {
+        if (first_time(d, "SPLINE-degree"))
+            DX_WARN(d, sp.at_deg,
+                    "SPLINE of degree %g not drawn (curvestep converts degrees 1 to 3): geometry "
+                    "is missing",
+                    deg);
+    } else if ((e = spline_check(d, en, &sp, (unsigned)deg)) == CS_OK) {
+        e = spline_draw(d, en, &sp, (unsigned)deg);
+    }
+    vfree(&sp.cp);
+    vfree(&sp.fp);
+    vfree(&sp.kv);
+    vfree(&sp.wv);
     return e;
 }
 
@@ -1179,7 +1233,11 @@ static size_t text_plain(const char *s, size_t n, bool mtext, char *out, size_t 
         char c = s[i];
         if (c == '%' && i + 2 < n && s[i + 1] == '%') {
             char k = (char)(s[i + 2] | 0x20);
-            const char *r = k == 'd' ? "o" : k == 'p' ? "+-" : k == 'c' ? "O" : s[i + 2] == '%' ? "%" : "";
+            const char *r = k == 'd'          ? "o"
+                            : k == 'p'        ? "+-"
+                            : k == 'c'        ? "O"
+                            : s[i + 2] == '%' ? "%"
+                                              : "";
             while (*r)
                 out[o++] = *r++;
             i += 3;
@@ -1304,12 +1362,12 @@ static cs_err_t ent_text(dx_t *d, const dx_ent_t *en, bool attrib)
     cs_err_t e = fields(d, en->i, en->end, codes, def, 12, &f);
     if (e == CS_OK)
         e = entity_ocs(d, en, f.v[11], &m, &ok);
-    if (e != CS_OK || !ok || (attrib && ((long)f.v[10] & 1)) || text_skipped(d, en))
+    if (e != CS_OK || !ok || (attrib && (flag(f.v[10]) & 1)) || text_skipped(d, en))
         return e;
     char t[DX_TEXT_MAX + 8];
     size_t n = text_value(d, en, false, t, sizeof t);
     double h = f.v[4], wf = f.v[6] > 0 ? f.v[6] : 1, rot = f.v[5];
-    int hj = (int)f.v[8], vj = attrib ? 0 : (int)f.v[9];
+    long hj = flag(f.v[8]), vj = attrib ? 0 : flag(f.v[9]);
     double x = f.v[0], y = f.v[1];
     if ((hj != 0 || vj != 0) && f.at[2] != SIZE_MAX) {
         if (hj == 3 || hj == 5) { /* between the two points: width (and for 3 height) fit */
@@ -1335,7 +1393,7 @@ static cs_err_t ent_text(dx_t *d, const dx_ent_t *en, bool attrib)
     int ha = hj == 1 || hj == 4 ? 1 : hj == 2 ? 2 : 0;
     if (hj == 4)
         y0 = -h / 2;
-    cs_path_affine_t tm = text_map(&m, x, y, rot, (long)f.v[7]);
+    cs_path_affine_t tm = text_map(&m, x, y, rot, flag(f.v[7]));
     return text_lines(d, &tm, t, n, h, wf, 0, ha, y0, en->i);
 }
 
@@ -1360,7 +1418,7 @@ static cs_err_t ent_mtext(dx_t *d, const dx_ent_t *en)
     if (!(h > 0) || n == 0)
         return CS_OK;
     double rot = f.at[2] != SIZE_MAX ? atan2(f.v[3], f.v[2]) * (180.0 / M_PI) : f.v[5];
-    long att = (long)f.v[6];
+    long att = flag(f.v[6]);
     if (att < 1 || att > 9)
         att = 1;
     size_t lines = 1;
@@ -1396,8 +1454,8 @@ static cs_err_t ent_leader(dx_t *d, const dx_ent_t *en)
 static cs_err_t too_many(dx_t *d, size_t gi)
 {
     return DX_FAIL(d, gi, CS_ERR_RANGE,
-                "more than %llu entities and block copies drawn: the drawing is too large",
-                CS_DXF_MAX_VISITS);
+                   "more than %llu entities and block copies drawn: the drawing is too large",
+                   CS_DXF_MAX_VISITS);
 }
 
 /* --- blocks -------------------------------------------------------------------------------- */
@@ -1419,7 +1477,7 @@ static cs_err_t draw_block(dx_t *d, int b, const cs_path_affine_t *m, size_t gi)
     for (unsigned k = 0; k < d->depth; k++)
         if (d->stack[k] == (size_t)b)
             return DX_FAIL(d, gi, CS_ERR_RANGE, "block '%s' inserts itself (recursion)",
-                        shown(d, d->blk[b].name, nm));
+                           shown(d, d->blk[b].name, nm));
     if (d->depth >= CS_DXF_MAX_DEPTH)
         return DX_FAIL(d, gi, CS_ERR_RANGE, "blocks nested deeper than %d", CS_DXF_MAX_DEPTH);
     d->stack[d->depth++] = (size_t)b;
@@ -1452,7 +1510,7 @@ static cs_err_t ent_insert(dx_t *d, const dx_ent_t *en, bool dimension)
         }
         return name < en->end
                    ? DX_FAIL(d, name, CS_ERR_PARSE, "INSERT of block '%s', which is not defined",
-                          shown(d, name, nm))
+                             shown(d, name, nm))
                    : DX_FAIL(d, en->i, CS_ERR_PARSE, "INSERT without a block name (group 2)");
     }
     if (dimension) /* the dimension's picture, in world coordinates */
@@ -1464,7 +1522,7 @@ static cs_err_t ent_insert(dx_t *d, const dx_ent_t *en, bool dimension)
     double cols = f.v[6] < 1 ? 1 : f.v[6], rows = f.v[7] < 1 ? 1 : f.v[7];
     if (cols > CS_DXF_MAX_ARRAY || rows > CS_DXF_MAX_ARRAY)
         return DX_FAIL(d, f.at[cols > CS_DXF_MAX_ARRAY ? 6 : 7], CS_ERR_RANGE,
-                    "INSERT array larger than %d", CS_DXF_MAX_ARRAY);
+                       "INSERT array larger than %d", CS_DXF_MAX_ARRAY);
     double r = f.v[5] * (M_PI / 180.0), c = cos(r), s = sin(r);
     const dx_block_t *bk = &d->blk[b];
     for (long row = 0; row < (long)rows; row++)
@@ -1639,24 +1697,39 @@ void cs_dxf_opts_init(cs_dxf_opts_t *o)
     memset(o, 0, sizeof *o);
 }
 
+/* Line i of buf[0..len) from *pos, blanks trimmed: [*s, *e); false at the end. */
+static bool sniff_line(const char *buf, size_t len, size_t *pos, size_t *s, size_t *e)
+{
+    if (*pos >= len)
+        return false;
+    size_t a = *pos, b = a;
+    while (b < len && buf[b] != '\n')
+        b++;
+    *pos = b < len ? b + 1 : len;
+    while (a < b && blank(buf[a]))
+        a++;
+    while (b > a && blank(buf[b - 1]))
+        b--;
+    *s = a;
+    *e = b;
+    return true;
+}
+
 bool cs_dxf_is(const char *buf, size_t len)
 {
-    size_t i = cs_readall_bom(buf, len);
-    if (len - i >= sizeof DX_BINARY - 1 && memcmp(buf + i, DX_BINARY, sizeof DX_BINARY - 1) == 0)
+    size_t pos = cs_readall_bom(buf, len), s, e, vs, ve;
+    if (len - pos >= sizeof DX_BINARY - 1 &&
+        memcmp(buf + pos, DX_BINARY, sizeof DX_BINARY - 1) == 0)
         return true;
-    while (i < len && (buf[i] == ' ' || buf[i] == '\t'))
-        i++;
-    if (i >= len || buf[i] != '0')
-        return false;
-    i++;
-    while (i < len && (buf[i] == ' ' || buf[i] == '\t' || buf[i] == '\r'))
-        i++;
-    if (i >= len || buf[i] != '\n')
-        return false;
-    i++;
-    while (i < len && (buf[i] == ' ' || buf[i] == '\t'))
-        i++;
-    return len - i >= 7 && memcmp(buf + i, "SECTION", 7) == 0;
+    /* group pairs: any 999 comments (LibreCAD starts with one), then 0 / SECTION */
+    for (int k = 0; k < 8 && sniff_line(buf, len, &pos, &s, &e); k++) {
+        if (!sniff_line(buf, len, &pos, &vs, &ve))
+            return false;
+        if (e - s == 3 && memcmp(buf + s, "999", 3) == 0)
+            continue;
+        return e - s == 1 && buf[s] == '0' && ve - vs == 7 && memcmp(buf + vs, "SECTION", 7) == 0;
+    }
+    return false;
 }
 
 static cs_err_t dxf_run(dx_t *d)

@@ -38,8 +38,9 @@ typedef struct {
 /* Defaults: warnings to stderr, no font, units from the file. */
 void cs_dxf_opts_init(cs_dxf_opts_t *o);
 
-/* True when buf[0..len) starts like a DXF file: optional blanks, group code 0, then SECTION (or
- * the binary DXF sentinel). For content detection of stdin and unknown names. */
+/* True when buf[0..len) starts like a DXF file: after any 999 comment pairs (LibreCAD writes
+ * one), group code 0 then SECTION, blanks around each allowed; or the binary DXF sentinel. For
+ * content detection of stdin and unknown names. */
 bool cs_dxf_is(const char *buf, size_t len);
 
 /* Parses the DXF text buf[0..len) (need not be NUL-terminated) named name and appends the drawn

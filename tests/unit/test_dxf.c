@@ -130,8 +130,8 @@ static double on_circle(size_t a, size_t b, double cx, double cy, double r)
             cs_ref_vec_t q = cs_ref_eval(&P.elems[i].curve, k / 64.0);
             double d = hypot(q.x - cx, q.y - cy);
             if (fabs(d - r) > ARC_TOL)
-                fail_msg("element %zu t=%d/64: distance %.9f from the centre, radius %.9f", i, k,
-                         d, r);
+                fail_msg("element %zu t=%d/64: distance %.9f from the centre, radius %.9f", i, k, d,
+                         r);
             double ang = atan2(q.y - cy, q.x - cx);
             if (!isnan(prev)) {
                 double da = ang - prev;
@@ -146,7 +146,8 @@ static double on_circle(size_t a, size_t b, double cx, double cy, double r)
     return turn;
 }
 
-/* --- entities ---------------------------------------------------------------------------------- */
+/* --- entities ----------------------------------------------------------------------------------
+ */
 
 static void test_line(void **state)
 {
@@ -196,8 +197,8 @@ static void test_ellipse(void **state)
     double ux = 8, uy = 3, vx = -1.5, vy = 4;
     near_pt(start_of(0), 60 + ux * cos(0.3) + vx * sin(0.3), 20 + uy * cos(0.3) + vy * sin(0.3),
             PT_TOL);
-    near_pt(end_of(P.n - 1), 60 + ux * cos(4.0) + vx * sin(4.0),
-            20 + uy * cos(4.0) + vy * sin(4.0), PT_TOL);
+    near_pt(end_of(P.n - 1), 60 + ux * cos(4.0) + vx * sin(4.0), 20 + uy * cos(4.0) + vy * sin(4.0),
+            PT_TOL);
     joined(0, P.n);
     double u2 = ux * ux + uy * uy, v2 = vx * vx + vy * vy;
     for (size_t i = 0; i < P.n; i++)
@@ -214,8 +215,8 @@ static void test_ellipse(void **state)
         }
     /* Full ellipse, normal (0,0,-1): minor = 0.25 ((0,0,-1) x (0,2)) = (0.5, 0): a closed curve
      * running the other way (clockwise seen from above). */
-    assert_int_equal(rde("0\nELLIPSE\n10\n0\n20\n0\n11\n0\n21\n2\n40\n0.25\n210\n0\n220\n0\n230\n-1\n"),
-                     CS_OK);
+    assert_int_equal(
+        rde("0\nELLIPSE\n10\n0\n20\n0\n11\n0\n21\n2\n40\n0.25\n210\n0\n220\n0\n230\n-1\n"), CS_OK);
     assert_int_equal(P.n, 4);
     near_pt(start_of(0), 0, 2, PT_TOL);
     near_pt(cs_ref_eval(&P.elems[0].curve, 1.0), 0.5, 0, PT_TOL); /* a quarter: +90 degrees */
@@ -287,9 +288,10 @@ static void test_polyline(void **state)
     near_pt(end_of(k + 1), 0, 0, PT_TOL);
     joined(0, k + 2);
     /* 3-D polyline (70 = 8): world coordinates, z dropped; a polyface mesh: warned, skipped. */
-    assert_int_equal(rde("0\nPOLYLINE\n70\n8\n0\nVERTEX\n10\n1\n20\n2\n30\n3\n0\nVERTEX\n10\n4\n20\n6\n30\n-5\n"
-                         "0\nSEQEND\n0\nPOLYLINE\n70\n64\n0\nVERTEX\n10\n1\n20\n1\n0\nSEQEND\n"),
-                     CS_OK);
+    assert_int_equal(
+        rde("0\nPOLYLINE\n70\n8\n0\nVERTEX\n10\n1\n20\n2\n30\n3\n0\nVERTEX\n10\n4\n20\n6\n30\n-5\n"
+            "0\nSEQEND\n0\nPOLYLINE\n70\n64\n0\nVERTEX\n10\n1\n20\n1\n0\nSEQEND\n"),
+        CS_OK);
     assert_int_equal(P.n, 1);
     near_pt(end_of(0), 4, 6, PT_TOL);
     assert_int_equal(nwarn, 1);
@@ -302,14 +304,16 @@ static void test_polyline(void **state)
 static void test_extrusion(void **state)
 {
     (void)state;
-    assert_int_equal(rde("0\nARC\n10\n10\n20\n0\n30\n0\n40\n2\n210\n0\n220\n0\n230\n-1\n50\n0\n51\n90\n"),
-                     CS_OK);
+    assert_int_equal(
+        rde("0\nARC\n10\n10\n20\n0\n30\n0\n40\n2\n210\n0\n220\n0\n230\n-1\n50\n0\n51\n90\n"),
+        CS_OK);
     near_pt(start_of(0), -12, 0, PT_TOL);
     near_pt(end_of(P.n - 1), -10, 2, PT_TOL);
     assert_true(fabs(on_circle(0, P.n, -10, 0, 2) + M_PI / 2) < 1e-3);
     /* LWPOLYLINE with elevation and the same normal: z along N moves nothing in x, y. */
-    assert_int_equal(rde("0\nLWPOLYLINE\n90\n2\n38\n5\n210\n0\n220\n0\n230\n-1\n10\n1\n20\n2\n10\n3\n20\n-4\n"),
-                     CS_OK);
+    assert_int_equal(
+        rde("0\nLWPOLYLINE\n90\n2\n38\n5\n210\n0\n220\n0\n230\n-1\n10\n1\n20\n2\n10\n3\n20\n-4\n"),
+        CS_OK);
     near_pt(start_of(0), -1, 2, PT_TOL);
     near_pt(end_of(0), -3, -4, PT_TOL);
     /* A tilted normal (1, 0, 0) sees the plane edge-on: warned, not drawn. A normal (0, 1, 1)
@@ -327,9 +331,9 @@ static void test_extrusion(void **state)
 }
 
 /* A block B (base (1, 1)): a line (1,1)-(5,1). */
-#define BLOCK_B                                                                                   \
-    "0\nSECTION\n2\nBLOCKS\n0\nBLOCK\n2\nB\n10\n1\n20\n1\n0\nLINE\n10\n1\n20\n1\n11\n5\n21\n1\n" \
-    "0\nENDBLK\n0\nBLOCK\n2\nN\n10\n0\n20\n0\n0\nINSERT\n2\nb\n10\n10\n20\n10\n50\n90\n41\n0.5\n" \
+#define BLOCK_B                                                                                    \
+    "0\nSECTION\n2\nBLOCKS\n0\nBLOCK\n2\nB\n10\n1\n20\n1\n0\nLINE\n10\n1\n20\n1\n11\n5\n21\n1\n"   \
+    "0\nENDBLK\n0\nBLOCK\n2\nN\n10\n0\n20\n0\n0\nINSERT\n2\nb\n10\n10\n20\n10\n50\n90\n41\n0.5\n"  \
     "42\n0.5\n0\nENDBLK\n0\nENDSEC\n"
 
 static void xform(double ix, double iy, double sx, double sy, double rot, double bx, double by,
@@ -408,8 +412,8 @@ static void test_insert_errors(void **state)
 
 /* The NURBS of degree p (n points x, y, weights w or NULL, knots kn) at u, in the span s with
  * kn[s] <= u <= kn[s+1] (The NURBS Book, A2.2 / de Boor, in homogeneous coordinates). */
-static void de_boor(unsigned p, const double (*pt)[2], const double *w, const double *kn,
-                    size_t s, double u, double *ox, double *oy)
+static void de_boor(unsigned p, const double (*pt)[2], const double *w, const double *kn, size_t s,
+                    double u, double *ox, double *oy)
 {
     double d[4][3];
     for (unsigned j = 0; j <= p; j++) {
@@ -502,20 +506,23 @@ static void test_spline_fit_and_errors(void **state)
     (void)state;
     /* Fit points only: the natural spline through them, chord-length parameter (cs_spline):
      * each segment ends on its fit point. */
-    assert_int_equal(rde("0\nSPLINE\n71\n3\n74\n4\n11\n0\n21\n0\n11\n10\n21\n5\n11\n20\n21\n-3\n11\n30\n21\n2\n"),
+    assert_int_equal(rde("0\nSPLINE\n71\n3\n74\n4\n11\n0\n21\n0\n11\n10\n21\n5\n11\n20\n21\n-"
+                         "3\n11\n30\n21\n2\n"),
                      CS_OK);
     assert_int_equal(P.n, 3);
     near_pt(end_of(0), 10, 5, PT_TOL);
     near_pt(end_of(1), 20, -3, PT_TOL);
     near_pt(end_of(2), 30, 2, PT_TOL);
     /* a knot count that does not fit: at the first knot */
-    assert_int_equal(rde("0\nSPLINE\n71\n2\n40\n0\n40\n1\n10\n0\n20\n0\n10\n1\n20\n1\n10\n2\n20\n0\n"),
-                     CS_ERR_PARSE);
+    assert_int_equal(
+        rde("0\nSPLINE\n71\n2\n40\n0\n40\n1\n10\n0\n20\n0\n10\n1\n20\n1\n10\n2\n20\n0\n"),
+        CS_ERR_PARSE);
     assert_int_equal(D.loc.line, 20);
     assert_non_null(strstr(D.reason, "need 6 knots"));
     /* decreasing knots: at the knot */
-    assert_int_equal(rde("0\nSPLINE\n71\n1\n40\n0\n40\n0\n40\n2\n40\n1\n10\n0\n20\n0\n10\n1\n20\n1\n"),
-                     CS_ERR_PARSE);
+    assert_int_equal(
+        rde("0\nSPLINE\n71\n1\n40\n0\n40\n0\n40\n2\n40\n1\n10\n0\n20\n0\n10\n1\n20\n1\n"),
+        CS_ERR_PARSE);
     assert_int_equal(D.loc.line, 26);
     /* an interior knot p + 1 times: the curve would break there */
     assert_int_equal(rde("0\nSPLINE\n71\n1\n40\n0\n40\n0\n40\n1\n40\n1\n40\n2\n40\n2\n"
@@ -558,23 +565,22 @@ static void test_units(void **state)
     assert_int_equal(nwarn, 0);
     near_pt(end_of(1), 3 * 25.4, 0, PT_TOL);
     /* CRLF reads the same */
-    assert_int_equal(rd("0\r\nSECTION\r\n2\r\nENTITIES\r\n0\r\nLINE\r\n 11\r\n 2.5 \r\n0\r\nENDSEC\r\n"),
-                     CS_OK);
+    assert_int_equal(
+        rd("0\r\nSECTION\r\n2\r\nENTITIES\r\n0\r\nLINE\r\n 11\r\n 2.5 \r\n0\r\nENDSEC\r\n"), CS_OK);
     near_pt(end_of(0), 2.5, 0, PT_TOL);
 }
 
 static void test_layers_and_skipped(void **state)
 {
     (void)state;
-    const char *f =
-        "0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n"
-        "0\nSECTION\n2\nTABLES\n0\nTABLE\n2\nLAYER\n70\n3\n"
-        "0\nLAYER\n2\nOFF\n70\n0\n62\n-7\n0\nLAYER\n2\nFROZEN\n70\n1\n62\n7\n"
-        "0\nLAYER\n2\nON\n70\n0\n62\n1\n0\nENDTAB\n0\nENDSEC\n"
-        "0\nSECTION\n2\nENTITIES\n"
-        "0\nLINE\n8\noff\n11\n1\n0\nLINE\n8\nOFF\n11\n2\n0\nLINE\n8\nFROZEN\n11\n3\n"
-        "0\nLINE\n8\nON\n11\n4\n0\nHATCH\n8\nON\n0\nHATCH\n0\nSOLID\n0\nPOINT\n"
-        "0\nLINE\n67\n1\n11\n5\n0\nLINE\n60\n1\n11\n6\n0\nWHATEVER\n0\nENDSEC\n";
+    const char *f = "0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n"
+                    "0\nSECTION\n2\nTABLES\n0\nTABLE\n2\nLAYER\n70\n3\n"
+                    "0\nLAYER\n2\nOFF\n70\n0\n62\n-7\n0\nLAYER\n2\nFROZEN\n70\n1\n62\n7\n"
+                    "0\nLAYER\n2\nON\n70\n0\n62\n1\n0\nENDTAB\n0\nENDSEC\n"
+                    "0\nSECTION\n2\nENTITIES\n"
+                    "0\nLINE\n8\noff\n11\n1\n0\nLINE\n8\nOFF\n11\n2\n0\nLINE\n8\nFROZEN\n11\n3\n"
+                    "0\nLINE\n8\nON\n11\n4\n0\nHATCH\n8\nON\n0\nHATCH\n0\nSOLID\n0\nPOINT\n"
+                    "0\nLINE\n67\n1\n11\n5\n0\nLINE\n60\n1\n11\n6\n0\nWHATEVER\n0\nENDSEC\n";
     assert_int_equal(rd(f), CS_OK);
     assert_int_equal(P.n, 1);
     near_pt(end_of(0), 4, 0, PT_TOL);
@@ -586,9 +592,10 @@ static void test_layers_and_skipped(void **state)
     assert_non_null(strstr(warns, "paper-space"));
     assert_non_null(strstr(warns, "WHATEVER: not supported"));
     /* DIMENSION draws its block; LEADER its line */
-    const char *g = "0\nSECTION\n2\nBLOCKS\n0\nBLOCK\n2\n*D1\n0\nLINE\n10\n0\n20\n-10\n11\n50\n21\n-10\n"
-                    "0\nENDBLK\n0\nENDSEC\n0\nSECTION\n2\nENTITIES\n0\nDIMENSION\n2\n*D1\n"
-                    "0\nLEADER\n10\n0\n20\n0\n10\n5\n20\n5\n10\n9\n20\n5\n0\nENDSEC\n";
+    const char *g =
+        "0\nSECTION\n2\nBLOCKS\n0\nBLOCK\n2\n*D1\n0\nLINE\n10\n0\n20\n-10\n11\n50\n21\n-10\n"
+        "0\nENDBLK\n0\nENDSEC\n0\nSECTION\n2\nENTITIES\n0\nDIMENSION\n2\n*D1\n"
+        "0\nLEADER\n10\n0\n20\n0\n10\n5\n20\n5\n10\n9\n20\n5\n0\nENDSEC\n";
     assert_int_equal(rd_opts(g, false, 1), CS_OK);
     assert_int_equal(P.n, 3);
     near_pt(end_of(0), 50, -10, PT_TOL);
@@ -614,7 +621,8 @@ static void test_text(void **state)
         }
     assert_true(fabs(lo - 5) < 1e-3 && fabs(hi - 15) < 1e-3 && xlo >= 5);
     /* rotated 90 degrees: the stem lies along -x from the point */
-    const char *g = "0\nSECTION\n2\nENTITIES\n0\nTEXT\n10\n5\n20\n5\n40\n10\n50\n90\n1\nL\n0\nENDSEC\n";
+    const char *g =
+        "0\nSECTION\n2\nENTITIES\n0\nTEXT\n10\n5\n20\n5\n40\n10\n50\n90\n1\nL\n0\nENDSEC\n";
     assert_int_equal(rd_opts(g, true, 1), CS_OK);
     double xmin = 1e9, xmax = -1e9;
     for (size_t i = 0; i < P.n; i++)
@@ -675,7 +683,10 @@ static void test_detect(void **state)
     const char *f = "  0\r\nSECTION\r\n  2\r\nHEADER\r\n";
     assert_int_equal(cs_input_detect("a.DXF", "", 0), CS_INPUT_DXF);
     assert_int_equal(cs_input_detect(NULL, f, strlen(f)), CS_INPUT_DXF);
-    assert_int_equal(cs_input_detect(NULL, "0\nSECTIONS", 10), CS_INPUT_DXF);
+    const char *lc = "  999\ndxfrw 0.6.3\n  0\nSECTION\n";
+    assert_int_equal(cs_input_detect(NULL, lc, strlen(lc)), CS_INPUT_DXF); /* LibreCAD's start */
+    assert_int_equal(cs_input_detect(NULL, "0\nSECTION\n", 10), CS_INPUT_DXF);
+    assert_int_equal(cs_input_detect(NULL, "0\nSECTIONS\n", 11), CS_INPUT_SVG);
     assert_int_equal(cs_input_detect(NULL, "0 0 L 1 1", 9), CS_INPUT_SVG);
     assert_true(cs_dxf_is("AutoCAD Binary DXF\r\n", 20));
     assert_string_equal(cs_input_format_name(CS_INPUT_DXF), "dxf");
@@ -684,20 +695,13 @@ static void test_detect(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_line),
-        cmocka_unit_test(test_circle_arc),
-        cmocka_unit_test(test_ellipse),
-        cmocka_unit_test(test_bulge),
-        cmocka_unit_test(test_polyline),
-        cmocka_unit_test(test_extrusion),
-        cmocka_unit_test(test_insert),
-        cmocka_unit_test(test_insert_errors),
-        cmocka_unit_test(test_spline),
-        cmocka_unit_test(test_spline_fit_and_errors),
-        cmocka_unit_test(test_units),
-        cmocka_unit_test(test_layers_and_skipped),
-        cmocka_unit_test(test_text),
-        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_line),     cmocka_unit_test(test_circle_arc),
+        cmocka_unit_test(test_ellipse),  cmocka_unit_test(test_bulge),
+        cmocka_unit_test(test_polyline), cmocka_unit_test(test_extrusion),
+        cmocka_unit_test(test_insert),   cmocka_unit_test(test_insert_errors),
+        cmocka_unit_test(test_spline),   cmocka_unit_test(test_spline_fit_and_errors),
+        cmocka_unit_test(test_units),    cmocka_unit_test(test_layers_and_skipped),
+        cmocka_unit_test(test_text),     cmocka_unit_test(test_errors),
         cmocka_unit_test(test_detect),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
