@@ -1432,6 +1432,44 @@ static cs_err_t ent_mtext(dx_t *d, const dx_ent_t *en)
     return text_lines(d, &tm, t, n, h, 1, pitch, ha, y0, en->i);
 }
 
+/* SOLID and TRACE (corners 10, 11, 12, 13 in the OCS, filled in the order 1 2 4 3: the DXF
+ * Reference's "bow tie") and 3DFACE (corners in the world, edges 1 2 3 4, 70 bits 1/2/4/8 hide
+ * edges 1..4): the outline, as fills are drawn for SVG. A missing fourth corner is the third. */
+static cs_err_t ent_face(dx_t *d, const dx_ent_t *en, bool face3d)
+{
+    static const int codes[] = {10, 20, 11, 21, 12, 22, 13, 23, 70, 30};
+    static const double def[] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    dx_fields_t f;
+    cs_path_affine_t m = en->m;
+    bool ok = true;
+    cs_err_t e = fields(d, en->i, en->end, codes, def, 10, &f);
+    if (e == CS_OK && !face3d)
+        e = entity_ocs(d, en, f.v[9], &m, &ok);
+    if (e != CS_OK || !ok)
+        return e;
+    if (f.at[6] == SIZE_MAX) { /* a triangle */
+        f.v[6] = f.v[4];
+        f.v[7] = f.v[5];
+    }
+    static const int order_solid[] = {0, 1, 3, 2}, order_face[] = {0, 1, 2, 3};
+    const int *ord = face3d ? order_face : order_solid;
+    long hide = face3d ? flag(f.v[8]) : 0;
+    cs_vec3_t q[4];
+    for (int k = 0; k < 4 && e == CS_OK; k++)
+        e = conv(d, &m, f.v[2 * ord[k]], f.v[2 * ord[k] + 1], en->i, &q[k]);
+    if (e == CS_OK && first_time(d, "fill-outline"))
+        DX_WARN(d, en->i, "filled SOLID/TRACE/3DFACE: fills are not drawn, their outline is");
+    cs_path_new_subpath(d->path);
+    for (int k = 0; k < 4 && e == CS_OK; k++) {
+        if (hide & (1L << k)) {
+            cs_path_new_subpath(d->path);
+            continue;
+        }
+        e = line(d, &q[k], &q[(k + 1) % 4], en->i);
+    }
+    return e;
+}
+
 /* LEADER: its vertices (10, 20) as lines; the arrowhead is not drawn. */
 static cs_err_t ent_leader(dx_t *d, const dx_ent_t *en)
 {
@@ -1549,9 +1587,6 @@ static const struct {
 } skipped[] = {
     {"POINT", "points are not drawn (a dot has no path)"},
     {"HATCH", "hatches and fills are not drawn: their boundaries and pattern lines are missing"},
-    {"SOLID", "filled triangles/quadrilaterals are not drawn: geometry is missing"},
-    {"TRACE", "filled traces are not drawn: geometry is missing"},
-    {"3DFACE", "3-D faces are not drawn: geometry is missing"},
     {"IMAGE", "raster images are not drawn"},
     {"WIPEOUT", "wipeouts are not applied: what they mask is drawn"},
     {"XLINE", "construction lines (infinite) are not drawn"},
@@ -1636,6 +1671,8 @@ static cs_err_t entity(dx_t *d, dx_ent_t *en, size_t *next)
         return ent_insert(d, en, true);
     if (is(d, en->i, "LEADER"))
         return ent_leader(d, en);
+    if (is(d, en->i, "SOLID") || is(d, en->i, "TRACE") || is(d, en->i, "3DFACE"))
+        return ent_face(d, en, is(d, en->i, "3DFACE"));
     if (is(d, en->i, "SEQEND") || is(d, en->i, "VIEWPORT") || is(d, en->i, "VERTEX") ||
         is(d, en->i, "ATTDEF"))
         return CS_OK; /* an INSERT's attributes end; paper-space viewports; stray vertices;

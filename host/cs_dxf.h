@@ -5,10 +5,10 @@
  * (extrusion 210/220/230: (0,0,-1) mirrors x; any other normal is projected onto XY), and the
  * geometry of LINE, ARC, CIRCLE, ELLIPSE (exact rational pieces, cs_arc_build), LWPOLYLINE and
  * POLYLINE (bulges as exact arcs), SPLINE (cs_gnurbs -> the core's cs_nurbs; fit points only:
- * cs_spline), TEXT/MTEXT/ATTRIB (Hershey stroke font), DIMENSION (its block), LEADER; the rest
- * is skipped with one warning per kind saying what the drawing loses. Everything is drawn as
- * seen from above: z is dropped. Y points up, as in the machine frame. See docs/inputs.md
- * "## DXF". */
+ * cs_spline), TEXT/MTEXT/ATTRIB (Hershey stroke font), DIMENSION (its block), LEADER, and
+ * SOLID/TRACE/3DFACE as outlines; the rest is skipped with one warning per kind saying what the
+ * drawing loses. Everything is drawn as seen from above: z is dropped. Y points up, as in the
+ * machine frame. See docs/inputs.md "## DXF". */
 #ifndef CS_DXF_H
 #define CS_DXF_H
 

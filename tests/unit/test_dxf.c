@@ -579,18 +579,38 @@ static void test_layers_and_skipped(void **state)
                     "0\nLAYER\n2\nON\n70\n0\n62\n1\n0\nENDTAB\n0\nENDSEC\n"
                     "0\nSECTION\n2\nENTITIES\n"
                     "0\nLINE\n8\noff\n11\n1\n0\nLINE\n8\nOFF\n11\n2\n0\nLINE\n8\nFROZEN\n11\n3\n"
-                    "0\nLINE\n8\nON\n11\n4\n0\nHATCH\n8\nON\n0\nHATCH\n0\nSOLID\n0\nPOINT\n"
+                    "0\nLINE\n8\nON\n11\n4\n0\nHATCH\n8\nON\n0\nHATCH\n0\nIMAGE\n0\nPOINT\n"
                     "0\nLINE\n67\n1\n11\n5\n0\nLINE\n60\n1\n11\n6\n0\nWHATEVER\n0\nENDSEC\n";
     assert_int_equal(rd(f), CS_OK);
     assert_int_equal(P.n, 1);
     near_pt(end_of(0), 4, 0, PT_TOL);
-    /* layers off and frozen once each; HATCH, SOLID, POINT, paper space, the unknown once */
+    /* layers off and frozen once each; HATCH, IMAGE, POINT, paper space, the unknown once */
     assert_int_equal(nwarn, 7);
     assert_non_null(strstr(warns, "layer 'OFF' is off"));
     assert_non_null(strstr(warns, "layer 'FROZEN' is frozen"));
     assert_non_null(strstr(warns, "HATCH: hatches and fills are not drawn"));
     assert_non_null(strstr(warns, "paper-space"));
     assert_non_null(strstr(warns, "WHATEVER: not supported"));
+    /* SOLID: the outline in the order 1 2 4 3 (the bow tie), in its OCS (here mirrored);
+     * a triangle (no 13); 3DFACE: edges 1 2 3 4, edge 2 hidden (70 = 2) */
+    assert_int_equal(rde("0\nSOLID\n10\n0\n20\n0\n11\n4\n21\n0\n12\n0\n22\n3\n13\n4\n23\n3\n"
+                         "230\n-1\n0\nTRACE\n10\n0\n20\n0\n11\n1\n21\n0\n12\n0\n22\n1\n"
+                         "0\n3DFACE\n10\n0\n20\n0\n11\n5\n21\n0\n12\n5\n22\n5\n13\n0\n23\n5\n"
+                         "70\n2\n"),
+                     CS_OK);
+    assert_int_equal(P.n, 4 + 3 + 3);
+    static const double sq[5][2] = {{0, 0}, {-4, 0}, {-4, 3}, {0, 3}, {0, 0}};
+    for (int k = 0; k < 4; k++) {
+        near_pt(start_of((size_t)k), sq[k][0], sq[k][1], PT_TOL);
+        near_pt(end_of((size_t)k), sq[k + 1][0], sq[k + 1][1], PT_TOL);
+    }
+    near_pt(end_of(4), 1, 0, PT_TOL);
+    near_pt(end_of(5), 0, 1, PT_TOL); /* the triangle: 1 2 3(=4) 3 */
+    near_pt(end_of(6), 0, 0, PT_TOL);
+    near_pt(start_of(8), 5, 5, PT_TOL); /* edge 2 (5,0)-(5,5) hidden */
+    assert_true(P.elems[8].subpath != P.elems[7].subpath);
+    assert_int_equal(nwarn, 1);
+    assert_non_null(strstr(warns, "their outline is"));
     /* DIMENSION draws its block; LEADER its line */
     const char *g =
         "0\nSECTION\n2\nBLOCKS\n0\nBLOCK\n2\n*D1\n0\nLINE\n10\n0\n20\n-10\n11\n50\n21\n-10\n"

@@ -77,8 +77,15 @@ def cases():
         r = msp.add_blockref('B1', (40, -40))
         r.dxf.extrusion = (0, 0, -1)
 
+    def solid(doc, msp):  # drawn as outlines (warned: fills are not drawn)
+        msp.add_solid([(0, 0), (4, 0), (0, 3), (4, 3)])
+        msp.add_solid([(10, 0), (14, 1), (11, 4)])
+        t = msp.add_trace([(20, 0), (24, 0), (20, 2), (24, 2)])
+        t.dxf.extrusion = (0, 0, -1)
+        msp.add_3dface([(30, 0, 0), (35, 0, 1), (35, 5, 2), (30, 5, 0)])
+
     return [(f.__name__, f) for f in (line, circle, arc, arc_mirrored, ellipse, lwpolyline,
-                                       polyline, spline, insert)]
+                                       polyline, spline, insert, solid)]
 
 
 def write(outdir):
