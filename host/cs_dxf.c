@@ -1222,8 +1222,23 @@ static cs_err_t text_vertex(void *ctx, double x, double y, bool move)
     return line(l->d, &a, &q, l->gi);
 }
 
+/* s[0..n) starts with an AutoCAD Unicode escape \U+XXXX (4 hex digits): its code point. */
+static bool unicode_escape(const char *s, size_t n, unsigned long *cp)
+{
+    if (n < 7 || s[1] != 'U' || s[2] != '+')
+        return false;
+    char hex[5];
+    memcpy(hex, s + 3, 4);
+    hex[4] = '\0';
+    char *end;
+    *cp = strtoul(hex, &end, 16);
+    return end == hex + 4 && hex[0] != '-' && hex[0] != '+' && hex[0] != ' ';
+}
+
 /* The text with AutoCAD's control codes resolved: %%d -> 'o' (degree sign), %%p -> "+-", %%c ->
- * 'O' (diameter), %%% -> '%', %%u %%o %%k dropped; for MTEXT also its format codes
+ * 'O' (diameter), %%% -> '%', %%u %%o %%k dropped; \U+XXXX: the character (ASCII), 'o', "+-",
+ * 'O' for the degree, plus-minus and diameter signs, '?' for the rest; for MTEXT also its format
+ * codes
  * (\P and \n: new line; \~: space; \S a^b; -> a/b; \\ \{ \}: the character; {, }, and
  * \X...; switches such as \fArial|b0; \H2.5x; \C1; dropped). Lines end with '\n'. */
 static size_t text_plain(const char *s, size_t n, bool mtext, char *out, size_t cap)
@@ -1241,6 +1256,21 @@ static size_t text_plain(const char *s, size_t n, bool mtext, char *out, size_t 
             while (*r)
                 out[o++] = *r++;
             i += 3;
+            continue;
+        }
+        unsigned long cp;
+        if (c == '\\' && unicode_escape(s + i, n - i, &cp)) { /* \U+00B0 */
+            const char *r = cp == 0xB0                   ? "o"
+                            : cp == 0xB1                 ? "+-"
+                            : cp == 0xD8 || cp == 0x2205 ? "O"
+                            : cp < 0x7F && cp >= 0x20    ? NULL
+                                                         : "?";
+            if (r)
+                while (*r)
+                    out[o++] = *r++;
+            else
+                out[o++] = (char)cp;
+            i += 7;
             continue;
         }
         if (mtext && (c == '{' || c == '}')) {

@@ -666,6 +666,17 @@ static void test_text(void **state)
             hi = fmax(hi, q.y);
         }
     assert_true(fabs(hi - 0) < 1e-3 && fabs(lo - (-3 - 5.0)) < 1e-3);
+    /* control codes: %%d and \U+00B0 are both the degree sign 'o', \U+0041 is 'A': the same
+     * strokes as "1o1oA" */
+    const char *c1 =
+        "0\nSECTION\n2\nENTITIES\n0\nTEXT\n40\n5\n1\n1%%d1\\U+00B0\\U+0041\n0\nENDSEC\n";
+    const char *c2 = "0\nSECTION\n2\nENTITIES\n0\nTEXT\n40\n5\n1\n1o1oA\n0\nENDSEC\n";
+    assert_int_equal(rd_opts(c2, true, 1), CS_OK);
+    size_t n2 = P.n;
+    cs_ref_vec_t last2 = end_of(n2 - 1);
+    assert_int_equal(rd_opts(c1, true, 1), CS_OK);
+    assert_int_equal(P.n, n2);
+    near_pt(end_of(P.n - 1), last2.x, last2.y, PT_TOL);
     /* no font: skipped with one warning */
     assert_int_equal(rd_opts(f, false, 1), CS_OK);
     assert_int_equal(P.n, 0);
