@@ -5,7 +5,8 @@
 # lie within 0.005 mm of each other both ways (ezdxf's own arcs are cubic approximations, within
 # 2.7e-4 of the radius; its splines are the exact NURBS). Then real files (tests/data/dxf, from
 # dxf-parser: an AutoCAD arc with extrusion (0,0,-1), ellipses with ratio > 1, a spline beyond
-# the range), units, standard input, warnings once per kind, and located errors.
+# the range; from ezdxf: an AutoCAD 2.x drawing), units, standard input, warnings once per kind,
+# and located errors.
 # Uses $CS_BUILD (the build directory); ends with "cli: N passed, M failed".
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
@@ -68,6 +69,12 @@ run "ellipse.dxf" 0 flatten --stats tests/data/dxf/ellipse.dxf &&
             ok = mn > -20.001 && mn < -19.99 && mx < 20.001 && mx > 19.99 && \
                  v[1] == v[n - 1] && v[2] == v[n] }
         END { exit !ok }' "$T/out"
+# AutoCAD 2.x (AC1003, from ezdxf's tests): tabs before values, 10 11 before 20 21 (ezdxf 0.18's
+# own reader refuses it). 13 LINEs and 9 ARCs: seven of at most 90 degrees (1 piece each) and two
+# of 180 (2 each): 13 + 7 + 4 = 24 elements, one subpath per entity; 3.625 in wide.
+run "AC1003" 0 flatten --stats --units inch tests/data/dxf/AC1003_LINE_Example.dxf &&
+    expect_err "AC1003" '24 elements in 22 subpaths' &&
+    expect "AC1003: width" awk 'NF == 2 { if ($1 > mx) mx = $1 } END { exit !(mx > 92.07 && mx < 92.08) }' "$T/out"
 # A spline reaching x = 4994: beyond the +/-4096 mm range, at its control point.
 run "splines.dxf" 1 flatten tests/data/dxf/splines.dxf &&
     expect_error "splines.dxf" tests/data/dxf/splines.dxf 94 1
