@@ -29,7 +29,7 @@ struct cs_css_rule {
     compound_t c[CS_CSS_MAX_COMPOUNDS]; /* left to right; the last matches the element */
     unsigned n;
     unsigned long long rank; /* specificity << 32 | order */
-    span_t decls;            /* the declaration block's text */
+    size_t dfirst, dn;       /* its block's declarations: s->decls[dfirst..dfirst + dn) */
 };
 
 void cs_css_init(cs_css_sheet_t *s)
@@ -43,6 +43,7 @@ void cs_css_free(cs_css_sheet_t *s)
         free(s->texts[i]);
     free(s->texts);
     free(s->rules);
+    free(s->decls);
     cs_css_init(s);
 }
 
@@ -147,12 +148,13 @@ static bool ieq(const char *a, const char *b, size_t n)
 
 /* --- declarations --------------------------------------------------------------------------- */
 
-typedef struct {
+struct cs_css_decl {
     span_t name, value;
     bool important;
-    bool bad; /* no colon, or no property name */
+    bool bad;   /* no colon, or no property name */
     size_t off; /* offset of the declaration in the scanned text */
-} decl_t;
+};
+typedef struct cs_css_decl decl_t;
 
 /* The next declaration of s[*i..len); false at the end. */
 static bool next_decl(const char *s, size_t len, size_t *i, decl_t *d)
@@ -203,22 +205,16 @@ static bool better(const cs_css_value_t *a, const cs_css_value_t *b)
     return a->rank >= b->rank;
 }
 
-/* Offers every declaration of decls[0..n) of one of props to out (rank: the rule's). */
-static void offer(const char *decls, size_t n, unsigned long long rank, const char *const *props,
-                  size_t np, cs_css_value_t *out)
+/* Offers declaration d to out if it declares one of props (rank: its rule's). */
+static void offer(const decl_t *d, unsigned long long rank, const char *const *props, size_t np,
+                  cs_css_value_t *out)
 {
-    size_t i = 0;
-    decl_t d;
-    while (next_decl(decls, n, &i, &d)) {
-        if (d.bad)
+    for (size_t k = 0; k < np; k++) {
+        if (strlen(props[k]) != d->name.n || !ieq(props[k], d->name.p, d->name.n))
             continue;
-        for (size_t k = 0; k < np; k++) {
-            if (strlen(props[k]) != d.name.n || !ieq(props[k], d.name.p, d.name.n))
-                continue;
-            cs_css_value_t c = {d.value.p, d.value.n, d.important, true, rank};
-            if (better(&c, &out[k]))
-                out[k] = c;
-        }
+        cs_css_value_t c = {d->value.p, d->value.n, d->important, true, rank};
+        if (better(&c, &out[k]))
+            out[k] = c;
     }
 }
 
@@ -226,8 +222,11 @@ cs_css_value_t cs_css_inline(const char *decls, const char *prop)
 {
     cs_css_value_t v;
     memset(&v, 0, sizeof v);
-    if (decls)
-        offer(decls, strlen(decls), 0, &prop, 1, &v);
+    size_t i = 0, n = decls ? strlen(decls) : 0;
+    decl_t d;
+    while (n && next_decl(decls, n, &i, &d))
+        if (!d.bad)
+            offer(&d, 0, &prop, 1, &v);
     return v;
 }
 
@@ -349,7 +348,7 @@ static bool add_rule(cs_css_sheet_t *s, const cs_css_rule_t *r)
 
 /* Every selector of a rule's prelude s[ps..pe) with its block: a group holding an invalid
  * selector is dropped whole (CSS); an unsupported one alone. */
-static bool add_group(cs_css_sheet_t *s, const char *t, size_t ps, size_t pe, span_t decls,
+static bool add_group(cs_css_sheet_t *s, const char *t, size_t ps, size_t pe, size_t dfirst,
                       cs_css_warn_fn warn, void *ctx)
 {
     cs_css_rule_t *tmp = malloc(sizeof *tmp); /* ~3 KB: off the stack */
@@ -374,7 +373,8 @@ static bool add_group(cs_css_sheet_t *s, const char *t, size_t ps, size_t pe, sp
                      "unsupported selector (pseudo-class, attribute, sibling or namespace "
                      "selector): it matches nothing here");
             if (pass == 1 && k == SEL_OK) {
-                tmp[0].decls = decls;
+                tmp[0].dfirst = dfirst;
+                tmp[0].dn = s->ndecls - dfirst;
                 tmp[0].rank = (unsigned long long)spec << 32 | (unsigned long long)s->nrules;
                 if (!add_rule(s, &tmp[0])) {
                     free(tmp);
@@ -388,15 +388,30 @@ static bool add_group(cs_css_sheet_t *s, const char *t, size_t ps, size_t pe, sp
     return true;
 }
 
-/* Warns about each malformed declaration of a block. */
-static void check_decls(span_t b, const char *t, cs_css_warn_fn warn, void *ctx)
+/* The declarations of a block into s->decls (parsed once for every element they are offered
+ * to); a warning for each malformed one. */
+static bool read_decls(cs_css_sheet_t *s, span_t b, const char *t, cs_css_warn_fn warn, void *ctx)
 {
     size_t i = 0;
     decl_t d;
-    while (warn && next_decl(b.p, b.n, &i, &d))
-        if (d.bad)
-            warn(ctx, (size_t)(b.p - t) + d.off, "css-decl",
-                 "malformed declaration (expected property: value): skipped");
+    while (next_decl(b.p, b.n, &i, &d)) {
+        if (d.bad) {
+            if (warn)
+                warn(ctx, (size_t)(b.p - t) + d.off, "css-decl",
+                     "malformed declaration (expected property: value): skipped");
+            continue;
+        }
+        if (s->ndecls == s->dcap) {
+            size_t ncap = s->dcap ? s->dcap * 2 : 16;
+            decl_t *nd = realloc(s->decls, ncap * sizeof *nd);
+            if (!nd)
+                return false;
+            s->decls = nd;
+            s->dcap = ncap;
+        }
+        s->decls[s->ndecls++] = d;
+    }
+    return true;
 }
 
 bool cs_css_add(cs_css_sheet_t *s, const char *text, size_t len, cs_css_warn_fn warn, void *ctx)
@@ -433,8 +448,8 @@ bool cs_css_add(cs_css_sheet_t *s, const char *text, size_t len, cs_css_warn_fn 
         }
         size_t be = scan_to(t, len, pe + 1, "}"); /* the end of the sheet closes it (CSS) */
         span_t b = {t + pe + 1, be - pe - 1};
-        check_decls(b, t, warn, ctx);
-        if (!add_group(s, t, ps, pe, b, warn, ctx))
+        size_t dfirst = s->ndecls;
+        if (!read_decls(s, b, t, warn, ctx) || !add_group(s, t, ps, pe, dfirst, warn, ctx))
             return false;
         i = be < len ? be + 1 : len;
     }
@@ -505,6 +520,7 @@ void cs_css_cascade(const cs_css_sheet_t *s, const cs_css_elem_t *e, const char 
         const cs_css_rule_t *r = &s->rules[i];
         unsigned budget = MATCH_BUDGET;
         if (r->n && match_from(r, r->n - 1, e, &budget))
-            offer(r->decls.p, r->decls.n, r->rank, props, n, out);
+            for (size_t k = 0; k < r->dn; k++)
+                offer(&s->decls[r->dfirst + k], r->rank, props, n, out);
     }
 }

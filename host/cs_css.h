@@ -39,12 +39,15 @@ typedef struct {
 typedef void (*cs_css_warn_fn)(void *ctx, size_t off, const char *kind, const char *msg);
 
 typedef struct cs_css_rule cs_css_rule_t;
+typedef struct cs_css_decl cs_css_decl_t;
 
 typedef struct {
     char **texts; /* owned copies of the sheets (values point into them) */
     size_t ntexts;
     cs_css_rule_t *rules;
     size_t nrules, cap;
+    cs_css_decl_t *decls; /* every rule's declarations, parsed */
+    size_t ndecls, dcap;
     bool out_of_memory;
 } cs_css_sheet_t;
 
