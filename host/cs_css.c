@@ -56,8 +56,8 @@ static bool is_ws(char c)
 
 static bool is_ident(char c)
 {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '_' || c == '-' || (unsigned char)c >= 0x80;
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-' || (unsigned char)c >= 0x80;
 }
 
 /* Past a comment at s[i] ("/ *...* /"; unterminated: to the end); i when none. */
@@ -294,8 +294,7 @@ static int parse_compound(const char *s, size_t len, size_t *i, compound_t *c, u
 
 /* One selector s[0..len) (no commas) into r; specificity after CSS 2.1 §6.4.3 (ids, classes,
  * types; each count below 1024). */
-static int parse_selector(const char *s, size_t len, cs_css_rule_t *r, unsigned *spec,
-                          size_t *bad)
+static int parse_selector(const char *s, size_t len, cs_css_rule_t *r, unsigned *spec, size_t *bad)
 {
     size_t i = skip_blank(s, len, 0, false);
     char comb = 0;
@@ -363,8 +362,7 @@ static bool add_group(cs_css_sheet_t *s, const char *t, size_t ps, size_t pe, si
             int k = parse_selector(t + a, b - a, &tmp[0], &spec, &bad);
             if (pass == 0 && k == SEL_INVALID) {
                 if (warn)
-                    warn(ctx, a + bad, "css-selector",
-                         "invalid selector: the rule is skipped");
+                    warn(ctx, a + bad, "css-selector", "invalid selector: the rule is skipped");
                 free(tmp);
                 return true;
             }
@@ -494,8 +492,7 @@ static bool compound_match(const compound_t *c, const cs_css_elem_t *e)
 
 /* Compounds 0..k of r against e and its ancestors, right to left, backtracking over the
  * ancestors a descendant combinator allows (within *budget steps). */
-static bool match_from(const cs_css_rule_t *r, unsigned k, const cs_css_elem_t *e,
-                       unsigned *budget)
+static bool match_from(const cs_css_rule_t *r, unsigned k, const cs_css_elem_t *e, unsigned *budget)
 {
     if (*budget == 0)
         return false;

@@ -30,7 +30,7 @@ typedef struct {
     const char *text;
     size_t len;
     bool important;
-    bool set; /* false: not declared */
+    bool set;                /* false: not declared */
     unsigned long long rank; /* sheets: specificity, then order (larger wins, same importance) */
 } cs_css_value_t;
 

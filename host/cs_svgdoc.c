@@ -1,4 +1,7 @@
 /* cs_svgdoc: SVG documents through expat (see cs_svgdoc.h).
+ * Two passes: expat reads the document into a tree of nodes (attributes copied, with the raw
+ * offset and line/column of each start tag); then an id index and the style sheets are built and
+ * the tree is walked depth first, a <use> walking the element it refers to as its child.
  * Expat hands over attribute values already decoded, without positions; to point an error at
  * the right character, the raw start tag is re-scanned from expat's byte index, the attribute's
  * value decoded here with a map from each decoded byte to its offset in the file. */
@@ -30,8 +33,8 @@
 
 /* The properties the reader takes from style sheets, style="" and attributes (read_style). */
 enum { P_DISPLAY, P_VISIBILITY, P_STROKE, P_FILL, P_FONT_SIZE, P_ANCHOR, NPROPS };
-static const char *const style_props[NPROPS] = {"display",   "visibility", "stroke",
-                                                "fill",      "font-size",  "text-anchor"};
+static const char *const style_props[NPROPS] = {"display", "visibility", "stroke",
+                                                "fill",    "font-size",  "text-anchor"};
 
 /* --- file loading ------------------------------------------------------------------------ */
 
@@ -402,19 +405,19 @@ cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *
 /* --- the document walk ------------------------------------------------------------------ */
 
 typedef struct {
-    cs_path_affine_t m; /* user space of this element -> mm */
-    bool hidden;        /* inside <defs>, <symbol>, <clipPath>...: not drawn directly */
-    bool none;          /* display="none" here or above: nothing below is drawn */
-    bool invisible;     /* visibility hidden/collapse (inherited, a child may override) */
-    bool stroke, fill;  /* stroke / fill paint other than none (inherited properties) */
-    double vw, vh;      /* nearest viewport's size in user units (percentages); 0 = unknown */
-    double font_size;   /* inherited font-size, user units (initial: medium = 16) */
-    int anchor;         /* inherited text-anchor: 0 start, 1 middle, 2 end */
-    size_t node;        /* the document node this frame walks */
-    size_t inst;        /* <use>: the referenced element, walked as its only child; or NONE */
-    bool instance;      /* this element is walked as the referenced element of a <use> */
-    bool entered;       /* its children have been started */
-    unsigned use_depth; /* <use> elements above, through instances */
+    cs_path_affine_t m;  /* user space of this element -> mm */
+    bool hidden;         /* inside <defs>, <symbol>, <clipPath>...: not drawn directly */
+    bool none;           /* display="none" here or above: nothing below is drawn */
+    bool invisible;      /* visibility hidden/collapse (inherited, a child may override) */
+    bool stroke, fill;   /* stroke / fill paint other than none (inherited properties) */
+    double vw, vh;       /* nearest viewport's size in user units (percentages); 0 = unknown */
+    double font_size;    /* inherited font-size, user units (initial: medium = 16) */
+    int anchor;          /* inherited text-anchor: 0 start, 1 middle, 2 end */
+    size_t node;         /* the document node this frame walks */
+    size_t inst;         /* <use>: the referenced element, walked as its only child; or NONE */
+    bool instance;       /* this element is walked as the referenced element of a <use> */
+    bool entered;        /* its children have been started */
+    unsigned use_depth;  /* <use> elements above, through instances */
     bool has_uw, has_uh; /* a <use>'s width / height (for a <symbol> or <svg> it refers to) */
     double use_w, use_h;
 } frame_t;
@@ -434,7 +437,7 @@ typedef struct {
 typedef struct {
     const char *id;
     size_t node;
-} id_t_;
+} idref_t;
 
 typedef struct doc doc_t;
 typedef cs_err_t (*elem_fn)(doc_t *d, const char *local, const char **atts, size_t tag);
@@ -455,9 +458,9 @@ struct doc {
     cs_err_t err;
     node_t *nodes;
     size_t nnodes, ncap;
-    size_t open;         /* first pass: the element being read; NONE at the top */
-    unsigned textlike;   /* first pass: open <text> / <style> elements (their data is kept) */
-    id_t_ *ids;          /* elements with an id, sorted by id then document order */
+    size_t open;       /* first pass: the element being read; NONE at the top */
+    unsigned textlike; /* first pass: open <text> / <style> elements (their data is kept) */
+    idref_t *ids;      /* elements with an id, sorted by id then document order */
     size_t nids;
     cs_css_elem_t *elems; /* each node as selectors see it */
     cs_css_sheet_t sheet; /* every <style> of the document, in document order */
@@ -803,11 +806,9 @@ static cs_path_affine_t viewbox_map(const viewbox_t *vb, double ex, double ey, d
  * over the style sheets' rules (`sheet`, by importance, specificity and order; !important in
  * a sheet over a plain style="") over the presentation attribute of the same name. Writes a
  * NUL-terminated, trimmed copy to out; false when none is given. */
-static bool get_prop(const char **atts, int k, const cs_css_value_t *sheet, char *out,
-                     size_t cap)
+static bool get_prop(const char **atts, int k, const cs_css_value_t *sheet, char *out, size_t cap)
 {
-    cs_css_value_t v = cs_css_pick(cs_css_inline(att_get(atts, "style"), style_props[k]),
-                                   sheet[k]);
+    cs_css_value_t v = cs_css_pick(cs_css_inline(att_get(atts, "style"), style_props[k]), sheet[k]);
     const char *found = v.text;
     size_t flen = v.len;
     if (!v.set) {
@@ -1056,8 +1057,7 @@ static cs_err_t on_use(doc_t *d, const char *local, const char **atts, size_t ta
     }
     cs_err_t e = element_transform(d, atts, tag, &f->m);
     double x, y;
-    if (e != CS_OK ||
-        (e = get_length(d, f, atts, tag, "x", LEN_X, 0.0, &x, NULL)) != CS_OK ||
+    if (e != CS_OK || (e = get_length(d, f, atts, tag, "x", LEN_X, 0.0, &x, NULL)) != CS_OK ||
         (e = get_length(d, f, atts, tag, "y", LEN_Y, 0.0, &y, NULL)) != CS_OK ||
         (e = get_length(d, f, atts, tag, "width", LEN_X, 0.0, &f->use_w, &f->has_uw)) != CS_OK ||
         (e = get_length(d, f, atts, tag, "height", LEN_Y, 0.0, &f->use_h, &f->has_uh)) != CS_OK)
@@ -1228,8 +1228,7 @@ static cs_err_t draw_gen(doc_t *d, const char *local, gen_t *g, size_t tag)
 }
 
 /* Shape prologue: counts it, decides whether it is drawn, applies its transform. */
-static cs_err_t shape_begin(doc_t *d, const char **atts, size_t tag, bool open,
-                            bool *draw)
+static cs_err_t shape_begin(doc_t *d, const char **atts, size_t tag, bool open, bool *draw)
 {
     d->stats->shapes++;
     *draw = drawn(d, open);
@@ -1565,9 +1564,8 @@ static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, s
     if (d->stack[d->depth - 1].hidden)
         return CS_OK;
     d->stats->ignored++;
-    warn_once(d,
-              strcmp(local, "text") == 0 ? "text" : "image",
-              tag, "ignoring <%s> elements: not drawn", local);
+    warn_once(d, strcmp(local, "text") == 0 ? "text" : "image", tag,
+              "ignoring <%s> elements: not drawn", local);
     return CS_OK;
 }
 
@@ -1583,7 +1581,7 @@ static const struct {
     {"marker", on_hidden},    {"pattern", on_hidden},    {"rect", on_rect},
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
     {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
-    {"use", on_use},  {"image", on_unsupported}, {"tspan", on_tspan},
+    {"use", on_use},          {"image", on_unsupported}, {"tspan", on_tspan},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */
@@ -1720,7 +1718,7 @@ static void XMLCALL on_chars(void *ud, const XML_Char *s, int len)
 
 static int id_cmp(const void *a, const void *b)
 {
-    const id_t_ *x = a, *y = b;
+    const idref_t *x = a, *y = b;
     int c = strcmp(x->id, y->id);
     return c ? c : (x->node > y->node) - (x->node < y->node);
 }
@@ -1755,7 +1753,8 @@ static cs_err_t index_nodes(doc_t *d)
 
 /* --- style sheets ------------------------------------------------------------------------- */
 
-/* A <style> element's text, with the raw offset of each piece (for warnings). */
+/* Where a sheet's warnings point: its <style> element, whose character data pieces give the raw
+ * offset of each byte of the sheet's text. */
 typedef struct {
     doc_t *d;
     size_t node;
@@ -1831,8 +1830,8 @@ static cs_err_t enter(doc_t *d, size_t idx, bool instance)
     } else {
         memset(f, 0, sizeof *f);
         f->m = cs_path_affine_identity();
-        f->fill = true;       /* SVG initial values: fill black, stroke none */
-        f->font_size = 16;    /* font-size: medium (CSS: 16 px) */
+        f->fill = true;    /* SVG initial values: fill black, stroke none */
+        f->font_size = 16; /* font-size: medium (CSS: 16 px) */
     }
     bool in_use = d->depth > 0 && f->use_depth > 0; /* the parent is a <use> or inside one */
     d->depth++;

@@ -27,7 +27,7 @@ typedef void (*cs_svgdoc_warn_fn)(void *ctx, const cs_path_diag_t *w);
 typedef struct {
     cs_path_affine_t xform; /* applied after the document's own transforms (user units -> mm) */
     const cs_hershey_font_t *font; /* stroke font for <text> (cs_hershey); NULL: text ignored */
-    cs_svgdoc_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    cs_svgdoc_warn_fn warn;        /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_svgdoc_opts_t;
 

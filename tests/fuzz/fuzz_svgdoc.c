@@ -105,8 +105,8 @@ static const char *const seeds[] = {
 };
 
 static const char *const seed_dirs[] = {"../shared/data/svg/resvg_path_tests",
-                                        "../shared/data/svg/w3c_svg11_paths",
-                                        "tests/data/svg/use", NULL};
+                                        "../shared/data/svg/w3c_svg11_paths", "tests/data/svg/use",
+                                        NULL};
 
 int main(int argc, char **argv)
 {

@@ -1340,7 +1340,8 @@ static void test_use_refused(void **state)
     assert_int_equal(P.n, 4);
     assert_int_equal(nwarn, 1);
     /* Nesting: 10 levels are drawn; past CS_SVGDOC_MAX_USE_DEPTH, a warning and nothing. */
-    for (int levels = 10; levels <= CS_SVGDOC_MAX_USE_DEPTH + 8; levels += CS_SVGDOC_MAX_USE_DEPTH - 2) {
+    for (int levels = 10; levels <= CS_SVGDOC_MAX_USE_DEPTH + 8;
+         levels += CS_SVGDOC_MAX_USE_DEPTH - 2) {
         char doc[8000];
         int n = snprintf(doc, sizeof doc, "<svg><defs><line id='g0' x2='1' stroke='red'/>");
         for (int i = 1; i <= levels; i++)
@@ -1395,11 +1396,12 @@ static void test_style_sheets(void **state)
                      4);
     /* Specificity (CSS 2.1 §6.4.3): #id over .class over type, whatever the order; a compound
      * line.c over .c; the universal selector counts nothing. */
-    assert_int_equal(drawn_lines("<svg><style>#x{stroke:none} .c{stroke:red} line.d{stroke:none}"
-                                 " .d{stroke:red} *{stroke:red} line{stroke:none}</style>"
-                                 "<line id='x' class='c' x2='1'/><line class='d' x2='2'/>"
-                                 "<line x2='3'/><rect x='20' width='1' height='1' fill='none'/></svg>"),
-                     1u << 19 | 1u << 20); /* the rect, by '*': x 20 and 21 */
+    assert_int_equal(
+        drawn_lines("<svg><style>#x{stroke:none} .c{stroke:red} line.d{stroke:none}"
+                    " .d{stroke:red} *{stroke:red} line{stroke:none}</style>"
+                    "<line id='x' class='c' x2='1'/><line class='d' x2='2'/>"
+                    "<line x2='3'/><rect x='20' width='1' height='1' fill='none'/></svg>"),
+        1u << 19 | 1u << 20); /* the rect, by '*': x 20 and 21 */
     assert_int_equal(P.n, 4); /* the rect: '*' */
     /* Sheet over presentation attributes; style="" over the sheet; !important in the sheet over
      * style=""; !important in style="" over all. */
@@ -1476,7 +1478,7 @@ static void test_use_style_files(void **state)
     assert_int_equal(read_file(DATA "use/matplotlib-multi-font-aspath.svg"), CS_OK);
     double k = 203.2 / 576;
     assert_int_equal(S.uses, 26);
-    assert_int_equal(nwarn, 1); /* fills drawn as outlines */
+    assert_int_equal(nwarn, 1);                    /* fills drawn as outlines */
     expect_pt(&P.elems[0].curve.p[0], 0, 432 * k); /* the white background patch */
     /* 'T' (use without x), then 'h' at x = 61.083984, glyph units scaled by 0.015625, all in
      * translate(86.4 226.8) scale(0.27 -0.27). */
