@@ -268,8 +268,8 @@ static int xform_kind(const char *s, size_t nl)
 
 /* The arguments of a transform from s[*i] (just after its '('), up to and past the ')': *n of
  * them into v. CS_OK, or CS_ERR_PARSE with *bad and *why. */
-static cs_err_t xform_args(const char *s, size_t len, size_t *i, int kind, double v[6],
-                           unsigned *n, size_t *bad, const char **why)
+static cs_err_t xform_args(const char *s, size_t len, size_t *i, int kind, double v[6], unsigned *n,
+                           size_t *bad, const char **why)
 {
     *n = 0;
     for (;;) {
@@ -805,7 +805,8 @@ static cs_path_affine_t viewbox_map(const viewbox_t *vb, double ex, double ey, d
 /* Value of property k for an element: CSS cascade order (CSS 2.1 §6.4, SVG 1.1 §6.4): style=""
  * over the style sheets' rules (`sheet`, by importance, specificity and order; !important in
  * a sheet over a plain style="") over the presentation attribute of the same name. Writes a
- * NUL-terminated, trimmed copy to out; false when none is given. */
+ * NUL-terminated, trimmed copy to out in lower case (CSS keywords are ASCII case-insensitive:
+ * NONE is none); false when none is given. */
 static bool get_prop(const char **atts, int k, const cs_css_value_t *sheet, char *out, size_t cap)
 {
     cs_css_value_t v = cs_css_pick(cs_css_inline(att_get(atts, "style"), style_props[k]), sheet[k]);
@@ -825,7 +826,8 @@ static bool get_prop(const char **atts, int k, const cs_css_value_t *sheet, char
     }
     if (flen >= cap)
         flen = cap - 1;
-    memcpy(out, found, flen);
+    for (size_t i = 0; i < flen; i++)
+        out[i] = found[i] >= 'A' && found[i] <= 'Z' ? (char)(found[i] - 'A' + 'a') : found[i];
     out[flen] = '\0';
     return true;
 }

@@ -1428,6 +1428,12 @@ static void test_style_sheets(void **state)
                      1);
     assert_int_equal(nwarn, 1);
     expect_warning("doc.svg:1:13:", "at-rules");
+    /* Keywords in any case (CSS: ASCII case-insensitive), from a sheet or an attribute. */
+    assert_int_equal(drawn_lines("<svg><style>.u{stroke:NONE}</style><line class='u' "
+                                 "stroke='red' x2='1'/><line stroke='None' x2='2'/>"
+                                 "<line stroke='red' x2='3' display='NONE'/>"
+                                 "<line stroke='RED' x2='4'/></svg>"),
+                     8);
     /* Another type of sheet: ignored with a warning. */
     assert_int_equal(drawn_lines("<svg><style type='text/xsl'>line{stroke:red}</style>"
                                  "<line x2='1'/></svg>"),
