@@ -1475,7 +1475,7 @@ static void test_style_sheet_errors(void **state)
 }
 
 /* Real and realistic files: matplotlib's text as glyph paths in <defs> placed by <use>,
- * Illustrator's class sheet, Inkscape's clones and symbols. Expected points from the files'
+ * Illustrator's class sheet, Inkscape's clones and symbols, cairo's glyph symbols. Expected points from the files'
  * numbers and transforms by hand. */
 static void test_use_style_files(void **state)
 {
@@ -1526,6 +1526,18 @@ static void test_use_style_files(void **state)
     expect_pt(&P.elems[9].curve.p[1], 15, 70);
     assert_int_equal(nwarn, 0);
     assert_int_equal(S.uses, 2);
+    /* cairo (1.16, cairo_show_text): each glyph a <symbol> without viewBox (so only the use's
+     * x, y place it), filled through the enclosing <g style="fill:...">; 200 pt over viewBox
+     * 200: 25.4 / 72 mm per unit. 'H' at (10, 50) starts M 2.9375 -21.875 L 5.90625 -21.875;
+     * the stroked frame M 5 5 ... L 5 95 Z comes last. */
+    assert_int_equal(read_file(DATA "use/cairo-text.svg"), CS_OK);
+    double pt = 25.4 / 72;
+    assert_int_equal(S.uses, 8);
+    assert_int_equal(nwarn, 1); /* fills drawn as outlines */
+    expect_pt(&P.elems[0].curve.p[0], (10 + 2.9375) * pt, (50 - 21.875) * pt);
+    expect_pt(&P.elems[0].curve.p[1], (10 + 5.90625) * pt, (50 - 21.875) * pt);
+    expect_pt(&P.elems[P.n - 1].curve.p[0], 5 * pt, 95 * pt);
+    expect_pt(&P.elems[P.n - 1].curve.p[1], 5 * pt, 5 * pt);
 }
 
 int main(void)
