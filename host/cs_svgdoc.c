@@ -1045,6 +1045,7 @@ static cs_err_t on_use(doc_t *d, const char *local, const char **atts, size_t ta
     const char *href = att_get(atts, "href"); /* SVG 2: href over xlink:href */
     if (!href)
         href = att_get(atts, XLINK_HREF);
+    f->none = true; /* its own children are never drawn (only what it refers to) */
     if (!href)
         return CS_OK; /* nothing referenced, nothing drawn */
     while (is_xml_space(*href))
@@ -1073,6 +1074,7 @@ static cs_err_t on_use(doc_t *d, const char *local, const char **atts, size_t ta
     f->m = cs_path_affine_mul(f->m, t);
     f->use_depth++;
     f->inst = target;
+    f->none = false;
     d->stats->uses++;
     return CS_OK;
 }

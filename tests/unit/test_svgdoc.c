@@ -1321,6 +1321,13 @@ static void test_use_refused(void **state)
     assert_int_equal(nwarn, 1);
     expect_warning("doc.svg:2:3:", "no element has this id");
     assert_int_equal(S.ignored, 1);
+    /* A use's own children are not drawn, whether it draws or not. */
+    assert_int_equal(read_text("<svg><use href='#nope'><line x2='1' stroke='red'/></use><use>"
+                               "<line x2='2' stroke='red'/></use><use href='#l'><line x2='3' "
+                               "stroke='red'/></use><line id='l' x2='4' stroke='red'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_pt(&P.elems[0].curve.p[1], 4, 0);
     /* Another file: a warning. */
     assert_int_equal(read_text("<svg><use href='other.svg#a'/></svg>"), CS_OK);
     expect_warning("doc.svg:1:6:", "another file");
@@ -1475,8 +1482,8 @@ static void test_style_sheet_errors(void **state)
 }
 
 /* Real and realistic files: matplotlib's text as glyph paths in <defs> placed by <use>,
- * Illustrator's class sheet, Inkscape's clones and symbols, cairo's glyph symbols. Expected points from the files'
- * numbers and transforms by hand. */
+ * Illustrator's class sheet, Inkscape's clones and symbols, cairo's glyph symbols. Expected points
+ * from the files' numbers and transforms by hand. */
 static void test_use_style_files(void **state)
 {
     (void)state;
