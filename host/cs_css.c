@@ -2,6 +2,7 @@
  * Grammar after CSS Syntax 3 (tokenisation simplified: strings, comments, blocks) and
  * Selectors 3 (type, universal, id, class, descendant and child combinators). */
 #include "cs_css.h"
+#include "cs_path.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -333,14 +334,10 @@ static int parse_selector(const char *s, size_t len, cs_css_rule_t *r, unsigned 
 
 static bool add_rule(cs_css_sheet_t *s, const cs_css_rule_t *r)
 {
-    if (s->nrules == s->cap) {
-        size_t ncap = s->cap ? s->cap * 2 : 16;
-        cs_css_rule_t *nr = realloc(s->rules, ncap * sizeof *nr);
-        if (!nr)
-            return false;
-        s->rules = nr;
-        s->cap = ncap;
-    }
+    void *b = s->rules;
+    if (!cs_path_grow(&b, &s->cap, s->nrules + 1, sizeof *s->rules))
+        return false;
+    s->rules = b;
     s->rules[s->nrules++] = *r;
     return true;
 }
@@ -399,14 +396,10 @@ static bool read_decls(cs_css_sheet_t *s, span_t b, const char *t, cs_css_warn_f
                      "malformed declaration (expected property: value): skipped");
             continue;
         }
-        if (s->ndecls == s->dcap) {
-            size_t ncap = s->dcap ? s->dcap * 2 : 16;
-            decl_t *nd = realloc(s->decls, ncap * sizeof *nd);
-            if (!nd)
-                return false;
-            s->decls = nd;
-            s->dcap = ncap;
-        }
+        void *nd = s->decls;
+        if (!cs_path_grow(&nd, &s->dcap, s->ndecls + 1, sizeof *s->decls))
+            return false;
+        s->decls = nd;
         s->decls[s->ndecls++] = d;
     }
     return true;

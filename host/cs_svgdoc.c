@@ -1613,14 +1613,10 @@ static bool pass1_fail(doc_t *d)
 /* A new node under the open element at raw offset tag; its index in *idx. */
 static bool node_add(doc_t *d, size_t tag, size_t *idx)
 {
-    if (d->nnodes == d->ncap) {
-        size_t ncap = d->ncap ? d->ncap * 2 : 64;
-        node_t *nn = realloc(d->nodes, ncap * sizeof *nn);
-        if (!nn)
-            return pass1_fail(d);
-        d->nodes = nn;
-        d->ncap = ncap;
-    }
+    void *nn = d->nodes;
+    if (!cs_path_grow(&nn, &d->ncap, d->nnodes + 1, sizeof *d->nodes))
+        return pass1_fail(d);
+    d->nodes = nn;
     node_t *n = &d->nodes[d->nnodes];
     memset(n, 0, sizeof *n);
     n->tag = tag;
@@ -1819,15 +1815,11 @@ static cs_err_t read_sheets(doc_t *d)
  * its parent's, its style, its element's handler. */
 static cs_err_t enter(doc_t *d, size_t idx, bool instance)
 {
-    if (d->depth == d->cap) {
-        size_t ncap = d->cap ? d->cap * 2 : 16;
-        frame_t *ns = realloc(d->stack, ncap * sizeof *ns);
-        if (!ns)
-            return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->nodes[idx].tag),
-                                    "out of memory");
-        d->stack = ns;
-        d->cap = ncap;
-    }
+    void *ns = d->stack;
+    if (!cs_path_grow(&ns, &d->cap, d->depth + 1, sizeof *d->stack))
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->nodes[idx].tag),
+                                "out of memory");
+    d->stack = ns;
     frame_t *f = &d->stack[d->depth];
     if (d->depth > 0) { /* a new frame inherits transform, visibility, paint, viewport */
         *f = d->stack[d->depth - 1];
