@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Drop-cutter finishing (`curvestep toolpath --cutter`, issue 20) on a teacup-like surface of
 # revolution (an outer wall, a rounded rim, an inner wall and a bottom: steep inside and out) and
-# on an n-sided (Varady) patch: every strategy is gouge-free by the independent --check, raster
-# and raster+waterline leave at most H for every cutter, and the G-code plans on the router and
-# passes the simulator's check; and the check's own measures against hand formulas (the cusp of
-# ball passes over a plane, the rest material in a V groove). Coarse H and tol on small parts
+# on an n-sided (Varady) patch: every strategy is gouge-free by the independent --check, raster,
+# waterline and raster+waterline leave at most H for every cutter, and the G-code plans on the
+# router and passes the simulator's check; and the check's own measures against hand formulas
+# (the cusp of ball passes over a plane, the rest material in a V groove). Coarse H and tol on small parts
 # keep it to seconds of CPU; the teapot's figures are in the benchmark (tests/bench/bench_dropcut.c).
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib/common.sh"
