@@ -188,23 +188,19 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
     return CS_OK;
 }
 
-/* x t / 2^30 rounded half away from zero, for 0 <= t <= 2^30 (every parameter and step of the
- * tracer) and |x| < 2^62: bit for bit cs_fixed_mul64_q30, inline. With |x| = xh 2^32 + xl the
- * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
- * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
- * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
+/* x t / 2^30 rounded half up (floor(x t / 2^30 + 1/2), <= 1/2 unit off), for 0 <= t <= 2^30
+ * (every parameter and step of the tracer) and |x| < 2^62, inline. With x = xh 2^32 + xl (xh
+ * the signed top half, -2^30 <= xh < 2^30; xl the unsigned low half) the product is
+ * 4 xh t + floor((xl t + 2^29) / 2^30) (the first term is a multiple of 2^30 before the shift, so
+ * only the second rounds, and it is >= 0): one signed and one unsigned 32x32 -> 64 product
+ * (SMULL and UMULL on a Cortex-M3), no absolute value and no branch on the sign, which is data
+ * (a mispredicted branch costs a host core some 15 cycles). */
 static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
-    uint64_t m = uabs64(x);
     uint32_t ut = (uint32_t)t;
-#if defined(__SIZEOF_INT128__)
-    __extension__ typedef unsigned __int128 u128_t;
-    uint64_t r = (uint64_t)(((u128_t)m * ut + ((uint64_t)1 << 29)) >> 30);
-#else
-    uint64_t hi = (uint64_t)(uint32_t)(m >> 32) * ut, lo = (uint64_t)(uint32_t)m * ut;
-    uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
-#endif
-    return x < 0 ? -(int64_t)r : (int64_t)r;
+    int32_t xh = (int32_t)(uint32_t)((uint64_t)x >> 32); /* two's complement top half */
+    uint64_t lo = (uint64_t)(uint32_t)x * ut;
+    return (int64_t)xh * ut * 4 + (int64_t)((lo + ((uint64_t)1 << 29)) >> 30);
 }
 
 /* At the vertex t: B(t) rounded to the LSB into *pt, and B'(t), B''(t) / 2
