@@ -198,28 +198,10 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
 static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
     uint32_t ut = (uint32_t)t;
-    int32_t xh = (int32_t)(uint32_t)((uint64_t)x >> 32); /* two's complement top half */
+    uint32_t hi = (uint32_t)((uint64_t)x >> 32); /* the two's complement top half, as int32: */
+    int32_t xh = hi <= INT32_MAX ? (int32_t)hi : -(int32_t)(~hi) - 1; /* (a no-op, defined) */
     uint64_t lo = (uint64_t)(uint32_t)x * ut;
     return (int64_t)xh * ut * 4 + (int64_t)((lo + ((uint64_t)1 << 29)) >> 30);
-}
-
-/* At the vertex t: B(t) rounded to the LSB into *pt, and B'(t), B''(t) / 2
- * for the chords from t into p->d (per axis, LSB * 2^F). One Horner scheme shares a3 t:
- * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
- * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
- * rounding to the LSB (docs/fixed-point.md). */
-static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
-{
-    cs_param_t t = p->t;
-    for (unsigned k = 0; k < 2; k++) {
-        int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
-        p->d[1][k] = a2 + 3 * a3t;
-        p->d[0][k] = p->a[1][k] + mul_t(2 * a2 + 3 * a3t, t);
-        int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
-        /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
-        cs_fixed_vec_set(pt, k, (cs_pos_t)cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F));
-    }
-    pt->z = p->z;
 }
 
 /* v / 2^s rounded half up, for 0 <= s < 32 and a result that fits int32: the result's bits are
@@ -239,6 +221,26 @@ static int32_t rsh_round32(int64_t v, unsigned s)
 #endif
     return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
 }
+
+/* At the vertex t: B(t) rounded to the LSB into *pt, and B'(t), B''(t) / 2
+ * for the chords from t into p->d (per axis, LSB * 2^F). One Horner scheme shares a3 t:
+ * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
+ * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
+ * rounding to the LSB (docs/fixed-point.md). */
+static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
+{
+    cs_param_t t = p->t;
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
+        p->d[1][k] = a2 + 3 * a3t;
+        p->d[0][k] = p->a[1][k] + mul_t(2 * a2 + 3 * a3t, t);
+        int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
+        /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
+        cs_fixed_vec_set(pt, k, rsh_round32(p->a[0][k] + mul_t(acc, t), F));
+    }
+    pt->z = p->z;
+}
+
 /* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
  * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
  * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
