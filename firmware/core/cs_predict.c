@@ -34,6 +34,15 @@
 #define HOT_INLINE
 #endif
 
+/* Speed builds (the host, -O2): the step search specialised for each flatness test (the test
+ * inlined into it, no call through a pointer) and the test's helpers inline; size builds (-Os:
+ * every firmware image) keep one out-of-line copy of each. The same source either way. */
+#if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define SPEED_INLINE __attribute__((always_inline)) inline
+#else
+#define SPEED_INLINE
+#endif
+
 static HOT_INLINE uint64_t uabs64(int64_t v)
 {
     return v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
@@ -48,7 +57,7 @@ static HOT_INLINE uint64_t uabs64(int64_t v)
 #define MAJ_SCALE 1024
 static const int16_t maj_coef[4][2] = {/* p, q coefficients: q/p <= 1/2 then > 1/2, same sign */
                                        {456, 272}, {456, -190}, {416, 352}, {426, -130}};
-static uint64_t majorant(int64_t c1, int64_t c2)
+static SPEED_INLINE uint64_t majorant(int64_t c1, int64_t c2)
 {
     uint64_t p = uabs64(c1), q = uabs64(c2);
     if (p < q) { /* p = max, q = min */
@@ -81,7 +90,7 @@ static HOT_INLINE int64_t dot(const int32_t a[2], const int32_t b[2])
 }
 
 /* Smallest k with v >> k < 2^bits. */
-static unsigned shift_below(uint64_t v, unsigned bits)
+static SPEED_INLINE unsigned shift_below(uint64_t v, unsigned bits)
 {
     unsigned n = cs_fixed_bitlen64(v);
     return n > bits ? n - bits : 0;
@@ -210,7 +219,7 @@ static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
  * 32-bit shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and no
  * negative value is shifted (implementation-defined in C99). hi << (32 - s) is written
  * (hi << 1) << (31 - s), 0 for s = 0 with no shift by 32 (undefined): no branch for s = 0. */
-static int32_t rsh_round32(int64_t v, unsigned s)
+static SPEED_INLINE int32_t rsh_round32(int64_t v, unsigned s)
 {
     uint64_t u = (uint64_t)v + ((1u << s) >> 1); /* 32-bit shifts: s < 32 */
 #if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
@@ -253,7 +262,7 @@ CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS +
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
 {
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
@@ -272,7 +281,7 @@ static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h
  * (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x), c = 89/256;
  * within [-0.0115, +0.0079] of the exact log2 v (checked on all 2^15 mantissas, the truncation
  * to 16 bits and to Q8 included). The predictor's only logarithm. */
-static int32_t log2_q8(uint64_t v)
+static SPEED_INLINE int32_t log2_q8(uint64_t v)
 {
     unsigned n = cs_fixed_bitlen64(v);
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
@@ -285,7 +294,7 @@ static int32_t log2_q8(uint64_t v)
  * log2_q8 is within [-0.0115, +0.0079] of the exact logarithm of its integer (checked on all
  * 2^15 mantissas), the halving truncates by < 1/512: the result is within [-6.9, +6.0] / 256
  * of the exact log2 of the room. */
-static int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
+static SPEED_INLINE int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
 {
     if (found == 0)
         return ROOM_CAP;
@@ -297,7 +306,7 @@ static int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
  * log when it is clear (|room| >= ROOM_SURE = 8/256 > the log's error, so its sign is the exact
  * comparison's), otherwise exactly in 128 bits. */
 #define ROOM_SURE 8
-static bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
+static SPEED_INLINE bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
 {
     int32_t r = room_log(k, dd, found);
     *room = r;
@@ -340,7 +349,7 @@ static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
-static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
+static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
 {
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
@@ -384,7 +393,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
  * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
  * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). At most cap (0 <= cap <= 2^30). */
-static cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
+static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
 {
     int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
     int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
@@ -517,7 +526,7 @@ typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, in
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
+static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
 {
     /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
     cs_param_t rem = CS_PARAM_ONE - p->t;
