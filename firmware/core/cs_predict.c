@@ -39,8 +39,10 @@
  * every firmware image) keep one out-of-line copy of each. The same source either way. */
 #if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
 #define SPEED_INLINE __attribute__((always_inline)) inline
+#define SPEED_UNROLL _Pragma("GCC unroll 8") /* the fixed-count loops of the test unrolled */
 #else
 #define SPEED_INLINE
+#define SPEED_UNROLL
 #endif
 
 static HOT_INLINE uint64_t uabs64(int64_t v)
@@ -56,7 +58,10 @@ static HOT_INLINE uint64_t uabs64(int64_t v)
  * up to 1/1024. Worst overestimate 1.3 %. */
 #define MAJ_SCALE 1024
 static const int16_t maj_coef[4][2] = {/* p, q coefficients: q/p <= 1/2 then > 1/2, same sign */
-                                       {456, 272}, {456, -190}, {416, 352}, {426, -130}};
+                                       {456, 272},
+                                       {456, -190},
+                                       {416, 352},
+                                       {426, -130}};
 static SPEED_INLINE uint64_t majorant(int64_t c1, int64_t c2)
 {
     uint64_t p = uabs64(c1), q = uabs64(c2);
@@ -72,7 +77,6 @@ static SPEED_INLINE uint64_t majorant(int64_t c1, int64_t c2)
     /* modulo 2^64 with the negative coefficient: the true value is >= 0 (q <= p) and < 2^63 */
     return p * (uint64_t)cf[0] + q * (uint64_t)(int64_t)cf[1];
 }
-
 
 /* a b for |a|, |b| < 2^31: one 32x32 -> 64 multiply (SMULL on a Cortex-M3, one call of the
  * 32x32 product on the M0+) where int64 operands would take a 64x64 product. */
@@ -222,7 +226,7 @@ static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 static SPEED_INLINE int32_t rsh_round32(int64_t v, unsigned s)
 {
     uint64_t u = (uint64_t)v + ((1u << s) >> 1); /* 32-bit shifts: s < 32 */
-#if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
+#if defined(__SIZEOF_INT128__)                   /* a 64-bit core: one shift */
     uint32_t r = (uint32_t)(u >> s);
 #else
     uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
@@ -239,6 +243,7 @@ static SPEED_INLINE int32_t rsh_round32(int64_t v, unsigned s)
 static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
     cs_param_t t = p->t;
+    SPEED_UNROLL
     for (unsigned k = 0; k < 2; k++) {
         int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
         p->d[1][k] = a2 + 3 * a3t;
@@ -262,8 +267,10 @@ CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS +
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
+                                   int64_t v[3][2])
 {
+    SPEED_UNROLL
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
@@ -318,8 +325,8 @@ static SPEED_INLINE bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
  * test's 32-bit components (below 2^27: |V - D|^2 below 2^57), with vd = V . D, cr = D x V and
  * dd = |D|^2 already computed; r2 = r^2. */
-static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t vd, int64_t cr,
-                        int64_t dd, uint64_t r2)
+static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t vd, int64_t cr, int64_t dd,
+                        uint64_t r2)
 {
     if (dd == 0 || vd <= 0 || vd >= dd) { /* nearest point is an end: 0 (also D = 0) or D */
         int32_t e[2];
@@ -349,15 +356,18 @@ static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
-static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
+static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h,
+                                   int32_t *room)
 {
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
     sub_curve(p, d, h, v);
     uint64_t m = 0;
+    SPEED_UNROLL
     for (unsigned i = 0; i < 3; i++)
-        for (unsigned k = 0; k < 2; k++)
-            m |= uabs64(v[i][k]);
+        SPEED_UNROLL
+    for (unsigned k = 0; k < 2; k++)
+        m |= uabs64(v[i][k]);
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
         s = p->thr_shift; /* thr 2^F >> s < 2^THR_BITS */
@@ -368,12 +378,15 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_pa
      * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
      * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
     int32_t w[4][2];
+    SPEED_UNROLL
     for (unsigned i = 0; i < 3; i++)
-        for (unsigned k = 0; k < 2; k++)
-            w[i][k] = rsh_round32(v[i][k], s);
+        SPEED_UNROLL
+    for (unsigned k = 0; k < 2; k++)
+        w[i][k] = rsh_round32(v[i][k], s);
     w[3][0] = -w[2][1];
     w[3][1] = w[2][0];
     int64_t pr[P_N];
+    SPEED_UNROLL
     for (unsigned i = 0; i < P_N; i++)
         pr[i] = dot(w[prod_rows[i][0]], w[prod_rows[i][1]]);
     int64_t tt = mul32(T, T), dd = pr[P_DD];
@@ -526,7 +539,8 @@ typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, in
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
+static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
+                                         int32_t *lo_room)
 {
     /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
     cs_param_t rem = CS_PARAM_ONE - p->t;
@@ -578,7 +592,7 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *
     /* Next chord: the step this one would have needed to fill the tolerance (its step
      * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
     cs_param_t ideal = predict(h, room, CS_PARAM_ONE);
-    cs_param_t nh = trend(ideal, p->h_ideal); /* < 2^31 (trend above) */
+    cs_param_t nh = trend(ideal, p->h_ideal);   /* < 2^31 (trend above) */
     p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : nh;
     p->done = false;
