@@ -564,19 +564,19 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
            pps >= 1 && arcs_worst_pps >= 1 ? "met" : "MISSED");
     printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost): the "
            "wall clock of this shared machine is noisy (compare within one table, and expect "
-           "the ratios to move by 2x between runs); by instructions (`bench_peers --profile` "
-           "under callgrind, the three sets at the three tolerances) the tracer spends 859 a "
-           "point and 33.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.29x cairo's "
-           "curves/s and 0.79x its points/s (before issue 18's second pass: 1,024 and 39.5 k). "
-           "Each chord costs 1.15-1.26 verified flatness tests (a sub-curve of 12 Q30 products, "
-           "cross and dot products, a 4-piece majorant, three logarithms for the predictor: no "
-           "division) plus B(t) and its derivatives by one Horner scheme (8 products); cairo's "
-           "subdivision spends fewer instructions a point but emits 1.6x the chords, and the "
-           "tracer's data-dependent branches cost more cycles per instruction than cairo's loop. "
-           "Arcs (conic pieces): 1,220 instructions a point and 197 k an arc against "
-           "cairo_arc's 672 and 171 k (0.87x its arcs/s by instructions); each test projects "
-           "two homogeneous points by 64-bit divisions, which cost far more cycles than "
-           "instructions.\n\n");
+           "the ratios to move by 2x between runs; `bench_peers --speed` times only the default "
+           "tracer and cairo, for a quick A/B); by instructions (`bench_peers --profile` under "
+           "callgrind, the three sets at the three tolerances) the tracer spends 650 a point "
+           "and 25.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.70x cairo's curves/s and "
+           "1.05x its points/s (before issue 18's host pass 928 and 35.9 k; before its second "
+           "pass 1,024 and 39.5 k). Each chord costs 1.06-1.73 verified flatness tests (most at "
+           "0.1 mm, where 20 chords a curve leave the predictor little to extrapolate from; a "
+           "sub-curve of 12 Q30 products, cross and dot products, a 4-piece majorant, three "
+           "logarithms: no division, no branch on the sign of a product) plus B(t) and its "
+           "derivatives by one Horner scheme (8 products). Arcs (conic pieces): 1,170 "
+           "instructions a point and 189 k an arc against cairo_arc's 672 and 171 k (0.90x its "
+           "arcs/s by instructions); each test projects two homogeneous points by four 64-bit "
+           "divisions, which cost far more cycles than instructions.\n\n");
 }
 
 /* Arcs per second and points per second of engine e over the arcs at tol, N_RUNS runs each
