@@ -127,10 +127,10 @@ static void client_usage(FILE *f, const char *name)
         fprintf(f, "usage: curvestep submit [--socket PATH] [--mode segments|curves] [--tol MM]\n"
                    "                        [--feed MM/S] [--font FILE.jhf] [input and layout\n"
                    "                        options] FILE\n"
-                   "Queues the job FILE (SVG, G-code or HPGL) on the daemon (`curvestep serve`).\n"
+                   "Queues the job FILE (SVG, G-code, HPGL or DXF) on the daemon (`curvestep serve`).\n"
                    "The daemon reads and plans it whole now: a bad file is refused at once with\n"
                    "file:line:col: reason. Prints the job's number. Options as for `stream`;\n"
-                   "--font FILE.jhf: the stroke font for SVG <text> and HP-GL LB (read by the\n"
+                   "--font FILE.jhf: the stroke font for SVG <text>, HP-GL LB, DXF TEXT (read by the\n"
                    "daemon at submit; a file that is not a font is refused, file:line:col).\n");
     else if (strcmp(name, "status") == 0)
         fprintf(f, "usage: curvestep status [--socket PATH]\n"

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cs_dropcheck.h"
+
 #define DC_MAX_DEPTH   24 /* bisections of one along-pass interval */
 #define DC_SCAN_FRACS  7  /* cross fractions 1/8 .. 7/8 of a gap, at least */
 #define DC_SCAN_MAX    64 /* cross points in one gap, at most */
@@ -297,6 +299,22 @@ static double line_env(const dc_ctx_t *c, const dc_line_t *l, double s, double d
     return best;
 }
 
+/* Appends (x, y) to p's flagged points. */
+static bool flag_push(cs_dcpath_t *p, double x, double y)
+{
+    if (p->nflag == p->flagcap) {
+        size_t cap = p->flagcap ? 2 * p->flagcap : 256;
+        double(*f)[2] = realloc(p->flag, cap * sizeof *f);
+        if (!f)
+            return false;
+        p->flag = f;
+        p->flagcap = cap;
+    }
+    p->flag[p->nflag][0] = x;
+    p->flag[p->nflag++][1] = y;
+    return true;
+}
+
 /* Largest material height left between lines[i] and lines[i + 1], estimated as in the header
  * with the cutters of every line within R of the point, at every position along it within R
  * (line_env); *cusp gets the gap to refine for the worst point: the gap holding the axis of a
@@ -305,7 +323,8 @@ static double line_env(const dc_ctx_t *c, const dc_line_t *l, double s, double d
  * whose estimate at the same along-pass position (an upper bound) is no more than the worst so
  * far cannot change the result and is not searched along the passes. */
 static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w, size_t n,
-                           size_t i, double min_gap, size_t *cusp, double *stuck)
+                           size_t i, double min_gap, size_t *cusp, double *stuck, cs_dcpath_t *fl,
+                           double need)
 {
     const dc_line_t *a = &lines[i], *b = &lines[i + 1];
     const dc_line_t *fine = a->n >= b->n ? a : b;
@@ -367,6 +386,8 @@ static double left_between(dc_ctx_t *c, const dc_line_t *lines, const double *w,
                     /* no pass can be added there: rest material (a slot narrower than the
                      * cutter, a corner) or a wall; reported, not chased */
                     *stuck = fmax(*stuck, left);
+                    if (left > need && !flag_push(fl, x, y))
+                        return -1;
                     continue;
                 }
                 worst = left;
@@ -475,9 +496,13 @@ static cs_err_t refine_gaps(cs_dcpath_t *p, dc_ctx_t *c, dc_set_t *set, double m
     double need = c->o->scallop_mm - c->ms->eps - c->o->tol_mm / 2;
     cs_err_t e = CS_OK;
     for (size_t i = 0; i + 1 < set->n && e == CS_OK;) {
-        size_t g;
+        size_t g, mark = p->nflag;
         double stuck = 0;
-        double left = left_between(c, set->l, set->w, set->n, i, min_gap, &g, &stuck);
+        double left = left_between(c, set->l, set->w, set->n, i, min_gap, &g, &stuck, p, need);
+        if (left < 0)
+            return CS_ERR_FULL;
+        if (left > need && set->n < c->o->max_passes)
+            p->nflag = mark; /* the gap changes: its points are flagged when it is final */
         if (left <= need || set->n >= c->o->max_passes) {
             p->capped |= left > need && set->n >= c->o->max_passes;
             p->max_left = fmax(p->max_left, left);
@@ -542,6 +567,52 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
     return e;
 }
 
+/* One short pass at each of the n axis positions at (xy, mm): three drops tol / 2 apart along x. */
+static cs_err_t fill_at(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                        const cs_dcpath_opts_t *o, const double (*at)[2], size_t n)
+{
+    cs_err_t e = CS_OK;
+    for (size_t i = 0; i < n && e == CS_OK; i++) {
+        double q[3][3];
+        for (int j = 0; j < 3; j++) {
+            bool hit;
+            q[j][0] = at[i][0] + (j - 1) * o->tol_mm / 2;
+            q[j][1] = at[i][1];
+            double z = cs_dropcut_drop(ms, t, q[j][0], q[j][1], &hit);
+            q[j][2] = hit ? fmax(z, o->min_z) : o->min_z;
+            p->drops++;
+        }
+        e = cs_dcpath_append(p, (const double(*)[3])q, 3, at[i][1]);
+    }
+    return e;
+}
+
+cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                        const cs_surffile_t *sf, const cs_dcpath_opts_t *o, double step_mm,
+                        bool flagged, size_t *added)
+{
+    cs_dropcheck_win_t win = {(const double(*)[2])p->flag, p->nflag, t->r_mm / 4};
+    if (flagged && p->nflag == 0)
+        return CS_OK;
+    for (int round = 0; round < (flagged ? 1 : 2); round++) {
+        cs_dropcheck_t ck;
+        double(*at)[2];
+        size_t nat;
+        cs_err_t e = cs_dropcheck_gaps(sf, t, (const double(*)[3])p->pt, p->start, p->npass, o->box,
+                                       step_mm, o->scallop_mm - ms->eps, ms->eps,
+                                       flagged ? &win : NULL, &ck, &at, &nat);
+        if (e == CS_OK)
+            e = fill_at(p, ms, t, o, (const double(*)[2])at, nat);
+        free(at);
+        *added += nat;
+        if (e != CS_OK)
+            return e;
+        if (nat == 0)
+            break;
+    }
+    return CS_OK;
+}
+
 /* Does the straight move a -> b keep the cutter no lower than the drop height less slack? */
 static bool link_clear(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t, const double a[3],
                        const double b[3], double step, double slack)
@@ -578,6 +649,7 @@ void cs_dcpath_link(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool
 
 void cs_dcpath_free(cs_dcpath_t *p)
 {
+    free(p->flag);
     free(p->pt);
     free(p->start);
     free(p->w);

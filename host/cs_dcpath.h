@@ -19,11 +19,11 @@
  * touching the surface there (r sin(slope) + R - r downhill of the point). A gap narrower than
  * twice the least width (a sixteenth of a ball's flat-ground step) is not split, so gaps end
  * between it and twice it; points whose gap cannot be split (rest material, walls) are
- * reported, not chased. Every value is a cutter of the path, so the estimate at a cross point
- * is never below the envelope (the cross points lie at most the least width apart, and between
- * them it may miss a ball's cusp peak by up to the cusp's slope times half that step, which
- * is not allowed for: on a plane, passes 0.875 mm apart, R 2, it reads 0.0428 mm where the cusp
- * is 0.0484). Points within R of the rim of the
+ * reported and flagged for the fill-in (cs_dcpath_fill), not chased. Every value is a cutter
+ * of the path, so the estimate at a cross point is never below the envelope (the cross points
+ * lie at most the least width apart, and between them it may miss a ball's cusp peak by up to
+ * the cusp's slope times half that step, which is not allowed for: on a plane, passes 0.875 mm
+ * apart, R 2, it reads 0.0428 mm where the cusp is 0.0484). Points within R of the rim of the
  * surface's projection and on walls (slope > 5) are left out, as in the check (cs_dropcheck.h). */
 #ifndef CS_DCPATH_H
 #define CS_DCPATH_H
@@ -32,6 +32,7 @@
 #include <stddef.h>
 
 #include "cs_dropcut.h"
+#include "cs_surffile.h"
 
 typedef struct {
     double angle_deg;  /* raster direction, degrees from +x (0: passes along x) */
@@ -57,6 +58,8 @@ typedef struct {
     bool capped;       /* max_passes was reached */
     size_t drops;      /* drop-cutter queries made */
     size_t links;      /* passes joined to the one before at cutting height (cs_dcpath_link) */
+    double (*flag)[2]; /* xy (mm) of the points estimated over H where no pass can be added: */
+    size_t nflag, flagcap; /* where the fill-in looks (cs_dropcut_cmd.c) */
 } cs_dcpath_t;
 
 void cs_dcpath_init(cs_dcpath_t *p);
@@ -66,6 +69,15 @@ double cs_dcpath_step(const cs_dropcut_tool_t *t, double h);
  * CS_ERR_FULL out of memory, CS_ERR_RANGE for a region or step that makes no sense. */
 cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                           const cs_dcpath_opts_t *o);
+/* Rest-material fill-in: the check's own measure of the passes (cs_dropcheck_gaps, z-map step
+ * step_mm, the ideal cutter keeping the mesh bound eps) finds the nodes left more than H - eps
+ * that a cutter from above could reach and the axis position from which the ideal cutter comes
+ * nearest to each; one short pass there (three drops tol / 2 apart along x). flagged: only the
+ * nodes within R / 4 of p's flagged points, one round (the raster); else every node, two rounds
+ * at most (raster+waterline). *added counts the passes added. CS_ERR_FULL out of memory. */
+cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                        const cs_surffile_t *sf, const cs_dcpath_opts_t *o, double step_mm,
+                        bool flagged, size_t *added);
 /* Joins each pass to the one before it where the straight move between the end of one and the
  * start of the next stays within tol_mm / 2 of the drop-cutter height of tool t or above it
  * (sampled every step_mm along the move; the passes' own chords are held to the same): one

@@ -43,6 +43,9 @@ typedef struct {
     double *cmax; /* per sample cell: its highest sample z (prunes the gouge test) */
     double *dropm; /* per node: the ideal drop height there, NAN until needed (rest_at) */
     unsigned char *gap; /* per node, or NULL: 1 where a cutter would close a gap (cs_dropcheck_gaps) */
+    unsigned char *win; /* per node, or NULL: 1 where the scallop is measured (cs_dropcheck_gaps) */
+    cs_dropcut_tool_t big; /* the cutter enlarged by the margin (R + m, r + m): the ideal drop */
+    double margin;         /* mm: the planner's stated margin m (cs_dropcheck.h) */
     long stride;  /* nodes between the ideal cutter's positions (rest_at) */
 } ck_t;
 
@@ -328,9 +331,10 @@ static double tool_dist(const cs_dropcut_tool_t *t, const double p[3], double sx
     return d > 0 ? d : 0;
 }
 
-/* Every chord sampled at spacing <= step: the gouge at each sample, the samples kept. */
+/* Every chord sampled at spacing <= step: the gouge at each sample (unless !gouge: the fill-in
+ * wants the gaps only), the samples kept. */
 static cs_err_t walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3],
-                     const size_t *start, size_t npass, cs_dropcheck_t *o)
+                     const size_t *start, size_t npass, bool gouge, cs_dropcheck_t *o)
 {
     cs_err_t e = CS_OK;
     for (size_t pass = 0; pass < npass; pass++)
@@ -345,7 +349,8 @@ static cs_err_t walk(ck_t *k, const cs_dropcut_tool_t *t, const double (*pts)[3]
                 double f = n ? (double)j / (double)n : 0, p[3];
                 for (int c = 0; c < 3; c++)
                     p[c] = a[c] + f * (b[c] - a[c]);
-                visit_gouge(k, t, p, o);
+                if (gouge)
+                    visit_gouge(k, t, p, o);
                 e = push3(&k->p, &k->np, &k->pcap, p);
                 o->path_samples++;
             }
@@ -491,11 +496,13 @@ static double drop_cell(const ck_t *k, const cs_dropcut_tool_t *t, long gx, long
 }
 
 /* The ideal drop at node c: the highest tip of a cutter whose axis stands at c that no surface
- * sample enters, max over samples q within R of q.z - h(|q - c|) (the dense samples of the exact
+ * sample enters with the margin m kept, i.e. the cutter K + B(m) (R + m, r + m) dropped, max over
+ * samples q within R + m of q.z - h'(|q - c|), raised by m (the dense samples of the exact
  * surface, as the gouge test). The cells in rings from the axis out: the highest contacts come
  * first, so that most cells farther out are pruned by their bound. Memoised. */
-static double ideal_drop(ck_t *k, const cs_dropcut_tool_t *t, long cx, long cy)
+static double ideal_drop(ck_t *k, long cx, long cy)
 {
+    const cs_dropcut_tool_t *t = &k->big;
     size_t c = node(k, cx, cy);
     if (!isnan(k->dropm[c]))
         return k->dropm[c];
@@ -513,7 +520,7 @@ static double ideal_drop(ck_t *k, const cs_dropcut_tool_t *t, long cx, long cy)
                 best = drop_cell(k, t, gx + ring, gy + i, x, y, best);
             }
         }
-    return k->dropm[c] = best;
+    return k->dropm[c] = best + k->margin; /* K + B(m) resting there: K's tip m higher */
 }
 
 /* How near any cutter position from above comes to the surface point s over node (ix, iy): min
@@ -531,10 +538,11 @@ static double ideal_dist(ck_t *k, const cs_dropcut_tool_t *t, long ix, long iy, 
     double sz = k->top[node(k, ix, iy)];
     for (long cy = by - rn; cy <= by + rn && best > 0; cy += k->stride)
         for (long cx = bx - rn; cx <= bx + rn && best > 0; cx += k->stride) {
-            double d = hypot((double)(cx - ix), (double)(cy - iy)) * k->step;
-            if (d > r || d - t->r_mm >= best || node(k, cx, cy) == (size_t)-1)
+            double dx = (double)(cx - ix) * k->step, dy = (double)(cy - iy) * k->step;
+            double d2 = dx * dx + dy * dy, near = t->r_mm + best; /* squares: no root */
+            if (d2 > r * r || d2 >= near * near || node(k, cx, cy) == (size_t)-1)
                 continue; /* (no cutter whose axis stands d away comes nearer than d - R) */
-            double z = ideal_drop(k, t, cx, cy);
+            double z = ideal_drop(k, cx, cy);
             double q[3] = {k->box[0] + (double)cx * k->step, k->box[1] + (double)cy * k->step, z};
             double dd = z > -HUGE_VAL ? tool_dist(t, q, sx, sy, sz) : HUGE_VAL;
             if (dd < best) {
@@ -587,7 +595,7 @@ static void measure(ck_t *k, const cs_dropcut_tool_t *t, const unsigned char *fa
                     cs_dropcheck_t *out)
 {
     for (size_t n = 0; n < k->mx * k->my; n++) {
-        if (k->top[n] == -HUGE_VAL || !far[n])
+        if (k->top[n] == -HUGE_VAL || !far[n] || (k->win && !k->win[n]))
             continue;
         if (wall_at(k, n)) {
             out->walls++;
@@ -673,14 +681,47 @@ static cs_err_t collect(const ck_t *k, double (**at)[2], size_t *nat)
     return CS_OK;
 }
 
+/* The window of the measure: the nodes within rad of one of the n points (xy, mm): each point's
+ * nearest node, then those dilated by a disk of rad. */
+static cs_err_t window(ck_t *k, const double (*near)[2], size_t n, double rad)
+{
+    size_t nn = k->mx * k->my;
+    unsigned char *c = calloc(nn, 1);
+    if (!c || !(k->win = calloc(nn, 1))) {
+        free(c);
+        return CS_ERR_FULL;
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t m = node(k, lround((near[i][0] - k->box[0]) / k->step), lround((near[i][1] - k->box[1]) / k->step));
+        if (m != (size_t)-1)
+            c[m] = 1;
+    }
+    long rn = (long)ceil(rad / k->step);
+    for (size_t m = 0; m < nn; m++) {
+        long ix = (long)(m % k->mx), iy = (long)(m / k->mx);
+        for (long jy = -rn; c[m] && jy <= rn; jy++)
+            for (long jx = -rn; jx <= rn; jx++) {
+                size_t q = node(k, ix + jx, iy + jy);
+                if (q != (size_t)-1 && jx * jx + jy * jy <= rn * rn)
+                    k->win[q] = 1;
+            }
+    }
+    free(c);
+    return CS_OK;
+}
+
 static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                       const double (*pts)[3], const size_t *start, size_t npass,
-                      const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
-                      double (**at)[2], size_t *nat)
+                      const double box[4], double step_mm, double h_mm, double margin_mm,
+                      const cs_dropcheck_win_t *w, cs_dropcheck_t *out, double (**at)[2],
+                      size_t *nat)
 {
     memset(out, 0, sizeof *out);
     ck_t k;
     memset(&k, 0, sizeof k);
+    k.margin = margin_mm;
+    k.big.r_mm = t->r_mm + margin_mm;
+    k.big.c_mm = t->c_mm + margin_mm;
     unsigned char *far = NULL;
     /* Twice the promise (a failure still shows its size), within half the cutter. */
     k.dcap = fmin(fmax(2 * h_mm, 0.1), t->r_mm / 2);
@@ -690,7 +731,7 @@ static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     if (e == CS_OK)
         e = bucket(&k, fmax(t->r_mm / 8, 2 * step_mm));
     if (e == CS_OK) {
-        e = walk(&k, t, pts, start, npass, out);
+        e = walk(&k, t, pts, start, npass, at == NULL, out);
         out->surf_samples = k.ns;
     }
     if (e == CS_OK)
@@ -702,11 +743,14 @@ static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
     }
     if (e == CS_OK && at && !(k.gap = calloc(k.mx * k.my, 1)))
         e = CS_ERR_FULL;
+    if (e == CS_OK && w)
+        e = window(&k, w->pts, w->n, w->rad_mm);
     if (e == CS_OK)
         measure(&k, t, far, h_mm, out);
     if (e == CS_OK && at)
         e = collect(&k, at, nat);
     free(k.gap);
+    free(k.win);
     free(far);
     free(k.s);
     free(k.start);
@@ -724,17 +768,19 @@ static cs_err_t check(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
 
 cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out)
+                          const double box[4], double step_mm, double h_mm, double margin_mm,
+                          cs_dropcheck_t *out)
 {
-    return check(sf, t, pts, start, npass, box, step_mm, h_mm, out, NULL, NULL);
+    return check(sf, t, pts, start, npass, box, step_mm, h_mm, margin_mm, NULL, out, NULL, NULL);
 }
 
 cs_err_t cs_dropcheck_gaps(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                            const double (*pts)[3], const size_t *start, size_t npass,
-                           const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
-                           double (**at)[2], size_t *nat)
+                           const double box[4], double step_mm, double h_mm, double margin_mm,
+                           const cs_dropcheck_win_t *w, cs_dropcheck_t *out, double (**at)[2],
+                           size_t *nat)
 {
     *at = NULL;
     *nat = 0;
-    return check(sf, t, pts, start, npass, box, step_mm, h_mm, out, at, nat);
+    return check(sf, t, pts, start, npass, box, step_mm, h_mm, margin_mm, w, out, at, nat);
 }

@@ -11,8 +11,9 @@
  *    R - sqrt(R^2 - (w/2)^2) (tests/cli/test_dropcut_shapes.sh);
  *  - rest material: where more than H is left, how near any cutter from above can come to s:
  *    the ideal cutter, dropped onto the surface samples at z-map nodes within R + cap, no
- *    farther apart than 0.05 mm (the
- *    grayscale closing of the surface by the cutter). Where even that stays more than H away
+ *    farther apart than 0.05 mm (the grayscale closing of the surface by the cutter), keeping
+ *    the planner's stated margin m: dropped as K + B(m) (R + m, r + m) and raised by m, as the
+ *    planner's gouge-free drop is defined (cs_dropcut.h), so "gouge-free within m". Where even that stays more than H away
  *    (slots narrower than the cutter, the foot of a wall, the gap between the teapot's lid and
  *    its rim) the node is unreachable, counted apart (nodes, area, depth). At such a node, and
  *    wherever the ideal cutter stays more than H / 4 off s (nearer, a lattice position may
@@ -51,21 +52,31 @@ typedef struct {
     double corner_left_mm; /* the most material left over such a node, rest <= H, mm */
 } cs_dropcheck_t;
 
+/* Where cs_dropcheck_gaps measures: the z-map nodes within rad_mm of one of the n points. */
+typedef struct {
+    const double (*pts)[2]; /* xy, mm */
+    size_t n;
+    double rad_mm;
+} cs_dropcheck_win_t;
+
 /* Checks the passes (tip points pts[start[k] .. start[k + 1]), k < npass, mm) of tool t over sf
  * within the region box (x0 y0 x1 y1) at sampling step step_mm; nodes left more than h_mm get
- * the ideal envelope (rest material). CS_ERR_FULL out of memory. */
+ * the ideal envelope (rest material) of the cutter that keeps margin_mm off the surface (the
+ * planner's stated margin). CS_ERR_FULL out of memory. */
 cs_err_t cs_dropcheck_run(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                           const double (*pts)[3], const size_t *start, size_t npass,
-                          const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out);
+                          const double box[4], double step_mm, double h_mm, double margin_mm,
+                          cs_dropcheck_t *out);
 
-/* The same, and the gaps: *at (malloc'd, *nat points, the caller frees) gets the axis positions
+/* The gaps, no gouge test: *at (malloc'd, *nat points, the caller frees) gets the axis positions
  * (x, y, mm; the z-map nodes where the ideal cutter stands) from which a cutter dropped onto the
  * surface comes nearest to each node left more than h_mm beyond the best any cutter could do,
- * where one more cutter position closes the gap (the planner's fill-in, cs_dropcut_cmd.c).
- * CS_ERR_FULL out of memory. */
+ * where one more cutter position closes the gap (the planner's fill-in, cs_dropcut_cmd.c);
+ * only the nodes of window w are measured (NULL: all). CS_ERR_FULL out of memory. */
 cs_err_t cs_dropcheck_gaps(const cs_surffile_t *sf, const cs_dropcut_tool_t *t,
                            const double (*pts)[3], const size_t *start, size_t npass,
-                           const double box[4], double step_mm, double h_mm, cs_dropcheck_t *out,
-                           double (**at)[2], size_t *nat);
+                           const double box[4], double step_mm, double h_mm, double margin_mm,
+                           const cs_dropcheck_win_t *w, cs_dropcheck_t *out, double (**at)[2],
+                           size_t *nat);
 
 #endif

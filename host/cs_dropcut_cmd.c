@@ -195,20 +195,22 @@ static bool write_gcode(const dc_args_t *a, const cs_dcpath_t *p, double safe)
     return fclose(f) == 0 && !badw;
 }
 
-static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dcpath_t *p)
+/* The check, the ideal cutter keeping the planner's stated margin (its mesh bound eps). */
+static int report_check(const dc_args_t *a, const cs_surffile_t *sf, const cs_dcpath_t *p,
+                        double margin)
 {
     cs_dropcheck_t ck;
     double step = a->check_step > 0 ? a->check_step : 0.05;
     cs_err_t e = cs_dropcheck_run(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass,
-                                  a->po.box, step, a->po.scallop_mm, &ck);
+                                  a->po.box, step, a->po.scallop_mm, margin, &ck);
     if (e != CS_OK) {
         fprintf(stderr, "curvestep toolpath: check: out of memory\n");
         return CS_EXIT_INTERNAL;
     }
     fprintf(stderr,
-            "toolpath: check (step %g mm, %zu surface samples, %zu cutter positions, %zu nodes, "
-            "%zu on walls left out): gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
-            step, ck.surf_samples, ck.path_samples, ck.nodes, ck.walls, ck.gouge_mm, ck.scallop_mm,
+            "toolpath: check (step %g mm, margin %g mm, %zu surface samples, %zu cutter positions, "
+            "%zu nodes, %zu on walls left out): gouge %.6f mm, scallop %.6f mm at (%.3f, %.3f)\n",
+            step, margin, ck.surf_samples, ck.path_samples, ck.nodes, ck.walls, ck.gouge_mm, ck.scallop_mm,
             ck.scallop_at[0], ck.scallop_at[1]);
     if (ck.rest_nodes > 0)
         fprintf(stderr,
@@ -265,44 +267,6 @@ static int build_mesh(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *
     return CS_EXIT_OK;
 }
 
-/* Fill-in (raster+waterline): the check's own measure of the passes (cs_dropcheck_gaps) finds
- * the nodes left more than H - eps that a cutter from above could reach, and the axis position
- * from which the ideal cutter comes nearest to each; a short pass there (three drops tol / 2
- * apart along x) closes the gap. Two rounds at most; *added counts the passes. */
-static int fill_in(const dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms,
-                   cs_dcpath_t *p, size_t *added)
-{
-    double step = a->check_step > 0 ? a->check_step : 0.05, d = a->tol / 2;
-    for (int round = 0; round < 2; round++) {
-        cs_dropcheck_t ck;
-        double(*at)[2];
-        size_t nat;
-        if (cs_dropcheck_gaps(sf, &a->tool, (const double(*)[3])p->pt, p->start, p->npass, a->po.box,
-                              step, a->po.scallop_mm - ms->eps, &ck, &at, &nat) != CS_OK)
-            return CS_EXIT_INTERNAL;
-        cs_err_t e = CS_OK;
-        for (size_t i = 0; i < nat && e == CS_OK; i++) {
-            double q[3][3];
-            for (int j = 0; j < 3; j++) {
-                bool hit;
-                q[j][0] = at[i][0] + (j - 1) * d;
-                q[j][1] = at[i][1];
-                double z = cs_dropcut_drop(ms, &a->tool, q[j][0], q[j][1], &hit);
-                q[j][2] = hit ? fmax(z, a->po.min_z) : a->po.min_z;
-                p->drops++;
-            }
-            e = cs_dcpath_append(p, (const double(*)[3])q, 3, at[i][1]);
-            *added += 1;
-        }
-        free(at);
-        if (e != CS_OK)
-            return CS_EXIT_INTERNAL;
-        if (nat == 0)
-            break;
-    }
-    return CS_EXIT_OK;
-}
-
 /* The passes of the chosen strategy, joined where the link is clear (unless --no-link). */
 static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
 {
@@ -314,8 +278,9 @@ static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs
                 e == CS_ERR_FULL ? "out of memory" : "the region or step-over is empty");
         return e == CS_ERR_FULL ? CS_EXIT_INTERNAL : CS_EXIT_USAGE;
     }
-    size_t filled = 0;
-    if (a->combo && fill_in(a, sf, ms, p, &filled) != CS_EXIT_OK) {
+    size_t filled = 0, nflag = p->nflag;
+    double step = a->check_step > 0 ? a->check_step : 0.05;
+    if (!a->waterline && cs_dcpath_fill(p, ms, &a->tool, sf, &a->po, step, !a->combo, &filled) != CS_OK) {
         fprintf(stderr, "curvestep toolpath: fill-in: out of memory\n");
         return CS_EXIT_INTERNAL;
     }
@@ -329,12 +294,12 @@ static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs
     if (a->stats)
         fprintf(stderr,
                 "toolpath: %s cutter R %g mm corner %g mm, %s: mesh %zu triangles within %.6f mm, "
-                "%zu passes (%zu added for the scallop, %zu short fill-in passes), %zu linked at cutting height (%zu "
+                "%zu passes (%zu added for the scallop, %zu short fill-in passes at %zu flagged points), %zu linked at cutting height (%zu "
                 "retracts), %zu points, %zu drops, estimated scallop %.6f mm (nan: not estimated), "
                 "%.6f mm where no pass can be added (rest material, walls)\n",
                 a->tool_kind, a->tool.r_mm, a->tool.c_mm,
                 a->waterline ? "waterline" : a->combo ? "raster+waterline" : "raster",
-                ms->ntri, ms->eps, before, p->refined, filled, p->links, p->npass, p->n, p->drops,
+                ms->ntri, ms->eps, before, p->refined, filled, nflag, p->links, p->npass, p->n, p->drops,
                 p->max_left, p->max_stuck);
     return CS_EXIT_OK;
 }
@@ -356,7 +321,7 @@ static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
         }
     }
     if (status == CS_EXIT_OK && a->check)
-        status = report_check(a, sf, &p);
+        status = report_check(a, sf, &p, ms.eps);
     cs_dcpath_free(&p);
     cs_dropcut_free(&ms);
     return status;

@@ -6,6 +6,7 @@
 #include <strings.h>
 
 #include "cs_curvefile.h"
+#include "cs_dxf.h"
 #include "cs_gcode.h"
 #include "cs_hpgl.h"
 #include "cs_readall.h"
@@ -28,6 +29,8 @@ const char *cs_input_format_name(cs_input_format_t f)
         return "hpgl";
     case CS_INPUT_CURVES:
         return "curves";
+    case CS_INPUT_DXF:
+        return "dxf";
     default:
         return "auto";
     }
@@ -43,7 +46,7 @@ static cs_input_format_t by_extension(const char *filename)
         {"nc", CS_INPUT_GCODE}, {"gcode", CS_INPUT_GCODE},   {"ngc", CS_INPUT_GCODE},
         {"g", CS_INPUT_GCODE},  {"tap", CS_INPUT_GCODE},     {"cnc", CS_INPUT_GCODE},
         {"plt", CS_INPUT_HPGL}, {"hpgl", CS_INPUT_HPGL},     {"hgl", CS_INPUT_HPGL},
-        {"hpg", CS_INPUT_HPGL}, {"curves", CS_INPUT_CURVES},
+        {"hpg", CS_INPUT_HPGL}, {"curves", CS_INPUT_CURVES}, {"dxf", CS_INPUT_DXF},
     };
     if (!filename || strcmp(filename, "-") == 0)
         return CS_INPUT_AUTO;
@@ -79,6 +82,8 @@ cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t 
         return f;
     if (cs_curvefile_is(buf, len))
         return CS_INPUT_CURVES;
+    if (cs_dxf_is(buf, len))
+        return CS_INPUT_DXF;
     size_t i = cs_readall_bom(buf, len);
     while (i < len && (buf[i] == ' ' || buf[i] == '\t' || buf[i] == '\r' || buf[i] == '\n'))
         i++;
@@ -142,7 +147,7 @@ static cs_err_t load_font(const cs_input_opts_t *o, cs_hershey_font_t *f, bool *
     return CS_OK;
 }
 
-/* SVG and HP-GL: the drawing readers, with the stroke font for their text. */
+/* SVG, HP-GL and DXF: the drawing readers, with the stroke font for their text. */
 static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const char *buf, size_t len,
                               const cs_input_opts_t *o, cs_path_t *path, cs_path_diag_t *diag)
 {
@@ -158,6 +163,14 @@ static cs_err_t parse_drawing(cs_input_format_t fmt, const char *name, const cha
         ho.warn_ctx = o->warn_ctx;
         ho.font = have ? &font : NULL;
         e = cs_hpgl_read(name, buf, len, &ho, path, diag);
+    } else if (fmt == CS_INPUT_DXF) {
+        cs_dxf_opts_t xo;
+        cs_dxf_opts_init(&xo);
+        xo.warn = o->warn;
+        xo.warn_ctx = o->warn_ctx;
+        xo.font = have ? &font : NULL;
+        xo.unit_mm = o->units == CS_UNITS_INCH ? 25.4 : o->units == CS_UNITS_MM ? 1.0 : 0.0;
+        e = cs_dxf_read(name, buf, len, &xo, path, diag);
     } else {
         cs_svgdoc_opts_t so;
         cs_svgdoc_opts_init(&so);

@@ -1,7 +1,7 @@
 /* cs_input: the one input loader every command that takes FILE uses. Reads the whole file (or
  * standard input) first, picks the reader by extension or, for other names and stdin, by
  * content, and runs it: SVG documents and bare SVG path data (cs_svgdoc), G-code (cs_gcode),
- * HP-GL (cs_hpgl), curves files (cs_curvefile). A job is parsed whole before anything is sent. */
+ * HP-GL (cs_hpgl), DXF (cs_dxf), curves files (cs_curvefile). A job is parsed whole before anything is sent. */
 #ifndef CS_INPUT_H
 #define CS_INPUT_H
 
@@ -16,6 +16,7 @@ typedef enum {
     CS_INPUT_GCODE = 2,
     CS_INPUT_HPGL = 3,
     CS_INPUT_CURVES = 4, /* curvestep's curves file (cs_curvefile) */
+    CS_INPUT_DXF = 5,    /* AutoCAD DXF, ASCII (cs_dxf) */
 } cs_input_format_t;
 
 /* G-code dialect (--dialect): whose modal defaults, words and error behaviour apply
@@ -43,7 +44,7 @@ typedef struct {
     double pen_down_z_mm, pen_up_z_mm;
     double pen_z_feed_mm_s; /* the pen's Z moves' speed ([pen] z_feed), mm/s; 0: rapid */
     cs_dialect_t dialect;  /* --dialect (G-code) */
-    cs_units_t units;      /* --units (G-code) */
+    cs_units_t units;      /* --units (G-code: start units; DXF: overrides $INSUNITS) */
     const char *font_file; /* --font: stroke font for SVG <text> and HP-GL LB; NULL: default */
     size_t max_bytes;      /* input size limit in bytes; 0: the default (docs/inputs.md) */
     cs_input_format_t
@@ -58,11 +59,12 @@ void cs_input_opts_init(cs_input_opts_t *o);
 
 /* The reader for filename (may be NULL or "-") holding buf[0..len): by extension (.svg; .txt
  * and .d = bare path data -> SVG; .nc .gcode .ngc .g .tap .cnc -> G-code; .plt .hpgl .hgl .hpg
- * -> HP-GL; .curves -> curves file; any case), else by content (a first token
- * "curvestep-curves" is a curves file; the rest: docs/inputs.md). Never CS_INPUT_AUTO. */
+ * -> HP-GL; .dxf -> DXF; .curves -> curves file; any case), else by content (a first token
+ * "curvestep-curves" is a curves file, "0" then "SECTION" DXF; the rest: docs/inputs.md). Never
+ * CS_INPUT_AUTO. */
 cs_input_format_t cs_input_detect(const char *filename, const char *buf, size_t len);
 
-/* Short name of a format ("svg", "gcode", "hpgl", "curves", "auto"). */
+/* Short name of a format ("svg", "gcode", "hpgl", "curves", "dxf", "auto"). */
 const char *cs_input_format_name(cs_input_format_t f);
 
 /* Parses buf[0..len) named name (for diagnostics) as format f (CS_INPUT_AUTO: detected from

@@ -108,7 +108,9 @@ static const struct {
      set_lenient},
     {"dialect", "D", NULL, "linuxcnc or grbl",
      "G-code dialect: linuxcnc (default) or grbl (docs/inputs.md)", set_dialect},
-    {"units", "U", NULL, "mm or inch", "units a G-code program starts in: mm (default) or inch",
+    {"units", "U", NULL, "mm or inch",
+     "units a G-code program starts in: mm (default) or inch;\nfor DXF, the drawing's unit "
+     "(overrides $INSUNITS)",
      set_units},
     {"scale", "F", NULL, "a factor in [0.0001, 10000]",
      "scale the drawing by F about the origin (control points,\nexactly)", set_scale},

@@ -1,4 +1,7 @@
 /* cs_svgdoc: SVG documents through expat (see cs_svgdoc.h).
+ * Two passes: expat reads the document into a tree of nodes (attributes copied, with the raw
+ * offset and line/column of each start tag); then an id index and the style sheets are built and
+ * the tree is walked depth first, a <use> walking the element it refers to as its child.
  * Expat hands over attribute values already decoded, without positions; to point an error at
  * the right character, the raw start tag is re-scanned from expat's byte index, the attribute's
  * value decoded here with a map from each decoded byte to its offset in the file. */
@@ -14,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cs_css.h"
 #include "cs_svgpath.h"
 
 #ifndef M_PI
@@ -24,6 +28,13 @@
 /* Element names come from expat as "namespace-URI<sep>local-name" (or just "local-name"). */
 #define NS_SEP     '\x1f'
 #define MAX_WARNED 32
+#define XLINK_HREF "http://www.w3.org/1999/xlink\x1fhref"
+#define NONE       ((size_t)-1)
+
+/* The properties the reader takes from style sheets, style="" and attributes (read_style). */
+enum { P_DISPLAY, P_VISIBILITY, P_STROKE, P_FILL, P_FONT_SIZE, P_ANCHOR, NPROPS };
+static const char *const style_props[NPROPS] = {"display", "visibility", "stroke",
+                                                "fill",    "font-size",  "text-anchor"};
 
 /* --- file loading ------------------------------------------------------------------------ */
 
@@ -257,8 +268,8 @@ static int xform_kind(const char *s, size_t nl)
 
 /* The arguments of a transform from s[*i] (just after its '('), up to and past the ')': *n of
  * them into v. CS_OK, or CS_ERR_PARSE with *bad and *why. */
-static cs_err_t xform_args(const char *s, size_t len, size_t *i, int kind, double v[6],
-                           unsigned *n, size_t *bad, const char **why)
+static cs_err_t xform_args(const char *s, size_t len, size_t *i, int kind, double v[6], unsigned *n,
+                           size_t *bad, const char **why)
 {
     *n = 0;
     for (;;) {
@@ -394,15 +405,39 @@ cs_err_t cs_svgdoc_parse_transform(const char *s, size_t len, cs_path_affine_t *
 /* --- the document walk ------------------------------------------------------------------ */
 
 typedef struct {
-    cs_path_affine_t m; /* user space of this element -> mm */
-    bool hidden;        /* inside <defs>, <symbol>, <clipPath>...: not drawn directly */
-    bool none;          /* display="none" here or above: nothing below is drawn */
-    bool invisible;     /* visibility hidden/collapse (inherited, a child may override) */
-    bool stroke, fill;  /* stroke / fill paint other than none (inherited properties) */
-    double vw, vh;      /* nearest viewport's size in user units (percentages); 0 = unknown */
-    double font_size;   /* inherited font-size, user units (initial: medium = 16) */
-    int anchor;         /* inherited text-anchor: 0 start, 1 middle, 2 end */
+    cs_path_affine_t m;  /* user space of this element -> mm */
+    bool hidden;         /* inside <defs>, <symbol>, <clipPath>...: not drawn directly */
+    bool none;           /* display="none" here or above: nothing below is drawn */
+    bool invisible;      /* visibility hidden/collapse (inherited, a child may override) */
+    bool stroke, fill;   /* stroke / fill paint other than none (inherited properties) */
+    double vw, vh;       /* nearest viewport's size in user units (percentages); 0 = unknown */
+    double font_size;    /* inherited font-size, user units (initial: medium = 16) */
+    int anchor;          /* inherited text-anchor: 0 start, 1 middle, 2 end */
+    size_t node;         /* the document node this frame walks */
+    size_t inst;         /* <use>: the referenced element, walked as its only child; or NONE */
+    bool instance;       /* this element is walked as the referenced element of a <use> */
+    bool entered;        /* its children have been started */
+    unsigned use_depth;  /* <use> elements above, through instances */
+    bool has_uw, has_uh; /* a <use>'s width / height (for a <symbol> or <svg> it refers to) */
+    double use_w, use_h;
 } frame_t;
+
+/* The document as read by the first pass: elements (and the character data of <text> and
+ * <style>) with their attributes copied, linked as a tree, walked by the second pass. */
+typedef struct {
+    const char *local; /* SVG local name; NULL: foreign element, or character data */
+    char **atts;       /* name/value pairs, NULL-terminated (one allocation with the strings) */
+    const char *text;  /* character data (atts == NULL) */
+    size_t tn;
+    size_t tag;  /* raw offset of the start tag (of the data) */
+    cursor_t at; /* its position */
+    size_t parent, first, last, next;
+} node_t;
+
+typedef struct {
+    const char *id;
+    size_t node;
+} idref_t;
 
 typedef struct doc doc_t;
 typedef cs_err_t (*elem_fn)(doc_t *d, const char *local, const char **atts, size_t tag);
@@ -420,13 +455,22 @@ struct doc {
     cursor_t tag; /* position of the current start tag */
     frame_t *stack;
     size_t depth, cap;
-    unsigned elements; /* start tags seen */
     cs_err_t err;
+    node_t *nodes;
+    size_t nnodes, ncap;
+    size_t open;       /* first pass: the element being read; NONE at the top */
+    unsigned textlike; /* first pass: open <text> / <style> elements (their data is kept) */
+    idref_t *ids;      /* elements with an id, sorted by id then document order */
+    size_t nids;
+    cs_css_elem_t *elems; /* each node as selectors see it */
+    cs_css_sheet_t sheet; /* every <style> of the document, in document order */
+    size_t inst_elems;    /* elements walked inside <use> instances */
     const char *warned[MAX_WARNED];
     size_t nwarned;
     /* the <text> being read: its current run's characters, pen position and frame */
     bool in_text;
     size_t text_depth, text_tag;
+    cursor_t text_at; /* position of text_tag */
     double tx, ty;
     frame_t tframe;
     char *tbuf;
@@ -758,79 +802,57 @@ static cs_path_affine_t viewbox_map(const viewbox_t *vb, double ex, double ey, d
     return m;
 }
 
-/* Value of a presentation property: the style attribute's declaration wins over the
- * attribute of the same name (CSS specificity of style="" over presentation attributes).
- * Writes a NUL-terminated, trimmed copy to out; false when neither is given. */
-static bool get_prop(const char **atts, const char *prop, char *out, size_t cap)
+/* Value of property k for an element: CSS cascade order (CSS 2.1 §6.4, SVG 1.1 §6.4): style=""
+ * over the style sheets' rules (`sheet`, by importance, specificity and order; !important in
+ * a sheet over a plain style="") over the presentation attribute of the same name. Writes a
+ * NUL-terminated, trimmed copy to out in lower case (CSS keywords are ASCII case-insensitive:
+ * NONE is none); false when none is given. */
+static bool get_prop(const char **atts, int k, const cs_css_value_t *sheet, char *out, size_t cap)
 {
-    const char *found = NULL;
-    size_t flen = 0;
-    const char *st = att_get(atts, "style");
-    size_t pl = strlen(prop);
-    for (const char *s = st; s && *s;) {
-        const char *semi = strchr(s, ';');
-        const char *end = semi ? semi : s + strlen(s);
-        const char *colon = memchr(s, ':', (size_t)(end - s));
-        if (colon) {
-            const char *a = s, *b = colon;
-            while (a < b && is_xml_space(*a))
-                a++;
-            while (b > a && is_xml_space(b[-1]))
-                b--;
-            if ((size_t)(b - a) == pl && memcmp(a, prop, pl) == 0) {
-                found = colon + 1;
-                flen = (size_t)(end - found);
-            }
-        }
-        s = semi ? semi + 1 : end;
-    }
-    if (!found) {
-        found = att_get(atts, prop);
+    cs_css_value_t v = cs_css_pick(cs_css_inline(att_get(atts, "style"), style_props[k]), sheet[k]);
+    const char *found = v.text;
+    size_t flen = v.len;
+    if (!v.set) {
+        found = att_get(atts, style_props[k]);
         if (!found)
             return false;
         flen = strlen(found);
-    }
-    while (flen > 0 && is_xml_space(*found)) {
-        found++;
-        flen--;
-    }
-    while (flen > 0 && is_xml_space(found[flen - 1]))
-        flen--;
-    /* "!important" does not matter here: there is no style sheet to win against. */
-    const char *bang = memchr(found, '!', flen);
-    if (bang) {
-        flen = (size_t)(bang - found);
+        while (flen > 0 && is_xml_space(*found)) {
+            found++;
+            flen--;
+        }
         while (flen > 0 && is_xml_space(found[flen - 1]))
             flen--;
     }
     if (flen >= cap)
         flen = cap - 1;
-    memcpy(out, found, flen);
+    for (size_t i = 0; i < flen; i++)
+        out[i] = found[i] >= 'A' && found[i] <= 'Z' ? (char)(found[i] - 'A' + 'a') : found[i];
     out[flen] = '\0';
     return true;
 }
 
 /* display, visibility, stroke and fill of this element (inherited ones start from the parent's
- * values, already in *f). */
-static void read_style(const char **atts, frame_t *f)
+ * values, already in *f); sheet: the style sheets' values for it (style_props order). */
+static void read_style(const char **atts, const cs_css_value_t *sheet, frame_t *f)
 {
     char v[64];
-    if (get_prop(atts, "display", v, sizeof v) && strcmp(v, "none") == 0)
+    if (get_prop(atts, P_DISPLAY, sheet, v, sizeof v) && strcmp(v, "none") == 0)
         f->none = true;
-    if (get_prop(atts, "visibility", v, sizeof v) && strcmp(v, "inherit") != 0)
+    if (get_prop(atts, P_VISIBILITY, sheet, v, sizeof v) && strcmp(v, "inherit") != 0)
         f->invisible = strcmp(v, "hidden") == 0 || strcmp(v, "collapse") == 0;
-    if (get_prop(atts, "stroke", v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
+    if (get_prop(atts, P_STROKE, sheet, v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
         f->stroke = strcmp(v, "none") != 0;
-    if (get_prop(atts, "fill", v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
+    if (get_prop(atts, P_FILL, sheet, v, sizeof v) && strcmp(v, "inherit") != 0 && v[0] != '\0')
         f->fill = strcmp(v, "none") != 0;
     char *end;
     /* font-size as a number of user units (px); other forms keep the inherited size */
-    if (get_prop(atts, "font-size", v, sizeof v)) {
+    if (get_prop(atts, P_FONT_SIZE, sheet, v, sizeof v)) {
         double fs = strtod(v, &end);
         if (end != v && (*end == '\0' || strcmp(end, "px") == 0) && fs > 0)
             f->font_size = fs;
     }
-    if (get_prop(atts, "text-anchor", v, sizeof v) && strcmp(v, "inherit") != 0)
+    if (get_prop(atts, P_ANCHOR, sheet, v, sizeof v) && strcmp(v, "inherit") != 0)
         f->anchor = strcmp(v, "middle") == 0 ? 1 : strcmp(v, "end") == 0 ? 2 : 0;
 }
 
@@ -897,6 +919,14 @@ static cs_err_t on_svg(doc_t *d, const char *local, const char **atts, size_t ta
         (e = get_length(d, f, atts, tag, "width", LEN_X, f->vw, &w, &hw)) != CS_OK ||
         (e = get_length(d, f, atts, tag, "height", LEN_Y, f->vh, &h, &hh)) != CS_OK)
         return e;
+    if (f->instance && f->has_uw) { /* a <use>'s width/height replace the <svg>'s (§5.6) */
+        w = f->use_w;
+        hw = true;
+    }
+    if (f->instance && f->has_uh) {
+        h = f->use_h;
+        hh = true;
+    }
     if (w < 0.0 || h < 0.0)
         return attr_fail(d, tag, w < 0.0 ? "width" : "height", 0, CS_ERR_PARSE, "negative size");
     if ((hw && w == 0.0) || (hh && h == 0.0)) {
@@ -929,18 +959,134 @@ static cs_err_t on_hidden(doc_t *d, const char *local, const char **atts, size_t
     return CS_OK;
 }
 
+/* <symbol>: never drawn where it stands; the instance of a <use> is a viewport (SVG 1.1 §5.5,
+ * §5.6; SVG 2 §5.6) of the use's width x height (else the symbol's own, else 100%) at the use's
+ * x, y (already in the transform), the symbol's viewBox mapped into it by its
+ * preserveAspectRatio (default xMidYMid meet). A zero width or height draws nothing. */
+static cs_err_t on_symbol(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    frame_t *f = &d->stack[d->depth - 1];
+    if (!f->instance)
+        return on_hidden(d, local, atts, tag);
+    viewbox_t vb;
+    double w, h;
+    bool hw, hh;
+    cs_err_t e;
+    if ((e = get_viewbox(d, atts, tag, &vb)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "width", LEN_X, f->vw, &w, &hw)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "height", LEN_Y, f->vh, &h, &hh)) != CS_OK)
+        return e;
+    w = f->has_uw ? f->use_w : w;
+    h = f->has_uh ? f->use_h : h;
+    if ((f->has_uw || hw) && w <= 0.0) {
+        f->none = true;
+        return CS_OK;
+    }
+    if ((f->has_uh || hh) && h <= 0.0) {
+        f->none = true;
+        return CS_OK;
+    }
+    if (vb.have && w > 0.0 && h > 0.0) {
+        f->m = cs_path_affine_mul(f->m, viewbox_map(&vb, 0.0, 0.0, w, h));
+        f->vw = vb.w;
+        f->vh = vb.h;
+    }
+    return CS_OK;
+}
+
+/* The element whose id is id (the first in document order), or NONE. */
+static size_t find_id(const doc_t *d, const char *id)
+{
+    size_t lo = 0, hi = d->nids;
+    while (lo < hi) { /* the first entry not below id */
+        size_t mid = lo + (hi - lo) / 2;
+        if (strcmp(d->ids[mid].id, id) < 0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < d->nids && strcmp(d->ids[lo].id, id) == 0 ? d->ids[lo].node : NONE;
+}
+
+/* Why a <use> draws nothing, said (once per kind) at its tag; NULL: it is drawn. */
+static const char *use_refusal(doc_t *d, const char *href, size_t *target, const char **key)
+{
+    *target = NONE;
+    if (href[0] != '#') {
+        *key = "use-external";
+        return "ignoring <use> of another file (only '#id' in the same file is drawn)";
+    }
+    *target = find_id(d, href + 1);
+    if (*target == NONE) {
+        *key = "use-missing";
+        return "<use>: no element has this id; nothing drawn (as in browsers)";
+    }
+    for (size_t k = 0; k < d->depth; k++)
+        if (d->stack[k].node == *target) {
+            *key = "use-cycle";
+            return "<use> refers to itself or to an element containing it (a cycle): not drawn";
+        }
+    if (d->stack[d->depth - 1].use_depth >= CS_SVGDOC_MAX_USE_DEPTH) {
+        *key = "use-depth";
+        return "<use> nested deeper than CS_SVGDOC_MAX_USE_DEPTH: not drawn";
+    }
+    return NULL;
+}
+
+/* <use> (SVG 1.1 §5.6, SVG 2 §5.6): the element href (or xlink:href) names by '#id' is drawn as
+ * the use's only child, inheriting the use's properties, in the use's user space followed by
+ * translate(x, y). width/height pass to a <symbol> or <svg> it refers to. */
+static cs_err_t on_use(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    (void)local;
+    frame_t *f = &d->stack[d->depth - 1];
+    if (f->hidden)
+        return CS_OK; /* in <defs>: drawn only through the instance of what holds it */
+    const char *href = att_get(atts, "href"); /* SVG 2: href over xlink:href */
+    if (!href)
+        href = att_get(atts, XLINK_HREF);
+    f->none = true; /* its own children are never drawn (only what it refers to) */
+    if (!href)
+        return CS_OK; /* nothing referenced, nothing drawn */
+    while (is_xml_space(*href))
+        href++;
+    const char *key = NULL;
+    size_t target;
+    const char *why = use_refusal(d, href, &target, &key);
+    if (why) {
+        d->stats->ignored++;
+        warn_once(d, key, tag, "%s: '%.100s'", why, href);
+        return CS_OK;
+    }
+    cs_err_t e = element_transform(d, atts, tag, &f->m);
+    double x, y;
+    if (e != CS_OK || (e = get_length(d, f, atts, tag, "x", LEN_X, 0.0, &x, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "y", LEN_Y, 0.0, &y, NULL)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "width", LEN_X, 0.0, &f->use_w, &f->has_uw)) != CS_OK ||
+        (e = get_length(d, f, atts, tag, "height", LEN_Y, 0.0, &f->use_h, &f->has_uh)) != CS_OK)
+        return e;
+    if ((f->has_uw && f->use_w < 0.0) || (f->has_uh && f->use_h < 0.0))
+        return attr_fail(d, tag, f->use_w < 0.0 ? "width" : "height", 0, CS_ERR_PARSE,
+                         "negative size");
+    cs_path_affine_t t = cs_path_affine_identity();
+    t.e = x;
+    t.f = y;
+    f->m = cs_path_affine_mul(f->m, t);
+    f->use_depth++;
+    f->inst = target;
+    f->none = false;
+    d->stats->uses++;
+    return CS_OK;
+}
+
 /* Whether a shape or path is drawn: not in <defs> and the like, visible, and with a stroke or a
  * fill (fills are drawn as their outline: a plotter has no area fill; said once). `open`
  * shapes (line) have no area, so only their stroke counts. */
-static bool drawn(doc_t *d, const char *local, size_t tag, bool open)
+static bool drawn(doc_t *d, bool open)
 {
     frame_t *f = &d->stack[d->depth - 1];
     if (f->hidden) {
-        d->stats->ignored++;
-        warn_once(d, "hidden", tag,
-                  "ignoring <%s> inside <defs>/<symbol>/<clipPath>... (not drawn directly; <use> "
-                  "is not supported yet)",
-                  local);
+        d->stats->ignored++; /* drawn only through a <use>, if one refers to it */
         return false;
     }
     if (f->invisible || (!f->stroke && (open || !f->fill))) {
@@ -1004,9 +1150,10 @@ static cs_err_t draw_data(doc_t *d, const char *text, size_t n, cs_svgpath_locat
 
 static cs_err_t on_path(doc_t *d, const char *local, const char **atts, size_t tag)
 {
+    (void)local;
     frame_t *f = &d->stack[d->depth - 1];
     d->stats->paths++;
-    if (!drawn(d, local, tag, false))
+    if (!drawn(d, false))
         return CS_OK;
     cs_err_t e = element_transform(d, atts, tag, &f->m);
     if (e != CS_OK)
@@ -1085,11 +1232,10 @@ static cs_err_t draw_gen(doc_t *d, const char *local, gen_t *g, size_t tag)
 }
 
 /* Shape prologue: counts it, decides whether it is drawn, applies its transform. */
-static cs_err_t shape_begin(doc_t *d, const char *local, const char **atts, size_t tag, bool open,
-                            bool *draw)
+static cs_err_t shape_begin(doc_t *d, const char **atts, size_t tag, bool open, bool *draw)
 {
     d->stats->shapes++;
-    *draw = drawn(d, local, tag, open);
+    *draw = drawn(d, open);
     if (!*draw)
         return CS_OK;
     return element_transform(d, atts, tag, &d->stack[d->depth - 1].m);
@@ -1108,7 +1254,7 @@ static cs_err_t non_negative(doc_t *d, size_t tag, const char *name, double v)
 static cs_err_t on_rect(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     bool draw, hrx, hry;
-    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    cs_err_t e = shape_begin(d, atts, tag, false, &draw);
     if (e != CS_OK || !draw)
         return e;
     frame_t *f = &d->stack[d->depth - 1];
@@ -1164,7 +1310,7 @@ static cs_err_t on_rect(doc_t *d, const char *local, const char **atts, size_t t
 static cs_err_t on_ellipse(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     bool draw, hrx = false, hry = false;
-    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    cs_err_t e = shape_begin(d, atts, tag, false, &draw);
     if (e != CS_OK || !draw)
         return e;
     frame_t *f = &d->stack[d->depth - 1];
@@ -1200,7 +1346,7 @@ static cs_err_t on_ellipse(doc_t *d, const char *local, const char **atts, size_
 static cs_err_t on_line(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     bool draw;
-    cs_err_t e = shape_begin(d, local, atts, tag, true, &draw);
+    cs_err_t e = shape_begin(d, atts, tag, true, &draw);
     if (e != CS_OK || !draw)
         return e;
     frame_t *f = &d->stack[d->depth - 1];
@@ -1233,7 +1379,7 @@ static void shifted_locate(void *ctx, size_t off, unsigned *line, unsigned *col)
 static cs_err_t on_poly(doc_t *d, const char *local, const char **atts, size_t tag)
 {
     bool draw;
-    cs_err_t e = shape_begin(d, local, atts, tag, false, &draw);
+    cs_err_t e = shape_begin(d, atts, tag, false, &draw);
     if (e != CS_OK || !draw)
         return e;
     const char *pv = att_get(atts, "points");
@@ -1326,37 +1472,37 @@ static cs_err_t text_flush(doc_t *d)
     d->tx = x0 + w;
     if (g.oom) {
         free(g.s);
-        return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
+        cs_path_loc_t l = {d->name, d->text_at.line, d->text_at.col};
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, l, "out of memory");
     }
     attr_t a; /* positions: the <text> tag */
     memset(&a, 0, sizeof a);
     a.raw_start = a.raw_end = d->text_tag;
-    a.base = cursor_at(d, d->text_tag);
+    a.base = d->text_at;
     a.cur = a.base;
     cs_err_t e = g.n ? draw_data_in(d, &f->m, g.s, g.n, attr_locate, &a) : CS_OK;
     free(g.s);
     return e;
 }
 
-static void XMLCALL on_chars(void *ud, const XML_Char *s, int len)
+/* Character data inside <text>: added to the run being read. */
+static cs_err_t text_append(doc_t *d, const char *s, size_t len)
 {
-    doc_t *d = ud;
-    if (!d->in_text || d->err != CS_OK || len <= 0)
-        return;
-    if (d->tn + (size_t)len > d->tcap) {
-        size_t cap = (d->tcap ? d->tcap * 2 : 256) + (size_t)len;
+    if (!d->in_text || len == 0)
+        return CS_OK;
+    if (d->tn + len > d->tcap) {
+        size_t cap = (d->tcap ? d->tcap * 2 : 256) + len;
         char *nb = realloc(d->tbuf, cap);
         if (!nb) {
-            d->err =
-                cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->text_tag), "out of memory");
-            XML_StopParser(d->xp, XML_FALSE);
-            return;
+            cs_path_loc_t l = {d->name, d->text_at.line, d->text_at.col};
+            return cs_path_diag_set(d->diag, CS_ERR_FULL, l, "out of memory");
         }
         d->tbuf = nb;
         d->tcap = cap;
     }
-    memcpy(d->tbuf + d->tn, s, (size_t)len);
-    d->tn += (size_t)len;
+    memcpy(d->tbuf + d->tn, s, len);
+    d->tn += len;
+    return CS_OK;
 }
 
 static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, size_t tag);
@@ -1368,7 +1514,7 @@ static cs_err_t on_text(doc_t *d, const char *local, const char **atts, size_t t
     if (d->o->font == NULL)
         return on_unsupported(d, local, atts, tag);
     frame_t *f = &d->stack[d->depth - 1];
-    if (!drawn(d, local, tag, false))
+    if (!drawn(d, false))
         return CS_OK;
     cs_err_t e = element_transform(d, atts, tag, &f->m);
     if (e != CS_OK)
@@ -1379,6 +1525,7 @@ static cs_err_t on_text(doc_t *d, const char *local, const char **atts, size_t t
     d->in_text = true;
     d->text_depth = d->depth;
     d->text_tag = tag;
+    d->text_at = d->tag;
     d->tframe = *f;
     d->tn = 0;
     return CS_OK;
@@ -1411,10 +1558,8 @@ static void text_end(doc_t *d)
         d->in_text = false;
     else if (d->depth >= 2)
         d->tframe = d->stack[d->depth - 2];
-    if (e != CS_OK) {
+    if (e != CS_OK)
         d->err = e;
-        XML_StopParser(d->xp, XML_FALSE);
-    }
 }
 
 static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, size_t tag)
@@ -1423,11 +1568,8 @@ static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, s
     if (d->stack[d->depth - 1].hidden)
         return CS_OK;
     d->stats->ignored++;
-    warn_once(d,
-              strcmp(local, "text") == 0  ? "text"
-              : strcmp(local, "use") == 0 ? "use"
-                                          : "image",
-              tag, "ignoring <%s> elements: not drawn", local);
+    warn_once(d, strcmp(local, "text") == 0 ? "text" : "image", tag,
+              "ignoring <%s> elements: not drawn", local);
     return CS_OK;
 }
 
@@ -1439,11 +1581,11 @@ static const struct {
 } handlers[] = {
     {"svg", on_svg},          {"g", on_container},       {"a", on_container},
     {"switch", on_container}, {"path", on_path},         {"defs", on_hidden},
-    {"symbol", on_hidden},    {"clipPath", on_hidden},   {"mask", on_hidden},
+    {"symbol", on_symbol},    {"clipPath", on_hidden},   {"mask", on_hidden},
     {"marker", on_hidden},    {"pattern", on_hidden},    {"rect", on_rect},
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
     {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
-    {"use", on_unsupported},  {"image", on_unsupported}, {"tspan", on_tspan},
+    {"use", on_use},          {"image", on_unsupported}, {"tspan", on_tspan},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */
@@ -1458,71 +1600,351 @@ static const char *svg_local(const char *el)
     return NULL;
 }
 
+/* --- first pass: the document tree ------------------------------------------------------- */
+
+static bool pass1_fail(doc_t *d)
+{
+    if (d->err == CS_OK)
+        d->err = cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->cur.off), "out of memory");
+    XML_StopParser(d->xp, XML_FALSE);
+    return false;
+}
+
+/* A new node under the open element at raw offset tag; its index in *idx. */
+static bool node_add(doc_t *d, size_t tag, size_t *idx)
+{
+    void *nn = d->nodes;
+    if (!cs_path_grow(&nn, &d->ncap, d->nnodes + 1, sizeof *d->nodes))
+        return pass1_fail(d);
+    d->nodes = nn;
+    node_t *n = &d->nodes[d->nnodes];
+    memset(n, 0, sizeof *n);
+    n->tag = tag;
+    cursor_advance(&d->cur, tag);
+    n->at = d->cur;
+    n->parent = d->open;
+    n->first = n->last = n->next = NONE;
+    if (d->open != NONE) {
+        node_t *p = &d->nodes[d->open];
+        if (p->last != NONE)
+            d->nodes[p->last].next = d->nnodes;
+        else
+            p->first = d->nnodes;
+        p->last = d->nnodes;
+    }
+    *idx = d->nnodes++;
+    return true;
+}
+
+/* Copies expat's attribute list and the local name into one allocation. */
+static char **atts_copy(const char *local, const XML_Char **atts)
+{
+    size_t n = 0, bytes = local ? strlen(local) + 1 : 0;
+    for (; atts[n]; n++)
+        bytes += strlen(atts[n]) + 1;
+    char **v = malloc((n + 2) * sizeof *v + bytes);
+    if (!v)
+        return NULL;
+    char *p = (char *)(v + n + 2);
+    for (size_t i = 0; i < n; i++) {
+        size_t k = strlen(atts[i]) + 1;
+        v[i] = memcpy(p, atts[i], k);
+        p += k;
+    }
+    v[n] = NULL;
+    v[n + 1] = local ? memcpy(p, local, strlen(local) + 1) : NULL; /* the name, after the NULL */
+    return v;
+}
+
+static bool is_textlike(const char *local)
+{
+    return local && (strcmp(local, "text") == 0 || strcmp(local, "style") == 0);
+}
+
 static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **atts)
 {
     doc_t *d = ud;
-    if (d->err != CS_OK)
-        return;
-    if (d->depth == d->cap) {
-        size_t ncap = d->cap ? d->cap * 2 : 16;
-        frame_t *ns = realloc(d->stack, ncap * sizeof *ns);
-        if (!ns) {
-            d->err = cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->cur.off), "out of memory");
-            XML_StopParser(d->xp, XML_FALSE);
-            return;
-        }
-        d->stack = ns;
-        d->cap = ncap;
-    }
-    /* A new frame inherits its parent's transform, visibility, paint and viewport. */
-    if (d->depth > 0)
-        d->stack[d->depth] = d->stack[d->depth - 1];
-    else {
-        memset(&d->stack[0], 0, sizeof d->stack[0]);
-        d->stack[0].m = cs_path_affine_identity();
-        d->stack[0].fill = true; /* SVG initial values: fill black, stroke none */
-        d->stack[0].font_size = 16; /* font-size: medium (CSS: 16 px) */
-    }
-    d->depth++;
     XML_Index bi = XML_GetCurrentByteIndex(d->xp);
-    size_t tag = bi < 0 ? d->cur.off : (size_t)bi;
-    cursor_advance(&d->cur, tag);
-    d->tag = d->cur;
+    size_t idx;
+    if (!node_add(d, bi < 0 ? d->cur.off : (size_t)bi, &idx))
+        return;
+    node_t *n = &d->nodes[idx];
     const char *local = svg_local(el);
-    if (d->elements++ == 0 && (!local || strcmp(local, "svg") != 0))
-        warn_once(d, "root", tag, "the root element is not <svg>");
-    frame_t *f = &d->stack[d->depth - 1];
-    if (!local || f->none)
-        return; /* foreign elements, and everything under display="none" */
-    read_style(atts, f);
-    if (f->none) {
-        d->stats->ignored++;
+    size_t na = 0;
+    while (atts[na])
+        na++;
+    n->atts = atts_copy(local, atts);
+    if (!n->atts) {
+        pass1_fail(d);
         return;
     }
-    for (size_t i = 0; i < sizeof handlers / sizeof handlers[0]; i++)
-        if (strcmp(local, handlers[i].name) == 0) {
-            cs_err_t e = handlers[i].fn(d, local, atts, tag);
-            if (e != CS_OK) {
-                d->err = e;
-                XML_StopParser(d->xp, XML_FALSE);
-            }
-            return;
-        }
+    n->local = n->atts[na + 1];
+    d->open = idx;
+    if (is_textlike(n->local))
+        d->textlike++;
 }
 
 static void XMLCALL on_end(void *ud, const XML_Char *el)
 {
     doc_t *d = ud;
     (void)el;
-    text_end(d);
-    if (d->depth > 0)
-        d->depth--;
+    if (d->open == NONE)
+        return;
+    if (is_textlike(d->nodes[d->open].local))
+        d->textlike--;
+    d->open = d->nodes[d->open].parent;
+}
+
+/* Character data inside <text> and <style> (the rest is white space between elements or
+ * content of elements that are not drawn). */
+static void XMLCALL on_chars(void *ud, const XML_Char *s, int len)
+{
+    doc_t *d = ud;
+    if (d->textlike == 0 || len <= 0 || d->err != CS_OK)
+        return;
+    XML_Index bi = XML_GetCurrentByteIndex(d->xp);
+    size_t idx;
+    if (!node_add(d, bi < 0 ? d->cur.off : (size_t)bi, &idx))
+        return;
+    char *t = malloc((size_t)len);
+    if (!t) {
+        pass1_fail(d);
+        return;
+    }
+    memcpy(t, s, (size_t)len);
+    d->nodes[idx].text = t;
+    d->nodes[idx].tn = (size_t)len;
+}
+
+static int id_cmp(const void *a, const void *b)
+{
+    const idref_t *x = a, *y = b;
+    int c = strcmp(x->id, y->id);
+    return c ? c : (x->node > y->node) - (x->node < y->node);
+}
+
+/* The id index and the elements as selectors see them. */
+static cs_err_t index_nodes(doc_t *d)
+{
+    d->ids = malloc((d->nnodes ? d->nnodes : 1) * sizeof *d->ids);
+    d->elems = malloc((d->nnodes ? d->nnodes : 1) * sizeof *d->elems);
+    if (!d->ids || !d->elems) {
+        cs_path_loc_t l = {d->name, 0, 0};
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, l, "out of memory");
+    }
+    for (size_t i = 0; i < d->nnodes; i++) {
+        const node_t *n = &d->nodes[i];
+        cs_css_elem_t *e = &d->elems[i];
+        memset(e, 0, sizeof *e);
+        e->parent = n->parent == NONE ? NULL : &d->elems[n->parent];
+        if (!n->atts)
+            continue;
+        e->name = n->local;
+        e->id = att_get((const char **)n->atts, "id");
+        e->cls = att_get((const char **)n->atts, "class");
+        if (e->id && n->local) {
+            d->ids[d->nids].id = e->id;
+            d->ids[d->nids++].node = i;
+        }
+    }
+    qsort(d->ids, d->nids, sizeof *d->ids, id_cmp);
+    return CS_OK;
+}
+
+/* --- style sheets ------------------------------------------------------------------------- */
+
+/* Where a sheet's warnings point: its <style> element, whose character data pieces give the raw
+ * offset of each byte of the sheet's text. */
+typedef struct {
+    doc_t *d;
+    size_t node;
+} sheet_ctx_t;
+
+static void sheet_warn(void *ctx, size_t off, const char *kind, const char *msg)
+{
+    sheet_ctx_t *c = ctx;
+    doc_t *d = c->d;
+    size_t raw = d->nodes[c->node].tag;
+    for (size_t k = d->nodes[c->node].first; k != NONE; k = d->nodes[k].next) {
+        const node_t *t = &d->nodes[k];
+        if (t->atts)
+            continue;
+        raw = t->tag + off;
+        if (off < t->tn)
+            break;
+        off -= t->tn;
+    }
+    warn_once(d, kind, raw, "style sheet: %s", msg);
+}
+
+/* Every <style> (type text/css or none) into the sheet, in document order. */
+static cs_err_t read_sheets(doc_t *d)
+{
+    for (size_t i = 0; i < d->nnodes; i++) {
+        const node_t *n = &d->nodes[i];
+        if (!n->local || strcmp(n->local, "style") != 0)
+            continue;
+        const char *type = att_get((const char **)n->atts, "type");
+        if (type && type[0] && strcmp(type, "text/css") != 0) {
+            warn_once(d, "style-type", n->tag, "ignoring a <style> of type '%.60s'", type);
+            continue;
+        }
+        size_t len = 0, k;
+        for (k = n->first; k != NONE; k = d->nodes[k].next)
+            len += d->nodes[k].atts ? 0 : d->nodes[k].tn;
+        char *text = malloc(len + 1), *p = text;
+        if (!text)
+            return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, n->tag), "out of memory");
+        for (k = n->first; k != NONE; k = d->nodes[k].next)
+            if (!d->nodes[k].atts) {
+                memcpy(p, d->nodes[k].text, d->nodes[k].tn);
+                p += d->nodes[k].tn;
+            }
+        sheet_ctx_t c = {d, i};
+        bool ok = cs_css_add(&d->sheet, text, len, sheet_warn, &c);
+        free(text);
+        if (!ok)
+            return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, n->tag), "out of memory");
+    }
+    return CS_OK;
+}
+
+/* --- second pass: the walk ------------------------------------------------------------------ */
+
+/* Starts node idx (as the referenced element of a <use> when instance): a frame inheriting
+ * its parent's, its style, its element's handler. */
+static cs_err_t enter(doc_t *d, size_t idx, bool instance)
+{
+    void *ns = d->stack;
+    if (!cs_path_grow(&ns, &d->cap, d->depth + 1, sizeof *d->stack))
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, loc_of(d, d->nodes[idx].tag),
+                                "out of memory");
+    d->stack = ns;
+    frame_t *f = &d->stack[d->depth];
+    if (d->depth > 0) { /* a new frame inherits transform, visibility, paint, viewport */
+        *f = d->stack[d->depth - 1];
+    } else {
+        memset(f, 0, sizeof *f);
+        f->m = cs_path_affine_identity();
+        f->fill = true;    /* SVG initial values: fill black, stroke none */
+        f->font_size = 16; /* font-size: medium (CSS: 16 px) */
+    }
+    bool in_use = d->depth > 0 && f->use_depth > 0; /* the parent is a <use> or inside one */
+    d->depth++;
+    f->node = idx;
+    f->inst = NONE;
+    f->instance = instance;
+    f->entered = false;
+    const node_t *n = &d->nodes[idx];
+    if (!n->atts) {
+        f->none = true; /* character data: no children */
+        return text_append(d, n->text, n->tn);
+    }
+    if (in_use && ++d->inst_elems > CS_SVGDOC_MAX_USE_ELEMENTS) {
+        cs_path_loc_t l = {d->name, n->at.line, n->at.col}; /* nested uses multiply */
+        return cs_path_diag_set(d->diag, CS_ERR_RANGE, l,
+                                "more than %u elements drawn through <use> "
+                                "(CS_SVGDOC_MAX_USE_ELEMENTS)",
+                                (unsigned)CS_SVGDOC_MAX_USE_ELEMENTS);
+    }
+    d->cur = n->at;
+    d->tag = n->at;
+    const char **atts = (const char **)n->atts;
+    if (idx == 0 && (!n->local || strcmp(n->local, "svg") != 0))
+        warn_once(d, "root", n->tag, "the root element is not <svg>");
+    if (!n->local || f->none)
+        return CS_OK; /* foreign elements, and everything under display="none" */
+    cs_css_value_t sheet[NPROPS];
+    if (d->sheet.nrules)
+        cs_css_cascade(&d->sheet, &d->elems[idx], style_props, NPROPS, sheet);
+    else
+        memset(sheet, 0, sizeof sheet);
+    read_style(atts, sheet, f);
+    if (f->none) {
+        d->stats->ignored++;
+        return CS_OK;
+    }
+    for (size_t i = 0; i < sizeof handlers / sizeof handlers[0]; i++)
+        if (strcmp(n->local, handlers[i].name) == 0)
+            return handlers[i].fn(d, n->local, atts, n->tag);
+    return CS_OK;
+}
+
+static void leave(doc_t *d)
+{
+    if (d->nodes[d->stack[d->depth - 1].node].atts)
+        text_end(d); /* the end of an element (not of character data) */
+    d->depth--;
+}
+
+/* Depth first from the root: each element's children in order (a <use>: the element it refers
+ * to), a <use>'s instance ending with it. */
+static cs_err_t walk(doc_t *d)
+{
+    if (d->nnodes == 0)
+        return CS_OK;
+    cs_err_t e = enter(d, 0, false);
+    while (e == CS_OK && d->err == CS_OK && d->depth > 0) {
+        frame_t *f = &d->stack[d->depth - 1];
+        if (!f->entered) {
+            f->entered = true;
+            size_t child = f->none ? NONE : f->inst != NONE ? f->inst : d->nodes[f->node].first;
+            if (child != NONE) {
+                e = enter(d, child, child == f->inst);
+                continue;
+            }
+        }
+        size_t node = f->node;
+        bool instance = f->instance;
+        leave(d);
+        if (d->depth > 0 && !instance && d->nodes[node].next != NONE)
+            e = enter(d, d->nodes[node].next, false);
+    }
+    return e != CS_OK ? e : d->err;
 }
 
 void cs_svgdoc_opts_init(cs_svgdoc_opts_t *o)
 {
     memset(o, 0, sizeof *o);
     o->xform = cs_path_affine_identity();
+}
+
+/* Pass 1: expat reads the whole document into d->nodes. */
+static cs_err_t read_tree(doc_t *d)
+{
+    d->xp = XML_ParserCreateNS(NULL, NS_SEP);
+    if (!d->xp) {
+        cs_path_loc_t l = {d->name, 0, 0};
+        return cs_path_diag_set(d->diag, CS_ERR_FULL, l, "out of memory");
+    }
+    XML_SetUserData(d->xp, d);
+    XML_SetElementHandler(d->xp, on_start, on_end);
+    XML_SetCharacterDataHandler(d->xp, on_chars);
+    enum XML_Status st = XML_Parse(d->xp, d->buf, (int)d->len, XML_TRUE);
+    cs_err_t e = d->err;
+    if (e == CS_OK && st != XML_STATUS_OK) {
+        cs_path_loc_t l = {d->name, (unsigned)XML_GetCurrentLineNumber(d->xp),
+                           (unsigned)XML_GetCurrentColumnNumber(d->xp) + 1};
+        e = cs_path_diag_set(d->diag, CS_ERR_PARSE, l, "XML error: %s",
+                             XML_ErrorString(XML_GetErrorCode(d->xp)));
+    }
+    XML_ParserFree(d->xp);
+    d->xp = NULL;
+    return e;
+}
+
+static void doc_free(doc_t *d)
+{
+    for (size_t i = 0; i < d->nnodes; i++) {
+        free(d->nodes[i].atts);
+        free((char *)d->nodes[i].text);
+    }
+    free(d->nodes);
+    free(d->ids);
+    free(d->elems);
+    cs_css_free(&d->sheet);
+    free(d->stack);
+    free(d->tbuf);
 }
 
 cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs_svgdoc_opts_t *o,
@@ -1547,6 +1969,8 @@ cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs
     d.cur.len = len;
     cursor_reset(&d.cur);
     d.tag = d.cur;
+    d.open = NONE;
+    cs_css_init(&d.sheet);
     d.name = cs_path_intern(path, name ? name : "-");
     if (!d.name) {
         cs_path_loc_t l = {"-", 0, 0};
@@ -1556,25 +1980,14 @@ cs_err_t cs_svgdoc_parse(const char *buf, size_t len, const char *name, const cs
         cs_path_loc_t l = {d.name, 0, 0};
         return cs_path_diag_set(diag, CS_ERR_IO, l, "file too large for the XML parser");
     }
-    d.xp = XML_ParserCreateNS(NULL, NS_SEP);
-    if (!d.xp) {
-        cs_path_loc_t l = {d.name, 0, 0};
-        return cs_path_diag_set(diag, CS_ERR_FULL, l, "out of memory");
-    }
-    XML_SetUserData(d.xp, &d);
-    XML_SetElementHandler(d.xp, on_start, on_end);
-    XML_SetCharacterDataHandler(d.xp, on_chars);
-    enum XML_Status st = XML_Parse(d.xp, buf, (int)len, XML_TRUE);
-    cs_err_t e = d.err;
-    if (e == CS_OK && st != XML_STATUS_OK) {
-        cs_path_loc_t l = {d.name, (unsigned)XML_GetCurrentLineNumber(d.xp),
-                           (unsigned)XML_GetCurrentColumnNumber(d.xp) + 1};
-        e = cs_path_diag_set(diag, CS_ERR_PARSE, l, "XML error: %s",
-                             XML_ErrorString(XML_GetErrorCode(d.xp)));
-    }
-    XML_ParserFree(d.xp);
-    free(d.stack);
-    free(d.tbuf);
+    cs_err_t e = read_tree(&d);
+    if (e == CS_OK)
+        e = index_nodes(&d);
+    if (e == CS_OK)
+        e = read_sheets(&d);
+    if (e == CS_OK)
+        e = walk(&d);
+    doc_free(&d);
     return e;
 }
 

@@ -1,10 +1,12 @@
 /* cs_svgdoc: reads an SVG document with expat into a cs_path_t: <path> data (through
  * cs_svgpath) and the basic shapes (rect with rounded corners, circle, ellipse, line, polyline,
  * polygon) as their SVG 1.1 equivalent paths, with every transform composed down the tree, the
- * root's width/height/viewBox/preserveAspectRatio (and nested <svg> viewports) mapped to mm, and
- * the display/visibility/stroke/fill properties (attributes or style="") deciding what is
- * drawn: fills are drawn as outlines. Errors point at the character inside the attribute in the
- * file. Also reads bare path data (a file holding only a 'd' value). See docs/inputs.md. */
+ * root's width/height/viewBox/preserveAspectRatio (and nested <svg> viewports) mapped to mm,
+ * <use> of any element, <g>, <symbol> or <svg> by '#id' (forward references too: the document
+ * is read whole into a tree first, then walked), and the display/visibility/stroke/fill
+ * properties (attributes, <style> sheets through cs_css, style="") deciding what is drawn:
+ * fills are drawn as outlines. Errors point at the character inside the attribute in the file.
+ * Also reads bare path data (a file holding only a 'd' value). See docs/inputs.md. */
 #ifndef CS_SVGDOC_H
 #define CS_SVGDOC_H
 
@@ -13,13 +15,19 @@
 #include "cs_hershey.h"
 #include "cs_path.h"
 
+/* <use> inside the instances of <use> deeper than this: a warning, not drawn. */
+#define CS_SVGDOC_MAX_USE_DEPTH 32
+/* Elements drawn through <use> in one document, at most (nested uses multiply: a few bytes of
+ * SVG could ask for billions): past it, CS_ERR_RANGE. */
+#define CS_SVGDOC_MAX_USE_ELEMENTS 1000000u
+
 /* Receives each warning (code CS_OK, loc and reason filled). */
 typedef void (*cs_svgdoc_warn_fn)(void *ctx, const cs_path_diag_t *w);
 
 typedef struct {
     cs_path_affine_t xform; /* applied after the document's own transforms (user units -> mm) */
     const cs_hershey_font_t *font; /* stroke font for <text> (cs_hershey); NULL: text ignored */
-    cs_svgdoc_warn_fn warn; /* NULL: "file:line:col: warning: reason" on stderr */
+    cs_svgdoc_warn_fn warn;        /* NULL: "file:line:col: warning: reason" on stderr */
     void *warn_ctx;
 } cs_svgdoc_opts_t;
 
@@ -27,8 +35,10 @@ typedef struct {
 typedef struct {
     unsigned paths;    /* <path> elements read (with or without a 'd' attribute) */
     unsigned shapes;   /* basic shapes read: rect, circle, ellipse, line, polyline, polygon */
-    unsigned ignored;  /* elements not drawn: text, use, image, display="none", no stroke and no
-                          fill, visibility hidden, paths and shapes inside <defs> and the like */
+    unsigned ignored;  /* elements not drawn: text without a font, image, display="none", no
+                          stroke and no fill, visibility hidden, paths and shapes inside <defs>
+                          and the like (where they stand), <use> refused (missing, cycle...) */
+    unsigned uses;     /* <use> instances drawn */
     unsigned warnings; /* warnings issued (each kind once per document) */
 } cs_svgdoc_stats_t;
 

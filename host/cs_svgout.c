@@ -261,7 +261,12 @@ cs_err_t cs_svgout_fprint(FILE *f, const cs_path_t *curves, const cs_path_poly_t
     fprintf(f, "</title>\n");
     fprintf(f, "<rect x=\"%.6f\" y=\"%.6f\" width=\"%.6f\" height=\"%.6f\" fill=\"white\"/>\n", vx,
             vy, vw, vh);
+    /* The machine's frame is y-up (SVG pages are turned when read, docs/inputs.md "Axes"), and
+     * an SVG picture is y-down: the drawing is mirrored about its box's middle, so it looks as
+     * on the bed seen from above (and an SVG input as in a browser); the legend is not. */
+    fprintf(f, "<g id=\"drawing\" transform=\"matrix(1 0 0 -1 0 %.6f)\">\n", box[1] + box[3]);
     draw_body(f, curves, chords, u);
+    fprintf(f, "</g>\n");
     draw_legend(f, o, curves, chords, box[0], box[3] + margin + line, line, span, u);
     fprintf(f, "</svg>\n");
     if (ferror(f))

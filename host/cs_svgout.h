@@ -1,7 +1,7 @@
 /* cs_svgout: writes an SVG picture of a flattening for people to look at: the exact curves (as
  * SVG path data from the Béziers; rational and high-degree ones as dense polylines) in one
  * colour, the emitted chords and their vertices (dots) in another, a legend and a scale bar,
- * with the viewBox fitted to the drawing (1 user unit = 1 mm). */
+ * with the viewBox fitted to the drawing (1 user unit = 1 mm), y up as the machine's frame. */
 #ifndef CS_SVGOUT_H
 #define CS_SVGOUT_H
 

@@ -13,7 +13,7 @@ static const struct {
     cs_cmd_fn fn;
     const char *summary;
 } commands[] = {
-    {"flatten", cs_cmd_flatten, "print a job's chords (SVG, G-code, HP-GL), within a tolerance"},
+    {"flatten", cs_cmd_flatten, "print a job's chords (SVG, G-code, HP-GL, DXF), within a tolerance"},
     {"plan", cs_cmd_plan, "plan a job into step segments (ticks dx dy dz) for a machine"},
     {"inspect", cs_cmd_inspect, "describe a job or surfaces file: elements, lengths, continuity"},
     {"toolpath", cs_cmd_toolpath, "surface patches: projected wireframe or ball-end finishing"},

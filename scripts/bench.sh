@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# make bench: run every build/bench/bench_* program and assemble docs/benchmarks.md.
+# make bench: run every build/bench/bench_* program and tests/bench/*.sh script (whole commands),
+# and assemble docs/benchmarks.md.
 # Each program gets the CSV path it must write (build/bench/<name>.csv) as its first argument
 # and prints its Markdown section on stdout (progress goes to stderr).
 set -euo pipefail
@@ -219,6 +220,13 @@ cpu=$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -n1)
         name=$(basename "$b")
         echo "bench: running $name" >&2
         "$b" "build/bench/$name.csv"
+        echo
+    done
+    # Benchmarks of whole commands (shell scripts running build/curvestep as a user does).
+    for b in tests/bench/*.sh; do
+        [ -f "$b" ] || continue
+        echo "bench: running $b" >&2
+        bash "$b" "build/bench/$(basename "$b" .sh).csv" || echo "($b failed)"
         echo
     done
     if [ -f build/cross/cortex-m0plus/sizes.txt ]; then

@@ -13,7 +13,7 @@ set -eu
 
 HOST="make gcc libc6-dev pkg-config git \
 libcmocka-dev libexpat1-dev libinih-dev libcairo2-dev \
-librsvg2-bin libmodbus-dev libgpiod-dev man-db python3"
+librsvg2-bin libmodbus-dev libgpiod-dev man-db python3 python3-ezdxf"
 FIRMWARE="gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi \
 gcc-avr avr-libc binutils-avr \
 qemu-system-arm simavr libsimavr-dev libelf-dev"

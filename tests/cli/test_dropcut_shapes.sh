@@ -11,38 +11,9 @@ set -u
 need_bin "$CS" "$SIM"
 M=contrib/machines/router-3018.ini
 
-# The teacup, computed here from its profile (r, z above the foot at z = -20, axis at (15, 15)):
-# each profile cubic turned by four quarter arcs with handles k = 4/3 tan(pi/8), patch row i =
-# profile point i, column j = arc point j (the exact tensor product of the profile and the arc).
-awk 'BEGIN {
-    pi = 3.14159265358979; k = 4 / 3 * sin(pi / 8) / cos(pi / 8); n = 0
-    seg[n++] = "4 0  5.5 1  6 3  6 5"            # outer wall
-    seg[n++] = "6 5  6 5.6  5.2 5.6  5.2 5"      # rounded rim
-    seg[n++] = "5.2 5  5.2 3  4.5 1.5  3 1"      # inner wall into the bottom
-    seg[n++] = "3 1  2 1  1 1  0 1"              # inner bottom, flat, to the axis
-    print "curvestep-surfaces 1"
-    for (s = 0; s < n; s++) {
-        split(seg[s], q, " ")
-        for (a = 0; a < 4; a++) {
-            t = a * pi / 2; c = cos(t); d = sin(t)
-            ax[0] = c; ay[0] = d; ax[1] = c - k * d; ay[1] = d + k * c
-            ax[3] = -d; ay[3] = c; ax[2] = -d + k * c; ay[2] = c + k * d
-            print "bezier 3 3"
-            for (i = 0; i < 4; i++) {
-                line = " "
-                for (j = 0; j < 4; j++)
-                    line = line sprintf(" %.9g %.9g %.9g", 15 + q[2 * i + 1] * ax[j],
-                                        15 + q[2 * i + 1] * ay[j], -20 + q[2 * i + 2])
-                print line
-            }
-        }
-    }
-}' >"$T/cup.txt"
-# The five-sided patch of tests/data/surfaces/pentagon.txt, halved and moved into the router's
-# travel (x' = x / 2 + 15, y' = y / 2 + 15, z' = z / 2 - 20).
-awk 'NF > 3 && $1 == 3 { l = "  3"; for (i = 2; i <= NF; i += 3)
-        l = l sprintf("  %.6g %.6g %.6g", $i / 2 + 15, $(i + 1) / 2 + 15, $(i + 2) / 2 - 20)
-    print l; next } { print }' tests/data/surfaces/pentagon.txt >"$T/pent.txt"
+. "$(dirname "${BASH_SOURCE[0]}")/lib/shapes.sh"
+cs_shape_cup "$T/cup.txt"    # the teacup (lib/shapes.sh): walls steep inside and out, flat bottom
+cs_shape_pent "$T/pent.txt"  # the five-sided Varady patch, halved
 expect "teacup: 16 bicubic patches" [ "$(grep -c '^bezier 3 3' "$T/cup.txt")" = 16 ]
 
 # gouge <= tol and (unless "any") scallop <= H, from the check's line in $T/err.
@@ -62,6 +33,10 @@ for s in cup pent; do
     done
     run "$s raster ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
         --tol 0.02 --check && gs "$s raster ball" 0.1
+    for c in flat:1.5 bull:1.5:0.5; do # the raster's fill-in where its estimate flags rest material
+        run "$s raster $c" 0 toolpath --patches "$T/$s.txt" --cutter "$c" --scallop 0.1 \
+            --tol 0.02 --check && gs "$s raster $c" 0.1
+    done
     # waterline alone leaves up to its level step on shallow ground (reported, not failed)
     run "$s waterline ball" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 --scallop 0.1 \
         --tol 0.02 --strategy waterline --check && gs "$s waterline ball" any

@@ -82,7 +82,7 @@ else
 fi
 
 # The scripts that take arguments (args.sh is sourced, not run).
-for s in scripts/*.sh tests/fw/bench_*.sh; do
+for s in scripts/*.sh tests/fw/bench_*.sh tests/bench/*.sh; do
     [ "$s" = scripts/args.sh ] && continue
     both "$s" bash "$root/$s"
 done

@@ -9,7 +9,8 @@
  * scripts/fuzz.sh (host sources are compiled in below, as the script links only the core).
  * fuzz-libs: -lexpat -lm
  * With -DCS_FUZZ_SEED_MAIN it writes a seed corpus into argv[1]: the documents below plus every
- * file of ../shared/data/svg/<dir>/. */
+ * file of ../shared/data/svg/<dir>/ and of tests/data/svg/use/ (matplotlib glyphs by <use>,
+ * an Illustrator-style class sheet, Inkscape clones). */
 #define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -19,6 +20,7 @@
 #include "fuzz_common.h"
 
 #include "../../host/cs_conv.c"
+#include "../../host/cs_css.c"
 #include "../../host/cs_err_text.c"
 #include "../../host/cs_hershey.c"
 #include "../../host/cs_path.c"
@@ -83,12 +85,28 @@ static const char *const seeds[] = {
     "<svg><defs><path d='M0 0L1 1'/></defs><text>hi</text><use href='#a'/>"
     "<rect width='-1' height='2'/></svg>",
     "<svg><polygon points='1 2 3'/></svg>",
+    "<svg xmlns:xlink='http://www.w3.org/1999/xlink'><use xlink:href='#g' x='5' "
+    "transform='rotate(9)'/><g id='g'><line x2='1' stroke='red'/><use href='#s' width='4' "
+    "height='9'/></g><symbol id='s' viewBox='1 2 3 4' preserveAspectRatio='xMaxYMin slice'>"
+    "<path d='M0 0L1 1' stroke='red'/><use href='#n'/></symbol><defs><svg id='n' "
+    "viewBox='0 0 1 1'><circle r='1'/></svg></defs><use href='#u' id='u'/><use href='#g'/>"
+    "<use href='x.svg#a'/><use href='#missing'/></svg>",
+    "<svg><defs><g id='a'><use href='#b'/><use href='#b'/><use href='#b'/></g><g id='b'>"
+    "<use href='#c'/><use href='#c'/></g><g id='c'><line x2='1' stroke='red'/></g></defs>"
+    "<use href='#a'/></svg>",
+    "<svg><style type='text/css'><![CDATA[@import url(a.css); @media print{g{x:y}}"
+    ".st0{fill:none;stroke:#000;stroke-width:0.5} .st1,.st2{display:none} #i{stroke:none!"
+    "important} g.k > line , svg g line{visibility:hidden} *{font-size:3px} line:hover{} "
+    "li%ne{} a b c d e f g h i j k l m n o p q{}  /* c */ rect{stroke red]]></style>"
+    "<g class='k'><line class='st0 st1' x2='3'/><line id='i' style='stroke:red !important'/>"
+    "</g><rect class='st2' width='1' height='1'/><text class='st0'>x</text></svg>",
     "<svg viewBox='0 0 0 1'/>",
     "M 10 10 L 20 20",
 };
 
 static const char *const seed_dirs[] = {"../shared/data/svg/resvg_path_tests",
-                                        "../shared/data/svg/w3c_svg11_paths", NULL};
+                                        "../shared/data/svg/w3c_svg11_paths", "tests/data/svg/use",
+                                        NULL};
 
 int main(int argc, char **argv)
 {

@@ -619,7 +619,7 @@ static void test_transforms(void **state)
 static void test_skipped_content(void **state)
 {
     (void)state;
-    /* Paths in <defs> are not drawn (said once); shapes without a size draw nothing; a path
+    /* Paths in <defs> are not drawn where they stand; shapes without a size draw nothing; a path
      * without d draws nothing; foreign-namespace elements are ignored; svg-prefixed elements
      * are read; the drawn path is filled (the default paint): said once. */
     const char *doc = "<svg xmlns='http://www.w3.org/2000/svg' xmlns:x='urn:x'>"
@@ -634,7 +634,7 @@ static void test_skipped_content(void **state)
     expect_pt(&P.elems[0].curve.p[1], 2, 2);
     assert_int_equal(S.paths, 3); /* defs path, empty path, drawn path */
     assert_int_equal(S.shapes, 3);
-    assert_int_equal(nwarn, 2); /* hidden path, fill */
+    assert_int_equal(nwarn, 1); /* fill (a <defs> path is silently drawn only through <use>) */
     assert_non_null(strstr(last_warn, "fills are not drawn"));
     assert_int_equal(S.ignored, 1);
     assert_int_equal(read_text("<s:svg xmlns:s='http://www.w3.org/2000/svg'>"
@@ -1173,6 +1173,380 @@ static void test_drawn_up_to_error(void **state)
     assert_int_equal(read_text("<svg><path d='M 0 0 L 5000 0'/></svg>"), CS_ERR_RANGE);
 }
 
+/* --- <use>, <symbol> and style sheets ----------------------------------------------------- */
+
+/* A 2-D affine map x' = a x + c y + e, y' = b x + d y + f (SVG 1.1 §7.4), for expected values
+ * worked out here, independently of cs_path_affine. */
+typedef struct {
+    double a, b, c, d, e, f;
+} aff_t;
+
+static aff_t aff(double a, double b, double c, double d, double e, double f)
+{
+    aff_t m = {a, b, c, d, e, f};
+    return m;
+}
+
+static aff_t aff_mul(aff_t m, aff_t n) /* m then n in m's space: the matrix product m n */
+{
+    return aff(m.a * n.a + m.c * n.b, m.b * n.a + m.d * n.b, m.a * n.c + m.c * n.d,
+               m.b * n.c + m.d * n.d, m.a * n.e + m.c * n.f + m.e, m.b * n.e + m.d * n.f + m.f);
+}
+
+static void expect_map(const cs_vec3_t *p, aff_t m, double x, double y)
+{
+    expect_pt(p, m.a * x + m.c * y + m.e, m.b * x + m.d * y + m.f);
+}
+
+/* Whether some element starts at (x, y). */
+static bool starts_at(double x, double y)
+{
+    for (size_t i = 0; i < P.n; i++)
+        if (pt_is(&P.elems[i].curve.p[0], x, y))
+            return true;
+    return false;
+}
+
+static void expect_warning(const char *where, const char *what)
+{
+    if (!strstr(last_warn, where) || !strstr(last_warn, what))
+        fail_msg("warning '%s', expected '%s' ... '%s'", last_warn, where, what);
+}
+
+static void test_use_elements(void **state)
+{
+    (void)state;
+    /* The use's transform, then translate(x, y) (SVG 1.1 §5.6); the original is drawn too. */
+    assert_int_equal(read_text("<svg><path id='p' d='M1 2 L3 4' stroke='black'/>"
+                               "<use href='#p' x='10' y='20' transform='scale(2)'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    aff_t m = aff_mul(aff(2, 0, 0, 2, 0, 0), aff(1, 0, 0, 1, 10, 20));
+    expect_pt(&P.elems[0].curve.p[0], 1, 2);
+    expect_map(&P.elems[1].curve.p[0], m, 1, 2);
+    expect_map(&P.elems[1].curve.p[1], m, 3, 4);
+    assert_int_equal(S.uses, 1);
+    /* A forward reference by xlink:href to a group with its own transform: the instance comes
+     * first, in document order. */
+    assert_int_equal(read_text("<svg xmlns:xlink='http://www.w3.org/1999/xlink'>"
+                               "<use xlink:href='#g' x='5'/><g id='g' transform='rotate(90)'>"
+                               "<line x2='1' stroke='red'/></g></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    m = aff_mul(aff(1, 0, 0, 1, 5, 0), aff(0, 1, -1, 0, 0, 0)); /* rotate(90): (1,0) -> (0,1) */
+    expect_map(&P.elems[0].curve.p[1], m, 1, 0);
+    expect_pt(&P.elems[1].curve.p[1], 0, 1);
+    /* href wins over xlink:href (SVG 2). */
+    assert_int_equal(read_text("<svg xmlns:xlink='http://www.w3.org/1999/xlink'><defs>"
+                               "<line id='a' x2='1' stroke='red'/><line id='b' x2='7' "
+                               "stroke='red'/></defs><use xlink:href='#a' href='#b'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[1], 7, 0);
+    /* Properties come from the use, not from where the element stands: stroke none and fill
+     * none around the <defs> do not hide it; a stroke around them does not show it. */
+    assert_int_equal(read_text("<svg><g stroke='none' fill='none'><defs><path id='r' "
+                               "d='M0 0 L1 0'/></defs></g><use href='#r' stroke='black' "
+                               "fill='none'/><g stroke='black'><defs><path id='s' d='M0 0 L2 "
+                               "0'/></defs></g><use href='#s' fill='none'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[1], 1, 0);
+    assert_int_equal(nwarn, 0);
+    /* A use inside <defs> is drawn only through what holds it; a nested use composes. */
+    assert_int_equal(read_text("<svg><defs><line id='l' x2='1' stroke='red'/>"
+                               "<g id='two'><use href='#l'/><use href='#l' y='3'/></g></defs>"
+                               "<use href='#two' x='10'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_pt(&P.elems[0].curve.p[0], 10, 0);
+    expect_pt(&P.elems[1].curve.p[1], 11, 3);
+    assert_int_equal(S.uses, 3);
+}
+
+static void test_use_symbol_viewbox(void **state)
+{
+    (void)state;
+    /* Viewport 40 x 40 at (100, 50) for viewBox 5 0 10 20 (SVG 1.1 §7.8): meet scales by
+     * min(40/10, 40/20) = 2 and centres the 20 x 40 result: x + (40 - 10 * 2) / 2. */
+    static const struct {
+        const char *par;
+        double sx, sy, tx, ty;
+    } cases[] = {
+        {"", 2, 2, 100 + (40 - 10 * 2) / 2.0 - 5 * 2, 50},
+        {" preserveAspectRatio='xMinYMax slice'", 4, 4, 100 - 5 * 4, 50 + (40 - 20 * 4)},
+        {" preserveAspectRatio='none'", 4, 2, 100 - 5 * 4, 50},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char doc[400];
+        snprintf(doc, sizeof doc,
+                 "<svg><use href='#s' x='100' y='50' width='40' height='40'/>"
+                 "<symbol id='s' viewBox='5 0 10 20'%s><path d='M5 0 L15 20' stroke='red'/>"
+                 "</symbol></svg>",
+                 cases[i].par);
+        assert_int_equal(read_text(doc), CS_OK);
+        assert_int_equal(P.n, 1);
+        aff_t m = aff(cases[i].sx, 0, 0, cases[i].sy, cases[i].tx, cases[i].ty);
+        expect_map(&P.elems[0].curve.p[0], m, 5, 0);
+        expect_map(&P.elems[0].curve.p[1], m, 15, 20);
+    }
+    /* No width/height on the use: 100% of the viewport (viewBox 200 x 100, no size: user
+     * units are mm), meet: min(200/10, 100/20) = 5, centred in x. A symbol by itself is not
+     * drawn; a zero width draws nothing. */
+    assert_int_equal(read_text("<svg viewBox='0 0 200 100'><symbol id='s' viewBox='0 0 10 20'>"
+                               "<path d='M0 0 L10 20' stroke='red'/></symbol><use href='#s'/>"
+                               "<use href='#s' width='0'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[0], (200 - 10 * 5) / 2.0, 0);
+    expect_pt(&P.elems[0].curve.p[1], (200 - 10 * 5) / 2.0 + 50, 100);
+    /* A nested <svg>: the use's width/height replace its own (20 x 40, meet: 20, centred in
+     * y), at the use's x. */
+    assert_int_equal(read_text("<svg><defs><svg id='n' width='10' height='10' "
+                               "viewBox='0 0 1 1'><path d='M0 0 L1 1' stroke='red'/></svg>"
+                               "</defs><use href='#n' x='1' width='20' height='40'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[0], 1, (40 - 20) / 2.0);
+    expect_pt(&P.elems[0].curve.p[1], 21, (40 - 20) / 2.0 + 20);
+}
+
+static void test_use_refused(void **state)
+{
+    (void)state;
+    /* A missing id: a warning at the use, nothing drawn for it, the rest drawn. */
+    assert_int_equal(read_text("<svg>\n  <use href='#nope'/><line x2='1' stroke='red'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    assert_int_equal(nwarn, 1);
+    expect_warning("doc.svg:2:3:", "no element has this id");
+    assert_int_equal(S.ignored, 1);
+    /* A use's own children are not drawn, whether it draws or not. */
+    assert_int_equal(read_text("<svg><use href='#nope'><line x2='1' stroke='red'/></use><use>"
+                               "<line x2='2' stroke='red'/></use><use href='#l'><line x2='3' "
+                               "stroke='red'/></use><line id='l' x2='4' stroke='red'/></svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 2);
+    expect_pt(&P.elems[0].curve.p[1], 4, 0);
+    /* Another file: a warning. */
+    assert_int_equal(read_text("<svg><use href='other.svg#a'/></svg>"), CS_OK);
+    expect_warning("doc.svg:1:6:", "another file");
+    /* Cycles: a use of itself, of its own group, and two groups using each other: a warning,
+     * the rest drawn once each. */
+    assert_int_equal(read_text("<svg><use id='u' href='#u'/></svg>"), CS_OK);
+    expect_warning("doc.svg:1:6:", "cycle");
+    assert_int_equal(read_text("<svg><g id='a'><line x2='1' stroke='red'/><use href='#a'/></g>"
+                               "</svg>"),
+                     CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_warning("doc.svg:1:43:", "cycle");
+    assert_int_equal(read_text("<svg><g id='a'><line x2='1' stroke='red'/><use href='#b'/></g>"
+                               "<g id='b'><line x2='2' stroke='red'/><use href='#a'/></g></svg>"),
+                     CS_OK);
+    /* a, b through a's use, b, a through b's use; each repeat refused */
+    assert_int_equal(P.n, 4);
+    assert_int_equal(nwarn, 1);
+    /* Nesting: 10 levels are drawn; past CS_SVGDOC_MAX_USE_DEPTH, a warning and nothing. */
+    for (int levels = 10; levels <= CS_SVGDOC_MAX_USE_DEPTH + 8;
+         levels += CS_SVGDOC_MAX_USE_DEPTH - 2) {
+        char doc[8000];
+        int n = snprintf(doc, sizeof doc, "<svg><defs><line id='g0' x2='1' stroke='red'/>");
+        for (int i = 1; i <= levels; i++)
+            n += snprintf(doc + n, sizeof doc - (size_t)n, "<g id='g%d'><use href='#g%d'/></g>", i,
+                          i - 1);
+        snprintf(doc + n, sizeof doc - (size_t)n, "</defs><use href='#g%d'/></svg>", levels);
+        assert_int_equal(read_text(doc), CS_OK);
+        assert_int_equal(P.n, levels <= CS_SVGDOC_MAX_USE_DEPTH ? 1 : 0);
+        assert_int_equal(nwarn, levels <= CS_SVGDOC_MAX_USE_DEPTH ? 0 : 1);
+    }
+    /* Uses that multiply (10 per level, 7 levels: 10^7 lines) stop at
+     * CS_SVGDOC_MAX_USE_ELEMENTS with a range error at the element past it. */
+    char doc[4000];
+    int n = snprintf(doc, sizeof doc, "<svg><defs><line id='g0'/>");
+    for (int i = 1; i <= 7; i++) {
+        n += snprintf(doc + n, sizeof doc - (size_t)n, "<g id='g%d'>", i);
+        for (int k = 0; k < 10; k++)
+            n += snprintf(doc + n, sizeof doc - (size_t)n, "<use href='#g%d'/>", i - 1);
+        n += snprintf(doc + n, sizeof doc - (size_t)n, "</g>");
+    }
+    snprintf(doc + n, sizeof doc - (size_t)n, "</defs><use href='#g7'/></svg>");
+    assert_int_equal(read_text(doc), CS_ERR_RANGE);
+    assert_non_null(strstr(D.reason, "CS_SVGDOC_MAX_USE_ELEMENTS"));
+    assert_int_equal(D.loc.line, 1);
+}
+
+/* Whether each of the lines x2 = 1, 2, 3... of a document is drawn: a bit mask. */
+static unsigned drawn_lines(const char *doc)
+{
+    if (read_text(doc) != CS_OK)
+        fail_msg("%s: %s", doc, D.reason);
+    unsigned mask = 0;
+    for (size_t i = 0; i < P.n; i++)
+        mask |= 1u << (unsigned)lround(P.elems[i].curve.p[1].x * LSB);
+    return mask >> 1;
+}
+
+static void test_style_sheets(void **state)
+{
+    (void)state;
+    /* Classes (several per element), later rules over earlier ones of equal specificity. */
+    assert_int_equal(drawn_lines("<svg><style>.a{stroke:none;fill:none} .b{stroke:black}"
+                                 "</style><line class='a' x2='1'/><line class='a b' x2='2'/>"
+                                 "<line class=' b ' x2='3'/></svg>"),
+                     2 | 4);
+    assert_int_equal(nwarn, 0);
+    /* display:none from a class hides a group; visibility from a class. */
+    assert_int_equal(drawn_lines("<svg><style>.h{display:none} .v{visibility:hidden}</style>"
+                                 "<g class='h'><line x2='1' stroke='red'/></g>"
+                                 "<line class='v' x2='2' stroke='red'/>"
+                                 "<line x2='3' stroke='red'/></svg>"),
+                     4);
+    /* Specificity (CSS 2.1 §6.4.3): #id over .class over type, whatever the order; a compound
+     * line.c over .c; the universal selector counts nothing. */
+    assert_int_equal(
+        drawn_lines("<svg><style>#x{stroke:none} .c{stroke:red} line.d{stroke:none}"
+                    " .d{stroke:red} *{stroke:red} line{stroke:none}</style>"
+                    "<line id='x' class='c' x2='1'/><line class='d' x2='2'/>"
+                    "<line x2='3'/><rect x='20' width='1' height='1' fill='none'/></svg>"),
+        1u << 19 | 1u << 20); /* the rect, by '*': x 20 and 21 */
+    assert_int_equal(P.n, 4); /* the rect: '*' */
+    /* Sheet over presentation attributes; style="" over the sheet; !important in the sheet over
+     * style=""; !important in style="" over all. */
+    assert_int_equal(drawn_lines("<svg><style>.n{stroke:none} .i{stroke:none !important}"
+                                 "</style><line class='n' stroke='red' x2='1'/>"
+                                 "<line class='n' style='stroke:red' x2='2'/>"
+                                 "<line class='i' style='stroke:red' x2='3'/>"
+                                 "<line class='i' style='stroke:red!important' x2='4'/></svg>"),
+                     2 | 8);
+    /* Comma groups, descendant and child combinators, a sheet after the elements, in CDATA. */
+    assert_int_equal(drawn_lines("<svg><g class='k'><g><line x2='1'/></g></g><line x2='2'/>"
+                                 "<g id='q'><line x2='3'/></g><line id='r' x2='4'/>"
+                                 "<style><![CDATA[ g.k line, #r {stroke:red} svg > g > line"
+                                 "{stroke:blue} ]]></style></svg>"),
+                     1 | 4 | 8);
+    /* Selectors match in the document: a class on an element in <defs> applies to its use. */
+    assert_int_equal(drawn_lines("<svg><style>.s{stroke:red}</style><defs><line id='l' "
+                                 "class='s' x2='1'/></defs><use href='#l'/></svg>"),
+                     1);
+    /* At-rules: skipped with one warning, the rules after them read. */
+    assert_int_equal(drawn_lines("<svg><style>@import url(x.css); @media print { line{stroke:"
+                                 "none} } @font-face{font-family:x} line{stroke:red}</style>"
+                                 "<line x2='1'/></svg>"),
+                     1);
+    assert_int_equal(nwarn, 1);
+    expect_warning("doc.svg:1:13:", "at-rules");
+    /* Keywords in any case (CSS: ASCII case-insensitive), from a sheet or an attribute. */
+    assert_int_equal(drawn_lines("<svg><style>.u{stroke:NONE}</style><line class='u' "
+                                 "stroke='red' x2='1'/><line stroke='None' x2='2'/>"
+                                 "<line stroke='red' x2='3' display='NONE'/>"
+                                 "<line stroke='RED' x2='4'/></svg>"),
+                     8);
+    /* Another type of sheet: ignored with a warning. */
+    assert_int_equal(drawn_lines("<svg><style type='text/xsl'>line{stroke:red}</style>"
+                                 "<line x2='1'/></svg>"),
+                     0);
+    expect_warning("doc.svg:1:6:", "text/xsl");
+}
+
+static void test_style_sheet_errors(void **state)
+{
+    (void)state;
+    /* A malformed declaration: a warning at its place in the file, the others kept. */
+    assert_int_equal(drawn_lines("<svg>\n<style>\nline{stroke red; fill:none}\n"
+                                 "rect{stroke:red}\n</style><line x2='1' stroke='red'/>"
+                                 "<rect width='2' height='2' fill='none'/></svg>"),
+                     1 | 2);
+    assert_int_equal(nwarn, 1);
+    expect_warning("doc.svg:3:6:", "malformed declaration");
+    /* An invalid selector drops its whole rule (CSS), an unsupported one only itself. */
+    assert_int_equal(drawn_lines("<svg><style>li%ne, line{stroke:red}</style><line x2='1'/>"
+                                 "</svg>"),
+                     0);
+    expect_warning("doc.svg:1:15:", "invalid selector");
+    assert_int_equal(drawn_lines("<svg><style>line:hover, #b{stroke:red}</style>"
+                                 "<line x2='1'/><line id='b' x2='2'/></svg>"),
+                     2);
+    expect_warning("doc.svg:1:17:", "unsupported selector");
+    /* The end of the sheet closes an open block; a selector without a block is a warning. */
+    assert_int_equal(drawn_lines("<svg><style>line{stroke:red</style><line x2='1'/></svg>"), 1);
+    assert_int_equal(nwarn, 0);
+    assert_int_equal(drawn_lines("<svg><style>line{stroke:red} rect</style><line x2='1'/>"
+                                 "</svg>"),
+                     1);
+    expect_warning("doc.svg:1:30:", "without a { declaration block");
+    /* Comments, HTML comment tokens, strings with braces, an empty sheet. */
+    assert_int_equal(drawn_lines("<svg><style>&lt;!-- /* x{stroke:none} */ line{font-family:'a}b';"
+                                 "stroke:red} --&gt;</style><style/><line x2='1'/></svg>"),
+                     1);
+    assert_int_equal(nwarn, 0);
+}
+
+/* Real and realistic files: matplotlib's text as glyph paths in <defs> placed by <use>,
+ * Illustrator's class sheet, Inkscape's clones and symbols, cairo's glyph symbols. Expected points
+ * from the files' numbers and transforms by hand. */
+static void test_use_style_files(void **state)
+{
+    (void)state;
+    /* matplotlib: 576 pt (768 px = 203.2 mm) over viewBox 576: k mm per user unit. */
+    assert_int_equal(read_file(DATA "use/matplotlib-multi-font-aspath.svg"), CS_OK);
+    double k = 203.2 / 576;
+    assert_int_equal(S.uses, 26);
+    assert_int_equal(nwarn, 1);                    /* fills drawn as outlines */
+    expect_pt(&P.elems[0].curve.p[0], 0, 432 * k); /* the white background patch */
+    /* 'T' (use without x), then 'h' at x = 61.083984, glyph units scaled by 0.015625, all in
+     * translate(86.4 226.8) scale(0.27 -0.27). */
+    aff_t text = aff_mul(aff(k, 0, 0, k, 0, 0), aff(0.27, 0, 0, -0.27, 86.4, 226.8));
+    aff_t glyph = aff(0.015625, 0, 0, 0.015625, 0, 0);
+    expect_map(&P.elems[4].curve.p[0], aff_mul(text, glyph), -19, 4666);
+    aff_t h = aff_mul(aff_mul(text, aff(1, 0, 0, 1, 61.083984, 0)), glyph);
+    assert_true(starts_at(h.a * 3513 + h.e, h.d * 2113 + h.f));
+    aff_t bang = aff_mul(aff_mul(text, aff(1, 0, 0, 1, 1503.208984, 0)), glyph);
+    expect_map(&P.elems[P.n - 1].curve.p[0], bang, 966, 2619); /* '!' ends ...L 966 2619 */
+    for (size_t i = 0; i < P.n; i++) {
+        const cs_vec3_t *p = &P.elems[i].curve.p[0];
+        assert_true(p->x * LSB >= -PT_TOL && p->x * LSB <= 203.2 + PT_TOL);
+        assert_true(p->y * LSB >= -PT_TOL && p->y * LSB <= 152.4 + PT_TOL);
+    }
+    /* Illustrator: viewBox 200 x 100 on 100 mm x 50 mm (0.5 mm per unit). Drawn: the .st0
+     * rect (4 lines), the .st3 line, the .st4 polyline (2), the white-filled .st5 circle
+     * (4 arcs), the line stroked by its second class; not drawn: .st1 (no paint), .st2
+     * (display none, alone or as a second class). */
+    assert_int_equal(read_file(DATA "use/illustrator-style.svg"), CS_OK);
+    assert_int_equal(P.n, 4 + 1 + 2 + 4 + 1);
+    expect_pt(&P.elems[0].curve.p[0], 5, 5);
+    expect_pt(&P.elems[4].curve.p[0], 5, 45);
+    expect_pt(&P.elems[4].curve.p[1], 95, 45);
+    expect_pt(&P.elems[5].curve.p[0], 65, 5);
+    expect_pt(&P.elems[11].curve.p[0], 10, 25);
+    expect_pt(&P.elems[11].curve.p[1], 20, 25);
+    assert_int_equal(nwarn, 1); /* the circle's fill */
+    /* Inkscape: 1 mm per unit. The clone (before its original) at translate(50, 0), the
+     * original, the symbol's cross (viewBox 10 x 10 in 20 x 10 at (10, 60): scale 1, centred:
+     * x + 5); the hidden layer's clone not drawn. */
+    assert_int_equal(read_file(DATA "use/inkscape-clones.svg"), CS_OK);
+    assert_int_equal(P.n, 4 + 4 + 2);
+    expect_pt(&P.elems[0].curve.p[0], 60, 10);
+    expect_pt(&P.elems[4].curve.p[0], 10, 10);
+    expect_pt(&P.elems[8].curve.p[0], 15, 60);
+    expect_pt(&P.elems[8].curve.p[1], 25, 70);
+    expect_pt(&P.elems[9].curve.p[0], 25, 60);
+    expect_pt(&P.elems[9].curve.p[1], 15, 70);
+    assert_int_equal(nwarn, 0);
+    assert_int_equal(S.uses, 2);
+    /* cairo (1.16, cairo_show_text): each glyph a <symbol> without viewBox (so only the use's
+     * x, y place it), filled through the enclosing <g style="fill:...">; 200 pt over viewBox
+     * 200: 25.4 / 72 mm per unit. 'H' at (10, 50) starts M 2.9375 -21.875 L 5.90625 -21.875;
+     * the stroked frame M 5 5 ... L 5 95 Z comes last. */
+    assert_int_equal(read_file(DATA "use/cairo-text.svg"), CS_OK);
+    double pt = 25.4 / 72;
+    assert_int_equal(S.uses, 8);
+    assert_int_equal(nwarn, 1); /* fills drawn as outlines */
+    expect_pt(&P.elems[0].curve.p[0], (10 + 2.9375) * pt, (50 - 21.875) * pt);
+    expect_pt(&P.elems[0].curve.p[1], (10 + 5.90625) * pt, (50 - 21.875) * pt);
+    expect_pt(&P.elems[P.n - 1].curve.p[0], 5 * pt, 95 * pt);
+    expect_pt(&P.elems[P.n - 1].curve.p[1], 5 * pt, 5 * pt);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1193,6 +1567,12 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_style_display, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_files_flatten, setup, teardown),
         cmocka_unit_test_setup_teardown(test_drawn_up_to_error, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_use_elements, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_use_symbol_viewbox, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_use_refused, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_style_sheets, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_style_sheet_errors, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_use_style_files, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -30,6 +30,7 @@ typedef struct {
     int polylines, circles, svg;
     char curves_d[1 << 16]; /* the d of <path id="curves"> */
     double vb[4];
+    double drawing[6]; /* the transform of <g id="drawing"> */
     char legend[2048];
     bool in_text;
 } pic_t;
@@ -53,6 +54,20 @@ static void XMLCALL pic_start(void *ud, const XML_Char *el, const XML_Char **att
         }
         if (id && d && !strcmp(id, "curves"))
             snprintf(p->curves_d, sizeof p->curves_d, "%s", d);
+    }
+    if (!strcmp(el, "g")) {
+        const char *id = NULL, *tr = NULL;
+        for (int i = 0; atts[i]; i += 2) {
+            if (!strcmp(atts[i], "id"))
+                id = atts[i + 1];
+            if (!strcmp(atts[i], "transform"))
+                tr = atts[i + 1];
+        }
+        if (id && tr && !strcmp(id, "drawing"))
+            assert_int_equal(sscanf(tr, "matrix(%lf %lf %lf %lf %lf %lf)", &p->drawing[0],
+                                    &p->drawing[1], &p->drawing[2], &p->drawing[3],
+                                    &p->drawing[4], &p->drawing[5]),
+                             6);
     }
     if (!strcmp(el, "svg")) {
         p->svg++;
@@ -145,9 +160,15 @@ static void test_picture_round_trip(void **state)
     assert_non_null(strstr(pic.legend, "subdiv"));
     assert_non_null(strstr(pic.legend, "0.125"));
     assert_non_null(strstr(pic.legend, "chords: 4 (6 vertices, 2 polylines)"));
-    for (size_t i = 0; i < ch.n; i++)
+    /* The drawing is y-up (the machine's frame) in a y-down picture: mirrored, x kept, and
+     * every vertex, as drawn, inside the viewBox above the legend. */
+    const double *m = pic.drawing;
+    assert_true(m[0] == 1 && m[1] == 0 && m[2] == 0 && m[3] == -1 && m[4] == 0);
+    for (size_t i = 0; i < ch.n; i++) {
+        double y = m[5] - ch.pts[i].y;
         assert_true(ch.pts[i].x > pic.vb[0] && ch.pts[i].x < pic.vb[0] + pic.vb[2] &&
-                    ch.pts[i].y > pic.vb[1] && ch.pts[i].y < pic.vb[1] + pic.vb[3]);
+                    y > pic.vb[1] && y < pic.vb[1] + pic.vb[3]);
+    }
 
     /* The curves, read back by the path reader. */
     cs_path_t back;
