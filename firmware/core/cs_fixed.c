@@ -243,11 +243,11 @@ int64_t cs_fixed_div_round(int64_t n, int64_t d)
     return n < 0 ? -q : q;
 }
 
+#if !defined(CS_FIXED_BITLEN_INLINE) /* else inline in cs_fixed.h */
 unsigned cs_fixed_bitlen64(uint64_t v)
 {
 #if defined(__GNUC__) && !(defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB == 1)
-    /* one count-leading-zeros instruction: the predicted-step tracer asks for a bit length
-     * several times a flatness test */
+    /* one count-leading-zeros call (AVR: libgcc's) */
     return v == 0 ? 0u : 64u - (unsigned)__builtin_clzll(v);
 #else
     /* Thumb-1 (Cortex-M0+) has no CLZ and libgcc's takes 84 bytes: halving on the 32-bit half
@@ -266,6 +266,7 @@ unsigned cs_fixed_bitlen64(uint64_t v)
     return b + (unsigned)x; /* x is now 0 or 1 */
 #endif
 }
+#endif
 
 cs_i128_t cs_fixed_i128_mul_u64(cs_i128_t a, uint64_t m)
 {

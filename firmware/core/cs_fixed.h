@@ -114,8 +114,19 @@ uint8_t cs_fixed_binom(unsigned n, unsigned k);
 /* round(n / d) for d > 0, half away from zero (-2.5 -> -3); |n| + d/2 must not overflow int64.
  * ISR-safe (pure). */
 int64_t cs_fixed_div_round(int64_t n, int64_t d);
-/* Number of significant bits of v (0 for 0, 64 for 2^63..). ISR-safe (pure). */
+/* Number of significant bits of v (0 for 0, 64 for 2^63..). ISR-safe (pure). Inline where the
+ * core counts leading zeros in one instruction (64-bit hosts, Thumb-2): the predicted-step
+ * tracer asks for it four times a flatness test (a call was 5 % of its host instructions). */
+#if defined(__GNUC__) &&                                                                           \
+    (defined(__SIZEOF_INT128__) || (defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB >= 2))
+#define CS_FIXED_BITLEN_INLINE 1
+static inline unsigned cs_fixed_bitlen64(uint64_t v)
+{
+    return v == 0 ? 0u : 64u - (unsigned)__builtin_clzll(v);
+}
+#else
 unsigned cs_fixed_bitlen64(uint64_t v);
+#endif
 
 /* Coordinate `axis` (0 = x, 1 = y, 2 = z) of a vector: the one accessor the per-axis loops of
  * the curve, surface and basis code share. axis must be < 3. */

@@ -16,10 +16,11 @@
 #define ROOM_FAIL (-2 * ROOM_ONE)  /* room 1/4: what a failing hull test or T <= 0 reports */
 #define ROOM_MIN  (-30 * ROOM_ONE) /* room 2^-30: the step shrinks at most 2^15 times */
 #define ROOM_HULL 0                /* room 1: a passing hull test (says nothing of the trend) */
-/* Accept a passing step whose deviation bound is within 1/1.10 of the threshold (log2(1.10) =
- * 0.1375, 35/256): the step is then within about 5 % of the largest that passes. 1.05 costs
- * 9 % more M3 instructions for 0.1 % fewer chords; 1.15 saves 2.3 % for 0.1 % more. */
-#define ROOM_ACCEPT 35
+/* Accept a passing step whose deviation bound is within 1/1.15 of the threshold (log2(1.15) =
+ * 0.2016, 52/256): the step is then within about 7 % of the largest that passes. Against 1.10
+ * (35/256): 0.5 % more chords at 0.1 mm (bench_peers' random set), 7 % fewer tests a chord
+ * there, 5 % fewer M3 instructions a chord (docs/fixed-point.md, Cost). */
+#define ROOM_ACCEPT 52
 
 /* The small helpers of the hot path (mul_t, dot, uabs64): inline on cores with a 32x32 -> 64
  * multiply instruction (about 8 instructions a call saved on the M3, 32 calls a chord); one
@@ -32,6 +33,17 @@
 #define HOT_INLINE __attribute__((noinline))
 #else
 #define HOT_INLINE
+#endif
+
+/* Speed builds (the host, -O2): the step search specialised for each flatness test (the test
+ * inlined into it, no call through a pointer) and the test's helpers inline; size builds (-Os:
+ * every firmware image) keep one out-of-line copy of each. The same source either way. */
+#if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define SPEED_INLINE __attribute__((always_inline)) inline
+#define SPEED_UNROLL _Pragma("GCC unroll 8") /* the fixed-count loops of the test unrolled */
+#else
+#define SPEED_INLINE
+#define SPEED_UNROLL
 #endif
 
 static HOT_INLINE uint64_t uabs64(int64_t v)
@@ -47,8 +59,11 @@ static HOT_INLINE uint64_t uabs64(int64_t v)
  * up to 1/1024. Worst overestimate 1.3 %. */
 #define MAJ_SCALE 1024
 static const int16_t maj_coef[4][2] = {/* p, q coefficients: q/p <= 1/2 then > 1/2, same sign */
-                                       {456, 272}, {456, -190}, {416, 352}, {426, -130}};
-static uint64_t majorant(int64_t c1, int64_t c2)
+                                       {456, 272},
+                                       {456, -190},
+                                       {416, 352},
+                                       {426, -130}};
+static SPEED_INLINE uint64_t majorant(int64_t c1, int64_t c2)
 {
     uint64_t p = uabs64(c1), q = uabs64(c2);
     if (p < q) { /* p = max, q = min */
@@ -63,7 +78,6 @@ static uint64_t majorant(int64_t c1, int64_t c2)
     /* modulo 2^64 with the negative coefficient: the true value is >= 0 (q <= p) and < 2^63 */
     return p * (uint64_t)cf[0] + q * (uint64_t)(int64_t)cf[1];
 }
-
 
 /* a b for |a|, |b| < 2^31: one 32x32 -> 64 multiply (SMULL on a Cortex-M3, one call of the
  * 32x32 product on the M0+) where int64 operands would take a 64x64 product. */
@@ -81,7 +95,7 @@ static HOT_INLINE int64_t dot(const int32_t a[2], const int32_t b[2])
 }
 
 /* Smallest k with v >> k < 2^bits. */
-static unsigned shift_below(uint64_t v, unsigned bits)
+static SPEED_INLINE unsigned shift_below(uint64_t v, unsigned bits)
 {
     unsigned n = cs_fixed_bitlen64(v);
     return n > bits ? n - bits : 0;
@@ -188,23 +202,38 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
     return CS_OK;
 }
 
-/* x t / 2^30 rounded half away from zero, for 0 <= t <= 2^30 (every parameter and step of the
- * tracer) and |x| < 2^62: bit for bit cs_fixed_mul64_q30, inline. With |x| = xh 2^32 + xl the
- * product is xh t 4 + (xl t + 2^29) / 2^30 (the first term is a multiple of 2^30 before the
- * shift, so only the second rounds): two 32x32 -> 64 products (UMULL on a Cortex-M3, xh, xl and
- * t all fit 32 bits) where the compiler has no 128-bit type, one 64x64 -> 128 where it has. */
+/* x t / 2^30 rounded half up (floor(x t / 2^30 + 1/2), <= 1/2 unit off), for 0 <= t <= 2^30
+ * (every parameter and step of the tracer) and |x| < 2^62, inline. With x = xh 2^32 + xl (xh
+ * the signed top half, -2^30 <= xh < 2^30; xl the unsigned low half) the product is
+ * 4 xh t + floor((xl t + 2^29) / 2^30) (the first term is a multiple of 2^30 before the shift, so
+ * only the second rounds, and it is >= 0): one signed and one unsigned 32x32 -> 64 product
+ * (SMULL and UMULL on a Cortex-M3), no absolute value and no branch on the sign, which is data
+ * (a mispredicted branch costs a host core some 15 cycles). */
 static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
-    uint64_t m = uabs64(x);
     uint32_t ut = (uint32_t)t;
-#if defined(__SIZEOF_INT128__)
-    __extension__ typedef unsigned __int128 u128_t;
-    uint64_t r = (uint64_t)(((u128_t)m * ut + ((uint64_t)1 << 29)) >> 30);
+    uint32_t hi = (uint32_t)((uint64_t)x >> 32); /* the two's complement top half, as int32: */
+    int32_t xh = hi <= INT32_MAX ? (int32_t)hi : -(int32_t)(~hi) - 1; /* (a no-op, defined) */
+    uint64_t lo = (uint64_t)(uint32_t)x * ut;
+    return (int64_t)xh * ut * 4 + (int64_t)((lo + ((uint64_t)1 << 29)) >> 30);
+}
+
+/* v / 2^s rounded half up, for 0 <= s < 32 and a result that fits int32: the result's bits are
+ * bits s..s+31 of v + floor(2^(s-1)) in two's complement (a logical and an arithmetic shift
+ * differ only in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by
+ * 32-bit shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and no
+ * negative value is shifted (implementation-defined in C99). hi << (32 - s) is written
+ * (hi << 1) << (31 - s), 0 for s = 0 with no shift by 32 (undefined): no branch for s = 0. */
+static SPEED_INLINE int32_t rsh_round32(int64_t v, unsigned s)
+{
+    uint64_t u = (uint64_t)v + ((1u << s) >> 1); /* 32-bit shifts: s < 32 */
+#if defined(__SIZEOF_INT128__)                   /* a 64-bit core: one shift */
+    uint32_t r = (uint32_t)(u >> s);
 #else
-    uint64_t hi = (uint64_t)(uint32_t)(m >> 32) * ut, lo = (uint64_t)(uint32_t)m * ut;
-    uint64_t r = (hi << 2) + ((lo + ((uint64_t)1 << 29)) >> 30);
+    uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
+    uint32_t r = (lo >> s) | ((hi << 1) << (31 - s));
 #endif
-    return x < 0 ? -(int64_t)r : (int64_t)r;
+    return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
 }
 
 /* At the vertex t: B(t) rounded to the LSB into *pt, and B'(t), B''(t) / 2
@@ -215,34 +244,18 @@ static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
     cs_param_t t = p->t;
+    SPEED_UNROLL
     for (unsigned k = 0; k < 2; k++) {
         int64_t a3t = mul_t(p->a[3][k], t), a2 = p->a[2][k];
         p->d[1][k] = a2 + 3 * a3t;
         p->d[0][k] = p->a[1][k] + mul_t(2 * a2 + 3 * a3t, t);
         int64_t acc = p->a[1][k] + mul_t(a2 + a3t, t);
         /* |B(t)| <= CS_POS_LIMIT + 1: in the convex hull of valid points, plus rounding. */
-        cs_fixed_vec_set(pt, k, (cs_pos_t)cs_fixed_round_shift64(p->a[0][k] + mul_t(acc, t), F));
+        cs_fixed_vec_set(pt, k, rsh_round32(p->a[0][k] + mul_t(acc, t), F));
     }
     pt->z = p->z;
 }
 
-/* v / 2^s rounded half up, for 0 <= s < 32 and a result that fits int32: the result's bits are
- * bits s..s+31 of v + floor(2^(s-1)) in two's complement (a logical and an arithmetic shift
- * differ only in bits 64 - s and up, above those), so it is taken from the two 32-bit halves by
- * 32-bit shifts, not a variable 64-bit shift (about 17 instructions on a Cortex-M3), and no
- * negative value is shifted (implementation-defined in C99). hi << (32 - s) is written
- * (hi << 1) << (31 - s), 0 for s = 0 with no shift by 32 (undefined): no branch for s = 0. */
-static int32_t rsh_round32(int64_t v, unsigned s)
-{
-    uint64_t u = (uint64_t)v + ((1u << s) >> 1); /* 32-bit shifts: s < 32 */
-#if defined(__SIZEOF_INT128__) /* a 64-bit core: one shift */
-    uint32_t r = (uint32_t)(u >> s);
-#else
-    uint32_t lo = (uint32_t)u, hi = (uint32_t)(u >> 32);
-    uint32_t r = (lo >> s) | ((hi << 1) << (31 - s));
-#endif
-    return r <= INT32_MAX ? (int32_t)r : -(int32_t)(~r) - 1;
-}
 /* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
  * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
  * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
@@ -255,8 +268,10 @@ CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS +
  * LSB * 2^F: from the Taylor coefficients c1 = B'(t) h, c2 = B''(t) h^2 / 2, c3 = a3 h^3,
  * Q1 - Q0 = c1 / 3, Q2 - Q0 = (2 c1 + c2) / 3, Q3 - Q0 = c1 + c2 + c3 (the blossom of the
  * piece, computed directly; each product rounded once, docs/fixed-point.md). */
-static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h, int64_t v[3][2])
+static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h,
+                                   int64_t v[3][2])
 {
+    SPEED_UNROLL
     for (unsigned k = 0; k < 2; k++) {
         /* Nested products (not h^2, h^3 rounded to Q30 first, whose rounding would be scaled
          * by |d2| up to 2^44 units): <= 1/2 unit per product. */
@@ -274,7 +289,7 @@ static void sub_curve(const cs_predict_t *p, const int64_t d[2][2], cs_param_t h
  * (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x), c = 89/256;
  * within [-0.0115, +0.0079] of the exact log2 v (checked on all 2^15 mantissas, the truncation
  * to 16 bits and to Q8 included). The predictor's only logarithm. */
-static int32_t log2_q8(uint64_t v)
+static SPEED_INLINE int32_t log2_q8(uint64_t v)
 {
     unsigned n = cs_fixed_bitlen64(v);
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
@@ -287,7 +302,7 @@ static int32_t log2_q8(uint64_t v)
  * log2_q8 is within [-0.0115, +0.0079] of the exact logarithm of its integer (checked on all
  * 2^15 mantissas), the halving truncates by < 1/512: the result is within [-6.9, +6.0] / 256
  * of the exact log2 of the room. */
-static int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
+static SPEED_INLINE int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
 {
     if (found == 0)
         return ROOM_CAP;
@@ -299,7 +314,7 @@ static int32_t room_log(uint64_t k, uint64_t dd, uint64_t found)
  * log when it is clear (|room| >= ROOM_SURE = 8/256 > the log's error, so its sign is the exact
  * comparison's), otherwise exactly in 128 bits. */
 #define ROOM_SURE 8
-static bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
+static SPEED_INLINE bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
 {
     int32_t r = room_log(k, dd, found);
     *room = r;
@@ -311,8 +326,8 @@ static bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_t *room)
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
  * test's 32-bit components (below 2^27: |V - D|^2 below 2^57), with vd = V . D, cr = D x V and
  * dd = |D|^2 already computed; r2 = r^2. */
-static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t vd, int64_t cr,
-                        int64_t dd, uint64_t r2)
+static bool seg_dist_ok(const int32_t v[2], const int32_t d[2], int64_t vd, int64_t cr, int64_t dd,
+                        uint64_t r2)
 {
     if (dd == 0 || vd <= 0 || vd >= dd) { /* nearest point is an end: 0 (also D = 0) or D */
         int32_t e[2];
@@ -342,15 +357,18 @@ static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
 
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
-static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
+static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h,
+                                   int32_t *room)
 {
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
     int64_t v[3][2];
     sub_curve(p, d, h, v);
     uint64_t m = 0;
+    SPEED_UNROLL
     for (unsigned i = 0; i < 3; i++)
-        for (unsigned k = 0; k < 2; k++)
-            m |= uabs64(v[i][k]);
+        SPEED_UNROLL
+    for (unsigned k = 0; k < 2; k++)
+        m |= uabs64(v[i][k]);
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
         s = p->thr_shift; /* thr 2^F >> s < 2^THR_BITS */
@@ -361,12 +379,15 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
      * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
      * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
     int32_t w[4][2];
+    SPEED_UNROLL
     for (unsigned i = 0; i < 3; i++)
-        for (unsigned k = 0; k < 2; k++)
-            w[i][k] = rsh_round32(v[i][k], s);
+        SPEED_UNROLL
+    for (unsigned k = 0; k < 2; k++)
+        w[i][k] = rsh_round32(v[i][k], s);
     w[3][0] = -w[2][1];
     w[3][1] = w[2][0];
     int64_t pr[P_N];
+    SPEED_UNROLL
     for (unsigned i = 0; i < P_N; i++)
         pr[i] = dot(w[prod_rows[i][0]], w[prod_rows[i][1]]);
     int64_t tt = mul32(T, T), dd = pr[P_DD];
@@ -386,7 +407,7 @@ static bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h, int3
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
  * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
  * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). At most cap (0 <= cap <= 2^30). */
-static cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
+static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
 {
     int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
     int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
@@ -519,7 +540,8 @@ typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, in
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx, int32_t *lo_room)
+static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
+                                         int32_t *lo_room)
 {
     /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
     cs_param_t rem = CS_PARAM_ONE - p->t;
@@ -571,7 +593,7 @@ static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *
     /* Next chord: the step this one would have needed to fill the tolerance (its step
      * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
     cs_param_t ideal = predict(h, room, CS_PARAM_ONE);
-    cs_param_t nh = trend(ideal, p->h_ideal); /* < 2^31 (trend above) */
+    cs_param_t nh = trend(ideal, p->h_ideal);   /* < 2^31 (trend above) */
     p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : nh;
     p->done = false;

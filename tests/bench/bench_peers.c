@@ -564,19 +564,39 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
            pps >= 1 && arcs_worst_pps >= 1 ? "met" : "MISSED");
     printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost): the "
            "wall clock of this shared machine is noisy (compare within one table, and expect "
-           "the ratios to move by 2x between runs); by instructions (`bench_peers --profile` "
-           "under callgrind, the three sets at the three tolerances) the tracer spends 859 a "
-           "point and 33.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.29x cairo's "
-           "curves/s and 0.79x its points/s (before issue 18's second pass: 1,024 and 39.5 k). "
-           "Each chord costs 1.15-1.26 verified flatness tests (a sub-curve of 12 Q30 products, "
-           "cross and dot products, a 4-piece majorant, three logarithms for the predictor: no "
-           "division) plus B(t) and its derivatives by one Horner scheme (8 products); cairo's "
-           "subdivision spends fewer instructions a point but emits 1.6x the chords, and the "
-           "tracer's data-dependent branches cost more cycles per instruction than cairo's loop. "
-           "Arcs (conic pieces): 1,220 instructions a point and 197 k an arc against "
-           "cairo_arc's 672 and 171 k (0.87x its arcs/s by instructions); each test projects "
-           "two homogeneous points by 64-bit divisions, which cost far more cycles than "
-           "instructions.\n\n");
+           "the ratios to move by 2x between runs; `bench_peers --speed` times only the default "
+           "tracer and cairo, for a quick A/B); by instructions (`bench_peers --profile` under "
+           "callgrind, the three sets at the three tolerances) the tracer spends 650 a point "
+           "and 25.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.70x cairo's curves/s and "
+           "1.05x its points/s (before issue 18's host pass 928 and 35.9 k; before its second "
+           "pass 1,024 and 39.5 k). Each chord costs 1.06-1.73 verified flatness tests (most at "
+           "0.1 mm, where 20 chords a curve leave the predictor little to extrapolate from; a "
+           "sub-curve of 12 Q30 products, cross and dot products, a 4-piece majorant, three "
+           "logarithms: no division, no branch on the sign of a product) plus B(t) and its "
+           "derivatives by one Horner scheme (8 products). Arcs (conic pieces): 1,170 "
+           "instructions a point and 189 k an arc against cairo_arc's 672 and 171 k (0.90x its "
+           "arcs/s by instructions); each test projects two homogeneous points by four 64-bit "
+           "divisions, which cost far more cycles than instructions.\n\n");
+}
+
+/* Arcs per second and points per second of engine e over the arcs at tol, N_RUNS runs each
+ * repeating the arcs for at least 30 ms, sorted (the median at N_RUNS / 2). */
+static void arcs_speed(double tol, int e, double aps[N_RUNS], double pps[N_RUNS])
+{
+    for (int r = 0; r < N_RUNS; r++) {
+        size_t na = 0, np = 0;
+        double t0 = bench_now(), t1;
+        do {
+            for (int k = 0; k < N_ARCS; k++)
+                np += arc_flatten(&arcs[k], tol, e, NULL);
+            na += N_ARCS;
+            t1 = bench_now();
+        } while (t1 - t0 < 0.03);
+        aps[r] = (double)na / (t1 - t0);
+        pps[r] = (double)np / (t1 - t0);
+    }
+    qsort(aps, N_RUNS, sizeof aps[0], cmp_d);
+    qsort(pps, N_RUNS, sizeof pps[0], cmp_d);
 }
 
 static void arcs_report(FILE *csv)
@@ -607,20 +627,7 @@ static void arcs_report(FILE *csv)
             double dev = 0, aps[N_RUNS], pps[N_RUNS];
             for (int k = 0; k < N_ARCS; k++)
                 chords += arc_flatten(&arcs[k], tol, e, e == ENG_CAIRO ? NULL : &dev);
-            for (int r = 0; r < N_RUNS; r++) {
-                size_t na = 0, np = 0;
-                double t0 = bench_now(), t1;
-                do {
-                    for (int k = 0; k < N_ARCS; k++)
-                        np += arc_flatten(&arcs[k], tol, e, NULL);
-                    na += N_ARCS;
-                    t1 = bench_now();
-                } while (t1 - t0 < 0.03);
-                aps[r] = (double)na / (t1 - t0);
-                pps[r] = (double)np / (t1 - t0);
-            }
-            qsort(aps, N_RUNS, sizeof aps[0], cmp_d);
-            qsort(pps, N_RUNS, sizeof pps[0], cmp_d);
+            arcs_speed(tol, e, aps, pps);
             if (e == ENG_CAIRO) {
                 cairo_aps = aps[N_RUNS / 2];
                 cairo_pps = pps[N_RUNS / 2];
@@ -693,6 +700,29 @@ __attribute__((noinline)) static size_t profile_arcs_cairo(size_t *n)
     return profile_arcs(ENG_CAIRO, n);
 }
 
+/* --speed: the default tracer against cairo only, wall clock (median of N_RUNS), on the random
+ * set and the arcs at the three tolerances: a quick A/B of the tracer's host speed (the full
+ * run takes minutes, most of it in the judge). */
+static int speed_only(const bench_set_t *sets)
+{
+    printf("set tol(mm) pred-curves/s cairo-curves/s ratio pred-pts/s cairo-pts/s ratio\n");
+    for (int ti = 0; ti < N_TOLS; ti++) {
+        double pp, cp, pc = speed(&sets[0], tols_mm[ti], ENG_PRED, &pp);
+        double cc = speed(&sets[0], tols_mm[ti], ENG_CAIRO, &cp);
+        printf("random %g %.3g %.3g %.2f %.3g %.3g %.2f\n", tols_mm[ti], pc, cc, pc / cc, pp, cp,
+               pp / cp);
+    }
+    for (int ti = 0; ti < N_TOLS; ti++) {
+        double pa[N_RUNS], pp[N_RUNS], ca[N_RUNS], cp[N_RUNS];
+        arcs_speed(tols_mm[ti], ENG_PRED, pa, pp);
+        arcs_speed(tols_mm[ti], ENG_CAIRO, ca, cp);
+        int m = N_RUNS / 2;
+        printf("arcs %g %.3g %.3g %.2f %.3g %.3g %.2f\n", tols_mm[ti], pa[m], ca[m], pa[m] / ca[m],
+               pp[m], cp[m], pp[m] / cp[m]);
+    }
+    return 0;
+}
+
 static int profile(const bench_set_t *sets)
 {
     size_t n[4] = {0, 0, 0, 0};
@@ -708,15 +738,18 @@ static int profile(const bench_set_t *sets)
 int main(int argc, char **argv)
 {
     static const char usage[] =
-        "usage: bench_peers [OUT.csv | --profile]\n"
+        "usage: bench_peers [OUT.csv | --profile | --speed]\n"
         "curvestep's tracers beside cairo and AGG on one corpus of cubics; a Markdown\n"
         "section on stdout, the figures in OUT.csv. --profile: only the default tracer and\n"
-        "cairo, once over the corpus and the arcs (for callgrind, see profile_curves).\n";
+        "cairo, once over the corpus and the arcs (for callgrind, see profile_curves).\n"
+        "--speed: only the default tracer's and cairo's wall-clock speed on the random set\n"
+        "and the arcs (a quick A/B; no judge, no file).\n";
     bool prof = argc == 2 && strcmp(argv[1], "--profile") == 0;
-    int usage_rc = prof ? -1 : bench_args_check(argc, argv, usage, 1);
+    bool spd = argc == 2 && strcmp(argv[1], "--speed") == 0;
+    int usage_rc = prof || spd ? -1 : bench_args_check(argc, argv, usage, 1);
     if (usage_rc >= 0)
         return usage_rc;
-    FILE *csv = argc > 1 && !prof ? fopen(argv[1], "w") : NULL;
+    FILE *csv = argc > 1 && !prof && !spd ? fopen(argv[1], "w") : NULL;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
     cr = cairo_create(surf);
     bench_set_t sets[3] = {{"random cubics + hard cases", NULL, 0, 0},
@@ -725,9 +758,9 @@ int main(int argc, char **argv)
     random_and_hard(&sets[0]);
     size_t skipped = bench_svg_curves(&sets[1], NULL, 0, planar_cubic);
     teapot_set(&sets[2]);
-    if (prof) {
+    if (prof || spd) {
         arcs_set();
-        return profile(sets);
+        return prof ? profile(sets) : speed_only(sets);
     }
     static result_t res[3][N_TOLS][N_ENG];
     static size_t greedy[3][N_TOLS];
