@@ -1809,6 +1809,10 @@ static cs_err_t dxf_run(dx_t *d)
                                 "binary DXF is not read: save the drawing as ASCII DXF");
     }
     cs_err_t e = lex(d);
+    /* A file cut short in transfer still parses up to its cut: draw it, but say so. */
+    if (e == CS_OK && d->ng > 0 && !(d->g[d->ng - 1].code == 0 && is(d, d->ng - 1, "EOF")))
+        DX_WARN(d, d->ng - 1, "the file ends without 0/EOF: it may be cut short (drawn as far "
+                              "as it goes)");
     if (e == CS_OK)
         e = each_section(d, "HEADER", read_header);
     if (e == CS_OK && d->unit_mm == 0) {
