@@ -17,14 +17,9 @@ cs_path_loc_t cs_gcode_loc(const gc_t *g, unsigned col)
     return l;
 }
 
-void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+static void warn_text(gc_t *g, unsigned col, const char *msg)
 {
     cs_path_diag_t w;
-    char msg[sizeof w.reason];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
     cs_path_diag_set(&w, CS_OK, cs_gcode_loc(g, col), "%s", msg);
     if (g->stats)
         g->stats->warnings++;
@@ -34,11 +29,45 @@ void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
         cs_path_warn_print(stderr, &w);
 }
 
+void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+{
+    char msg[sizeof((cs_path_diag_t *)0)->reason];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    warn_text(g, col, msg);
+}
+
+void cs_gcode_warn_once(gc_t *g, unsigned col, const char *fmt, ...)
+{
+    char msg[sizeof((cs_path_diag_t *)0)->reason];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    /* FNV-1a of the text: the kind of warning, whatever its place. */
+    uint32_t h = 2166136261u;
+    for (const char *c = msg; *c; c++)
+        h = (h ^ (unsigned char)*c) * 16777619u;
+    for (unsigned i = 0; i < g->nwarned; i++)
+        if (g->warned[i] == h) {
+            if (g->stats)
+                g->stats->warnings++;
+            return;
+        }
+    if (g->nwarned < GC_MAX_WARN_ONCE)
+        g->warned[g->nwarned++] = h;
+    size_t n = strlen(msg);
+    snprintf(msg + n, sizeof msg - n, " (reported once)");
+    warn_text(g, col, msg);
+}
+
 /* An unsupported word: an error, or a warning (and CS_OK: the caller ignores it) when lenient. */
 static cs_err_t unsupported(gc_t *g, unsigned col, const char *what)
 {
     if (g->o->lenient) {
-        cs_gcode_warn(g, col, "%s is not supported: ignored (--lenient)", what);
+        cs_gcode_warn_once(g, col, "%s is not supported: ignored (--lenient)", what);
         return CS_OK;
     }
     return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col),
@@ -221,8 +250,8 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
             /* Grbl 1.1 reads T and changes nothing (it has no tool changer). */
         } else if (i == 'T' - 'A' && g->o->lenient) {
             /* No tool changer: the tool in the machine stays, nothing moves. */
-            cs_gcode_warn(g, b->w[i].col,
-                          "T (tool select): ignored, there is no tool changer (--lenient)");
+            cs_gcode_warn_once(g, b->w[i].col,
+                               "T (tool select): ignored, there is no tool changer (--lenient)");
         } else if ((e = unsupported(g, b->w[i].col, what)) != CS_OK) {
             return e;
         }
@@ -362,7 +391,7 @@ static cs_err_t drop_g(gc_t *g, gline_t *l, int v, unsigned c)
         return unsupported(g, c, what);
     bool motion;
     if (!moves_or_takes_axes(v, &motion)) {
-        cs_gcode_warn(g, c, "%s is not supported: ignored (--lenient)", what);
+        cs_gcode_warn_once(g, c, "%s is not supported: ignored (--lenient)", what);
         return CS_OK;
     }
     l->drop = true;
@@ -645,8 +674,9 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
         if (!g->o->lenient)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->w[i].col),
                                     "%c word not used by anything on this line", 'A' + i);
-        cs_gcode_warn(g, b->w[i].col,
-                      "%c word not used by anything on this line: ignored (--lenient)", 'A' + i);
+        cs_gcode_warn_once(g, b->w[i].col,
+                           "%c word not used by anything on this line: ignored (--lenient)",
+                           'A' + i);
     }
     if (end)
         g->ended = true;

@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "cs_gcode.h"
 #include "cs_gexpr.h"
@@ -18,6 +19,8 @@
 /* pi, spelled out: M_PI is POSIX, not C99 (the fuzz build uses plain -std=c99). */
 #define GC_PI  3.14159265358979323846
 #define BIT(c) (1u << ((c) - 'A'))
+/* Kinds of once-only warning remembered per program (beyond: each is printed every time). */
+#define GC_MAX_WARN_ONCE 64
 
 /* Motion modes: the motion group's G code (cs_gcode_words.h), or one of these. */
 enum {
@@ -84,6 +87,9 @@ typedef struct {
     cs_path_loc_t nurbs_loc;
     double nurbs_feed;
     cs_gexpr_store_t st; /* parameters (LinuxCNC) */
+    /* Warnings given once per program (cs_gcode_warn_once): hashes of their texts. */
+    uint32_t warned[GC_MAX_WARN_ONCE];
+    unsigned nwarned;
 } gc_t;
 
 /* One line's words. */
@@ -103,6 +109,10 @@ typedef struct {
 cs_path_loc_t cs_gcode_loc(const gc_t *g, unsigned col);
 /* A warning at col (counted in stats; to opts->warn or stderr). */
 void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...);
+/* The same for a warning about something that changes no geometry (a word ignored): given the
+ * first time its text occurs in the program, with "(reported once)"; later ones are counted in
+ * stats only, so a CAM file with a T word per tool change does not repeat it per line. */
+void cs_gcode_warn_once(gc_t *g, unsigned col, const char *fmt, ...);
 /* Machine mm -> Q15.16; CS_ERR_RANGE with diag outside +/-4096 mm. */
 cs_err_t cs_gcode_to_vec(gc_t *g, const double p[3], unsigned col, cs_vec3_t *out);
 /* Coordinate axis (0 x, 1 y, 2 z) of v. */

@@ -441,6 +441,55 @@ static void test_arc_r_form(void **state)
     assert_true(fabs(turned + M_PI) < 1e-6);
 }
 
+/* The offset along the plane's normal (FreeCAD's posts write "G2 X.. Y.. I.. J.. K0.000" on
+ * every arc): LinuxCNC refuses it at the word, Grbl ignores it, --lenient ignores it with one
+ * warning for the whole program. The arc is the one drawn without it in every case. */
+static void test_arc_off_plane_offset(void **state)
+{
+    (void)state;
+    const char *t = "G17 G1 X10 Y0 F60\nG3 X0 Y10 I-10 J0 K0.000\nG3 X-10 Y0 I0 J-10 K0.000\n";
+    expect_diag(parse(t), CS_ERR_PARSE, 2, 19);
+    assert_non_null(strstr(D.reason, "--dialect grbl"));
+    /* Grbl: silently, as Grbl does for K0; a non-zero K is warned (once) and ignored too. */
+    assert_int_equal(parse_dialect(t, CS_GCODE_GRBL), CS_OK);
+    assert_int_equal(nwarn, 0);
+    double turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI) < 1e-6);
+    assert_int_equal(parse_dialect("G1 X10 F60\nG3 X0 Y10 I-10 K5\n", CS_GCODE_GRBL), CS_OK);
+    assert_int_equal(nwarn, 1);
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+    /* --lenient: both arcs drawn, one warning printed, both counted. */
+    assert_int_equal(parse_opts(t, true), CS_OK);
+    assert_int_equal(nwarn, 1);
+    assert_int_equal(S.warnings, 2);
+    assert_non_null(strstr(last_warn, "t.nc:2:19: K word in a G17-plane arc: ignored"));
+    assert_non_null(strstr(last_warn, "(reported once)"));
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI) < 1e-6);
+    expect_continuous();
+    /* G18 (Z-X, I/K): J is the normal's word. */
+    expect_diag(parse("G18 G1 X10 F60\nG3 X0 Z-10 I-10 J0\n"), CS_ERR_PARSE, 2, 17);
+    assert_int_equal(parse_dialect("G18 G1 X10 F60\nG3 X0 Z-10 I-10 J0\n", CS_GCODE_GRBL),
+                     CS_OK);
+}
+
+/* A word --lenient ignores (nothing moves for it) is reported once per program, at its first
+ * place, however often the CAM file repeats it; each is still counted. A skipped block (it
+ * would have moved) is reported every time. */
+static void test_lenient_ignored_words_reported_once(void **state)
+{
+    (void)state;
+    const char *t = "T1 M6 G43 H1\nG1 X1 F60\nT2 M6 G43 H2\nG1 X2\nT3 M6 G43 H3\n"
+                    "G81 X5 Y5 Z-1 R1\nG81 X6 Y5 Z-1 R1\nG80\nG1 X3\n";
+    assert_int_equal(parse_opts(t, true), CS_OK);
+    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G81 blocks. */
+    assert_int_equal(nwarn, 6);
+    assert_int_equal(S.warnings, 14);
+    assert_non_null(strstr(last_warn, "t.nc:7:1: G81 is not supported: its block skipped"));
+    expect_pt(P.n - 1, 1, 3, 0, 0, PT_TOL);
+}
+
 static void test_arc_errors(void **state)
 {
     (void)state;
@@ -1324,6 +1373,8 @@ int main(void)
         cmocka_unit_test(test_arc_full_circle_and_turns),
         cmocka_unit_test(test_arc_r_form),
         cmocka_unit_test(test_arc_errors),
+        cmocka_unit_test(test_arc_off_plane_offset),
+        cmocka_unit_test(test_lenient_ignored_words_reported_once),
         cmocka_unit_test(test_arc_tiny_pieces),
         cmocka_unit_test(test_arc_small_radius_near_quarter),
         cmocka_unit_test(test_arc_piece_halved_by_rounding),
