@@ -1573,6 +1573,24 @@ static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, s
     return CS_OK;
 }
 
+/* <flowRoot>: Inkscape 0.x's flowed text (an SVG 1.2 draft no browser draws). Its text is
+ * not drawn, and neither is its <flowRegion> shape, which is the frame the text flows in, not
+ * something Inkscape shows: drawing it would plot a box nobody sees on screen. */
+static cs_err_t on_flowed(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    (void)local;
+    (void)atts;
+    frame_t *f = &d->stack[d->depth - 1];
+    if (!f->hidden) {
+        d->stats->ignored++;
+        warn_once(d, "flowRoot", tag,
+                  "ignoring <flowRoot> (Inkscape flowed text): neither its text nor its frame is "
+                  "drawn; Inkscape's Text > Convert to Text makes it drawable");
+    }
+    f->hidden = true;
+    return CS_OK;
+}
+
 /* What each SVG element does. Unlisted elements (title, desc, style, metadata...) are skipped
  * with their subtree drawn normally. */
 static const struct {
@@ -1586,6 +1604,7 @@ static const struct {
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
     {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
     {"use", on_use},          {"image", on_unsupported}, {"tspan", on_tspan},
+    {"flowRoot", on_flowed},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */

@@ -1213,6 +1213,27 @@ static void expect_warning(const char *where, const char *what)
         fail_msg("warning '%s', expected '%s' ... '%s'", last_warn, where, what);
 }
 
+/* Inkscape 0.x flowed text: <flowRoot> holds a <flowRegion> shape (the frame the text flows
+ * in, not shown by Inkscape) and <flowPara> text. Neither is drawn; one warning at the first
+ * <flowRoot>; the stroked line after it is drawn. */
+static void test_flowroot_not_drawn(void **state)
+{
+    (void)state;
+    const char *doc = "<svg xmlns='http://www.w3.org/2000/svg'>\n"
+                      "<flowRoot style='font-size:40px'><flowRegion><rect width='200' "
+                      "height='100' x='50' y='60'/></flowRegion><flowPara>Flowed</flowPara>"
+                      "</flowRoot>\n"
+                      "<flowRoot><flowRegion><path d='M0 0 L5 5'/></flowRegion></flowRoot>\n"
+                      "<line x1='1' y1='2' x2='3' y2='4' stroke='black'/></svg>";
+    assert_int_equal(read_text(doc), CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[0], 1, 2);
+    expect_pt(&P.elems[0].curve.p[1], 3, 4);
+    assert_int_equal(nwarn, 1);
+    expect_warning(":2:1:", "ignoring <flowRoot> (Inkscape flowed text)");
+    assert_int_equal(S.ignored, 4); /* the two flowRoots and the two frame shapes */
+}
+
 static void test_use_elements(void **state)
 {
     (void)state;
@@ -1567,6 +1588,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_style_display, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_files_flatten, setup, teardown),
         cmocka_unit_test_setup_teardown(test_drawn_up_to_error, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_flowroot_not_drawn, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_elements, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_symbol_viewbox, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_refused, setup, teardown),
