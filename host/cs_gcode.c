@@ -358,7 +358,8 @@ static bool grbl_lacks(int v)
 {
     return v == GC_G5 || v == GC_G5_1 || v == GC_G5_2 || v == GC_G5_3 || v == GC_G6_2 ||
            v == GC_G64 || v == GC_G61_1 || v == GC_G90_1 || v == GC_G59_1 || v == GC_G59_2 ||
-           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3;
+           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3 || v == GC_G81 || v == GC_G98 ||
+           v == GC_G99;
 }
 
 /* Codes that move (threading, probing, canned cycles...) or read the line's axis words for
@@ -472,6 +473,10 @@ static bool run_g_mode(gc_t *g, int v)
     case GC_G40:   /* cutter radius compensation off */
     case GC_G49:   /* tool length offset off */
         return true;
+    case GC_G98: /* canned cycles retract to the higher of R and the Z they start at */
+    case GC_G99: /* ... to R */
+        g->retract_r = v == GC_G99;
+        return true;
     default:
         return false;
     }
@@ -505,8 +510,8 @@ static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
             l->g64 = true;
             l->g64col = c;
         } else if (cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
-                   v != GC_G73 && v != GC_G74 && v != GC_G76 && v < GC_G81) {
-            e = set_motion(g, l, v, c); /* G0 .. G6.2 and (with a probe) G38.2 .. G38.5 */
+                   v != GC_G73 && v != GC_G74 && v != GC_G76 && v <= GC_G81) {
+            e = set_motion(g, l, v, c); /* G0 .. G6.2, (with a probe) G38.2 .. G38.5, G81 */
         } else {
             e = drop_g(g, l, v, c);
         }
@@ -587,6 +592,7 @@ static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_
 /* The motion of a line (modal: the mode in effect when the line has none). */
 static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first_col)
 {
+    bool same_cycle = g->motion == MOT_G81 && (l->motion == MOT_LINE_NONE || l->motion == MOT_G81);
     if (l->motion != MOT_LINE_NONE)
         g->motion = l->motion;
     if (b->machine && g->motion != MOT_G0 && g->motion != MOT_G1)
@@ -632,6 +638,10 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
     case GC_G38_4:
     case GC_G38_5:
         e = cs_gcode_probe(g, b, g->motion, l->mcol);
+        g->g5_prev = false;
+        break;
+    case MOT_G81:
+        e = cs_gcode_cycle(g, b, same_cycle, l->mcol);
         g->g5_prev = false;
         break;
     default: /* G5.2 / G6.2 mode after its block: axis words alone start nothing */
@@ -953,6 +963,7 @@ void cs_gcode_start_modes(gc_t *g)
     g->ijk_abs = false;
     g->feed = 0;
     g->g5_prev = false;
+    g->retract_r = false; /* G98 */
     g->spindle = GC_M5;
     /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
     g->motion = g->o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;

@@ -34,7 +34,8 @@ enum {
     MOT_G5 = GC_G5,
     MOT_G51 = GC_G5_1,
     MOT_G52 = GC_G5_2,
-    MOT_G62 = GC_G6_2
+    MOT_G62 = GC_G6_2,
+    MOT_G81 = GC_G81
 };
 
 /* Numbered parameters the reader keeps (LinuxCNC G-code reference, "Numbered Parameters"); the
@@ -87,6 +88,11 @@ typedef struct {
     cs_path_loc_t nurbs_loc;
     double nurbs_feed;
     cs_gexpr_store_t st; /* parameters (LinuxCNC) */
+    /* canned cycles (cs_gcode_cycle.c) */
+    bool retract_r;   /* G99: retract to R; G98 (the start): to the higher of R and the old Z */
+    bool cyc_set;     /* a cycle has run: its R and Z numbers below may be left out */
+    double cyc_r;     /* the last cycle's R and Z numbers as written (program units) */
+    double cyc_z;
     /* Warnings given once per program (cs_gcode_warn_once): hashes of their texts. */
     uint32_t warned[GC_MAX_WARN_ONCE];
     unsigned nwarned;
@@ -141,6 +147,9 @@ void cs_gcode_plane_axes(int plane, int ax[3]);
 
 /* G2 (ccw false) / G3 from g->pos (cs_gcode_arc.c). */
 cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col);
+/* G81 drilling cycle from g->pos (cs_gcode_cycle.c); same: the line before ran G81 too (its R
+ * and Z stick). */
+cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, bool same, unsigned col);
 /* The open NURBS block -> path elements; g->pos ends on its last point (cs_gcode_nurbs.c). */
 cs_err_t cs_gcode_nurbs_close(gc_t *g);
 /* A G5.2 line (first) or a control point line of its block. */

@@ -330,7 +330,7 @@ static void test_unsupported_strict_and_lenient(void **state)
 static void test_lenient_drops_words_of_dropped_codes(void **state)
 {
     (void)state;
-    const char *t = "G0 Z5\nG81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
+    const char *t = "G0 Z5\nG83 X1 Y1 Z-1 R1 Q0.5 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
                     "G1 X4 F60\n";
     expect_diag(parse(t), CS_ERR_UNSUPPORTED, 2, 1);
     assert_int_equal(parse_opts(t, true), CS_OK);
@@ -339,7 +339,7 @@ static void test_lenient_drops_words_of_dropped_codes(void **state)
     expect_pt(1, 1, 3, 0, 5, PT_TOL);
     expect_pt(2, 1, 4, 0, 5, PT_TOL);
     expect_continuous();
-    /* One warning per skipped block, naming the code and every word skipped with it: the G81
+    /* One warning per skipped block, naming the code and every word skipped with it: the G83
      * line, its modal repeat "X2 Y2", G52, G33. */
     assert_int_equal(nwarn, 4);
     assert_non_null(strstr(last_warn, "t.nc:7:1: G33 is not supported: its block skipped, with "
@@ -481,13 +481,84 @@ static void test_lenient_ignored_words_reported_once(void **state)
 {
     (void)state;
     const char *t = "T1 M6 G43 H1\nG1 X1 F60\nT2 M6 G43 H2\nG1 X2\nT3 M6 G43 H3\n"
-                    "G81 X5 Y5 Z-1 R1\nG81 X6 Y5 Z-1 R1\nG80\nG1 X3\n";
+                    "G83 X5 Y5 Z-1 R1 Q1\nG83 X6 Y5 Z-1 R1 Q1\nG80\nG1 X3\n";
     assert_int_equal(parse_opts(t, true), CS_OK);
-    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G81 blocks. */
+    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G83 blocks. */
     assert_int_equal(nwarn, 6);
     assert_int_equal(S.warnings, 14);
-    assert_non_null(strstr(last_warn, "t.nc:7:1: G81 is not supported: its block skipped"));
+    assert_non_null(strstr(last_warn, "t.nc:7:1: G83 is not supported: its block skipped"));
     expect_pt(P.n - 1, 1, 3, 0, 0, PT_TOL);
+}
+
+/* Expected moves of a canned cycle, worked out by hand from LinuxCNC's G81 description: each
+ * row one element, its end point and whether it is a rapid; the elements run on from each
+ * other (expect_continuous). */
+typedef struct {
+    double x, y, z;
+    bool rapid;
+} move_t;
+
+static void expect_moves(size_t first, const move_t *m, size_t n)
+{
+    assert_int_equal(P.n, first + n);
+    for (size_t k = 0; k < n; k++) {
+        expect_pt(first + k, 1, m[k].x, m[k].y, m[k].z, PT_TOL);
+        assert_int_equal(P.elems[first + k].rapid, m[k].rapid);
+    }
+    expect_continuous();
+}
+
+/* G81 (LinuxCNC "G81 Drilling Cycle"): rapid over the hole, rapid to R, feed to Z, rapid out to
+ * the higher of R and the starting Z (G98, the start mode) or to R (G99); R and Z stick on the
+ * modal lines that follow (Fusion 360 and FreeCAD write one hole per line). */
+static void test_g81_drilling_cycle(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G0 X0 Y0 Z10\nG98 G81 X5 Y6 Z-2 R3 F100\nX15\nG99 Y20\nG80\n"
+                           "G0 Z12\n"),
+                     CS_OK);
+    const move_t a[] = {
+        {5, 6, 10, true},   {5, 6, 3, true},   {5, 6, -2, false},  {5, 6, 10, true},
+        {15, 6, 10, true},  {15, 6, 3, true},  {15, 6, -2, false}, {15, 6, 10, true},
+        {15, 20, 10, true}, {15, 20, 3, true}, {15, 20, -2, false}, {15, 20, 3, true},
+        {15, 20, 12, true},
+    };
+    expect_moves(1, a, sizeof a / sizeof a[0]);
+    assert_int_equal(P.elems[3].loc.line, 2);
+    assert_int_equal(P.elems[7].loc.line, 3);
+    /* G91 with L3: X Y add up at each repeat, R is from the starting Z (1 + -0.5), Z from R;
+     * a move that goes nowhere (R after the first hole, under G99) adds no element. */
+    assert_int_equal(parse("G0 X1 Y1 Z1\nG91 G99 G81 X2 Y0 R-0.5 Z-1 L3 F100\n"), CS_OK);
+    const move_t b[] = {
+        {3, 1, 1, true}, {3, 1, 0.5, true}, {3, 1, -0.5, false}, {3, 1, 0.5, true},
+        {5, 1, 0.5, true}, {5, 1, -0.5, false}, {5, 1, 0.5, true},
+        {7, 1, 0.5, true}, {7, 1, -0.5, false}, {7, 1, 0.5, true},
+    };
+    expect_moves(1, b, sizeof b / sizeof b[0]);
+    /* Below R at the start: first up to R (once), and G98 then retracts to R, the higher. */
+    assert_int_equal(parse("G0 Z-1\nG81 X2 R1 Z-3 F100\n"), CS_OK);
+    const move_t c[] = {{0, 0, 1, true}, {2, 0, 1, true}, {2, 0, -3, false}, {2, 0, 1, true}};
+    expect_moves(1, c, sizeof c / sizeof c[0]);
+    /* Work offsets apply as to any move (G54 X offset 10). */
+    assert_int_equal(parse("G10 L2 P1 X10\nG0 X0 Y0 Z5\nG81 X1 R2 Z0 F60\n"), CS_OK);
+    const move_t d[] = {{11, 0, 5, true}, {11, 0, 2, true}, {11, 0, 0, false}, {11, 0, 5, true}};
+    expect_moves(1, d, sizeof d / sizeof d[0]);
+}
+
+static void test_g81_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G81 X1 Z-1 F60\n"), CS_ERR_PARSE, 1, 1);            /* no R */
+    expect_diag(parse("G81 X1 R1 F60\n"), CS_ERR_PARSE, 1, 1);             /* no Z */
+    expect_diag(parse("G0 Z5\nG81 X1 R-2 Z-1 F60\n"), CS_ERR_PARSE, 2, 1); /* R below Z */
+    expect_diag(parse("G18\nG81 X1 R1 Z0 F60\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G81 X1 R1 Z0 L0 F60\n"), CS_ERR_PARSE, 1, 14);
+    /* R and Z stick only while the same cycle goes on. */
+    expect_diag(parse("G81 X1 R1 Z0 F60\nG0 Z5\nG81 X2\n"), CS_ERR_PARSE, 3, 1);
+    /* Grbl 1.1 has no canned cycles (error:20). */
+    expect_diag(parse_dialect("G81 X1 R1 Z0 F60\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 1);
+    assert_non_null(strstr(D.reason, "Grbl"));
+    expect_diag(parse_dialect("G98\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 1);
 }
 
 static void test_arc_errors(void **state)
@@ -1373,6 +1444,8 @@ int main(void)
         cmocka_unit_test(test_arc_full_circle_and_turns),
         cmocka_unit_test(test_arc_r_form),
         cmocka_unit_test(test_arc_errors),
+        cmocka_unit_test(test_g81_drilling_cycle),
+        cmocka_unit_test(test_g81_errors),
         cmocka_unit_test(test_arc_off_plane_offset),
         cmocka_unit_test(test_lenient_ignored_words_reported_once),
         cmocka_unit_test(test_arc_tiny_pieces),
