@@ -243,8 +243,11 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || strchr(supported, 'A' + i))
             continue;
-        char what[48];
-        snprintf(what, sizeof what, "the %c word", 'A' + i);
+        char what[96];
+        snprintf(what, sizeof what, "the %c word%s", 'A' + i,
+                 i == 'H' - 'A'   ? " (G43's tool length offset number: there is no tool table)"
+                 : i == 'D' - 'A' ? " (G41/G42's cutter compensation number)"
+                                  : "");
         cs_err_t e;
         if (i == 'T' - 'A' && g->o->dialect == CS_GCODE_GRBL) {
             /* Grbl 1.1 reads T and changes nothing (it has no tool changer). */
@@ -842,6 +845,10 @@ static cs_err_t not_a_word(gc_t *g, char c, unsigned col)
                                        "(--dialect grbl)"
                                      : "an O-word must begin its line (only a line number may "
                                        "come before it)");
+    if (c == '@' || c == '^') /* LinuxCNC's polar coordinates (hole-circle.ngc: "G0 @1.5 ^0") */
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col),
+                                "polar coordinates (@ distance, ^ angle) are not supported: give "
+                                "the point as X and Y");
     if ((unsigned char)c < 0x20 || (unsigned char)c >= 0x7F)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                                 "unexpected byte 0x%02X", (unsigned)(unsigned char)c);

@@ -351,7 +351,11 @@ static void test_syntax_errors(void **state)
     (void)state;
     expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
-    expect_diag(parse("G1 X1 F1\nG1 X2 @\n"), CS_ERR_PARSE, 2, 7);
+    expect_diag(parse("G1 X1 F1\nG1 X2 $\n"), CS_ERR_PARSE, 2, 7);
+    /* LinuxCNC's polar coordinates (nc_files/hole-circle.ngc), named, even with --lenient. */
+    expect_diag(parse("G0 @1.5 ^0\n"), CS_ERR_UNSUPPORTED, 1, 4);
+    assert_non_null(strstr(D.reason, "polar coordinates"));
+    expect_diag(parse_opts("G0 X1\nG91 ^60\n", true), CS_ERR_UNSUPPORTED, 2, 5);
     expect_diag(parse("G0 G1 X1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("X1 Y1\n"), CS_ERR_PARSE, 1, 1);
     expect_diag(parse("G1 X1 I2 F1\n"), CS_ERR_PARSE, 1, 7);
