@@ -361,8 +361,8 @@ static bool grbl_lacks(int v)
 {
     return v == GC_G5 || v == GC_G5_1 || v == GC_G5_2 || v == GC_G5_3 || v == GC_G6_2 ||
            v == GC_G64 || v == GC_G61_1 || v == GC_G90_1 || v == GC_G59_1 || v == GC_G59_2 ||
-           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3 || v == GC_G81 || v == GC_G98 ||
-           v == GC_G99;
+           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3 || v == GC_G73 || v == GC_G81 ||
+           v == GC_G83 || v == GC_G98 || v == GC_G99;
 }
 
 /* Codes that move (threading, probing, canned cycles...) or read the line's axis words for
@@ -512,9 +512,11 @@ static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
         } else if (v == GC_G64) {
             l->g64 = true;
             l->g64col = c;
-        } else if (cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
-                   v != GC_G73 && v != GC_G74 && v != GC_G76 && v <= GC_G81) {
-            e = set_motion(g, l, v, c); /* G0 .. G6.2, (with a probe) G38.2 .. G38.5, G81 */
+        } else if ((cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
+                    v != GC_G73 && v != GC_G74 && v != GC_G76 && v < GC_G81) ||
+                   v == GC_G73 || v == GC_G81 || v == GC_G83) {
+            /* G0 .. G6.2, (with a probe) G38.2 .. G38.5, the cycles G73 G81 G83 */
+            e = set_motion(g, l, v, c);
         } else {
             e = drop_g(g, l, v, c);
         }
@@ -595,7 +597,7 @@ static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_
 /* The motion of a line (modal: the mode in effect when the line has none). */
 static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first_col)
 {
-    bool same_cycle = g->motion == MOT_G81 && (l->motion == MOT_LINE_NONE || l->motion == MOT_G81);
+    int before = g->motion;
     if (l->motion != MOT_LINE_NONE)
         g->motion = l->motion;
     if (b->machine && g->motion != MOT_G0 && g->motion != MOT_G1)
@@ -643,8 +645,10 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
         e = cs_gcode_probe(g, b, g->motion, l->mcol);
         g->g5_prev = false;
         break;
+    case MOT_G73:
     case MOT_G81:
-        e = cs_gcode_cycle(g, b, same_cycle, l->mcol);
+    case MOT_G83:
+        e = cs_gcode_cycle(g, b, g->motion, before == g->motion, l->mcol);
         g->g5_prev = false;
         break;
     default: /* G5.2 / G6.2 mode after its block: axis words alone start nothing */

@@ -35,7 +35,9 @@ enum {
     MOT_G51 = GC_G5_1,
     MOT_G52 = GC_G5_2,
     MOT_G62 = GC_G6_2,
-    MOT_G81 = GC_G81
+    MOT_G73 = GC_G73, /* canned cycles (cs_gcode_cycle.c) */
+    MOT_G81 = GC_G81,
+    MOT_G83 = GC_G83
 };
 
 /* Numbered parameters the reader keeps (LinuxCNC G-code reference, "Numbered Parameters"); the
@@ -90,9 +92,10 @@ typedef struct {
     cs_gexpr_store_t st; /* parameters (LinuxCNC) */
     /* canned cycles (cs_gcode_cycle.c) */
     bool retract_r;   /* G99: retract to R; G98 (the start): to the higher of R and the old Z */
-    bool cyc_set;     /* a cycle has run: its R and Z numbers below may be left out */
-    double cyc_r;     /* the last cycle's R and Z numbers as written (program units) */
+    bool cyc_set;     /* a cycle has run: its R, Z (and Q) numbers below may be left out */
+    double cyc_r;     /* the last cycle's R, Z and Q numbers as written (program units) */
     double cyc_z;
+    double cyc_q;
     /* Warnings given once per program (cs_gcode_warn_once): hashes of their texts. */
     uint32_t warned[GC_MAX_WARN_ONCE];
     unsigned nwarned;
@@ -147,9 +150,9 @@ void cs_gcode_plane_axes(int plane, int ax[3]);
 
 /* G2 (ccw false) / G3 from g->pos (cs_gcode_arc.c). */
 cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col);
-/* G81 drilling cycle from g->pos (cs_gcode_cycle.c); same: the line before ran G81 too (its R
- * and Z stick). */
-cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, bool same, unsigned col);
+/* Canned cycle code (MOT_G73, MOT_G81 or MOT_G83) from g->pos (cs_gcode_cycle.c); same: the
+ * same cycle was in effect before the line (its R, Z and Q stick). */
+cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, int code, bool same, unsigned col);
 /* The open NURBS block -> path elements; g->pos ends on its last point (cs_gcode_nurbs.c). */
 cs_err_t cs_gcode_nurbs_close(gc_t *g);
 /* A G5.2 line (first) or a control point line of its block. */

@@ -330,7 +330,7 @@ static void test_unsupported_strict_and_lenient(void **state)
 static void test_lenient_drops_words_of_dropped_codes(void **state)
 {
     (void)state;
-    const char *t = "G0 Z5\nG83 X1 Y1 Z-1 R1 Q0.5 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
+    const char *t = "G0 Z5\nG85 X1 Y1 Z-1 R1 Q0.5 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
                     "G1 X4 F60\n";
     expect_diag(parse(t), CS_ERR_UNSUPPORTED, 2, 1);
     assert_int_equal(parse_opts(t, true), CS_OK);
@@ -339,7 +339,7 @@ static void test_lenient_drops_words_of_dropped_codes(void **state)
     expect_pt(1, 1, 3, 0, 5, PT_TOL);
     expect_pt(2, 1, 4, 0, 5, PT_TOL);
     expect_continuous();
-    /* One warning per skipped block, naming the code and every word skipped with it: the G83
+    /* One warning per skipped block, naming the code and every word skipped with it: the G85
      * line, its modal repeat "X2 Y2", G52, G33. */
     assert_int_equal(nwarn, 4);
     assert_non_null(strstr(last_warn, "t.nc:7:1: G33 is not supported: its block skipped, with "
@@ -485,12 +485,12 @@ static void test_lenient_ignored_words_reported_once(void **state)
 {
     (void)state;
     const char *t = "T1 M6 G43 H1\nG1 X1 F60\nT2 M6 G43 H2\nG1 X2\nT3 M6 G43 H3\n"
-                    "G83 X5 Y5 Z-1 R1 Q1\nG83 X6 Y5 Z-1 R1 Q1\nG80\nG1 X3\n";
+                    "G85 X5 Y5 Z-1 R1 Q1\nG85 X6 Y5 Z-1 R1 Q1\nG80\nG1 X3\n";
     assert_int_equal(parse_opts(t, true), CS_OK);
-    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G83 blocks. */
+    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G85 blocks. */
     assert_int_equal(nwarn, 6);
     assert_int_equal(S.warnings, 14);
-    assert_non_null(strstr(last_warn, "t.nc:7:1: G83 is not supported: its block skipped"));
+    assert_non_null(strstr(last_warn, "t.nc:7:1: G85 is not supported: its block skipped"));
     expect_pt(P.n - 1, 1, 3, 0, 0, PT_TOL);
 }
 
@@ -547,6 +547,41 @@ static void test_g81_drilling_cycle(void **state)
     assert_int_equal(parse("G10 L2 P1 X10\nG0 X0 Y0 Z5\nG81 X1 R2 Z0 F60\n"), CS_OK);
     const move_t d[] = {{11, 0, 5, true}, {11, 0, 2, true}, {11, 0, 0, false}, {11, 0, 5, true}};
     expect_moves(1, d, sizeof d / sizeof d[0]);
+}
+
+/* G83 and G73 (LinuxCNC 2.9 convert_cycle_g83 / g73): pecks of Q from R while above the
+ * bottom; G83 rapids out to R after each and back down to 0.254 mm (0.010 in) above the peck,
+ * G73 only backs off those 0.254 mm; then a feed to Z and the rapid out. Q sticks like R and Z. */
+static void test_g83_g73_pecking(void **state)
+{
+    (void)state;
+    const double u = 0.254;
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG99 G83 X1 Y2 Z-3 R1 Q1.5 F100\n"), CS_OK);
+    const move_t a[] = {
+        {1, 2, 5, true},  {1, 2, 1, true},        {1, 2, -0.5, false}, {1, 2, 1, true},
+        {1, 2, -0.5 + u, true}, {1, 2, -2, false}, {1, 2, 1, true},     {1, 2, -2 + u, true},
+        {1, 2, -3, false}, {1, 2, 1, true},
+    };
+    expect_moves(1, a, sizeof a / sizeof a[0]);
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG73 X1 Y2 Z-3 R1 Q1.5 F100\n"), CS_OK);
+    const move_t b[] = {
+        {1, 2, 5, true},         {1, 2, 1, true},   {1, 2, -0.5, false}, {1, 2, -0.5 + u, true},
+        {1, 2, -2, false},       {1, 2, -2 + u, true}, {1, 2, -3, false}, {1, 2, 5, true},
+    };
+    expect_moves(1, b, sizeof b / sizeof b[0]);
+    /* A peck that would end on the bottom is the final feed; R, Z and Q stick on "X3". */
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG99 G83 X1 Y2 Z-1 R1 Q1 F100\nX3\n"), CS_OK);
+    const move_t c[] = {
+        {1, 2, 5, true},  {1, 2, 1, true},  {1, 2, 0, false}, {1, 2, 1, true},
+        {1, 2, u, true},  {1, 2, -1, false}, {1, 2, 1, true},
+        {3, 2, 1, true},  {3, 2, 0, false}, {3, 2, 1, true},  {3, 2, u, true},
+        {3, 2, -1, false}, {3, 2, 1, true},
+    };
+    expect_moves(1, c, sizeof c / sizeof c[0]);
+    expect_diag(parse("G83 X1 R1 Z-1 F60\n"), CS_ERR_PARSE, 1, 1);     /* no Q */
+    expect_diag(parse("G83 X1 R1 Z-1 Q0 F60\n"), CS_ERR_PARSE, 1, 15); /* Q not positive */
+    /* Another cycle's R, Z do not carry over. */
+    expect_diag(parse("G81 X1 R1 Z0 F60\nG83 X2 Q1\n"), CS_ERR_PARSE, 2, 1);
 }
 
 static void test_g81_errors(void **state)
@@ -1450,6 +1485,7 @@ int main(void)
         cmocka_unit_test(test_arc_errors),
         cmocka_unit_test(test_g81_drilling_cycle),
         cmocka_unit_test(test_g81_errors),
+        cmocka_unit_test(test_g83_g73_pecking),
         cmocka_unit_test(test_arc_off_plane_offset),
         cmocka_unit_test(test_lenient_ignored_words_reported_once),
         cmocka_unit_test(test_arc_tiny_pieces),
