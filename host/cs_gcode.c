@@ -536,6 +536,7 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
             k += (size_t)snprintf(words + k, sizeof words - k, " %c%g", *q, w->v);
         w->has = false;
     }
+    b->polar[0].has = b->polar[1].has = false;
     if (modal)
         cs_gcode_warn(g, col,
                       "move in the unsupported motion mode %s skipped, with its words%s "
@@ -545,6 +546,45 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
         cs_gcode_warn(g, col,
                       "%s is not supported: its block skipped, with its words%s (--lenient)", what,
                       k ? words : " (none)");
+}
+
+cs_err_t cs_gcode_polar(gc_t *g, block_t *b, const double cur[2], double out[2])
+{
+    const word_t *d = &b->polar[0], *a = &b->polar[1];
+    double r = hypot(cur[0], cur[1]), th = atan2(cur[1], cur[0]);
+    b->polar_used = true;
+    if (g->incr) {
+        if (cur[0] == 0 && cur[1] == 0)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE,
+                                    cs_gcode_loc(g, d->has ? d->col : a->col),
+                                    "incremental polar coordinates at the origin: the angle is "
+                                    "undefined (LinuxCNC refuses it too)");
+        r += d->has ? d->v : 0;
+        th += a->has ? a->v * GC_PI / 180 : 0;
+    } else {
+        r = d->has ? d->v : r;
+        th = a->has ? a->v * GC_PI / 180 : th;
+    }
+    out[0] = r * cos(th);
+    out[1] = r * sin(th);
+    return CS_OK;
+}
+
+/* A straight move, arc or spline whose end is given by @ / ^: its X and Y words, as the
+ * program would have written them (G91: increments). */
+static cs_err_t polar_to_xy(gc_t *g, block_t *b)
+{
+    double cur[2], p[2];
+    for (int a = 0; a < 2; a++)
+        cur[a] = (g->pos[a] - cs_gcode_offset(g, a)) / g->unit;
+    cs_err_t e = cs_gcode_polar(g, b, cur, p);
+    for (int a = 0; a < 2 && e == CS_OK; a++) {
+        word_t *w = &b->w['X' - 'A' + a];
+        w->has = true;
+        w->v = g->incr ? p[a] - cur[a] : p[a];
+        w->col = b->polar[b->polar[0].has ? 0 : 1].col;
+    }
+    return e;
 }
 
 /* G10, G28, G30, G92: the line's axis words are theirs, so no motion word may share it. */
@@ -606,7 +646,8 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
                                 "coordinates)");
     /* A move happens when the line has axis words or arc / spline words; a motion word alone
      * ("G2" on its own line) only sets the mode. */
-    bool go = cs_gcode_any_axis(b);
+    bool polar = b->polar[0].has || b->polar[1].has;
+    bool go = cs_gcode_any_axis(b) || polar;
     for (const char *q = "IJKRPQ"; *q; q++)
         go = go || (b->w[*q - 'A'].has && !(b->used & BIT(*q))); /* G64's P and Q are its own */
     if (!go)
@@ -618,8 +659,15 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
         drop_block(g, b, g->dropped_code, first_col, true);
         return CS_OK;
     }
+    if (polar && (b->w['X' - 'A'].has || b->w['Y' - 'A'].has))
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE,
+                                cs_gcode_loc(g, b->w[b->w['X' - 'A'].has ? 'X' - 'A' : 'Y' - 'A'].col),
+                                "X or Y with polar coordinates (@ ^) on one line");
     double t[3];
     cs_err_t e = CS_OK;
+    if (polar && g->motion != MOT_G73 && g->motion != MOT_G81 && g->motion != MOT_G83 &&
+        (e = polar_to_xy(g, b)) != CS_OK)
+        return e;
     switch (g->motion) {
     case MOT_G0:
     case MOT_G1:
@@ -685,6 +733,11 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
                                         : run_motion(g, b, &l, first_col)) != CS_OK)
         return e;
     /* Words given but not used by anything on the line. */
+    for (int k = 0; k < 2; k++)
+        if (b->polar[k].has && !b->polar_used)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->polar[k].col),
+                                    "%c (polar coordinates) not used by anything on this line",
+                                    k ? '^' : '@');
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || (b->used & (1u << i)))
             continue;
@@ -849,16 +902,40 @@ static cs_err_t not_a_word(gc_t *g, char c, unsigned col)
                                        "(--dialect grbl)"
                                      : "an O-word must begin its line (only a line number may "
                                        "come before it)");
-    if (c == '@' || c == '^') /* LinuxCNC's polar coordinates (hole-circle.ngc: "G0 @1.5 ^0") */
+    if (c == '@' || c == '^') /* LinuxCNC's polar coordinates, read in its dialect only */
         return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col),
-                                "polar coordinates (@ distance, ^ angle) are not supported: give "
-                                "the point as X and Y");
+                                "polar coordinates (@ distance, ^ angle) are LinuxCNC's: not in "
+                                "Grbl 1.1 (--dialect grbl)");
     if ((unsigned char)c < 0x20 || (unsigned char)c >= 0x7F)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                                 "unexpected byte 0x%02X", (unsigned)(unsigned char)c);
     return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                             "unexpected character '%c' (expected a word: a letter and a number)",
                             c);
+}
+
+/* LinuxCNC's @ (distance) or ^ (angle) at s[*i] (column col): its value into b->polar. */
+static cs_err_t read_polar(gc_t *g, block_t *b, const char *s, size_t n, size_t *i, unsigned col)
+{
+    char c = s[*i];
+    word_t *w = &b->polar[c == '^'];
+    (*i)++;
+    while (*i < n && (s[*i] == ' ' || s[*i] == '\t'))
+        (*i)++;
+    double v;
+    cs_err_t e = read_value(g, s, n, i, c, col, &v);
+    if (e != CS_OK)
+        return e;
+    if (w->has)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
+                                "%c given twice on one line", c);
+    if (!isfinite(v) || fabs(v) > 1e9)
+        return cs_path_diag_set(g->diag, CS_ERR_RANGE, cs_gcode_loc(g, col),
+                                "%c value out of range", c);
+    w->has = true;
+    w->v = v;
+    w->col = col;
+    return CS_OK;
 }
 
 /* One line s[0..n) (without its end of line). */
@@ -900,6 +977,13 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
         if (c == '#') {
             if ((e = read_assign(g, s, code_end, &i)) != CS_OK)
                 return e;
+            continue;
+        }
+        if ((c == '@' || c == '^') && g->o->dialect != CS_GCODE_GRBL) {
+            if ((e = read_polar(g, &b, s, code_end, &i, col)) != CS_OK)
+                return e;
+            if (first_col == 0)
+                first_col = col;
             continue;
         }
         int li = letter_index(c);

@@ -123,6 +123,14 @@ cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, int code, bool same, unsigned col)
     double clear = g->retract_r ? r : fmax(z0, r);
     for (int k = 0; k < reps && e == CS_OK; k++) {
         double x = g->pos[0], y = g->pos[1];
+        if (b->polar[0].has || b->polar[1].has) {
+            /* each repeat turns / moves on from the last hole (G91; hole-circle.ngc) */
+            double cur[2] = {(x - c[0]) / g->unit, (y - c[1]) / g->unit}, p[2];
+            if ((e = cs_gcode_polar(g, b, cur, p)) != CS_OK)
+                return e;
+            x = p[0] * g->unit + c[0];
+            y = p[1] * g->unit + c[1];
+        }
         if (X->has)
             x = g->incr ? x + X->v * g->unit : X->v * g->unit + c[0];
         if (Y->has)

@@ -112,6 +112,8 @@ typedef struct {
     unsigned mcol[8];
     unsigned nm;
     unsigned used; /* bit per letter consumed by the block */
+    word_t polar[2];  /* LinuxCNC's polar coordinates: @ (distance), ^ (angle, degrees) */
+    bool polar_used;
 } block_t;
 
 /* Location col on the line being read. */
@@ -148,6 +150,10 @@ cs_err_t cs_gcode_probe(gc_t *g, block_t *b, int code, unsigned col);
 /* The plane's axes: first, second (counter-clockwise from first to second), normal. */
 void cs_gcode_plane_axes(int plane, int ax[3]);
 
+/* The point the line's @ / ^ give from the program point cur (program units): G90 about the
+ * origin, the missing one kept from cur; G91 added to cur's distance and angle (LinuxCNC
+ * "Polar Coordinates"). CS_ERR_PARSE with diag for G91 at the origin. */
+cs_err_t cs_gcode_polar(gc_t *g, block_t *b, const double cur[2], double out[2]);
 /* G2 (ccw false) / G3 from g->pos (cs_gcode_arc.c). */
 cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col);
 /* Canned cycle code (MOT_G73, MOT_G81 or MOT_G83) from g->pos (cs_gcode_cycle.c); same: the

@@ -352,16 +352,54 @@ static void test_syntax_errors(void **state)
     expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("G1 X1 F1\nG1 X2 $\n"), CS_ERR_PARSE, 2, 7);
-    /* LinuxCNC's polar coordinates (nc_files/hole-circle.ngc), named, even with --lenient. */
-    expect_diag(parse("G0 @1.5 ^0\n"), CS_ERR_UNSUPPORTED, 1, 4);
-    assert_non_null(strstr(D.reason, "polar coordinates"));
-    expect_diag(parse_opts("G0 X1\nG91 ^60\n", true), CS_ERR_UNSUPPORTED, 2, 5);
     expect_diag(parse("G0 G1 X1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("X1 Y1\n"), CS_ERR_PARSE, 1, 1);
     expect_diag(parse("G1 X1 I2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X1 F0\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X5000 F1\n"), CS_ERR_RANGE, 1, 1);
     expect_diag(parse("G1.5 X1\n"), CS_ERR_UNSUPPORTED, 1, 1);
+}
+
+/* LinuxCNC "Polar Coordinates": @ distance, ^ angle (degrees) of X Y about the program origin;
+ * G91 adds them to the current point's. The reference's own square: "F100 G1 @.5 ^90 / G91
+ * ^90 / ^90 / ^90 / ^90" visits (0, .5) (-.5, 0) (0, -.5) (.5, 0) (0, .5). */
+static void test_polar_coordinates(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("F100 G1 @.5 ^90\nG91 ^90\n^90\n^90\n^90\n"), CS_OK);
+    const double sq[5][2] = {{0, .5}, {-.5, 0}, {0, -.5}, {.5, 0}, {0, .5}};
+    assert_int_equal(P.n, 5);
+    for (size_t k = 0; k < 5; k++)
+        expect_pt(k, 1, sq[k][0], sq[k][1], 0, PT_TOL);
+    /* G90 with one of them: the other kept from the current point (5 at 53.13 deg). */
+    assert_int_equal(parse("G0 X3 Y4\nG0 ^0\nG0 X3 Y4\nG0 @10\n"), CS_OK);
+    expect_pt(1, 1, 5, 0, 0, PT_TOL);
+    expect_pt(3, 1, 6, 8, 0, PT_TOL);
+    /* About the program origin: work offsets apply (G54 X 10). */
+    assert_int_equal(parse("G10 L2 P1 X10\nG0 @2 ^90\n"), CS_OK);
+    expect_pt(0, 1, 10, 2, 0, PT_TOL);
+    /* An arc's end: a quarter circle from (1, 0) to (0, 1). */
+    assert_int_equal(parse("G0 X1 Y0\nG3 @1 ^90 I-1 J0 F60\n"), CS_OK);
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[0]) <= PT_TOL && fabs(e[1] - 1) <= PT_TOL);
+    /* LinuxCNC's nc_files/hole-circle.ngc, in short: G91 G81 with ^60 L6 drills six holes 60
+     * degrees apart on its 1.5 in circle, R and Z incremental. */
+    assert_int_equal(parse("G20 G0 X1.5 Y0 Z0\nG91 G81 R.1 Z-.5 ^60 L6 F10\n"), CS_OK);
+    assert_int_equal(P.n, 20);
+    expect_pt(1, 1, 38.1, 0, 2.54, PT_TOL);
+    for (int k = 0; k < 6; k++) {
+        double th = (k + 1) * M_PI / 3;
+        expect_pt((size_t)(3 + 3 * k), 1, 38.1 * cos(th), 38.1 * sin(th), -10.16, PT_TOL);
+        expect_pt((size_t)(4 + 3 * k), 1, 38.1 * cos(th), 38.1 * sin(th), 2.54, PT_TOL);
+    }
+    expect_continuous();
+    /* Errors: G91 at the origin (no angle), X or Y with them, unused, twice, Grbl. */
+    expect_diag(parse("G91 G0 ^90\n"), CS_ERR_PARSE, 1, 8);
+    expect_diag(parse("G0 X1 @1\n"), CS_ERR_PARSE, 1, 4);
+    expect_diag(parse("G10 L2 P1 @1\n"), CS_ERR_PARSE, 1, 11);
+    expect_diag(parse("G0 @1 @2\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse_dialect("G0 @1\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 4);
 }
 
 /* ---- arcs -------------------------------------------------------------------------------- */
@@ -1478,6 +1516,7 @@ int main(void)
         cmocka_unit_test(test_unsupported_strict_and_lenient),
         cmocka_unit_test(test_lenient_drops_words_of_dropped_codes),
         cmocka_unit_test(test_syntax_errors),
+        cmocka_unit_test(test_polar_coordinates),
         cmocka_unit_test(test_arc_ijk_quarter_both_directions),
         cmocka_unit_test(test_arc_planes),
         cmocka_unit_test(test_arc_full_circle_and_turns),
