@@ -1117,6 +1117,12 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
         }
         g.pos[2] = o->pen_up_z_mm;
     }
+    /* A UTF-8 byte order mark (Windows editors write one) is no G-code: skipped, so that line 1's
+     * columns count from the first character shown. */
+    if (len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0) {
+        buf += 3;
+        len -= 3;
+    }
     cs_gflow_t fl;
     e = cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops, diag);
     if (e == CS_OK)

@@ -352,6 +352,12 @@ static void test_syntax_errors(void **state)
     expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("G1 X1 F1\nG1 X2 $\n"), CS_ERR_PARSE, 2, 7);
+    /* A UTF-8 byte order mark is skipped (in both dialects), columns counted after it. */
+    assert_int_equal(parse("\xef\xbb\xbfG1 X1 F60\n"), CS_OK);
+    expect_pt(0, 1, 1, 0, 0, PT_TOL);
+    assert_int_equal(parse_dialect("\xef\xbb\xbfG1 X1 F60\n", CS_GCODE_GRBL), CS_OK);
+    expect_diag(parse("\xef\xbb\xbfG1 X1 $\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse("G1 X1\xef\xbb\xbf\n"), CS_ERR_PARSE, 1, 6); /* elsewhere: a stray byte */
     expect_diag(parse("G0 G1 X1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("X1 Y1\n"), CS_ERR_PARSE, 1, 1);
     expect_diag(parse("G1 X1 I2 F1\n"), CS_ERR_PARSE, 1, 7);
