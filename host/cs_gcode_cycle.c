@@ -10,6 +10,9 @@
 
 /* L: the number of repeats, a whole number 1.. (LinuxCNC: "L-" repeats; 1 without it). */
 #define CYC_MAX_REPEATS 10000
+/* Pecks per hole: beyond, Q is refused as too small for the depth (a Q so small that d - Q
+ * rounds back to d would otherwise never reach the bottom). */
+#define CYC_MAX_PECKS 100000
 
 /* How far above the last peck's bottom G83 comes back down at rapid, and G73 backs off:
  * LinuxCNC 2.9's G83_RAPID_DELTA, 0.010 in (0.254 mm in either unit). */
@@ -114,6 +117,11 @@ cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, int code, bool same, unsigned col)
                                 "G%d: R (%g) is below Z (%g): the retract plane must be above "
                                 "the bottom of the hole",
                                 code / 10, r / g->unit, bottom / g->unit);
+    if (code != MOT_G81 && (r - bottom) / (qn * g->unit) > CYC_MAX_PECKS)
+        return cs_path_diag_set(g->diag, CS_ERR_RANGE,
+                                cs_gcode_loc(g, b->w['Q' - 'A'].has ? b->w['Q' - 'A'].col : col),
+                                "G%d: Q %g is too small for a hole %g deep (more than %d pecks)",
+                                code / 10, qn, (r - bottom) / g->unit, CYC_MAX_PECKS);
     g->cyc_r = rn;
     g->cyc_z = zn;
     g->cyc_q = qn;

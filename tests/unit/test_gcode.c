@@ -624,6 +624,9 @@ static void test_g83_g73_pecking(void **state)
     expect_moves(1, c, sizeof c / sizeof c[0]);
     expect_diag(parse("G83 X1 R1 Z-1 F60\n"), CS_ERR_PARSE, 1, 1);     /* no Q */
     expect_diag(parse("G83 X1 R1 Z-1 Q0 F60\n"), CS_ERR_PARSE, 1, 15); /* Q not positive */
+    /* A Q so small that the pecks would never end (d - Q == d in double): refused. */
+    expect_diag(parse("G73 X1 R4000 Z-4000 Q0.00000000001 F60\n"), CS_ERR_RANGE, 1, 21);
+    expect_diag(parse("G73 X1 R4000 Z-4000 Q0.0799 F60\n"), CS_ERR_RANGE, 1, 21); /* 100 125 */
     /* Another cycle's R, Z do not carry over. */
     expect_diag(parse("G81 X1 R1 Z0 F60\nG83 X2 Q1\n"), CS_ERR_PARSE, 2, 1);
 }
