@@ -29,38 +29,45 @@ static void warn_text(gc_t *g, unsigned col, const char *msg)
         cs_path_warn_print(stderr, &w);
 }
 
-void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+/* A warning from fmt and ap; once: only the first time its text occurs in the program (the
+ * others counted), marked so. */
+static void warn_v(gc_t *g, unsigned col, bool once, const char *fmt, va_list ap)
 {
     char msg[sizeof((cs_path_diag_t *)0)->reason];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (once) {
+        /* FNV-1a of the text: the kind of warning, whatever its place. */
+        uint32_t h = 2166136261u;
+        for (const char *c = msg; *c; c++)
+            h = (h ^ (unsigned char)*c) * 16777619u;
+        for (unsigned i = 0; i < g->nwarned; i++)
+            if (g->warned[i] == h) {
+                if (g->stats)
+                    g->stats->warnings++;
+                return;
+            }
+        if (g->nwarned < GC_MAX_WARN_ONCE)
+            g->warned[g->nwarned++] = h;
+        size_t n = strlen(msg);
+        snprintf(msg + n, sizeof msg - n, " (reported once)");
+    }
+    warn_text(g, col, msg);
+}
+
+void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    warn_v(g, col, false, fmt, ap);
     va_end(ap);
-    warn_text(g, col, msg);
 }
 
 void cs_gcode_warn_once(gc_t *g, unsigned col, const char *fmt, ...)
 {
-    char msg[sizeof((cs_path_diag_t *)0)->reason];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    warn_v(g, col, true, fmt, ap);
     va_end(ap);
-    /* FNV-1a of the text: the kind of warning, whatever its place. */
-    uint32_t h = 2166136261u;
-    for (const char *c = msg; *c; c++)
-        h = (h ^ (unsigned char)*c) * 16777619u;
-    for (unsigned i = 0; i < g->nwarned; i++)
-        if (g->warned[i] == h) {
-            if (g->stats)
-                g->stats->warnings++;
-            return;
-        }
-    if (g->nwarned < GC_MAX_WARN_ONCE)
-        g->warned[g->nwarned++] = h;
-    size_t n = strlen(msg);
-    snprintf(msg + n, sizeof msg - n, " (reported once)");
-    warn_text(g, col, msg);
 }
 
 /* An unsupported word: an error, or a warning (and CS_OK: the caller ignores it) when lenient. */
