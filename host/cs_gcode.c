@@ -506,6 +506,13 @@ static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
         }
         if (run_g_mode(g, v))
             continue;
+        if (v == GC_G4 && b->w['P' - 'A'].has && b->w['P' - 'A'].v == 0 && !cs_gcode_any_axis(b)) {
+            /* "G4 P0": a dwell of no time, which laser and plotter posts and senders write to
+             * wait for the moves before it; the plan runs every move in order: nothing to do.
+             * A real dwell stays unsupported (the plan has no pauses). */
+            b->used |= BIT('P');
+            continue;
+        }
         if (cs_gcode_coord_system(v) != 0 || v == GC_G28_1 || v == GC_G30_1 || v == GC_G92_1 ||
             v == GC_G92_2 || v == GC_G92_3) {
             cs_gcode_wcs_set(g, v);

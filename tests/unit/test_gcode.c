@@ -317,6 +317,13 @@ static void test_unsupported_strict_and_lenient(void **state)
 {
     (void)state;
     expect_diag(parse("G1 X1 F60\nG4 P1\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    /* A dwell of no time is nothing to do, in both dialects; any other stays unsupported. */
+    assert_int_equal(parse("G1 X1 F60\nG4 P0\nG1 X2\n"), CS_OK);
+    assert_int_equal(P.n, 2);
+    assert_int_equal(parse_dialect("G1 X1 F60\nG4 P0.000\n", CS_GCODE_GRBL), CS_OK);
+    expect_diag(parse("G1 X1 F60\nG4 P0.01\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G1 X1 F60\nG4\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G1 X1 F60\nG4 P0 X3\n"), CS_ERR_UNSUPPORTED, 2, 1);
     expect_diag(parse("G1 X1 F60 M6\n"), CS_ERR_UNSUPPORTED, 1, 11);
     expect_diag(parse("G1 X1 A3 F60\n"), CS_ERR_UNSUPPORTED, 1, 7);
     assert_int_equal(parse_opts("G1 X1 F60\nG4 P1\nG1 X2 A3\n", true), CS_OK);
