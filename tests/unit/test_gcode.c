@@ -359,6 +359,9 @@ static void test_syntax_errors(void **state)
     expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("G1 X1 F1\nG1 X2 $\n"), CS_ERR_PARSE, 2, 7);
+    /* A Fanuc-style program number line: refused at its O, saying what it is. */
+    expect_diag(parse("%\nO1001 (PART)\nG0 X1\n"), CS_ERR_PARSE, 2, 1);
+    assert_non_null(strstr(D.reason, "program number"));
     /* A UTF-8 byte order mark is skipped (in both dialects), columns counted after it. */
     assert_int_equal(parse("\xef\xbb\xbfG1 X1 F60\n"), CS_OK);
     expect_pt(0, 1, 1, 0, 0, PT_TOL);
