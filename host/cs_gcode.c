@@ -17,14 +17,9 @@ cs_path_loc_t cs_gcode_loc(const gc_t *g, unsigned col)
     return l;
 }
 
-void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+static void warn_text(gc_t *g, unsigned col, const char *msg)
 {
     cs_path_diag_t w;
-    char msg[sizeof w.reason];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
     cs_path_diag_set(&w, CS_OK, cs_gcode_loc(g, col), "%s", msg);
     if (g->stats)
         g->stats->warnings++;
@@ -34,11 +29,52 @@ void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
         cs_path_warn_print(stderr, &w);
 }
 
+/* A warning from fmt and ap; once: only the first time its text occurs in the program (the
+ * others counted), marked so. */
+static void warn_v(gc_t *g, unsigned col, bool once, const char *fmt, va_list ap)
+{
+    char msg[sizeof((cs_path_diag_t *)0)->reason];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (once) {
+        /* FNV-1a of the text: the kind of warning, whatever its place. */
+        uint32_t h = 2166136261u;
+        for (const char *c = msg; *c; c++)
+            h = (h ^ (unsigned char)*c) * 16777619u;
+        for (unsigned i = 0; i < g->nwarned; i++)
+            if (g->warned[i] == h) {
+                if (g->stats)
+                    g->stats->warnings++;
+                return;
+            }
+        if (g->nwarned < GC_MAX_WARN_ONCE)
+            g->warned[g->nwarned++] = h;
+        size_t n = strlen(msg);
+        snprintf(msg + n, sizeof msg - n, " (reported once)");
+    }
+    warn_text(g, col, msg);
+}
+
+void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    warn_v(g, col, false, fmt, ap);
+    va_end(ap);
+}
+
+void cs_gcode_warn_once(gc_t *g, unsigned col, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    warn_v(g, col, true, fmt, ap);
+    va_end(ap);
+}
+
 /* An unsupported word: an error, or a warning (and CS_OK: the caller ignores it) when lenient. */
 static cs_err_t unsupported(gc_t *g, unsigned col, const char *what)
 {
     if (g->o->lenient) {
-        cs_gcode_warn(g, col, "%s is not supported: ignored (--lenient)", what);
+        cs_gcode_warn_once(g, col, "%s is not supported: ignored (--lenient)", what);
         return CS_OK;
     }
     return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col),
@@ -214,15 +250,18 @@ static cs_err_t run_letters(gc_t *g, block_t *b)
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || strchr(supported, 'A' + i))
             continue;
-        char what[48];
-        snprintf(what, sizeof what, "the %c word", 'A' + i);
+        char what[96];
+        snprintf(what, sizeof what, "the %c word%s", 'A' + i,
+                 i == 'H' - 'A'   ? " (G43's tool length offset number: there is no tool table)"
+                 : i == 'D' - 'A' ? " (G41/G42's cutter compensation number)"
+                                  : "");
         cs_err_t e;
         if (i == 'T' - 'A' && g->o->dialect == CS_GCODE_GRBL) {
             /* Grbl 1.1 reads T and changes nothing (it has no tool changer). */
         } else if (i == 'T' - 'A' && g->o->lenient) {
             /* No tool changer: the tool in the machine stays, nothing moves. */
-            cs_gcode_warn(g, b->w[i].col,
-                          "T (tool select): ignored, there is no tool changer (--lenient)");
+            cs_gcode_warn_once(g, b->w[i].col,
+                               "T (tool select): ignored, there is no tool changer (--lenient)");
         } else if ((e = unsupported(g, b->w[i].col, what)) != CS_OK) {
             return e;
         }
@@ -329,7 +368,8 @@ static bool grbl_lacks(int v)
 {
     return v == GC_G5 || v == GC_G5_1 || v == GC_G5_2 || v == GC_G5_3 || v == GC_G6_2 ||
            v == GC_G64 || v == GC_G61_1 || v == GC_G90_1 || v == GC_G59_1 || v == GC_G59_2 ||
-           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3;
+           v == GC_G59_3 || v == GC_G92_2 || v == GC_G92_3 || v == GC_G73 || v == GC_G81 ||
+           v == GC_G83 || v == GC_G98 || v == GC_G99;
 }
 
 /* Codes that move (threading, probing, canned cycles...) or read the line's axis words for
@@ -362,7 +402,7 @@ static cs_err_t drop_g(gc_t *g, gline_t *l, int v, unsigned c)
         return unsupported(g, c, what);
     bool motion;
     if (!moves_or_takes_axes(v, &motion)) {
-        cs_gcode_warn(g, c, "%s is not supported: ignored (--lenient)", what);
+        cs_gcode_warn_once(g, c, "%s is not supported: ignored (--lenient)", what);
         return CS_OK;
     }
     l->drop = true;
@@ -443,6 +483,10 @@ static bool run_g_mode(gc_t *g, int v)
     case GC_G40:   /* cutter radius compensation off */
     case GC_G49:   /* tool length offset off */
         return true;
+    case GC_G98: /* canned cycles retract to the higher of R and the Z they start at */
+    case GC_G99: /* ... to R */
+        g->retract_r = v == GC_G99;
+        return true;
     default:
         return false;
     }
@@ -462,6 +506,13 @@ static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
         }
         if (run_g_mode(g, v))
             continue;
+        if (v == GC_G4 && b->w['P' - 'A'].has && b->w['P' - 'A'].v == 0 && !cs_gcode_any_axis(b)) {
+            /* "G4 P0": a dwell of no time, which laser and plotter posts and senders write to
+             * wait for the moves before it; the plan runs every move in order: nothing to do.
+             * A real dwell stays unsupported (the plan has no pauses). */
+            b->used |= BIT('P');
+            continue;
+        }
         if (cs_gcode_coord_system(v) != 0 || v == GC_G28_1 || v == GC_G30_1 || v == GC_G92_1 ||
             v == GC_G92_2 || v == GC_G92_3) {
             cs_gcode_wcs_set(g, v);
@@ -475,9 +526,11 @@ static cs_err_t run_g(gc_t *g, block_t *b, gline_t *l)
         } else if (v == GC_G64) {
             l->g64 = true;
             l->g64col = c;
-        } else if (cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
-                   v != GC_G73 && v != GC_G74 && v != GC_G76 && v < GC_G81) {
-            e = set_motion(g, l, v, c); /* G0 .. G6.2 and (with a probe) G38.2 .. G38.5 */
+        } else if ((cs_gcode_group_g(v) == GC_GROUP_MOTION && v != GC_G33 && v != GC_G33_1 &&
+                    v != GC_G73 && v != GC_G74 && v != GC_G76 && v < GC_G81) ||
+                   v == GC_G73 || v == GC_G81 || v == GC_G83) {
+            /* G0 .. G6.2, (with a probe) G38.2 .. G38.5, the cycles G73 G81 G83 */
+            e = set_motion(g, l, v, c);
         } else {
             e = drop_g(g, l, v, c);
         }
@@ -497,6 +550,7 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
             k += (size_t)snprintf(words + k, sizeof words - k, " %c%g", *q, w->v);
         w->has = false;
     }
+    b->polar[0].has = b->polar[1].has = false;
     if (modal)
         cs_gcode_warn(g, col,
                       "move in the unsupported motion mode %s skipped, with its words%s "
@@ -506,6 +560,45 @@ static void drop_block(gc_t *g, block_t *b, int code, unsigned col, bool modal)
         cs_gcode_warn(g, col,
                       "%s is not supported: its block skipped, with its words%s (--lenient)", what,
                       k ? words : " (none)");
+}
+
+cs_err_t cs_gcode_polar(gc_t *g, block_t *b, const double cur[2], double out[2])
+{
+    const word_t *d = &b->polar[0], *a = &b->polar[1];
+    double r = hypot(cur[0], cur[1]), th = atan2(cur[1], cur[0]);
+    b->polar_used = true;
+    if (g->incr) {
+        if (cur[0] == 0 && cur[1] == 0)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE,
+                                    cs_gcode_loc(g, d->has ? d->col : a->col),
+                                    "incremental polar coordinates at the origin: the angle is "
+                                    "undefined (LinuxCNC refuses it too)");
+        r += d->has ? d->v : 0;
+        th += a->has ? a->v * GC_PI / 180 : 0;
+    } else {
+        r = d->has ? d->v : r;
+        th = a->has ? a->v * GC_PI / 180 : th;
+    }
+    out[0] = r * cos(th);
+    out[1] = r * sin(th);
+    return CS_OK;
+}
+
+/* A straight move, arc or spline whose end is given by @ / ^: its X and Y words, as the
+ * program would have written them (G91: increments). */
+static cs_err_t polar_to_xy(gc_t *g, block_t *b)
+{
+    double cur[2], p[2];
+    for (int a = 0; a < 2; a++)
+        cur[a] = (g->pos[a] - cs_gcode_offset(g, a)) / g->unit;
+    cs_err_t e = cs_gcode_polar(g, b, cur, p);
+    for (int a = 0; a < 2 && e == CS_OK; a++) {
+        word_t *w = &b->w['X' - 'A' + a];
+        w->has = true;
+        w->v = g->incr ? p[a] - cur[a] : p[a];
+        w->col = b->polar[b->polar[0].has ? 0 : 1].col;
+    }
+    return e;
 }
 
 /* G10, G28, G30, G92: the line's axis words are theirs, so no motion word may share it. */
@@ -558,6 +651,7 @@ static cs_err_t run_nurbs(gc_t *g, block_t *b, const gline_t *l, unsigned first_
 /* The motion of a line (modal: the mode in effect when the line has none). */
 static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first_col)
 {
+    int before = g->motion;
     if (l->motion != MOT_LINE_NONE)
         g->motion = l->motion;
     if (b->machine && g->motion != MOT_G0 && g->motion != MOT_G1)
@@ -566,7 +660,8 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
                                 "coordinates)");
     /* A move happens when the line has axis words or arc / spline words; a motion word alone
      * ("G2" on its own line) only sets the mode. */
-    bool go = cs_gcode_any_axis(b);
+    bool polar = b->polar[0].has || b->polar[1].has;
+    bool go = cs_gcode_any_axis(b) || polar;
     for (const char *q = "IJKRPQ"; *q; q++)
         go = go || (b->w[*q - 'A'].has && !(b->used & BIT(*q))); /* G64's P and Q are its own */
     if (!go)
@@ -578,8 +673,15 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
         drop_block(g, b, g->dropped_code, first_col, true);
         return CS_OK;
     }
+    if (polar && (b->w['X' - 'A'].has || b->w['Y' - 'A'].has))
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE,
+                                cs_gcode_loc(g, b->w[b->w['X' - 'A'].has ? 'X' - 'A' : 'Y' - 'A'].col),
+                                "X or Y with polar coordinates (@ ^) on one line");
     double t[3];
     cs_err_t e = CS_OK;
+    if (polar && g->motion != MOT_G73 && g->motion != MOT_G81 && g->motion != MOT_G83 &&
+        (e = polar_to_xy(g, b)) != CS_OK)
+        return e;
     switch (g->motion) {
     case MOT_G0:
     case MOT_G1:
@@ -603,6 +705,12 @@ static cs_err_t run_motion(gc_t *g, block_t *b, const gline_t *l, unsigned first
     case GC_G38_4:
     case GC_G38_5:
         e = cs_gcode_probe(g, b, g->motion, l->mcol);
+        g->g5_prev = false;
+        break;
+    case MOT_G73:
+    case MOT_G81:
+    case MOT_G83:
+        e = cs_gcode_cycle(g, b, g->motion, before == g->motion, l->mcol);
         g->g5_prev = false;
         break;
     default: /* G5.2 / G6.2 mode after its block: axis words alone start nothing */
@@ -639,14 +747,20 @@ static cs_err_t run_block(gc_t *g, block_t *b, unsigned first_col)
                                         : run_motion(g, b, &l, first_col)) != CS_OK)
         return e;
     /* Words given but not used by anything on the line. */
+    for (int k = 0; k < 2; k++)
+        if (b->polar[k].has && !b->polar_used)
+            return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->polar[k].col),
+                                    "%c (polar coordinates) not used by anything on this line",
+                                    k ? '^' : '@');
     for (int i = 0; i < 26; i++) {
         if (!b->w[i].has || (b->used & (1u << i)))
             continue;
         if (!g->o->lenient)
             return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, b->w[i].col),
                                     "%c word not used by anything on this line", 'A' + i);
-        cs_gcode_warn(g, b->w[i].col,
-                      "%c word not used by anything on this line: ignored (--lenient)", 'A' + i);
+        cs_gcode_warn_once(g, b->w[i].col,
+                           "%c word not used by anything on this line: ignored (--lenient)",
+                           'A' + i);
     }
     if (end)
         g->ended = true;
@@ -802,12 +916,40 @@ static cs_err_t not_a_word(gc_t *g, char c, unsigned col)
                                        "(--dialect grbl)"
                                      : "an O-word must begin its line (only a line number may "
                                        "come before it)");
+    if (c == '@' || c == '^') /* LinuxCNC's polar coordinates, read in its dialect only */
+        return cs_path_diag_set(g->diag, CS_ERR_UNSUPPORTED, cs_gcode_loc(g, col),
+                                "polar coordinates (@ distance, ^ angle) are LinuxCNC's: not in "
+                                "Grbl 1.1 (--dialect grbl)");
     if ((unsigned char)c < 0x20 || (unsigned char)c >= 0x7F)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                                 "unexpected byte 0x%02X", (unsigned)(unsigned char)c);
     return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
                             "unexpected character '%c' (expected a word: a letter and a number)",
                             c);
+}
+
+/* LinuxCNC's @ (distance) or ^ (angle) at s[*i] (column col): its value into b->polar. */
+static cs_err_t read_polar(gc_t *g, block_t *b, const char *s, size_t n, size_t *i, unsigned col)
+{
+    char c = s[*i];
+    word_t *w = &b->polar[c == '^'];
+    (*i)++;
+    while (*i < n && (s[*i] == ' ' || s[*i] == '\t'))
+        (*i)++;
+    double v;
+    cs_err_t e = read_value(g, s, n, i, c, col, &v);
+    if (e != CS_OK)
+        return e;
+    if (w->has)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, col),
+                                "%c given twice on one line", c);
+    if (!isfinite(v) || fabs(v) > 1e9)
+        return cs_path_diag_set(g->diag, CS_ERR_RANGE, cs_gcode_loc(g, col),
+                                "%c value out of range", c);
+    w->has = true;
+    w->v = v;
+    w->col = col;
+    return CS_OK;
 }
 
 /* One line s[0..n) (without its end of line). */
@@ -849,6 +991,13 @@ static cs_err_t do_line(gc_t *g, const char *s, size_t n)
         if (c == '#') {
             if ((e = read_assign(g, s, code_end, &i)) != CS_OK)
                 return e;
+            continue;
+        }
+        if ((c == '@' || c == '^') && g->o->dialect != CS_GCODE_GRBL) {
+            if ((e = read_polar(g, &b, s, code_end, &i, col)) != CS_OK)
+                return e;
+            if (first_col == 0)
+                first_col = col;
             continue;
         }
         int li = letter_index(c);
@@ -923,6 +1072,7 @@ void cs_gcode_start_modes(gc_t *g)
     g->ijk_abs = false;
     g->feed = 0;
     g->g5_prev = false;
+    g->retract_r = false; /* G98 */
     g->spindle = GC_M5;
     /* Grbl 1.1's defaults at power-up include G0 (its "$G" report: G0 G54 G17 G21 G90 G94). */
     g->motion = g->o->dialect == CS_GCODE_GRBL ? MOT_G0 : MOT_NONE;
@@ -980,6 +1130,12 @@ cs_err_t cs_gcode_read(const char *name, const char *buf, size_t len, const cs_g
             return e;
         }
         g.pos[2] = o->pen_up_z_mm;
+    }
+    /* A UTF-8 byte order mark (Windows editors write one) is no G-code: skipped, so that line 1's
+     * columns count from the first character shown. */
+    if (len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0) {
+        buf += 3;
+        len -= 3;
     }
     cs_gflow_t fl;
     e = cs_gflow_init(&fl, g.name, buf, len, o->dialect != CS_GCODE_GRBL, o->max_loops, diag);

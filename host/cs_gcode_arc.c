@@ -254,6 +254,29 @@ static cs_err_t arc_centre_r(gc_t *g, block_t *b, bool ccw, const double t[3], u
     return CS_OK;
 }
 
+/* The offset along the plane's normal (K in G17, J in G18, I in G19), which FreeCAD's posts
+ * and others write as K0 on every arc. LinuxCNC refuses it (interp_arc.cc convert_arc:
+ * NCE_K_WORD_GIVEN_FOR_ARC_IN_XY_PLANE and the like); Grbl 1.1 reads and ignores it (gcode.c
+ * clears I, J and K for every arc): the centre lies in the plane whatever it says. So: ignored
+ * in Grbl's dialect (warned once when it is not 0), a warning with --lenient, else an error that
+ * says both. */
+static cs_err_t off_plane_offset(gc_t *g, block_t *b, const word_t *w, char letter, bool ccw,
+                                 const char *names)
+{
+    bool grbl = g->o->dialect == CS_GCODE_GRBL;
+    if (!grbl && !g->o->lenient)
+        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, w->col),
+                                "%c word in a G%d arc: the G%d plane uses %s (LinuxCNC refuses "
+                                "it; Grbl ignores it: --dialect grbl or --lenient)",
+                                letter, ccw ? 3 : 2, g->plane, names);
+    if (!grbl || w->v != 0)
+        cs_gcode_warn_once(g, w->col,
+                           "%c word in a G%d-plane arc: ignored, the centre is in the plane (%s)%s",
+                           letter, g->plane, names, grbl ? "" : " (--lenient)");
+    b->used |= BIT(letter);
+    return CS_OK;
+}
+
 /* G2 / G3. */
 cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
 {
@@ -267,10 +290,11 @@ cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col)
     const word_t *r = &b->w['R' - 'A'];
     const word_t *ofs[3] = {&b->w['I' - 'A'], &b->w['J' - 'A'], &b->w['K' - 'A']};
     bool has_ijk = ofs[ax[0]]->has || ofs[ax[1]]->has;
-    if (ofs[ax[2]]->has)
-        return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, ofs[ax[2]]->col),
-                                "%c word in a G%d arc: the G%d plane uses %s", (char)('I' + ax[2]),
-                                ccw ? 3 : 2, g->plane, names);
+    if (ofs[ax[2]]->has) {
+        cs_err_t eo = off_plane_offset(g, b, ofs[ax[2]], (char)('I' + ax[2]), ccw, names);
+        if (eo != CS_OK)
+            return eo;
+    }
     if (r->has && has_ijk)
         return cs_path_diag_set(g->diag, CS_ERR_PARSE, cs_gcode_loc(g, r->col),
                                 "R and %s in one arc: give the centre one way", names);

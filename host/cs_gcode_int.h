@@ -7,6 +7,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "cs_gcode.h"
 #include "cs_gexpr.h"
@@ -18,6 +19,8 @@
 /* pi, spelled out: M_PI is POSIX, not C99 (the fuzz build uses plain -std=c99). */
 #define GC_PI  3.14159265358979323846
 #define BIT(c) (1u << ((c) - 'A'))
+/* Kinds of once-only warning remembered per program (beyond: each is printed every time). */
+#define GC_MAX_WARN_ONCE 64
 
 /* Motion modes: the motion group's G code (cs_gcode_words.h), or one of these. */
 enum {
@@ -31,7 +34,10 @@ enum {
     MOT_G5 = GC_G5,
     MOT_G51 = GC_G5_1,
     MOT_G52 = GC_G5_2,
-    MOT_G62 = GC_G6_2
+    MOT_G62 = GC_G6_2,
+    MOT_G73 = GC_G73, /* canned cycles (cs_gcode_cycle.c) */
+    MOT_G81 = GC_G81,
+    MOT_G83 = GC_G83
 };
 
 /* Numbered parameters the reader keeps (LinuxCNC G-code reference, "Numbered Parameters"); the
@@ -84,6 +90,15 @@ typedef struct {
     cs_path_loc_t nurbs_loc;
     double nurbs_feed;
     cs_gexpr_store_t st; /* parameters (LinuxCNC) */
+    /* canned cycles (cs_gcode_cycle.c) */
+    bool retract_r;   /* G99: retract to R; G98 (the start): to the higher of R and the old Z */
+    bool cyc_set;     /* a cycle has run: its R, Z (and Q) numbers below may be left out */
+    double cyc_r;     /* the last cycle's R, Z and Q numbers as written (program units) */
+    double cyc_z;
+    double cyc_q;
+    /* Warnings given once per program (cs_gcode_warn_once): hashes of their texts. */
+    uint32_t warned[GC_MAX_WARN_ONCE];
+    unsigned nwarned;
 } gc_t;
 
 /* One line's words. */
@@ -97,12 +112,18 @@ typedef struct {
     unsigned mcol[8];
     unsigned nm;
     unsigned used; /* bit per letter consumed by the block */
+    word_t polar[2];  /* LinuxCNC's polar coordinates: @ (distance), ^ (angle, degrees) */
+    bool polar_used;
 } block_t;
 
 /* Location col on the line being read. */
 cs_path_loc_t cs_gcode_loc(const gc_t *g, unsigned col);
 /* A warning at col (counted in stats; to opts->warn or stderr). */
 void cs_gcode_warn(gc_t *g, unsigned col, const char *fmt, ...);
+/* The same for a warning about something that changes no geometry (a word ignored): given the
+ * first time its text occurs in the program, with "(reported once)"; later ones are counted in
+ * stats only, so a CAM file with a T word per tool change does not repeat it per line. */
+void cs_gcode_warn_once(gc_t *g, unsigned col, const char *fmt, ...);
 /* Machine mm -> Q15.16; CS_ERR_RANGE with diag outside +/-4096 mm. */
 cs_err_t cs_gcode_to_vec(gc_t *g, const double p[3], unsigned col, cs_vec3_t *out);
 /* Coordinate axis (0 x, 1 y, 2 z) of v. */
@@ -129,8 +150,15 @@ cs_err_t cs_gcode_probe(gc_t *g, block_t *b, int code, unsigned col);
 /* The plane's axes: first, second (counter-clockwise from first to second), normal. */
 void cs_gcode_plane_axes(int plane, int ax[3]);
 
+/* The point the line's @ / ^ give from the program point cur (program units): G90 about the
+ * origin, the missing one kept from cur; G91 added to cur's distance and angle (LinuxCNC
+ * "Polar Coordinates"). CS_ERR_PARSE with diag for G91 at the origin. */
+cs_err_t cs_gcode_polar(gc_t *g, block_t *b, const double cur[2], double out[2]);
 /* G2 (ccw false) / G3 from g->pos (cs_gcode_arc.c). */
 cs_err_t cs_gcode_arc(gc_t *g, block_t *b, bool ccw, unsigned col);
+/* Canned cycle code (MOT_G73, MOT_G81 or MOT_G83) from g->pos (cs_gcode_cycle.c); same: the
+ * same cycle was in effect before the line (its R, Z and Q stick). */
+cs_err_t cs_gcode_cycle(gc_t *g, block_t *b, int code, bool same, unsigned col);
 /* The open NURBS block -> path elements; g->pos ends on its last point (cs_gcode_nurbs.c). */
 cs_err_t cs_gcode_nurbs_close(gc_t *g);
 /* A G5.2 line (first) or a control point line of its block. */

@@ -44,6 +44,9 @@ cs_gcode_group_t cs_gcode_group_g(int g)
     case GC_G61_1:
     case GC_G64:
         return GC_GROUP_PATH;
+    case GC_G98:
+    case GC_G99:
+        return GC_GROUP_RETURN;
     default:
         break;
     }

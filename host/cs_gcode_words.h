@@ -57,6 +57,7 @@ enum {
     GC_G76 = 760,
     GC_G80 = 800,
     GC_G81 = 810,
+    GC_G83 = 830,
     GC_G89 = 890,
     GC_G90 = 900,
     GC_G90_1 = 901,
@@ -68,6 +69,8 @@ enum {
     GC_G92_3 = 923,
     GC_G93 = 930,
     GC_G94 = 940,
+    GC_G98 = 980,
+    GC_G99 = 990,
 };
 
 /* M codes (tenths). */
@@ -96,6 +99,7 @@ typedef enum {
     GC_GROUP_TOOL_LEN,   /* 8: G49 */
     GC_GROUP_COORD,      /* 12: G54-G59.3 */
     GC_GROUP_PATH,       /* 13: G61 G61.1 G64 */
+    GC_GROUP_RETURN,     /* 10: G98 G99 (canned cycle return level) */
     GC_GROUP_M_STOP,     /* M 4: M2 M30 */
     GC_GROUP_M_SPINDLE,  /* M 7: M3 M4 M5 */
     GC_GROUP_M_COOLANT,  /* M 8: M7 M8 M9 */

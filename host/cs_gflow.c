@@ -115,7 +115,12 @@ static cs_err_t gf_parse(cs_gflow_line_t *l, const char *s, const char *name, si
     for (int q = CS_GFLOW_SUB; q <= CS_GFLOW_CONTINUE; q++)
         if (gf_words[q] && strcmp(kw, gf_words[q]) == 0)
             l->kind = (cs_gflow_kind_t)q;
-    loc.col = cs_gflow_col(s, at);
+    loc.col = m == 0 ? l->ocol : cs_gflow_col(s, at);
+    if (l->kind == CS_GFLOW_NONE && m == 0)
+        return cs_path_diag_set(d, CS_ERR_PARSE, loc,
+                                "o%s without a keyword: a program number (\"O1001 (NAME)\", as "
+                                "Fanuc-style posts begin) is no LinuxCNC O-word; delete the line",
+                                l->label);
     if (l->kind == CS_GFLOW_NONE)
         return cs_path_diag_set(d, CS_ERR_PARSE, loc,
                                 "o%s: expected sub, endsub, call, return, if, elseif, else, "

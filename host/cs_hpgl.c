@@ -196,6 +196,16 @@ static int next_num(hp_t *h, const char *mn, double *v, size_t *off, cs_err_t *e
                   what_at(h, i > s ? i : s, b));
         return -1;
     }
+    /* "1e15": an exponent is no HP-GL number, and "e1" is no instruction (two letters): say
+     * so at the number rather than "expected a two-letter instruction" at the digit after. */
+    if (i + 1 < h->len && (h->buf[i] == 'e' || h->buf[i] == 'E') &&
+        (is_digit(h->buf[i + 1]) ||
+         ((h->buf[i + 1] == '+' || h->buf[i + 1] == '-') && i + 2 < h->len &&
+          is_digit(h->buf[i + 2])))) {
+        *e = fail(h, s, CS_ERR_PARSE, "%s: number in exponent form: HP-GL numbers have no exponent",
+                  mn);
+        return -1;
+    }
     if (i - s > HP_NUM_CHARS) {
         *e = fail(h, s, CS_ERR_RANGE, "%s: number too long (%zu characters)", mn, i - s);
         return -1;

@@ -1573,6 +1573,24 @@ static cs_err_t on_unsupported(doc_t *d, const char *local, const char **atts, s
     return CS_OK;
 }
 
+/* <flowRoot>: Inkscape 0.x's flowed text (an SVG 1.2 draft no browser draws). Its text is
+ * not drawn, and neither is its <flowRegion> shape, which is the frame the text flows in, not
+ * something Inkscape shows: drawing it would plot a box nobody sees on screen. */
+static cs_err_t on_flowed(doc_t *d, const char *local, const char **atts, size_t tag)
+{
+    (void)local;
+    (void)atts;
+    frame_t *f = &d->stack[d->depth - 1];
+    if (!f->hidden) {
+        d->stats->ignored++;
+        warn_once(d, "flowRoot", tag,
+                  "ignoring <flowRoot> (Inkscape flowed text): neither its text nor its frame is "
+                  "drawn; Inkscape's Text > Convert to Text makes it drawable");
+    }
+    f->hidden = true;
+    return CS_OK;
+}
+
 /* What each SVG element does. Unlisted elements (title, desc, style, metadata...) are skipped
  * with their subtree drawn normally. */
 static const struct {
@@ -1586,6 +1604,7 @@ static const struct {
     {"circle", on_ellipse},   {"ellipse", on_ellipse},   {"line", on_line},
     {"polyline", on_poly},    {"polygon", on_poly},      {"text", on_text},
     {"use", on_use},          {"image", on_unsupported}, {"tspan", on_tspan},
+    {"flowRoot", on_flowed},
 };
 
 /* The local name when el is in the SVG namespace (or in none), else NULL. */
@@ -1877,8 +1896,55 @@ static void leave(doc_t *d)
     d->depth--;
 }
 
+static bool is_switch(const doc_t *d, size_t node)
+{
+    const char *l = d->nodes[node].local;
+    return l && d->nodes[node].atts && strcmp(l, "switch") == 0;
+}
+
+/* systemLanguage="en-US, fr": true when a tag is English ("en" or "en-..."): the reader has
+ * no user language, and English is the likeliest reader of a file that offers it. */
+static bool language_ok(const char *v)
+{
+    while (*v) {
+        while (*v == ' ' || *v == ',' || *v == '\t' || *v == '\n' || *v == '\r')
+            v++;
+        if ((v[0] == 'e' || v[0] == 'E') && (v[1] == 'n' || v[1] == 'N') &&
+            (v[2] == '\0' || v[2] == '-' || v[2] == ',' || v[2] == ' '))
+            return true;
+        while (*v && *v != ',')
+            v++;
+    }
+    return false;
+}
+
+/* <switch> (SVG 1.1 §5.8): only its first direct child whose conditions hold is drawn. Here
+ * requiredFeatures holds (SVG 2 drops it), a non-empty requiredExtensions does not (the reader
+ * has no extension), systemLanguage holds for English; and a <foreignObject> is passed over,
+ * since it draws nothing here, so its SVG fallback is drawn (draw.io writes each label as an
+ * HTML foreignObject with a <text> after it, and ends every file with a switch whose first
+ * child is an empty <g>, so that "Text is not SVG - cannot display" shows only in viewers
+ * without SVG 1.1: it is not drawn). NONE when no child qualifies. */
+static size_t switch_pick(const doc_t *d, size_t sw)
+{
+    for (size_t k = d->nodes[sw].first; k != NONE; k = d->nodes[k].next) {
+        const node_t *n = &d->nodes[k];
+        if (!n->local || !n->atts || strcmp(n->local, "foreignObject") == 0)
+            continue;
+        const char **atts = (const char **)n->atts;
+        const char *ext = att_get(atts, "requiredExtensions");
+        const char *lang = att_get(atts, "systemLanguage");
+        if (ext && strspn(ext, " \t\r\n") != strlen(ext))
+            continue;
+        if (lang && !language_ok(lang))
+            continue;
+        return k;
+    }
+    return NONE;
+}
+
 /* Depth first from the root: each element's children in order (a <use>: the element it refers
- * to), a <use>'s instance ending with it. */
+ * to; a <switch>: its one child switch_pick chooses), a <use>'s instance ending with it. */
 static cs_err_t walk(doc_t *d)
 {
     if (d->nnodes == 0)
@@ -1888,7 +1954,10 @@ static cs_err_t walk(doc_t *d)
         frame_t *f = &d->stack[d->depth - 1];
         if (!f->entered) {
             f->entered = true;
-            size_t child = f->none ? NONE : f->inst != NONE ? f->inst : d->nodes[f->node].first;
+            size_t child = f->none              ? NONE
+                           : f->inst != NONE      ? f->inst
+                           : is_switch(d, f->node) ? switch_pick(d, f->node)
+                                                   : d->nodes[f->node].first;
             if (child != NONE) {
                 e = enter(d, child, child == f->inst);
                 continue;
@@ -1897,7 +1966,8 @@ static cs_err_t walk(doc_t *d)
         size_t node = f->node;
         bool instance = f->instance;
         leave(d);
-        if (d->depth > 0 && !instance && d->nodes[node].next != NONE)
+        if (d->depth > 0 && !instance && d->nodes[node].next != NONE &&
+            !is_switch(d, d->stack[d->depth - 1].node))
             e = enter(d, d->nodes[node].next, false);
     }
     return e != CS_OK ? e : d->err;

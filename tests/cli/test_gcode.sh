@@ -57,7 +57,7 @@ for f in arc-xy-plane.nc arc-yz-plane.nc arc-zx-plane.nc one-inch-circle.nc; do
     run "$f" 0 flatten --stats "$DATA/$f" && expect_dev "$f" 0.01
 done
 run "thread strict" 1 flatten "$DATA/helical-thread-milling.nc" &&
-    expect_err "thread strict" "^$DATA/helical-thread-milling.nc:2:9: the D word is not supported"
+    expect_err "thread strict" "^$DATA/helical-thread-milling.nc:2:9: the D word \(G41/G42.s cutter compensation number\) is not supported"
 run "thread lenient" 0 flatten --lenient --stats "$DATA/helical-thread-milling.nc" &&
     expect_dev "thread lenient" 0.01 && expect_err "thread warns" ":2:5: warning: G42 is not supported"
 # refused by default (as LinuxCNC does), each at its exact line:col ...

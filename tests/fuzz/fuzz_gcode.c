@@ -21,6 +21,7 @@
 #include "../../host/cs_err_text.c"
 #include "../../host/cs_gcode.c"
 #include "../../host/cs_gcode_arc.c"
+#include "../../host/cs_gcode_cycle.c"
 #include "../../host/cs_gcode_nurbs.c"
 #include "../../host/cs_gcode_wcs.c"
 #include "../../host/cs_gcode_words.c"
@@ -181,6 +182,10 @@ static const char *const seeds[] = {
     "G90 G94\nG17\nG21\nX10 Y5\nG1 Z-1 F300\nG2 X20 Y5 I5 J0\nM8\nM9\nM30\n",
     "G0 X100\nG3 X0 Y100.09 I-100 F100\nG0 X4000 Y0\nG3 X0 Y4002.9 I-4000\n",
     "G81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG38.2 Z-5\n",
+    "G0 Z5\nG99 G83 X1 Y2 Z-3 R1 Q1.5 F100\nX3\nG98 G73 Y4 Z-2 R1 Q0.7\nG91 G81 X1 R-1 Z-1 L3\n",
+    "G20 G0 X1.5 Y0 Z0\nG91 G81 R.1 Z-.5 ^60 L6 F10\nG90 G1 @.5 ^90\nG91 ^90\n@.1\n"
+    "G3 @1 ^45 R2\n",
+    "\xef\xbb\xbfG17 G2 X1 Y1 I1 J0 K0 F60\n",
 };
 
 int main(int argc, char **argv)

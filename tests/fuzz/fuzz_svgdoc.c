@@ -68,6 +68,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
 #ifdef CS_FUZZ_SEED_MAIN
 static const char *const seeds[] = {
+    "<svg xmlns='http://www.w3.org/2000/svg' xmlns:x='http://www.w3.org/1999/xlink'>"
+    "<switch><foreignObject><p xmlns='http://www.w3.org/1999/xhtml'>a</p></foreignObject>"
+    "<text x='1' y='9'>Box</text><line x1='0' y1='0' x2='1' y2='1' stroke='black'/></switch>"
+    "<switch><g requiredFeatures='x'/><text>Text is not SVG</text></switch>"
+    "<switch id='s'><line systemLanguage='fr' x2='5' stroke='black'/>"
+    "<line systemLanguage='en-US' y2='5' stroke='black'/><rect requiredExtensions='e' width='1' "
+    "height='1'/></switch><use x:href='#s' x='10'/>"
+    "<flowRoot><flowRegion><rect width='20' height='10'/></flowRegion><flowPara>f</flowPara>"
+    "</flowRoot></svg>",
     "<svg xmlns='http://www.w3.org/2000/svg' width='100mm' height='50mm' viewBox='0 0 200 100'>"
     "<rect x='10' y='10' width='50' height='30' rx='5' stroke='black' fill='none'/>"
     "<circle cx='100' cy='50' r='20'/><ellipse cx='150' cy='50' rx='30' ry='10'/>"

@@ -317,6 +317,13 @@ static void test_unsupported_strict_and_lenient(void **state)
 {
     (void)state;
     expect_diag(parse("G1 X1 F60\nG4 P1\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    /* A dwell of no time is nothing to do, in both dialects; any other stays unsupported. */
+    assert_int_equal(parse("G1 X1 F60\nG4 P0\nG1 X2\n"), CS_OK);
+    assert_int_equal(P.n, 2);
+    assert_int_equal(parse_dialect("G1 X1 F60\nG4 P0.000\n", CS_GCODE_GRBL), CS_OK);
+    expect_diag(parse("G1 X1 F60\nG4 P0.01\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G1 X1 F60\nG4\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G1 X1 F60\nG4 P0 X3\n"), CS_ERR_UNSUPPORTED, 2, 1);
     expect_diag(parse("G1 X1 F60 M6\n"), CS_ERR_UNSUPPORTED, 1, 11);
     expect_diag(parse("G1 X1 A3 F60\n"), CS_ERR_UNSUPPORTED, 1, 7);
     assert_int_equal(parse_opts("G1 X1 F60\nG4 P1\nG1 X2 A3\n", true), CS_OK);
@@ -330,7 +337,7 @@ static void test_unsupported_strict_and_lenient(void **state)
 static void test_lenient_drops_words_of_dropped_codes(void **state)
 {
     (void)state;
-    const char *t = "G0 Z5\nG81 X1 Y1 Z-1 R1 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
+    const char *t = "G0 Z5\nG85 X1 Y1 Z-1 R1 Q0.5 F100\nX2 Y2\nG80\nG0 X3\nG52 X0 Y0\nG33 Z0 K1\n"
                     "G1 X4 F60\n";
     expect_diag(parse(t), CS_ERR_UNSUPPORTED, 2, 1);
     assert_int_equal(parse_opts(t, true), CS_OK);
@@ -339,7 +346,7 @@ static void test_lenient_drops_words_of_dropped_codes(void **state)
     expect_pt(1, 1, 3, 0, 5, PT_TOL);
     expect_pt(2, 1, 4, 0, 5, PT_TOL);
     expect_continuous();
-    /* One warning per skipped block, naming the code and every word skipped with it: the G81
+    /* One warning per skipped block, naming the code and every word skipped with it: the G85
      * line, its modal repeat "X2 Y2", G52, G33. */
     assert_int_equal(nwarn, 4);
     assert_non_null(strstr(last_warn, "t.nc:7:1: G33 is not supported: its block skipped, with "
@@ -351,13 +358,64 @@ static void test_syntax_errors(void **state)
     (void)state;
     expect_diag(parse("G1 X1 X2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X F1\n"), CS_ERR_PARSE, 1, 4);
-    expect_diag(parse("G1 X1 F1\nG1 X2 @\n"), CS_ERR_PARSE, 2, 7);
+    expect_diag(parse("G1 X1 F1\nG1 X2 $\n"), CS_ERR_PARSE, 2, 7);
+    /* A Fanuc-style program number line: refused at its O, saying what it is. */
+    expect_diag(parse("%\nO1001 (PART)\nG0 X1\n"), CS_ERR_PARSE, 2, 1);
+    assert_non_null(strstr(D.reason, "program number"));
+    /* A UTF-8 byte order mark is skipped (in both dialects), columns counted after it. */
+    assert_int_equal(parse("\xef\xbb\xbfG1 X1 F60\n"), CS_OK);
+    expect_pt(0, 1, 1, 0, 0, PT_TOL);
+    assert_int_equal(parse_dialect("\xef\xbb\xbfG1 X1 F60\n", CS_GCODE_GRBL), CS_OK);
+    expect_diag(parse("\xef\xbb\xbfG1 X1 $\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse("G1 X1\xef\xbb\xbf\n"), CS_ERR_PARSE, 1, 6); /* elsewhere: a stray byte */
     expect_diag(parse("G0 G1 X1\n"), CS_ERR_PARSE, 1, 4);
     expect_diag(parse("X1 Y1\n"), CS_ERR_PARSE, 1, 1);
     expect_diag(parse("G1 X1 I2 F1\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X1 F0\n"), CS_ERR_PARSE, 1, 7);
     expect_diag(parse("G1 X5000 F1\n"), CS_ERR_RANGE, 1, 1);
     expect_diag(parse("G1.5 X1\n"), CS_ERR_UNSUPPORTED, 1, 1);
+}
+
+/* LinuxCNC "Polar Coordinates": @ distance, ^ angle (degrees) of X Y about the program origin;
+ * G91 adds them to the current point's. The reference's own square: "F100 G1 @.5 ^90 / G91
+ * ^90 / ^90 / ^90 / ^90" visits (0, .5) (-.5, 0) (0, -.5) (.5, 0) (0, .5). */
+static void test_polar_coordinates(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("F100 G1 @.5 ^90\nG91 ^90\n^90\n^90\n^90\n"), CS_OK);
+    const double sq[5][2] = {{0, .5}, {-.5, 0}, {0, -.5}, {.5, 0}, {0, .5}};
+    assert_int_equal(P.n, 5);
+    for (size_t k = 0; k < 5; k++)
+        expect_pt(k, 1, sq[k][0], sq[k][1], 0, PT_TOL);
+    /* G90 with one of them: the other kept from the current point (5 at 53.13 deg). */
+    assert_int_equal(parse("G0 X3 Y4\nG0 ^0\nG0 X3 Y4\nG0 @10\n"), CS_OK);
+    expect_pt(1, 1, 5, 0, 0, PT_TOL);
+    expect_pt(3, 1, 6, 8, 0, PT_TOL);
+    /* About the program origin: work offsets apply (G54 X 10). */
+    assert_int_equal(parse("G10 L2 P1 X10\nG0 @2 ^90\n"), CS_OK);
+    expect_pt(0, 1, 10, 2, 0, PT_TOL);
+    /* An arc's end: a quarter circle from (1, 0) to (0, 1). */
+    assert_int_equal(parse("G0 X1 Y0\nG3 @1 ^90 I-1 J0 F60\n"), CS_OK);
+    double e[3];
+    end_of(P.n - 1, e);
+    assert_true(fabs(e[0]) <= PT_TOL && fabs(e[1] - 1) <= PT_TOL);
+    /* LinuxCNC's nc_files/hole-circle.ngc, in short: G91 G81 with ^60 L6 drills six holes 60
+     * degrees apart on its 1.5 in circle, R and Z incremental. */
+    assert_int_equal(parse("G20 G0 X1.5 Y0 Z0\nG91 G81 R.1 Z-.5 ^60 L6 F10\n"), CS_OK);
+    assert_int_equal(P.n, 20);
+    expect_pt(1, 1, 38.1, 0, 2.54, PT_TOL);
+    for (int k = 0; k < 6; k++) {
+        double th = (k + 1) * M_PI / 3;
+        expect_pt((size_t)(3 + 3 * k), 1, 38.1 * cos(th), 38.1 * sin(th), -10.16, PT_TOL);
+        expect_pt((size_t)(4 + 3 * k), 1, 38.1 * cos(th), 38.1 * sin(th), 2.54, PT_TOL);
+    }
+    expect_continuous();
+    /* Errors: G91 at the origin (no angle), X or Y with them, unused, twice, Grbl. */
+    expect_diag(parse("G91 G0 ^90\n"), CS_ERR_PARSE, 1, 8);
+    expect_diag(parse("G0 X1 @1\n"), CS_ERR_PARSE, 1, 4);
+    expect_diag(parse("G10 L2 P1 @1\n"), CS_ERR_PARSE, 1, 11);
+    expect_diag(parse("G0 @1 @2\n"), CS_ERR_PARSE, 1, 7);
+    expect_diag(parse_dialect("G0 @1\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 4);
 }
 
 /* ---- arcs -------------------------------------------------------------------------------- */
@@ -439,6 +497,164 @@ static void test_arc_r_form(void **state)
     assert_int_equal(parse("G1 X0 Y0 F60\nG2 X20 Y0 R10\n"), CS_OK);
     turned = check_circle(0, 0, 1, 10, 0, 10, ARC_TOL, 0, 0, PT_TOL);
     assert_true(fabs(turned + M_PI) < 1e-6);
+}
+
+/* The offset along the plane's normal (FreeCAD's posts write "G2 X.. Y.. I.. J.. K0.000" on
+ * every arc): LinuxCNC refuses it at the word, Grbl ignores it, --lenient ignores it with one
+ * warning for the whole program. The arc is the one drawn without it in every case. */
+static void test_arc_off_plane_offset(void **state)
+{
+    (void)state;
+    const char *t = "G17 G1 X10 Y0 F60\nG3 X0 Y10 I-10 J0 K0.000\nG3 X-10 Y0 I0 J-10 K0.000\n";
+    expect_diag(parse(t), CS_ERR_PARSE, 2, 19);
+    assert_non_null(strstr(D.reason, "--dialect grbl"));
+    /* Grbl: silently, as Grbl does for K0; a non-zero K is warned (once) and ignored too. */
+    assert_int_equal(parse_dialect(t, CS_GCODE_GRBL), CS_OK);
+    assert_int_equal(nwarn, 0);
+    double turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI) < 1e-6);
+    assert_int_equal(parse_dialect("G1 X10 F60\nG3 X0 Y10 I-10 K5\n", CS_GCODE_GRBL), CS_OK);
+    assert_int_equal(nwarn, 1);
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI / 2) < 1e-6);
+    /* --lenient: both arcs drawn, one warning printed, both counted. */
+    assert_int_equal(parse_opts(t, true), CS_OK);
+    assert_int_equal(nwarn, 1);
+    assert_int_equal(S.warnings, 2);
+    assert_non_null(strstr(last_warn, "t.nc:2:19: K word in a G17-plane arc: ignored"));
+    assert_non_null(strstr(last_warn, "(reported once)"));
+    turned = check_circle(1, 0, 1, 0, 0, 10, ARC_TOL, 0, 0, PT_TOL);
+    assert_true(fabs(turned - M_PI) < 1e-6);
+    expect_continuous();
+    /* G18 (Z-X, I/K): J is the normal's word. */
+    expect_diag(parse("G18 G1 X10 F60\nG3 X0 Z-10 I-10 J0\n"), CS_ERR_PARSE, 2, 17);
+    assert_int_equal(parse_dialect("G18 G1 X10 F60\nG3 X0 Z-10 I-10 J0\n", CS_GCODE_GRBL),
+                     CS_OK);
+}
+
+/* A word --lenient ignores (nothing moves for it) is reported once per program, at its first
+ * place, however often the CAM file repeats it; each is still counted. A skipped block (it
+ * would have moved) is reported every time. */
+static void test_lenient_ignored_words_reported_once(void **state)
+{
+    (void)state;
+    const char *t = "T1 M6 G43 H1\nG1 X1 F60\nT2 M6 G43 H2\nG1 X2\nT3 M6 G43 H3\n"
+                    "G85 X5 Y5 Z-1 R1 Q1\nG85 X6 Y5 Z-1 R1 Q1\nG80\nG1 X3\n";
+    assert_int_equal(parse_opts(t, true), CS_OK);
+    /* T, M6, G43, H once each (4 printed of 12), plus the two skipped G85 blocks. */
+    assert_int_equal(nwarn, 6);
+    assert_int_equal(S.warnings, 14);
+    assert_non_null(strstr(last_warn, "t.nc:7:1: G85 is not supported: its block skipped"));
+    expect_pt(P.n - 1, 1, 3, 0, 0, PT_TOL);
+}
+
+/* Expected moves of a canned cycle, worked out by hand from LinuxCNC's G81 description: each
+ * row one element, its end point and whether it is a rapid; the elements run on from each
+ * other (expect_continuous). */
+typedef struct {
+    double x, y, z;
+    bool rapid;
+} move_t;
+
+static void expect_moves(size_t first, const move_t *m, size_t n)
+{
+    assert_int_equal(P.n, first + n);
+    for (size_t k = 0; k < n; k++) {
+        expect_pt(first + k, 1, m[k].x, m[k].y, m[k].z, PT_TOL);
+        assert_int_equal(P.elems[first + k].rapid, m[k].rapid);
+    }
+    expect_continuous();
+}
+
+/* G81 (LinuxCNC "G81 Drilling Cycle"): rapid over the hole, rapid to R, feed to Z, rapid out to
+ * the higher of R and the starting Z (G98, the start mode) or to R (G99); R and Z stick on the
+ * modal lines that follow (Fusion 360 and FreeCAD write one hole per line). */
+static void test_g81_drilling_cycle(void **state)
+{
+    (void)state;
+    assert_int_equal(parse("G0 X0 Y0 Z10\nG98 G81 X5 Y6 Z-2 R3 F100\nX15\nG99 Y20\nG80\n"
+                           "G0 Z12\n"),
+                     CS_OK);
+    const move_t a[] = {
+        {5, 6, 10, true},   {5, 6, 3, true},   {5, 6, -2, false},  {5, 6, 10, true},
+        {15, 6, 10, true},  {15, 6, 3, true},  {15, 6, -2, false}, {15, 6, 10, true},
+        {15, 20, 10, true}, {15, 20, 3, true}, {15, 20, -2, false}, {15, 20, 3, true},
+        {15, 20, 12, true},
+    };
+    expect_moves(1, a, sizeof a / sizeof a[0]);
+    assert_int_equal(P.elems[3].loc.line, 2);
+    assert_int_equal(P.elems[7].loc.line, 3);
+    /* G91 with L3: X Y add up at each repeat, R is from the starting Z (1 + -0.5), Z from R;
+     * a move that goes nowhere (R after the first hole, under G99) adds no element. */
+    assert_int_equal(parse("G0 X1 Y1 Z1\nG91 G99 G81 X2 Y0 R-0.5 Z-1 L3 F100\n"), CS_OK);
+    const move_t b[] = {
+        {3, 1, 1, true}, {3, 1, 0.5, true}, {3, 1, -0.5, false}, {3, 1, 0.5, true},
+        {5, 1, 0.5, true}, {5, 1, -0.5, false}, {5, 1, 0.5, true},
+        {7, 1, 0.5, true}, {7, 1, -0.5, false}, {7, 1, 0.5, true},
+    };
+    expect_moves(1, b, sizeof b / sizeof b[0]);
+    /* Below R at the start: first up to R (once), and G98 then retracts to R, the higher. */
+    assert_int_equal(parse("G0 Z-1\nG81 X2 R1 Z-3 F100\n"), CS_OK);
+    const move_t c[] = {{0, 0, 1, true}, {2, 0, 1, true}, {2, 0, -3, false}, {2, 0, 1, true}};
+    expect_moves(1, c, sizeof c / sizeof c[0]);
+    /* Work offsets apply as to any move (G54 X offset 10). */
+    assert_int_equal(parse("G10 L2 P1 X10\nG0 X0 Y0 Z5\nG81 X1 R2 Z0 F60\n"), CS_OK);
+    const move_t d[] = {{11, 0, 5, true}, {11, 0, 2, true}, {11, 0, 0, false}, {11, 0, 5, true}};
+    expect_moves(1, d, sizeof d / sizeof d[0]);
+}
+
+/* G83 and G73 (LinuxCNC 2.9 convert_cycle_g83 / g73): pecks of Q from R while above the
+ * bottom; G83 rapids out to R after each and back down to 0.254 mm (0.010 in) above the peck,
+ * G73 only backs off those 0.254 mm; then a feed to Z and the rapid out. Q sticks like R and Z. */
+static void test_g83_g73_pecking(void **state)
+{
+    (void)state;
+    const double u = 0.254;
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG99 G83 X1 Y2 Z-3 R1 Q1.5 F100\n"), CS_OK);
+    const move_t a[] = {
+        {1, 2, 5, true},  {1, 2, 1, true},        {1, 2, -0.5, false}, {1, 2, 1, true},
+        {1, 2, -0.5 + u, true}, {1, 2, -2, false}, {1, 2, 1, true},     {1, 2, -2 + u, true},
+        {1, 2, -3, false}, {1, 2, 1, true},
+    };
+    expect_moves(1, a, sizeof a / sizeof a[0]);
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG73 X1 Y2 Z-3 R1 Q1.5 F100\n"), CS_OK);
+    const move_t b[] = {
+        {1, 2, 5, true},         {1, 2, 1, true},   {1, 2, -0.5, false}, {1, 2, -0.5 + u, true},
+        {1, 2, -2, false},       {1, 2, -2 + u, true}, {1, 2, -3, false}, {1, 2, 5, true},
+    };
+    expect_moves(1, b, sizeof b / sizeof b[0]);
+    /* A peck that would end on the bottom is the final feed; R, Z and Q stick on "X3". */
+    assert_int_equal(parse("G0 X0 Y0 Z5\nG99 G83 X1 Y2 Z-1 R1 Q1 F100\nX3\n"), CS_OK);
+    const move_t c[] = {
+        {1, 2, 5, true},  {1, 2, 1, true},  {1, 2, 0, false}, {1, 2, 1, true},
+        {1, 2, u, true},  {1, 2, -1, false}, {1, 2, 1, true},
+        {3, 2, 1, true},  {3, 2, 0, false}, {3, 2, 1, true},  {3, 2, u, true},
+        {3, 2, -1, false}, {3, 2, 1, true},
+    };
+    expect_moves(1, c, sizeof c / sizeof c[0]);
+    expect_diag(parse("G83 X1 R1 Z-1 F60\n"), CS_ERR_PARSE, 1, 1);     /* no Q */
+    expect_diag(parse("G83 X1 R1 Z-1 Q0 F60\n"), CS_ERR_PARSE, 1, 15); /* Q not positive */
+    /* A Q so small that the pecks would never end (d - Q == d in double): refused. */
+    expect_diag(parse("G73 X1 R4000 Z-4000 Q0.00000000001 F60\n"), CS_ERR_RANGE, 1, 21);
+    expect_diag(parse("G73 X1 R4000 Z-4000 Q0.0799 F60\n"), CS_ERR_RANGE, 1, 21); /* 100 125 */
+    /* Another cycle's R, Z do not carry over. */
+    expect_diag(parse("G81 X1 R1 Z0 F60\nG83 X2 Q1\n"), CS_ERR_PARSE, 2, 1);
+}
+
+static void test_g81_errors(void **state)
+{
+    (void)state;
+    expect_diag(parse("G81 X1 Z-1 F60\n"), CS_ERR_PARSE, 1, 1);            /* no R */
+    expect_diag(parse("G81 X1 R1 F60\n"), CS_ERR_PARSE, 1, 1);             /* no Z */
+    expect_diag(parse("G0 Z5\nG81 X1 R-2 Z-1 F60\n"), CS_ERR_PARSE, 2, 1); /* R below Z */
+    expect_diag(parse("G18\nG81 X1 R1 Z0 F60\n"), CS_ERR_UNSUPPORTED, 2, 1);
+    expect_diag(parse("G81 X1 R1 Z0 L0 F60\n"), CS_ERR_PARSE, 1, 14);
+    /* R and Z stick only while the same cycle goes on. */
+    expect_diag(parse("G81 X1 R1 Z0 F60\nG0 Z5\nG81 X2\n"), CS_ERR_PARSE, 3, 1);
+    /* Grbl 1.1 has no canned cycles (error:20). */
+    expect_diag(parse_dialect("G81 X1 R1 Z0 F60\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 1);
+    assert_non_null(strstr(D.reason, "Grbl"));
+    expect_diag(parse_dialect("G98\n", CS_GCODE_GRBL), CS_ERR_UNSUPPORTED, 1, 1);
 }
 
 static void test_arc_errors(void **state)
@@ -1319,11 +1535,17 @@ int main(void)
         cmocka_unit_test(test_unsupported_strict_and_lenient),
         cmocka_unit_test(test_lenient_drops_words_of_dropped_codes),
         cmocka_unit_test(test_syntax_errors),
+        cmocka_unit_test(test_polar_coordinates),
         cmocka_unit_test(test_arc_ijk_quarter_both_directions),
         cmocka_unit_test(test_arc_planes),
         cmocka_unit_test(test_arc_full_circle_and_turns),
         cmocka_unit_test(test_arc_r_form),
         cmocka_unit_test(test_arc_errors),
+        cmocka_unit_test(test_g81_drilling_cycle),
+        cmocka_unit_test(test_g81_errors),
+        cmocka_unit_test(test_g83_g73_pecking),
+        cmocka_unit_test(test_arc_off_plane_offset),
+        cmocka_unit_test(test_lenient_ignored_words_reported_once),
         cmocka_unit_test(test_arc_tiny_pieces),
         cmocka_unit_test(test_arc_small_radius_near_quarter),
         cmocka_unit_test(test_arc_piece_halved_by_rounding),

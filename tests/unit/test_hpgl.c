@@ -360,7 +360,14 @@ static void test_errors(void **state)
     assert_int_equal(D.loc.col, 16);
     assert_int_equal(P.n, 1);
     assert_int_equal(rd("IN;PR100000,0,100000,0;"), CS_ERR_RANGE);
-    assert_int_equal(rd("IN;PD1e5,0;"), CS_ERR_PARSE); /* no exponents in HP-GL */
+    /* No exponents in HP-GL: said at the number (it read as a digit then an "e1" mnemonic). */
+    assert_int_equal(rd("IN;PD1e5,0;"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 6);
+    assert_non_null(strstr(D.reason, "PD: number in exponent form"));
+    assert_int_equal(rd("IN;PU10,0;PD;AA0,0,1E-3;"), CS_ERR_PARSE);
+    assert_int_equal(D.loc.col, 20);
+    /* ... while a letter pair after a number is the next instruction, E or not. */
+    assert_int_equal(rd("IN;PA10,10EA20,20;"), CS_OK);
     assert_int_equal(rd("IN;PD99999999999,0;"), CS_ERR_RANGE);
     /* Parameter counts. */
     assert_int_equal(rd("IN;AA0,0;"), CS_ERR_PARSE);

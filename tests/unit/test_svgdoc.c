@@ -1213,6 +1213,55 @@ static void expect_warning(const char *where, const char *what)
         fail_msg("warning '%s', expected '%s' ... '%s'", last_warn, where, what);
 }
 
+/* Inkscape 0.x flowed text: <flowRoot> holds a <flowRegion> shape (the frame the text flows
+ * in, not shown by Inkscape) and <flowPara> text. Neither is drawn; one warning at the first
+ * <flowRoot>; the stroked line after it is drawn. */
+static void test_flowroot_not_drawn(void **state)
+{
+    (void)state;
+    const char *doc = "<svg xmlns='http://www.w3.org/2000/svg'>\n"
+                      "<flowRoot style='font-size:40px'><flowRegion><rect width='200' "
+                      "height='100' x='50' y='60'/></flowRegion><flowPara>Flowed</flowPara>"
+                      "</flowRoot>\n"
+                      "<flowRoot><flowRegion><path d='M0 0 L5 5'/></flowRegion></flowRoot>\n"
+                      "<line x1='1' y1='2' x2='3' y2='4' stroke='black'/></svg>";
+    assert_int_equal(read_text(doc), CS_OK);
+    assert_int_equal(P.n, 1);
+    expect_pt(&P.elems[0].curve.p[0], 1, 2);
+    expect_pt(&P.elems[0].curve.p[1], 3, 4);
+    assert_int_equal(nwarn, 1);
+    expect_warning(":2:1:", "ignoring <flowRoot> (Inkscape flowed text)");
+    assert_int_equal(S.ignored, 4); /* the two flowRoots and the two frame shapes */
+}
+
+/* <switch>: only the first child whose conditions hold; a foreignObject is passed over for
+ * its SVG fallback (draw.io's labels), an empty first <g> hides the rest (draw.io's "Text is
+ * not SVG - cannot display" footer), systemLanguage holds for English, requiredExtensions never. */
+static void test_switch(void **state)
+{
+    (void)state;
+    const char *doc =
+        "<svg xmlns='http://www.w3.org/2000/svg'>"
+        "<switch><foreignObject requiredFeatures='http://www.w3.org/TR/SVG11/feature#"
+        "Extensibility'><p xmlns='http://www.w3.org/1999/xhtml'>x</p></foreignObject>"
+        "<line x1='1' y1='1' x2='2' y2='2' stroke='black'/>"
+        "<line x1='3' y1='3' x2='4' y2='4' stroke='black'/></switch>"
+        "<switch><g requiredFeatures='http://www.w3.org/TR/SVG11/feature#Extensibility'/>"
+        "<line x1='5' y1='5' x2='6' y2='6' stroke='black'/></switch>"
+        "<switch><line systemLanguage='fr' x1='7' y1='7' x2='8' y2='8' stroke='black'/>"
+        "<line systemLanguage='en-GB, de' x1='9' y1='9' x2='10' y2='10' stroke='black'/>"
+        "<line x1='11' y1='11' x2='12' y2='12' stroke='black'/></switch>"
+        "<switch><line requiredExtensions='http://example.org/ext' x1='12' y1='0' x2='0' y2='0' "
+        "stroke='black'/><line x1='13' y1='13' x2='14' y2='14' stroke='black'/></switch>"
+        "<line x1='15' y1='15' x2='16' y2='16' stroke='black'/></svg>";
+    assert_int_equal(read_text(doc), CS_OK);
+    assert_int_equal(P.n, 4);
+    expect_pt(&P.elems[0].curve.p[0], 1, 1);
+    expect_pt(&P.elems[1].curve.p[0], 9, 9);
+    expect_pt(&P.elems[2].curve.p[0], 13, 13);
+    expect_pt(&P.elems[3].curve.p[1], 16, 16);
+}
+
 static void test_use_elements(void **state)
 {
     (void)state;
@@ -1567,6 +1616,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_style_display, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_files_flatten, setup, teardown),
         cmocka_unit_test_setup_teardown(test_drawn_up_to_error, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_flowroot_not_drawn, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_switch, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_elements, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_symbol_viewbox, setup, teardown),
         cmocka_unit_test_setup_teardown(test_use_refused, setup, teardown),
