@@ -72,7 +72,9 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
 /* Rest-material fill-in: the check's own measure of the passes (cs_dropcheck_gaps, z-map step
  * step_mm, the ideal cutter keeping the mesh bound eps) finds the nodes left more than H - eps
  * that a cutter from above could reach and the axis position from which the ideal cutter comes
- * nearest to each; one short pass there (three drops tol / 2 apart along x). flagged: only the
+ * nearest to each; one short pass there (the drop there and those tol / 2 before and after it
+ * along x, each kept only where its chord passes the raster's test: no chord joins a low drop
+ * to a high one across a jump). flagged: only the
  * nodes within R / 4 of p's flagged points, one round (the raster); else every node, two rounds
  * at most (raster+waterline). *added counts the passes added. CS_ERR_FULL out of memory. */
 cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
