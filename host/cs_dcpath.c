@@ -613,12 +613,12 @@ static cs_err_t fill_at(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_
 
 cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                         const cs_surffile_t *sf, const cs_dcpath_opts_t *o, double step_mm,
-                        bool flagged, size_t *added)
+                        bool flagged, int rounds, size_t *added)
 {
     cs_dropcheck_win_t win = {(const double(*)[2])p->flag, p->nflag, t->r_mm / 4};
     if (flagged && p->nflag == 0)
         return CS_OK;
-    for (int round = 0; round < (flagged ? 1 : 2); round++) {
+    for (int round = 0; round < rounds; round++) {
         cs_dropcheck_t ck;
         double(*at)[2];
         size_t nat;

@@ -576,7 +576,7 @@ static void test_fill_step(void **state)
     assert_non_null(p.flag);
     p.flag[0][0] = STEP_XW - 0.6, p.flag[0][1] = 5, p.nflag = p.flagcap = 1;
     size_t added = 0;
-    assert_int_equal(cs_dcpath_fill(&p, &ms, &t, &sf, &o, step, true, &added), CS_OK);
+    assert_int_equal(cs_dcpath_fill(&p, &ms, &t, &sf, &o, step, true, 1, &added), CS_OK);
     assert_true(added > 0 && p.npass == added);
     double worst = 0;
     size_t beside = 0;
