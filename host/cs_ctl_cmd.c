@@ -93,7 +93,7 @@ static int run_job(const ctl_args_t *a, cs_stream_job_t *job, ctl_seen_t *seen)
 {
     cs_serial_t ser;
     if (cs_serial_open(&ser, a->port, (uint32_t)a->baud) != 0) {
-        fprintf(stderr, "curvestep %s: %s: %s\n", a->who, a->port, strerror(errno));
+        fprintf(stderr, "curvestep %s: %s: %s\n", a->who, a->port, cs_serial_strerror(errno));
         return CS_EXIT_NO_DEVICE;
     }
     struct sigaction sa;

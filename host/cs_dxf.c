@@ -1799,6 +1799,15 @@ bool cs_dxf_is(const char *buf, size_t len)
     return false;
 }
 
+/* Does the last 0/SECTION lack its 0/ENDSEC? */
+static bool cut_short(const dx_t *d)
+{
+    for (size_t i = d->ng; i-- > 0;)
+        if (d->g[i].code == 0 && (is(d, i, "ENDSEC") || is(d, i, "SECTION")))
+            return is(d, i, "SECTION");
+    return false;
+}
+
 static cs_err_t dxf_run(dx_t *d)
 {
     size_t b = cs_readall_bom(d->buf, d->len);
@@ -1809,6 +1818,11 @@ static cs_err_t dxf_run(dx_t *d)
                                 "binary DXF is not read: save the drawing as ASCII DXF");
     }
     cs_err_t e = lex(d);
+    /* A file cut short in transfer still parses up to its cut: draw it, but say so. The sign:
+     * its last section never ends (a file that only lacks its closing 0/EOF is whole). */
+    if (e == CS_OK && cut_short(d))
+        DX_WARN(d, d->ng - 1, "the file ends inside a section (no 0/ENDSEC): it may be cut "
+                              "short (drawn as far as it goes)");
     if (e == CS_OK)
         e = each_section(d, "HEADER", read_header);
     if (e == CS_OK && d->unit_mm == 0) {

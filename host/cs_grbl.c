@@ -1006,7 +1006,7 @@ static int start(grbl_t *g)
     }
     const cs_joblink_cfg_t *dc = &g->cfg->dev; /* serial: cs_stream; else cs_grbl_link */
     if (dc->port != NULL && cs_serial_open(&g->ser, dc->port, dc->baud) != 0) {
-        fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", dc->port, strerror(errno));
+        fprintf(stderr, "curvestep grbl: cannot open %s: %s\n", dc->port, cs_serial_strerror(errno));
         return CS_EXIT_NO_DEVICE;
     }
     if (dc->port != NULL)

@@ -166,7 +166,7 @@ static int serial_open(cs_joblink_t *l, const cs_joblink_job_t *j)
     if (l->ser_open)
         return CS_EXIT_OK;
     if (cs_serial_open(&l->ser, l->cfg.port, l->cfg.baud) != 0) {
-        snprintf(l->why, sizeof l->why, "%s: %s", l->cfg.port, strerror(errno));
+        snprintf(l->why, sizeof l->why, "%s: %s", l->cfg.port, cs_serial_strerror(errno));
         return CS_EXIT_NO_DEVICE;
     }
     cs_serial_set_line_rate(&l->ser, l->cfg.line_rate);

@@ -6,6 +6,7 @@
 #include <poll.h>
 #include <pty.h>
 #include <string.h>
+#include <sys/file.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -99,8 +100,10 @@ static int make_raw(int fd, uint32_t baud)
  * on this project's Linux 6.18 machine, with the pty index just freed by the previous device,
  * stat and open of the path the creator printed fail with ENOENT on and off for up to 57 ms
  * (3 of 300 creations; `curvestep stream` to a fresh `curvestep-sim --pty` failed to open it 2
- * times in 300). A path under /dev/pts/ is therefore retried on ENOENT until this deadline. */
-#define CS_SERIAL_PTS_WAIT_S 5.0
+ * times in 300). A path under /dev/pts/ is therefore retried on ENOENT until this deadline
+ * (35 times the longest gap seen; kept short: a path whose device has gone for good can be
+ * given to the next pty created, and a sender still waiting would open that one). */
+#define CS_SERIAL_PTS_WAIT_S 2.0
 
 static int open_tty(const char *path)
 {
@@ -132,6 +135,16 @@ int cs_serial_open(cs_serial_t *s, const char *path, uint32_t baud)
         errno = ENOTTY;
         return -1;
     }
+    /* One program on a port at a time: two senders' frames interleaved on one line would each
+     * be taken for the other's retransmissions (seen once on a loaded test machine: a sender
+     * that waited for a vanished pty's path opened the next device given that number). The
+     * lock is advisory, as pyserial's exclusive mode: every curvestep program takes it. */
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        int e = errno == EWOULDBLOCK ? EBUSY : errno;
+        close(fd);
+        errno = e;
+        return -1;
+    }
     if (make_raw(fd, baud) != 0) {
         int e = errno;
         close(fd);
@@ -143,6 +156,13 @@ int cs_serial_open(cs_serial_t *s, const char *path, uint32_t baud)
     tcflush(fd, TCIOFLUSH);
     s->fd = fd;
     return 0;
+}
+
+const char *cs_serial_strerror(int e)
+{
+    if (e == EBUSY)
+        return "in use by another program (it holds the port's lock): one sender at a time";
+    return strerror(e);
 }
 
 void cs_serial_attach(cs_serial_t *s, int fd)

@@ -36,9 +36,13 @@ typedef struct {
 
 /* Opens path (a tty or pty slave) read/write, non-blocking, raw 8N1 at baud (one of the termios
  * rates 1200..4000000; 0 = leave the speed alone), and discards stale input (tcflush). Returns 0,
- * or -1 with errno set (EINVAL for an unsupported baud). A /dev/pts/ path that does not exist
- * is retried for up to 5 s (a fresh pty's entry can be missing for a moment). Not ISR-safe. */
+ * or -1 with errno set (EINVAL for an unsupported baud, EBUSY when another program holds the
+ * port: an exclusive flock is taken). A /dev/pts/ path that does not exist is retried for up
+ * to 2 s (a fresh pty's entry can be missing for a moment). Not ISR-safe. */
 int cs_serial_open(cs_serial_t *s, const char *path, uint32_t baud);
+/* Why cs_serial_open failed, for people: strerror(e), except EBUSY (another program holds the
+ * port). A static string. */
+const char *cs_serial_strerror(int e);
 /* Wraps an already open fd (a pty end from cs_serial_openpty): sets O_NONBLOCK, no termios. */
 void cs_serial_attach(cs_serial_t *s, int fd);
 /* Closes the port (fd = -1). */

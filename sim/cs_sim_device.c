@@ -912,7 +912,7 @@ static int device_line(device_run_t *d)
     }
     cs_serial_t ser;
     if (cs_serial_open(&ser, d->port, (uint32_t)d->o.baud) != 0) {
-        fprintf(stderr, "curvestep-sim: %s: %s\n", d->port, strerror(errno));
+        fprintf(stderr, "curvestep-sim: %s: %s\n", d->port, cs_serial_strerror(errno));
         return DEV_INPUT;
     }
     d->fd = ser.fd;

@@ -235,7 +235,7 @@ static int rtu_open(const char *dev, uint32_t baud, char parity, cs_serial_t *se
         return 0;
     }
     if (cs_serial_open(ser, dev, baud) != 0) {
-        fprintf(stderr, "curvestep-sim: %s: %s\n", dev, strerror(errno));
+        fprintf(stderr, "curvestep-sim: %s: %s\n", dev, cs_serial_strerror(errno));
         return 1;
     }
     if (set_parity(ser->fd, parity) != 0) {

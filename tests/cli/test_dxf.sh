@@ -98,6 +98,15 @@ printf '0\nSECTION\n2\nENTITIES\n0\nHATCH\n0\nHATCH\n0\nPOINT\n10\n1\n20\n1\n0\n
 run "skipped" 0 flatten "$T/sk.dxf" && expect_err "skipped" 'sk.dxf:6:1: warning: HATCH: ' &&
     expect "skipped: HATCH warned once" test "$(grep -c 'HATCH' "$T/err")" = 1 &&
     expect_err "skipped" 'sk.dxf:10:1: warning: POINT: '
+# A file cut short (no ENDSEC, no EOF): drawn as far as it goes, with a warning at its last
+# group; a file whose sections all end but which lacks 0/EOF is whole (as the unit tests'
+# snippets): no warning.
+printf '0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n1\n20\n2\n11\n3\n21\n4' >"$T/cut.dxf"
+run "cut short" 0 flatten "$T/cut.dxf" && expect_out "cut short" '1.000000 2.000000\n3.000000 4.000000\n' &&
+    expect_err "cut short" 'cut.dxf:14:1: warning: the file ends inside a section \(no 0/ENDSEC\)'
+head -n -2 "$T/sk.dxf" >"$T/noeof.dxf"
+run "no EOF but whole" 0 flatten "$T/noeof.dxf" &&
+    expect "complete file: no cut-short warning" bash -c "! grep -q 'cut short' '$T/err'"
 
 # --- errors: file:line:col, exit 1, nothing on stdout -------------------------------------
 printf 'AutoCAD Binary DXF\r\n\032\000' >"$T/bin.dxf"

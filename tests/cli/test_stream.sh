@@ -53,6 +53,24 @@ expect "segments: final position exact" grep -q 'rounded to steps: exact' "$T/se
 expect "segments: deviation reported" grep -qE '^max deviation: [0-9.]+ mm .* ok$' "$T/seg.sim"
 expect "segments: picture drawn" grep -q '<polyline' "$T/seg.svg"
 
+# 1b. one sender at a time: while another program holds the port's lock (an exclusive flock, as
+# pyserial's exclusive mode; taken here by python, not by the code under test) a sender is
+# refused at once, exit 4, naming why, and the device receives nothing.
+start_sim busy
+python3 -c 'import fcntl, os, sys, time
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_NOCTTY)
+fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+open(sys.argv[2], "w").write("held\n")
+time.sleep(120)' "$PTY" "$T/held" &
+holder=$!
+pids+=("$holder")
+wait_until 60 test -s "$T/held"
+run "port locked by another program: exit 4" 4 stream --port "$PTY" "$JOB" &&
+    expect_err "port locked: says why" "$PTY: in use by another program"
+kill "$holder" 2>/dev/null
+wait_sim
+expect "port locked: the device received nothing" grep -q ' 0 messages executed' "$T/busy.sim"
+
 # 2. curves mode, with arcs approximated by cubics: same checks on the device.
 start_sim cur --reference "$ARCS" --check
 timeout -k 5 60 "$CS" stream --mode curves --port "$PTY" "$ARCS" >"$T/cur.out" 2>"$T/cur.err"; rc=$?
