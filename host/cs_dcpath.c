@@ -567,7 +567,27 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
     return e;
 }
 
-/* One short pass at each of the n axis positions at (xy, mm): three drops tol / 2 apart along x. */
+/* Is the chord from a to b (tip points, mm) within tol / 2 of the drop height of t, as refine
+ * holds the raster's chords: at its midpoint and both quarter points? */
+static bool chord_clear(cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
+                        const cs_dcpath_opts_t *o, const double a[3], const double b[3],
+                        size_t *drops)
+{
+    for (int k = 1; k <= 3; k++) {
+        double f = k / 4.0, z = a[2] + f * (b[2] - a[2]);
+        bool hit;
+        double d = cs_dropcut_drop(ms, t, a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), &hit);
+        (*drops)++;
+        if (fabs((hit ? fmax(d, o->min_z) : o->min_z) - z) > o->tol_mm / 2)
+            return false;
+    }
+    return true;
+}
+
+/* One short pass at each of the n axis positions at (xy, mm): the drop there, and the drops
+ * tol / 2 before and after it along x where the chord to them passes refine's test (near a jump
+ * of the drop height, a low and a high drop joined by a chord would cut into the step: that
+ * side is left out, down to the one point, a plunge). */
 static cs_err_t fill_at(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                         const cs_dcpath_opts_t *o, const double (*at)[2], size_t n)
 {
@@ -582,19 +602,23 @@ static cs_err_t fill_at(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_
             q[j][2] = hit ? fmax(z, o->min_z) : o->min_z;
             p->drops++;
         }
-        e = cs_dcpath_append(p, (const double(*)[3])q, 3, at[i][1]);
+        bool lo = chord_clear(ms, t, o, q[0], q[1], &p->drops);
+        bool hi = chord_clear(ms, t, o, q[1], q[2], &p->drops);
+        if (!lo)
+            memcpy(q[0], q[1], sizeof q[0]), memcpy(q[1], q[2], sizeof q[1]);
+        e = cs_dcpath_append(p, (const double(*)[3])q, 1 + (size_t)lo + (size_t)hi, at[i][1]);
     }
     return e;
 }
 
 cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                         const cs_surffile_t *sf, const cs_dcpath_opts_t *o, double step_mm,
-                        bool flagged, size_t *added)
+                        bool flagged, int rounds, size_t *added)
 {
     cs_dropcheck_win_t win = {(const double(*)[2])p->flag, p->nflag, t->r_mm / 4};
     if (flagged && p->nflag == 0)
         return CS_OK;
-    for (int round = 0; round < (flagged ? 1 : 2); round++) {
+    for (int round = 0; round < rounds; round++) {
         cs_dropcheck_t ck;
         double(*at)[2];
         size_t nat;

@@ -72,12 +72,15 @@ cs_err_t cs_dcpath_raster(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcu
 /* Rest-material fill-in: the check's own measure of the passes (cs_dropcheck_gaps, z-map step
  * step_mm, the ideal cutter keeping the mesh bound eps) finds the nodes left more than H - eps
  * that a cutter from above could reach and the axis position from which the ideal cutter comes
- * nearest to each; one short pass there (three drops tol / 2 apart along x). flagged: only the
- * nodes within R / 4 of p's flagged points, one round (the raster); else every node, two rounds
- * at most (raster+waterline). *added counts the passes added. CS_ERR_FULL out of memory. */
+ * nearest to each; one short pass there (the drop there and those tol / 2 before and after it
+ * along x, each kept only where its chord passes the raster's test: no chord joins a low drop
+ * to a high one across a jump). flagged: only the nodes within R / 4 of p's flagged points (the
+ * raster); else every node (waterline, raster+waterline: they flag nothing). rounds (>= 1): the
+ * measure again on the passes so far while the last round added some, at most that many in all.
+ * *added counts the passes added. CS_ERR_FULL out of memory. */
 cs_err_t cs_dcpath_fill(cs_dcpath_t *p, cs_dropcut_mesh_t *ms, const cs_dropcut_tool_t *t,
                         const cs_surffile_t *sf, const cs_dcpath_opts_t *o, double step_mm,
-                        bool flagged, size_t *added);
+                        bool flagged, int rounds, size_t *added);
 /* Joins each pass to the one before it where the straight move between the end of one and the
  * start of the next stays within tol_mm / 2 of the drop-cutter height of tool t or above it
  * (sampled every step_mm along the move; the passes' own chords are held to the same): one

@@ -35,6 +35,7 @@
  * second difference over a node steeper than WL_KINK), which levels on the grid cannot hug,
  * get a raster each way at a quarter of that step-over (at most sqrt(2rH - H^2)), clipped
  * the same way. Nodes where the cutter rests on the floor, not the surface, want nothing.
+ * The command then adds the fill-in over the whole region (cs_dcpath_fill, one round).
  * Host only, double precision. */
 #ifndef CS_DCWATER_H
 #define CS_DCWATER_H

@@ -261,7 +261,9 @@ static int build_mesh(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *
     return CS_EXIT_OK;
 }
 
-/* The passes of the chosen strategy, joined where the link is clear (unless --no-link). */
+/* The passes of the chosen strategy, then the fill-in (the raster's around its flagged points,
+ * the others' over the whole region: they flag nothing), joined where the link is clear (unless
+ * --no-link). */
 static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs_dcpath_t *p)
 {
     cs_err_t e = a->waterline ? cs_dcwater_plan(p, ms, &a->tool, &a->po)
@@ -274,7 +276,11 @@ static int plan(dc_args_t *a, const cs_surffile_t *sf, cs_dropcut_mesh_t *ms, cs
     }
     size_t filled = 0, nflag = p->nflag;
     double step = a->check_step > 0 ? a->check_step : 0.05;
-    if (!a->waterline && cs_dcpath_fill(p, ms, &a->tool, sf, &a->po, step, !a->combo, &filled) != CS_OK) {
+    /* raster+waterline keeps its two rounds; the waterline's second round found nothing on the
+     * teapot with any cutter (docs/surfaces.md) and costs a whole measure, so one */
+    bool flagged = !a->combo && !a->waterline;
+    int rounds = a->combo ? 2 : 1;
+    if (cs_dcpath_fill(p, ms, &a->tool, sf, &a->po, step, flagged, rounds, &filled) != CS_OK) {
         fprintf(stderr, "curvestep toolpath: fill-in: out of memory\n");
         return CS_EXIT_INTERNAL;
     }

@@ -71,7 +71,7 @@ static void one(const cs_surffile_t *sf, run_t *r)
     cs_dcpath_init(&p);
     size_t filled = 0;
     if (cs_dcpath_raster(&p, &ms, &tool, &o) != CS_OK ||
-        cs_dcpath_fill(&p, &ms, &tool, sf, &o, 0.05, true, &filled) != CS_OK)
+        cs_dcpath_fill(&p, &ms, &tool, sf, &o, 0.05, true, 1, &filled) != CS_OK)
         exit(3);
     r->npass = p.npass;
     cs_dcpath_link(&p, &ms, &tool, r->tol, r->tol);

@@ -14,7 +14,12 @@
  *    grid's pyramid several levels deep): a ball's drop against the highest centre height at
  *    which the ball still meets a triangle (bisection on the 3-D point-triangle distance), a flat
  *    end's against the highest point of the triangle within R (vertices, edge-circle crossings,
- *    the rim point up the plane's gradient), both to 1e-7 mm. */
+ *    the rim point up the plane's gradient), both to 1e-7 mm;
+ *  - the rest-material fill-in (cs_dcpath_fill) beside a step: a floor, a vertical wall 4 mm
+ *    high, a plateau; the ball's drop jumps from 0 to 4 - R at R from the wall. Every chord of
+ *    every fill-in pass, sampled 64 times, stays within tol of the drop height written here
+ *    (4 - R + sqrt(R^2 - d^2) within R of the wall, 4 over the plateau, 0 beyond), and some pass
+ *    stands within tol / 2 of the jump (else the test proves nothing). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -26,6 +31,7 @@
 
 #include <cmocka.h>
 
+#include "cs_dcpath.h"
 #include "cs_dropcut.h"
 #include "cs_surffile.h"
 
@@ -527,6 +533,78 @@ static void test_soup(void **state)
     free(tri);
 }
 
+/* --- the fill-in beside a jump of the drop height ------------------------------------------ */
+
+#define STEP_XW 10.0 /* the wall's x; floor z 0 before it, plateau z STEP_H after */
+#define STEP_H  4.0
+
+/* The ball's tip dropped onto the step at axis x (written here from the geometry). */
+static double step_drop(double r, double x)
+{
+    double d = STEP_XW - x;
+    if (d <= 0)
+        return STEP_H;
+    return d < r ? STEP_H - r + sqrt(r * r - d * d) : 0;
+}
+
+static void test_fill_step(void **state)
+{
+    (void)state;
+    static const char text[] = "curvestep-surfaces 1\n"
+                               "bezier 1 1\n 4 2 0  4 8 0\n 10 2 0  10 8 0\n"
+                               "bezier 1 1\n 10 2 0  10 8 0\n 10 2 4  10 8 4\n"
+                               "bezier 1 1\n 10 2 4  10 8 4\n 14 2 4  14 8 4\n";
+    cs_surffile_t sf;
+    cs_path_diag_t d;
+    assert_int_equal(cs_surffile_parse(text, strlen(text), "step", 1, 0.01, &sf, &d), CS_OK);
+    const cs_dropcut_tool_t t = {2, 2};
+    const double tol = 0.01, step = 0.05;
+    cs_dropcut_mesh_t ms;
+    assert_int_equal(cs_dropcut_build(&ms, &sf, tol / 4, tol / 8, t.r_mm), CS_OK);
+    assert_true(ms.eps < tol / 4);
+    /* The ideal cutter (R + eps) nearest the foot of the wall stands on the floor at the last
+     * position of the fill-in's lattice (the region's corner plus multiples of step) short of
+     * R + eps from the wall: put one tol / 4 short of it, so that the pass's next drop, tol / 2
+     * on, lands past the jump. The region reaches R beyond the window all round (the measure's
+     * interior). */
+    double x0 = STEP_XW - t.r_mm - ms.eps - tol / 4 - 60 * step;
+    cs_dcpath_opts_t o = {.scallop_mm = 0.05, .tol_mm = tol, .box = {x0, 2.2, 12.2, 7.8}, .min_z = 0};
+    cs_dcpath_t p;
+    cs_dcpath_init(&p);
+    /* flagged at the foot of the wall: the fill-in looks within R / 4 of it */
+    p.flag = malloc(sizeof *p.flag);
+    assert_non_null(p.flag);
+    p.flag[0][0] = STEP_XW - 0.6, p.flag[0][1] = 5, p.nflag = p.flagcap = 1;
+    size_t added = 0;
+    assert_int_equal(cs_dcpath_fill(&p, &ms, &t, &sf, &o, step, true, 1, &added), CS_OK);
+    assert_true(added > 0 && p.npass == added);
+    double worst = 0;
+    size_t beside = 0;
+    for (size_t k = 0; k < p.npass; k++) {
+        for (size_t i = p.start[k]; i < p.start[k + 1]; i++) {
+            const double *a = p.pt[i];
+            double z0 = step_drop(t.r_mm, a[0]);
+            beside += fabs(step_drop(t.r_mm, a[0] - tol / 2) - z0) > 1 ||
+                      fabs(step_drop(t.r_mm, a[0] + tol / 2) - z0) > 1;
+            if (i + 1 == p.start[k + 1])
+                continue;
+            const double *b = p.pt[i + 1];
+            for (int j = 0; j <= 64; j++) {
+                double f = j / 64.0;
+                worst = fmax(worst, step_drop(t.r_mm, a[0] + f * (b[0] - a[0])) -
+                                        (a[2] + f * (b[2] - a[2])));
+            }
+        }
+    }
+    printf("fill-in beside a step: %zu passes, %zu points within tol / 2 of the jump, deepest "
+           "chord %.6f mm under the drop height (tol %g)\n", p.npass, beside, worst, tol);
+    assert_true(beside > 0);
+    assert_true(worst <= tol);
+    cs_dcpath_free(&p);
+    cs_dropcut_free(&ms);
+    cs_surffile_free(&sf);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -536,6 +614,7 @@ int main(void)
         cmocka_unit_test(test_grid_eps),
         cmocka_unit_test(test_gouge_free),
         cmocka_unit_test(test_soup),
+        cmocka_unit_test(test_fill_step),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
