@@ -2,6 +2,7 @@
  * the mesh (cs_dropcut), plans the raster (cs_dcpath), writes the tool points and G-code a Grbl
  * or LinuxCNC machine runs as written, and with --check measures gouge and scallop against the
  * exact surface (cs_dropcheck). The options are listed in `curvestep toolpath --help`. */
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -24,7 +25,7 @@
 #define DC_MAX_PASSES     20000
 
 typedef struct {
-    const char *file, *gcode, *name;
+    const char *file, *gcode, *name, *trace; /* trace: --check-trace, an executed path */
     double scale, tol, feed, plunge, safe_z, spindle, min_z, check_step;
     bool have_safe_z, have_min_z, have_stock, check, stats, centre, no_link, waterline, combo;
     cs_dropcut_tool_t tool;
@@ -85,6 +86,7 @@ static int parse_value(int c, const char *v, dc_args_t *a)
     case 'm': a->have_min_z = true; return cs_conv_number(v, &a->min_z) ? 0 : bad("--min-z", v, "a height in mm");
     case 's': return cs_conv_number(v, &a->spindle) && a->spindle >= 0 ? 0 : bad("--spindle", v, "a speed in rev/min >= 0");
     case 'k': a->have_stock = true; return parse_box(v, a->po.box) ? 0 : bad("--stock", v, "X0,Y0,X1,Y1 (mm, X0 < X1, Y0 < Y1)");
+    case 'R': a->trace = v; return 0;
     case 'K': return cs_conv_number(v, &a->check_step) && a->check_step > 0 ? 0 : bad("--check-step", v, "a distance in mm > 0");
     case 'W':
         if (strcmp(v, "raster") && strcmp(v, "waterline") && strcmp(v, "raster+waterline"))
@@ -114,6 +116,7 @@ static int parse_args(int argc, char **argv, dc_args_t *a)
         {"output", required_argument, NULL, 'o'},  {"check-step", required_argument, NULL, 'K'},
         {"check", no_argument, NULL, 'C'},         {"stats", no_argument, NULL, 'T'},
         {"no-link", no_argument, NULL, 'L'},       {"strategy", required_argument, NULL, 'W'},
+        {"check-trace", required_argument, NULL, 'R'},
         {NULL, 0, NULL, 0},
     };
     int c;
@@ -327,6 +330,65 @@ static int plan_and_write(dc_args_t *a, const cs_surffile_t *sf)
     return status;
 }
 
+/* The executed path of `curvestep-sim --trace` (t_s,axis,dir,x_mm,y_mm,z_mm, one line per
+ * step edge; spindle lines "s" skipped) as one pass of tip points: the machine's position is the
+ * programmed point (the tip, or the corner's centre with --output centre). */
+static int load_trace(const dc_args_t *a, cs_dcpath_t *p)
+{
+    FILE *f = fopen(a->trace, "r");
+    if (!f) {
+        fprintf(stderr, "%s:0:0: cannot read: %s\n", a->trace, strerror(errno));
+        return CS_EXIT_INPUT;
+    }
+    char line[256];
+    double(*pt)[3] = NULL;
+    size_t n = 0, cap = 0, ln = 0;
+    int st = CS_EXIT_OK;
+    while (st == CS_EXIT_OK && fgets(line, sizeof line, f)) {
+        double t, x, y, z;
+        char ax;
+        int dir;
+        if (++ln == 1 && strncmp(line, "t_s,", 4) == 0)
+            continue;
+        if (sscanf(line, "%lf,%c,%d,%lf,%lf,%lf", &t, &ax, &dir, &x, &y, &z) != 6) {
+            fprintf(stderr, "%s:%zu:1: not a curvestep-sim --trace line\n", a->trace, ln);
+            st = CS_EXIT_INPUT;
+        } else if (ax != 's') {
+            if (n == cap && !cs_path_grow((void **)&pt, &cap, n + 1, sizeof *pt))
+                st = CS_EXIT_INTERNAL;
+            else
+                memcpy(pt[n++], (double[3]){x, y, a->centre ? z - a->tool.c_mm : z}, sizeof *pt);
+        }
+    }
+    fclose(f);
+    if (st == CS_EXIT_OK && n < 2) {
+        fprintf(stderr, "%s:%zu:1: the trace holds no move\n", a->trace, ln);
+        st = CS_EXIT_INPUT;
+    }
+    if (st == CS_EXIT_OK && cs_dcpath_append(p, (const double(*)[3])pt, n, 0) != CS_OK)
+        st = CS_EXIT_INTERNAL;
+    free(pt);
+    return st;
+}
+
+/* --check-trace: the check of item 6 on the path a machine (the simulator) executed. */
+static int check_trace(dc_args_t *a, const cs_surffile_t *sf)
+{
+    cs_dropcut_mesh_t ms;
+    cs_dcpath_t p;
+    cs_dcpath_init(&p);
+    int status = build_mesh(a, sf, &ms);
+    if (status == CS_EXIT_OK)
+        status = load_trace(a, &p);
+    if (status == CS_EXIT_OK) {
+        fprintf(stderr, "toolpath: checking the executed path %s: %zu positions\n", a->trace, p.n);
+        status = report_check(a, sf, &p, ms.eps);
+    }
+    cs_dcpath_free(&p);
+    cs_dropcut_free(&ms);
+    return status;
+}
+
 int cs_cmd_toolpath_drop(int argc, char **argv)
 {
     dc_args_t a;
@@ -343,7 +405,7 @@ int cs_cmd_toolpath_drop(int argc, char **argv)
     st = cs_surffile_load("curvestep toolpath", a.file, a.scale, a.tol / 4, &sf);
     if (st != CS_EXIT_OK)
         return st;
-    st = plan_and_write(&a, &sf);
+    st = a.trace ? check_trace(&a, &sf) : plan_and_write(&a, &sf);
     if (fflush(stdout) != 0 && st == CS_EXIT_OK)
         st = CS_EXIT_INTERNAL;
     cs_surffile_free(&sf);

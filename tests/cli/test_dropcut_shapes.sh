@@ -46,9 +46,22 @@ for s in cup pent; do
     # the G-code runs on the router as written, and the simulator's check passes
     run "$s: gcode plans on the router" 0 plan --machine "$M" -o "$T/$s.seg" "$T/$s.ball:1.5.nc"
     "$SIM" --replay "$T/$s.seg" --machine "$M" --reference "$T/$s.ball:1.5.nc" --check \
-        >"$T/$s.sim" 2>&1
+        --trace "$T/$s.trace" >"$T/$s.sim" 2>&1
     expect "$s: simulator check passes" [ $? -eq 0 ]
     expect "$s: simulator final position exact" grep -q 'rounded to steps: exact' "$T/$s.sim"
+    # the executed path (every step edge the simulator made) against the surface: within tol
+    # and H; the same trace 0.05 mm lower gouges by the executed gouge + 0.05 and fails
+    run "$s: executed path checked" 0 toolpath --patches "$T/$s.txt" --cutter ball:1.5 \
+        --scallop 0.1 --tol 0.02 --check-trace "$T/$s.trace" && gs "$s executed path" 0.1
+    g0=$(sed -n 's/.*gouge \([0-9.]*\) mm.*/\1/p' "$T/err")
+    [ "$s" = cup ] || continue
+    awk -F, 'NR == 1 { print; next } { printf "%s,%s,%s,%s,%s,%.5f\n", $1, $2, $3, $4, $5, $6 - 0.05 }' \
+        "$T/$s.trace" >"$T/low.trace"
+    run "$s: executed path 0.05 mm low fails" 1 toolpath --patches "$T/$s.txt" --cutter ball:1.5 \
+        --scallop 0.1 --tol 0.02 --check-trace "$T/low.trace"
+    g1=$(sed -n 's/.*gouge \([0-9.]*\) mm.*/\1/p' "$T/err")
+    expect "$s: lowered 0.05 mm, gouge $g0 -> $g1 (+0.05 +- 0.001)" \
+        awk -v a="$g0" -v b="$g1" 'BEGIN { exit !(a != "" && b != "" && b - a > 0.049 && b - a < 0.051) }'
 done
 
 # The check's measures against hand formulas. (1) Passes of a ball R, w apart, over a plane leave
