@@ -22,7 +22,8 @@ static void serve_usage(FILE *f)
             "usage: curvestep serve --port DEV | --modbus-tcp HOST:PORT | --modbus-rtu DEV\n"
             "                       | --gpio CHIP\n"
             "                       [--baud N] [--line-rate BPS] [--parity none|even|odd] [--unit ID]\n"
-            "                       [--machine FILE.ini] [--socket PATH] [--max-input-mb N]\n"
+            "                       [--modbus-timeout MS] [--machine FILE.ini] [--socket PATH]\n"
+            "                       [--max-input-mb N]\n"
             "Streams the jobs submitted to it over one link, one at a time, in the order they\n"
             "came (as `curvestep stream` does: read once and planned whole at submit time, then\n"
             "streamed with the protocol of docs/protocol.md, over Modbus as in docs/modbus.md,\n"
@@ -43,6 +44,7 @@ static void serve_usage(FILE *f)
             "                  pty is otherwise timed at memory speed)\n"
             "  --parity P      Modbus RTU: even (default, 8E1), odd (8O1), none (8N2)\n"
             "  --unit ID       Modbus unit id, 1..247 (default 1)\n"
+            "  --modbus-timeout MS  Modbus: one try's wait for its answer (default 200)\n"
             "  --machine FILE  machine description (default: the built-in plotter)\n"
             "  --max-input-mb N  refuse a submitted job file larger than N MiB (default 64)\n"
             "  --socket PATH   the socket (default %s); its directory must belong to\n"
@@ -113,6 +115,11 @@ int cs_cmd_serve(int argc, char **argv)
     }
     if (cfg.link.parity != 0 && cfg.link.modbus_rtu == NULL) {
         fprintf(stderr, "curvestep serve: --parity applies to --modbus-rtu only\n");
+        return CS_EXIT_USAGE;
+    }
+    if (cfg.link.mb_timeout_ms != 0 && cfg.link.modbus_rtu == NULL &&
+        cfg.link.modbus_tcp == NULL) {
+        fprintf(stderr, "curvestep serve: --modbus-timeout applies to a Modbus link only\n");
         return CS_EXIT_USAGE;
     }
     return cs_daemon_serve(&cfg);

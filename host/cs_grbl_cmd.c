@@ -33,6 +33,7 @@ static void usage(FILE *f)
           "                     id (default 1)\n"
           "  --modbus-rtu DEV   a Modbus RTU device on serial line DEV; --baud N (default\n"
           "                     115200), --parity none|even|odd (default even), --unit ID\n"
+          "                     --modbus-timeout MS: one try's wait for an answer (default 200)\n"
           "  --gpio CHIP        step/dir lines of GPIO chip CHIP, wired as the machine file's\n"
           "                     [gpio] section says (requested for each chunk); --gpio\n"
           "                     record:FILE runs on no hardware and writes the last chunk's\n"
@@ -106,6 +107,10 @@ int cs_cmd_grbl(int argc, char **argv)
     }
     if (c.dev.line_rate != 0 && c.dev.port == NULL) {
         fprintf(stderr, "curvestep grbl: --line-rate applies to --port only\n");
+        return CS_EXIT_USAGE;
+    }
+    if (c.dev.mb_timeout_ms != 0 && c.dev.modbus_tcp == NULL && c.dev.modbus_rtu == NULL) {
+        fprintf(stderr, "curvestep grbl: --modbus-timeout applies to a Modbus link only\n");
         return CS_EXIT_USAGE;
     }
     static char found[4096];

@@ -40,8 +40,8 @@ static int modbus_peek(cs_grbl_link_t *k, int32_t pos[CS_PROTO_AXES_MAX])
 {
     const cs_joblink_cfg_t *c = &k->l.cfg;
     cs_mb_client_t mb;
-    if (cs_mb_open_link(&mb, c->modbus_tcp, c->modbus_rtu, c->baud, c->parity, c->unit, k->l.why,
-                        sizeof k->l.why) != 0)
+    if (cs_mb_open_link(&mb, c->modbus_tcp, c->modbus_rtu, c->baud, c->parity, c->unit,
+                        c->mb_timeout_ms, k->l.why, sizeof k->l.why) != 0)
         return CS_EXIT_NO_DEVICE;
     cs_mb_status_t st;
     cs_mb_rc_t rc = cs_mb_read_status(&mb, &st);

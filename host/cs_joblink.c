@@ -80,6 +80,12 @@ int cs_joblink_option(const char *cmd, int argc, char **argv, int *i, cs_joblink
             fprintf(stderr, "curvestep %s: --parity wants none, even or odd\n", cmd);
             return -1;
         }
+    } else if (strcmp(a, "--modbus-timeout") == 0) {
+        if (cs_joblink_parse_count(v, 60000, &n) != 0 || n < 10) {
+            fprintf(stderr, "curvestep %s: --modbus-timeout wants milliseconds, 10..60000\n", cmd);
+            return -1;
+        }
+        l->mb_timeout_ms = (uint32_t)n;
     } else if (strcmp(a, "--line-rate") == 0) {
         if (cs_joblink_parse_count(v, 100000000, &n) != 0 || n < 10) {
             fprintf(stderr, "curvestep %s: --line-rate wants bits/s (>= 10)\n", cmd);

@@ -36,6 +36,7 @@ typedef struct {
     uint32_t baud;            /* serial and Modbus RTU line speed (termios rate) */
     char parity;              /* Modbus RTU: 'E', 'O' or 'N' (0: 'E') */
     int unit;                 /* Modbus unit id */
+    uint32_t mb_timeout_ms;   /* Modbus: one try's wait for its answer, ms (0: CS_MB_TIMEOUT_MS) */
     uint32_t line_rate;       /* serial: pace writes to this many bits/s (0: none) */
     const char *machine_file; /* GPIO: its [gpio] section (NULL: the built-in machine) */
 } cs_joblink_cfg_t;
@@ -113,9 +114,9 @@ extern const cs_joblink_ops_t cs_joblink_gpio_ops;
  * with the reason in l->why when none or more than one is named. */
 int cs_joblink_select(cs_joblink_t *l, const cs_joblink_cfg_t *cfg);
 /* argv[*i] is one of the link options (--port, --modbus-tcp, --modbus-rtu, --gpio, --unit,
- * --baud, --parity, --line-rate) with its value: stores it in *l, moves *i onto the value and
- * returns 1; any other word: 0; a bad value: -1 after "curvestep CMD: --baud wants ..." on
- * stderr (a usage error). */
+ * --baud, --parity, --modbus-timeout, --line-rate) with its value: stores it in *l, moves *i onto
+ * the value and returns 1; any other word: 0; a bad value: -1 after "curvestep CMD: --baud wants
+ * ..." on stderr (a usage error). */
 int cs_joblink_option(const char *cmd, int argc, char **argv, int *i, cs_joblink_cfg_t *l);
 /* s is a whole decimal number 0..max and nothing else: 0 with *out set, else -1. */
 int cs_joblink_parse_count(const char *s, unsigned long long max, unsigned long long *out);

@@ -16,8 +16,9 @@ static int modbus_open(cs_joblink_t *l, const cs_joblink_job_t *j)
         snprintf(l->why, sizeof l->why, "--line-rate applies to --port only");
         return CS_EXIT_USAGE;
     }
-    int orc = cs_mb_open_link(&l->mb, l->cfg.modbus_tcp, l->cfg.modbus_rtu, l->cfg.baud,
-                              l->cfg.parity, l->cfg.unit, l->why, sizeof l->why);
+    int orc =
+        cs_mb_open_link(&l->mb, l->cfg.modbus_tcp, l->cfg.modbus_rtu, l->cfg.baud, l->cfg.parity,
+                        l->cfg.unit, l->cfg.mb_timeout_ms, l->why, sizeof l->why);
     if (orc != 0)
         return orc == -2 ? CS_EXIT_USAGE : CS_EXIT_NO_DEVICE;
     l->mb_open = true;

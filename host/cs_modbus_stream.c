@@ -246,11 +246,11 @@ cs_mb_rc_t cs_mb_write_command(cs_mb_client_t *c, uint16_t cmd)
 }
 
 int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
-                    int unit, char *why, size_t cap)
+                    int unit, uint32_t timeout_ms, char *why, size_t cap)
 {
+    uint32_t timeout = timeout_ms != 0 ? timeout_ms : CS_MB_TIMEOUT_MS;
     if (tcp != NULL)
-        return cs_mb_open_tcp(c, tcp, unit, CS_MB_TIMEOUT_MS, CS_MB_TRIES, why, cap);
-    uint32_t timeout = CS_MB_TIMEOUT_MS;
+        return cs_mb_open_tcp(c, tcp, unit, timeout, CS_MB_TRIES, why, cap);
     if (strncmp(rtu, "/dev/pts/", 9) != 0 && baud > 0) {
         /* request of CS_MODBUS_MAILBOX_REGS registers + its answer, 11 bits a byte */
         uint32_t bytes = 9u + 2u * CS_MODBUS_MAILBOX_REGS + 8u;

@@ -60,9 +60,11 @@ void cs_mb_close(cs_mb_client_t *c);
 #define CS_MB_TIMEOUT_MS 200u
 #define CS_MB_TRIES      6u
 /* The client every command uses: TCP to tcp ("HOST:PORT") when it is not NULL, else RTU on the
- * device rtu at baud with parity (0: 'E') for unit, with the timing above. As cs_mb_open_*. */
+ * device rtu at baud with parity (0: 'E') for unit, with the timing above; timeout_ms (0:
+ * CS_MB_TIMEOUT_MS) is one try's wait before the line's own time (--modbus-timeout). As
+ * cs_mb_open_*. */
 int cs_mb_open_link(cs_mb_client_t *c, const char *tcp, const char *rtu, uint32_t baud, char parity,
-                    int unit, char *why, size_t cap);
+                    int unit, uint32_t timeout_ms, char *why, size_t cap);
 
 /* The device's input registers, decoded. */
 typedef struct {

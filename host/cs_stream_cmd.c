@@ -55,6 +55,8 @@ static void usage(FILE *f)
           "  --parity P         Modbus RTU character format: even (default: 8E1, the Modbus\n"
           "                     serial-line default), odd (8O1) or none (8N2: no parity, two\n"
           "                     stop bits, as the spec asks). Must match the device's setting\n"
+          "  --modbus-timeout MS  Modbus: one try's wait for its answer (default 200 ms, plus\n"
+          "                     the line time at --baud on RTU); 6 tries, then exit 6\n"
           "  --gpio CHIP        run the job here, on the step/dir lines of GPIO chip CHIP\n"
           "                     (the machine file's [gpio] section; README, GPIO).\n"
           "                     --gpio record:FILE runs it on no hardware and writes every\n"
@@ -104,7 +106,7 @@ typedef struct {
     const char *job_file;
     cs_jobplan_opts_t jo;
     cs_joblink_cfg_t link;
-    size_t resume_from; /* --resume-from N */
+    size_t resume_from;   /* --resume-from N */
     bool resume_ask;      /* --resume */
     const char *position; /* --position X,Y,Z (mm) */
     int32_t pos[CS_AXES]; /* --position in steps */
@@ -184,8 +186,8 @@ static bool resume_opts_bad(bool serial, bool ask, bool from, bool pos)
                             "docs/streaming.md, Resume)"
                       : ask && (from || pos) ? "--resume asks the device where to go on: it takes "
                                                "neither --resume-from nor --position"
-                      : pos && !from ? "--position needs --resume-from N"
-                                     : NULL;
+                      : pos && !from         ? "--position needs --resume-from N"
+                                             : NULL;
     if (why != NULL)
         fprintf(stderr, "curvestep stream: %s\n", why);
     return why != NULL;
@@ -235,6 +237,10 @@ static int pick_link(stream_args_t *a, cs_joblink_t *l)
         return CS_EXIT_USAGE;
     if (a->link.parity != 0 && a->link.modbus_rtu == NULL) {
         fprintf(stderr, "curvestep stream: --parity applies to --modbus-rtu only\n");
+        return CS_EXIT_USAGE;
+    }
+    if (a->link.mb_timeout_ms != 0 && a->link.modbus_rtu == NULL && a->link.modbus_tcp == NULL) {
+        fprintf(stderr, "curvestep stream: --modbus-timeout applies to a Modbus link only\n");
         return CS_EXIT_USAGE;
     }
     if (a->curves && !l->ops->curves) {

@@ -41,13 +41,13 @@ stream() {
     while [ $# -gt 0 ] && [ "$1" != -- ]; do simargs+=("$1"); shift; done
     [ $# -gt 0 ] && shift
     streamargs=("$@")
-    timeout -k 5 300 "$SIM" --pty --speed "$SPEED" --idle-exit 1 --reference "$JOB" --check \
+    timeout -k 5 300 "$SIM" --pty --speed "$SPEED" --reference "$JOB" --check \
         --svg "$OUT/$name.svg" --png "$OUT/$name.png" "${simargs[@]}" \
         >"$OUT/$name.report" 2>"$OUT/$name.simlog" &
     local sim=$!
     pids+=("$sim")
     local pty=
-    for _ in $(seq 100); do
+    for _ in $(seq 1200); do # up to 60 s: a loaded machine starts it late
         pty=$(head -n1 "$OUT/$name.report" 2>/dev/null)
         [ -n "$pty" ] && break
         sleep 0.05
@@ -61,7 +61,10 @@ stream() {
     timeout -k 5 300 "$CS" stream --port "$pty" --mode "$mode" "${streamargs[@]}" "$JOB" \
         >"$OUT/$name.stream" 2>"$OUT/$name.progress"
     local rc=$?
-    for _ in $(seq 600); do kill -0 "$sim" 2>/dev/null || break; sleep 0.05; done
+    # SIGTERM: the device finishes what its executor holds, then reports (a stalled host on a
+    # loaded machine must not end it mid-job, as an idle timeout would)
+    kill "$sim" 2>/dev/null
+    for _ in $(seq 1200); do kill -0 "$sim" 2>/dev/null || break; sleep 0.05; done
     wait "$sim"
     local simrc=$?
     grep -v 'to continue' "$OUT/$name.stream" | sed 's/^stream: /  host:   /'

@@ -137,12 +137,14 @@ stream_final() {
     shift 2
     while [ "$1" != "--" ]; do margs+=("$1"); shift; done
     shift
-    timeout -k 5 60 "$SIM" --pty --instant --idle-exit 1 "${margs[@]}" >"$T/sim.out" \
-        2>"$T/sim.err" &
+    # (the device is ended by SIGTERM once the stream is done: a short --idle-exit can fire
+    # mid-job when a loaded machine stalls the host)
+    timeout -k 5 60 "$SIM" --pty --instant "${margs[@]}" >"$T/sim.out" 2>"$T/sim.err" &
     simpid=$!
     pids+=($simpid)
     wait_pty "$T/sim.out" 60
     if [ -n "$PTY" ] && run "$name" 0 stream --quiet "${margs[@]}" --port "$PTY" "$1"; then
+        kill "$simpid" 2>/dev/null
         wait_until 60 gone "$simpid"
         grep -q "^final position: $final" "$T/sim.out" && ok ||
             ko "$name: $(grep '^final position' "$T/sim.out")"

@@ -160,14 +160,16 @@ once_as_base() {
     expect "$1: same step trace as without faults" cmp -s <(steps_of "$1") <(steps_of base)
 }
 # answers lost after the device acted: the host's retries are answered, not executed again;
-# answers sent late, past the host's 200 ms: the host retries, then meets the late answer;
+# answers sent late, 1 s, past the host's --modbus-timeout 600: the host retries, then meets the
+# late answer; (the tries of every run are widened from the default 200 ms so that six runs at
+# once under ASan on a loaded machine still answer in time)
 # exception 6 (server device busy): nothing taken, the host writes it again
 # (all six at once, and a seventh, fault-free, over RTU in 8N2: both sides --parity none, where
 # the default is 8E1; a pty takes either)
 for mode in tcp rtu; do
-    launch "drop_$mode" $mode "--faults drop=0.02,seed=3" "$SMALL"
-    launch "late_$mode" $mode "--faults delay=0.02,delay-ms=400,seed=7" "$SMALL"
-    launch "busy_$mode" $mode "--faults busy=0.2,seed=5" "$SMALL"
+    launch "drop_$mode" $mode "--faults drop=0.02,seed=3" --modbus-timeout 1000 "$SMALL"
+    launch "late_$mode" $mode "--faults delay=0.02,delay-ms=1000,seed=7" --modbus-timeout 600 "$SMALL"
+    launch "busy_$mode" $mode "--faults busy=0.2,seed=5" --modbus-timeout 1000 "$SMALL"
 done
 launch par_rtu rtu "--parity none" --parity none "$SMALL"
 landed
@@ -204,8 +206,15 @@ expect "resume: job executed" grep -q "job executed" "$T/fail.out"
 once_as_base fail
 
 # 5. a wrong unit id: the device does not answer, the host says to check --unit (exit 4).
+#    (and over TCP once more with --modbus-timeout 1000: each try waits 1 s, so at most one try
+#    a second, where the default makes five)
 for mode in tcp rtu; do launch "unit_$mode" $mode "" --unit 7 "$SMALL"; done
+launch unit_slow tcp "" --unit 7 --modbus-timeout 1000 "$SMALL"
 landed
+tries_per_s=$(sed -n 's/.*no answer from unit 7: \([0-9]*\) tries in \([0-9.]*\) s.*/\1 \2/p' "$T/unit_slow.out")
+expect "unit --modbus-timeout 1000: exit 4" [ "$(rc_of unit_slow)" = 4 ]
+expect "unit --modbus-timeout 1000: tries 1 s apart ($tries_per_s)" \
+    awk -v v="$tries_per_s" 'BEGIN { split(v, a, " "); exit !(a[1] > 0 && a[1] <= a[2] + 1) }'
 for mode in tcp rtu; do
     expect "unit $mode: exit 4" [ "$(rc_of "unit_$mode")" = 4 ]
     expect "unit $mode: says so" grep -qE 'no device answered \(no answer from unit 7: [0-9]+ tries in [0-9.]+ s; is --unit right' "$T/unit_$mode.out"
@@ -244,6 +253,12 @@ run "bad --parity" 2 stream --modbus-rtu "$T/no-such-tty" --parity mark "$SMALL"
 expect_err "says what --parity wants" 'parity wants none, even or odd'
 run "--parity is for --modbus-rtu" 2 stream --modbus-tcp 127.0.0.1:1 --parity even "$SMALL"
 expect_err "says where --parity applies" 'parity applies to --modbus-rtu only'
+run "bad --modbus-timeout" 2 stream --modbus-tcp 127.0.0.1:1 --modbus-timeout 5 "$SMALL"
+expect_err "says what --modbus-timeout wants" 'modbus-timeout wants milliseconds, 10..60000'
+run "--modbus-timeout is for Modbus" 2 stream --port "$T/no-such-tty" --modbus-timeout 500 "$SMALL"
+expect_err "says where --modbus-timeout applies" 'modbus-timeout applies to a Modbus link only'
+run "serve: --modbus-timeout is for Modbus" 2 serve --port "$T/no-such-tty" --modbus-timeout 500
+expect_err "serve says where --modbus-timeout applies" 'modbus-timeout applies to a Modbus link only'
 "$SIM" --modbus-rtu pty --parity space >"$T/out" 2>"$T/err"
 expect "sim: bad --parity (exit 2)" [ $? -eq 2 ]
 "$SIM" --modbus-tcp 127.0.0.1:0 --parity odd >"$T/out" 2>"$T/err"

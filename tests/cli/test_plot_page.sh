@@ -40,13 +40,14 @@ expect "replay: check ok" grep -q '^check: ok$' "$T/replay.out"
 expect "replay: $lowers pen-downs, strokes reached" \
     grep -qE "^pen: $lowers pen-downs; drawn strokes reached pen down within .* ok\$" "$T/replay.out"
 
-timeout -k 5 120 "$SIM" --pty --instant --idle-exit 1 --machine "$MC" "${LAY[@]}" --reference "$JOB" \
+timeout -k 5 120 "$SIM" --pty --instant --machine "$MC" "${LAY[@]}" --reference "$JOB" \
     --check >"$T/dev.sim" 2>"$T/dev.err" &
 sp=$!
 pids+=($sp)
 wait_pty "$T/dev.sim" 60
 timeout -k 5 120 "$CS" stream --machine "$MC" "${LAY[@]}" --port "$PTY" "$JOB" >"$T/s.out" 2>&1
 expect "stream: exit 0" [ $? -eq 0 ]
+kill "$sp" 2>/dev/null # SIGTERM: it finishes what it holds, then reports (exit 0)
 wait_until 60 gone "$sp"
 wait "$sp"
 expect "device: exit 0" [ $? -eq 0 ]

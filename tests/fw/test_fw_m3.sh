@@ -73,25 +73,27 @@ expect "image built" [ -f "$ELF" ]
 
 # The curves-mode reference runs meanwhile: the simulator's device on its own pty, instant.
 (
-    timeout -k 5 240 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
+    timeout -k 5 240 "$SIM" --pty --instant --machine "$INI" >"$T/sim.out" 2>"$T/sim.err" &
     spid=$!
     spty=
     end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/sim.out" 2>/dev/null); sleep 0.05; done
     timeout -k 5 240 "$CS" stream --mode curves --machine "$INI" --feed $FEED --port "$spty" "$JOB" \
         >"$T/simcur.out" 2>&1
+    kill "$spid" 2>/dev/null # SIGTERM: finishes what it holds, then reports
     wait "$spid"
 ) &
 REFPID=$!
 pids+=("$REFPID")
 # The segments-mode twin: the simulator's device fed the plan the image gets in case 1.
 (
-    timeout -k 5 240 "$SIM" --pty --instant --idle-exit 1 --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
+    timeout -k 5 240 "$SIM" --pty --instant --machine "$INI" >"$T/simseg.out" 2>"$T/simseg.err" &
     spid=$!
     spty=
     end=$((SECONDS + 60))
     while [ $SECONDS -lt $end ] && [ -z "$spty" ]; do spty=$(head -n1 "$T/simseg.out" 2>/dev/null); sleep 0.05; done
     timeout -k 5 240 "$CS" stream --machine "$INI" --feed $FEED --port "$spty" "$JOB" >"$T/simseg.stream" 2>&1
+    kill "$spid" 2>/dev/null
     wait "$spid"
 ) &
 SEGPID=$!

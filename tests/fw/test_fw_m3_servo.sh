@@ -21,12 +21,13 @@ nseg=$(grep -vc -e '^#' -e '^pen ' "$T/job.seg")
 expect "plan has pen events ($pens)" [ "$pens" -gt 0 ]
 
 # the simulator's device, fed the same stream: its execution log is the reference
-timeout -k 5 120 "$SIM" --pty --instant --idle-exit 1 --machine "$MC" >"$T/dev.sim" 2>/dev/null &
+timeout -k 5 120 "$SIM" --pty --instant --machine "$MC" >"$T/dev.sim" 2>/dev/null &
 pids+=($!)
 SIMPID=$!
 wait_pty "$T/dev.sim" 60
 timeout -k 5 120 "$CS" stream --machine "$MC" --feed $FEED --port "$PTY" "$JOB" >/dev/null 2>&1
 expect "sim: stream exit 0" [ $? -eq 0 ]
+kill "$SIMPID" 2>/dev/null # SIGTERM: finishes what it holds, then reports
 wait_until 60 gone "$SIMPID"
 simlog=$(sed -n 's/^log: \([0-9]* segments hash [0-9]*\),.*/\1/p' "$T/dev.sim")
 expect "sim: $nseg segments logged ($simlog)" [ "${simlog%% *}" = "$nseg" ]
