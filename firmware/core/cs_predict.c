@@ -156,7 +156,8 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
     p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
     p->h_ideal = 0;
     p->thr = tol - CS_PREDICT_SLACK_LSB;
-    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
+    /* the least shift of thr 2^F below 2^THR_BITS, from thr alone (no 64-bit shift on the M0+) */
+    p->thr_shift = (uint8_t)shift_below((uint32_t)p->thr, THR_BITS - F);
     p->z = c->p[0].z;
     p->end = c->p[c->degree];
     return CS_OK;
