@@ -39,9 +39,11 @@
  * inlined into it, no call through a pointer) and the test's helpers inline; size builds (-Os:
  * every firmware image) keep one out-of-line copy of each. The same source either way. */
 #if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define SPEED_BUILD  1
 #define SPEED_INLINE __attribute__((always_inline)) inline
 #define SPEED_UNROLL _Pragma("GCC unroll 8") /* the fixed-count loops of the test unrolled */
 #else
+#define SPEED_BUILD 0
 #define SPEED_INLINE
 #define SPEED_UNROLL
 #endif
@@ -57,7 +59,8 @@ static HOT_INLINE uint64_t uabs64(int64_t v)
  * q/p = 0, 1/2, 1 (same and opposite signs) it lies below the chord through the samples
  * m(1,0) = 4/9, m(1,+-1/2) = 1/sqrt(3), 0.35210, m(1,1) = 3/4, m(1,-1) = sqrt(3)/6, each rounded
  * up to 1/1024. Worst overestimate 1.3 %. */
-#define MAJ_SCALE 1024
+#define MAJ_SCALE     1024
+#define MAX_U64(a, b) ((a) > (b) ? (a) : (b))
 static const int16_t maj_coef[4][2] = {/* p, q coefficients: q/p <= 1/2 then > 1/2, same sign */
                                        {456, 272},
                                        {456, -190},
@@ -74,6 +77,14 @@ static SPEED_INLINE uint64_t majorant(int64_t c1, int64_t c2)
     /* Signs compared on the top bits; a zero c1 or c2 counts as either sign (q = 0 then, and
      * both rows of the first segment give 456 p). */
     bool same = (((uint64_t)c1 ^ (uint64_t)c2) >> 63) == 0;
+#if SPEED_BUILD
+    /* The interpolant of a convex function is convex: each sign's bound is the larger of its two
+     * rows (they meet at q = p/2), the same value as the row chosen below, without a load whose
+     * address is data (host cores: about 3 % of the wall clock at 0.1 mm). */
+    if (same)
+        return MAX_U64(p * 456 + q * 272, p * 416 + q * 352);
+    return MAX_U64(p * 456 - q * 190, p * 426 - q * 130);
+#endif
     const int16_t *cf = maj_coef[(2 * q <= p ? 0 : 2) + (same ? 0 : 1)];
     /* modulo 2^64 with the negative coefficient: the true value is >= 0 (q <= p) and < 2^63 */
     return p * (uint64_t)cf[0] + q * (uint64_t)(int64_t)cf[1];
@@ -145,13 +156,15 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
     p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
     p->h_ideal = 0;
     p->thr = tol - CS_PREDICT_SLACK_LSB;
-    p->thr_shift = (uint8_t)shift_below((uint64_t)p->thr << F, THR_BITS);
+    /* the least shift of thr 2^F below 2^THR_BITS, from thr alone (no 64-bit shift on the M0+) */
+    p->thr_shift = (uint8_t)shift_below((uint32_t)p->thr, THR_BITS - F);
     p->z = c->p[0].z;
     p->end = c->p[c->degree];
     return CS_OK;
 }
 
 static void eval_poly(cs_predict_t *p, cs_vec3_t *pt);
+static cs_param_t first_step(const cs_predict_t *p);
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
 
@@ -181,6 +194,7 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     }
     cs_vec3_t p0;
     eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
+    p->h_next = first_step(p);
     p->next = next_poly;
     p->done = false;
     return CS_OK;
@@ -241,7 +255,7 @@ static SPEED_INLINE int32_t rsh_round32(int64_t v, unsigned s)
  * B''/2 = a2 + 3 (a3 t), B' = a1 + (2 a2 + 3 (a3 t)) t, B = a0 + (a1 + (a2 + a3 t) t) t, each
  * product rounded once (<= 1/2 unit): <= 3/2 units off in B''/2, 2 in B', 3/2 in B before its
  * rounding to the LSB (docs/fixed-point.md). */
-static void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
+static SPEED_INLINE void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
     cs_param_t t = p->t;
     SPEED_UNROLL
@@ -407,27 +421,64 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_pa
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
  * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
  * 2^f ~ 1 + f - c f (1 - f), c = 88/256 (within 0.3 %). At most cap (0 <= cap <= 2^30). */
+#define EXP2_Q15(f) ((1u << 15) + (f) - (((((f) * ((1u << 15) - (f))) >> 15) * 88u) >> 8))
+#if SPEED_BUILD
+/* Speed builds: 2^f for the 512 fractions f = j / 512, the same formula evaluated by the
+ * compiler (1 KB of table; a load instead of two dependent multiplies on the path from one test
+ * to the next). */
+#define EXP2_J(j)  (uint16_t) EXP2_Q15((uint32_t)(j) << 6)
+#define EXP2_4(j)  EXP2_J(j), EXP2_J((j) + 1), EXP2_J((j) + 2), EXP2_J((j) + 3)
+#define EXP2_16(j) EXP2_4(j), EXP2_4((j) + 4), EXP2_4((j) + 8), EXP2_4((j) + 12)
+#define EXP2_64(j) EXP2_16(j), EXP2_16((j) + 16), EXP2_16((j) + 32), EXP2_16((j) + 48)
+static const uint16_t exp2_q15[512] = {EXP2_64(0),   EXP2_64(64),  EXP2_64(128), EXP2_64(192),
+                                       EXP2_64(256), EXP2_64(320), EXP2_64(384), EXP2_64(448)};
+#endif
 static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t cap)
 {
     int32_t e = room - ROOM_MIN;             /* >= 0: no negative value is shifted */
     int32_t i = (e >> 9) - (-ROOM_MIN >> 9); /* floor(room / 512), -15 .. 2 */
-    uint32_t f = ((uint32_t)e & 511u) << 6;  /* Q15 */
-    uint32_t m = (1u << 15) + f - ((((f * ((1u << 15) - f)) >> 15) * 88u) >> 8);
+#if SPEED_BUILD
+    uint32_t m = exp2_q15[(uint32_t)e & 511u];
+#else
+    uint32_t f = ((uint32_t)e & 511u) << 6; /* Q15 */
+    uint32_t m = EXP2_Q15(f);
+#endif
     uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
     nh >>= 15 - i; /* = (nh 2^i) >> 15 for i >= 0 (no overflow: < 2^48), floors nest for i < 0 */
     nh -= nh / 64;
     return nh > (uint64_t)cap ? cap : (cs_param_t)nh; /* both callers cap it: once, here */
 }
 
+/* The first chord's step, from the curvature at t = 0: a piece [0, h] deviates from its chord
+ * by about h^2 |B' x B''/2| / (4 |B'|) (the sagitta of its osculating parabola), so the room of
+ * h = 1 is thr |w1| / |w1 x w2| with w1, w2 = B'(0), B''(0)/2 = a1, a2 in units of 4 LSB
+ * (4 thr |B'| / |B' x B''/2| = 4 thr 4 |w1| / (16 |w1 x w2|)), and predict turns it into the
+ * step that would just fill the tolerance (1/64 short). a1, a2 are exact multiples of 2^F below
+ * 2^32 LSB (begin), so w1, w2 < 2^30 (products < 2^61), floored: a guess the tests verify as
+ * any other step. A straight start (w1 x w2 = 0) tries the whole curve. */
+static cs_param_t first_step(const cs_predict_t *p)
+{
+    const int64_t *a = &p->a[1][0]; /* a1x, a1y, a2x, a2y */
+    int32_t w[6];
+    for (unsigned i = 0; i < 4; i++) {
+        uint32_t u = (uint32_t)((uint64_t)a[i] >> (F + 2)); /* floor(a / 2^(F+2)), two's compl. */
+        w[i] = u <= INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
+    }
+    w[4] = -w[1]; /* w1's normal (-y, x): w1 x w2 = w[4..5] . w[2..3] */
+    w[5] = w[0];
+    int32_t r; /* room_ok for its room (one routine on the M0+: its verdict is not needed) */
+    (void)room_ok((uint32_t)p->thr, (uint64_t)dot(w, w), uabs64(dot(w + 4, w + 2)), &r);
+    return predict(CS_PARAM_ONE, r, CS_PARAM_ONE);
+}
+
 /* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
  * ideal step changes smoothly along the curve), at least a/2; a alone when there is no last
- * one (b = 0). 0 <= a <= 2^30 and 0 < b <= 2^30: 2a - b < 2^31, no overflow. */
+ * one (b = 0). 0 <= a <= 2^30 and 0 <= b <= 2^30: 2a - b < 2^31, no overflow. (Selects and
+ * unsigned halvings: 4 bytes less on the M0+ than a branch and signed divisions.) */
 static cs_param_t trend(cs_param_t a, cs_param_t b)
 {
-    if (b == 0)
-        return a;
-    cs_param_t n = 2 * a - b;
-    return n < a / 2 ? a / 2 : n;
+    cs_param_t n = b == 0 ? a : 2 * a - b, half = (cs_param_t)((uint32_t)a >> 1); /* a >= 0 */
+    return n < half ? half : n;
 }
 
 /* --- conic arcs ------------------------------------------------------------------------- */
@@ -558,13 +609,13 @@ static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, co
         }
         int32_t nh = predict(h, room, rem);
         if (nh <= lo || nh >= hi)
-            nh = lo + (hi - lo) / 2;
-        if (nh <= lo || nh == h || hi - lo <= 1)
+            nh = lo + (int32_t)((uint32_t)(hi - lo) >> 1); /* hi > lo: no signed halving */
+        if (nh == h || hi - lo <= 1) /* (nh <= lo only when bisected with hi - lo <= 1) */
             break;
         h = nh;
     }
     for (unsigned k = 0; lo == 0 && k < CS_PARAM_FRAC_BITS + 1; k++) {
-        h = hi / 2; /* the predictor gave up: halve until a step passes */
+        h = (int32_t)((uint32_t)hi >> 1); /* the predictor gave up: halve until a step passes */
         if (h == 0)
             break;
         int32_t room;
@@ -579,7 +630,8 @@ static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, co
 
 /* Moves to the next vertex by the step find_step gave: CS_OK and *eval when the caller
  * computes the vertex at p->t, CS_OK and *pt = P_n at the end, CS_ERR_DEPTH for no step. */
-static cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *pt, bool *eval)
+static SPEED_INLINE cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room, cs_vec3_t *pt,
+                                     bool *eval)
 {
     *eval = false;
     p->done = true;

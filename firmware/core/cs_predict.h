@@ -2,7 +2,8 @@
  * quadratics, cubics: what SVG, G5 and G5.1 give) and planar conic arcs (rational quadratics
  * with w1^2 <= w0 w2: the circles and ellipses of cs_arc, SVG 'A', G2/G3). Each chord's parameter
  * step is predicted from the last one, the room the last flatness test left (deviation ~ h^2) and
- * the trend of that over the last two chords (no division: rooms are carried as logarithms), then
+ * the trend of that over the last two chords (no division: rooms are carried as logarithms; a
+ * polynomial curve's first step from its curvature at the start), then
  * VERIFIED by one flatness test on the sub-curve [t, t + h], whose control points are
  * computed directly from the power-basis Taylor expansion at t (no chain of de Casteljau splits).
  * The test bounds the exact deviation of the sub-curve from its chord by a piecewise-linear
