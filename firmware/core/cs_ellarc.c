@@ -33,9 +33,8 @@ static uint64_t sqrt_q62(uint64_t v)
 {
     if (v == 0)
         return 0;
-    unsigned e = 0; /* even shift bringing v into [2^60, 2^62) */
-    while ((v << e) < ((uint64_t)1 << 60))
-        e += 2;
+    unsigned b = cs_fixed_bitlen64(v); /* even shift e bringing v into [2^60, 2^62) */
+    unsigned e = b >= 61 ? 0 : (62 - b) & ~1u;
     uint64_t m = v << e;
     uint64_t r0 = cs_fixed_isqrt64(m); /* [2^30, 2^31) */
     uint64_t rem = m - r0 * r0;        /* <= 2 r0 <= 2^32 */
@@ -44,16 +43,19 @@ static uint64_t sqrt_q62(uint64_t v)
 }
 
 /* asin(z) for z (Q62) with z2 = z^2 <= sin^2(22.5deg): z (1 + z2/6 + 3 z2^2/40 + ...), twelve
- * terms by Horner (tail < 2^-40 relative, all terms positive so it is an underestimate charged
- * to the set-up margin, docs/fixed-point.md). */
+ * terms at most by Horner (tail < 2^-40 relative, all terms positive so it is an underestimate
+ * charged to the set-up margin, docs/fixed-point.md). */
 static uint64_t asin_z(uint64_t z, uint64_t z2)
 {
     static const uint64_t c[12] = {
         4611686018427387904u, 768614336404564651u, 345876451382054093u, 205878840108365531u,
         140111988407082098u,  103173373281578636u, 80025501070968044u,  64401474671398093u,
         53273278680384452u,   45017478183131891u,  38693594343120506u,  33723073330664314u};
-    uint64_t p = c[11];
-    for (unsigned k = 11; k-- > 0;)
+    /* terms past z2^k with z2^k < 2^-44 dropped: k = 44 / log2(1/z2) (z2 >= 2^-40 here) */
+    unsigned lg = 62 - cs_fixed_bitlen64(z2 | 1), k = lg == 0 ? 11 : 44 / lg + 1;
+    k = k > 11 ? 11 : k;
+    uint64_t p = c[k];
+    while (k-- > 0)
         p = c[k] + mulq(p, z2);
     return mulq(z, p);
 }
@@ -238,10 +240,11 @@ static cs_err_t plan(cs_ellarc_t *a, const shape_t *f, uint64_t alpha2, uint64_t
     }
     uint64_t x = x_range(f, thr, Q62_ONE, 0, cw, sw, shape_at(f, Q62_ONE, 0), shape_at(f, cw, sw));
     unsigned m = 1;
-    /* an eccentric piece with room for 2 or more chords a sub-range: (2 alpha)^2 >= 2 x m^2 */
+    /* an eccentric piece of many chords (n ~ 2 alpha / sqrt(8 x) at the worst step): 8
+     * sub-ranges from 24 chords, 4 from 8 (fewer chords do not repay the set-up) */
     if (f->l > (uint64_t)f->p / 32 && x != UINT64_MAX) {
         uint64_t a2 = mulq(alpha2, alpha2), x62 = (x < cap ? x : cap) << 2;
-        m = a2 / 128 >= x62 ? 8 : a2 / 32 >= x62 ? 4 : 1;
+        m = a2 / (8 * 24 * 24) >= x62 ? 8 : a2 / (8 * 8 * 8) >= x62 ? 4 : 1;
     }
     a->m = (uint8_t)m;
     if (m == 1) {
