@@ -113,11 +113,12 @@ fw_section() {
     curve_core fd_rat "-DCURVE_CORE_FD" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c
     local fd_rat=$CORE_BYTES
-    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision and the predicted step, rational included):"
+    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision, the predicted step and the arc tracer, rational included):"
     echo
     curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
-        firmware/core/cs_predict.c firmware/core/cs_trace.c firmware/core/cs_fd3.c
+        firmware/core/cs_predict.c firmware/core/cs_trace.c firmware/core/cs_fd3.c \
+        firmware/core/cs_ellarc.c
     local trace=$CORE_BYTES
     echo "**The planar polynomial FD path alone** (cs_fd3 + what it takes from cs_fd: pieces of"
     echo "a cubic with an exact step count each, the block loop cs_fd3_fill):"

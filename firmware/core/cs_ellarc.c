@@ -292,7 +292,7 @@ static bool count_ok(const cs_ellarc_t *a, uint64_t alpha2)
         dmax = d > dmax ? d : dmax;
         dmin = d < dmin ? d : dmin;
     }
-    return n <= CS_ELLARC_MAX_CHORDS && cs_fixed_cmp_prod_u64(n * n, dmax, 15u << 20, dmin) <= 0;
+    return n <= CS_ELLARC_MAX_CHORDS && cs_fixed_cmp_prod_u64(n * n, dmax, (uint64_t)15 << 20, dmin) <= 0;
 }
 
 cs_err_t cs_ellarc_begin(cs_ellarc_t *a, const cs_bezier_t *c, cs_pos_t tol)

@@ -18,8 +18,10 @@
 /* Fraction bits of the recurrence's state (units of 2^-28 LSB). */
 #define CS_ELLARC_FRAC 28
 /* Rounding budget charged against the tolerance (LSB): the vertex rounding (1/2) plus the
- * recurrence's accumulated error (<= (n^2/2 + 3n + 4) 2^-28 LSB <= 2^-4 for n <= 2^12). */
-#define CS_ELLARC_SLACK_LSB 1
+ * recurrence's accumulated error (< 2^-4 LSB, docs/fixed-point.md "Arc tracer"), rounded up to
+ * 2 like cs_predict's, so that a tolerance given in mm and rounded to the LSB (0.001 mm = 66
+ * LSB, 0.46 LSB more than asked) is still met in mm. */
+#define CS_ELLARC_SLACK_LSB 2
 /* Least tolerance (LSB) the arc tracer takes; below it cs_trace uses the conic predictor. */
 #define CS_ELLARC_TOL_MIN (CS_ELLARC_SLACK_LSB + 2)
 /* Most chords a piece may take (the error bound above); a piece needing more is refused. */

@@ -17,7 +17,8 @@ typedef enum {
     CS_TRACE_FD = 0,      /* uniform forward differences, step count from Wang's bound */
     CS_TRACE_AFD = 1,     /* adaptive forward differences (step doubling/halving) */
     CS_TRACE_SUBDIV = 2,  /* flatness subdivision: farthest flat chord by de Casteljau splits */
-    CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict) */
+    CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict);
+                           * circle and ellipse pieces by the rotation recurrence (cs_ellarc) */
 } cs_trace_method_t;
 
 /* The method every caller uses unless told otherwise (flatten, plan, stream, the daemon, the
