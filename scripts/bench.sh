@@ -173,6 +173,8 @@ fw_section() {
                 else if (w == "trace_afd_chord") w = "cs_trace, AFD: one chord (begin included)"
                 else if (w == "trace_subdiv_chord") w = "cs_trace, subdivision: one chord (begin included)"
                 else if (w == "trace_predict_chord") w = "**cs_trace, predicted step (the default): one chord (begin included)**"
+                else if (w == "trace_arc_chord") w = "cs_trace, default, 50 mm quarter circle: one chord (the arc tracer, begin included)"
+                else if (w == "trace_conic_chord") w = "cs_predict_begin_conic, the same arc: one chord (the conic predictor, begin included)"
                 else if (w == "planner_chord") w = "**cs_planner_line3 + cs_segment_next: one chord planned and cut**"
                 printf "| %s | %d | %d | %.0f |\n", w, n, i, i / n }
             $2 == "planner_segments" {seg = $4}
