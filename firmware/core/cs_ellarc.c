@@ -168,7 +168,10 @@ static bool shape_min_inside(const shape_t *f, uint64_t ca, uint64_t sa, uint64_
  * thr sqrt(fmin) 2^(28 - sh) / det. UINT64_MAX when it does not fit. */
 static uint64_t x_of(const shape_t *f, int64_t fmin, uint64_t thr)
 {
-    uint64_t num = thr * cs_fixed_isqrt64(fmin > 0 ? (uint64_t)fmin : 0); /* < 2^60 */
+    /* sqrt(fmin) to 20 bits (fmin shifted below 2^40: half the digit steps), rounded down */
+    uint64_t fm = fmin > 0 ? (uint64_t)fmin : 0;
+    unsigned h = cs_fixed_bitlen64(fm) > 40 ? (cs_fixed_bitlen64(fm) - 39) / 2 : 0;
+    uint64_t num = thr * ((uint64_t)cs_fixed_isqrt64(fm >> (2 * h)) << h); /* < 2^60 */
     unsigned k = 88 - f->sh; /* num 2^k as hi:lo, k in 60..88 */
     uint64_t hi, lo, x;
     if (k >= 64) {
@@ -231,18 +234,23 @@ static cs_err_t plan(cs_ellarc_t *a, const shape_t *f, uint64_t alpha2, uint64_t
 {
     /* the overshoot cap x <= 2 b^2/(a^2 + b^2) = (P - L)/P and the series' range */
     int64_t capv;
-    uint64_t cap = X22;
-    if (cs_fixed_muldiv64(f->p - (int64_t)f->l, (int64_t)1 << 60, f->p, &capv) == CS_OK &&
+    uint64_t cap = X22; /* (P - L)/P >= X22 while L <= P/2: nothing to compute */
+    if (f->l > (uint64_t)f->p / 2 &&
+        cs_fixed_muldiv64(f->p - (int64_t)f->l, (int64_t)1 << 60, f->p, &capv) == CS_OK &&
         capv >= 0) {
         uint64_t c = (uint64_t)capv;
         c -= (c >> 20) + (c > 64 ? 64 : c);
         cap = c < cap ? c : cap;
     }
-    uint64_t x = x_range(f, thr, Q62_ONE, 0, cw, sw, shape_at(f, Q62_ONE, 0), shape_at(f, cw, sw));
+    /* a circle to 2^-16 (L <= P/2^16): the least |A t|^2, P - L, is everywhere */
+    bool round = f->l <= (uint64_t)f->p >> 16;
+    uint64_t x = round ? x_of(f, f->p - (int64_t)f->l - 2, thr)
+                       : x_range(f, thr, Q62_ONE, 0, cw, sw, shape_at(f, Q62_ONE, 0),
+                                 shape_at(f, cw, sw));
     unsigned m = 1;
     /* an eccentric piece of many chords (n ~ 2 alpha / sqrt(8 x) at the worst step): 8
      * sub-ranges from 24 chords, 4 from 8 (fewer chords do not repay the set-up) */
-    if (f->l > (uint64_t)f->p / 32 && x != UINT64_MAX) {
+    if (!round && f->l > (uint64_t)f->p / 32 && x != UINT64_MAX) {
         uint64_t a2 = mulq(alpha2, alpha2), x62 = (x < cap ? x : cap) << 2;
         m = a2 / (8 * 24 * 24) >= x62 ? 8 : a2 / (8 * 8 * 8) >= x62 ? 4 : 1;
     }
@@ -388,8 +396,9 @@ cs_err_t cs_ellarc_next(cs_ellarc_t *a, cs_vec3_t *pt)
             a->d[i] = (t < 0 ? -ta : ta) - ky[i] / 2;
         }
     }
-    pt->x = (cs_pos_t)cs_fixed_round_shift64(a->x[0], FR);
-    pt->y = (cs_pos_t)cs_fixed_round_shift64(a->x[1], FR);
+    /* rounded to the nearest LSB (half up: floor(x + 1/2), arithmetic shift) */
+    pt->x = (cs_pos_t)((a->x[0] + ((int64_t)1 << (FR - 1))) >> FR);
+    pt->y = (cs_pos_t)((a->x[1] + ((int64_t)1 << (FR - 1))) >> FR);
     pt->z = a->end.z;
     return CS_OK;
 }
