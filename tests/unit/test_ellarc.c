@@ -66,7 +66,7 @@ static double chord_dev(const ell_t *e, double f0, double f1)
     double lo = f0, hi = f1, x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), d1, d2;
     ell_pt(e, x1, p), d1 = seg_dist(p, a, b);
     ell_pt(e, x2, p), d2 = seg_dist(p, a, b);
-    for (int i = 0; i < 60; i++) {
+    for (int i = 0; i < 45; i++) { /* 0.618^45 < 1e-9 of the step */
         if (d1 > d2) {
             hi = x2, x2 = x1, d2 = d1, x1 = hi - g * (hi - lo);
             ell_pt(e, x1, p), d1 = seg_dist(p, a, b);
@@ -85,7 +85,7 @@ static size_t greedy(const ell_t *e, double tol)
     for (double f = 0; f < e->sweep; n++) {
         double lo = f, hi = e->sweep;
         if (chord_dev(e, f, hi) > tol) {
-            for (int i = 0; i < 50; i++) {
+            for (int i = 0; i < 40; i++) { /* 2^-40 of the sweep */
                 double mid = 0.5 * (lo + hi);
                 if (chord_dev(e, f, mid) <= tol)
                     lo = mid;
@@ -171,7 +171,7 @@ static void test_arcs(void **state)
             for (size_t ai = 0; ai < 3; ai++)
                 for (size_t si = 0; si < 4; si++) {
                     double r = radii[ri], q = aspect[ai], rot = 0.3 * (double)si;
-                    if (r > 200 && ti == 2 && si > 0)
+                    if (r > 200 && ti > 0 && si > 0)
                         continue; /* keep the double greedy short */
                     ell_t e = {{-r * 0.5, 7}, {r * cos(rot), r * sin(rot)},
                                {-r * q * sin(rot), r * q * cos(rot)}, sweeps[si] * M_PI / 180};
@@ -196,7 +196,7 @@ static void test_random(void **state)
 {
     (void)state;
     unsigned taken = 0, pieces = 0;
-    for (int k = 0; k < 300; k++) {
+    for (int k = 0; k < 200; k++) {
         double r = exp(log(0.05) + urand() * log(2000 / 0.05)), a = urand() * 6.2832;
         double b = a + 0.3 + urand() * 2.5, q = 0.05 + urand();
         ell_t e = {{(urand() - 0.5) * 1000, (urand() - 0.5) * 1000},
