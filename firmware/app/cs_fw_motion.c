@@ -458,11 +458,20 @@ static void feed(cs_fw_motion_t *a)
     }
 }
 
+/* HELD only once the hold's ramp has ended (the executor refused the next segment at rest, or
+ * there was nothing left to run): a sender that waits for HELD (Grbl's Hold:0, the host's
+ * ABORT after HOLD) must not act while the axes still decelerate. Until then: RUNNING. */
+static bool held_at_rest(const cs_fw_motion_t *a)
+{
+    return cs_hold_stopped(&a->hold) || cs_fw_motion_done(a);
+}
+
 static void update_state(cs_fw_motion_t *a)
 {
     uint8_t ctl = cs_fw_ctl_state(a);
     uint8_t st = ctl == CS_PROTO_STATE_ALARM ? ctl
-                 : a->hold.hold && !a->ctl.cancel ? CS_PROTO_STATE_HELD
+                 : a->hold.hold && !a->ctl.cancel && held_at_rest(a) ? CS_PROTO_STATE_HELD
+                 : a->hold.hold && !a->ctl.cancel                    ? CS_PROTO_STATE_RUNNING
                  : ctl != 0xFFu                   ? ctl
                  : !cs_fw_motion_done(a) ? CS_PROTO_STATE_RUNNING
                  : a->aborted            ? CS_PROTO_STATE_ABORTED

@@ -94,6 +94,8 @@ static void test_commands_and_error_latch(void **state)
     assert_int_equal(app.submit(app.ctx, &m, 0), CS_OK);
     app.command(app.ctx, CS_MODBUS_CMD_HOLD);
     cs_fw_modbus_poll(&fm);
+    port_posix_run(UINT64_MAX); /* the executor meets the hold: refuses the segment, at rest */
+    cs_fw_modbus_poll(&fm);
     app.status(app.ctx, &st);
     assert_int_equal(st.state, CS_PROTO_STATE_HELD);
     app.command(app.ctx, CS_MODBUS_CMD_RESUME);

@@ -1,7 +1,8 @@
 /* Tests of the device's motion side (firmware/app/cs_fw_motion.c) running on the POSIX port, as
  * in the simulator: queued SEGMENT messages execute in order, once each, with the last executed
  * sequence and the position as their sums say (computed here from the messages); the queue's
- * credits and its full case; feed hold mid-job stops at rest with work left and the position of
+ * credits and its full case; feed hold mid-job reports RUNNING while it ramps down, then HELD
+ * at rest with work left and the position of
  * the executed segments, resume finishes with the same segment log as a run without a hold;
  * abort drops what is queued; the take limit; refused message types; a PEN is set exactly
  * between the segments queued around it and the settle segment after it makes no step; SETPOS
@@ -111,6 +112,18 @@ static void test_hold_resume(void **state)
     assert_int_equal(mid.pos[1], port_posix_position(1));
     assert_true(mid.pos[0] != 0 || mid.pos[1] != 0);
     cs_fw_motion_hold(&mo, true);
+    /* ramping down: RUNNING, not yet HELD (a sender that waits for HELD must not act while the
+     * axes still move); a quarter of the ramp later the position has moved on */
+    cs_proto_status_t ramp;
+    cs_fw_motion_poll(&mo);
+    cs_fw_motion_status(&mo, &ramp);
+    assert_int_equal(ramp.state, CS_PROTO_STATE_RUNNING);
+    assert_true(mo.hold.ramp_ticks > 4);
+    run_until(port_posix_now() + mo.hold.ramp_ticks / 4);
+    cs_proto_status_t later;
+    cs_fw_motion_status(&mo, &later);
+    assert_int_equal(later.state, CS_PROTO_STATE_RUNNING);
+    assert_true(later.pos[0] != ramp.pos[0] || later.pos[1] != ramp.pos[1]);
     run_until(UINT64_MAX);
     cs_proto_status_t st;
     cs_fw_motion_status(&mo, &st);
