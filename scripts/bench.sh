@@ -113,11 +113,12 @@ fw_section() {
     curve_core fd_rat "-DCURVE_CORE_FD" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c
     local fd_rat=$CORE_BYTES
-    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision and the predicted step, rational included):"
+    echo "**Every tracer** (cs_trace: FD, AFD, flatness subdivision, the predicted step and the arc tracer, rational included):"
     echo
     curve_core trace "-DCURVE_CORE_TRACE" firmware/core/cs_fixed.c firmware/core/cs_bezier.c \
         firmware/core/cs_fd.c firmware/core/cs_afd.c firmware/core/cs_subdiv.c \
-        firmware/core/cs_predict.c firmware/core/cs_trace.c firmware/core/cs_fd3.c
+        firmware/core/cs_predict.c firmware/core/cs_trace.c firmware/core/cs_fd3.c \
+        firmware/core/cs_ellarc.c
     local trace=$CORE_BYTES
     echo "**The planar polynomial FD path alone** (cs_fd3 + what it takes from cs_fd: pieces of"
     echo "a cubic with an exact step count each, the block loop cs_fd3_fill):"
@@ -172,6 +173,8 @@ fw_section() {
                 else if (w == "trace_afd_chord") w = "cs_trace, AFD: one chord (begin included)"
                 else if (w == "trace_subdiv_chord") w = "cs_trace, subdivision: one chord (begin included)"
                 else if (w == "trace_predict_chord") w = "**cs_trace, predicted step (the default): one chord (begin included)**"
+                else if (w == "trace_arc_chord") w = "cs_trace, default, 50 mm quarter circle: one chord (the arc tracer, begin included)"
+                else if (w == "trace_conic_chord") w = "cs_predict_begin_conic, the same arc: one chord (the conic predictor, begin included)"
                 else if (w == "planner_chord") w = "**cs_planner_line3 + cs_segment_next: one chord planned and cut**"
                 printf "| %s | %d | %d | %.0f |\n", w, n, i, i / n }
             $2 == "planner_segments" {seg = $4}

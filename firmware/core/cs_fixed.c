@@ -102,12 +102,18 @@ uint32_t cs_fixed_vec_len(int64_t dx, int64_t dy, int64_t dz)
 
 void cs_fixed_mul_u64(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo)
 {
+#if defined(__SIZEOF_INT128__) /* a 64-bit host: one multiply instruction */
+    unsigned __int128 p = (unsigned __int128)a * b;
+    *hi = (uint64_t)(p >> 64);
+    *lo = (uint64_t)p;
+#else
     /* Schoolbook on 32-bit halves; the carries are summed in 64 bits so none is lost. */
     uint64_t a0 = a & 0xFFFFFFFFu, a1 = a >> 32, b0 = b & 0xFFFFFFFFu, b1 = b >> 32;
     uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
     uint64_t mid = (p00 >> 32) + (p01 & 0xFFFFFFFFu) + (p10 & 0xFFFFFFFFu);
     *lo = (p00 & 0xFFFFFFFFu) | (mid << 32);
     *hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+#endif
 }
 
 int cs_fixed_cmp_prod_u64(uint64_t a, uint64_t b, uint64_t c, uint64_t d)
@@ -144,6 +150,11 @@ cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out)
     if (hi >= uc)
         return CS_ERR_OVERFLOW;
     uint64_t rem = hi, q = 0;
+#if defined(__SIZEOF_INT128__) && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
+    unsigned __int128 n = ((unsigned __int128)hi << 64) | lo;
+    q = (uint64_t)(n / uc);
+    rem = (uint64_t)(n % uc);
+#else
     for (int i = 63; i >= 0; i--) {
         uint64_t carry = rem >> 63;
         rem = (rem << 1) | ((lo >> i) & 1u);
@@ -153,6 +164,7 @@ cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out)
             q |= 1u;
         }
     }
+#endif
     /* Round half away from zero: rem >= c - rem (no overflow of 2 * rem). Check the range
      * before the increment too: q = UINT64_MAX would wrap to 0 and pass the check. */
     if (q > (uint64_t)INT64_MAX)
@@ -186,6 +198,11 @@ cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q)
         return CS_ERR_OVERFLOW;
     /* rem < d < 2^63 throughout, so rem << 1 never loses a bit. */
     uint64_t rem = hi, quo = 0;
+#if defined(__SIZEOF_INT128__) && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
+    unsigned __int128 n = ((unsigned __int128)hi << 64) | lo;
+    quo = (uint64_t)(n / d);
+    rem = (uint64_t)(n % d);
+#else
     for (unsigned i = 64; i-- > 0;) {
         rem = (rem << 1) | ((lo >> i) & 1u);
         quo <<= 1;
@@ -194,6 +211,7 @@ cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q)
             quo |= 1u;
         }
     }
+#endif
     if (rem >= d - rem) { /* 2 * rem >= d: round half up */
         if (quo == UINT64_MAX)
             return CS_ERR_OVERFLOW;

@@ -27,6 +27,12 @@ static cs_err_t begin_reach(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
 static cs_err_t begin_predict(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
 {
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
+    /* a circle or ellipse piece: equal-angle chords by the rotation recurrence (cs_ellarc);
+     * the conic predictor takes the pieces it refuses (tol below its minimum, other weights) */
+    if (c->rational && cs_ellarc_begin(&tr->u.arc, c, tol) == CS_OK) {
+        tr->impl = CS_TRACE_IMPL_ELLARC;
+        return CS_OK;
+    }
     if (cs_predict_accepts(c)) {
         tr->impl = CS_TRACE_IMPL_PREDICT;
         return c->rational ? cs_predict_begin_conic(&tr->u.pr, c, tol)
@@ -115,6 +121,9 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
     case CS_TRACE_IMPL_PREDICT:
         e = cs_predict_next(&tr->u.pr, pt);
+        break;
+    case CS_TRACE_IMPL_ELLARC:
+        e = cs_ellarc_next(&tr->u.arc, pt);
         break;
 #endif
 #if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV

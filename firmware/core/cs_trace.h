@@ -7,6 +7,7 @@
 
 #include "cs_afd.h"
 #include "cs_bezier.h"
+#include "cs_ellarc.h"
 #include "cs_fd.h"
 #include "cs_fd3.h"
 #include "cs_predict.h"
@@ -16,7 +17,8 @@ typedef enum {
     CS_TRACE_FD = 0,      /* uniform forward differences, step count from Wang's bound */
     CS_TRACE_AFD = 1,     /* adaptive forward differences (step doubling/halving) */
     CS_TRACE_SUBDIV = 2,  /* flatness subdivision: farthest flat chord by de Casteljau splits */
-    CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict) */
+    CS_TRACE_PREDICT = 3, /* predicted step, verified by one direct sub-curve test (cs_predict);
+                           * circle and ellipse pieces by the rotation recurrence (cs_ellarc) */
 } cs_trace_method_t;
 
 /* The method every caller uses unless told otherwise (flatten, plan, stream, the daemon, the
@@ -48,6 +50,7 @@ typedef enum {
     CS_TRACE_IMPL_SUBDIV_REACH = 3,
     CS_TRACE_IMPL_PREDICT = 4,
     CS_TRACE_IMPL_FD3 = 5, /* CS_TRACE_FD on a planar polynomial curve of degree <= 3 (cs_fd3) */
+    CS_TRACE_IMPL_ELLARC = 6, /* CS_TRACE_PREDICT on a circle or ellipse piece (cs_ellarc) */
 } cs_trace_impl_t;
 
 /* Which tracers an image carries (compile-time, e.g. -DCS_TRACE_METHODS=CS_TRACE_WITH_PREDICT):
@@ -82,6 +85,7 @@ typedef struct {
 #endif
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
         cs_predict_t pr;
+        cs_ellarc_t arc;
 #endif
         uint8_t none; /* keeps the union valid when nothing is configured */
     } u;

@@ -5,12 +5,15 @@
  *   fd      cs_fd_next per point (uniform forward differences, the inner loop)
  *   fd3     cs_fd3_next per point (the planar polynomial FD path: 3 adds per coordinate)
  *   trace   cs_trace_next per chord for each tracer (FD, AFD, subdivision)
+ *   arc     cs_trace per chord of a 50 mm quarter circle (cs_arc, one conic piece) by the
+ *           default (the arc tracer cs_ellarc) and by the conic predictor (cs_predict)
  *   planner cs_planner_line3 + cs_segment_next per chord: what the device does with each chord
  *           of a CURVE message (the look-ahead plan and its step segments)
  * Prints one line per figure over semihosting ("bench: NAME calls N cycles C") and exits with
  * status 0 (1 when a call failed). scripts/bench.sh runs it. */
 #include <stdint.h>
 
+#include "cs_arc.h"
 #include "cs_fd.h"
 #include "cs_fd3.h"
 #include "cs_planner.h"
@@ -90,6 +93,29 @@ static void bench_trace(const cs_bezier_t *c, cs_trace_method_t m, const char *n
     if (e != CS_END)
         failed = true;
     print(name, n, t1 - t0);
+}
+
+/* A 50 mm quarter circle at 0.01 mm: the default (cs_ellarc) and the conic predictor. */
+static void bench_arc(void)
+{
+    static const cs_vec3_t cen = {0, 0, 0}, u = {50 * CS_POS_ONE_MM, 0, 0},
+                           v = {0, 50 * CS_POS_ONE_MM, 0};
+    cs_bezier_t seg[CS_ARC_MAX_SEGMENTS];
+    unsigned n = 0;
+    if (cs_arc_build(&cen, &u, &v, CS_PARAM_ONE, 0, 0, CS_PARAM_ONE, true, seg, &n) != CS_OK ||
+        n != 1) {
+        failed = true;
+        return;
+    }
+    bench_trace(&seg[0], CS_TRACE_PREDICT, "trace_arc_chord");
+    static cs_predict_t p;
+    cs_vec3_t pt;
+    uint32_t t0 = cycles(), k = 0;
+    if (cs_predict_begin_conic(&p, &seg[0], CS_POS_ONE_MM / 100) != CS_OK)
+        failed = true;
+    while (cs_predict_next(&p, &pt) == CS_OK)
+        k++;
+    print("trace_conic_chord", k, cycles() - t0);
 }
 
 static void bench_fd3(const cs_bezier_t *c, cs_pos_t tol)
@@ -211,6 +237,7 @@ int main(void)
     bench_trace(&c, CS_TRACE_AFD, "trace_afd_chord");
     bench_trace(&c, CS_TRACE_SUBDIV, "trace_subdiv_chord");
     bench_trace(&c, CS_TRACE_PREDICT, "trace_predict_chord");
+    bench_arc();
     bench_planner(&c);
     semihost_exit(failed ? 1u : 0u);
     for (;;)
