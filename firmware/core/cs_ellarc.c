@@ -91,9 +91,7 @@ static uint64_t uabs(int64_t v)
 /* (|v| c) / 2^62 with v's sign, c unsigned Q62 (or any scale 2^62 divides out): |v| c < 2^126. */
 static int64_t mul_sq(int64_t v, uint64_t c)
 {
-    uint64_t hi, lo;
-    cs_fixed_mul_u64(uabs(v), c, &hi, &lo);
-    int64_t t = (int64_t)((hi << 2) | (lo >> 62));
+    int64_t t = (int64_t)mulq(uabs(v), c); /* inline on 64-bit hosts (the set-up's most used) */
     return v < 0 ? -t : t;
 }
 
@@ -124,9 +122,7 @@ typedef struct {
 static bool shape(const int64_t y0[2], const int64_t v0[2], shape_t *f)
 {
     uint64_t m = uabs(y0[0]) | uabs(y0[1]) | uabs(v0[0]) | uabs(v0[1]);
-    unsigned sh = 0;
-    while ((m >> sh) >= ((uint64_t)1 << 30))
-        sh++;
+    unsigned b = cs_fixed_bitlen64(m), sh = b > 30 ? b - 30 : 0; /* the least: m >> sh < 2^30 */
     int64_t y[2] = {y0[0] >> sh, y0[1] >> sh}, v[2] = {v0[0] >> sh, v0[1] >> sh};
     f->sh = sh;
     f->yy = y[0] * y[0] + y[1] * y[1];

@@ -65,7 +65,8 @@ cs_err_t cs_fixed_narrow(int64_t v, int32_t *out);
 /* Arithmetic shift right with rounding half away from zero, n in 0..62. Exact for n = 0. */
 int64_t cs_fixed_round_shift64(int64_t v, unsigned n);
 
-/* floor(sqrt(v)) for any uint64 (bitwise, no division, no float). */
+/* floor(sqrt(v)) for any uint64, exact, no float (64-bit hosts: Newton by native division from
+ * a tangent seed, 4 or 5 divisions; other targets: bitwise digit steps, no division). ISR-safe. */
 uint32_t cs_fixed_isqrt64(uint64_t v);
 /* Euclidean length of a vector, in cs_pos_t units (rounded down): exact integer sqrt of the
  * 64-bit sum of squares (|component| <= 2^30 keeps the sum inside uint64). */

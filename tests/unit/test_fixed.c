@@ -1,6 +1,7 @@
 /* Unit tests for cs_fixed: every checked operation against an exact __int128 / long double
  * reference (fine in tests), with overflow detection at the edges, rounding half away from
- * zero, isqrt64 exhaustively near squares and at UINT64_MAX, and the 128-bit helpers. */
+ * zero, isqrt64 exhaustively near squares, around powers of two and at UINT64_MAX, and the
+ * 128-bit helpers. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -225,6 +226,20 @@ static void test_isqrt64(void **state)
     check_isqrt(UINT64_MAX - 1);
     check_isqrt(0xFFFFFFFE00000001ull); /* (2^32 - 1)^2 */
     check_isqrt(0xFFFFFFFE00000000ull);
+    /* the 64-bit hosts' Newton seed (a tangent of sqrt) is tightest where the normalised v is
+     * 2^63 (X = 2): around 2^(2j+1) and 2^(2j) at every bit length, and random bit lengths */
+    for (unsigned j = 0; j < 32; j++)
+        for (uint64_t d = 0; d < 64; d++) {
+            uint64_t a = (uint64_t)1 << (2 * j + 1), b = (uint64_t)1 << (2 * j);
+            check_isqrt(a + d);
+            check_isqrt(b + d);
+            if (d < b) {
+                check_isqrt(a - d - 1);
+                check_isqrt(b - d);
+            }
+        }
+    for (int i = 0; i < 100000; i++)
+        check_isqrt(ref_rng_next(&g) >> (ref_rng_next(&g) % 64));
 }
 
 static void test_vec_len(void **state)
