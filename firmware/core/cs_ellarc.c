@@ -17,7 +17,7 @@
 /* (a b) / 2^62 for unsigned Q62 a, b (truncated). */
 static uint64_t mulq(uint64_t a, uint64_t b)
 {
-#if defined(__SIZEOF_INT128__) /* a 64-bit host: one multiply, inline */
+#if CS_FIXED_WIDE /* a 64-bit host: one multiply, inline */
     return (uint64_t)(((unsigned __int128)a * b) >> 62);
 #else
     uint64_t hi, lo;

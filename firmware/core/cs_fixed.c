@@ -118,7 +118,7 @@ uint32_t cs_fixed_vec_len(int64_t dx, int64_t dy, int64_t dz)
 
 void cs_fixed_mul_u64(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo)
 {
-#if defined(__SIZEOF_INT128__) /* a 64-bit host: one multiply instruction */
+#if CS_FIXED_WIDE /* a 64-bit host: one multiply instruction */
     unsigned __int128 p = (unsigned __int128)a * b;
     *hi = (uint64_t)(p >> 64);
     *lo = (uint64_t)p;
@@ -166,7 +166,7 @@ cs_err_t cs_fixed_muldiv64(int64_t a, int64_t b, int64_t c, int64_t *out)
     if (hi >= uc)
         return CS_ERR_OVERFLOW;
     uint64_t rem = hi, q = 0;
-#if defined(__SIZEOF_INT128__) && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
+#if CS_FIXED_WIDE && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
     unsigned __int128 n = ((unsigned __int128)hi << 64) | lo;
     q = (uint64_t)(n / uc);
     rem = (uint64_t)(n % uc);
@@ -214,7 +214,7 @@ cs_err_t cs_fixed_div_u128(uint64_t hi, uint64_t lo, uint64_t d, uint64_t *q)
         return CS_ERR_OVERFLOW;
     /* rem < d < 2^63 throughout, so rem << 1 never loses a bit. */
     uint64_t rem = hi, quo = 0;
-#if defined(__SIZEOF_INT128__) && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
+#if CS_FIXED_WIDE && __STDC_HOSTED__ /* 64-bit host: natively (libgcc's divide) */
     unsigned __int128 n = ((unsigned __int128)hi << 64) | lo;
     quo = (uint64_t)(n / d);
     rem = (uint64_t)(n % d);

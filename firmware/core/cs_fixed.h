@@ -72,6 +72,18 @@ uint32_t cs_fixed_isqrt64(uint64_t v);
  * 64-bit sum of squares (|component| <= 2^30 keeps the sum inside uint64). */
 uint32_t cs_fixed_vec_len(int64_t dx, int64_t dy, int64_t dz);
 
+/* CS_FIXED_WIDE 1: the compiler has a 128-bit integer (64-bit hosts), so cs_fixed_mul_u64 is one
+ * multiply and, in hosted builds only (libgcc's divide: a freestanding core calls nothing outside
+ * itself), cs_fixed_muldiv64 and cs_fixed_div_u128 divide natively; same results. 0: the
+ * portable loops every MCU runs (tests/unit/test_fixed_narrow runs test_fixed on them). */
+#ifndef CS_FIXED_WIDE
+#if defined(__SIZEOF_INT128__)
+#define CS_FIXED_WIDE 1
+#else
+#define CS_FIXED_WIDE 0
+#endif
+#endif
+
 /* Unsigned 64x64 -> 128 multiply, result as hi:lo (for exact comparisons of squared
  * distances; the core has no __int128 on 32-bit and 8-bit targets). */
 void cs_fixed_mul_u64(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo);
