@@ -77,7 +77,7 @@ int32_t cs_fixed_sub_sat(int32_t a, int32_t b)
 
 uint32_t cs_fixed_isqrt64(uint64_t v)
 {
-#if defined(__SIZEOF_INT128__) /* a 64-bit target: 64-bit division is one instruction */
+#if CS_FIXED_WIDE /* a 64-bit host: 64-bit division is one instruction (no libgcc call) */
     /* Newton from above, x' = floor((x + floor(v/x)) / 2), stops at floor(sqrt(v)) exactly (the
      * integer iteration never goes below it and decreases while x > floor(sqrt v)). Seed: v
      * shifted by an even e into [2^62, 2^64), t = its top 32 bits = X 2^30 (X in [1, 4)); the

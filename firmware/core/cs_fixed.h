@@ -65,8 +65,8 @@ cs_err_t cs_fixed_narrow(int64_t v, int32_t *out);
 /* Arithmetic shift right with rounding half away from zero, n in 0..62. Exact for n = 0. */
 int64_t cs_fixed_round_shift64(int64_t v, unsigned n);
 
-/* floor(sqrt(v)) for any uint64, exact, no float (64-bit hosts: Newton by native division from
- * a tangent seed, 4 or 5 divisions; other targets: bitwise digit steps, no division). ISR-safe. */
+/* floor(sqrt(v)) for any uint64, exact, no float (CS_FIXED_WIDE: Newton by native 64-bit
+ * division from a tangent seed, 4 or 5 divisions; else bitwise digit steps, no division). */
 uint32_t cs_fixed_isqrt64(uint64_t v);
 /* Euclidean length of a vector, in cs_pos_t units (rounded down): exact integer sqrt of the
  * 64-bit sum of squares (|component| <= 2^30 keeps the sum inside uint64). */
@@ -74,8 +74,9 @@ uint32_t cs_fixed_vec_len(int64_t dx, int64_t dy, int64_t dz);
 
 /* CS_FIXED_WIDE 1: the compiler has a 128-bit integer (64-bit hosts), so cs_fixed_mul_u64 is one
  * multiply and, in hosted builds only (libgcc's divide: a freestanding core calls nothing outside
- * itself), cs_fixed_muldiv64 and cs_fixed_div_u128 divide natively; same results. 0: the
- * portable loops every MCU runs (tests/unit/test_fixed_narrow runs test_fixed on them). */
+ * itself), cs_fixed_muldiv64 and cs_fixed_div_u128 divide natively, and cs_fixed_isqrt64 is
+ * Newton's iteration on 64-bit divisions; same results. 0: the portable loops every MCU runs
+ * (tests/unit/test_fixed_narrow runs test_fixed on them). */
 #ifndef CS_FIXED_WIDE
 #if defined(__SIZEOF_INT128__)
 #define CS_FIXED_WIDE 1
