@@ -22,6 +22,7 @@
 #include "cs_ellarc.h"
 #include "cs_ref.h"
 #include "cs_trace.h"
+#include "ref_ellarc.h"
 
 #define MM(v)     ((cs_pos_t)lround((v)*65536.0))
 #define MAX_VERTS 200000
@@ -38,66 +39,7 @@ static double urand(void)
     return (double)(rng >> 11) / 9007199254740992.0;
 }
 
-typedef struct {
-    double c[2], u[2], v[2], sweep; /* x(phi) = C + U cos phi + V sin phi, phi in [0, sweep] */
-} ell_t;
-
-static void ell_pt(const ell_t *e, double phi, double p[2])
-{
-    for (int i = 0; i < 2; i++)
-        p[i] = e->c[i] + e->u[i] * cos(phi) + e->v[i] * sin(phi);
-}
-
-static double seg_dist(const double p[2], const double a[2], const double b[2])
-{
-    double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-    double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    return hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
-}
-
-/* Largest distance of the arc [f0, f1] from its chord (unimodal on a convex arc). */
-static double chord_dev(const ell_t *e, double f0, double f1)
-{
-    double a[2], b[2], p[2];
-    ell_pt(e, f0, a);
-    ell_pt(e, f1, b);
-    const double g = 0.6180339887498949;
-    double lo = f0, hi = f1, x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), d1, d2;
-    ell_pt(e, x1, p), d1 = seg_dist(p, a, b);
-    ell_pt(e, x2, p), d2 = seg_dist(p, a, b);
-    for (int i = 0; i < 45; i++) { /* 0.618^45 < 1e-9 of the step */
-        if (d1 > d2) {
-            hi = x2, x2 = x1, d2 = d1, x1 = hi - g * (hi - lo);
-            ell_pt(e, x1, p), d1 = seg_dist(p, a, b);
-        } else {
-            lo = x1, x1 = x2, d1 = d2, x2 = lo + g * (hi - lo);
-            ell_pt(e, x2, p), d2 = seg_dist(p, a, b);
-        }
-    }
-    return fmax(d1, d2);
-}
-
-/* Greedy chord count over the whole arc (no vertex forced at the pieces' joins). */
-static size_t greedy(const ell_t *e, double tol)
-{
-    size_t n = 0;
-    for (double f = 0; f < e->sweep; n++) {
-        double lo = f, hi = e->sweep;
-        if (chord_dev(e, f, hi) > tol) {
-            for (int i = 0; i < 40; i++) { /* 2^-40 of the sweep */
-                double mid = 0.5 * (lo + hi);
-                if (chord_dev(e, f, mid) <= tol)
-                    lo = mid;
-                else
-                    hi = mid;
-            }
-            hi = lo;
-        }
-        f = hi;
-    }
-    return n;
-}
+typedef ref_ellarc_t ell_t; /* the arc in mm, and the double reference (tests/support) */
 
 /* The promise for one piece by cs_trace's default (the arc tracer when it takes the piece);
  * returns the chord count, *arc = whether cs_ellarc ran. */
@@ -176,7 +118,7 @@ static void test_arcs(void **state)
                     ell_t e = {{-r * 0.5, 7}, {r * cos(rot), r * sin(rot)},
                                {-r * q * sin(rot), r * q * cos(rot)}, sweeps[si] * M_PI / 180};
                     chords[ai] += check_arc(&e, MM(tols_mm[ti]), &taken, &pieces);
-                    gr[ai] += greedy(&e, tols_mm[ti]);
+                    gr[ai] += ref_ellarc_greedy(&e, tols_mm[ti]);
                 }
         double ratio = (double)(chords[0] + chords[1]) / (double)(gr[0] + gr[1]);
         double flat = (double)chords[2] / (double)gr[2];
