@@ -217,14 +217,22 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
 }
 
 /* x t / 2^30 rounded half up (floor(x t / 2^30 + 1/2), <= 1/2 unit off), for 0 <= t <= 2^30
- * (every parameter and step of the tracer) and |x| < 2^62, inline. With x = xh 2^32 + xl (xh
- * the signed top half, -2^30 <= xh < 2^30; xl the unsigned low half) the product is
- * 4 xh t + floor((xl t + 2^29) / 2^30) (the first term is a multiple of 2^30 before the shift, so
- * only the second rounds, and it is >= 0): one signed and one unsigned 32x32 -> 64 product
- * (SMULL and UMULL on a Cortex-M3), no absolute value and no branch on the sign, which is data
- * (a mispredicted branch costs a host core some 15 cycles). */
+ * (every parameter and step of the tracer) and |x| < 2^61 (the 64-bit path below), inline.
+ * With x = xh 2^32 + xl (xh the signed top half, -2^30 <= xh < 2^30; xl the unsigned low half)
+ * the product is 4 xh t + floor((xl t + 2^29) / 2^30) (the first term is a multiple of 2^30
+ * before the shift, so only the second rounds, and it is >= 0): one signed and one unsigned
+ * 32x32 -> 64 product (SMULL and UMULL on a Cortex-M3), no absolute value and no branch on the
+ * sign, which is data (a mispredicted branch costs a host core some 15 cycles). */
 static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
+#if defined(__SIZEOF_INT128__)
+    /* 64-bit hosts: the same value from one 64x64 -> 128 product, (4 x)(t 2^32) = x t 2^34, as
+     * floor((x t 2^34 + 2^63) / 2^64): its top half plus the top bit of its low half (4 x fits:
+     * every caller's |x| is below 2^60; t 2^32 <= 2^62, shared by a test's 12 products). Four
+     * instructions a product against seven (about 6 % of a chord at 0.001 mm). */
+    __int128 pr = (__int128)(x * 4) * ((int64_t)t << 32);
+    return (int64_t)(pr >> 64) + (int64_t)((uint64_t)pr >> 63);
+#endif
     uint32_t ut = (uint32_t)t;
     uint32_t hi = (uint32_t)((uint64_t)x >> 32); /* the two's complement top half, as int32: */
     int32_t xh = hi <= INT32_MAX ? (int32_t)hi : -(int32_t)(~hi) - 1; /* (a no-op, defined) */
