@@ -313,9 +313,16 @@ static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2],
  * to 16 bits and to Q8 included). The predictor's only logarithm. */
 static SPEED_INLINE int32_t log2_q8(uint64_t v)
 {
+#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+    /* 64-bit hosts: v normalised by one shift (its leading 1 to bit 63) gives the same 16 bits,
+     * zeros below a short v's last bit, as the two shifts and the select below */
+    unsigned c = (unsigned)__builtin_clzll(v), n = 64 - c;
+    uint32_t m = (uint32_t)((v << c) >> 48);
+#else
     unsigned n = cs_fixed_bitlen64(v);
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
-    uint32_t x = m - (1u << 15);                                               /* Q15 */
+#endif
+    uint32_t x = m - (1u << 15); /* Q15 */
     uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
     return (int32_t)((n - 1) * ROOM_ONE + (l >> 7));
 }
