@@ -47,6 +47,13 @@
 #define SPEED_INLINE
 #define SPEED_UNROLL
 #endif
+/* 64-bit speed builds: the test's shift guessed from the last test (cs_predict.h, guess), so
+ * that the test's products do not wait for the shift of its own components (below). */
+#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+#define HOST_GUESS 1
+#else
+#define HOST_GUESS 0
+#endif
 
 static HOT_INLINE uint64_t uabs64(int64_t v)
 {
@@ -195,6 +202,9 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     cs_vec3_t p0;
     eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
     p->h_next = first_step(p);
+#if defined(__SIZEOF_INT128__)
+    p->guess[0] = -1; /* no shift guessed: the first test sets it (HOST_GUESS) */
+#endif
     p->next = next_poly;
     p->done = false;
     return CS_OK;
@@ -352,6 +362,20 @@ static SPEED_INLINE bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_
     return cs_fixed_cmp_prod_u64(found, found, k * k, dd) <= 0;
 }
 
+#if HOST_GUESS
+/* room_ok with log2_q8(k) given (the guess's: k depends on the shift alone). */
+static SPEED_INLINE bool room_ok_lk(int32_t lk, uint64_t k, uint64_t dd, uint64_t found,
+                                    int32_t *room)
+{
+    int32_t r = found == 0 ? ROOM_CAP : lk + log2_q8(dd) / 2 - log2_q8(found);
+    r = r > ROOM_CAP ? ROOM_CAP : r < ROOM_MIN ? ROOM_MIN : r;
+    *room = r;
+    if (r >= ROOM_SURE || r <= -ROOM_SURE)
+        return r > 0;
+    return cs_fixed_cmp_prod_u64(found, found, k * k, dd) <= 0;
+}
+#endif
+
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
  * test's 32-bit components (below 2^27: |V - D|^2 below 2^57), with vd = V . D, cr = D x V and
  * dd = |D|^2 already computed; r2 = r^2. */
@@ -384,12 +408,30 @@ static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
     return true;
 }
 
+#if HOST_GUESS
+/* The guess of the next test (p->guess): shift s, T = thr 2^F >> s less 2, log2_q8(3072 T) (T
+ * > 0). A test whose own shift differs sets it here, out of line: the shift changes seldom
+ * (about once a curve), and the test's path does not wait on this branch, which is predicted. */
+enum { G_S, G_T, G_LK };
+static __attribute__((noinline, cold)) void guess_set(const cs_predict_t *p, int32_t *g, unsigned s)
+{
+    int32_t T = (int32_t)(((int64_t)p->thr << F) >> s) - 2;
+    g[G_S] = (int32_t)s;
+    g[G_T] = T;
+    g[G_LK] = T > 0 ? log2_q8((uint32_t)(3 * MAJ_SCALE) * (uint32_t)T) : 0;
+}
+#endif
+
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
-static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_param_t h,
-                                   int32_t *room)
+static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t h, int32_t *room)
 {
+#if HOST_GUESS
+    int32_t *g = ctx; /* the guess (p->guess); B'(t), B''(t) / 2 in p->d */
+    const int64_t(*d)[2] = (const int64_t(*)[2])p->d;
+#else
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
+#endif
     int64_t v[3][2];
     sub_curve(p, d, h, v);
     uint64_t m = 0;
@@ -401,9 +443,16 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_pa
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
         s = p->thr_shift; /* thr 2^F >> s < 2^THR_BITS */
+#if HOST_GUESS
+    if (s != (unsigned)g[G_S])
+        guess_set(p, g, s);
+    s = (unsigned)g[G_S]; /* what follows does not wait for the shift computed above */
+    int32_t T = g[G_T];
+#else
     /* thr 2^F >> s in 32 bits (thr > 0; no 64-bit shift), less 2 units for the rounding of the
      * shift below */
     int32_t T = (s >= F ? p->thr >> (s - F) : p->thr << (F - s)) - 2;
+#endif
     /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
      * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
      * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
@@ -430,7 +479,11 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, const void *ctx, cs_pa
     uint64_t found = majorant(pr[P_CR1], pr[P_CR2]);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^20: < 2^32, a 32-bit product */
+#if HOST_GUESS
+    return room_ok_lk(g[G_LK], k, (uint64_t)dd, found, room);
+#else
     return room_ok(k, (uint64_t)dd, found, room);
+#endif
 }
 
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
@@ -544,7 +597,7 @@ static void conic_start(const cs_predict_t *p, conic_start_t *c0)
  * distance (omega = W1 / sqrt(W0 W2) <= 1), and by convexity no point is farther from the chord
  * segment than that factor times dist(Q1, segment). Decided exactly on squares, with the factor
  * rounded up to 1/256. */
-static bool test_conic(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room)
+static bool test_conic(const cs_predict_t *p, void *ctx, cs_param_t h, int32_t *room)
 {
     const conic_start_t *c0 = ctx;
     int64_t b1[3], b2[3], q1[2], q2[2], v[2], d[2];
@@ -602,11 +655,11 @@ static void eval_conic(const cs_predict_t *p, cs_vec3_t *pt)
 
 /* One flatness test of the piece [t, t + h]; ctx is what every trial piece from t shares
  * (B'(t) and B''(t)/2, or the conic's start). */
-typedef bool (*test_fn)(const cs_predict_t *p, const void *ctx, cs_param_t h, int32_t *room);
+typedef bool (*test_fn)(const cs_predict_t *p, void *ctx, cs_param_t h, int32_t *room);
 
 /* The largest step found passing: predicted, corrected by the room each test leaves, bracketed
  * between the largest passing and the smallest failing step. 0 when none passes. */
-static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, const void *ctx,
+static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, void *ctx,
                                          int32_t *lo_room)
 {
     /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
@@ -672,7 +725,11 @@ static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt)
 {
     int32_t room = ROOM_HULL;
     bool eval;
+#if HOST_GUESS
+    cs_param_t h = find_step(p, test_step, p->guess, &room); /* sets room: before step_to */
+#else
     cs_param_t h = find_step(p, test_step, p->d, &room); /* sets room: before step_to reads it */
+#endif
     cs_err_t e = step_to(p, h, room, pt, &eval);
     if (eval)
         eval_poly(p, pt);

@@ -47,6 +47,11 @@ struct cs_predict {
     cs_pos_t z;         /* the plane's z (every control point has it) */
     cs_vec3_t end;      /* P_n, returned exactly as the last vertex */
     bool done;
+#if defined(__SIZEOF_INT128__)
+    /* 64-bit hosts: the last test's shift, its threshold and that threshold's log, the next
+     * test's guess (cs_predict.c, HOST_GUESS; -1 in guess[0]: none yet) */
+    int32_t guess[3];
+#endif
 };
 
 /* True when cs_predict takes c: every control point at the same z, and polynomial of degree
