@@ -549,6 +549,39 @@ static cs_param_t trend(cs_param_t a, cs_param_t b)
     return n < half ? half : n;
 }
 
+#if HOST_GUESS
+/* predict before its cap (< 2^34), the same steps: for next_step below. */
+static SPEED_INLINE uint64_t predict_raw(cs_param_t h, int32_t room)
+{
+    int32_t e = room - ROOM_MIN, i = (e >> 9) - (-ROOM_MIN >> 9);
+    uint64_t nh = ((uint64_t)(uint32_t)h * exp2_q15[(uint32_t)e & 511u]) >> (15 - i);
+    return nh - nh / 64;
+}
+
+/* The next chord's step as step_to computes it below (predict, trend, clamp to 1 .. 2^30), at
+ * most rem = 1 - t, out of line: the host's rare case. */
+static __attribute__((noinline, cold)) cs_param_t next_step_slow(cs_param_t h, int32_t room,
+                                                                 cs_param_t b, cs_param_t rem)
+{
+    cs_param_t nh = trend(predict(h, room, CS_PARAM_ONE), b);
+    nh = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : nh;
+    return nh < rem ? nh : rem;
+}
+
+/* The same value: 2 a - b (a = predict_raw) when no cap, select or clamp of next_step_slow acts
+ * (a <= 2^30, b != 0, 2 a - b >= a / 2, 1 <= 2 a - b <= rem), else next_step_slow. The test of
+ * that is a branch, predicted, where the five selects were a chain of dependent instructions
+ * from the test's room to the next test's step (which waits for it: host cores, 64-bit). */
+static SPEED_INLINE cs_param_t next_step(cs_param_t h, int32_t room, cs_param_t b, cs_param_t rem)
+{
+    uint64_t a = predict_raw(h, room);
+    int64_t n = 2 * (int64_t)a - b;
+    if (a > CS_PARAM_ONE || b == 0 || n < (int64_t)(a >> 1) || n < 1 || n > rem)
+        return next_step_slow(h, room, b, rem);
+    return (cs_param_t)n;
+}
+#endif
+
 /* --- conic arcs ------------------------------------------------------------------------- */
 /* a + (b - a) u, u in Q30 (|b - a| < 2^60: one rounding of 1/2 unit). */
 static int64_t lerp(int64_t a, int64_t b, cs_param_t u)
@@ -664,7 +697,11 @@ static SPEED_INLINE cs_param_t find_step(const cs_predict_t *p, test_fn test, vo
 {
     /* 0 <= lo, h <= rem <= 2^30 and hi <= rem + 1: int32 throughout (no 64-bit compares) */
     cs_param_t rem = CS_PARAM_ONE - p->t;
+#if HOST_GUESS
+    int32_t lo = 0, hi = rem + 1, h = p->h_next; /* <= rem already (step_to, HOST_GUESS) */
+#else
     int32_t lo = 0, hi = rem + 1, h = p->h_next < rem ? p->h_next : rem;
+#endif
     for (unsigned k = 0; k < CS_PREDICT_MAX_TESTS; k++) {
         int32_t room;
         if (test(p, ctx, h, &room)) {
@@ -713,9 +750,15 @@ static SPEED_INLINE cs_err_t step_to(cs_predict_t *p, cs_param_t h, int32_t room
     /* Next chord: the step this one would have needed to fill the tolerance (its step
      * corrected by its room), extrapolated by the trend of that ideal step (trend above). */
     cs_param_t ideal = predict(h, room, CS_PARAM_ONE);
+#if HOST_GUESS
+    /* at most the rest of the curve: find_step takes it as it is (no select on the path) */
+    p->h_next = next_step(h, room, p->h_ideal, CS_PARAM_ONE - p->t);
+    p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
+#else
     cs_param_t nh = trend(ideal, p->h_ideal);   /* < 2^31 (trend above) */
     p->h_ideal = room == ROOM_HULL ? 0 : ideal; /* a hull test says nothing of the trend */
     p->h_next = nh < 1 ? 1 : nh > CS_PARAM_ONE ? CS_PARAM_ONE : nh;
+#endif
     p->done = false;
     *eval = true;
     return CS_OK;
