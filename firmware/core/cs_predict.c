@@ -237,11 +237,12 @@ static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
 #if defined(__SIZEOF_INT128__)
     /* 64-bit hosts: the same value from one 64x64 -> 128 product, (4 x)(t 2^32) = x t 2^34, as
-     * floor((x t 2^34 + 2^63) / 2^64): its top half plus the top bit of its low half (4 x fits:
-     * every caller's |x| is below 2^60; t 2^32 <= 2^62, shared by a test's 12 products). Four
-     * instructions a product against seven (about 6 % of a chord at 0.001 mm). */
+     * floor((x t 2^34 + 2^63) / 2^64), the top half of a 128-bit sum (4 x fits: every caller's
+     * |x| is below 2^60; t 2^32 <= 2^62, shared by a test's 12 products). Five instructions a
+     * product against seven (about 6 % of a chord at 0.001 mm); written as that sum, not as the
+     * top half plus the low half's top bit, GCC 12 keeps the nested products in registers. */
     __int128 pr = (__int128)(x * 4) * ((int64_t)t << 32);
-    return (int64_t)(pr >> 64) + (int64_t)((uint64_t)pr >> 63);
+    return (int64_t)((pr + ((__int128)1 << 63)) >> 64);
 #endif
     uint32_t ut = (uint32_t)t;
     uint32_t hi = (uint32_t)((uint64_t)x >> 32); /* the two's complement top half, as int32: */
@@ -362,20 +363,6 @@ static SPEED_INLINE bool room_ok(uint64_t k, uint64_t dd, uint64_t found, int32_
     return cs_fixed_cmp_prod_u64(found, found, k * k, dd) <= 0;
 }
 
-#if HOST_GUESS
-/* room_ok with log2_q8(k) given (the guess's: k depends on the shift alone). */
-static SPEED_INLINE bool room_ok_lk(int32_t lk, uint64_t k, uint64_t dd, uint64_t found,
-                                    int32_t *room)
-{
-    int32_t r = found == 0 ? ROOM_CAP : lk + log2_q8(dd) / 2 - log2_q8(found);
-    r = r > ROOM_CAP ? ROOM_CAP : r < ROOM_MIN ? ROOM_MIN : r;
-    *room = r;
-    if (r >= ROOM_SURE || r <= -ROOM_SURE)
-        return r > 0;
-    return cs_fixed_cmp_prod_u64(found, found, k * k, dd) <= 0;
-}
-#endif
-
 /* dist(V, segment 0-D) <= r, decided exactly as cs_subdiv_dist_ok decides it, planar and on the
  * test's 32-bit components (below 2^27: |V - D|^2 below 2^57), with vd = V . D, cr = D x V and
  * dd = |D|^2 already computed; r2 = r^2. */
@@ -408,30 +395,11 @@ static bool hull_flat(const int32_t w[4][2], const int64_t pr[P_N], uint64_t r2)
     return true;
 }
 
-#if HOST_GUESS
-/* The guess of the next test (p->guess): shift s, T = thr 2^F >> s less 2, log2_q8(3072 T) (T
- * > 0). A test whose own shift differs sets it here, out of line: the shift changes seldom
- * (about once a curve), and the test's path does not wait on this branch, which is predicted. */
-enum { G_S, G_T, G_LK };
-static __attribute__((noinline, cold)) void guess_set(const cs_predict_t *p, int32_t *g, unsigned s)
-{
-    int32_t T = (int32_t)(((int64_t)p->thr << F) >> s) - 2;
-    g[G_S] = (int32_t)s;
-    g[G_T] = T;
-    g[G_LK] = T > 0 ? log2_q8((uint32_t)(3 * MAJ_SCALE) * (uint32_t)T) : 0;
-}
-#endif
-
 /* One flatness test of [t, t + h]: true when the sub-curve is proven within thr of its chord;
  * *room = log2 of how much larger the deviation bound could be (Q8), for the step predictor. */
 static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t h, int32_t *room)
 {
-#if HOST_GUESS
-    int32_t *g = ctx; /* the guess (p->guess); B'(t), B''(t) / 2 in p->d */
-    const int64_t(*d)[2] = (const int64_t(*)[2])p->d;
-#else
     const int64_t(*d)[2] = ctx; /* B'(t), B''(t) / 2 */
-#endif
     int64_t v[3][2];
     sub_curve(p, d, h, v);
     uint64_t m = 0;
@@ -443,16 +411,9 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
     unsigned s = shift_below(m, UNIT_BITS); /* components >> s < 2^UNIT_BITS */
     if (s < p->thr_shift)
         s = p->thr_shift; /* thr 2^F >> s < 2^THR_BITS */
-#if HOST_GUESS
-    if (s != (unsigned)g[G_S])
-        guess_set(p, g, s);
-    s = (unsigned)g[G_S]; /* what follows does not wait for the shift computed above */
-    int32_t T = g[G_T];
-#else
     /* thr 2^F >> s in 32 bits (thr > 0; no 64-bit shift), less 2 units for the rounding of the
      * shift below */
     int32_t T = (s >= F ? p->thr >> (s - F) : p->thr << (F - s)) - 2;
-#endif
     /* Rounded (half up: <= 1/2 unit), inline: this is the hot path. After the shift every
      * component is below 2^UNIT_BITS + 1 < 2^31, so each cross and dot product below is one
      * 32x32 -> 64 multiply (SMULL on a Cortex-M3), a sum of two below 2^53. */
@@ -479,12 +440,91 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
     uint64_t found = majorant(pr[P_CR1], pr[P_CR2]);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
     uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^20: < 2^32, a 32-bit product */
-#if HOST_GUESS
-    return room_ok_lk(g[G_LK], k, (uint64_t)dd, found, room);
-#else
     return room_ok(k, (uint64_t)dd, found, room);
-#endif
 }
+
+#if HOST_GUESS
+/* --- the test on 64-bit hosts (HOST_GUESS) -------------------------------------------------
+ * The same verdict and room as test_step, with nothing on the path from the step to the room
+ * (which the next step waits for: host cores are latency-bound here) that the products do not
+ * need: the shift and what follows from it are the last test's (p->guess), set anew out of
+ * line when the test's own shift differs (a test in 7 at 0.01 mm, in 18 at 0.001 on
+ * bench_peers' set); the convex-hull fallback and T <= 0 go to test_step itself, a room clamped
+ * or too close to 1 for its log to room_ok (2 % of the tests), each out of line after a
+ * branch, which the core predicts instead of waiting for its operands. */
+enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
+
+static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned s)
+{
+    int64_t T = (((int64_t)q->thr << F) >> s) - 2; /* test_step's T for this s */
+    q->guess[G_S] = s;
+    q->guess[G_K] = T > 0 ? 3 * MAJ_SCALE * T : 0;
+    q->guess[G_TT] = 64 * T * T;
+    q->guess[G_LK] = T > 0 ? log2_q8((uint64_t)(3 * MAJ_SCALE * T)) : 0;
+}
+
+static __attribute__((noinline, cold)) bool test_slow(cs_predict_t *q, cs_param_t h, int32_t *room)
+{
+    return test_step(q, q->d, h, room);
+}
+
+/* room_ok, out of line. */
+static __attribute__((noinline, cold)) bool room_slow(uint64_t k, uint64_t dd, uint64_t found,
+                                                      int32_t *room)
+{
+    return room_ok(k, dd, found, room);
+}
+
+/* The test's shift (test_step's), from |components| without a branch on their signs. */
+static SPEED_INLINE unsigned host_shift(const cs_predict_t *p, const int64_t v[3][2])
+{
+    uint64_t m = 0;
+    SPEED_UNROLL
+    for (unsigned i = 0; i < 6; i++) {
+        uint64_t x = (uint64_t)v[i / 2][i % 2], sg = (uint64_t)(v[i / 2][i % 2] >> 63);
+        m |= (x ^ sg) - sg;
+    }
+    unsigned s = shift_below(m, UNIT_BITS);
+    return s < p->thr_shift ? p->thr_shift : s;
+}
+
+/* test_step on the guess (ctx: the state itself, which the guess is set in). Each component
+ * rounded by one arithmetic shift of its 64-bit sum with the half (GCC shifts a negative int
+ * arithmetically), the value rsh_round32 gives (it fits 32 bits), with no sign extension. */
+static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t h, int32_t *room)
+{
+    const int64_t *g = p->guess;
+    int64_t v[3][2], w[3][2];
+    sub_curve(p, (const int64_t(*)[2])p->d, h, v);
+    unsigned s = host_shift(p, v);
+    if (s != (uint64_t)g[G_S])
+        guess_set(ctx, s);
+    if (g[G_K] == 0) /* T <= 0 */
+        return test_slow(ctx, h, room);
+    s = (unsigned)g[G_S]; /* not the shift above: what follows does not wait for it */
+    int64_t half = ((int64_t)1 << s) >> 1;
+    SPEED_UNROLL
+    for (unsigned i = 0; i < 6; i++)
+        w[i / 2][i % 2] = (v[i / 2][i % 2] + half) >> s;
+    int64_t dd = w[2][0] * w[2][0] + w[2][1] * w[2][1];
+    int64_t dot1 = w[0][0] * w[2][0] + w[0][1] * w[2][1];
+    int64_t dot2 = w[1][0] * w[2][0] + w[1][1] * w[2][1];
+    if (dd < g[G_TT] || (uint64_t)dot1 > (uint64_t)dd || (uint64_t)dot2 > (uint64_t)dd)
+        return test_slow(ctx, h, room);
+    uint64_t found =
+        majorant(w[2][0] * w[0][1] - w[2][1] * w[0][0], w[2][0] * w[1][1] - w[2][1] * w[1][0]);
+    /* room_log without its clamps and room_ok's decision on the log alone: any other case is
+     * room_slow's (the log of a positive dd is >= 0: its halving is a shift) */
+    if (found == 0)
+        return room_slow((uint64_t)g[G_K], (uint64_t)dd, found, room);
+    int32_t r = (int32_t)g[G_LK] + (int32_t)((uint32_t)log2_q8((uint64_t)dd) >> 1);
+    r -= log2_q8(found);
+    if (r > ROOM_CAP || r < ROOM_MIN || (r < ROOM_SURE && r > -ROOM_SURE))
+        return room_slow((uint64_t)g[G_K], (uint64_t)dd, found, room);
+    *room = r;
+    return r > 0;
+}
+#endif
 
 /* Step predicted from a tested one: deviation ~ h^2, so h sqrt(room), 1.6 % short. sqrt(room)
  * = 2^(r/2) (r = log2 room in Q8, so r itself is log2 sqrt(room) in Q9): 2^i (1 + f) with
@@ -508,7 +548,7 @@ static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t ca
 #if SPEED_BUILD
     uint32_t m = exp2_q15[(uint32_t)e & 511u];
 #else
-    uint32_t f = ((uint32_t)e & 511u) << 6; /* Q15 */
+    uint32_t f = ((uint32_t)e & 511u) << 6;                                    /* Q15 */
     uint32_t m = EXP2_Q15(f);
 #endif
     uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
@@ -769,7 +809,7 @@ static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt)
     int32_t room = ROOM_HULL;
     bool eval;
 #if HOST_GUESS
-    cs_param_t h = find_step(p, test_step, p->guess, &room); /* sets room: before step_to */
+    cs_param_t h = find_step(p, test_fast, p, &room); /* sets room: before step_to reads it */
 #else
     cs_param_t h = find_step(p, test_step, p->d, &room); /* sets room: before step_to reads it */
 #endif

@@ -48,9 +48,9 @@ struct cs_predict {
     cs_vec3_t end;      /* P_n, returned exactly as the last vertex */
     bool done;
 #if defined(__SIZEOF_INT128__)
-    /* 64-bit hosts: the last test's shift, its threshold and that threshold's log, the next
-     * test's guess (cs_predict.c, HOST_GUESS; -1 in guess[0]: none yet) */
-    int32_t guess[3];
+    /* 64-bit hosts: the last test's shift and what follows from it (its threshold, that
+     * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; guess[0] = -1: none) */
+    int64_t guess[4];
 #endif
 };
 
