@@ -463,16 +463,28 @@ static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned 
     q->guess[G_LK] = T > 0 ? log2_q8((uint64_t)(3 * MAJ_SCALE * T)) : 0;
 }
 
-static __attribute__((noinline, cold)) bool test_slow(cs_predict_t *q, cs_param_t h, int32_t *room)
+/* test_step and room_ok out of line, verdict and room packed as 2 room + verdict: no address
+ * of the caller's room leaves it, which can then stay in a register (not stored and loaded
+ * again on the path to the next step). */
+static __attribute__((noinline, cold)) int32_t test_slow(cs_predict_t *q, cs_param_t h)
 {
-    return test_step(q, q->d, h, room);
+    int32_t room;
+    bool ok = test_step(q, q->d, h, &room);
+    return 2 * room + ok;
 }
 
-/* room_ok, out of line. */
-static __attribute__((noinline, cold)) bool room_slow(uint64_t k, uint64_t dd, uint64_t found,
-                                                      int32_t *room)
+static __attribute__((noinline, cold)) int32_t room_slow(uint64_t k, uint64_t dd, uint64_t found)
 {
-    return room_ok(k, dd, found, room);
+    int32_t room;
+    bool ok = room_ok(k, dd, found, &room);
+    return 2 * room + ok;
+}
+
+/* Unpacks test_slow's or room_slow's answer: room, ROOM_MIN .. ROOM_CAP, and the verdict. */
+static SPEED_INLINE bool unpack(int32_t x, int32_t *room)
+{
+    *room = (x - (x & 1)) / 2; /* exact: no negative value shifted */
+    return (x & 1) != 0;
 }
 
 /* The test's shift (test_step's), from |components| without a branch on their signs. */
@@ -500,7 +512,7 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     if (s != (uint64_t)g[G_S])
         guess_set(ctx, s);
     if (g[G_K] == 0) /* T <= 0 */
-        return test_slow(ctx, h, room);
+        return unpack(test_slow(ctx, h), room);
     s = (unsigned)g[G_S]; /* not the shift above: what follows does not wait for it */
     int64_t half = ((int64_t)1 << s) >> 1;
     SPEED_UNROLL
@@ -510,17 +522,17 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     int64_t dot1 = w[0][0] * w[2][0] + w[0][1] * w[2][1];
     int64_t dot2 = w[1][0] * w[2][0] + w[1][1] * w[2][1];
     if (dd < g[G_TT] || (uint64_t)dot1 > (uint64_t)dd || (uint64_t)dot2 > (uint64_t)dd)
-        return test_slow(ctx, h, room);
+        return unpack(test_slow(ctx, h), room);
     uint64_t found =
         majorant(w[2][0] * w[0][1] - w[2][1] * w[0][0], w[2][0] * w[1][1] - w[2][1] * w[1][0]);
     /* room_log without its clamps and room_ok's decision on the log alone: any other case is
      * room_slow's (the log of a positive dd is >= 0: its halving is a shift) */
     if (found == 0)
-        return room_slow((uint64_t)g[G_K], (uint64_t)dd, found, room);
+        return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
     int32_t r = (int32_t)g[G_LK] + (int32_t)((uint32_t)log2_q8((uint64_t)dd) >> 1);
     r -= log2_q8(found);
     if (r > ROOM_CAP || r < ROOM_MIN || (r < ROOM_SURE && r > -ROOM_SURE))
-        return room_slow((uint64_t)g[G_K], (uint64_t)dd, found, room);
+        return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
     *room = r;
     return r > 0;
 }
