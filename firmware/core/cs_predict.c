@@ -602,12 +602,11 @@ static cs_param_t trend(cs_param_t a, cs_param_t b)
 }
 
 #if HOST_GUESS
-/* predict before its cap (< 2^34), the same steps: for next_step below. */
+/* predict before its last step (nh - nh / 64) and its cap (< 2^34): for next_step below. */
 static SPEED_INLINE uint64_t predict_raw(cs_param_t h, int32_t room)
 {
     int32_t e = room - ROOM_MIN, i = (e >> 9) - (-ROOM_MIN >> 9);
-    uint64_t nh = ((uint64_t)(uint32_t)h * exp2_q15[(uint32_t)e & 511u]) >> (15 - i);
-    return nh - nh / 64;
+    return ((uint64_t)(uint32_t)h * exp2_q15[(uint32_t)e & 511u]) >> (15 - i);
 }
 
 /* The next chord's step as step_to computes it below (predict, trend, clamp to 1 .. 2^30), at
@@ -626,8 +625,9 @@ static __attribute__((noinline, cold)) cs_param_t next_step_slow(cs_param_t h, i
  * from the test's room to the next test's step (which waits for it: host cores, 64-bit). */
 static SPEED_INLINE cs_param_t next_step(cs_param_t h, int32_t room, cs_param_t b, cs_param_t rem)
 {
-    uint64_t a = predict_raw(h, room);
-    int64_t n = 2 * (int64_t)a - b;
+    uint64_t u = predict_raw(h, room), a = u - u / 64;
+    /* 2 a - b as (2 u - b) - 2 (u / 64): one instruction less between u and the step */
+    int64_t n = (2 * (int64_t)u - b) - (int64_t)((u >> 5) & ~(uint64_t)1);
     if (a > CS_PARAM_ONE || b == 0 || n < (int64_t)(a >> 1) || n < 1 || n > rem)
         return next_step_slow(h, room, b, rem);
     return (cs_param_t)n;
