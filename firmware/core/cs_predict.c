@@ -330,8 +330,8 @@ static SPEED_INLINE int32_t log2_q8(uint64_t v)
     unsigned c = (unsigned)__builtin_clzll(v), n = 64 - c;
     uint32_t m = (uint32_t)((v << c) >> 48);
 #else
-    unsigned n = cs_fixed_bitlen64(v);
-    uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n); /* [2^15, 2^16) */
+    unsigned n = cs_fixed_bitlen64(v); /* m below: the top 16 bits, in [2^15, 2^16) */
+    uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n);
 #endif
     uint32_t x = m - (1u << 15); /* Q15 */
     uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
@@ -450,7 +450,7 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
  * need: the shift and what follows from it are the last test's (p->guess), set anew out of
  * line when the test's own shift differs (a test in 7 at 0.01 mm, in 18 at 0.001 on
  * bench_peers' set); the convex-hull fallback and T <= 0 go to test_step itself, a room clamped
- * or too close to 1 for its log to room_ok (2 % of the tests), each out of line after a
+ * or too close to 1 for its log to room_ok (up to 2 % of the tests), each out of line after a
  * branch, which the core predicts instead of waiting for its operands. */
 enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
 
@@ -464,8 +464,8 @@ static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned 
 }
 
 /* test_step and room_ok out of line, verdict and room packed as 2 room + verdict: no address
- * of the caller's room leaves it, which can then stay in a register (not stored and loaded
- * again on the path to the next step). */
+ * of the caller's room leaves the inline path (a room whose address is passed out lives in
+ * memory). */
 static __attribute__((noinline, cold)) int32_t test_slow(cs_predict_t *q, cs_param_t h)
 {
     int32_t room;
@@ -507,7 +507,7 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
 {
     const int64_t *g = p->guess;
     int64_t v[3][2], w[3][2];
-    sub_curve(p, (const int64_t(*)[2])p->d, h, v);
+    sub_curve(p, p->d, h, v);
     unsigned s = host_shift(p, v);
     if (s != (uint64_t)g[G_S])
         guess_set(ctx, s);
@@ -560,7 +560,7 @@ static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t ca
 #if SPEED_BUILD
     uint32_t m = exp2_q15[(uint32_t)e & 511u];
 #else
-    uint32_t f = ((uint32_t)e & 511u) << 6;                                    /* Q15 */
+    uint32_t f = ((uint32_t)e & 511u) << 6; /* Q15 */
     uint32_t m = EXP2_Q15(f);
 #endif
     uint64_t nh = (uint64_t)(uint32_t)h * m; /* h 2^f in Q15, < 2^46 */
