@@ -318,6 +318,22 @@ static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2],
     }
 }
 
+#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+/* 64-bit speed builds: the fraction below, l >> 7, for each of the 2^15 mantissas x, the same
+ * formula evaluated by the compiler (32 KB of table: one load, within L1 on the host, instead
+ * of two dependent multiplies on the path from the deviation found to the next step; 5 % of
+ * a chord at 0.01 mm). */
+#define LG_X(x)   (uint8_t)(((x) + (((((x) * (32768u - (x))) >> 15) * 89u) >> 8)) >> 7)
+#define LG_4(j)   LG_X(j), LG_X((j) + 1), LG_X((j) + 2), LG_X((j) + 3)
+#define LG_16(j)  LG_4(j), LG_4((j) + 4), LG_4((j) + 8), LG_4((j) + 12)
+#define LG_64(j)  LG_16(j), LG_16((j) + 16), LG_16((j) + 32), LG_16((j) + 48)
+#define LG_256(j) LG_64(j), LG_64((j) + 64), LG_64((j) + 128), LG_64((j) + 192)
+#define LG_1K(j)  LG_256(j), LG_256((j) + 256), LG_256((j) + 512), LG_256((j) + 768)
+#define LG_4K(j)  LG_1K(j), LG_1K((j) + 1024), LG_1K((j) + 2048), LG_1K((j) + 3072)
+#define LG_16K(j) LG_4K(j), LG_4K((j) + 4096), LG_4K((j) + 8192), LG_4K((j) + 12288)
+static const uint8_t lg_frac[32768] = {LG_16K(0u), LG_16K(16384u)};
+#endif
+
 /* log2(v) in Q8 for v > 0: the bit length gives the integer part, the next 15 bits x
  * (v = 2^e (1 + x), 0 <= x < 1) the fraction by log2(1 + x) ~ x + c x (1 - x), c = 89/256;
  * within [-0.0115, +0.0079] of the exact log2 v (checked on all 2^15 mantissas, the truncation
@@ -334,6 +350,9 @@ static SPEED_INLINE int32_t log2_q8(uint64_t v)
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n);
 #endif
     uint32_t x = m - (1u << 15); /* Q15 */
+#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+    return (int32_t)((n - 1) * ROOM_ONE + lg_frac[x]);
+#endif
     uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
     return (int32_t)((n - 1) * ROOM_ONE + (l >> 7));
 }
