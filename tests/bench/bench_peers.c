@@ -548,23 +548,22 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
     goal_speed_row("curves/s >= 2x cairo's", cps_t, arcs_worst_cps, 2);
     goal_speed_row("points/s >= cairo's", pps_t, arcs_worst_pps, 1);
     printf("\n");
-    printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost): the "
-           "wall clock of this shared machine is noisy (compare within one table, and expect "
-           "the ratios to move by 2x between runs; `bench_peers --speed` times only the default "
-           "tracer and cairo, for a quick A/B); by instructions (`bench_peers --profile` under "
-           "callgrind, the three sets at the three tolerances) the tracer spends 650 a point "
-           "and 25.2 k a curve against cairo's 679 and 42.9 k, i.e. 1.70x cairo's curves/s and "
-           "1.05x its points/s (before issue 18's host pass 928 and 35.9 k; before its second "
-           "pass 1,024 and 39.5 k). Each chord costs 1.06-1.73 verified flatness tests (most at "
-           "0.1 mm, where 20 chords a curve leave the predictor little to extrapolate from; a "
-           "sub-curve of 12 Q30 products, cross and dot products, a 4-piece majorant, three "
-           "logarithms: no division, no branch on the sign of a product) plus B(t) and its "
-           "derivatives by one Horner scheme (8 products); after issue 18's third pass (first "
-           "step from the curvature, 2026-12-02) 607 a point and 23.5 k a curve, 1.82x and 1.12x "
-           "by instructions. Arcs go through the arc tracer (cs_ellarc, docs/fixed-point.md "
-           "\"Arc tracer\": a rotation recurrence, no division a vertex): under --profile "
-           "5.34 M instructions for the arcs against cairo_arc's 30.7 M (the conic predictor "
-           "it replaced: 1,170 a point, 189 k an arc, 0.90x cairo_arc by instructions).\n\n");
+    printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost and "
+           "\"Host path of 64-bit speed builds\"): wall clock on this shared machine moves by up "
+           "to 2x between runs (compare within one table; `bench_peers --speed` times only the "
+           "default tracer and cairo, for a quick A/B). The tracer is bound by the latency of one "
+           "chain of dependent operations a flatness test (sub-curve products, normalising shift, "
+           "cross products, majorant, logarithm, next step; 12 cycles of delay added before each "
+           "test cost 3-4 ns a chord). On 2026-12-03 the host path (bit for bit the portable "
+           "code's vertices) took a chord from 65 / 46 / 41 ns to 48 / 31 / 26 ns at 0.1 / 0.01 / "
+           "0.001 mm (random set, quiet machine). What is left at 0.1 mm: a curve there is only "
+           "about 20 chords (4 on the teapot), so the set-up (about 45 ns a curve) counts, and "
+           "the step predictor misses more: 1.62 tests a chord (1.05 at 0.001 mm), each miss a "
+           "mispredicted branch and a second chain. A better host predictor (the next chord's "
+           "test predicted from the accepted one, a log-log secant) cut that to 1.18 tests but "
+           "only 5 %% of the time, and would have made the host trace other chords than the "
+           "firmware; not merged. Arcs go through the arc tracer (cs_ellarc: a rotation "
+           "recurrence, no division a vertex).\n\n");
 }
 
 /* Arcs per second and points per second of engine e over the arcs at tol, N_RUNS runs each
