@@ -47,9 +47,20 @@
 #define SPEED_INLINE
 #define SPEED_UNROLL
 #endif
-/* 64-bit speed builds: the test's shift guessed from the last test (cs_predict.h, guess), so
- * that the test's products do not wait for the shift of its own components (below). */
-#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+/* 64-bit hosts (HOST_WIDE): mul_t by one 128-bit product and, in speed builds, log2_q8 by a
+ * table and the test's shift guessed from the last test (cs_predict.h, guess), so that the
+ * test's products do not wait for the shift of its own components (below). The same values as
+ * the portable code, which every firmware image runs; CS_PREDICT_PORTABLE 1 builds the portable
+ * code on a 64-bit host too (tests/unit/test_predict_portable.c runs test_predict on it). */
+#ifndef CS_PREDICT_PORTABLE
+#define CS_PREDICT_PORTABLE 0
+#endif
+#if defined(__SIZEOF_INT128__) && !CS_PREDICT_PORTABLE
+#define HOST_WIDE 1
+#else
+#define HOST_WIDE 0
+#endif
+#if SPEED_BUILD && HOST_WIDE
 #define HOST_GUESS 1
 #else
 #define HOST_GUESS 0
@@ -235,7 +246,7 @@ cs_err_t cs_predict_begin_conic(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t 
  * sign, which is data (a mispredicted branch costs a host core some 15 cycles). */
 static HOT_INLINE int64_t mul_t(int64_t x, cs_param_t t)
 {
-#if defined(__SIZEOF_INT128__)
+#if HOST_WIDE
     /* 64-bit hosts: the same value from one 64x64 -> 128 product, (4 x)(t 2^32) = x t 2^34, as
      * floor((x t 2^34 + 2^63) / 2^64), the top half of a 128-bit sum (4 x fits: every caller's
      * |x| is below 2^60; t 2^32 <= 2^62, shared by a test's 12 products). Five instructions a
@@ -318,7 +329,7 @@ static SPEED_INLINE void sub_curve(const cs_predict_t *p, const int64_t d[2][2],
     }
 }
 
-#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+#if SPEED_BUILD && HOST_WIDE
 /* 64-bit speed builds: the fraction below, l >> 7, for each of the 2^15 mantissas x, the same
  * formula evaluated by the compiler (32 KB of table: one load, within L1 on the host, instead
  * of two dependent multiplies on the path from the deviation found to the next step; 5 % of
@@ -340,7 +351,7 @@ static const uint8_t lg_frac[32768] = {LG_16K(0u), LG_16K(16384u)};
  * to 16 bits and to Q8 included). The predictor's only logarithm. */
 static SPEED_INLINE int32_t log2_q8(uint64_t v)
 {
-#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+#if SPEED_BUILD && HOST_WIDE
     /* 64-bit hosts: v normalised by one shift (its leading 1 to bit 63) gives the same 16 bits,
      * zeros below a short v's last bit, as the two shifts and the select below */
     unsigned c = (unsigned)__builtin_clzll(v), n = 64 - c;
@@ -350,7 +361,7 @@ static SPEED_INLINE int32_t log2_q8(uint64_t v)
     uint32_t m = n > 16 ? (uint32_t)(v >> (n - 16)) : (uint32_t)v << (16 - n);
 #endif
     uint32_t x = m - (1u << 15); /* Q15 */
-#if SPEED_BUILD && defined(__SIZEOF_INT128__)
+#if SPEED_BUILD && HOST_WIDE
     return (int32_t)((n - 1) * ROOM_ONE + lg_frac[x]);
 #endif
     uint32_t l = x + ((((x * ((1u << 15) - x)) >> 15) * 89u) >> 8);
