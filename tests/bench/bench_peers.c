@@ -686,18 +686,21 @@ __attribute__((noinline)) static size_t profile_arcs_cairo(size_t *n)
     return profile_arcs(ENG_CAIRO, n);
 }
 
-/* --speed: the default tracer against cairo only, wall clock (median of N_RUNS), on the random
- * set and the arcs at the three tolerances: a quick A/B of the tracer's host speed (the full
- * run takes minutes, most of it in the judge). */
+/* --speed: the default tracer against cairo only, wall clock (median of N_RUNS), on the three
+ * sets (random, SVG, teapot) and the arcs at the three tolerances: a quick A/B of the tracer's
+ * host speed (the full run takes minutes, most of it in the judge). */
 static int speed_only(const bench_set_t *sets)
 {
     printf("set tol(mm) pred-curves/s cairo-curves/s ratio pred-pts/s cairo-pts/s ratio\n");
-    for (int ti = 0; ti < N_TOLS; ti++) {
-        double pp, cp, pc = speed(&sets[0], tols_mm[ti], ENG_PRED, &pp);
-        double cc = speed(&sets[0], tols_mm[ti], ENG_CAIRO, &cp);
-        printf("random %g %.3g %.3g %.2f %.3g %.3g %.2f\n", tols_mm[ti], pc, cc, pc / cc, pp, cp,
-               pp / cp);
-    }
+    enum { N_SETS = 3 };
+    static const char *set_name[N_SETS] = {"random", "svg", "teapot"};
+    for (int si = 0; si < N_SETS; si++)
+        for (int ti = 0; ti < N_TOLS; ti++) {
+            double pp, cp, pc = speed(&sets[si], tols_mm[ti], ENG_PRED, &pp);
+            double cc = speed(&sets[si], tols_mm[ti], ENG_CAIRO, &cp);
+            printf("%s %g %.3g %.3g %.2f %.3g %.3g %.2f\n", set_name[si], tols_mm[ti], pc, cc,
+                   pc / cc, pp, cp, pp / cp);
+        }
     for (int ti = 0; ti < N_TOLS; ti++) {
         double pa[N_RUNS], pp[N_RUNS], ca[N_RUNS], cp[N_RUNS];
         arcs_speed(tols_mm[ti], ENG_PRED, pa, pp);
@@ -728,7 +731,7 @@ int main(int argc, char **argv)
         "curvestep's tracers beside cairo and AGG on one corpus of cubics; a Markdown\n"
         "section on stdout, the figures in OUT.csv. --profile: only the default tracer and\n"
         "cairo, once over the corpus and the arcs (for callgrind, see profile_curves).\n"
-        "--speed: only the default tracer's and cairo's wall-clock speed on the random set\n"
+        "--speed: only the default tracer's and cairo's wall-clock speed on the three sets\n"
         "and the arcs (a quick A/B; no judge, no file).\n";
     bool prof = argc == 2 && strcmp(argv[1], "--profile") == 0;
     bool spd = argc == 2 && strcmp(argv[1], "--speed") == 0;
