@@ -158,9 +158,23 @@ bool cs_predict_accepts(const cs_bezier_t *c)
     return planar_ok(c) && (!c->rational || conic_ok(c));
 }
 
+/* cs_fixed_vec_ok: every coordinate within CS_POS_LIMIT. Speed builds inline, by one unsigned
+ * compare each (|v| <= L as v + L <= 2 L; L = 2^28: no overflow) and no call. */
+static SPEED_INLINE bool point_ok(const cs_vec3_t *v)
+{
+#if SPEED_BUILD
+    uint32_t lim = (uint32_t)CS_POS_LIMIT;
+    return ((uint32_t)v->x + lim <= 2 * lim) & ((uint32_t)v->y + lim <= 2 * lim) &
+           ((uint32_t)v->z + lim <= 2 * lim);
+#else
+    return cs_fixed_vec_ok(v);
+#endif
+}
+
 /* What both begins share: the checks (tolerance, then the curve: ok is the caller's verdict on
  * it, so that the polynomial begin links no conic check, then its range) and the tracing state. */
-static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol, bool ok)
+static SPEED_INLINE cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol,
+                                          bool ok)
 {
     p->done = true;
     if (tol < CS_PREDICT_TOL_MIN || tol > CS_PREDICT_TOL_MAX)
@@ -168,7 +182,7 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
     if (!ok)
         return CS_ERR_UNSUPPORTED;
     for (unsigned i = 0; i <= c->degree; i++)
-        if (!cs_fixed_vec_ok(&c->p[i]))
+        if (!point_ok(&c->p[i]))
             return CS_ERR_RANGE;
     p->t = 0;
     p->h_next = CS_PARAM_ONE; /* first try the whole curve as one chord */
@@ -182,15 +196,54 @@ static cs_err_t begin_common(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol
 }
 
 static void eval_poly(cs_predict_t *p, cs_vec3_t *pt);
+static cs_param_t first_step_w(const cs_predict_t *p, int32_t w[6]);
+#if !SPEED_BUILD
 static cs_param_t first_step(const cs_predict_t *p);
+#endif
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
+
+#if SPEED_BUILD
+/* Speed builds: the power basis of the loops below in closed form, the same exact integers
+ * (a_i = C(n, i) times the i-th forward difference): a1 = n (P1 - P0), a2 = 3 (P2 - 2 P1 + P0)
+ * for a cubic, P2 - 2 P1 + P0 for a quadratic, a3 = P3 - 3 P2 + 3 P1 - P0; B'(0) = a1 and
+ * B''(0) / 2 = a2 written straight into p->d (eval_poly at t = 0 multiplies by 0: the same
+ * values), and first_step's w (a1, a2 in units of 4 LSB, floored: a >> 2, GCC shifts a negative
+ * value arithmetically) in registers, not loaded back from p->a (whose two 8-byte stores the
+ * vectorised load waited for). */
+static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int32_t w[4])
+{
+    unsigned n = c->degree;
+    SPEED_UNROLL
+    for (unsigned k = 0; k < 2; k++) {
+        int64_t x0 = cs_fixed_vec_get(&c->p[0], k), x1 = cs_fixed_vec_get(&c->p[1], k);
+        int64_t a1 = x1 - x0, a2 = 0, a3 = 0;
+        if (n >= 2) {
+            int64_t x2 = cs_fixed_vec_get(&c->p[2], k);
+            a2 = x2 - 2 * x1 + x0;
+            if (n == 3) {
+                a3 = cs_fixed_vec_get(&c->p[3], k) - 3 * x2 + 3 * x1 - x0;
+                a2 *= 3;
+            }
+        }
+        a1 *= n;
+        const int64_t one = (int64_t)1 << F;
+        p->a[0][k] = x0 * one;
+        p->a[1][k] = p->d[0][k] = a1 * one;
+        p->a[2][k] = p->d[1][k] = a2 * one;
+        p->a[3][k] = a3 * one;
+        w[k] = (int32_t)(a1 >> 2);
+        w[2 + k] = (int32_t)(a2 >> 2);
+    }
+}
+#endif
 
 cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
 {
     cs_err_t e = begin_common(p, c, tol, !c->rational && planar_ok(c));
     if (e != CS_OK)
         return e;
+#if !SPEED_BUILD
     unsigned n = c->degree;
     for (unsigned k = 0; k < 2; k++) {
         /* Power basis from the Bernstein points: a_i = C(n, i) (i-th forward difference of the
@@ -213,6 +266,11 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     cs_vec3_t p0;
     eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
     p->h_next = first_step(p);
+#else
+    int32_t w[6];
+    power_basis(p, c, w);
+    p->h_next = first_step_w(p, w);
+#endif
 #if defined(__SIZEOF_INT128__)
     p->guess[0] = -1; /* no shift guessed: the first test sets it (HOST_GUESS) */
 #endif
@@ -606,6 +664,16 @@ static SPEED_INLINE cs_param_t predict(cs_param_t h, int32_t room, cs_param_t ca
  * step that would just fill the tolerance (1/64 short). a1, a2 are exact multiples of 2^F below
  * 2^32 LSB (begin), so w1, w2 < 2^30 (products < 2^61), floored: a guess the tests verify as
  * any other step. A straight start (w1 x w2 = 0) tries the whole curve. */
+static SPEED_INLINE cs_param_t first_step_w(const cs_predict_t *p, int32_t w[6])
+{
+    w[4] = -w[1]; /* w1's normal (-y, x): w1 x w2 = w[4..5] . w[2..3] */
+    w[5] = w[0];
+    int32_t r; /* room_ok for its room (one routine on the M0+: its verdict is not needed) */
+    (void)room_ok((uint32_t)p->thr, (uint64_t)dot(w, w), uabs64(dot(w + 4, w + 2)), &r);
+    return predict(CS_PARAM_ONE, r, CS_PARAM_ONE);
+}
+
+#if !SPEED_BUILD /* speed builds: w from power_basis */
 static cs_param_t first_step(const cs_predict_t *p)
 {
     const int64_t *a = &p->a[1][0]; /* a1x, a1y, a2x, a2y */
@@ -614,12 +682,9 @@ static cs_param_t first_step(const cs_predict_t *p)
         uint32_t u = (uint32_t)((uint64_t)a[i] >> (F + 2)); /* floor(a / 2^(F+2)), two's compl. */
         w[i] = u <= INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
     }
-    w[4] = -w[1]; /* w1's normal (-y, x): w1 x w2 = w[4..5] . w[2..3] */
-    w[5] = w[0];
-    int32_t r; /* room_ok for its room (one routine on the M0+: its verdict is not needed) */
-    (void)room_ok((uint32_t)p->thr, (uint64_t)dot(w, w), uabs64(dot(w + 4, w + 2)), &r);
-    return predict(CS_PARAM_ONE, r, CS_PARAM_ONE);
+    return first_step_w(p, w);
 }
+#endif
 
 /* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
  * ideal step changes smoothly along the curve), at least a/2; a alone when there is no last
