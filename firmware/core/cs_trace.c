@@ -27,16 +27,22 @@ static cs_err_t begin_reach(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
 static cs_err_t begin_predict(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol)
 {
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
-    /* a circle or ellipse piece: equal-angle chords by the rotation recurrence (cs_ellarc);
-     * the conic predictor takes the pieces it refuses (tol below its minimum, other weights) */
-    if (c->rational && cs_ellarc_begin(&tr->u.arc, c, tol) == CS_OK) {
+    if (!c->rational) {
+        /* cs_predict_begin makes cs_predict_accepts' checks itself: CS_ERR_UNSUPPORTED (tol is
+         * within its range, the asserts above) exactly for a curve it does not take */
+        tr->impl = CS_TRACE_IMPL_PREDICT;
+        cs_err_t e = cs_predict_begin(&tr->u.pr, c, tol);
+        if (e != CS_ERR_UNSUPPORTED)
+            return e;
+    } else if (cs_ellarc_begin(&tr->u.arc, c, tol) == CS_OK) {
+        /* a circle or ellipse piece: equal-angle chords by the rotation recurrence (cs_ellarc);
+         * the conic predictor takes the pieces it refuses (tol below its minimum, other
+         * weights) */
         tr->impl = CS_TRACE_IMPL_ELLARC;
         return CS_OK;
-    }
-    if (cs_predict_accepts(c)) {
+    } else if (cs_predict_accepts(c)) {
         tr->impl = CS_TRACE_IMPL_PREDICT;
-        return c->rational ? cs_predict_begin_conic(&tr->u.pr, c, tol)
-                           : cs_predict_begin(&tr->u.pr, c, tol);
+        return cs_predict_begin_conic(&tr->u.pr, c, tol);
     }
 #endif
     return begin_reach(tr, c, tol);
@@ -85,7 +91,7 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
         return CS_ERR_ARG;
     if (tol < CS_TRACE_TOL_MIN || tol > CS_TRACE_TOL_MAX)
         return CS_ERR_TOLERANCE;
-    cs_err_t e = method == CS_TRACE_PREDICT ? begin_predict(tr, c, tol)
+    cs_err_t e = method == CS_TRACE_PREDICT  ? begin_predict(tr, c, tol)
                  : method == CS_TRACE_SUBDIV ? begin_reach(tr, c, tol)
                  : method == CS_TRACE_FD     ? begin_fd(tr, c, tol)
                                              : begin_afd(tr, c, tol);
