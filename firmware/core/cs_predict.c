@@ -211,8 +211,7 @@ static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
  * values), and first_step's w (a1, a2 in units of 4 LSB, floored: a >> 2, GCC shifts a negative
  * value arithmetically) in registers, not loaded back from p->a (whose two 8-byte stores the
  * vectorised load waited for). */
-static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int64_t a[4][2],
-                                     int32_t w[4])
+static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int32_t w[4])
 {
     unsigned n = c->degree;
     SPEED_UNROLL
@@ -228,10 +227,6 @@ static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int6
             }
         }
         a1 *= n;
-        a[0][k] = x0;
-        a[1][k] = a1;
-        a[2][k] = a2;
-        a[3][k] = a3;
         const int64_t one = (int64_t)1 << F;
         p->a[0][k] = x0 * one;
         p->a[1][k] = p->d[0][k] = a1 * one;
@@ -248,16 +243,18 @@ static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int6
  * 2^F, v0 = a1, v1 = 2 a1 + a2, v2 = 3 (a1 + a2 + a3) (|v| < 2^31: exact products). If V0 and
  * V1 are lambda V2 with 0 <= lambda <= 1 (the control points on one line, the inner ones
  * projecting onto the chord) and the test's T > 0, the test passes (docs/fixed-point.md,
- * "One-chord curves"): the curve is the one chord to P_n, traced without that test. */
-static SPEED_INLINE bool straight(const cs_predict_t *p, const int64_t a[4][2])
+ * "One-chord curves"): the curve is the one chord to P_n, traced without that test. Out of line
+ * (the a_i from p->a, exact multiples of 2^F): the other curves' begin keeps its registers. */
+static __attribute__((noinline)) bool straight(const cs_predict_t *p)
 {
     int64_t v[3][2];
     uint64_t m = 0;
     SPEED_UNROLL
     for (unsigned k = 0; k < 2; k++) {
-        v[0][k] = a[1][k];
-        v[1][k] = 2 * a[1][k] + a[2][k];
-        v[2][k] = 3 * (a[1][k] + a[2][k] + a[3][k]);
+        int64_t a1 = p->a[1][k] >> F, a2 = p->a[2][k] >> F, a3 = p->a[3][k] >> F;
+        v[0][k] = a1;
+        v[1][k] = 2 * a1 + a2;
+        v[2][k] = 3 * (a1 + a2 + a3);
         m |= uabs64(v[0][k]) | uabs64(v[1][k]) | uabs64(v[2][k]);
     }
     unsigned s = shift_below(m << F, UNIT_BITS); /* the test's shift and T (test_step) */
@@ -314,16 +311,15 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
     p->h_next = first_step(p);
 #else
-    int64_t a[4][2];
     int32_t w[6];
-    power_basis(p, c, a, w);
+    power_basis(p, c, w);
     p->h_next = first_step_w(p, w);
 #endif
 #if defined(__SIZEOF_INT128__)
     p->guess[0] = -1; /* no shift guessed: the first test sets it (HOST_GUESS) */
 #endif
 #if SPEED_BUILD
-    p->next = p->h_next == CS_PARAM_ONE && straight(p, a) ? next_last : next_poly;
+    p->next = p->h_next == CS_PARAM_ONE && straight(p) ? next_last : next_poly;
 #else
     p->next = next_poly;
 #endif
