@@ -244,7 +244,8 @@ static SPEED_INLINE void power_basis(cs_predict_t *p, const cs_bezier_t *c, int3
  * V1 are lambda V2 with 0 <= lambda <= 1 (the control points on one line, the inner ones
  * projecting onto the chord) and the test's T > 0, the test passes (docs/fixed-point.md,
  * "One-chord curves"): the curve is the one chord to P_n, traced without that test. Out of line
- * (the a_i from p->a, exact multiples of 2^F): the other curves' begin keeps its registers. */
+ * (the a_i from p->a, exact multiples of 2^F: an exact arithmetic shift, GCC's for a negative
+ * value): the other curves' begin keeps its registers. */
 static __attribute__((noinline)) bool straight(const cs_predict_t *p)
 {
     int64_t v[3][2];
