@@ -737,11 +737,12 @@ static cs_param_t first_step(const cs_predict_t *p)
 
 /* The ideal step a of this chord extrapolated linearly from the last one's, b: 2a - b (the
  * ideal step changes smoothly along the curve), at least a/2; a alone when there is no last
- * one (b = 0). 0 <= a <= 2^30 and 0 <= b <= 2^30: 2a - b < 2^31, no overflow. (Selects and
+ * one (b = 0). 0 <= a <= 2^30 and 0 < b <= 2^30: 2a - b < 2^31, taken as a + (a - b) (2a alone
+ * is 2^31 for a = 2^30: a signed overflow, UBSan's, on a curve's whole step). (Selects and
  * unsigned halvings: 4 bytes less on the M0+ than a branch and signed divisions.) */
 static cs_param_t trend(cs_param_t a, cs_param_t b)
 {
-    cs_param_t n = b == 0 ? a : 2 * a - b, half = (cs_param_t)((uint32_t)a >> 1); /* a >= 0 */
+    cs_param_t n = b == 0 ? a : a + (a - b), half = (cs_param_t)((uint32_t)a >> 1); /* a >= 0 */
     return n < half ? half : n;
 }
 
