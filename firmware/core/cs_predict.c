@@ -4,9 +4,12 @@
 
 #include <stddef.h>
 
+/* The test's threshold T is below 2^THR_BITS = 2^14 units, at least 2^13 - 2 when it sets the
+ * shift (what the smallest tolerance, 4 LSB, has at s = 0): the shift is then the threshold's on
+ * most chords, not the chord's length, and changes rarely (docs/fixed-point.md). */
 #define F               CS_PREDICT_FRAC
 #define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
-#define THR_BITS        20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
+#define THR_BITS        14 /* threshold below 2^14 units: (3072 T)^2 < 2^64 */
 #define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
 /* The room a test leaves, (bound allowed) / (bound found), is carried as its base-2 logarithm
  * in Q8 (ROOM_ONE = 1.0 in the log, i.e. a factor 2): products and square roots of rooms are
@@ -302,7 +305,7 @@ static SPEED_INLINE void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 
 /* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
  * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
- * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
+ * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 26. */
 CS_STATIC_ASSERT(((int64_t)8 * CS_POS_LIMIT << F) < ((int64_t)1 << (UNIT_BITS + 31)),
                  predict_unit_shift_below_32);
 CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS + 31)),
@@ -469,7 +472,7 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
     }
     uint64_t found = majorant(pr[P_CR1], pr[P_CR2]);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
-    uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^20: < 2^32, a 32-bit product */
+    uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^14: < 2^26, a 32-bit product */
     return room_ok(k, (uint64_t)dd, found, room);
 }
 
@@ -478,10 +481,11 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
  * The same verdict and room as test_step, with nothing on the path from the step to the room
  * (which the next step waits for: host cores are latency-bound here) that the products do not
  * need: the shift and what follows from it are the last test's (p->guess), set anew out of
- * line when the test's own shift differs (a test in 7 at 0.01 mm, in 18 at 0.001 on
- * bench_peers' set); the convex-hull fallback and T <= 0 go to test_step itself, a room clamped
- * or too close to 1 for its log to room_ok (up to 2 % of the tests), each out of line after a
- * branch, which the core predicts instead of waiting for its operands. */
+ * line when the test's own shift differs (bench_peers' random set: the first test of each
+ * curve, then one test in 230 at 0.01 mm, one in 70 at 0.001: THR_BITS); the convex-hull
+ * fallback and T <= 0 go to test_step itself, a room clamped or too close to 1 for its log to
+ * room_ok (up to 2 % of the tests), each out of line after a branch, which the core predicts
+ * instead of waiting for its operands. */
 enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
 
 static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned s)

@@ -43,7 +43,7 @@ struct cs_predict {
     cs_param_t h_next;  /* the step predicted for the next chord */
     cs_param_t h_ideal; /* the step the last chord would have needed (0: none known) */
     cs_pos_t thr;       /* tol - slack, LSB */
-    uint8_t thr_shift;  /* least shift of thr * 2^F below 2^20 (the test's unit) */
+    uint8_t thr_shift;  /* least shift of thr * 2^F below 2^14 (the test's unit) */
     cs_pos_t z;         /* the plane's z (every control point has it) */
     cs_vec3_t end;      /* P_n, returned exactly as the last vertex */
     bool done;
