@@ -188,6 +188,9 @@ static void eval_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_param_t first_step(const cs_predict_t *p);
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
+#if HOST_GUESS
+static void guess_set(cs_predict_t *q, unsigned s);
+#endif
 
 cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
 {
@@ -216,8 +219,8 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     cs_vec3_t p0;
     eval_poly(p, &p0); /* B'(0), B''(0) / 2 (p0 = P_0 is not needed: one routine, no branch) */
     p->h_next = first_step(p);
-#if defined(__SIZEOF_INT128__)
-    p->guess[0] = -1; /* no shift guessed: the first test sets it (HOST_GUESS) */
+#if HOST_GUESS
+    guess_set(p, p->thr_shift); /* the shift of most tests (THR_BITS): the first one's guess */
 #endif
     p->next = next_poly;
     p->done = false;
@@ -481,11 +484,11 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
  * The same verdict and room as test_step, with nothing on the path from the step to the room
  * (which the next step waits for: host cores are latency-bound here) that the products do not
  * need: the shift and what follows from it are the last test's (p->guess), set anew out of
- * line when the test's own shift differs (bench_peers' random set: the first test of each
- * curve, then one test in 230 at 0.01 mm, one in 70 at 0.001: THR_BITS); the convex-hull
- * fallback and T <= 0 go to test_step itself, a room clamped or too close to 1 for its log to
- * room_ok (up to 2 % of the tests), each out of line after a branch, which the core predicts
- * instead of waiting for its operands. */
+ * line when the test's own shift differs (bench_peers' random set: about one test in 230 at
+ * 0.01 mm, one in 70 at 0.001, none at 0.1: THR_BITS); the convex-hull fallback and T <= 0 go to
+ * test_step itself, a room clamped or too close to 1 for its log to room_ok (up to 2 % of the
+ * tests), each out of line after a branch, which the core predicts instead of waiting for its
+ * operands. */
 enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
 
 static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned s)

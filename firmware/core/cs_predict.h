@@ -49,7 +49,8 @@ struct cs_predict {
     bool done;
 #if defined(__SIZEOF_INT128__)
     /* 64-bit hosts: the last test's shift and what follows from it (its threshold, that
-     * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; guess[0] = -1: none) */
+     * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; begin guesses the
+     * threshold's shift) */
     int64_t guess[4];
 #endif
 };
