@@ -19,11 +19,11 @@
 #define ROOM_FAIL (-2 * ROOM_ONE)  /* room 1/4: what a failing hull test or T <= 0 reports */
 #define ROOM_MIN  (-30 * ROOM_ONE) /* room 2^-30: the step shrinks at most 2^15 times */
 #define ROOM_HULL 0                /* room 1: a passing hull test (says nothing of the trend) */
-/* Accept a passing step whose deviation bound is within 1/1.15 of the threshold (log2(1.15) =
- * 0.2016, 52/256): the step is then within about 7 % of the largest that passes. Against 1.10
- * (35/256): 0.5 % more chords at 0.1 mm (bench_peers' random set), 7 % fewer tests a chord
- * there, 5 % fewer M3 instructions a chord (docs/fixed-point.md, Cost). */
-#define ROOM_ACCEPT 52
+/* Accept a passing step whose deviation bound is within 1/1.35 of the threshold (log2(1.347) =
+ * 0.430, 110/256): the step is then within about 14 % of the largest that passes. Against 1.15
+ * (52/256): 1.0 % more chords at 0.1 mm (bench_peers' random set), 10 % fewer tests a chord
+ * there, 9 % less host time a curve (docs/fixed-point.md, Predictor). */
+#define ROOM_ACCEPT 110
 
 /* The small helpers of the hot path (mul_t, dot, uabs64): inline on cores with a 32x32 -> 64
  * multiply instruction (about 8 instructions a call saved on the M3, 32 calls a chord); one
