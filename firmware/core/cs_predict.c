@@ -562,16 +562,22 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
         return unpack(test_slow(ctx, h), room);
     uint64_t found =
         majorant(w[2][0] * w[0][1] - w[2][1] * w[0][0], w[2][0] * w[1][1] - w[2][1] * w[1][0]);
-    /* room_log without its clamps and room_ok's decision on the log alone: any other case is
-     * room_slow's (the log of a positive dd is >= 0: its halving is a shift) */
+    /* room_log without its clamps (a clamped room is room_slow's: the log of a positive dd is
+     * >= 0, its halving a shift) and room_ok's decision: on the log when it is clear, else
+     * exactly, found^2 <= k^2 dd in 128 bits (k < 2^32: k^2 < 2^64, found^2 < 2^128), inline:
+     * 7.5 % of the tests at 0.1 mm on bench_peers' random set, 18 % on the teapot, land within
+     * 8/256 of 1 (a well predicted step's room is 1/64 above it). As || of the two, not a
+     * branch-free | and &, which puts the 128-bit products on the path to the verdict. */
     if (found == 0)
         return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
+    uint64_t k = (uint64_t)g[G_K];
+    bool exact = (unsigned __int128)found * found <= (unsigned __int128)(k * k) * (uint64_t)dd;
     int32_t r = (int32_t)g[G_LK] + (int32_t)((uint32_t)log2_q8((uint64_t)dd) >> 1);
     r -= log2_q8(found);
-    if (r > ROOM_CAP || r < ROOM_MIN || (r < ROOM_SURE && r > -ROOM_SURE))
-        return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
+    if (r > ROOM_CAP || r < ROOM_MIN)
+        return unpack(room_slow(k, (uint64_t)dd, found), room);
     *room = r;
-    return r > 0;
+    return r >= ROOM_SURE || (r > -ROOM_SURE && exact);
 }
 #endif
 
