@@ -510,6 +510,23 @@ static __attribute__((noinline, cold)) int32_t test_slow(cs_predict_t *q, cs_par
     return 2 * room + ok;
 }
 
+/* test_step's convex-hull fallback on test_fast's rounded components w (V1, V2, D: below
+ * 2^26 + 1, int32) and tt64 = 64 T^2 (T > 0), packed as test_slow's: the sub-curve and its
+ * shift are not computed again. */
+static __attribute__((noinline, cold)) int32_t hull_slow(const int64_t w[3][2], int64_t tt64)
+{
+    int32_t v[4][2];
+    int64_t pr[P_N];
+    for (unsigned i = 0; i < 6; i++)
+        v[i / 2][i % 2] = (int32_t)w[i / 2][i % 2];
+    v[3][0] = -v[2][1];
+    v[3][1] = v[2][0];
+    for (unsigned i = 0; i < P_N; i++)
+        pr[i] = dot(v[prod_rows[i][0]], v[prod_rows[i][1]]);
+    bool ok = hull_flat((const int32_t(*)[2])v, pr, (uint64_t)(tt64 / 4)); /* (4 T)^2 */
+    return 2 * (ok ? ROOM_HULL : ROOM_FAIL) + ok;
+}
+
 static __attribute__((noinline, cold)) int32_t room_slow(uint64_t k, uint64_t dd, uint64_t found)
 {
     int32_t room;
@@ -559,7 +576,7 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     int64_t dot1 = w[0][0] * w[2][0] + w[0][1] * w[2][1];
     int64_t dot2 = w[1][0] * w[2][0] + w[1][1] * w[2][1];
     if (dd < g[G_TT] || (uint64_t)dot1 > (uint64_t)dd || (uint64_t)dot2 > (uint64_t)dd)
-        return unpack(test_slow(ctx, h), room);
+        return unpack(hull_slow(w, g[G_TT]), room);
     uint64_t found =
         majorant(w[2][0] * w[0][1] - w[2][1] * w[0][0], w[2][0] * w[1][1] - w[2][1] * w[1][0]);
     /* room_log without its clamps (a clamped room is room_slow's: the log of a positive dd is
