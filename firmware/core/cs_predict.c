@@ -489,11 +489,19 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
  * test_step itself, a room clamped or too close to 1 for its log to room_ok (up to 2 % of the
  * tests), each out of line after a branch, which the core predicts instead of waiting for its
  * operands. */
-enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
+/* The guess: s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0), and the m (host_bits) whose
+ * shift is s, LO <= m < LO + SPAN. */
+enum { G_S, G_K, G_TT, G_LK, G_LO, G_SPAN, G_N };
+CS_STATIC_ASSERT(sizeof(((cs_predict_t *)0)->guess) == G_N * sizeof(int64_t), predict_guess_n);
 
 static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned s)
 {
     int64_t T = (((int64_t)q->thr << F) >> s) - 2; /* test_step's T for this s */
+    /* test_step's shift of m is s exactly for LO <= m < LO + SPAN: m < 2^(UNIT_BITS + s) when
+     * s is the threshold's, else the bit length of m is UNIT_BITS + s (s < 32: below 2^58) */
+    int64_t lo = s > q->thr_shift ? (int64_t)1 << (UNIT_BITS - 1 + s) : 0;
+    q->guess[G_LO] = lo;
+    q->guess[G_SPAN] = ((int64_t)1 << (UNIT_BITS + s)) - lo;
     q->guess[G_S] = s;
     q->guess[G_K] = T > 0 ? 3 * MAJ_SCALE * T : 0;
     q->guess[G_TT] = 64 * T * T;
@@ -541,8 +549,8 @@ static SPEED_INLINE bool unpack(int32_t x, int32_t *room)
     return (x & 1) != 0;
 }
 
-/* The test's shift (test_step's), from |components| without a branch on their signs. */
-static SPEED_INLINE unsigned host_shift(const cs_predict_t *p, const int64_t v[3][2])
+/* The or of the test's |components| (test_step's m), without a branch on their signs. */
+static SPEED_INLINE uint64_t host_bits(const int64_t v[3][2])
 {
     uint64_t m = 0;
     SPEED_UNROLL
@@ -550,8 +558,14 @@ static SPEED_INLINE unsigned host_shift(const cs_predict_t *p, const int64_t v[3
         uint64_t x = (uint64_t)v[i / 2][i % 2], sg = (uint64_t)(v[i / 2][i % 2] >> 63);
         m |= (x ^ sg) - sg;
     }
+    return m;
+}
+
+/* The test's shift for m = host_bits, out of line: the guess's is checked on m itself. */
+static __attribute__((noinline, cold)) void guess_miss(cs_predict_t *q, uint64_t m)
+{
     unsigned s = shift_below(m, UNIT_BITS);
-    return s < p->thr_shift ? p->thr_shift : s;
+    guess_set(q, s < q->thr_shift ? q->thr_shift : s);
 }
 
 /* test_step on the guess (ctx: the state itself, which the guess is set in). Each component
@@ -562,12 +576,12 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     const int64_t *g = p->guess;
     int64_t v[3][2], w[3][2];
     sub_curve(p, p->d, h, v);
-    unsigned s = host_shift(p, v);
-    if (s != (uint64_t)g[G_S])
-        guess_set(ctx, s);
+    uint64_t m = host_bits(v);
+    if (m - (uint64_t)g[G_LO] >= (uint64_t)g[G_SPAN])
+        guess_miss(ctx, m);
     if (g[G_K] == 0) /* T <= 0 */
         return unpack(test_slow(ctx, h), room);
-    s = (unsigned)g[G_S]; /* not the shift above: what follows does not wait for it */
+    unsigned s = (unsigned)g[G_S]; /* what follows does not wait for m */
     int64_t half = ((int64_t)1 << s) >> 1;
     SPEED_UNROLL
     for (unsigned i = 0; i < 6; i++)

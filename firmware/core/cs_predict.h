@@ -51,7 +51,7 @@ struct cs_predict {
     /* 64-bit hosts: the last test's shift and what follows from it (its threshold, that
      * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; begin guesses the
      * threshold's shift) */
-    int64_t guess[4];
+    int64_t guess[6];
 #endif
 };
 
