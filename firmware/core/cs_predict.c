@@ -4,9 +4,12 @@
 
 #include <stddef.h>
 
+/* The test's threshold T is below 2^THR_BITS = 2^14 units, at least 2^13 - 2 when it sets the
+ * shift (what the smallest tolerance, 4 LSB, has at s = 0): the shift is then the threshold's on
+ * most chords, not the chord's length, and changes rarely (docs/fixed-point.md). */
 #define F               CS_PREDICT_FRAC
 #define UNIT_BITS       26 /* sub-curve vectors scaled below 2^26 units: cross products < 2^53 */
-#define THR_BITS        20 /* threshold below 2^20 units: (3072 T)^2 < 2^64 */
+#define THR_BITS        14 /* threshold below 2^14 units: (3072 T)^2 < 2^64 */
 #define CONIC_UNIT_BITS 24 /* conic vectors below 2^24 units: cross * 2^9 < 2^58 */
 /* The room a test leaves, (bound allowed) / (bound found), is carried as its base-2 logarithm
  * in Q8 (ROOM_ONE = 1.0 in the log, i.e. a factor 2): products and square roots of rooms are
@@ -16,11 +19,11 @@
 #define ROOM_FAIL (-2 * ROOM_ONE)  /* room 1/4: what a failing hull test or T <= 0 reports */
 #define ROOM_MIN  (-30 * ROOM_ONE) /* room 2^-30: the step shrinks at most 2^15 times */
 #define ROOM_HULL 0                /* room 1: a passing hull test (says nothing of the trend) */
-/* Accept a passing step whose deviation bound is within 1/1.15 of the threshold (log2(1.15) =
- * 0.2016, 52/256): the step is then within about 7 % of the largest that passes. Against 1.10
- * (35/256): 0.5 % more chords at 0.1 mm (bench_peers' random set), 7 % fewer tests a chord
- * there, 5 % fewer M3 instructions a chord (docs/fixed-point.md, Cost). */
-#define ROOM_ACCEPT 52
+/* Accept a passing step whose deviation bound is within 1/1.35 of the threshold (log2(1.347) =
+ * 0.430, 110/256): the step is then within about 14 % of the largest that passes. Against 1.15
+ * (52/256): 1.0 % more chords at 0.1 mm (bench_peers' random set), 10 % fewer tests a chord
+ * there, 9 % less host time a curve (docs/fixed-point.md, Predictor). */
+#define ROOM_ACCEPT 110
 
 /* The small helpers of the hot path (mul_t, dot, uabs64): inline on cores with a 32x32 -> 64
  * multiply instruction (about 8 instructions a call saved on the M3, 32 calls a chord); one
@@ -202,6 +205,9 @@ static cs_param_t first_step(const cs_predict_t *p);
 #endif
 static cs_err_t next_poly(cs_predict_t *p, cs_vec3_t *pt);
 static cs_err_t next_conic(cs_predict_t *p, cs_vec3_t *pt);
+#if HOST_GUESS
+static void guess_set(cs_predict_t *q, unsigned s);
+#endif
 
 #if SPEED_BUILD
 /* Speed builds: the power basis of the loops below in closed form, the same exact integers
@@ -316,13 +322,14 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     power_basis(p, c, w);
     p->h_next = first_step_w(p, w);
 #endif
-#if defined(__SIZEOF_INT128__)
-    p->guess[0] = -1; /* no shift guessed: the first test sets it (HOST_GUESS) */
-#endif
 #if SPEED_BUILD
     p->next = p->h_next == CS_PARAM_ONE && straight(p) ? next_last : next_poly;
 #else
     p->next = next_poly;
+#endif
+#if HOST_GUESS
+    if (p->next == next_poly) /* a one-chord curve runs no test */
+        guess_set(p, p->thr_shift); /* the shift of most tests (THR_BITS): the first one's guess */
 #endif
     p->done = false;
     return CS_OK;
@@ -409,7 +416,7 @@ static SPEED_INLINE void eval_poly(cs_predict_t *p, cs_vec3_t *pt)
 
 /* The test's shift s is below 32: its components are below 8 CS_POS_LIMIT 2^F (3 (Q_i - Q0),
  * Q_i in the hull of points inside CS_POS_LIMIT), so shift_below(., UNIT_BITS) <= 17, and the
- * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 20. */
+ * threshold's own shift is at most bitlen(CS_PREDICT_TOL_MAX 2^F) - THR_BITS = 26. */
 CS_STATIC_ASSERT(((int64_t)8 * CS_POS_LIMIT << F) < ((int64_t)1 << (UNIT_BITS + 31)),
                  predict_unit_shift_below_32);
 CS_STATIC_ASSERT(((int64_t)CS_PREDICT_TOL_MAX << F) < ((int64_t)1 << (THR_BITS + 31)),
@@ -576,7 +583,7 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
     }
     uint64_t found = majorant(pr[P_CR1], pr[P_CR2]);
     /* Deviation bound m(c1, c2) / (1024 * 3 |D|) <= T, i.e. found <= 3072 T |D|. */
-    uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^20: < 2^32, a 32-bit product */
+    uint64_t k = (uint32_t)(3 * MAJ_SCALE) * (uint32_t)T; /* T < 2^14: < 2^26, a 32-bit product */
     return room_ok(k, (uint64_t)dd, found, room);
 }
 
@@ -585,15 +592,24 @@ static SPEED_INLINE bool test_step(const cs_predict_t *p, void *ctx, cs_param_t 
  * The same verdict and room as test_step, with nothing on the path from the step to the room
  * (which the next step waits for: host cores are latency-bound here) that the products do not
  * need: the shift and what follows from it are the last test's (p->guess), set anew out of
- * line when the test's own shift differs (a test in 7 at 0.01 mm, in 18 at 0.001 on
- * bench_peers' set); the convex-hull fallback and T <= 0 go to test_step itself, a room clamped
- * or too close to 1 for its log to room_ok (up to 2 % of the tests), each out of line after a
- * branch, which the core predicts instead of waiting for its operands. */
-enum { G_S, G_K, G_TT, G_LK }; /* s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0) */
+ * line when the test's own shift differs (bench_peers' random set: about one test in 230 at
+ * 0.01 mm, one in 70 at 0.001, none at 0.1: THR_BITS); the convex-hull fallback and T <= 0 go to
+ * test_step itself, a room clamped or too close to 1 for its log to room_ok (up to 2 % of the
+ * tests), each out of line after a branch, which the core predicts instead of waiting for its
+ * operands. */
+/* The guess: s, k = 3072 T, 64 T^2, log2_q8(k) (T > 0; else k = 0), and the m (host_bits) whose
+ * shift is s, LO <= m < LO + SPAN. */
+enum { G_S, G_K, G_TT, G_LK, G_LO, G_SPAN, G_N };
+CS_STATIC_ASSERT(sizeof(((cs_predict_t *)0)->guess) == G_N * sizeof(int64_t), predict_guess_n);
 
 static __attribute__((noinline, cold)) void guess_set(cs_predict_t *q, unsigned s)
 {
     int64_t T = (((int64_t)q->thr << F) >> s) - 2; /* test_step's T for this s */
+    /* test_step's shift of m is s exactly for LO <= m < LO + SPAN: m < 2^(UNIT_BITS + s) when
+     * s is the threshold's, else the bit length of m is UNIT_BITS + s (s < 32: below 2^58) */
+    int64_t lo = s > q->thr_shift ? (int64_t)1 << (UNIT_BITS - 1 + s) : 0;
+    q->guess[G_LO] = lo;
+    q->guess[G_SPAN] = ((int64_t)1 << (UNIT_BITS + s)) - lo;
     q->guess[G_S] = s;
     q->guess[G_K] = T > 0 ? 3 * MAJ_SCALE * T : 0;
     q->guess[G_TT] = 64 * T * T;
@@ -610,6 +626,23 @@ static __attribute__((noinline, cold)) int32_t test_slow(cs_predict_t *q, cs_par
     return 2 * room + ok;
 }
 
+/* test_step's convex-hull fallback on test_fast's rounded components w (V1, V2, D: below
+ * 2^26 + 1, int32) and tt64 = 64 T^2 (T > 0), packed as test_slow's: the sub-curve and its
+ * shift are not computed again. */
+static __attribute__((noinline, cold)) int32_t hull_slow(const int64_t w[3][2], int64_t tt64)
+{
+    int32_t v[4][2];
+    int64_t pr[P_N];
+    for (unsigned i = 0; i < 6; i++)
+        v[i / 2][i % 2] = (int32_t)w[i / 2][i % 2];
+    v[3][0] = -v[2][1];
+    v[3][1] = v[2][0];
+    for (unsigned i = 0; i < P_N; i++)
+        pr[i] = dot(v[prod_rows[i][0]], v[prod_rows[i][1]]);
+    bool ok = hull_flat((const int32_t(*)[2])v, pr, (uint64_t)(tt64 / 4)); /* (4 T)^2 */
+    return 2 * (ok ? ROOM_HULL : ROOM_FAIL) + ok;
+}
+
 static __attribute__((noinline, cold)) int32_t room_slow(uint64_t k, uint64_t dd, uint64_t found)
 {
     int32_t room;
@@ -624,8 +657,8 @@ static SPEED_INLINE bool unpack(int32_t x, int32_t *room)
     return (x & 1) != 0;
 }
 
-/* The test's shift (test_step's), from |components| without a branch on their signs. */
-static SPEED_INLINE unsigned host_shift(const cs_predict_t *p, const int64_t v[3][2])
+/* The or of the test's |components| (test_step's m), without a branch on their signs. */
+static SPEED_INLINE uint64_t host_bits(const int64_t v[3][2])
 {
     uint64_t m = 0;
     SPEED_UNROLL
@@ -633,8 +666,14 @@ static SPEED_INLINE unsigned host_shift(const cs_predict_t *p, const int64_t v[3
         uint64_t x = (uint64_t)v[i / 2][i % 2], sg = (uint64_t)(v[i / 2][i % 2] >> 63);
         m |= (x ^ sg) - sg;
     }
+    return m;
+}
+
+/* The test's shift for m = host_bits, out of line: the guess's is checked on m itself. */
+static __attribute__((noinline, cold)) void guess_miss(cs_predict_t *q, uint64_t m)
+{
     unsigned s = shift_below(m, UNIT_BITS);
-    return s < p->thr_shift ? p->thr_shift : s;
+    guess_set(q, s < q->thr_shift ? q->thr_shift : s);
 }
 
 /* test_step on the guess (ctx: the state itself, which the guess is set in). Each component
@@ -645,12 +684,12 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     const int64_t *g = p->guess;
     int64_t v[3][2], w[3][2];
     sub_curve(p, p->d, h, v);
-    unsigned s = host_shift(p, v);
-    if (s != (uint64_t)g[G_S])
-        guess_set(ctx, s);
+    uint64_t m = host_bits(v);
+    if (m - (uint64_t)g[G_LO] >= (uint64_t)g[G_SPAN])
+        guess_miss(ctx, m);
     if (g[G_K] == 0) /* T <= 0 */
         return unpack(test_slow(ctx, h), room);
-    s = (unsigned)g[G_S]; /* not the shift above: what follows does not wait for it */
+    unsigned s = (unsigned)g[G_S]; /* what follows does not wait for m */
     int64_t half = ((int64_t)1 << s) >> 1;
     SPEED_UNROLL
     for (unsigned i = 0; i < 6; i++)
@@ -659,19 +698,25 @@ static SPEED_INLINE bool test_fast(const cs_predict_t *p, void *ctx, cs_param_t 
     int64_t dot1 = w[0][0] * w[2][0] + w[0][1] * w[2][1];
     int64_t dot2 = w[1][0] * w[2][0] + w[1][1] * w[2][1];
     if (dd < g[G_TT] || (uint64_t)dot1 > (uint64_t)dd || (uint64_t)dot2 > (uint64_t)dd)
-        return unpack(test_slow(ctx, h), room);
+        return unpack(hull_slow(w, g[G_TT]), room);
     uint64_t found =
         majorant(w[2][0] * w[0][1] - w[2][1] * w[0][0], w[2][0] * w[1][1] - w[2][1] * w[1][0]);
-    /* room_log without its clamps and room_ok's decision on the log alone: any other case is
-     * room_slow's (the log of a positive dd is >= 0: its halving is a shift) */
+    /* room_log without its clamps (a clamped room is room_slow's: the log of a positive dd is
+     * >= 0, its halving a shift) and room_ok's decision: on the log when it is clear, else
+     * exactly, found^2 <= k^2 dd in 128 bits (k < 2^32: k^2 < 2^64, found^2 < 2^128), inline:
+     * 7.5 % of the tests at 0.1 mm on bench_peers' random set, 18 % on the teapot, land within
+     * 8/256 of 1 (a well predicted step's room is 1/64 above it). As || of the two, not a
+     * branch-free | and &, which puts the 128-bit products on the path to the verdict. */
     if (found == 0)
         return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
+    uint64_t k = (uint64_t)g[G_K];
+    bool exact = (unsigned __int128)found * found <= (unsigned __int128)(k * k) * (uint64_t)dd;
     int32_t r = (int32_t)g[G_LK] + (int32_t)((uint32_t)log2_q8((uint64_t)dd) >> 1);
     r -= log2_q8(found);
-    if (r > ROOM_CAP || r < ROOM_MIN || (r < ROOM_SURE && r > -ROOM_SURE))
-        return unpack(room_slow((uint64_t)g[G_K], (uint64_t)dd, found), room);
+    if (r > ROOM_CAP || r < ROOM_MIN)
+        return unpack(room_slow(k, (uint64_t)dd, found), room);
     *room = r;
-    return r > 0;
+    return r >= ROOM_SURE || (r > -ROOM_SURE && exact);
 }
 #endif
 

@@ -43,14 +43,15 @@ struct cs_predict {
     cs_param_t h_next;  /* the step predicted for the next chord */
     cs_param_t h_ideal; /* the step the last chord would have needed (0: none known) */
     cs_pos_t thr;       /* tol - slack, LSB */
-    uint8_t thr_shift;  /* least shift of thr * 2^F below 2^20 (the test's unit) */
+    uint8_t thr_shift;  /* least shift of thr * 2^F below 2^14 (the test's unit) */
     cs_pos_t z;         /* the plane's z (every control point has it) */
     cs_vec3_t end;      /* P_n, returned exactly as the last vertex */
     bool done;
 #if defined(__SIZEOF_INT128__)
     /* 64-bit hosts: the last test's shift and what follows from it (its threshold, that
-     * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; guess[0] = -1: none) */
-    int64_t guess[4];
+     * threshold's log), the next test's guess (cs_predict.c, HOST_GUESS; begin guesses the
+     * threshold's shift) */
+    int64_t guess[6];
 #endif
 };
 
