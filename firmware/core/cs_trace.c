@@ -110,6 +110,11 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
     }
     cs_err_t e;
     (void)pt; /* unused only when no engine is configured */
+#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
+    if (tr->impl == CS_TRACE_IMPL_PREDICT) /* the default: a direct branch, not the table */
+        e = cs_predict_next(&tr->u.pr, pt);
+    else
+#endif
     switch (tr->impl) {
 #if CS_TRACE_METHODS & CS_TRACE_WITH_FD
     case CS_TRACE_IMPL_FD:
@@ -125,9 +130,6 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
         break;
 #endif
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
-    case CS_TRACE_IMPL_PREDICT:
-        e = cs_predict_next(&tr->u.pr, pt);
-        break;
     case CS_TRACE_IMPL_ELLARC:
         e = cs_ellarc_next(&tr->u.arc, pt);
         break;
