@@ -241,10 +241,15 @@ RT=$(awk -F' *= *' '/^\[/ { ax = $0 } /^max_rate/ { r[ax] = $2 } /^max_accel/ { 
     END { for (k in r) if (r[k] / a[k] > t) t = r[k] / a[k]; print t * 5 / 4 }' "$MC")
 W=$(awk -v v=$JV -v k=$SPM 'BEGIN { print v * k * 0.005 }') # steps of one 5 ms segment
 want=$(awk -v v=$JV -v k=$SPM -v t="$RT" -v w="$W" 'BEGIN { print 0.81 * v * k * t / 2 - w / 2 }')
+# The speed at cruise over 4 segments (4 W steps): a step's ISR may start up to about 700
+# cycles late (the harness's TIMER1 vector-to-reti max, when a UART interrupt is in the way;
+# 10,000 cycles a step at 1600 steps/s), which over one 8-step window alone reads up to 1.8 %
+# fast, over 32 steps under 0.5 % (a loaded run read 1616.6 over 8 steps, 1603.4 over 32).
 read -r vmax run vend < <(awk -F, -v w="$W" -v v=$JV -v k=$SPM '
     $2 == 0 { t[++n] = $1 }
-    END { for (i = w + 1; i <= n; i++) { s = w * 16e6 / (t[i] - t[i - w])
-              if (s > m) m = s
+    END { for (i = 4 * w + 1; i <= n; i++) { s = 4 * w * 16e6 / (t[i] - t[i - 4 * w])
+              if (s > m) m = s }
+          for (i = w + 1; i <= n; i++) { s = w * 16e6 / (t[i] - t[i - w])
               if (!c && i > 3 * w && s < 0.9 * v * k) c = i }
           print m, (c ? n - c : -1), w * 16e6 / (t[n] - t[n - w]) }' "$T/jc.csv")
 expect "jog cancel: at $JV mm/s before the cancel (${vmax:-?} steps/s, want $((JV * SPM)) within 1 %)" \
