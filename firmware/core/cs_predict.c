@@ -328,8 +328,9 @@ cs_err_t cs_predict_begin(cs_predict_t *p, const cs_bezier_t *c, cs_pos_t tol)
     p->next = next_poly;
 #endif
 #if HOST_GUESS
-    if (p->next == next_poly) /* a one-chord curve runs no test */
-        guess_set(p, p->thr_shift); /* the shift of most tests (THR_BITS): the first one's guess */
+    /* the shift of most tests (THR_BITS) as the first one's guess; a one-chord curve runs none */
+    if (p->next == next_poly)
+        guess_set(p, p->thr_shift);
 #endif
     p->done = false;
     return CS_OK;

@@ -100,6 +100,34 @@ cs_err_t cs_trace_begin(cs_trace_t *tr, const cs_bezier_t *c, cs_pos_t tol,
     return e;
 }
 
+/* The next vertex of every engine but the default one (cs_trace_next below). */
+static cs_err_t next_other(cs_trace_t *tr, cs_vec3_t *pt)
+{
+    (void)pt; /* unused only when no engine is configured */
+    switch (tr->impl) {
+#if CS_TRACE_METHODS & CS_TRACE_WITH_FD
+    case CS_TRACE_IMPL_FD:
+        return cs_fd_next(&tr->u.fd, pt);
+    case CS_TRACE_IMPL_FD3:
+        return cs_fd3_next(&tr->u.fd3, pt);
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_AFD
+    case CS_TRACE_IMPL_AFD:
+        return cs_afd_next(&tr->u.afd, pt);
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
+    case CS_TRACE_IMPL_ELLARC:
+        return cs_ellarc_next(&tr->u.arc, pt);
+#endif
+#if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV
+    case CS_TRACE_IMPL_SUBDIV_REACH:
+        return cs_subdiv_reach_next(&tr->u.reach, pt);
+#endif
+    default: /* no engine started (cannot happen after a successful begin) */
+        return CS_ERR_ARG;
+    }
+}
+
 cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
 {
     if (tr->done)
@@ -108,41 +136,14 @@ cs_err_t cs_trace_next(cs_trace_t *tr, cs_vec3_t *pt)
         tr->done = true;
         return CS_ERR_DEPTH;
     }
-    cs_err_t e;
-    (void)pt; /* unused only when no engine is configured */
 #if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
-    if (tr->impl == CS_TRACE_IMPL_PREDICT) /* the default: a direct branch, not the table */
-        e = cs_predict_next(&tr->u.pr, pt);
-    else
+    /* the default tracer by a direct branch, not through the switch's jump table (an indirect
+     * jump a vertex: 1.5 % of a curve at 0.1 mm on the host) */
+    cs_err_t e =
+        tr->impl == CS_TRACE_IMPL_PREDICT ? cs_predict_next(&tr->u.pr, pt) : next_other(tr, pt);
+#else
+    cs_err_t e = next_other(tr, pt);
 #endif
-    switch (tr->impl) {
-#if CS_TRACE_METHODS & CS_TRACE_WITH_FD
-    case CS_TRACE_IMPL_FD:
-        e = cs_fd_next(&tr->u.fd, pt);
-        break;
-    case CS_TRACE_IMPL_FD3:
-        e = cs_fd3_next(&tr->u.fd3, pt);
-        break;
-#endif
-#if CS_TRACE_METHODS & CS_TRACE_WITH_AFD
-    case CS_TRACE_IMPL_AFD:
-        e = cs_afd_next(&tr->u.afd, pt);
-        break;
-#endif
-#if CS_TRACE_METHODS & CS_TRACE_WITH_PREDICT
-    case CS_TRACE_IMPL_ELLARC:
-        e = cs_ellarc_next(&tr->u.arc, pt);
-        break;
-#endif
-#if CS_TRACE_METHODS & CS_TRACE_WITH_SUBDIV
-    case CS_TRACE_IMPL_SUBDIV_REACH:
-        e = cs_subdiv_reach_next(&tr->u.reach, pt);
-        break;
-#endif
-    default: /* no engine started (cannot happen after a successful begin) */
-        e = CS_ERR_ARG;
-        break;
-    }
     if (e == CS_OK)
         tr->count++;
     else

@@ -495,8 +495,7 @@ static void arcs_report(FILE *csv);
 /* One speed row of the goal table: the worst ratio to cairo's over the sets, and at each
  * tolerance, with the arcs', against goal; the verdict names the tolerances (or the arcs) that
  * miss. */
-static void goal_speed_row(const char *what, const double worst_t[N_TOLS], double arcs,
-                           double goal)
+static void goal_speed_row(const char *what, const double worst_t[N_TOLS], double arcs, double goal)
 {
     double worst = arcs;
     char per[96] = "", miss[64] = "";
@@ -547,22 +546,34 @@ static void goals18(result_t res[3][N_TOLS][N_ENG], size_t greedy[3][N_TOLS],
     goal_speed_row("curves/s >= 2x cairo's", cps_t, arcs_worst_cps, 2);
     goal_speed_row("points/s >= cairo's", pps_t, arcs_worst_pps, 1);
     printf("\n");
-    printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost and "
-           "\"Host path of 64-bit speed builds\"): wall clock on this shared machine moves by up "
-           "to 2x between runs (compare within one table; `bench_peers --speed` times only the "
-           "default tracer and cairo, for a quick A/B). The tracer is bound by the latency of one "
-           "chain of dependent operations a flatness test (sub-curve products, normalising shift, "
-           "cross products, majorant, logarithm, next step; 12 cycles of delay added before each "
-           "test cost 3-4 ns a chord). On 2026-12-03 the host path (bit for bit the portable "
-           "code's vertices) took a chord from 65 / 46 / 41 ns to 48 / 31 / 26 ns at 0.1 / 0.01 / "
-           "0.001 mm (random set, quiet machine). What is left at 0.1 mm: a curve there is only "
-           "about 20 chords (4 on the teapot), so the set-up (about 45 ns a curve) counts, and "
-           "the step predictor misses more: 1.62 tests a chord (1.05 at 0.001 mm), each miss a "
-           "mispredicted branch and a second chain. A better host predictor (the next chord's "
-           "test predicted from the accepted one, a log-log secant) cut that to 1.18 tests but "
-           "only 5 %% of the time, and would have made the host trace other chords than the "
-           "firmware; not merged. Arcs go through the arc tracer (cs_ellarc: a rotation "
-           "recurrence, no division a vertex).\n\n");
+    printf("What limits the speed (docs/fixed-point.md, \"Predicted-step tracer\", Cost, \"Host "
+           "path of 64-bit speed builds\" and \"Per-curve work of speed builds\"): wall clock on "
+           "this shared machine moves between runs, cairo's too (compare within one table; "
+           "`bench_peers --speed` times only the default tracer and cairo on the three sets and "
+           "the arcs, in a fresh process, for a quick A/B). The tracer is bound by the latency of "
+           "one chain of dependent operations a flatness test (sub-curve products, cross "
+           "products, majorant, logarithm, next step). On 2026-12-03 two passes, each keeping "
+           "the host's vertices bit for bit the portable code's (the firmware's), took the random "
+           "set from 1511 / 3325 / 9302 ns a curve to 821-858 / 1912-1994 / 5503-5648 at 0.1 / "
+           "0.01 / 0.001 mm and the teapot's from 217 / 409 / 977 to 156-160 / 337-346 / "
+           "889-893 (focused harness, several runs): the test's "
+           "threshold below 2^14 units, so that it sets the normalising shift on nearly every "
+           "test (the host guesses it: 0.5 wrong guesses a chord at 0.1 mm -> 0), the acceptance "
+           "at 1.35 (1.62 -> 1.45 tests a chord at 0.1 mm, +1 %% chords), the set-up of a curve "
+           "50 -> about 20 ns, one-chord curves without their test. What is left at 0.1 mm, "
+           "where the ratio to cairo is closest to 2: `--speed` measures 1.90-1.97x on the "
+           "random set and 1.94-1.97x on the teapot, whole runs of this table on "
+           "2026-12-03 1.89x to 2.06x (cairo's own curves/s moved by 7 %% between them). A "
+           "curve is 20.6 chords and 1.45 tests a chord there (26 %% of the first tests fail, "
+           "20 %% pass with more room than accepted: the ideal step changes more between "
+           "neighbouring chords than the acceptance window; a host-only "
+           "predictor that halved the retries gained 5 %% and would make the host trace other "
+           "chords than the firmware). On the teapot a third of the curves are one chord and 78 "
+           "are folds (radial edges out and back along a line) whose first chord takes 3.8 tests: "
+           "a first step just past the turning point (-5.6 %% on the set, host-only prototype) "
+           "needs a square root and a division, beyond the M0+ curve core's 18 bytes of room. "
+           "Arcs go through the arc tracer (cs_ellarc: a rotation recurrence, no division a "
+           "vertex).\n\n");
 }
 
 /* Arcs per second and points per second of engine e over the arcs at tol, N_RUNS runs each
