@@ -40,8 +40,17 @@
 
 /* Speed builds (the host, -O2): the step search specialised for each flatness test (the test
  * inlined into it, no call through a pointer) and the test's helpers inline; size builds (-Os:
- * every firmware image) keep one out-of-line copy of each. The same source either way. */
+ * every firmware image) keep one out-of-line copy of each. The same source either way, the same
+ * vertices (tests/unit/test_predict_same.c builds the size build's code with CS_PREDICT_SPEED 0
+ * and compares). */
+#ifndef CS_PREDICT_SPEED
 #if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define CS_PREDICT_SPEED 1
+#else
+#define CS_PREDICT_SPEED 0
+#endif
+#endif
+#if CS_PREDICT_SPEED
 #define SPEED_BUILD  1
 #define SPEED_INLINE __attribute__((always_inline)) inline
 #define SPEED_UNROLL _Pragma("GCC unroll 8") /* the fixed-count loops of the test unrolled */
